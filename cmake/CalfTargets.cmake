@@ -1,0 +1,99 @@
+# Target helpers shared by every layer: compile options, layers, commands, tests, fuzz targets.
+
+# Options every calf target compiles with.
+add_library(calf_options INTERFACE)
+target_compile_options(calf_options INTERFACE -Wall -Wextra -Wpedantic -Wshadow
+                       -Wnon-virtual-dtor -Wimplicit-fallthrough -Wvla)
+if(CALF_WERROR)
+  target_compile_options(calf_options INTERFACE -Werror)
+endif()
+if(CALF_SANITIZE)
+  target_compile_options(calf_options INTERFACE -fsanitize=address,undefined
+                         -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
+  target_link_options(calf_options INTERFACE -fsanitize=address,undefined)
+endif()
+
+# calf_layer(NAME DIR dir LINKS deps...): one library per layer. Sources are globbed so that work
+# in different files never edits this list; CONFIGURE_DEPENDS re-globs on every build.
+# Commands: every <dir>/tools/<name>.cc becomes the executable <name> with '_' turned into '-',
+# linked to the layer, CLI11 and fmt.
+function(calf_layer name)
+  cmake_parse_arguments(L "" "DIR" "LINKS" ${ARGN})
+  set(dir ${CMAKE_CURRENT_SOURCE_DIR}/${L_DIR})
+  file(GLOB sources CONFIGURE_DEPENDS ${dir}/src/*.cc)
+  if(sources)
+    add_library(${name} STATIC ${sources})
+    target_include_directories(${name} PUBLIC ${dir}/include PRIVATE ${dir}/src)
+    target_link_libraries(${name} PUBLIC ${L_LINKS} PRIVATE calf_options)
+  else()
+    add_library(${name} INTERFACE)
+    target_include_directories(${name} INTERFACE ${dir}/include)
+    target_link_libraries(${name} INTERFACE ${L_LINKS})
+  endif()
+  set_property(GLOBAL APPEND PROPERTY CALF_LAYERS ${name})
+  file(GLOB tools CONFIGURE_DEPENDS ${dir}/tools/*.cc)
+  foreach(tool_source ${tools})
+    get_filename_component(tool ${tool_source} NAME_WE)
+    string(REPLACE "_" "-" exe ${tool})
+    add_executable(${exe} ${tool_source})
+    target_link_libraries(${exe} PRIVATE ${name} CLI11::CLI11 fmt::fmt calf_options)
+    target_include_directories(${exe} PRIVATE ${dir}/tools)
+  endforeach()
+endfunction()
+
+# calf_check_layering(layer:allowed1,allowed2 ...): fails configuration when a layer links a calf
+# layer outside its allowed list (directly or through another layer).
+function(calf_check_layering)
+  foreach(rule ${ARGN})
+    string(REPLACE ":" ";" parts "${rule}")
+    list(GET parts 0 layer)
+    list(LENGTH parts n)
+    set(allowed "")
+    if(n GREATER 1)
+      list(GET parts 1 allowed_csv)
+      string(REPLACE "," ";" allowed "${allowed_csv}")
+    endif()
+    get_target_property(type ${layer} TYPE)
+    if(type STREQUAL "INTERFACE_LIBRARY")
+      get_target_property(links ${layer} INTERFACE_LINK_LIBRARIES)
+    else()
+      get_target_property(links ${layer} LINK_LIBRARIES)
+    endif()
+    get_property(layers GLOBAL PROPERTY CALF_LAYERS)
+    foreach(dep ${links})
+      if(dep IN_LIST layers AND NOT dep IN_LIST allowed)
+        message(FATAL_ERROR "calf layering: ${layer} links ${dep}, allowed: ${allowed}")
+      endif()
+    endforeach()
+  endforeach()
+endfunction()
+
+# calf_add_test(source LIBS...): one GoogleTest executable per test file, named after the file;
+# every test case in it becomes its own ctest entry.
+include(GoogleTest)
+function(calf_add_test source)
+  get_filename_component(name ${source} NAME_WE)
+  add_executable(${name} ${source})
+  target_link_libraries(${name} PRIVATE ${ARGN} GTest::gtest GTest::gtest_main calf_options)
+  gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST
+                       PROPERTIES ENVIRONMENT "CALF_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
+endfunction()
+
+# calf_add_fuzz_target(source LIBS...): a source defining LLVMFuzzerTestOneInput. With
+# CALF_LIBFUZZER (clang) it builds a libFuzzer binary; otherwise it links the standalone driver,
+# which replays tests/fuzz/corpus/<name>/ and then CALF_FUZZ_ITERATIONS deterministic mutations of
+# it, and registers that run as the ctest 'fuzz.<name>'.
+function(calf_add_fuzz_target source)
+  get_filename_component(name ${source} NAME_WE)
+  add_executable(${name} ${source})
+  target_link_libraries(${name} PRIVATE ${ARGN} calf_options)
+  set(corpus ${PROJECT_SOURCE_DIR}/tests/fuzz/corpus/${name})
+  if(CALF_LIBFUZZER)
+    target_compile_options(${name} PRIVATE -fsanitize=fuzzer)
+    target_link_options(${name} PRIVATE -fsanitize=fuzzer)
+    add_test(NAME fuzz.${name} COMMAND ${name} -runs=${CALF_FUZZ_ITERATIONS} ${corpus})
+  else()
+    target_sources(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests/fuzz/standalone_driver.cc)
+    add_test(NAME fuzz.${name} COMMAND ${name} --iterations ${CALF_FUZZ_ITERATIONS} ${corpus})
+  endif()
+endfunction()
