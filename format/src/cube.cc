@@ -1,0 +1,102 @@
+#include "calf/format/cube.h"
+
+#include <cassert>
+#include <cmath>
+
+namespace calf {
+namespace {
+
+// Per face: which axis is major and its sign, and how (s_c, t_c) are read off the direction.
+// sc = sc_sign * d[sc_axis], tc = tc_sign * d[tc_axis] (OpenGL 4.5 core, Table 8.19).
+struct FaceAxes {
+  int major_axis;
+  double major_sign;
+  int sc_axis;
+  double sc_sign;
+  int tc_axis;
+  double tc_sign;
+};
+
+constexpr FaceAxes kFaceAxes[kCubeFaceCount] = {
+    {0, +1, 2, -1, 1, -1},  // +X: sc = -z, tc = -y
+    {0, -1, 2, +1, 1, -1},  // -X: sc = +z, tc = -y
+    {1, +1, 0, +1, 2, +1},  // +Y: sc = +x, tc = +z
+    {1, -1, 0, +1, 2, -1},  // -Y: sc = +x, tc = -z
+    {2, +1, 0, +1, 1, -1},  // +Z: sc = +x, tc = -y
+    {2, -1, 0, -1, 1, -1},  // -Z: sc = -x, tc = -y
+};
+
+double component(const Direction& d, int axis) { return axis == 0 ? d.x : axis == 1 ? d.y : d.z; }
+
+Direction normalized(double x, double y, double z) {
+  const double len = std::sqrt(x * x + y * y + z * z);
+  return {x / len, y / len, z / len};
+}
+
+}  // namespace
+
+const char* cube_face_name(CubeFace face) {
+  static const char* const kNames[kCubeFaceCount] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
+  const int i = cube_face_index(face);
+  return i >= 0 && i < kCubeFaceCount ? kNames[i] : "?";
+}
+
+FaceCoord face_coord_from_direction(const Direction& d) {
+  const double ax = std::fabs(d.x), ay = std::fabs(d.y), az = std::fabs(d.z);
+  const bool valid = std::isfinite(ax) && std::isfinite(ay) && std::isfinite(az) &&
+                     (ax > 0 || ay > 0 || az > 0);
+  assert(valid && "face_coord_from_direction: direction must be finite and non-zero");
+  if (!valid) return FaceCoord{};
+  // Ties go to the first axis in X, Y, Z order, so seams and corners belong to one face.
+  int axis;
+  if (ax >= ay && ax >= az) {
+    axis = 0;
+  } else if (ay >= az) {
+    axis = 1;
+  } else {
+    axis = 2;
+  }
+  const double m = component(d, axis);
+  const int face = 2 * axis + (m < 0 ? 1 : 0);
+  const FaceAxes& f = kFaceAxes[face];
+  const double inv = 1.0 / std::fabs(m);
+  const double sc = f.sc_sign * component(d, f.sc_axis);
+  const double tc = f.tc_sign * component(d, f.tc_axis);
+  return {cube_face_from_index(face), 0.5 * (sc * inv + 1.0), 0.5 * (tc * inv + 1.0)};
+}
+
+Direction direction_from_face_coord(const FaceCoord& c) {
+  const FaceAxes& f = kFaceAxes[cube_face_index(c.face)];
+  double v[3];
+  v[f.major_axis] = f.major_sign;
+  v[f.sc_axis] = f.sc_sign * (2.0 * c.s - 1.0);
+  v[f.tc_axis] = f.tc_sign * (2.0 * c.t - 1.0);
+  return normalized(v[0], v[1], v[2]);
+}
+
+Direction direction_from_texel_coord(const FaceTexelCoord& c, uint32_t face_size) {
+  const double n = face_size;
+  return direction_from_face_coord({c.face, c.u / n, c.v / n});
+}
+
+Direction direction_from_texel(CubeFace face, uint32_t x, uint32_t y, uint32_t face_size) {
+  return direction_from_texel_coord({face, x + 0.5, y + 0.5}, face_size);
+}
+
+FaceTexelCoord texel_coord_from_direction(const Direction& d, uint32_t face_size) {
+  const FaceCoord c = face_coord_from_direction(d);
+  const double n = face_size;
+  return {c.face, c.s * n, c.t * n};
+}
+
+Texel texel_from_direction(const Direction& d, uint32_t face_size) {
+  const FaceTexelCoord c = texel_coord_from_direction(d, face_size);
+  const auto clamp_texel = [face_size](double u) -> uint32_t {
+    if (!(u > 0)) return 0;  // also catches NaN
+    const double f = std::floor(u);
+    return f >= face_size ? face_size - 1 : static_cast<uint32_t>(f);
+  };
+  return {c.face, clamp_texel(c.u), clamp_texel(c.v)};
+}
+
+}  // namespace calf
