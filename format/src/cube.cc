@@ -26,7 +26,9 @@ constexpr FaceAxes kFaceAxes[kCubeFaceCount] = {
     {2, -1, 0, -1, 1, -1},  // -Z: sc = -x, tc = -y
 };
 
-double component(const Direction& d, int axis) { return axis == 0 ? d.x : axis == 1 ? d.y : d.z; }
+double component(const Direction& d, int axis) {
+  return axis == 0 ? d.x : axis == 1 ? d.y : d.z;
+}
 
 Direction normalized(double x, double y, double z) {
   const double len = std::sqrt(x * x + y * y + z * z);
@@ -43,8 +45,8 @@ const char* cube_face_name(CubeFace face) {
 
 FaceCoord face_coord_from_direction(const Direction& d) {
   const double ax = std::fabs(d.x), ay = std::fabs(d.y), az = std::fabs(d.z);
-  const bool valid = std::isfinite(ax) && std::isfinite(ay) && std::isfinite(az) &&
-                     (ax > 0 || ay > 0 || az > 0);
+  const bool valid =
+      std::isfinite(ax) && std::isfinite(ay) && std::isfinite(az) && (ax > 0 || ay > 0 || az > 0);
   assert(valid && "face_coord_from_direction: direction must be finite and non-zero");
   if (!valid) return FaceCoord{};
   // Ties go to the first axis in X, Y, Z order, so seams and corners belong to one face.

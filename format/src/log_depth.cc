@@ -80,8 +80,8 @@ Expected<uint16_t> LogDepthRange::encode(float z) const {
   const double x = (std::log(static_cast<double>(z)) - log_near_) * inv_step_;
   if (x < -1.0 || x > kLog16MaxFinite + 1.0) {
     return Status(ErrorId::kDepthOutOfRange, "depth " + float_text(z) + " is outside [z_near " +
-                                                 float_text(near_) + ", z_far " +
-                                                 float_text(far_) + "]");
+                                                 float_text(near_) + ", z_far " + float_text(far_) +
+                                                 "]");
   }
   return encode_unchecked(z);
 }

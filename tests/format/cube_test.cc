@@ -9,7 +9,9 @@
 namespace calf {
 namespace {
 
-double dot(const Direction& a, const Direction& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+double dot(const Direction& a, const Direction& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 // atan2 of |a x b| and a . b stays accurate for tiny angles, where acos(a . b) does not.
 double angle(const Direction& a, const Direction& b) {
   const double cx = a.y * b.z - a.z * b.y, cy = a.z * b.x - a.x * b.z, cz = a.x * b.y - a.y * b.x;
@@ -130,8 +132,8 @@ TEST(CubeTest, TexelsAcrossSeamsAreNeighboursInDirectionSpace) {
       } edges[] = {{0, i, -1, 0}, {n - 1, i, 1, 0}, {i, 0, 0, -1}, {i, n - 1, 0, 1}};
       for (const auto& edge : edges) {
         const Direction inside = direction_from_texel(e.face, edge.x, edge.y, n);
-        const Direction beyond = direction_from_texel_coord(
-            {e.face, edge.x + 0.5 + edge.du, edge.y + 0.5 + edge.dv}, n);
+        const Direction beyond =
+            direction_from_texel_coord({e.face, edge.x + 0.5 + edge.du, edge.y + 0.5 + edge.dv}, n);
         const Texel across = texel_from_direction(beyond, n);
         ASSERT_NE(across.face, e.face);
         const Direction neighbour = direction_from_texel(across.face, across.x, across.y, n);
@@ -143,9 +145,9 @@ TEST(CubeTest, TexelsAcrossSeamsAreNeighboursInDirectionSpace) {
         }
         EXPECT_NEAR(angle(inside, neighbour), closest, 1e-12)
             << cube_face_name(e.face) << " edge texel (" << edge.x << ", " << edge.y << ")";
-        const Direction inward = direction_from_texel(
-            e.face, static_cast<uint32_t>(static_cast<int>(edge.x) - edge.du),
-            static_cast<uint32_t>(static_cast<int>(edge.y) - edge.dv), n);
+        const Direction inward =
+            direction_from_texel(e.face, static_cast<uint32_t>(static_cast<int>(edge.x) - edge.du),
+                                 static_cast<uint32_t>(static_cast<int>(edge.y) - edge.dv), n);
         EXPECT_LT(angle(inside, neighbour), 1.5 * angle(inside, inward));
         ++seams_checked;
       }

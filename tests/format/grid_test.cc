@@ -52,7 +52,8 @@ TEST(GridTest, NonMultipleHasSmallerEdgeCells) {
   EXPECT_EQ(*g.cell_rect(3), (PixelRect{64, 64, 36, 36}));
   expect_partition(g);
   for (uint32_t face : {1u, 3u, 4u, 5u, 17u, 63u, 65u, 129u}) {
-    for (uint32_t cell : {1u, 4u, 7u, 16u, 64u, 200u}) expect_partition(must(FaceGrid::with_cell_size(face, cell)));
+    for (uint32_t cell : {1u, 4u, 7u, 16u, 64u, 200u})
+      expect_partition(must(FaceGrid::with_cell_size(face, cell)));
   }
 }
 
@@ -98,7 +99,8 @@ TEST(GridTest, TilesAreFourAligned) {
     for (uint32_t tiles : {1u, 2u, 3u, 8u}) {
       const FaceGrid g = must(FaceGrid::with_tiles_per_side(face, tiles));
       EXPECT_LE(g.cells_per_side(), tiles);
-      for (uint32_t i = 0; i + 1 < g.cells_per_side(); ++i) EXPECT_EQ(g.cell_rect(i, 0).width % 4, 0u);
+      for (uint32_t i = 0; i + 1 < g.cells_per_side(); ++i)
+        EXPECT_EQ(g.cell_rect(i, 0).width % 4, 0u);
       expect_partition(g);
     }
   }

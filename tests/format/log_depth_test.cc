@@ -118,7 +118,7 @@ TEST(LogDepthTest, InvalidRangesAreRejected) {
   struct Case {
     float near, far;
   } cases[] = {{1.0f, 1.0f}, {0.0f, 1.0f}, {-1.0f, 1.0f}, {2.0f, 1.0f}, {kNaN, 1.0f},
-               {1.0f, kNaN}, {1.0f, kInf}, {kInf, kInf}, {-kInf, 1.0f}};
+               {1.0f, kNaN}, {1.0f, kInf}, {kInf, kInf},  {-kInf, 1.0f}};
   for (const auto& c : cases) {
     auto r = LogDepthRange::make(c.near, c.far);
     ASSERT_FALSE(r.ok()) << c.near << " " << c.far;
@@ -138,8 +138,8 @@ TEST(LogDepthTest, CoveringWidensAFlatScene) {
   EXPECT_GT(r->z_far(), 5.0f);
   EXPECT_EQ(*r->encode(5.0f), 0);
   EXPECT_EQ(r->decode(0), 5.0f);
-  auto huge = LogDepthRange::covering(std::numeric_limits<float>::max(),
-                                      std::numeric_limits<float>::max());
+  auto huge =
+      LogDepthRange::covering(std::numeric_limits<float>::max(), std::numeric_limits<float>::max());
   ASSERT_TRUE(huge.ok());
   EXPECT_EQ(*huge->encode(std::numeric_limits<float>::max()), kLog16MaxFinite);
   EXPECT_FALSE(LogDepthRange::covering(5.0f, 4.0f).ok());

@@ -56,7 +56,8 @@ TEST(StatusTest, ExpectedHoldsValueOrStatus) {
   Expected<std::string> b(ErrorId::kFileOpen, "a.exr: no such file");
   EXPECT_FALSE(b.ok());
   EXPECT_EQ(b.status().id(), ErrorId::kFileOpen);
-  EXPECT_EQ(std::move(b).with_context("capture").status().message(), "capture: a.exr: no such file");
+  EXPECT_EQ(std::move(b).with_context("capture").status().message(),
+            "capture: a.exr: no such file");
 }
 
 // Every id in CALF_ERROR_LIST is unique, has a summary and a kind, and is documented in
@@ -69,10 +70,10 @@ TEST(StatusTest, EveryErrorIdIsUniqueAndDocumented) {
   std::stringstream doc;
   doc << in.rdbuf();
   std::set<int> numbers;
-#define CALF_CHECK_ID(name, number, kind, summary)                                        \
-  EXPECT_TRUE(numbers.insert(number).second) << "duplicate id " << number;                \
-  EXPECT_NE(std::string(error_summary(ErrorId::name)), "") << #name;                       \
-  EXPECT_NE(doc.str().find(error_code_string(ErrorId::name)), std::string::npos)           \
+#define CALF_CHECK_ID(name, number, kind, summary)                               \
+  EXPECT_TRUE(numbers.insert(number).second) << "duplicate id " << number;       \
+  EXPECT_NE(std::string(error_summary(ErrorId::name)), "") << #name;             \
+  EXPECT_NE(doc.str().find(error_code_string(ErrorId::name)), std::string::npos) \
       << error_code_string(ErrorId::name) << " (" #name ") is not documented in docs/ERRORS.md";
   CALF_ERROR_LIST(CALF_CHECK_ID)
 #undef CALF_CHECK_ID

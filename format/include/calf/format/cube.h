@@ -29,8 +29,12 @@ inline constexpr int kCubeFaceCount = 6;
 // "+X", "-X", "+Y", "-Y", "+Z", "-Z".
 const char* cube_face_name(CubeFace face);
 // Face i in OpenGL order; i must be in [0, 6).
-inline CubeFace cube_face_from_index(int i) { return static_cast<CubeFace>(i); }
-inline int cube_face_index(CubeFace face) { return static_cast<int>(face); }
+inline CubeFace cube_face_from_index(int i) {
+  return static_cast<CubeFace>(i);
+}
+inline int cube_face_index(CubeFace face) {
+  return static_cast<int>(face);
+}
 
 // A direction in scene space. Double precision: the conventions are the reference every fast path
 // is tested against; hot loops may convert to float after the lookup.

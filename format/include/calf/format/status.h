@@ -60,7 +60,7 @@ class [[nodiscard]] Expected {
   static_assert(!std::is_same_v<std::decay_t<T>, Status>, "Expected<Status> is meaningless");
 
  public:
-  Expected(T value) : v_(std::in_place_index<0>, std::move(value)) {}  // NOLINT: implicit
+  Expected(T value) : v_(std::in_place_index<0>, std::move(value)) {}        // NOLINT: implicit
   Expected(Status status) : v_(std::in_place_index<1>, std::move(status)) {  // NOLINT: implicit
     assert(!std::get<1>(v_).ok());
   }
@@ -69,9 +69,18 @@ class [[nodiscard]] Expected {
   bool ok() const { return v_.index() == 0; }
   explicit operator bool() const { return ok(); }
 
-  T& value() & { assert(ok()); return std::get<0>(v_); }
-  const T& value() const& { assert(ok()); return std::get<0>(v_); }
-  T&& value() && { assert(ok()); return std::get<0>(std::move(v_)); }
+  T& value() & {
+    assert(ok());
+    return std::get<0>(v_);
+  }
+  const T& value() const& {
+    assert(ok());
+    return std::get<0>(v_);
+  }
+  T&& value() && {
+    assert(ok());
+    return std::get<0>(std::move(v_));
+  }
   T& operator*() & { return value(); }
   const T& operator*() const& { return value(); }
   T&& operator*() && { return std::move(*this).value(); }
@@ -97,10 +106,10 @@ class [[nodiscard]] Expected {
 #define CALF_INTERNAL_CONCAT(a, b) CALF_INTERNAL_CONCAT2(a, b)
 
 // Returns the Status of `expr` from the enclosing function if it is an error.
-#define CALF_RETURN_IF_ERROR(expr)                         \
-  do {                                                     \
-    ::calf::Status calf_status_ = (expr);                  \
-    if (!calf_status_.ok()) return calf_status_;           \
+#define CALF_RETURN_IF_ERROR(expr)               \
+  do {                                           \
+    ::calf::Status calf_status_ = (expr);        \
+    if (!calf_status_.ok()) return calf_status_; \
   } while (false)
 
 // `lhs = *expr` when `expr` (an Expected) holds a value, else returns its Status. `lhs` may be a
