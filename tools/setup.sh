@@ -20,7 +20,7 @@ PACKAGES=(
   # capture ray tracer and scene loading
   libembree-dev libassimp-dev
   # player: GL, window, headless, maths, HUD
-  libglm-dev libglfw3-dev libosmesa6-dev libgl-dev libegl-dev libimgui-dev xvfb xauth
+  libglm-dev libglfw3-dev libosmesa6-dev libgl-dev libopengl-dev libglx-dev libegl-dev libimgui-dev xvfb xauth
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
   # measurement peers and plots
