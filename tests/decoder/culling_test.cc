@@ -1,0 +1,210 @@
+// Tests of view-dependent culling (decoder/include/calf/decoder/culling.h).
+#include "calf/decoder/culling.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <set>
+
+namespace calf {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+Vec3 v(double x, double y, double z) {
+  return {x, y, z};
+}
+double dot(const Vec3& a, const Vec3& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
+// Point-in-frustum by its face planes, oriented with the centroid inside: an independent check.
+bool contains(const Frustum& f, const Vec3& p, double tolerance = 1e-9) {
+  Vec3 c{};
+  for (const Vec3& q : f.corners()) c = {c.x + q.x / 8, c.y + q.y / 8, c.z + q.z / 8};
+  const int face_corner[6] = {0, 1, 2, 3, 0, 4};  // a corner on each face (see Frustum ctor)
+  for (int i = 0; i < 6; ++i) {
+    const Vec3& n = f.face_normals()[i];
+    const Vec3& q = f.corners()[face_corner[i]];
+    const double side_c = dot(n, {c.x - q.x, c.y - q.y, c.z - q.z});
+    const double side_p = dot(n, {p.x - q.x, p.y - q.y, p.z - q.z});
+    const double scale = std::sqrt(dot(n, n));
+    if (side_c * side_p < 0 && std::fabs(side_p) > tolerance * scale) return false;
+  }
+  return true;
+}
+
+Frustum box(double x0, double y0, double z0, double x1, double y1, double z1) {
+  return Frustum({v(x0, y0, z0), v(x1, y0, z0), v(x1, y1, z0), v(x0, y1, z0)},
+                 {v(x0, y0, z1), v(x1, y0, z1), v(x1, y1, z1), v(x0, y1, z1)});
+}
+
+TEST(CullingTest, SeparatingAxisBasics) {
+  const Frustum a = box(0, 0, 0, 1, 1, 1);
+  EXPECT_TRUE(frusta_intersect(a, a));
+  EXPECT_TRUE(frusta_intersect(a, box(0.25, 0.25, 0.25, 0.5, 0.5, 0.5)));  // inside
+  EXPECT_TRUE(frusta_intersect(a, box(1, 0, 0, 2, 1, 1)));                 // touching face
+  EXPECT_FALSE(frusta_intersect(a, box(1.001, 0, 0, 2, 1, 1)));
+  EXPECT_FALSE(frusta_intersect(a, box(2, 2, 2, 3, 3, 3)));
+  // A square prism rotated 45 degrees about z beside the box's (1, 1) edge: only its own face
+  // normal along x + y separates it when it is far enough out.
+  const auto diamond = [](double c) {
+    const double r = 0.75;
+    return Frustum({v(c + r, c, -1), v(c, c + r, -1), v(c - r, c, -1), v(c, c - r, -1)},
+                   {v(c + r, c, 2), v(c, c + r, 2), v(c - r, c, 2), v(c, c - r, 2)});
+  };
+  EXPECT_TRUE(frusta_intersect(a, diamond(1.3)));   // x + y edge at 1.85 < 2
+  EXPECT_FALSE(frusta_intersect(a, diamond(1.4)));  // x + y edge at 2.05 > 2
+}
+
+// Every point a cell's texels can stand for (a direction through the cell, a radial depth in the
+// range) lies inside the cell frustum.
+TEST(CullingTest, CellFrustumContainsItsTexels) {
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> u01(0, 1);
+  const FaceGrid grid = *FaceGrid::with_cell_size(64, 16);
+  const Vec3 vp = v(1, -2, 3);
+  for (int f = 0; f < kCubeFaceCount; ++f) {
+    for (uint32_t c = 0; c < grid.cell_count(); ++c) {
+      const PixelRect r = *grid.cell_rect(c);
+      const Frustum fr = cell_frustum(vp, cube_face_from_index(f), 64, r, 0.5, 20);
+      for (int k = 0; k < 20; ++k) {
+        const Direction d = direction_from_texel_coord(
+            {cube_face_from_index(f), r.x + u01(rng) * r.width, r.y + u01(rng) * r.height}, 64);
+        const double depth = 0.5 * std::pow(40.0, u01(rng));
+        ASSERT_TRUE(contains(fr, v(vp.x + d.x * depth, vp.y + d.y * depth, vp.z + d.z * depth)))
+            << "face " << f << " cell " << c;
+      }
+    }
+  }
+}
+
+TEST(CullingTest, EyeAtViewpointSeesTheFaceItLooksAt) {
+  const FaceGrid grid = *FaceGrid::with_cell_size(64, 16);
+  EyeView eye;
+  eye.position = v(0, 0, 0);
+  eye.forward = v(1, 0, 0);
+  eye.fov_y = kPi / 4;  // tan 22.5 deg = 0.41: inside the 4 middle cells' tangent range
+  const Frustum e = eye_frustum(eye);
+  const auto px = visible_cells_brute_force(v(0, 0, 0), CubeFace::kPosX, grid, 0.1, 10,
+                                            std::span(&e, 1), nullptr);
+  const auto nx = visible_cells_brute_force(v(0, 0, 0), CubeFace::kNegX, grid, 0.1, 10,
+                                            std::span(&e, 1), nullptr);
+  EXPECT_TRUE(nx.empty());
+  // 4 x 4 cells each span 0.5 in tangent; a 45 degree square eye reaches tangent 0.41 on both
+  // axes, so exactly the 4 middle cells.
+  EXPECT_EQ(px, (std::vector<uint32_t>{grid.cell_index(1, 1), grid.cell_index(2, 1),
+                                       grid.cell_index(1, 2), grid.cell_index(2, 2)}));
+}
+
+struct RandomScene {
+  Vec3 viewpoint;
+  std::vector<Frustum> eyes;
+};
+
+RandomScene random_scene(std::mt19937& rng, int eye_count) {
+  std::uniform_real_distribution<double> pos(-3, 3), u01(0, 1);
+  RandomScene s;
+  s.viewpoint = v(pos(rng), pos(rng), pos(rng));
+  for (int i = 0; i < eye_count; ++i) {
+    EyeView e;
+    e.position = v(pos(rng), pos(rng), pos(rng));
+    const double th = u01(rng) * 2 * kPi, ph = std::acos(2 * u01(rng) - 1);
+    e.forward = v(std::sin(ph) * std::cos(th), std::sin(ph) * std::sin(th), std::cos(ph));
+    e.up = std::fabs(e.forward.y) < 0.9 ? v(0, 1, 0) : v(1, 0, 0);
+    e.fov_y = 0.3 + u01(rng) * 1.5;
+    e.aspect = 0.5 + u01(rng) * 1.5;
+    e.near = 0.05;
+    e.far = 1 + u01(rng) * 8;
+    s.eyes.push_back(eye_frustum(e));
+  }
+  return s;
+}
+
+// The property the decoder relies on: for every level count the quadtree search returns exactly
+// the brute-force set, for one or several viewers; and the set for several viewers is the union
+// of each viewer's set.
+TEST(CullingTest, HierarchicalEqualsBruteForceAndUnionOverViewers) {
+  std::mt19937 rng(2);
+  int nonempty = 0, partial = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const uint32_t face_size = 32 + 16 * (trial % 5);
+    const FaceGrid grid = *FaceGrid::with_cell_size(face_size, 8 + 4 * (trial % 3));
+    const RandomScene s = random_scene(rng, 1 + trial % 3);
+    for (int f = 0; f < kCubeFaceCount; ++f) {
+      const CubeFace face = cube_face_from_index(f);
+      const auto brute =
+          visible_cells_brute_force(s.viewpoint, face, grid, 0.2, 6, s.eyes, nullptr);
+      for (uint32_t levels = 1; levels <= grid.quadtree_levels(); ++levels) {
+        ASSERT_EQ(
+            visible_cells_hierarchical(s.viewpoint, face, grid, 0.2, 6, s.eyes, levels, nullptr),
+            brute)
+            << "trial " << trial << " face " << f << " levels " << levels;
+      }
+      std::set<uint32_t> united;
+      for (const Frustum& e : s.eyes) {
+        for (uint32_t c : visible_cells_hierarchical(s.viewpoint, face, grid, 0.2, 6,
+                                                     std::span(&e, 1), 0, nullptr)) {
+          united.insert(c);
+        }
+      }
+      ASSERT_EQ(std::vector<uint32_t>(united.begin(), united.end()), brute);
+      nonempty += !brute.empty();
+      partial += !brute.empty() && brute.size() < grid.cell_count();
+    }
+  }
+  // The random scenes exercise the interesting case: some but not all cells visible.
+  EXPECT_GT(partial, 50);
+  EXPECT_GT(nonempty, partial);
+}
+
+// Conservative: a cell with any sampled texel point inside the eye frustum is never culled.
+TEST(CullingTest, NeverCullsACellWithAVisiblePoint) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u01(0, 1);
+  const FaceGrid grid = *FaceGrid::with_cell_size(32, 8);
+  for (int trial = 0; trial < 30; ++trial) {
+    const RandomScene s = random_scene(rng, 1);
+    for (int f = 0; f < kCubeFaceCount; ++f) {
+      const CubeFace face = cube_face_from_index(f);
+      const auto visible =
+          visible_cells_hierarchical(s.viewpoint, face, grid, 0.2, 6, s.eyes, 0, nullptr);
+      for (uint32_t c = 0; c < grid.cell_count(); ++c) {
+        const PixelRect r = *grid.cell_rect(c);
+        bool seen = false;
+        for (int k = 0; k < 200 && !seen; ++k) {
+          const Direction d = direction_from_texel_coord(
+              {face, r.x + u01(rng) * r.width, r.y + u01(rng) * r.height}, 32);
+          const double depth = 0.2 * std::pow(30.0, u01(rng));
+          const Vec3& o = s.viewpoint;
+          seen = contains(s.eyes[0], v(o.x + d.x * depth, o.y + d.y * depth, o.z + d.z * depth), 0);
+        }
+        if (seen) {
+          EXPECT_TRUE(std::binary_search(visible.begin(), visible.end(), c))
+              << "trial " << trial << " face " << f << " cell " << c;
+        }
+      }
+    }
+  }
+}
+
+TEST(CullingTest, HierarchyMakesFewerTestsForANarrowEye) {
+  const FaceGrid grid = *FaceGrid::with_cell_size(1024, 64);  // 16 x 16 cells, 5 levels
+  EyeView eye;
+  eye.forward = v(1, 0.1, 0.05);
+  eye.fov_y = 0.3;
+  const Frustum e = eye_frustum(eye);
+  CullStats flat, tree;
+  const auto a = visible_cells_hierarchical(v(0, 0, 0), CubeFace::kPosX, grid, 0.1, 50,
+                                            std::span(&e, 1), 1, &flat);
+  const auto b = visible_cells_hierarchical(v(0, 0, 0), CubeFace::kPosX, grid, 0.1, 50,
+                                            std::span(&e, 1), 5, &tree);
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(flat.tests, 256u);
+  EXPECT_LT(tree.tests, flat.tests / 2);
+  EXPECT_EQ(tree.visible_cells, a.size());
+}
+
+}  // namespace
+}  // namespace calf
