@@ -1,0 +1,58 @@
+// Chunk hashing and supercompression (format/SPEC.md "Hashes", "Supercompression").
+//
+// These functions are pure and thread-safe: an encoder may compress chunks on any number of
+// threads and hand the StoredChunks to the Writer in its own deterministic order; the bytes are
+// the same whatever the thread count, because each chunk is compressed single-threaded with a
+// fixed level.
+//
+//   none   stored == raw.
+//   zstd   one zstd frame (RFC 8878) with Frame_Content_Size == raw_size, no dictionary, no
+//          zstd checksum (the chunk hash covers the stored bytes), exactly stored_size bytes.
+//   LZMA2  one property byte (the LZMA2 dictionary size, encoded as in .xz filter flags), then a
+//          raw LZMA2 stream ending with its end marker, exactly stored_size bytes. The writer
+//          shrinks the dictionary to the chunk (>= 4 KiB); a reader refuses > kMaxLzmaDictionary.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "calf/format/container_types.h"
+#include "calf/format/status.h"
+
+namespace calf::container {
+
+// XXH3-64 with seed 0: every checksum and chunk hash of the container.
+uint64_t hash64(std::span<const uint8_t> bytes);
+
+// Compression levels. Fixed per clip: the same level gives the same bytes.
+struct CompressionOptions {
+  int zstd_level = 19;       // 1..22 (ZSTD_maxCLevel)
+  uint32_t lzma_preset = 6;  // 0..9
+};
+
+// A chunk ready for Writer::add_stored_chunk(): stored bytes, their scheme and raw length.
+struct StoredChunk {
+  Compression compression = Compression::kNone;
+  uint64_t raw_size = 0;
+  std::vector<uint8_t> bytes;
+};
+
+// The largest stored size `compress_chunk` can produce for `raw_size` bytes with `c`, and the
+// largest a reader accepts for that raw size (a larger one is kContainerChunkSize). Use it to
+// size a caller-owned stored buffer. Returns 0 for an unknown scheme.
+uint64_t stored_bound(uint64_t raw_size, Compression c);
+
+// Compresses `raw` with `c`. Errors: kContainerWriterMisuse (raw larger than kMaxRawChunkSize,
+// unknown scheme, level out of range), kContainerCompressor (library failure).
+Expected<StoredChunk> compress_chunk(std::span<const uint8_t> raw, Compression c,
+                                     const CompressionOptions& options = {});
+
+// Decompresses `stored` (scheme `c`) into `out`, whose size is the chunk's raw length; fails
+// with kContainerDecompress unless the stored bytes are exactly one well-formed stream that
+// decodes to exactly out.size() bytes, kContainerLimit for an LZMA2 dictionary above the limit,
+// kContainerCompression for an unknown scheme.
+Status decompress_chunk(std::span<const uint8_t> stored, Compression c, std::span<uint8_t> out);
+
+}  // namespace calf::container

@@ -1,0 +1,163 @@
+// Damage detection and limits: every single-bit change anywhere in a small golden file is
+// detected; truncation at every length is "need more data", never a crash; extension is
+// corrupt; documented limits hold; codec edge cases; fields and UTF-8 helpers.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "../conformance/container_corpus.h"
+
+namespace calf::container {
+namespace {
+
+using corpus::Bytes;
+
+TEST(ContainerRobustnessTest, EverySingleBitFlipIsDetected) {
+  for (const Bytes& golden : {*corpus::make_frozen_v1(), *corpus::make_empty()}) {
+    ASSERT_TRUE(corpus::first_error(golden).ok());
+    // Every offset, one bit each (rotating through the 8 positions); all 8 bits of each byte
+    // of the smallest file, whose bytes are all header and directory.
+    const int bits = golden.size() < 128 ? 8 : 1;
+    for (size_t at = 0; at < golden.size(); ++at) {
+      for (int k = 0; k < bits; ++k) {
+        Bytes damaged = golden;
+        damaged[at] ^= static_cast<uint8_t>(1u << ((at + k) % 8));
+        const Status s = corpus::first_error(damaged);
+        ASSERT_FALSE(s.ok()) << "bit flip at offset " << at << " went unnoticed";
+        EXPECT_NE(s.kind(), ErrorKind::kInternal) << s.to_string();
+      }
+    }
+  }
+}
+
+TEST(ContainerRobustnessTest, TruncationAtEveryLengthNeedsMoreData) {
+  const Bytes golden = *corpus::make_frozen_v1();
+  for (size_t n = 0; n < golden.size(); ++n) {
+    const Bytes cut(golden.begin(), golden.begin() + static_cast<std::ptrdiff_t>(n));
+    auto r = Reader::open(memory_source(std::span<const uint8_t>(cut)));
+    ASSERT_FALSE(r.ok()) << n;
+    EXPECT_EQ(r.status().id(), ErrorId::kContainerTruncated) << n << ": " << r.status().to_string();
+    EXPECT_EQ(r.status().kind(), ErrorKind::kNeedMoreData);
+  }
+  Bytes longer = golden;
+  longer.push_back(0);
+  EXPECT_EQ(corpus::first_error(longer).id(), ErrorId::kContainerFileSize);
+}
+
+TEST(ContainerRobustnessTest, MetadataLimits) {
+  corpus::Parts p = corpus::take_apart(*corpus::make_empty());
+  for (uint32_t i = 0; i <= kMaxMetadataEntries; ++i) {
+    char key[16];
+    std::snprintf(key, sizeof key, "k%06u", i);
+    p.metadata.push_back({key, ""});
+  }
+  EXPECT_EQ(corpus::first_error(corpus::assemble(p)).id(), ErrorId::kContainerLimit);
+  p.metadata.assign({{"a", std::string(kMaxMetadataBytes / 2, 'x')},
+                     {"b", std::string(kMaxMetadataBytes / 2, 'y')}});
+  EXPECT_EQ(corpus::first_error(corpus::assemble(p)).id(), ErrorId::kContainerLimit);
+  p.metadata.assign({{"a", std::string(kMaxMetadataBytes / 2, 'x')}});
+  EXPECT_TRUE(corpus::first_error(corpus::assemble(p)).ok());
+  p.metadata.assign({{"a", "1"}, {"a", "2"}});  // duplicates are not strictly increasing
+  EXPECT_EQ(corpus::first_error(corpus::assemble(p)).id(), ErrorId::kContainerMetadata);
+  p.metadata.assign({{std::string("a\0", 2), "1"}});
+  EXPECT_EQ(corpus::first_error(corpus::assemble(p)).id(), ErrorId::kContainerMetadata);
+}
+
+TEST(ContainerRobustnessTest, LeftoverDirectoryBytesAreCorrupt) {
+  corpus::Parts p = corpus::take_apart(*corpus::make_frozen_v1());
+  p.tracks[4].header.push_back(0);  // grows an opaque blob: still valid
+  EXPECT_TRUE(corpus::first_error(corpus::assemble(p)).ok());
+  // Three bytes after the last chunk entry, with sizes and checksums made consistent.
+  Bytes file = corpus::assemble(p);
+  file.insert(file.end() - 8, {0, 0, 0});
+  const uint64_t dir_at = load_le(file.data() + 32, 8);
+  const uint64_t dir_size = file.size() - dir_at;
+  store_le(file.data() + file.size() - 8,
+           hash64(std::span<const uint8_t>(file).subspan(dir_at, dir_size - 8)), 8);
+  store_le(file.data() + 24, file.size(), 8);
+  store_le(file.data() + 40, dir_size, 8);
+  corpus::reseal_header(file);
+  const Status s = corpus::first_error(file);
+  EXPECT_EQ(s.id(), ErrorId::kContainerDirectoryFormat) << s.to_string();
+  EXPECT_NE(s.message().find("3 bytes left over"), std::string::npos) << s.to_string();
+}
+
+TEST(ContainerRobustnessTest, LongerTrackHeadersFromLaterMinorVersionsAreAccepted) {
+  corpus::Parts p = corpus::take_apart(*corpus::make_frozen_v1());
+  p.tracks[0].header.insert(p.tracks[0].header.end(), {9, 9, 9, 9});
+  auto r = Reader::open(memory_source(corpus::assemble(p)));
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  EXPECT_EQ(std::get<LightfieldTrackHeader>(r->tracks()[0].header).face_size, 128u);
+}
+
+TEST(ContainerCodecTest, StoredBoundHoldsAndStreamsMustBeExact) {
+  std::mt19937_64 rng(9);
+  for (size_t size : {0, 1, 100, 65536, 300000}) {
+    Bytes raw(size);
+    for (auto& b : raw) b = static_cast<uint8_t>(rng());  // incompressible: worst case
+    for (uint16_t c = 0; c < kCompressionCount; ++c) {
+      const auto scheme = static_cast<Compression>(c);
+      auto stored = compress_chunk(raw, scheme, {1, 0});
+      ASSERT_TRUE(stored.ok()) << stored.status().to_string();
+      EXPECT_LE(stored->bytes.size(), stored_bound(size, scheme));
+      Bytes out(size);
+      ASSERT_TRUE(decompress_chunk(stored->bytes, scheme, out).ok());
+      EXPECT_EQ(out, raw);
+      if (scheme == Compression::kNone) continue;
+      Bytes longer = stored->bytes;
+      longer.push_back(0);  // trailing bytes after the stream
+      EXPECT_EQ(decompress_chunk(longer, scheme, out).id(), ErrorId::kContainerDecompress);
+      Bytes shorter(stored->bytes.begin(), stored->bytes.end() - 1);
+      EXPECT_EQ(decompress_chunk(shorter, scheme, out).id(), ErrorId::kContainerDecompress);
+      Bytes big(size + 1);  // the stream is shorter than the raw length claimed
+      EXPECT_EQ(decompress_chunk(stored->bytes, scheme, big).id(), ErrorId::kContainerDecompress);
+      if (size > 0) {
+        Bytes small(size - 1);
+        EXPECT_EQ(decompress_chunk(stored->bytes, scheme, small).id(),
+                  ErrorId::kContainerDecompress);
+      }
+    }
+  }
+  Bytes out(1);
+  EXPECT_EQ(decompress_chunk({}, Compression::kLzma2, out).id(), ErrorId::kContainerDecompress);
+  EXPECT_EQ(decompress_chunk(Bytes{1}, static_cast<Compression>(5), out).id(),
+            ErrorId::kContainerCompression);
+}
+
+TEST(ContainerFieldsTest, DeclaredSizesAndMessages) {
+  static_assert(fixed_size<FileHeader>() == 64);
+  static_assert(fixed_size<ChunkEntry>() == 64);
+  static_assert(fixed_size<LightfieldTrackHeader>() == 36);
+  const Bytes blob = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0};  // frame_count, fps_numerator, 2 bytes
+  auto h = decode_track_header<LightfieldTrackHeader>(blob, "track 0 (lightfield)");
+  ASSERT_FALSE(h.ok());
+  EXPECT_EQ(h.status().id(), ErrorId::kContainerTrackHeader);
+  EXPECT_NE(h.status().message().find(
+                "track 0 (lightfield): fps_denominator needs 4 bytes at offset 8, only 2 left"),
+            std::string::npos)
+      << h.status().message();
+  LightfieldTrackHeader lf;
+  lf.face_size = 77;
+  auto enc = encode_track_header(lf);
+  ASSERT_TRUE(enc.ok());
+  EXPECT_EQ(enc->size(), fixed_size<LightfieldTrackHeader>());
+  EXPECT_EQ(decode_track_header<LightfieldTrackHeader>(*enc, "")->face_size, 77u);
+  const auto printed = print_fields(lf);
+  ASSERT_EQ(printed.size(), 11u);
+  EXPECT_EQ(printed[4].name, "face_size");
+  EXPECT_EQ(printed[4].value, "77");
+}
+
+TEST(ContainerFieldsTest, Utf8Validation) {
+  EXPECT_TRUE(is_valid_utf8(""));
+  EXPECT_TRUE(is_valid_utf8("plain"));
+  EXPECT_TRUE(is_valid_utf8("\xc3\xa9\xe2\x9c\x93\xf0\x9f\x90\x84"));
+  EXPECT_FALSE(is_valid_utf8("\xc0\xaf"));          // overlong
+  EXPECT_FALSE(is_valid_utf8("\xed\xa0\x80"));      // surrogate
+  EXPECT_FALSE(is_valid_utf8("\xf4\x90\x80\x80"));  // above U+10FFFF
+  EXPECT_FALSE(is_valid_utf8("\xe2\x9c"));          // cut short
+  EXPECT_FALSE(is_valid_utf8("\x80"));
+}
+
+}  // namespace
+}  // namespace calf::container
