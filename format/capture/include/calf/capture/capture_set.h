@@ -1,0 +1,180 @@
+// Capture sets: the input of the encoder (format/CAPTURE.md is the specification).
+//
+// A capture set is a directory holding `manifest.json` and one OpenEXR image per view-frame. Each
+// image holds all six cube faces of one viewpoint at one frame as a vertical strip N texels wide
+// and 6N tall, faces in OpenGL order (+X, -X, +Y, -Y, +Z, -Z; calf/format/cube.h), with channels
+//   R, G, B                      linear colour, half float (HDR values kept)
+//   Z                            radial depth from the viewpoint centre, float; +inf = sky
+//   material.reflect/refract/ior optional (manifest "material": true), half float
+// The manifest is written last, so a set without one is incomplete by definition: a renderer that
+// fails half-way never leaves a set that looks complete.
+//
+// The reader is made for streaming encoders: open() parses and validates only the manifest;
+// read() decodes one view-frame into a caller-owned ViewFrame that is reused from call to call, and
+// validates every pixel it returns. Errors name the file, the JSON field, or the face and texel.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "calf/format/cube.h"
+#include "calf/format/status.h"
+
+namespace calf::capture {
+
+// Limits (CAPTURE.md "Limits"); larger sets are rejected with CALF-E134 before any allocation.
+inline constexpr uint32_t kMaxFrames = 1000000;
+inline constexpr uint32_t kMaxViewpoints = 4096;
+// The largest face a capture set may use (the container's kMaxFaceSize, calf/format/grid.h).
+inline constexpr uint32_t kMaxCaptureFaceSize = 16384;
+inline constexpr uint32_t kCaptureFormatVersion = 1;
+inline constexpr const char* kManifestFileName = "manifest.json";
+inline constexpr const char* kDefaultFilePattern = "view{view:03}_frame{frame:05}.exr";
+
+// A point or vector in scene units (right-handed, +Y up by convention of the sample scenes; the
+// format itself does not care which axis is up).
+struct Point3 {
+  double x = 0, y = 0, z = 0;
+  friend bool operator==(const Point3&, const Point3&) = default;
+};
+
+// An axis-aligned box, min <= max componentwise (a point or a flat box is allowed).
+struct Box3 {
+  Point3 min, max;
+  friend bool operator==(const Box3&, const Box3&) = default;
+};
+
+// One 360-degree camera: a cube map centred at `position` (no orientation: faces are world-axis
+// aligned). `name` is informative ("centre", "corner-+x+y-z"); unique within a set.
+struct Viewpoint {
+  std::string name;
+  Point3 position;
+  friend bool operator==(const Viewpoint&, const Viewpoint&) = default;
+};
+
+// Everything manifest.json declares. Field names match the JSON keys (CAPTURE.md).
+struct CaptureManifest {
+  uint32_t version = kCaptureFormatVersion;
+  uint32_t frame_count = 0;
+  double fps = 30;
+  uint32_t face_size = 0;
+  // Where the viewer may move during playback; the encoder and player use it for culling and
+  // view selection. Viewpoints usually lie inside or on it.
+  Box3 view_volume;
+  std::vector<Viewpoint> viewpoints;
+  // The image of view v, frame f is the pattern with "{view}" / "{frame}" replaced by the decimal
+  // index, "{view:0N}" zero-padded to N digits (N in 1..9). See validate rules in CAPTURE.md.
+  std::string file_pattern = kDefaultFilePattern;
+  // Whether every image has the three material channels.
+  bool material = false;
+  // Informative: the scene and program that made the set ("" when absent).
+  std::string scene;
+  std::string generator;
+  friend bool operator==(const CaptureManifest&, const CaptureManifest&) = default;
+};
+
+// Parses and validates manifest JSON. `source_name` (a path) prefixes every error message.
+// Errors: CALF-E130 syntax, E131 field, E132 format/version, E133 inconsistency, E134 limits.
+Expected<CaptureManifest> parse_manifest(std::string_view json, std::string_view source_name);
+// Checks a manifest built in memory against the same rules parse_manifest applies.
+Status validate_manifest(const CaptureManifest& manifest);
+// Canonical JSON for a valid manifest (2-space indent, fixed key order, doubles written so that
+// they parse back to the same bits): parse_manifest(serialize_manifest(m)) == m.
+std::string serialize_manifest(const CaptureManifest& manifest);
+// The image file name of view `view`, frame `frame` (no directory). Indices are not checked.
+std::string capture_file_name(const CaptureManifest& manifest, uint32_t view, uint32_t frame);
+
+// The pixels of one view-frame: six N x N faces, face-major then row-major, exactly the order of
+// the image's vertical strip. Texel (face, x, y) is element texel_index(face, x, y) of depth and
+// element 3 * texel_index(...) + c of color (c = R, G, B) and of material (c = reflect, refract,
+// ior). The caller owns it; the reader resizes it only when face size or material change.
+struct ViewFrame {
+  uint32_t face_size = 0;
+  bool has_material = false;
+  std::vector<float> color;     // 3 per texel, linear RGB, >= 0 and finite
+  std::vector<float> depth;     // 1 per texel, radial distance > 0, or +inf for sky
+  std::vector<float> material;  // 3 per texel when has_material, else empty
+
+  // Sizes the buffers for faces of `face_size` texels (contents unspecified).
+  void resize(uint32_t face_size, bool with_material);
+  size_t texel_count() const { return size_t{6} * face_size * face_size; }
+  size_t texel_index(CubeFace face, uint32_t x, uint32_t y) const {
+    return (static_cast<size_t>(cube_face_index(face)) * face_size + y) * face_size + x;
+  }
+};
+
+// Checks every pixel of a view-frame: depth classified by calf/format/log_depth.h (NaN, -inf and
+// values <= 0 are errors, +inf is sky), colour finite and >= 0, material weights in [0, 1] with
+// reflect + refract <= 1 and IOR finite and > 0. Errors (E137/E138/E139) name face, x and y;
+// `context` (a file name) prefixes them.
+Status validate_view_frame(const ViewFrame& frame, std::string_view context);
+
+// Reads a capture set one view-frame at a time. Movable, not copyable; no shared state, so
+// several readers (one per thread) may read one set concurrently.
+class CaptureSetReader {
+ public:
+  // Reads and validates `directory`/manifest.json. Does not touch the images (see check_files).
+  static Expected<CaptureSetReader> open(const std::filesystem::path& directory);
+
+  const CaptureManifest& manifest() const { return manifest_; }
+  const std::filesystem::path& directory() const { return directory_; }
+  std::filesystem::path image_path(uint32_t view, uint32_t frame) const;
+
+  // Whether every image the manifest names exists (CALF-E135 names the first missing one).
+  // Cheap (directory look-ups only); call it before a long encode to fail early.
+  Status check_files() const;
+
+  // Decodes view `view`, frame `frame` into `out` and validates its size, channels and pixels.
+  // Colour may be stored as half or float; depth must be float or half. Errors: E140 index,
+  // E135 missing, E136 format, E137-E139 pixels.
+  Status read(uint32_t view, uint32_t frame, ViewFrame* out) const;
+
+ private:
+  CaptureSetReader(std::filesystem::path directory, CaptureManifest manifest)
+      : directory_(std::move(directory)), manifest_(std::move(manifest)) {}
+  std::filesystem::path directory_;
+  CaptureManifest manifest_;
+};
+
+// Writes a capture set. Each image is written whole (temporary file, then rename); manifest.json
+// is written by finish() only once every view-frame is present, so an interrupted or failed run
+// leaves no set that looks complete. create() deletes a stale manifest.json in the directory for
+// the same reason.
+class CaptureSetWriter {
+ public:
+  // Validates `manifest`, creates `directory` (and parents) if needed.
+  static Expected<CaptureSetWriter> create(const std::filesystem::path& directory,
+                                           CaptureManifest manifest);
+
+  const CaptureManifest& manifest() const { return manifest_; }
+
+  // Validates and writes one view-frame (colour as half, depth as float, material as half).
+  // `frame_data` must match the manifest's face size and material flag (E141); indices must be
+  // in range (E140). Each view-frame may be written once, in any order, from any one thread at a
+  // time.
+  Status write(uint32_t view, uint32_t frame, const ViewFrame& frame_data);
+
+  // Writes manifest.json. Fails (E141) when a view-frame is missing.
+  Status finish();
+
+  // Removes every image this writer wrote (best effort): for a caller giving up after an error.
+  void abandon();
+
+ private:
+  CaptureSetWriter(std::filesystem::path directory, CaptureManifest manifest);
+  std::filesystem::path directory_;
+  CaptureManifest manifest_;
+  std::vector<bool> written_;  // view-major: view * frame_count + frame
+  bool finished_ = false;
+};
+
+// Writes `bytes` to `path` whole: a temporary file beside it, flushed, then renamed over `path`.
+// Errors: CALF-E004 naming the file and the system's reason. Shared by manifest, eye path and
+// image writers.
+Status write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
+
+}  // namespace calf::capture

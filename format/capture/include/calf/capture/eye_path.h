@@ -1,0 +1,80 @@
+// Eye paths and ground-truth images (format/CAPTURE.md, "Eye paths").
+//
+// An eye path is a list of perspective camera poses over time: where a viewer is, where it looks,
+// with which field of view, and for stereo which eye. calf-capture renders ground truth along one
+// (colour + radial depth per pose); the player renders its reconstruction along the same path and
+// compares. Camera convention (OpenGL): the camera looks along `forward`; image row 0 is the top
+// (towards `up`), column 0 the left. The ray through pixel (i, j) of a W x H image is
+//   d = normalize(forward + a * tan(fov_y / 2) * (W / H) * right + b * tan(fov_y / 2) * up)
+//   a = 2 (i + 0.5) / W - 1,   b = 1 - 2 (j + 0.5) / H,   right = normalize(cross(forward, up))
+// and the depth stored for it is the radial distance from `position` along d (like cube maps).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "calf/capture/capture_set.h"
+#include "calf/format/status.h"
+
+namespace calf::capture {
+
+enum class Eye : uint8_t { kMono, kLeft, kRight };
+// "mono", "left", "right".
+const char* eye_name(Eye eye);
+
+// One pose. forward and up are unit length and orthogonal after parsing (up is re-orthogonalised
+// against forward).
+struct EyePose {
+  double time = 0;  // seconds of scene time (frame f of a capture is at f / fps)
+  Point3 position;
+  Point3 forward{0, 0, -1};
+  Point3 up{0, 1, 0};
+  double fov_y_degrees = 60;  // vertical field of view, in (0, 180)
+  Eye eye = Eye::kMono;
+  friend bool operator==(const EyePose&, const EyePose&) = default;
+};
+
+struct EyePath {
+  uint32_t width = 256, height = 256;  // image size of every pose, 1..16384
+  // Ground-truth image of pose p: the pattern with "{pose}" (or "{pose:0N}") replaced by p, in
+  // the directory of the path file. Empty when the path has no images (a path to render).
+  std::string image_pattern;
+  std::vector<EyePose> poses;
+  friend bool operator==(const EyePath&, const EyePath&) = default;
+};
+
+inline constexpr const char* kEyePathFileName = "eye_path.json";
+inline constexpr const char* kDefaultImagePattern = "gt_{pose:05}.exr";
+inline constexpr uint32_t kMaxEyePoses = 1000000;
+
+// Parses and validates eye-path JSON. A pose gives its orientation as exactly one of
+//   "forward": [x, y, z] (+ optional "up", default [0, 1, 0]),
+//   "look_at": [x, y, z] (+ optional "up"), or
+//   "orientation": [w, x, y, z], a unit quaternion rotating the OpenGL camera frame (looking down
+//   -Z, +Y up) into the scene.
+// "fov_y_degrees" and "eye" are optional per pose (defaults: the path's "fov_y_degrees", else 60;
+// "mono"). Errors: E130 syntax, E132 format/version, E142 fields, E134 more than kMaxEyePoses.
+Expected<EyePath> parse_eye_path(std::string_view json, std::string_view source_name);
+// Reads and parses a file (E002/E003 when it cannot be read).
+Expected<EyePath> read_eye_path(const std::filesystem::path& path);
+// Canonical JSON (forward + up form, exact doubles): parse_eye_path(serialize_eye_path(p)) == p
+// for a parsed path.
+std::string serialize_eye_path(const EyePath& path);
+// The ground-truth image name of pose `index` ("" when the path has no image pattern).
+std::string eye_image_file_name(const EyePath& path, uint32_t index);
+
+// A perspective ground-truth image: W x H, row-major from the top row.
+struct PerspectiveImage {
+  uint32_t width = 0, height = 0;
+  std::vector<float> color;  // 3 per pixel, linear RGB
+  std::vector<float> depth;  // radial distance from the eye, +inf = sky
+};
+// Writes an EXR with half R, G, B and float Z, whole (temporary file + rename).
+Status write_perspective_image(const std::filesystem::path& path, const PerspectiveImage& image);
+// Reads one back, checking channels and pixels like CaptureSetReader::read.
+Expected<PerspectiveImage> read_perspective_image(const std::filesystem::path& path);
+
+}  // namespace calf::capture

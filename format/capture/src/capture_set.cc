@@ -1,0 +1,296 @@
+// Capture-set reader and writer (format/CAPTURE.md, "Images").
+#include "calf/capture/capture_set.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <system_error>
+
+#include "calf/format/log_depth.h"
+#include "exr_io.h"
+
+namespace calf::capture {
+
+namespace {
+
+// The largest finite half; colour above it would turn into +inf in the file.
+constexpr float kHalfMax = 65504.0f;
+// Half rounding of two weights that sum to 1 may exceed 1 by a few ulps.
+constexpr float kWeightSlack = 2e-3f;
+
+const char* const kMaterialChannels[3] = {"material.reflect", "material.refract", "material.ior"};
+
+std::string texel_text(const ViewFrame& f, size_t index) {
+  size_t n = f.face_size;
+  size_t face = index / (n * n);
+  size_t y = index / n % n;
+  size_t x = index % n;
+  return std::string("face ") + cube_face_name(cube_face_from_index(static_cast<int>(face))) +
+         " texel (" + std::to_string(x) + ", " + std::to_string(y) + ")";
+}
+
+std::string value_text(float v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", static_cast<double>(v));
+  return buf;
+}
+
+}  // namespace
+
+void ViewFrame::resize(uint32_t size, bool with_material) {
+  face_size = size;
+  has_material = with_material;
+  color.resize(texel_count() * 3);
+  depth.resize(texel_count());
+  material.resize(with_material ? texel_count() * 3 : 0);
+}
+
+Status validate_view_frame(const ViewFrame& f, std::string_view context) {
+  std::string ctx(context);
+  const size_t n = f.texel_count();
+  if (f.color.size() != 3 * n || f.depth.size() != n ||
+      f.material.size() != (f.has_material ? 3 * n : 0)) {
+    return Status(ErrorId::kCaptureWriterMisuse,
+                  ctx + ": buffer sizes do not match face size " + std::to_string(f.face_size));
+  }
+  for (size_t i = 0; i < n; ++i) {
+    float z = f.depth[i];
+    if (classify_depth(z) == DepthClass::kInvalid) {
+      return Status(ErrorId::kCaptureDepthPixel, ctx + ": " + texel_text(f, i) + ": depth " +
+                                                     value_text(z) +
+                                                     " (expected > 0, or +inf for sky)");
+    }
+    for (int c = 0; c < 3; ++c) {
+      float v = f.color[3 * i + c];
+      if (!(v >= 0 && v <= kHalfMax)) {
+        return Status(ErrorId::kCaptureColorPixel,
+                      ctx + ": " + texel_text(f, i) + ": colour channel " + "RGB"[c] + " is " +
+                          value_text(v) + " (expected finite, >= 0 and <= 65504)");
+      }
+    }
+    if (f.has_material) {
+      float rfl = f.material[3 * i], rfr = f.material[3 * i + 1], ior = f.material[3 * i + 2];
+      bool weights_ok = rfl >= 0 && rfl <= 1 && rfr >= 0 && rfr <= 1 && rfl + rfr <= 1 + kWeightSlack;
+      if (!weights_ok || !(std::isfinite(ior) && ior > 0)) {
+        return Status(ErrorId::kCaptureMaterialPixel,
+                      ctx + ": " + texel_text(f, i) + ": material (" + value_text(rfl) + ", " +
+                          value_text(rfr) + ", " + value_text(ior) +
+                          ") (expected weights in [0, 1] summing to <= 1 and IOR > 0)");
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+Status write_file_atomically(const std::filesystem::path& path, std::string_view bytes) {
+  const std::string temp = path.string() + ".tmp";
+  {
+    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+    if (!out) return Status(ErrorId::kFileWrite, path.string() + ": cannot create " + temp);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    out.flush();
+    if (!out) {
+      out.close();
+      std::error_code ignored;
+      std::filesystem::remove(temp, ignored);
+      return Status(ErrorId::kFileWrite, path.string() + ": write failed");
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(temp, path, ec);
+  if (ec) {
+    std::error_code ignored;
+    std::filesystem::remove(temp, ignored);
+    return Status(ErrorId::kFileWrite, path.string() + ": cannot rename into place: " +
+                                           ec.message());
+  }
+  return Status::Ok();
+}
+
+// ---- reader ------------------------------------------------------------------------------------
+
+Expected<CaptureSetReader> CaptureSetReader::open(const std::filesystem::path& directory) {
+  std::filesystem::path manifest_path = directory / kManifestFileName;
+  std::ifstream in(manifest_path, std::ios::binary);
+  if (!in) {
+    return Status(ErrorId::kFileOpen, manifest_path.string() +
+                                          ": cannot open (not a capture set, or an incomplete one)");
+  }
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) return Status(ErrorId::kFileRead, manifest_path.string() + ": read failed");
+  CALF_ASSIGN_OR_RETURN(CaptureManifest m, parse_manifest(text, manifest_path.string()));
+  return CaptureSetReader(directory, std::move(m));
+}
+
+std::filesystem::path CaptureSetReader::image_path(uint32_t view, uint32_t frame) const {
+  return directory_ / capture_file_name(manifest_, view, frame);
+}
+
+Status CaptureSetReader::check_files() const {
+  for (uint32_t v = 0; v < manifest_.viewpoints.size(); ++v) {
+    for (uint32_t f = 0; f < manifest_.frame_count; ++f) {
+      std::error_code ec;
+      std::filesystem::path p = image_path(v, f);
+      if (!std::filesystem::is_regular_file(p, ec)) {
+        return Status(ErrorId::kCaptureFileMissing,
+                      p.string() + ": missing (view " + std::to_string(v) + ", frame " +
+                          std::to_string(f) + ")");
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+Status CaptureSetReader::read(uint32_t view, uint32_t frame, ViewFrame* out) const {
+  const CaptureManifest& m = manifest_;
+  if (view >= m.viewpoints.size() || frame >= m.frame_count) {
+    return Status(ErrorId::kCaptureIndex,
+                  "view " + std::to_string(view) + ", frame " + std::to_string(frame) +
+                      " is outside the capture set (" + std::to_string(m.viewpoints.size()) +
+                      " views, " + std::to_string(m.frame_count) + " frames)");
+  }
+  const std::filesystem::path path = image_path(view, frame);
+  const std::string name = path.string();
+  CALF_ASSIGN_OR_RETURN(detail::ExrReader exr, detail::ExrReader::open(path));
+  const uint32_t n = m.face_size;
+  if (exr.width() != n || exr.height() != 6 * n) {
+    return Status(ErrorId::kCaptureImageFormat,
+                  name + ": image is " + std::to_string(exr.width()) + " x " +
+                      std::to_string(exr.height()) + ", expected " + std::to_string(n) + " x " +
+                      std::to_string(6 * n) + " (six faces of face_size " + std::to_string(n) +
+                      " stacked vertically)");
+  }
+  int idx[7];
+  const char* const required[4] = {"R", "G", "B", "Z"};
+  for (int c = 0; c < 4; ++c) {
+    idx[c] = exr.channel(required[c]);
+    if (idx[c] < 0) {
+      return Status(ErrorId::kCaptureImageFormat,
+                    name + ": channel '" + required[c] + "' is missing");
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    idx[4 + c] = exr.channel(kMaterialChannels[c]);
+    if (m.material && idx[4 + c] < 0) {
+      return Status(ErrorId::kCaptureImageFormat, name + ": channel '" + kMaterialChannels[c] +
+                                                      "' is missing (the manifest says material)");
+    }
+    if (!m.material && idx[4 + c] >= 0) {
+      return Status(ErrorId::kCaptureImageFormat,
+                    name + ": has channel '" + kMaterialChannels[c] +
+                        "' but the manifest says \"material\": false");
+    }
+  }
+  if (out->face_size != n || out->has_material != m.material ||
+      out->depth.size() != out->texel_count()) {
+    out->resize(n, m.material);
+  }
+  // One face at a time keeps the decode buffer at 1/6 of the image.
+  const size_t nch = static_cast<size_t>(exr.channel_count());
+  const size_t face_texels = static_cast<size_t>(n) * n;
+  std::vector<float> rows;
+  for (uint32_t face = 0; face < 6; ++face) {
+    CALF_RETURN_IF_ERROR(exr.read_rows(face * n, (face + 1) * n, &rows));
+    const size_t base = face * face_texels;
+    for (size_t i = 0; i < face_texels; ++i) {
+      const float* px = &rows[i * nch];
+      for (int c = 0; c < 3; ++c) out->color[3 * (base + i) + c] = px[idx[c]];
+      out->depth[base + i] = px[idx[3]];
+      if (m.material) {
+        for (int c = 0; c < 3; ++c) out->material[3 * (base + i) + c] = px[idx[4 + c]];
+      }
+    }
+  }
+  return validate_view_frame(*out, name);
+}
+
+// ---- writer ------------------------------------------------------------------------------------
+
+CaptureSetWriter::CaptureSetWriter(std::filesystem::path directory, CaptureManifest manifest)
+    : directory_(std::move(directory)), manifest_(std::move(manifest)) {
+  written_.assign(manifest_.viewpoints.size() * manifest_.frame_count, false);
+}
+
+Expected<CaptureSetWriter> CaptureSetWriter::create(const std::filesystem::path& directory,
+                                                    CaptureManifest manifest) {
+  CALF_RETURN_IF_ERROR(validate_manifest(manifest));
+  std::error_code ec;
+  std::filesystem::create_directories(directory, ec);
+  if (ec || !std::filesystem::is_directory(directory, ec)) {
+    return Status(ErrorId::kFileWrite, directory.string() + ": cannot create directory" +
+                                           (ec ? ": " + ec.message() : ""));
+  }
+  // A stale manifest would make a half-rewritten set look complete.
+  std::filesystem::remove(directory / kManifestFileName, ec);
+  if (ec) {
+    return Status(ErrorId::kFileWrite, (directory / kManifestFileName).string() +
+                                           ": cannot remove the old manifest: " + ec.message());
+  }
+  return CaptureSetWriter(directory, std::move(manifest));
+}
+
+Status CaptureSetWriter::write(uint32_t view, uint32_t frame, const ViewFrame& data) {
+  const CaptureManifest& m = manifest_;
+  if (finished_) return Status(ErrorId::kCaptureWriterMisuse, "write() after finish()");
+  if (view >= m.viewpoints.size() || frame >= m.frame_count) {
+    return Status(ErrorId::kCaptureIndex, "view " + std::to_string(view) + ", frame " +
+                                              std::to_string(frame) +
+                                              " is outside the manifest's counts");
+  }
+  const std::filesystem::path path = directory_ / capture_file_name(m, view, frame);
+  if (data.face_size != m.face_size || data.has_material != m.material) {
+    return Status(ErrorId::kCaptureWriterMisuse,
+                  path.string() + ": view-frame has face size " + std::to_string(data.face_size) +
+                      (data.has_material ? " with" : " without") +
+                      " material; the manifest says " + std::to_string(m.face_size) +
+                      (m.material ? " with" : " without"));
+  }
+  const size_t slot = static_cast<size_t>(view) * m.frame_count + frame;
+  if (written_[slot]) {
+    return Status(ErrorId::kCaptureWriterMisuse, path.string() + ": written twice");
+  }
+  CALF_RETURN_IF_ERROR(validate_view_frame(data, path.string()));
+  const uint32_t n = m.face_size;
+  std::vector<detail::ExrChannelOut> channels = {
+      {"R", true, data.color.data() + 0, 3},
+      {"G", true, data.color.data() + 1, 3},
+      {"B", true, data.color.data() + 2, 3},
+      {"Z", false, data.depth.data(), 1},
+  };
+  if (m.material) {
+    for (int c = 0; c < 3; ++c) {
+      channels.push_back({kMaterialChannels[c], true, data.material.data() + c, 3});
+    }
+  }
+  CALF_RETURN_IF_ERROR(detail::write_exr(path, n, 6 * n, channels));
+  written_[slot] = true;
+  return Status::Ok();
+}
+
+Status CaptureSetWriter::finish() {
+  if (finished_) return Status(ErrorId::kCaptureWriterMisuse, "finish() called twice");
+  for (size_t slot = 0; slot < written_.size(); ++slot) {
+    if (!written_[slot]) {
+      return Status(ErrorId::kCaptureWriterMisuse,
+                    "finish(): view " + std::to_string(slot / manifest_.frame_count) + ", frame " +
+                        std::to_string(slot % manifest_.frame_count) + " was never written");
+    }
+  }
+  CALF_RETURN_IF_ERROR(
+      write_file_atomically(directory_ / kManifestFileName, serialize_manifest(manifest_)));
+  finished_ = true;
+  return Status::Ok();
+}
+
+void CaptureSetWriter::abandon() {
+  for (size_t slot = 0; slot < written_.size(); ++slot) {
+    if (!written_[slot]) continue;
+    uint32_t view = static_cast<uint32_t>(slot / manifest_.frame_count);
+    uint32_t frame = static_cast<uint32_t>(slot % manifest_.frame_count);
+    std::error_code ignored;
+    std::filesystem::remove(directory_ / capture_file_name(manifest_, view, frame), ignored);
+    written_[slot] = false;
+  }
+}
+
+}  // namespace calf::capture

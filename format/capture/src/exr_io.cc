@@ -1,0 +1,128 @@
+#include "exr_io.h"
+
+#include <system_error>
+
+namespace calf::capture::detail {
+
+namespace {
+
+// OIIO keeps a per-thread error string; fetch it so that it does not leak into a later message.
+std::string oiio_error(const std::string& fallback) {
+  std::string e = OIIO::geterror();
+  return e.empty() ? fallback : e;
+}
+
+}  // namespace
+
+Status write_exr(const std::filesystem::path& path, uint32_t width, uint32_t height,
+                 const std::vector<ExrChannelOut>& channels) {
+  const std::string final_name = path.string();
+  const std::string temp_name = final_name + ".tmp";
+  const size_t nch = channels.size();
+  const size_t pixels = static_cast<size_t>(width) * height;
+  // Interleave once: OIIO converts float to each channel's own format while writing.
+  std::vector<float> interleaved(pixels * nch);
+  for (size_t c = 0; c < nch; ++c) {
+    const float* src = channels[c].data;
+    for (size_t i = 0; i < pixels; ++i) interleaved[i * nch + c] = src[i * channels[c].stride];
+  }
+  try {
+    std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create("exr");
+    if (!out) {
+      return Status(ErrorId::kFileWrite, final_name + ": " + oiio_error("no OpenEXR writer"));
+    }
+    OIIO::ImageSpec spec(static_cast<int>(width), static_cast<int>(height),
+                         static_cast<int>(nch), OIIO::TypeDesc::HALF);
+    spec.channelnames.clear();
+    spec.channelformats.clear();
+    for (const ExrChannelOut& ch : channels) {
+      spec.channelnames.emplace_back(ch.name);
+      spec.channelformats.push_back(ch.half ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
+    }
+    spec.alpha_channel = -1;
+    spec.z_channel = -1;
+    spec.attribute("compression", "zip");
+    // OIIO stamps the current time into the EXR header (capDate) unless DateTime is set; an empty
+    // one keeps the bytes a function of the pixels only (deterministic output, DESIGN.md).
+    spec.attribute("DateTime", "");
+    if (!out->open(temp_name, spec)) {
+      std::string e = out->geterror();
+      return Status(ErrorId::kFileWrite, final_name + ": " + (e.empty() ? "cannot open" : e));
+    }
+    bool ok = out->write_image(OIIO::TypeDesc::FLOAT, interleaved.data());
+    std::string e = ok ? "" : out->geterror();
+    ok = out->close() && ok;
+    if (!ok) {
+      std::error_code ignored;
+      std::filesystem::remove(temp_name, ignored);
+      return Status(ErrorId::kFileWrite, final_name + ": " + (e.empty() ? "write failed" : e));
+    }
+  } catch (const std::exception& ex) {
+    std::error_code ignored;
+    std::filesystem::remove(temp_name, ignored);
+    return Status(ErrorId::kFileWrite, final_name + ": " + ex.what());
+  }
+  std::error_code ec;
+  std::filesystem::rename(temp_name, path, ec);
+  if (ec) {
+    std::error_code ignored;
+    std::filesystem::remove(temp_name, ignored);
+    return Status(ErrorId::kFileWrite, final_name + ": cannot rename into place: " + ec.message());
+  }
+  return Status::Ok();
+}
+
+Expected<ExrReader> ExrReader::open(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    return Status(ErrorId::kCaptureFileMissing, path.string() + ": no such file");
+  }
+  ExrReader r;
+  r.path_ = path.string();
+  try {
+    r.input_ = OIIO::ImageInput::open(r.path_);
+    if (!r.input_) {
+      return Status(ErrorId::kCaptureImageFormat,
+                    r.path_ + ": not a readable image: " + oiio_error("unknown format"));
+    }
+    const OIIO::ImageSpec& spec = r.input_->spec();
+    if (spec.deep || spec.depth != 1 || spec.width <= 0 || spec.height <= 0) {
+      return Status(ErrorId::kCaptureImageFormat,
+                    r.path_ + ": not a flat 2-D image (deep or volume data)");
+    }
+    r.width_ = static_cast<uint32_t>(spec.width);
+    r.height_ = static_cast<uint32_t>(spec.height);
+    r.names_ = spec.channelnames;
+  } catch (const std::exception& e) {
+    return Status(ErrorId::kCaptureImageFormat, r.path_ + ": " + e.what());
+  }
+  return r;
+}
+
+int ExrReader::channel(const std::string& name) const {
+  for (size_t i = 0; i < names_.size(); ++i) {
+    if (names_[i] == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+Status ExrReader::read_rows(uint32_t y0, uint32_t y1, std::vector<float>* out) {
+  const size_t nch = names_.size();
+  out->resize(static_cast<size_t>(y1 - y0) * width_ * nch);
+  try {
+    const OIIO::ImageSpec& spec = input_->spec();
+    if (!input_->read_scanlines(0, 0, spec.y + static_cast<int>(y0), spec.y + static_cast<int>(y1),
+                                0, 0, static_cast<int>(nch), OIIO::TypeDesc::FLOAT,
+                                out->data())) {
+      std::string e = input_->geterror();
+      return Status(ErrorId::kCaptureImageFormat,
+                    path_ + ": rows " + std::to_string(y0) + ".." + std::to_string(y1) +
+                        " cannot be decoded: " + (e.empty() ? "truncated or corrupt" : e));
+    }
+  } catch (const std::exception& e) {
+    return Status(ErrorId::kCaptureImageFormat, path_ + ": " + e.what());
+  }
+  return Status::Ok();
+}
+
+}  // namespace calf::capture::detail

@@ -1,0 +1,116 @@
+// The calf-capture ray tracer (Embree 3) and the drivers that render capture sets and ground truth.
+//
+// Shading, per primary ray (paper 002's challenges: shading that changes where depth does not,
+// mirrors and glass):
+//   - direct light from point lights and the sun, with shadow rays;
+//   - ambient occlusion: `ao_samples` cosine-distributed rays per diffuse hit, each lit by the
+//     scene's ambient radiance when it travels ao_distance unobstructed;
+//   - mirror and glass by recursion up to `max_bounces` (total internal reflection reflects);
+//   - optional multiplicative noise, uniform in [-noise, +noise], that mimics a path tracer's
+//     per-frame noise.
+// Depth is the radial distance of the primary hit from the ray origin (the viewpoint centre), so
+// for mirror and glass it is the depth of the mirror or glass surface; material channels are the
+// primary surface's (reflect, refract, ior), (0, 0, 1) where nothing reflective is hit or on sky.
+//
+// Determinism: every pixel is a pure function of (scene, time, viewpoint, texel, seed): its random
+// numbers come from a counter-based hash of (seed, view, face, x, y, sample), AO patterns are the
+// same every frame (static surfaces stay bit-identical) and only the noise option also hashes the
+// frame. Threads share no mutable state, so output bytes do not depend on the thread count.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+
+#include "calf/capture/capture_set.h"
+#include "calf/capture/eye_path.h"
+#include "calf/format/status.h"
+#include "calf/samples/scene.h"
+
+namespace calf::samples {
+
+struct RenderOptions {
+  uint32_t threads = 0;      // 0: all hardware threads; 1..256 otherwise
+  uint64_t seed = 1;         // seeds AO directions and noise
+  uint32_t ao_samples = 8;   // 0..256; 0 disables ambient occlusion (ambient then unshadowed)
+  uint32_t max_bounces = 6;  // mirror / glass recursion depth, 0..32
+  float noise = 0;           // per-frame colour noise amplitude in [0, 1]
+};
+// E177 when an option is outside its range.
+Status validate_render_options(const RenderOptions& options);
+
+// Rays traced (primary, shadow, AO, secondary) and wall time, for Mrays/s.
+struct RenderStats {
+  uint64_t rays = 0;
+  double seconds = 0;
+  double mrays_per_second() const { return seconds > 0 ? rays / seconds * 1e-6 : 0; }
+};
+
+// A scene frozen at one time and built into an Embree BVH, ready to trace from any thread.
+class FrameTracer {
+ public:
+  // Builds the scene at `time` seconds. E174 for non-finite transformed geometry, E178 when
+  // Embree fails.
+  static Expected<std::unique_ptr<FrameTracer>> create(const Scene& scene, double time,
+                                                       const RenderOptions& options);
+  ~FrameTracer();
+  FrameTracer(const FrameTracer&) = delete;
+  FrameTracer& operator=(const FrameTracer&) = delete;
+
+  // Renders the cube map centred at `center` into `out` (resized to `face_size`, with material
+  // channels when `with_material`). `view` and `frame` only seed random numbers. Each texel's ray
+  // is calf::direction_from_texel(face, x, y, face_size).
+  RenderStats render_cube(const capture::Point3& center, uint32_t view, uint32_t frame,
+                          uint32_t face_size, bool with_material, capture::ViewFrame* out) const;
+
+  // Renders one perspective ground-truth image (the camera convention of eye_path.h).
+  RenderStats render_perspective(const capture::EyePose& pose, uint32_t width, uint32_t height,
+                                 uint32_t pose_index, capture::PerspectiveImage* out) const;
+
+  // Whether `point` is inside closed geometry: along most of 26 probe rays (axes, edge and corner
+  // directions) the point's winding number (back-face minus front-face crossings) is positive, or
+  // a surface lies closer than 1e-4 scene units. Needs consistently wound closed meshes.
+  bool inside_geometry(const capture::Point3& point) const;
+
+ private:
+  struct Impl;
+  explicit FrameTracer(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+// A capture to render: faces of `face_size` texels, `frames` frames (0: the scene's default) of
+// the scene from every viewpoint of `rig`.
+struct CaptureRequest {
+  uint32_t face_size = 256;  // 1..4096
+  uint32_t frames = 0;       // 0: scene.frame_count; else 1..100000
+  Rig rig;
+  RenderOptions render;
+  std::string generator = "calf-capture";  // recorded in the manifest
+};
+
+// Called after each view-frame or pose with (done, total); used for progress lines.
+using ProgressFn = std::function<void(uint64_t done, uint64_t total)>;
+
+// Fails with E176 when a viewpoint is inside geometry at any frame (checked before anything is
+// rendered), naming the viewpoint, its position and the frame.
+Status check_viewpoints(const Scene& scene, const Rig& rig, uint32_t frames, double fps,
+                        const RenderOptions& options);
+
+// Renders a complete capture set into `directory` (format/CAPTURE.md): checks options, scene and
+// viewpoints first, writes each view-frame as it is done and manifest.json last; on failure
+// removes the images it wrote, so no partial set remains that looks complete. Material channels
+// are written when the scene has mirror or glass.
+Expected<RenderStats> render_capture_set(const Scene& scene, const CaptureRequest& request,
+                                         const std::filesystem::path& directory,
+                                         const ProgressFn& progress);
+
+// Renders ground truth along `path` into `directory`: one EXR per pose named by the path's image
+// pattern (kDefaultImagePattern when empty), then eye_path.json (with that pattern) last. Poses
+// must not be inside geometry (E176).
+Expected<RenderStats> render_ground_truth(const Scene& scene, const capture::EyePath& path,
+                                          const RenderOptions& options,
+                                          const std::filesystem::path& directory,
+                                          const ProgressFn& progress);
+
+}  // namespace calf::samples

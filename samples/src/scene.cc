@@ -1,0 +1,187 @@
+// Scene validation, procedural geometry helpers and loading by name.
+#include <cmath>
+#include <system_error>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "calf/samples/scene.h"
+
+namespace calf::samples {
+
+namespace {
+
+bool finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+}  // namespace
+
+bool Scene::has_mirror_or_glass() const {
+  for (const Object& o : objects) {
+    if (o.material < materials.size() &&
+        (materials[o.material].reflect > 0 || materials[o.material].refract > 0)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+Status validate_scene(const Scene& scene) {
+  const std::string where = "scene '" + scene.name + "'";
+  size_t primitives = 0;
+  for (size_t m = 0; m < scene.materials.size(); ++m) {
+    const Material& mat = scene.materials[m];
+    bool ok = finite(mat.albedo) && finite(mat.emission) && mat.reflect >= 0 && mat.refract >= 0 &&
+              mat.reflect + mat.refract <= 1.0f + 1e-6f && std::isfinite(mat.ior) && mat.ior > 0 &&
+              glm::all(glm::greaterThanEqual(mat.emission, glm::vec3(0)));
+    if (!ok) {
+      return Status(ErrorId::kSceneGeometry,
+                    where + ": material " + std::to_string(m) + " is out of range");
+    }
+  }
+  for (const Object& o : scene.objects) {
+    if (o.material >= scene.materials.size()) {
+      return Status(ErrorId::kSceneGeometry, where + ": object '" + o.name + "' uses material " +
+                                                 std::to_string(o.material) + " of " +
+                                                 std::to_string(scene.materials.size()));
+    }
+    for (const glm::vec3& p : o.mesh.positions) {
+      if (!finite(p)) {
+        return Status(ErrorId::kSceneGeometry, where + ": object '" + o.name +
+                                                   "' has a non-finite vertex");
+      }
+    }
+    for (const glm::uvec3& t : o.mesh.triangles) {
+      if (t.x >= o.mesh.positions.size() || t.y >= o.mesh.positions.size() ||
+          t.z >= o.mesh.positions.size()) {
+        return Status(ErrorId::kSceneGeometry, where + ": object '" + o.name +
+                                                   "' has a triangle index out of range");
+      }
+    }
+    for (const Sphere& s : o.spheres) {
+      if (!finite(s.center) || !(s.radius > 0) || !std::isfinite(s.radius)) {
+        return Status(ErrorId::kSceneGeometry, where + ": object '" + o.name +
+                                                   "' has a sphere with a bad centre or radius");
+      }
+    }
+    primitives += o.mesh.triangles.size() + o.spheres.size();
+  }
+  if (primitives == 0) {
+    return Status(ErrorId::kSceneEmpty, where + ": no triangles and no spheres to render");
+  }
+  if (!(scene.fps > 0 && scene.fps <= 1000) || scene.frame_count == 0) {
+    return Status(ErrorId::kSceneGeometry, where + ": fps or frame count out of range");
+  }
+  return Status::Ok();
+}
+
+Expected<Scene> load_scene(std::string_view name_or_path) {
+  for (const SceneInfo& info : builtin_scenes()) {
+    if (name_or_path == info.name) return make_builtin_scene(name_or_path);
+  }
+  std::error_code ec;
+  std::filesystem::path path(name_or_path);
+  if (name_or_path.find('.') != std::string_view::npos || std::filesystem::exists(path, ec)) {
+    return load_scene_file(path);
+  }
+  std::string names;
+  for (const SceneInfo& info : builtin_scenes()) {
+    if (!names.empty()) names.append(", ");
+    names.append(info.name);
+  }
+  std::string message = "'";
+  message.append(name_or_path).append("' is neither a built-in scene (").append(names);
+  message.append(") nor a file");
+  return Status(ErrorId::kSceneUnknown, message);
+}
+
+// ---- geometry helpers ----------------------------------------------------------------------------
+
+void add_quad(TriangleMesh* mesh, const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2,
+              const glm::vec3& p3) {
+  uint32_t b = static_cast<uint32_t>(mesh->positions.size());
+  mesh->positions.insert(mesh->positions.end(), {p0, p1, p2, p3});
+  mesh->triangles.push_back({b, b + 1, b + 2});
+  mesh->triangles.push_back({b, b + 2, b + 3});
+}
+
+namespace {
+
+// The 6 faces of [-1, 1]^3 as corner lists, counter-clockwise seen from outside.
+void add_unit_box(TriangleMesh* mesh, const glm::mat4& m, bool inward) {
+  auto t = [&](float x, float y, float z) { return glm::vec3(m * glm::vec4(x, y, z, 1)); };
+  const float q[6][4][3] = {
+      {{1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}},      // +X
+      {{-1, -1, 1}, {-1, 1, 1}, {-1, 1, -1}, {-1, -1, -1}},  // -X
+      {{-1, 1, -1}, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}},      // +Y
+      {{-1, -1, 1}, {-1, -1, -1}, {1, -1, -1}, {1, -1, 1}},  // -Y
+      {{-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}},      // +Z
+      {{1, -1, -1}, {-1, -1, -1}, {-1, 1, -1}, {1, 1, -1}},  // -Z
+  };
+  // A reflection (negative determinant) flips the winding; undo it so outside stays outside.
+  bool flip = inward != (glm::determinant(glm::mat3(m)) < 0);
+  for (const auto& f : q) {
+    glm::vec3 c[4];
+    for (int i = 0; i < 4; ++i) c[i] = t(f[i][0], f[i][1], f[i][2]);
+    if (flip) {
+      add_quad(mesh, c[3], c[2], c[1], c[0]);
+    } else {
+      add_quad(mesh, c[0], c[1], c[2], c[3]);
+    }
+  }
+}
+
+glm::mat4 box_matrix(const glm::vec3& lo, const glm::vec3& hi) {
+  glm::mat4 m = glm::translate(glm::mat4(1), (lo + hi) * 0.5f);
+  return glm::scale(m, (hi - lo) * 0.5f);
+}
+
+}  // namespace
+
+void add_box(TriangleMesh* mesh, const glm::mat4& m) { add_unit_box(mesh, m, false); }
+
+void add_box(TriangleMesh* mesh, const glm::vec3& lo, const glm::vec3& hi) {
+  add_unit_box(mesh, box_matrix(lo, hi), false);
+}
+
+void add_room(TriangleMesh* mesh, const glm::vec3& lo, const glm::vec3& hi) {
+  add_unit_box(mesh, box_matrix(lo, hi), true);
+}
+
+void add_cylinder(TriangleMesh* mesh, const glm::mat4& m, uint32_t segments) {
+  auto t = [&](float x, float y, float z) { return glm::vec3(m * glm::vec4(x, y, z, 1)); };
+  bool flip = glm::determinant(glm::mat3(m)) < 0;
+  const glm::vec3 top = t(0, 1, 0), bottom = t(0, -1, 0);
+  for (uint32_t i = 0; i < segments; ++i) {
+    float a0 = 6.2831853f * static_cast<float>(i) / static_cast<float>(segments);
+    float a1 = 6.2831853f * static_cast<float>(i + 1) / static_cast<float>(segments);
+    // Angles grow from +X towards -Z so that quads wind outward.
+    glm::vec3 b0 = t(std::cos(a0), -1, -std::sin(a0)), b1 = t(std::cos(a1), -1, -std::sin(a1));
+    glm::vec3 u0 = t(std::cos(a0), 1, -std::sin(a0)), u1 = t(std::cos(a1), 1, -std::sin(a1));
+    uint32_t b = static_cast<uint32_t>(mesh->positions.size());
+    mesh->positions.insert(mesh->positions.end(), {b0, b1, u1, u0, top, bottom});
+    auto tri = [&](uint32_t i0, uint32_t i1, uint32_t i2) {
+      mesh->triangles.push_back(flip ? glm::uvec3(b + i0, b + i2, b + i1)
+                                     : glm::uvec3(b + i0, b + i1, b + i2));
+    };
+    tri(0, 1, 2);
+    tri(0, 2, 3);
+    tri(3, 2, 4);  // top cap
+    tri(1, 0, 5);  // bottom cap
+  }
+}
+
+capture::EyePose look_at_pose(double time, const glm::dvec3& position, const glm::dvec3& target,
+                              double fov_y_degrees) {
+  capture::EyePose pose;
+  pose.time = time;
+  pose.position = {position.x, position.y, position.z};
+  glm::dvec3 f = glm::normalize(target - position);
+  glm::dvec3 up = glm::normalize(glm::dvec3(0, 1, 0) - f * f.y);
+  pose.forward = {f.x, f.y, f.z};
+  pose.up = {up.x, up.y, up.z};
+  pose.fov_y_degrees = fov_y_degrees;
+  return pose;
+}
+
+}  // namespace calf::samples

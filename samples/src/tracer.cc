@@ -1,0 +1,486 @@
+// The Embree ray tracer: scene build at one time, shading, cube-map and perspective rendering.
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "calf/format/cube.h"
+#include "calf/samples/render.h"
+
+namespace calf::samples {
+
+namespace {
+
+constexpr float kPi = 3.14159265358979f;
+// Keeps colour inside half range (the capture format stores half).
+constexpr float kMaxRadiance = 65504.0f;
+
+// splitmix64's finaliser: a good 64-bit mix, the base of every random number here.
+uint64_t mix64(uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+// A counter-based stream: the same key gives the same numbers on every thread and every run.
+struct Rng {
+  uint64_t state;
+  explicit Rng(uint64_t key) : state(mix64(key)) {}
+  float uniform() {  // [0, 1)
+    state += 0x9E3779B97F4A7C15ull;
+    return static_cast<float>(mix64(state) >> 40) * (1.0f / 16777216.0f);
+  }
+};
+
+uint64_t pixel_key(uint64_t seed, uint64_t a, uint64_t b, uint64_t c, uint64_t d) {
+  uint64_t k = mix64(seed + 0x632BE59BD9B4E019ull);
+  for (uint64_t v : {a, b, c, d}) k = mix64(k ^ (v + 0x9E3779B97F4A7C15ull));
+  return k;
+}
+
+// An orthonormal basis around n (Duff et al. 2017, branchless).
+void basis(const glm::vec3& n, glm::vec3* t, glm::vec3* b) {
+  float s = std::copysign(1.0f, n.z);
+  float a = -1.0f / (s + n.z);
+  float c = n.x * n.y * a;
+  *t = glm::vec3(1 + s * n.x * n.x * a, s * c, -s * n.x);
+  *b = glm::vec3(c, s + n.y * n.y * a, -n.y);
+}
+
+struct Geometry {
+  uint32_t material = 0;
+  bool spheres = false;
+  std::vector<glm::vec3> positions;  // world space at the frame's time
+  std::vector<glm::uvec3> triangles;
+  std::vector<glm::vec4> balls;      // world centre + radius
+};
+
+struct LightAt {
+  glm::vec3 position, intensity;
+};
+
+struct Hit {
+  float t = 0;
+  uint32_t geom = 0, prim = 0;
+};
+
+}  // namespace
+
+struct FrameTracer::Impl {
+  RTCDevice device = nullptr;
+  RTCScene rtc = nullptr;
+  std::vector<Geometry> geometries;
+  std::vector<Material> materials;
+  std::vector<LightAt> lights;
+  Sky sky;
+  glm::vec3 sun_dir{0, 1, 0};
+  glm::vec3 ambient{0};
+  float ao_distance = 1;
+  RenderOptions options;
+
+  ~Impl() {
+    if (rtc) rtcReleaseScene(rtc);
+    if (device) rtcReleaseDevice(device);
+  }
+
+  bool intersect(const glm::vec3& o, const glm::vec3& d, float tnear, float tfar, Hit* hit,
+                 uint64_t* rays) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh;
+    rh.ray.org_x = o.x, rh.ray.org_y = o.y, rh.ray.org_z = o.z;
+    rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
+    rh.ray.tnear = tnear;
+    rh.ray.tfar = tfar;
+    rh.ray.time = 0;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(rtc, &ctx, &rh);
+    ++*rays;
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    hit->t = rh.ray.tfar;
+    hit->geom = rh.hit.geomID;
+    hit->prim = rh.hit.primID;
+    return true;
+  }
+
+  bool occluded(const glm::vec3& o, const glm::vec3& d, float tfar, uint64_t* rays) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay ray;
+    ray.org_x = o.x, ray.org_y = o.y, ray.org_z = o.z;
+    ray.dir_x = d.x, ray.dir_y = d.y, ray.dir_z = d.z;
+    ray.tnear = 0;
+    ray.tfar = tfar;
+    ray.time = 0;
+    ray.mask = 0xFFFFFFFFu;
+    ray.id = 0;
+    ray.flags = 0;
+    rtcOccluded1(rtc, &ctx, &ray);
+    ++*rays;
+    return ray.tfar < 0;  // Embree sets tfar to -inf on a hit
+  }
+
+  // Outward geometric normal (unit) of a hit at point p.
+  glm::vec3 normal(const Hit& h, const glm::vec3& p) const {
+    const Geometry& g = geometries[h.geom];
+    if (g.spheres) return glm::normalize(p - glm::vec3(g.balls[h.prim]));
+    const glm::uvec3& t = g.triangles[h.prim];
+    glm::vec3 n = glm::cross(g.positions[t.y] - g.positions[t.x], g.positions[t.z] - g.positions[t.x]);
+    float len = glm::length(n);
+    return len > 0 ? n / len : glm::vec3(0, 1, 0);
+  }
+
+  glm::vec3 sky_radiance(const glm::vec3& d) const {
+    float y = d.y;
+    glm::vec3 c = y >= 0 ? glm::mix(sky.horizon, sky.zenith, std::sqrt(y))
+                         : glm::mix(sky.horizon, sky.ground, std::sqrt(-y));
+    if (glm::any(glm::greaterThan(sky.sun_irradiance, glm::vec3(0))) &&
+        glm::dot(d, sun_dir) > sky.sun_cos_radius) {
+      c += glm::vec3(sky.sun_disc_radiance);
+    }
+    return c;
+  }
+
+  static float epsilon(const glm::vec3& p) {
+    return 1e-4f * (1.0f + std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}));
+  }
+
+  // Direct light + ambient occlusion at a diffuse point with normal n facing the viewer.
+  glm::vec3 diffuse(const glm::vec3& p, const glm::vec3& n, const glm::vec3& albedo, Rng* rng,
+                    uint64_t* rays) const {
+    const float eps = epsilon(p);
+    const glm::vec3 o = p + n * eps;
+    glm::vec3 irradiance(0);
+    for (const LightAt& l : lights) {
+      glm::vec3 to = l.position - p;
+      float dist2 = glm::dot(to, to);
+      if (!(dist2 > 0)) continue;
+      float dist = std::sqrt(dist2);
+      glm::vec3 dir = to / dist;
+      float c = glm::dot(n, dir);
+      if (c > 0 && !occluded(o, dir, dist * (1 - 1e-4f), rays)) {
+        irradiance += l.intensity * (c / dist2);
+      }
+    }
+    if (glm::any(glm::greaterThan(sky.sun_irradiance, glm::vec3(0)))) {
+      float c = glm::dot(n, sun_dir);
+      if (c > 0 && !occluded(o, sun_dir, INFINITY, rays)) irradiance += sky.sun_irradiance * c;
+    }
+    glm::vec3 color = albedo * (irradiance / kPi);
+    float visible = 1;
+    if (options.ao_samples > 0) {
+      glm::vec3 t, b;
+      basis(n, &t, &b);
+      uint32_t open = 0;
+      for (uint32_t s = 0; s < options.ao_samples; ++s) {
+        // Cosine-distributed direction, stratified in the first dimension.
+        float u1 = (static_cast<float>(s) + rng->uniform()) / static_cast<float>(options.ao_samples);
+        float u2 = rng->uniform();
+        float r = std::sqrt(u1), phi = 2 * kPi * u2;
+        glm::vec3 d = t * (r * std::cos(phi)) + b * (r * std::sin(phi)) +
+                      n * std::sqrt(std::max(0.0f, 1 - u1));
+        if (!occluded(o, d, ao_distance, rays)) ++open;
+      }
+      visible = static_cast<float>(open) / static_cast<float>(options.ao_samples);
+    }
+    return color + albedo * ambient * visible;
+  }
+
+  // Radiance along a ray; `primary` receives the first hit (t = +inf on a miss).
+  glm::vec3 trace(const glm::vec3& o, const glm::vec3& d, uint32_t bounce, Rng* rng,
+                  uint64_t* rays, Hit* primary, bool* hit_any) const {
+    Hit h;
+    if (!intersect(o, d, 0, INFINITY, &h, rays)) {
+      if (hit_any) *hit_any = false;
+      return sky_radiance(d);
+    }
+    if (hit_any) *hit_any = true;
+    if (primary) *primary = h;
+    const glm::vec3 p = o + d * h.t;
+    const glm::vec3 n_out = normal(h, p);
+    const bool front = glm::dot(n_out, d) < 0;
+    const glm::vec3 n = front ? n_out : -n_out;  // facing the ray
+    const Material& m = materials[geometries[h.geom].material];
+    glm::vec3 color = m.emission;
+    const float w_diffuse = std::max(0.0f, 1 - m.reflect - m.refract);
+    if (w_diffuse > 0) color += w_diffuse * diffuse(p, n, m.albedo, rng, rays);
+    if (m.reflect > 0 || m.refract > 0) {
+      const float eps = epsilon(p);
+      if (bounce >= options.max_bounces) {
+        color += (m.reflect + m.refract) * ambient;
+      } else {
+        glm::vec3 reflected = d - 2 * glm::dot(d, n) * n;
+        if (m.reflect > 0) {
+          color += m.reflect * trace(p + n * eps, reflected, bounce + 1, rng, rays, nullptr, nullptr);
+        }
+        if (m.refract > 0) {
+          float eta = front ? 1 / m.ior : m.ior;
+          float cosi = -glm::dot(d, n);
+          float k = 1 - eta * eta * (1 - cosi * cosi);
+          glm::vec3 c =
+              k < 0 ? trace(p + n * eps, reflected, bounce + 1, rng, rays, nullptr, nullptr)
+                    : trace(p - n * eps, glm::normalize(eta * d + (eta * cosi - std::sqrt(k)) * n),
+                            bounce + 1, rng, rays, nullptr, nullptr);
+          color += m.refract * c;
+        }
+      }
+    }
+    return color;
+  }
+
+  // One pixel: colour, depth and material of the primary hit.
+  void shade_pixel(const glm::vec3& o, const glm::vec3& d, uint64_t key, uint64_t noise_key,
+                   float* rgb, float* depth, float* material, uint64_t* rays) const {
+    Rng rng(key);
+    Hit h;
+    bool hit = false;
+    glm::vec3 c = trace(o, d, 0, &rng, rays, &h, &hit);
+    if (options.noise > 0) {
+      Rng n(noise_key);
+      c *= 1 + options.noise * (2 * n.uniform() - 1);
+    }
+    for (int i = 0; i < 3; ++i) rgb[i] = std::clamp(std::isfinite(c[i]) ? c[i] : 0.0f, 0.0f, kMaxRadiance);
+    *depth = hit ? h.t : INFINITY;
+    if (material) {
+      const Material* m = hit ? &materials[geometries[h.geom].material] : nullptr;
+      bool special = m && (m->reflect > 0 || m->refract > 0);
+      material[0] = special ? m->reflect : 0;
+      material[1] = special ? m->refract : 0;
+      material[2] = special ? m->ior : 1;
+    }
+  }
+
+  template <typename RowFn>
+  uint64_t parallel_rows(uint32_t rows, const RowFn& fn) const {
+    std::vector<uint64_t> counts(rows, 0);
+    tbb::task_arena arena(options.threads == 0 ? tbb::task_arena::automatic
+                                               : static_cast<int>(options.threads));
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<uint32_t>(0, rows),
+                        [&](const tbb::blocked_range<uint32_t>& r) {
+                          for (uint32_t row = r.begin(); row != r.end(); ++row) {
+                            fn(row, &counts[row]);
+                          }
+                        });
+    });
+    uint64_t total = 0;
+    for (uint64_t c : counts) total += c;
+    return total;
+  }
+};
+
+Status validate_render_options(const RenderOptions& o) {
+  auto bad = [](const std::string& what) { return Status(ErrorId::kCaptureOption, what); };
+  if (o.threads > 256) return bad("threads " + std::to_string(o.threads) + " is outside 0..256");
+  if (o.ao_samples > 256) {
+    return bad("ao-samples " + std::to_string(o.ao_samples) + " is outside 0..256");
+  }
+  if (o.max_bounces > 32) {
+    return bad("max-bounces " + std::to_string(o.max_bounces) + " is outside 0..32");
+  }
+  if (!(o.noise >= 0 && o.noise <= 1)) return bad("noise must be in [0, 1]");
+  return Status::Ok();
+}
+
+FrameTracer::FrameTracer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+FrameTracer::~FrameTracer() = default;
+
+Expected<std::unique_ptr<FrameTracer>> FrameTracer::create(const Scene& scene, double time,
+                                                           const RenderOptions& options) {
+  CALF_RETURN_IF_ERROR(validate_render_options(options));
+  CALF_RETURN_IF_ERROR(validate_scene(scene));
+  auto impl = std::make_unique<Impl>();
+  impl->options = options;
+  impl->materials = scene.materials;
+  impl->sky = scene.sky;
+  float sl = glm::length(scene.sky.sun_direction);
+  impl->sun_dir = sl > 0 ? scene.sky.sun_direction / sl : glm::vec3(0, 1, 0);
+  impl->ambient = scene.ambient;
+  impl->ao_distance = scene.ao_distance;
+  for (const PointLight& l : scene.lights) {
+    impl->lights.push_back({l.position(time), l.intensity(time)});
+  }
+  const std::string config = options.threads ? "threads=" + std::to_string(options.threads) : "";
+  impl->device = rtcNewDevice(config.c_str());
+  if (!impl->device) return Status(ErrorId::kRayTracer, "Embree: cannot create a device");
+  impl->rtc = rtcNewScene(impl->device);
+  // Robust mode: no cracks between triangles sharing an edge (stray sky pixels would be depth +inf
+  // holes in the middle of a wall).
+  rtcSetSceneFlags(impl->rtc, RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(impl->rtc, RTC_BUILD_QUALITY_HIGH);
+
+  for (const Object& o : scene.objects) {
+    const glm::mat4 m = o.transform ? o.transform(time) : glm::mat4(1);
+    const float scale = std::cbrt(std::fabs(glm::determinant(glm::mat3(m))));
+    for (int pass = 0; pass < 2; ++pass) {
+      Geometry g;
+      g.material = o.material;
+      g.spheres = pass == 1;
+      if (!g.spheres) {
+        if (o.mesh.triangles.empty()) continue;
+        g.triangles = o.mesh.triangles;
+        g.positions.reserve(o.mesh.positions.size());
+        for (const glm::vec3& p : o.mesh.positions) g.positions.emplace_back(m * glm::vec4(p, 1));
+      } else {
+        if (o.spheres.empty()) continue;
+        for (const Sphere& s : o.spheres) {
+          g.balls.emplace_back(glm::vec3(m * glm::vec4(s.center, 1)), s.radius * scale);
+        }
+      }
+      for (const glm::vec3& p : g.positions) {
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+          return Status(ErrorId::kSceneGeometry, "object '" + o.name + "' is not finite at time " +
+                                                     std::to_string(time));
+        }
+      }
+      for (const glm::vec4& b : g.balls) {
+        if (!std::isfinite(b.x) || !std::isfinite(b.y) || !std::isfinite(b.z) || !(b.w > 0) ||
+            !std::isfinite(b.w)) {
+          return Status(ErrorId::kSceneGeometry, "object '" + o.name +
+                                                     "' has a degenerate sphere at time " +
+                                                     std::to_string(time));
+        }
+      }
+      RTCGeometry geom;
+      if (!g.spheres) {
+        geom = rtcNewGeometry(impl->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+            geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+            g.positions.size()));
+        auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+            geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t),
+            g.triangles.size()));
+        if (!v || !idx) {
+          rtcReleaseGeometry(geom);
+          return Status(ErrorId::kRayTracer, "Embree: cannot allocate buffers");
+        }
+        for (size_t i = 0; i < g.positions.size(); ++i) {
+          v[3 * i] = g.positions[i].x, v[3 * i + 1] = g.positions[i].y, v[3 * i + 2] = g.positions[i].z;
+        }
+        for (size_t i = 0; i < g.triangles.size(); ++i) {
+          idx[3 * i] = g.triangles[i].x, idx[3 * i + 1] = g.triangles[i].y,
+                  idx[3 * i + 2] = g.triangles[i].z;
+        }
+      } else {
+        geom = rtcNewGeometry(impl->device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+            geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), g.balls.size()));
+        if (!v) {
+          rtcReleaseGeometry(geom);
+          return Status(ErrorId::kRayTracer, "Embree: cannot allocate buffers");
+        }
+        for (size_t i = 0; i < g.balls.size(); ++i) {
+          for (int c = 0; c < 4; ++c) v[4 * i + c] = g.balls[i][c];
+        }
+      }
+      rtcCommitGeometry(geom);
+      rtcAttachGeometryByID(impl->rtc, geom, static_cast<unsigned>(impl->geometries.size()));
+      rtcReleaseGeometry(geom);
+      impl->geometries.push_back(std::move(g));
+    }
+  }
+  tbb::task_arena arena(options.threads == 0 ? tbb::task_arena::automatic
+                                             : static_cast<int>(options.threads));
+  arena.execute([&] { rtcCommitScene(impl->rtc); });
+  if (RTCError e = rtcGetDeviceError(impl->device); e != RTC_ERROR_NONE) {
+    return Status(ErrorId::kRayTracer, "Embree: scene build failed with error " + std::to_string(e));
+  }
+  return std::unique_ptr<FrameTracer>(new FrameTracer(std::move(impl)));
+}
+
+RenderStats FrameTracer::render_cube(const capture::Point3& center, uint32_t view, uint32_t frame,
+                                     uint32_t face_size, bool with_material,
+                                     capture::ViewFrame* out) const {
+  out->resize(face_size, with_material);
+  const Impl& im = *impl_;
+  const glm::vec3 o(static_cast<float>(center.x), static_cast<float>(center.y),
+                    static_cast<float>(center.z));
+  const uint32_t n = face_size;
+  RenderStats stats;
+  stats.rays = im.parallel_rows(6 * n, [&](uint32_t row, uint64_t* rays) {
+    const uint32_t face = row / n, y = row % n;
+    for (uint32_t x = 0; x < n; ++x) {
+      const Direction dd = direction_from_texel(cube_face_from_index(static_cast<int>(face)), x, y, n);
+      const glm::vec3 d(static_cast<float>(dd.x), static_cast<float>(dd.y), static_cast<float>(dd.z));
+      const size_t i = (static_cast<size_t>(face) * n + y) * n + x;
+      // AO keys leave the frame out: static surfaces get the same samples every frame.
+      im.shade_pixel(o, d, pixel_key(im.options.seed, view, face, x, y),
+                     pixel_key(im.options.seed ^ 0xA5A5A5A5ull, view, face * n + y, x, frame),
+                     &out->color[3 * i], &out->depth[i],
+                     with_material ? &out->material[3 * i] : nullptr, rays);
+    }
+  });
+  return stats;
+}
+
+RenderStats FrameTracer::render_perspective(const capture::EyePose& pose, uint32_t width,
+                                            uint32_t height, uint32_t pose_index,
+                                            capture::PerspectiveImage* out) const {
+  out->width = width;
+  out->height = height;
+  out->color.assign(static_cast<size_t>(width) * height * 3, 0.0f);
+  out->depth.assign(static_cast<size_t>(width) * height, 0.0f);
+  const Impl& im = *impl_;
+  const glm::dvec3 f(pose.forward.x, pose.forward.y, pose.forward.z);
+  const glm::dvec3 up(pose.up.x, pose.up.y, pose.up.z);
+  const glm::dvec3 right = glm::normalize(glm::cross(f, up));
+  const double tan_half = std::tan(pose.fov_y_degrees * M_PI / 360.0);
+  const double aspect = static_cast<double>(width) / height;
+  const glm::vec3 o(static_cast<float>(pose.position.x), static_cast<float>(pose.position.y),
+                    static_cast<float>(pose.position.z));
+  RenderStats stats;
+  stats.rays = im.parallel_rows(height, [&](uint32_t j, uint64_t* rays) {
+    for (uint32_t i = 0; i < width; ++i) {
+      double a = 2 * (i + 0.5) / width - 1, b = 1 - 2 * (j + 0.5) / height;
+      glm::dvec3 dd = glm::normalize(f + a * tan_half * aspect * right + b * tan_half * up);
+      const size_t k = static_cast<size_t>(j) * width + i;
+      // Ground truth uses view id 2^32 - 1 - eye, never a capture view's.
+      uint64_t view_id = 0xFFFFFFFFull - static_cast<uint64_t>(pose.eye);
+      im.shade_pixel(o, glm::vec3(dd), pixel_key(im.options.seed, view_id, 0, i, j),
+                     pixel_key(im.options.seed ^ 0xA5A5A5A5ull, view_id, j, i, pose_index),
+                     &out->color[3 * k], &out->depth[k], nullptr, rays);
+    }
+  });
+  return stats;
+}
+
+bool FrameTracer::inside_geometry(const capture::Point3& point) const {
+  // Winding number along each of 26 probe rays: every back-face crossing (leaving a solid) counts
+  // +1, every front-face crossing (entering one) -1. For a union of closed, interpenetrating
+  // solids the sum is the number of solids containing the point, whatever is embedded in what;
+  // a majority vote over the rays tolerates a few open surfaces.
+  const glm::vec3 o(static_cast<float>(point.x), static_cast<float>(point.y),
+                    static_cast<float>(point.z));
+  int inside_votes = 0;
+  uint64_t rays = 0;
+  for (int dz = -1; dz <= 1; ++dz) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (!dx && !dy && !dz) continue;
+        const glm::vec3 d = glm::normalize(glm::vec3(dx, dy, dz));
+        int winding = 0;
+        float tnear = 0;
+        Hit h;
+        for (int crossing = 0; crossing < 256; ++crossing) {
+          if (!impl_->intersect(o, d, tnear, INFINITY, &h, &rays)) break;
+          if (crossing == 0 && h.t < 1e-4f) return true;  // touching a surface
+          winding += glm::dot(impl_->normal(h, o + d * h.t), d) > 0 ? 1 : -1;
+          tnear = h.t + 1e-5f * (1 + h.t);
+        }
+        if (winding > 0) ++inside_votes;
+      }
+    }
+  }
+  return inside_votes > 13;
+}
+
+}  // namespace calf::samples

@@ -1,0 +1,189 @@
+// calf-capture: renders capture sets (cube-map colour + depth [+ material] per viewpoint and
+// frame) and ground truth of the built-in sample scenes or of any file assimp imports.
+// Errors are one line with a stable id and exit status 1; usage errors exit 2.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <thread>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "calf/samples/render.h"
+#include "calf/samples/scene.h"
+
+namespace {
+
+using calf::Status;
+namespace samples = calf::samples;
+
+int fail(const Status& status) {
+  std::string line = status.to_string();
+  // One line: the rig help (multi-line) is summarised.
+  size_t newline = line.find('\n');
+  if (newline != std::string::npos) line = line.substr(0, newline) + " (see --help)";
+  std::fprintf(stderr, "calf-capture: %s\n", line.c_str());
+  return 1;
+}
+
+// Progress on stderr: one updating line on a terminal, a line per ~10 % otherwise.
+class Progress {
+ public:
+  Progress(const char* what, bool quiet) : what_(what), quiet_(quiet), tty_(isatty(2) != 0) {}
+  void operator()(uint64_t done, uint64_t total) {
+    if (quiet_) return;
+    double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    double eta = done ? elapsed / static_cast<double>(done) * static_cast<double>(total - done) : 0;
+    int percent = static_cast<int>(100 * done / total);
+    if (!tty_ && percent < next_percent_ && done != total) return;
+    next_percent_ = percent + 10;
+    std::fprintf(stderr, "%scalf-capture: %s %llu/%llu (%d%%) elapsed %.1f s, ETA %.1f s%s",
+                 tty_ ? "\r" : "", what_, static_cast<unsigned long long>(done),
+                 static_cast<unsigned long long>(total), percent, elapsed, eta,
+                 tty_ && done != total ? "" : "\n");
+    std::fflush(stderr);
+  }
+
+ private:
+  const char* what_;
+  bool quiet_, tty_;
+  int next_percent_ = 0;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "calf-capture: ray-trace capture sets (format/CAPTURE.md) and ground truth of sample scenes.\n"
+      "Writes DIR/manifest.json last, so an interrupted run never leaves a set that looks "
+      "complete.",
+      "calf-capture"};
+  std::string scene_arg, out_dir, rig_arg = "default", eye_path_file;
+  uint32_t face_size = 256, frames = 0, threads = 0, ao_samples = 8, max_bounces = 6;
+  uint64_t seed = 1;
+  float noise = 0;
+  std::string gt_size = "256x256";
+  bool list = false, ground_truth = false, quiet = false;
+  app.add_option("--scene", scene_arg,
+                 "built-in scene name (see --list-scenes) or a glTF/GLB/OBJ/PLY/FBX file");
+  app.add_option("--out", out_dir, "output directory (created if missing)");
+  app.add_option("--face-size", face_size, "cube face size in texels, 1..4096")
+      ->capture_default_str();
+  app.add_option("--frames", frames,
+                 "frames to render, 1..100000 (default: the scene's own, 30 for built-ins)");
+  app.add_option("--rig", rig_arg, std::string("viewpoints, one of:\n") + samples::kRigSyntaxHelp)
+      ->capture_default_str();
+  app.add_option("--threads", threads,
+                 "render threads, 0 = all hardware threads; output is identical for any count")
+      ->capture_default_str();
+  app.add_option("--seed", seed, "seed of AO directions and noise")->capture_default_str();
+  app.add_option("--ao-samples", ao_samples, "ambient-occlusion rays per diffuse hit, 0..256")
+      ->capture_default_str();
+  app.add_option("--max-bounces", max_bounces, "mirror/glass recursion depth, 0..32")
+      ->capture_default_str();
+  app.add_option("--noise", noise,
+                 "per-frame colour noise amplitude in [0, 1] mimicking a path tracer (0 = off)")
+      ->capture_default_str();
+  app.add_flag("--ground-truth", ground_truth,
+               "render perspective colour + depth along the scene's validation eye path instead "
+               "of a capture set; writes DIR/gt_NNNNN.exr and DIR/eye_path.json (last)");
+  app.add_option("--eye-path", eye_path_file,
+                 "render ground truth along this eye-path JSON (CAPTURE.md) instead");
+  app.add_option("--gt-size", gt_size, "image size WxH of --ground-truth images")
+      ->capture_default_str();
+  app.add_flag("--list-scenes", list, "print the built-in scenes and exit");
+  app.add_flag("--quiet", quiet, "no progress or summary lines on stderr");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    std::fputs(app.help().c_str(), stdout);
+    return 0;
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "calf-capture: %s (see --help)\n", e.what());
+    return 2;
+  }
+
+  if (list) {
+    for (const samples::SceneInfo& s : samples::builtin_scenes()) {
+      auto scene = samples::make_builtin_scene(s.name);
+      std::printf("%-11s %s; default rig %s, %u frames at %g fps\n", s.name, s.description,
+                  scene->default_rig.description.c_str(), scene->frame_count, scene->fps);
+    }
+    return 0;
+  }
+  if (scene_arg.empty() || out_dir.empty()) {
+    std::fprintf(stderr, "calf-capture: --scene and --out are required (see --help)\n");
+    return 2;
+  }
+
+  samples::RenderOptions render;
+  render.threads = threads;
+  render.seed = seed;
+  render.ao_samples = ao_samples;
+  render.max_bounces = max_bounces;
+  render.noise = noise;
+  if (Status s = samples::validate_render_options(render); !s.ok()) return fail(s);
+  if (face_size < 1 || face_size > 4096) {
+    return fail(Status(calf::ErrorId::kCaptureOption,
+                       fmt::format("--face-size {} is outside 1..4096", face_size)));
+  }
+  if (frames > 100000) {
+    return fail(Status(calf::ErrorId::kCaptureOption,
+                       fmt::format("--frames {} is outside 1..100000", frames)));
+  }
+  auto scene = samples::load_scene(scene_arg);
+  if (!scene.ok()) return fail(scene.status());
+  const uint32_t frame_count = frames ? frames : scene->frame_count;
+
+  samples::RenderStats stats;
+  if (ground_truth || !eye_path_file.empty()) {
+    calf::capture::EyePath path;
+    if (!eye_path_file.empty()) {
+      auto read = calf::capture::read_eye_path(eye_path_file);
+      if (!read.ok()) return fail(read.status());
+      path = std::move(*read);
+    } else {
+      unsigned w = 0, h = 0;
+      char x = 0, extra = 0;
+      if (std::sscanf(gt_size.c_str(), "%u%c%u%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 1 ||
+          h < 1 || w > 16384 || h > 16384) {
+        return fail(Status(calf::ErrorId::kCaptureOption,
+                           "--gt-size '" + gt_size + "' is not WxH with sizes in 1..16384"));
+      }
+      path = scene->validation_path(frame_count, scene->fps, w, h);
+    }
+    Progress progress("ground truth pose", quiet);
+    auto result = samples::render_ground_truth(*scene, path, render, out_dir,
+                                               [&](uint64_t d, uint64_t t) { progress(d, t); });
+    if (!result.ok()) return fail(result.status());
+    stats = *result;
+  } else {
+    samples::CaptureRequest request;
+    request.face_size = face_size;
+    request.frames = frame_count;
+    request.render = render;
+    request.generator = "calf-capture";
+    if (rig_arg == "default") {
+      request.rig = scene->default_rig;
+    } else {
+      auto rig = samples::parse_rig(rig_arg);
+      if (!rig.ok()) return fail(rig.status());
+      request.rig = std::move(*rig);
+    }
+    Progress progress("view-frame", quiet);
+    auto result = samples::render_capture_set(*scene, request, out_dir,
+                                              [&](uint64_t d, uint64_t t) { progress(d, t); });
+    if (!result.ok()) return fail(result.status());
+    stats = *result;
+  }
+  if (!quiet) {
+    std::fprintf(stderr, "calf-capture: %s: %.1f Mrays in %.2f s, %.2f Mrays/s, %u threads\n",
+                 out_dir.c_str(), static_cast<double>(stats.rays) * 1e-6, stats.seconds,
+                 stats.mrays_per_second(),
+                 threads ? threads : std::max(1u, std::thread::hardware_concurrency()));
+  }
+  return 0;
+}

@@ -1,0 +1,135 @@
+// Eye paths (calf/capture/eye_path.h, format/CAPTURE.md "Eye paths"): the three orientation
+// forms, exact round trip, ground-truth image I/O, and one test per parse error.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <string>
+
+#include "calf/capture/eye_path.h"
+
+namespace calf::capture {
+namespace {
+
+std::string path_json(const std::string& pose, const std::string& top = "") {
+  return R"({"format": "calf-eye-path", "version": 1, "width": 64, "height": 48, )" + top +
+         R"("poses": [)" + pose + "]}";
+}
+
+void expect_near(const Point3& a, const Point3& b) {
+  EXPECT_NEAR(a.x, b.x, 1e-12);
+  EXPECT_NEAR(a.y, b.y, 1e-12);
+  EXPECT_NEAR(a.z, b.z, 1e-12);
+}
+
+void expect_error(const std::string& json, ErrorId id, const std::string& needle) {
+  auto p = parse_eye_path(json, "gt/eye_path.json");
+  ASSERT_FALSE(p.ok()) << json;
+  EXPECT_EQ(p.status().id(), id) << p.status().to_string();
+  EXPECT_NE(p.status().message().find(needle), std::string::npos) << p.status().to_string();
+}
+
+TEST(EyePath, OrientationForms) {
+  auto p = parse_eye_path(
+      path_json(R"({"time": 0, "position": [0, 1, 0], "forward": [2, 0, 0]},
+                   {"time": 0.5, "position": [0, 1, 0], "look_at": [0, 1, -5], "up": [0, 3, 1],
+                    "fov_y_degrees": 90, "eye": "left"},
+                   {"time": 1, "position": [1, 2, 3], "orientation": [0.7071067811865476, 0, 0.7071067811865476, 0],
+                    "eye": "right"})",
+                R"("fov_y_degrees": 45, "image_pattern": "gt_{pose:04}.exr", )"),
+      "p");
+  ASSERT_TRUE(p.ok()) << p.status().to_string();
+  ASSERT_EQ(p->poses.size(), 3u);
+  EXPECT_EQ(p->width, 64u);
+  EXPECT_EQ(p->height, 48u);
+  expect_near(p->poses[0].forward, {1, 0, 0});
+  expect_near(p->poses[0].up, {0, 1, 0});
+  EXPECT_EQ(p->poses[0].fov_y_degrees, 45);  // the path's default
+  EXPECT_EQ(p->poses[0].eye, Eye::kMono);
+  expect_near(p->poses[1].forward, {0, 0, -1});
+  expect_near(p->poses[1].up, {0, 1, 0});  // re-orthogonalised against forward
+  EXPECT_EQ(p->poses[1].fov_y_degrees, 90);
+  EXPECT_EQ(p->poses[1].eye, Eye::kLeft);
+  // A quarter turn about +Y takes the camera's -Z to -X.
+  expect_near(p->poses[2].forward, {-1, 0, 0});
+  expect_near(p->poses[2].up, {0, 1, 0});
+  EXPECT_EQ(p->poses[2].eye, Eye::kRight);
+  EXPECT_EQ(eye_image_file_name(*p, 7), "gt_0007.exr");
+}
+
+TEST(EyePath, RoundTripIsExact) {
+  auto p = parse_eye_path(
+      path_json(R"({"time": 0.1, "position": [0.1, 1.7, -0.3], "look_at": [1, 0.2, -3]},
+                   {"time": 0.2, "position": [0.2, 1.6, -0.2], "orientation": [0.9, 0.1, 0.3, 0.2989983]})"),
+      "p");
+  ASSERT_TRUE(p.ok()) << p.status().to_string();
+  std::string text = serialize_eye_path(*p);
+  auto back = parse_eye_path(text, "q");
+  ASSERT_TRUE(back.ok()) << back.status().to_string();
+  EXPECT_EQ(*back, *p);
+  EXPECT_EQ(serialize_eye_path(*back), text);
+}
+
+TEST(EyePath, Errors) {
+  const std::string pos = R"("time": 0, "position": [0, 0, 0])";
+  expect_error("{", ErrorId::kManifestSyntax, "byte");
+  expect_error(R"({"format": "calf-eye-path", "version": 3, "poses": []})",
+               ErrorId::kManifestVersion, "version 3");
+  std::string zero_width = path_json("{" + pos + R"(, "forward": [0, 0, -1]})");
+  zero_width.replace(zero_width.find("\"width\": 64"), 11, "\"width\": 0");
+  expect_error(zero_width, ErrorId::kEyePathField, "'width'");
+  expect_error(path_json(""), ErrorId::kEyePathField, "'poses'");
+  expect_error(path_json(R"({"position": [0, 0, 0], "forward": [0, 0, -1]})"),
+               ErrorId::kEyePathField, "'poses[0].time': missing");
+  expect_error(path_json("{" + pos + "}"), ErrorId::kEyePathField, "exactly one of");
+  expect_error(path_json("{" + pos + R"(, "forward": [0, 0, -1], "look_at": [0, 0, 1]})"),
+               ErrorId::kEyePathField, "exactly one of");
+  expect_error(path_json("{" + pos + R"(, "forward": [0, 0, 0]})"), ErrorId::kEyePathField,
+               "parallel");
+  expect_error(path_json("{" + pos + R"(, "forward": [0, 2, 0]})"), ErrorId::kEyePathField,
+               "parallel");
+  expect_error(path_json("{" + pos + R"(, "look_at": [0, 0, 0]})"), ErrorId::kEyePathField,
+               "parallel");
+  expect_error(path_json("{" + pos + R"(, "orientation": [1, 1, 0, 0]})"),
+               ErrorId::kEyePathField, "not 1");
+  expect_error(path_json("{" + pos + R"(, "orientation": [1, 0, 0]})"), ErrorId::kEyePathField,
+               "'poses[0].orientation'");
+  expect_error(path_json("{" + pos + R"(, "orientation": [1, 0, 0, 0], "up": [0, 1, 0]})"),
+               ErrorId::kEyePathField, "'poses[0].up'");
+  expect_error(path_json("{" + pos + R"(, "forward": [0, 0, -1], "fov_y_degrees": 180})"),
+               ErrorId::kEyePathField, "fov_y_degrees");
+  expect_error(path_json("{" + pos + R"(, "forward": [0, 0, -1], "eye": "centre"})"),
+               ErrorId::kEyePathField, "'poses[0].eye'");
+  expect_error(path_json("{" + pos + R"(, "forward": [0, 0, -1], "roll": 3})"),
+               ErrorId::kEyePathField, "'poses[0].roll': unknown key");
+  expect_error(path_json("{" + pos + R"(, "forward": [0, 0, -1]})", R"("image_pattern": "gt.exr", )"),
+               ErrorId::kEyePathField, "image_pattern");
+  expect_error(path_json("{" + pos + R"(, "forward": [0, "a", -1]})"), ErrorId::kEyePathField,
+               "'poses[0].forward[1]'");
+}
+
+TEST(EyePath, GroundTruthImageRoundTrip) {
+  PerspectiveImage img;
+  img.width = 5;
+  img.height = 3;
+  img.color.resize(45);
+  img.depth.resize(15);
+  for (size_t i = 0; i < 15; ++i) {
+    for (int c = 0; c < 3; ++c) img.color[3 * i + c] = static_cast<float>(i + c) * 0.5f;
+    img.depth[i] = i == 4 ? std::numeric_limits<float>::infinity() : 1.0f + static_cast<float>(i) / 7;
+  }
+  auto file = std::filesystem::temp_directory_path() / "calf_eye_path_test_gt.exr";
+  ASSERT_TRUE(write_perspective_image(file, img).ok());
+  auto back = read_perspective_image(file);
+  ASSERT_TRUE(back.ok()) << back.status().to_string();
+  EXPECT_EQ(back->width, 5u);
+  EXPECT_EQ(back->height, 3u);
+  EXPECT_EQ(back->color, img.color);
+  EXPECT_EQ(back->depth, img.depth);
+  std::filesystem::remove(file);
+  EXPECT_EQ(read_perspective_image(file).status().id(), ErrorId::kCaptureFileMissing);
+}
+
+}  // namespace
+}  // namespace calf::capture
