@@ -1,0 +1,180 @@
+// The scalar CPU reference renderer of paper 002 Alg. 4: ray-march each eye ray through the
+// viewpoints' depth cube maps, then blend their colours. The GL renderer is tested against it.
+// docs/RENDERING.md describes the algorithm as implemented and every choice made where the paper
+// is vague; the summary:
+//
+// Intersection (Alg. 4 RayIntersection). Samples are taken at N_step + 1 constant steps of the
+// normalised log depth x = ln(z / near) / ln(far / near) (the paper's nonlin(), eq. 13) between
+// the march's near and far, z the radial distance from the ray origin. A sample p is in empty
+// space when at least one active view j sees it as such (footnote 2, BetweenViewpointAndGeometry):
+// the depth stored in view j's cube map in direction p - P_j (nearest texel) is farther than
+// |p - P_j|; sky texels are always farther. Views with |p - P_j| <= min_view_distance are ignored
+// for that sample (Alg. 4 line 21). The first sample that is not empty is a hit, provided at least
+// one view was consulted (the literal algorithm would call a sample that every view ignored a hit;
+// calf treats it as empty). The hit is refined by `refine_steps` bisections between the last
+// empty sample and the hit sample, in the same log-depth space, and placed at the middle of the
+// final interval. No hit up to far: the ray sees the sky.
+//
+// Colour (Alg. 4 SampleColor / CalculateColor). At the hit p each active view j contributes its
+// colour c_j in direction p - P_j with weight w_j = w_depth * w_cam:
+//   w_depth = exp(-depth_decay * |ln(d_j / |p - P_j|)|)   d_j the view's stored depth there
+//   w_cam   = exp(-cam_decay * |o - P_j| / |p - o|)         o the ray origin
+// so a view that sees p itself (d_j = |p - P_j|) dominates one whose surface there is elsewhere,
+// and among those the viewpoint nearest the eye (in units of the hit distance, about the parallax
+// angle in radians) wins. |ln(d_j / r)| is the paper's |nonlin(d_tex) - nonlin(r)| times each
+// view's ln(z_far / z_near), so views with different depth ranges are weighed on one scale.
+// Colour texels are sampled bilinearly (optionally depth-aware: each of the four taps is weighted
+// by its own depth agreement, so silhouettes do not bleed foreground into background); taps that
+// fall off a face are fetched from the neighbouring face through the cube conventions.
+// Sky: the colour of the views whose depth is sky in the ray direction (sky is at infinity, so
+// every viewpoint sees it in the same direction), bilinear over sky taps.
+//
+// RR variant (Alg. 4 *_RR, Sec. 6.1), when `rr` is set and views carry material: at a hit the
+// material (reflect, refract, IOR) is blended like colour, the normal comes from the depths
+// around the best view's texel, and one reflection and one refraction ray are marched from p
+// (starting `rr_start` = z_e from it) and shaded recursively up to `rr_max_depth` bounces:
+// c = w_rfl c_rfl + w_rfr c_rfr + (1 - w_rfl - w_rfr) c_diffuse; a secondary ray that hits
+// nothing gives its weight back to the diffuse colour (Alg. 4 lines 55 and 62).
+//
+// Deterministic: every pixel is computed independently in double precision; the image is the same
+// bit for bit whatever the thread count.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "calf/decoder/culling.h"
+#include "calf/format/status.h"
+#include "calf/player/view_set.h"
+
+namespace calf::player {
+
+// A perspective eye with the camera model of format/CAPTURE.md ("Eye paths"): the ray through
+// pixel (i, j) of a W x H image (row 0 at the top) is
+//   d = normalize(forward + a * h * (W / H) * right + b * h * up),
+//   a = 2 (i + 0.5) / W - 1,  b = 1 - 2 (j + 0.5) / H,  h = tan(fov_y / 2),
+//   right = normalize(cross(forward, up)),
+// so a reconstruction and calf-capture's ground truth for the same pose align pixel for pixel.
+struct Camera {
+  Vec3 position;
+  Vec3 forward{0, 0, -1};             // need not be unit length; not parallel to up
+  Vec3 up{0, 1, 0};                   // re-orthogonalised against forward
+  double fov_y = 1.5707963267948966;  // vertical field of view in radians, (0, pi)
+  uint32_t width = 64, height = 64;   // pixels, 1..16384 each
+};
+
+// The unit ray direction through pixel (i, j) of `camera` (formula above). The camera must be
+// valid (see CpuRenderer::render).
+Vec3 camera_ray(const Camera& camera, uint32_t i, uint32_t j);
+
+// Every knob of the renderer. Defaults follow the paper where it gives one.
+struct RenderOptions {
+  // N_step: constant steps in normalised log depth between near and far (1..65536). The paper
+  // leaves it open; 64 is what DESIGN.md's timings assume.
+  uint32_t steps = 64;
+  // The march range along each ray: radial distances from the ray origin, 0 < near < far,
+  // finite (Alg. 4 z_near / z_far). march_range_for() suggests one from the views.
+  double near = 0.01, far = 1000;
+  // How a view's depth map answers "is this point in front of your surface?" (footnote 2).
+  // Where the four texels around the direction hold one smooth surface (their depths within a
+  // factor 1 + smooth_depth_ratio of each other) the depth is interpolated bilinearly (in log
+  // space): no staircase of per-texel constant depths on slanted surfaces. 0 never interpolates.
+  double smooth_depth_ratio = 0;
+  // Across a depth discontinuity (or next to sky) interpolating would invent surfaces between
+  // foreground and background, so the point must instead be nearer than every texel whose centre
+  // lies within this many texels (per axis) of its direction; the nearest texel always counts.
+  // 0.5 is the paper's nearest texel: each view's silhouettes are then off by up to half a texel
+  // either way, and since a point is empty when any view says so, the eroding errors of all
+  // views add up and objects shrink. 1 takes all four bilinear taps (textureGather on the GPU):
+  // no view carves into an object, which instead grows by up to a texel. In [0, 1];
+  // docs/RENDERING.md has measurements.
+  double depth_footprint = 0.9;
+  // Bisection steps refining a hit between the last empty and the first hit sample (0..64).
+  // Each halves the depth uncertainty in log space: 8 turns a 20 % step into 0.08 %.
+  uint32_t refine_steps = 8;
+  // Views nearer than this to a sample do not vote on it (Alg. 4 line 21, which reuses z_near):
+  // the direction from a viewpoint to a point at its very centre is meaningless. >= 0.
+  // Negative: use `near`.
+  double min_view_distance = -1;
+  // w_depth decay per unit of |ln(d_j / r)| (a relative depth disagreement): 50 gives a view whose
+  // surface is 2 % off weight e^-1 relative to one that matches. > 0. Decays faster than w_cam,
+  // as the paper asks.
+  double depth_decay = 50;
+  // w_cam decay per unit of |o - P_j| / |p - o| (the eye-to-viewpoint distance in units of the hit
+  // distance). >= 0; 0 weighs all agreeing views equally.
+  double cam_decay = 20;
+  // Bilinear colour within and across faces (true), or the nearest texel (false).
+  bool bilinear_color = true;
+  // With bilinear colour: weigh each tap by its own depth agreement (true) or plain bilinear.
+  bool depth_aware_color = true;
+  // Indices into the ViewSet of the views to use, in any order; empty = all views.
+  std::vector<uint32_t> active_views;
+  // Worker threads over image rows (1..256). The result does not depend on it.
+  uint32_t threads = 1;
+  // RR variant (Sec. 6.1): reflection / refraction rays from the material faces. Views without
+  // material contribute (0, 0, 1); a view set without any makes it a no-op.
+  bool rr = false;
+  // z_e: secondary rays start marching this far from their surface point (> 0), so that they do
+  // not hit the surface they leave.
+  double rr_start = 0.05;
+  // Bounces of reflection / refraction followed (1..8).
+  uint32_t rr_max_depth = 1;
+};
+
+// A rendered frame: linear RGB float (3 per pixel, HDR kept) and the radial distance from the eye
+// to the surface each pixel shows (+inf for sky), row-major from the top row like ground truth.
+struct RenderedImage {
+  uint32_t width = 0, height = 0;
+  std::vector<float> color;
+  std::vector<float> depth;
+};
+
+// What one ray sees.
+struct RaySample {
+  double rgb[3] = {0, 0, 0};
+  double depth = 0;  // radial distance from the origin to the hit; +inf for sky
+  bool hit = false;
+};
+
+// A march range covering the views as seen from `eye`: far = max_j (|eye - P_j| + z_far_j)
+// (nothing any view stores lies beyond), near = min_j z_near_j / 4, at most far / 2^20.
+// Errors: CALF-E403 for an empty view set.
+Expected<RenderOptions> march_range_for(const ViewSet& views, const Vec3& eye,
+                                        RenderOptions options);
+
+class CpuRenderer {
+ public:
+  // Validates the options against the views (CALF-E403 naming the bad option). The renderer keeps
+  // a reference to `views`: they must outlive it and may be updated between frames.
+  static Expected<CpuRenderer> make(const ViewSet& views, const RenderOptions& options);
+
+  // Renders `camera` into `out` (resized). CALF-E403 for an invalid camera (non-finite position,
+  // zero or parallel forward / up, fov outside (0, pi), size outside 1..16384).
+  Status render(const Camera& camera, RenderedImage* out) const;
+
+  // One ray from `origin` along unit `direction`: Alg. 4 Main (or Main_RR with options.rr).
+  RaySample trace(const Vec3& origin, const Vec3& direction) const;
+
+  const RenderOptions& options() const { return options_; }
+
+ private:
+  CpuRenderer(const ViewSet& views, const RenderOptions& options);
+  struct Hit {
+    Vec3 p;        // the surface point
+    double z = 0;  // its distance from the ray origin
+  };
+  bool empty_at(const Vec3& p) const;
+  bool intersect(const Vec3& origin, const Vec3& dir, double start, Hit* hit) const;
+  void shade_surface(const Vec3& origin, const Vec3& p, double* rgb, int* best_view) const;
+  void shade_sky(const Vec3& origin, const Vec3& dir, double* rgb) const;
+  void shade_rr(const Vec3& origin, const Vec3& dir, const Hit& hit, uint32_t depth,
+                double* rgb) const;
+
+  const ViewSet* views_;
+  RenderOptions options_;
+  std::vector<const View*> active_;
+  double min_view_distance_ = 0;
+  double smooth_log_ratio_ = 0;
+};
+
+}  // namespace calf::player

@@ -1,0 +1,350 @@
+#include "calf/player/cpu_renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <thread>
+
+#include "calf/format/grid.h"
+#include "sampling.h"
+
+namespace calf::player {
+
+using internal::cross;
+using internal::dot;
+using internal::length;
+using internal::normalize;
+using internal::to_direction;
+using internal::operator+;
+using internal::operator-;
+using internal::operator*;
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+bool finite(const Vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+Status option_error(const std::string& what) {
+  return Status(ErrorId::kPlayerOptions, what);
+}
+
+// A camera's orthonormal frame, or false when forward / up are degenerate.
+bool camera_frame(const Camera& c, Vec3* f, Vec3* r, Vec3* u) {
+  if (!finite(c.forward) || !finite(c.up) || length(c.forward) == 0) return false;
+  *f = normalize(c.forward);
+  const Vec3 right = cross(*f, c.up);
+  const double len = length(right);
+  if (!(len > 1e-12 * std::max(1.0, length(c.up)))) return false;
+  *r = right * (1.0 / len);
+  *u = cross(*r, *f);
+  return true;
+}
+
+}  // namespace
+
+Vec3 camera_ray(const Camera& camera, uint32_t i, uint32_t j) {
+  Vec3 f, r, u;
+  camera_frame(camera, &f, &r, &u);
+  const double h = std::tan(camera.fov_y / 2);
+  const double a = 2.0 * (i + 0.5) / camera.width - 1.0;
+  const double b = 1.0 - 2.0 * (j + 0.5) / camera.height;
+  const double aspect = static_cast<double>(camera.width) / camera.height;
+  return normalize(f + r * (a * h * aspect) + u * (b * h));
+}
+
+Expected<RenderOptions> march_range_for(const ViewSet& views, const Vec3& eye,
+                                        RenderOptions options) {
+  if (views.views.empty()) return option_error("march range of an empty view set");
+  double far = 0, near = kInf;
+  for (const View& v : views.views) {
+    far = std::max(far, length(eye - v.position()) + v.range().z_far());
+    near = std::min(near, static_cast<double>(v.range().z_near()) / 4);
+  }
+  options.far = far;
+  options.near = std::min(near, far / (1 << 20));
+  return options;
+}
+
+CpuRenderer::CpuRenderer(const ViewSet& views, const RenderOptions& options)
+    : views_(&views), options_(options) {}
+
+Expected<CpuRenderer> CpuRenderer::make(const ViewSet& views, const RenderOptions& o) {
+  if (views.views.empty()) return option_error("the view set is empty");
+  if (o.steps < 1 || o.steps > 65536) {
+    return option_error("steps " + std::to_string(o.steps) + " is outside [1, 65536]");
+  }
+  if (!(o.near > 0) || !(o.far > o.near) || !std::isfinite(o.far)) {
+    return option_error("march range near " + std::to_string(o.near) + ", far " +
+                        std::to_string(o.far) + " is not 0 < near < far < inf");
+  }
+  if (!(o.depth_footprint >= 0 && o.depth_footprint <= 1)) {
+    return option_error("depth_footprint must be in [0, 1]");
+  }
+  if (!(o.smooth_depth_ratio >= 0) || !std::isfinite(o.smooth_depth_ratio)) {
+    return option_error("smooth_depth_ratio must be finite and >= 0");
+  }
+  if (o.refine_steps > 64) return option_error("refine_steps is above 64");
+  if (!(o.depth_decay > 0) || !std::isfinite(o.depth_decay)) {
+    return option_error("depth_decay must be finite and > 0");
+  }
+  if (!(o.cam_decay >= 0) || !std::isfinite(o.cam_decay)) {
+    return option_error("cam_decay must be finite and >= 0");
+  }
+  if (!std::isfinite(o.min_view_distance)) return option_error("min_view_distance is not finite");
+  if (o.threads < 1 || o.threads > 256) return option_error("threads is outside [1, 256]");
+  if (!(o.rr_start > 0) || !std::isfinite(o.rr_start)) {
+    return option_error("rr_start (z_e) must be finite and > 0");
+  }
+  if (o.rr_max_depth < 1 || o.rr_max_depth > 8) {
+    return option_error("rr_max_depth is outside [1, 8]");
+  }
+  CpuRenderer r(views, o);
+  if (o.active_views.empty()) {
+    for (const View& v : views.views) r.active_.push_back(&v);
+  } else {
+    for (uint32_t i : o.active_views) {
+      if (i >= views.views.size()) {
+        return option_error("active view " + std::to_string(i) + " is not below the view count " +
+                            std::to_string(views.views.size()));
+      }
+      r.active_.push_back(&views.views[i]);
+    }
+  }
+  r.smooth_log_ratio_ = std::log1p(std::max(o.smooth_depth_ratio, 0.0));
+  r.min_view_distance_ = o.min_view_distance < 0 ? o.near : o.min_view_distance;
+  return r;
+}
+
+// BetweenViewpointAndGeometry (footnote 2) over the active views: true as soon as one view that
+// is not too near sees p in front of its stored surface (or sees sky there).
+bool CpuRenderer::empty_at(const Vec3& p) const {
+  bool consulted = false;
+  for (const View* v : active_) {
+    const Vec3 x = p - v->position();
+    const double r = length(x);
+    if (r <= min_view_distance_) continue;
+    consulted = true;
+    const internal::BilinearTaps taps = internal::bilinear_taps(
+        texel_coord_from_direction(to_direction(x), v->face_size()), v->face_size());
+    uint16_t c[4], lo = kLog16Sky, hi = 0;
+    for (int k = 0; k < 4; ++k) {
+      c[k] = v->depth_code_at(taps.texel[k].face, taps.texel[k].x, taps.texel[k].y);
+      lo = std::min(lo, c[k]);
+      hi = std::max(hi, c[k]);
+    }
+    // Compared in code space: code > nonlin(r) * 65534 is exactly decode(code) > r, one log
+    // instead of one exp, and needs no special case for r outside [z_near, z_far].
+    const double rcode = v->range().normalized_from_depth(r) * kLog16MaxFinite;
+    if (hi != kLog16Sky && (hi - lo) * v->range().relative_step() <= smooth_log_ratio_) {
+      // One smooth surface around the direction: interpolate it (log-depth codes interpolate
+      // geometrically), which removes the staircase of per-texel constant depths.
+      double code = 0;
+      for (int k = 0; k < 4; ++k) code += taps.weight[k] * c[k];
+      if (code > rcode) return true;
+      continue;
+    }
+    // A depth discontinuity (or sky): the nearest surface among the texels whose centres lie
+    // within depth_footprint of the direction; the nearest texel always counts.
+    uint16_t code = kLog16Sky;
+    int nearest = 0;
+    for (int k = 0; k < 4; ++k) {
+      if (taps.weight[k] > taps.weight[nearest]) nearest = k;
+      if (taps.offset[k] < options_.depth_footprint - 1e-9) code = std::min(code, c[k]);
+    }
+    code = std::min(code, c[nearest]);
+    if (code == kLog16Sky || code > rcode) return true;
+  }
+  return !consulted;
+}
+
+// RayIntersection: constant steps in the march's normalised log depth from `start` to far.
+bool CpuRenderer::intersect(const Vec3& o, const Vec3& d, double start, Hit* hit) const {
+  const double log_ratio = std::log(options_.far / options_.near);
+  const auto lin = [&](double x) { return options_.near * std::exp(x * log_ratio); };
+  const double x0 = std::log(std::max(start, options_.near) / options_.near) / log_ratio;
+  if (!(x0 < 1)) return false;
+  const double step = (1 - x0) / options_.steps;
+  for (uint32_t i = 0; i <= options_.steps; ++i) {
+    const double x = i == options_.steps ? 1.0 : x0 + i * step;
+    if (empty_at(o + d * lin(x))) continue;
+    double lo = x - step, hi = x;
+    if (i == 0) {
+      lo = hi;  // already behind a surface at the first sample: nothing to refine
+    } else {
+      for (uint32_t k = 0; k < options_.refine_steps; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (empty_at(o + d * lin(mid)) ? lo : hi) = mid;
+      }
+    }
+    hit->z = lin(0.5 * (lo + hi));
+    hit->p = o + d * hit->z;
+    return true;
+  }
+  return false;
+}
+
+// SampleColor over the active views and their blend (CalculateColor). Weights are kept as
+// logarithms and normalised by the largest, so no view's weight underflows to zero.
+void CpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* rgb, int* best_view) const {
+  const double hit_distance = std::max(length(p - o), 1e-12);
+  double sum[3] = {0, 0, 0}, wsum = 0, best = -kInf;
+  struct Contribution {
+    double log_w, c[3];
+  };
+  // Views are few (the paper uses up to 16); a small fixed buffer would do, a vector is clearer.
+  std::vector<Contribution> contributions;
+  contributions.reserve(active_.size());
+  *best_view = -1;
+  for (size_t vi = 0; vi < active_.size(); ++vi) {
+    const View& v = *active_[vi];
+    const Vec3 x = p - v.position();
+    const double r = length(x);
+    if (r <= min_view_distance_) continue;
+    const FaceTexelCoord c = texel_coord_from_direction(to_direction(x), v.face_size());
+    const Texel nearest = texel_from_direction(to_direction(x), v.face_size());
+    const uint16_t ncode = v.depth_code_at(nearest.face, nearest.x, nearest.y);
+    if (ncode == kLog16Sky) continue;  // this view sees past p: it has no colour for it
+    const double ndiff = std::fabs(std::log(v.range().decode(ncode) / r));
+    Contribution k{-options_.depth_decay * ndiff, {0, 0, 0}};
+    if (!options_.bilinear_color) {
+      const float* col = v.color_at(nearest.face, nearest.x, nearest.y);
+      for (int ch = 0; ch < 3; ++ch) k.c[ch] = col[ch];
+    } else {
+      const internal::BilinearTaps taps = internal::bilinear_taps(c, v.face_size());
+      double diff[4], dmin = kInf;
+      for (int t = 0; t < 4; ++t) {
+        const uint16_t code = v.depth_code_at(taps.texel[t].face, taps.texel[t].x, taps.texel[t].y);
+        diff[t] = code == kLog16Sky ? kInf : std::fabs(std::log(v.range().decode(code) / r));
+        if (taps.weight[t] > 0) dmin = std::min(dmin, diff[t]);
+      }
+      double a[4], asum = 0;
+      for (int t = 0; t < 4; ++t) {
+        a[t] = taps.weight[t];
+        if (options_.depth_aware_color) {
+          a[t] *= diff[t] == kInf ? 0.0 : std::exp(-options_.depth_decay * (diff[t] - dmin));
+        }
+        asum += a[t];
+      }
+      for (int t = 0; t < 4; ++t) {
+        const float* col = v.color_at(taps.texel[t].face, taps.texel[t].x, taps.texel[t].y);
+        for (int ch = 0; ch < 3; ++ch) k.c[ch] += a[t] / asum * col[ch];
+      }
+      // Depth-aware: the view's w_depth is the bilinear blend of its taps' agreements.
+      if (options_.depth_aware_color) k.log_w = -options_.depth_decay * dmin + std::log(asum);
+    }
+    k.log_w -= options_.cam_decay * length(o - v.position()) / hit_distance;
+    if (k.log_w > best) {
+      best = k.log_w;
+      *best_view = static_cast<int>(vi);
+    }
+    contributions.push_back(k);
+  }
+  for (const Contribution& k : contributions) {
+    const double w = std::exp(k.log_w - best);
+    for (int ch = 0; ch < 3; ++ch) sum[ch] += w * k.c[ch];
+    wsum += w;
+  }
+  for (int ch = 0; ch < 3; ++ch) rgb[ch] = wsum > 0 ? sum[ch] / wsum : 0.0;
+}
+
+// Sky has no parallax: every view sees it in the ray's own direction. Views whose depth there is
+// sky count equally; if none is (the march ended before far geometry), all views do.
+void CpuRenderer::shade_sky(const Vec3& /*origin*/, const Vec3& d, double* rgb) const {
+  for (int pass = 0; pass < 2; ++pass) {
+    double sum[3] = {0, 0, 0};
+    int n = 0;
+    for (const View* v : active_) {
+      const Texel nearest = texel_from_direction(to_direction(d), v->face_size());
+      const bool sky = v->depth_code_at(nearest.face, nearest.x, nearest.y) == kLog16Sky;
+      if (pass == 0 && !sky) continue;
+      double c[3] = {0, 0, 0};
+      if (!options_.bilinear_color) {
+        const float* col = v->color_at(nearest.face, nearest.x, nearest.y);
+        for (int ch = 0; ch < 3; ++ch) c[ch] = col[ch];
+      } else {
+        const internal::BilinearTaps taps = internal::bilinear_taps(
+            texel_coord_from_direction(to_direction(d), v->face_size()), v->face_size());
+        double a[4], asum = 0;
+        for (int t = 0; t < 4; ++t) {
+          const bool tap_sky =
+              v->depth_code_at(taps.texel[t].face, taps.texel[t].x, taps.texel[t].y) == kLog16Sky;
+          a[t] = taps.weight[t] * (pass == 0 && options_.depth_aware_color && !tap_sky ? 0 : 1);
+          asum += a[t];
+        }
+        for (int t = 0; t < 4; ++t) {
+          const float* col = v->color_at(taps.texel[t].face, taps.texel[t].x, taps.texel[t].y);
+          for (int ch = 0; ch < 3; ++ch) c[ch] += a[t] / asum * col[ch];
+        }
+      }
+      for (int ch = 0; ch < 3; ++ch) sum[ch] += c[ch];
+      ++n;
+    }
+    if (n > 0) {
+      for (int ch = 0; ch < 3; ++ch) rgb[ch] = sum[ch] / n;
+      return;
+    }
+  }
+}
+
+RaySample CpuRenderer::trace(const Vec3& origin, const Vec3& direction) const {
+  RaySample s;
+  Hit hit;
+  if (!intersect(origin, direction, options_.near, &hit)) {
+    shade_sky(origin, direction, s.rgb);
+    s.depth = kInf;
+    return s;
+  }
+  s.hit = true;
+  s.depth = hit.z;
+  if (options_.rr) {
+    shade_rr(origin, direction, hit, 0, s.rgb);
+  } else {
+    int best;
+    shade_surface(origin, hit.p, s.rgb, &best);
+  }
+  return s;
+}
+
+Status CpuRenderer::render(const Camera& camera, RenderedImage* out) const {
+  Vec3 f, r, u;
+  if (!finite(camera.position) || !camera_frame(camera, &f, &r, &u)) {
+    return option_error("camera position, forward or up is not finite, zero or parallel");
+  }
+  if (!(camera.fov_y > 0) || !(camera.fov_y < 3.141592653589793)) {
+    return option_error("camera fov_y " + std::to_string(camera.fov_y) + " is outside (0, pi)");
+  }
+  if (camera.width < 1 || camera.height < 1 || camera.width > kMaxFaceSize ||
+      camera.height > kMaxFaceSize) {
+    return option_error("image size " + std::to_string(camera.width) + " x " +
+                        std::to_string(camera.height) + " is outside 1..16384");
+  }
+  out->width = camera.width;
+  out->height = camera.height;
+  const size_t pixels = size_t{camera.width} * camera.height;
+  out->color.assign(3 * pixels, 0.0f);
+  out->depth.assign(pixels, 0.0f);
+  // Rows are interleaved over the workers; each pixel depends only on its own ray, so the image
+  // does not depend on the thread count.
+  const auto work = [&](uint32_t first) {
+    for (uint32_t j = first; j < camera.height; j += options_.threads) {
+      for (uint32_t i = 0; i < camera.width; ++i) {
+        const RaySample s = trace(camera.position, camera_ray(camera, i, j));
+        const size_t k = size_t{j} * camera.width + i;
+        for (int ch = 0; ch < 3; ++ch) out->color[3 * k + ch] = static_cast<float>(s.rgb[ch]);
+        out->depth[k] = static_cast<float>(s.depth);
+      }
+    }
+  };
+  const uint32_t workers = std::min(options_.threads, camera.height);
+  std::vector<std::thread> pool;
+  for (uint32_t t = 1; t < workers; ++t) pool.emplace_back(work, t);
+  work(0);
+  for (std::thread& t : pool) t.join();
+  return Status::Ok();
+}
+
+}  // namespace calf::player

@@ -1,0 +1,101 @@
+// The RR variant of Alg. 4 (CalculateColor_RR, Sec. 6.1): reflection and refraction rays spawned
+// from the material faces, with normals from neighbouring depths.
+#include <cmath>
+
+#include "calf/player/cpu_renderer.h"
+#include "sampling.h"
+
+namespace calf::player {
+
+using internal::cross;
+using internal::dot;
+using internal::length;
+using internal::normalize;
+using internal::to_direction;
+using internal::to_vec;
+using internal::operator+;
+using internal::operator-;
+using internal::operator*;
+
+namespace {
+
+// The scene point a texel of `v` stands for, or false for sky.
+bool texel_point(const View& v, const Texel& t, Vec3* q) {
+  const uint16_t code = v.depth_code_at(t.face, t.x, t.y);
+  if (code == kLog16Sky) return false;
+  *q = v.position() +
+       to_vec(direction_from_texel(t.face, t.x, t.y, v.face_size())) * v.range().decode(code);
+  return true;
+}
+
+// The tangent along one texel axis at `centre`: of the two neighbours, the one whose point is
+// nearer (a one-sided difference never reaches across a depth discontinuity); false when both are
+// sky.
+bool tangent(const View& v, const Texel& t, int dx, int dy, const Vec3& centre, Vec3* out) {
+  const uint32_t n = v.face_size();
+  Vec3 a, b;
+  const bool ha = texel_point(
+      v, internal::texel_beyond_face(t.face, int64_t{t.x} + dx, int64_t{t.y} + dy, n), &a);
+  const bool hb = texel_point(
+      v, internal::texel_beyond_face(t.face, int64_t{t.x} - dx, int64_t{t.y} - dy, n), &b);
+  if (!ha && !hb) return false;
+  if (ha && (!hb || length(a - centre) <= length(b - centre))) {
+    *out = a - centre;
+  } else {
+    *out = centre - b;
+  }
+  return true;
+}
+
+// GLSL refract(): eta = n1 / n2; false on total internal reflection.
+bool refract_dir(const Vec3& d, const Vec3& n, double eta, Vec3* out) {
+  const double c = dot(n, d);
+  const double k = 1 - eta * eta * (1 - c * c);
+  if (k < 0) return false;
+  *out = normalize(d * eta - n * (eta * c + std::sqrt(k)));
+  return true;
+}
+
+}  // namespace
+
+void CpuRenderer::shade_rr(const Vec3& o, const Vec3& d, const Hit& hit, uint32_t depth,
+                           double* rgb) const {
+  int best = -1;
+  double diffuse[3];
+  shade_surface(o, hit.p, diffuse, &best);
+  for (int ch = 0; ch < 3; ++ch) rgb[ch] = diffuse[ch];
+  if (best < 0 || depth >= options_.rr_max_depth) return;
+  // Material and normal come from the view that weighs most at p (nearest texel): material is
+  // categorical at object edges, where blending weights would invent half-mirrors.
+  const View& v = *active_[best];
+  const Vec3 x = hit.p - v.position();
+  const Texel t = texel_from_direction(to_direction(x), v.face_size());
+  const Material m = v.material_at(t.face, t.x, t.y);
+  if (!(m.reflect > 0) && !(m.refract > 0)) return;
+  Vec3 centre, tu, tv;
+  if (!texel_point(v, t, &centre) || !tangent(v, t, 1, 0, centre, &tu) ||
+      !tangent(v, t, 0, 1, centre, &tv)) {
+    return;
+  }
+  Vec3 n = cross(tu, tv);
+  if (!(length(n) > 0)) return;
+  n = normalize(n);
+  if (dot(n, d) > 0) n = n * -1.0;  // face the incoming ray
+  double w[2] = {m.reflect, m.refract};
+  double c[2][3] = {{0, 0, 0}, {0, 0, 0}};
+  for (int kind = 0; kind < 2; ++kind) {
+    if (!(w[kind] > 0)) continue;
+    Vec3 dir = normalize(d - n * (2 * dot(d, n)));  // reflection; also refraction's TIR fallback
+    if (kind == 1) refract_dir(d, n, 1.0 / m.ior, &dir);
+    Hit next;
+    if (intersect(hit.p, dir, options_.rr_start, &next)) {
+      shade_rr(hit.p, dir, next, depth + 1, c[kind]);
+    } else {
+      shade_sky(hit.p, dir, c[kind]);  // a mirror shows the sky (the paper drops the weight)
+    }
+  }
+  const double wd = 1 - w[0] - w[1];
+  for (int ch = 0; ch < 3; ++ch) rgb[ch] = w[0] * c[0][ch] + w[1] * c[1][ch] + wd * diffuse[ch];
+}
+
+}  // namespace calf::player
