@@ -13,6 +13,12 @@ if(CALF_SANITIZE)
   target_link_options(calf_options INTERFACE -fsanitize=address,undefined)
 endif()
 
+# With libFuzzer, every calf target carries coverage instrumentation (not only the fuzz target's
+# own file), or the fuzzer runs blind through the libraries it is meant to explore.
+if(CALF_LIBFUZZER)
+  target_compile_options(calf_options INTERFACE -fsanitize=fuzzer-no-link)
+endif()
+
 # calf_layer(NAME DIR dir LINKS deps...): one library per layer. Sources are globbed so that work
 # in different files never edits this list; CONFIGURE_DEPENDS re-globs on every build.
 # Commands: every <dir>/tools/<name>.cc becomes the executable <name> with '_' turned into '-',

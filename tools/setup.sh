@@ -21,8 +21,8 @@ PACKAGES=(
   libembree-dev libassimp-dev
   # player: GL, window, headless, maths, HUD
   libglm-dev libglfw3-dev libosmesa6-dev libgl-dev libopengl-dev libglx-dev libegl-dev libimgui-dev xvfb xauth
-  # tests and benchmarks
-  libgtest-dev libgmock-dev libbenchmark-dev
+  # tests and benchmarks; clang + its runtime for the libFuzzer run of tools/test.sh
+  libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
   # measurement peers and plots
   ffmpeg zstd xz-utils gnuplot-nox
 )

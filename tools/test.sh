@@ -13,3 +13,24 @@ export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:strict_string_checks=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp"
 ctest --test-dir "$BUILD" --output-on-failure -j"$(nproc)" "$@"
+
+# The container reader under clang's libFuzzer for a bounded time (CALF_FUZZ_SECONDS, default 60),
+# seeded from the conformance files and the fuzz corpus. New inputs go to a scratch corpus under
+# the build dir, never into the repository; a crash fails this script and leaves its input in
+# build/fuzz/artifacts/ to be added to tests/fuzz/corpus/ as a regression case.
+if [ $# -eq 0 ]; then
+  FUZZ=build/fuzz
+  cmake -S . -B "$FUZZ" -G Ninja -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
+    -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DCALF_SANITIZE=ON \
+    -DCALF_LIBFUZZER=ON >/dev/null
+  cmake --build "$FUZZ" --target container_reader_fuzz
+  mkdir -p "$FUZZ/corpus-reader" "$FUZZ/artifacts"
+  if ! "$FUZZ"/tests/container_reader_fuzz -max_total_time="${CALF_FUZZ_SECONDS:-60}" \
+      -print_final_stats=1 -artifact_prefix="$FUZZ/artifacts/" "$FUZZ/corpus-reader" \
+      tests/conformance/container tests/fuzz/corpus/container_reader_fuzz >"$FUZZ/reader.log" 2>&1; then
+    tail -n 60 "$FUZZ/reader.log"
+    echo "calf: libFuzzer failed on the container reader; crash input in $FUZZ/artifacts/" >&2
+    exit 1
+  fi
+  grep -E "DONE|stat::number_of_executed_units" "$FUZZ/reader.log"
+fi

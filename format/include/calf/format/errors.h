@@ -42,12 +42,75 @@ enum class ErrorKind : uint8_t {
   X(kGridSize, 23, kInvalidArgument, "a face, cell or tile size is zero or too large")          \
   X(kGridIndex, 24, kInvalidArgument, "a cell, tile or quadtree index is outside its grid")     \
   /* container: 40-99 */                                                                        \
+  X(kContainerIdentifier, 40, kCorrupt, "the file does not start with the calf identifier")     \
+  X(kContainerVersion, 41, kUnsupported, "the file's major version is not supported")           \
+  X(kContainerRequiredFeature, 42, kUnsupported, "an unknown must-understand flag is set")      \
+  X(kContainerHeaderChecksum, 43, kCorrupt, "the header checksum does not match")               \
+  X(kContainerTruncated, 44, kNeedMoreData, "the file ends before its declared size")           \
+  X(kContainerFileSize, 45, kCorrupt, "the file is longer than its header declares")            \
+  X(kContainerDirectoryRange, 46, kCorrupt, "the directory is outside the file or misplaced")   \
+  X(kContainerDirectoryChecksum, 47, kCorrupt, "the directory checksum does not match")         \
+  X(kContainerDirectoryFormat, 48, kCorrupt, "a directory field is malformed")                  \
+  X(kContainerLimit, 49, kLimit, "a count or size exceeds a container limit")                   \
+  X(kContainerTrackKind, 50, kUnsupported, "a must-understand track has an unknown kind")       \
+  X(kContainerTrackHeader, 51, kCorrupt, "a track header is short or holds a bad value")        \
+  X(kContainerMetadata, 52, kCorrupt, "a metadata key or value is invalid")                     \
+  X(kContainerChunkRange, 53, kCorrupt, "a chunk lies outside the chunk area")                  \
+  X(kContainerChunkLayout, 54, kCorrupt, "a chunk is not at its canonical offset")              \
+  X(kContainerChunkTrack, 55, kCorrupt, "a chunk names a track that does not exist")            \
+  X(kContainerCompression, 56, kUnsupported, "a chunk uses an unknown supercompression")        \
+  X(kContainerChunkSize, 57, kCorrupt, "a chunk's stored/raw lengths contradict its scheme")    \
+  X(kContainerChunkHash, 58, kCorrupt, "a chunk's stored bytes do not match its hash")          \
+  X(kContainerDecompress, 59, kCorrupt, "a chunk does not decompress to its raw length")        \
+  X(kContainerPadding, 60, kCorrupt, "a padding byte is not zero")                              \
+  X(kContainerChunkId, 61, kInvalidArgument, "a chunk id is outside the chunk index")           \
+  X(kContainerBufferSize, 62, kInvalidArgument, "a buffer does not match a chunk's raw length") \
+  X(kContainerWriterMisuse, 63, kInvalidArgument, "the writer got a value the format forbids")  \
+  X(kContainerCompressor, 64, kInternal, "the compression library failed")                      \
   /* block codecs: 100-129 */                                                                   \
+  X(kBcDimensions, 100, kInvalidArgument, "an image is empty or wider/taller than 65536 px")   \
+  X(kBcBufferSize, 101, kInvalidArgument, "a pixel or block buffer is smaller than needed")    \
+  X(kBcStride, 102, kInvalidArgument, "a row stride is smaller than one row of pixels")        \
+  X(kBcOptions, 103, kInvalidArgument, "an encoder option or channel count is invalid")        \
+  X(kBcNonFinite, 104, kInvalidArgument, "HDR input holds NaN or infinity (rejected)")         \
+  X(kBcOutOfRange, 105, kInvalidArgument, "HDR input is out of the format's range (rejected)") \
   /* capture sets: 130-169 */                                                                   \
+  X(kManifestSyntax, 130, kCorrupt, "a manifest or eye path is not valid JSON")                 \
+  X(kManifestField, 131, kCorrupt, "a manifest field is missing, mistyped or out of range")     \
+  X(kManifestVersion, 132, kUnsupported, "a manifest has an unknown format or version")         \
+  X(kManifestInconsistent, 133, kCorrupt, "manifest fields contradict each other")              \
+  X(kCaptureLimit, 134, kLimit, "a capture set exceeds a documented size limit")                \
+  X(kCaptureFileMissing, 135, kIo, "an image named by the manifest is missing")                 \
+  X(kCaptureImageFormat, 136, kCorrupt, "an image has the wrong size, channels or type")        \
+  X(kCaptureDepthPixel, 137, kCorrupt, "a depth pixel is NaN, -inf, zero or negative")          \
+  X(kCaptureColorPixel, 138, kCorrupt, "a colour pixel is NaN, infinite or negative")           \
+  X(kCaptureMaterialPixel, 139, kCorrupt, "a material pixel is outside its documented range")   \
+  X(kCaptureIndex, 140, kInvalidArgument, "a view or frame index is outside the set")           \
+  X(kCaptureWriterMisuse, 141, kInvalidArgument, "the capture writer got a bad buffer or call") \
+  X(kEyePathField, 142, kCorrupt, "an eye path field is missing or out of range")               \
   /* calf-capture: 170-199 */                                                                   \
+  X(kSceneUnknown, 170, kInvalidArgument, "no built-in scene has that name")                    \
+  X(kSceneLoad, 171, kCorrupt, "a scene file could not be imported")                            \
+  X(kSceneFormat, 172, kUnsupported, "a scene file's format is not supported")                  \
+  X(kSceneEmpty, 173, kInvalidArgument, "a scene has no renderable geometry")                   \
+  X(kSceneGeometry, 174, kCorrupt, "a scene holds non-finite or degenerate geometry")           \
+  X(kRigSyntax, 175, kInvalidArgument, "a rig description cannot be parsed")                    \
+  X(kViewpointInsideGeometry, 176, kInvalidArgument, "a viewpoint or eye lies inside geometry") \
+  X(kCaptureOption, 177, kInvalidArgument, "a render option is outside its range")              \
+  X(kRayTracer, 178, kInternal, "Embree failed to create a device or scene")                    \
   /* encoder: 200-299 */                                                                        \
+  X(kEncoderOption, 200, kInvalidArgument, "an encoder option is outside its range")          \
+  X(kEncoderInput, 201, kCorrupt, "the capture set contradicts itself or the chosen options")  \
+  X(kLightfieldChunk, 202, kCorrupt, "a lightfield chunk is missing or contradicts its layout") \
+  X(kLightfieldFormat, 203, kUnsupported, "a lightfield track uses a format the decoder lacks") \
   /* decoder: 300-399 */                                                                        \
-  /* player: 400-499 */
+  /* player: 400-499 */                                                                         \
+  X(kPlayerViewSet, 400, kInvalidArgument, "a view's face size or position is invalid")         \
+  X(kPlayerRect, 401, kInvalidArgument, "a texture update rect or its source buffer is invalid") \
+  X(kPlayerNoMaterial, 402, kInvalidArgument, "material written to a view without material")    \
+  X(kPlayerOptions, 403, kInvalidArgument, "a render option or the eye is outside its range")   \
+  X(kPlayerGl, 404, kUnsupported, "an OpenGL context or a required GL feature is missing")    \
+  /* end of the list: every line above ends with a backslash */
 
 enum class ErrorId : uint16_t {
   kOk = 0,
