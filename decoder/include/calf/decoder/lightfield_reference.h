@@ -1,0 +1,71 @@
+// The reference full-frame decoder of the lightfield track (format/SPEC.md §11.1): view v, face f,
+// frame n -> linear RGB colour, log-16 depth codes and material codes, with no culling and no
+// caching. It reads exactly the chunks SPEC §11.1 says a decoder needs (one t chunk and at most two
+// keyframe chunks per cell, one region chunk per depth / material tile) and checks every count,
+// rectangle and size against the chunk before use: a corrupt file gives CALF-E202, an unknown
+// pixel format CALF-E203, never a crash. The fast view-dependent decoder is built on the same
+// layout; this one is what it is tested against.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "calf/format/container.h"
+#include "calf/format/status.h"
+
+namespace calf::decoder {
+
+// A view's index chunk (SPEC §11.1 "View index chunk").
+struct LightfieldViewInfo {
+  double position[3] = {0, 0, 0};
+  float z_near = 1, z_far = 2;
+  bool has_depth = false;     // the view saw a finite depth (else every code is sky)
+  bool has_material = false;  // material chunks exist for this view
+  uint32_t depth_keyframe_interval = 1, depth_window = 1;
+  float min_psnr_db = 0;  // informative: the encoder's Q
+};
+
+// One decoded face. colour: face_size^2 * 3 linear floats (row-major); depth: face_size^2 codes;
+// material: face_size^2 * 3 codes (reflect, refract, ior) or empty.
+struct LightfieldFace {
+  std::vector<float> colour;
+  std::vector<uint16_t> depth;
+  std::vector<uint8_t> material;
+};
+
+class LightfieldReference {
+ public:
+  // `reader` must outlive the decoder. Errors: kInvalidArgument (no such track, not lightfield),
+  // kLightfieldFormat, kLightfieldChunk (a missing or bad index chunk).
+  static Expected<LightfieldReference> open(const container::Reader& reader, uint16_t track);
+
+  const container::LightfieldTrackHeader& header() const { return header_; }
+  const LightfieldViewInfo& view(uint32_t v) const { return views_[v]; }
+
+  // Decodes view `view`, face `face` (GL order), frame `frame` into `out` (resized).
+  // Errors: kInvalidArgument (index out of range), kLightfieldChunk, container errors.
+  Status decode_face(uint32_t view, uint32_t face, uint32_t frame, LightfieldFace* out) const;
+
+  // The interpolation weights and keyframes of one colour cell (its t chunk), for tests and tools.
+  struct CellTimeline {
+    std::vector<uint32_t> keyframes;
+    std::vector<uint8_t> t;
+  };
+  Expected<CellTimeline> cell_timeline(uint32_t view, uint32_t face, uint32_t cell) const;
+  // The rectangle counts of every frame of one depth tile (keyframes included), for tests.
+  Expected<std::vector<uint32_t>> depth_rect_counts(uint32_t view, uint32_t face,
+                                                    uint32_t tile) const;
+
+ private:
+  LightfieldReference() = default;
+  const container::Reader* reader_ = nullptr;
+  uint16_t track_ = 0;
+  container::LightfieldTrackHeader header_;
+  std::vector<LightfieldViewInfo> views_;
+};
+
+// sRGB byte -> linear float, as every 8-bit colour format of the track is interpreted.
+float srgb8_to_linear(uint8_t v);
+
+}  // namespace calf::decoder

@@ -1,0 +1,769 @@
+#include "calf/encoder/lightfield_encode.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <numeric>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "calf/encoder/bc_encode.h"
+#include "calf/encoder/color_keyframes.h"
+#include "calf/encoder/depth_aabb.h"
+#include "calf/format/bc.h"
+#include "calf/format/grid.h"
+#include "calf/format/log_depth.h"
+#include "calf/format/version.h"
+#include "lightfield_layout.h"
+
+namespace calf {
+namespace {
+
+using container::ChunkKeys;
+using container::Compression;
+using container::LightfieldStream;
+using container::PixelFormat;
+using container::StoredChunk;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr uint32_t kLayoutVersion = 1;
+
+uint16_t pf(PixelFormat f) { return static_cast<uint16_t>(f); }
+
+// ---- Colour conversions (SPEC §11.1: 8-bit colour formats hold sRGB-encoded values) ----
+
+float srgb_encode(float v) {
+  if (!(v > 0.0f)) return 0.0f;
+  if (v >= 1.0f) return 1.0f;
+  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+uint8_t srgb8_from_linear(float v) {
+  return static_cast<uint8_t>(std::lround(srgb_encode(v) * 255.0f));
+}
+// The decoder's table: sRGB byte -> linear float (the same formula as decoder/lightfield).
+const std::array<float, 256>& srgb8_to_linear_table() {
+  static const std::array<float, 256> table = [] {
+    std::array<float, 256> t{};
+    for (int i = 0; i < 256; ++i) {
+      const double c = i / 255.0;
+      t[i] = static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+    }
+    return t;
+  }();
+  return table;
+}
+uint16_t half_from_colour(float v) {
+  return bc::float_to_half(std::min(v, 65504.0f));  // input is validated finite and >= 0
+}
+
+// ---- Options ----
+
+Status validate(const LightfieldEncodeOptions& o) {
+  auto bad = [](const std::string& what) { return Status(ErrorId::kEncoderOption, what); };
+  if (o.cell_size < 4 || o.cell_size > kMaxFaceSize || o.cell_size % 4 != 0) {
+    return bad("--cell " + std::to_string(o.cell_size) + ": expected a multiple of 4 in [4, 16384]");
+  }
+  if (!(o.min_psnr_db > 0 && o.min_psnr_db <= 200)) {
+    return bad("--psnr " + std::to_string(o.min_psnr_db) + ": expected (0, 200] dB");
+  }
+  if (o.depth_tiles_per_side < 1 || o.depth_tiles_per_side > 64) {
+    return bad("depth tiles per side " + std::to_string(o.depth_tiles_per_side) +
+               ": expected [1, 64]");
+  }
+  if (o.depth_window < 1 || o.depth_window > 65535) {
+    return bad("--depth-window " + std::to_string(o.depth_window) + ": expected [1, 65535]");
+  }
+  if (o.max_aabbs < 1 || o.max_aabbs > 64) {
+    return bad("--max-aabbs " + std::to_string(o.max_aabbs) + ": expected [1, 64]");
+  }
+  if (o.depth_keyframe_interval < 1) {
+    return bad("--depth-keyframe-interval 0: expected >= 1");
+  }
+  if (o.threads > 1024) return bad("--threads " + std::to_string(o.threads) + ": expected [0, 1024]");
+  if (static_cast<uint16_t>(o.supercompression) >= container::kCompressionCount) {
+    return bad("unknown supercompression");
+  }
+  return Status::Ok();
+}
+
+// ---- One view in memory ----
+
+struct ViewData {
+  uint32_t frames = 0, face_size = 0;
+  size_t texels = 0;              // per frame, all six faces
+  std::vector<uint16_t> colour;   // half RGB, [frame][texel][3]
+  std::vector<uint16_t> depth;    // log-16 codes, [frame][texel]
+  std::vector<uint8_t> material;  // [frame][texel][3] codes, empty without material
+  std::optional<LogDepthRange> range;  // none when the view sees only sky
+  bool has_material = false;           // some texel of some frame reflects or refracts
+
+  size_t index(uint32_t frame, uint32_t face, uint32_t x, uint32_t y) const {
+    return static_cast<size_t>(frame) * texels + (static_cast<size_t>(face) * face_size + y) * face_size + x;
+  }
+};
+
+uint8_t material_code(float v) {
+  return static_cast<uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
+}
+
+Status read_view(const capture::CaptureSetReader& input, uint32_t view, ViewData* out) {
+  const capture::CaptureManifest& m = input.manifest();
+  out->frames = m.frame_count;
+  out->face_size = m.face_size;
+  out->texels = size_t{6} * m.face_size * m.face_size;
+  out->colour.assign(out->texels * 3 * m.frame_count, 0);
+  out->material.clear();
+  if (m.material) out->material.assign(out->texels * 3 * m.frame_count, 0);
+  std::vector<float> depth(out->texels * m.frame_count);
+  float lo = std::numeric_limits<float>::infinity(), hi = 0;
+  capture::ViewFrame vf;
+  out->has_material = false;
+  for (uint32_t f = 0; f < m.frame_count; ++f) {
+    CALF_RETURN_IF_ERROR(input.read(view, f, &vf));
+    if (vf.face_size != m.face_size || vf.has_material != m.material) {
+      return Status(ErrorId::kEncoderInput, input.image_path(view, f).string() +
+                                                ": face size or material differs from the manifest");
+    }
+    uint16_t* c = &out->colour[f * out->texels * 3];
+    for (size_t i = 0; i < out->texels * 3; ++i) c[i] = half_from_colour(vf.color[i]);
+    float* d = &depth[f * out->texels];
+    for (size_t i = 0; i < out->texels; ++i) {
+      const float z = vf.depth[i];
+      d[i] = z;
+      if (std::isfinite(z)) {
+        lo = std::min(lo, z);
+        hi = std::max(hi, z);
+      }
+    }
+    if (m.material) {
+      uint8_t* mc = &out->material[f * out->texels * 3];
+      for (size_t i = 0; i < out->texels; ++i) {
+        mc[3 * i] = material_code(vf.material[3 * i]);
+        mc[3 * i + 1] = material_code(vf.material[3 * i + 1]);
+        mc[3 * i + 2] = material_code((vf.material[3 * i + 2] - 1.0f) / 2.0f);
+        if (mc[3 * i] != 0 || mc[3 * i + 1] != 0) out->has_material = true;
+      }
+    }
+  }
+  out->range.reset();
+  out->depth.assign(depth.size(), kLog16Sky);
+  if (hi > 0) {
+    CALF_ASSIGN_OR_RETURN(LogDepthRange r, LogDepthRange::covering(lo, hi));
+    out->range = r;
+    for (size_t i = 0; i < depth.size(); ++i) out->depth[i] = r.encode_unchecked(depth[i]);
+  }
+  if (!out->has_material) out->material.clear();
+  return Status::Ok();
+}
+
+// ---- Per-task output ----
+
+struct Pending {
+  ChunkKeys keys;
+  StoredChunk chunk;
+};
+
+struct TaskStats {
+  StreamBytes colour, depth, material;
+  uint64_t keyframes = 0, depth_keyframes = 0, pframes = 0, empty_pframes = 0;
+  double min_quality = kInf;
+  double max_rel = 0, sum_rel = 0;
+  uint64_t finite_texels = 0, sky_mismatches = 0;
+};
+
+struct TaskOut {
+  Status status;
+  std::vector<Pending> chunks;
+  TaskStats stats;
+};
+
+struct Context {
+  const LightfieldEncodeOptions* options;
+  const ViewData* view;
+  uint32_t view_index;
+  uint16_t track;
+  ColourCoding colour;  // resolved (never kAuto)
+  bool hdr;
+  FaceGrid cells, tiles;
+};
+
+Status add_chunk(const Context& ctx, TaskOut& out, ChunkKeys keys, const std::vector<uint8_t>& raw,
+                 StreamBytes& bytes) {
+  keys.track = ctx.track;
+  keys.view = ctx.view_index;
+  CALF_ASSIGN_OR_RETURN(StoredChunk c, container::compress_chunk(raw, ctx.options->supercompression,
+                                                                 ctx.options->levels));
+  bytes.spatial += raw.size();
+  bytes.stored += c.bytes.size();
+  bytes.chunks += 1;
+  out.chunks.push_back({keys, std::move(c)});
+  return Status::Ok();
+}
+
+// ---- Colour ----
+
+// One frame of a cell coded spatially: the bytes as the format stores them (before the block
+// split) and what the decoder shows (linear RGB floats).
+struct CodedFrame {
+  std::vector<uint8_t> bytes;
+  std::vector<float> shown;
+};
+
+Status code_colour_frame(ColourCoding coding, std::span<const float> rgb, uint32_t w, uint32_t h,
+                         CodedFrame* out) {
+  const size_t n = static_cast<size_t>(w) * h;
+  const auto& lut = srgb8_to_linear_table();
+  out->shown.resize(n * 3);
+  switch (coding) {
+    case ColourCoding::kBc1:
+    case ColourCoding::kBc7:
+    case ColourCoding::kRgba8: {
+      std::vector<uint8_t> rgba(n * 4);
+      for (size_t i = 0; i < n; ++i) {
+        for (int c = 0; c < 3; ++c) rgba[4 * i + c] = srgb8_from_linear(rgb[3 * i + c]);
+        rgba[4 * i + 3] = 255;
+      }
+      if (coding == ColourCoding::kRgba8) {
+        out->bytes = rgba;
+      } else {
+        const bc::Format f = coding == ColourCoding::kBc1 ? bc::Format::kBc1 : bc::Format::kBc7;
+        const bc::Image8 img{rgba.data(), w, h, size_t{w} * 4, 4};
+        out->bytes.assign(bc::encode_bound(f, w, h), 0);
+        if (coding == ColourCoding::kBc1) {
+          CALF_RETURN_IF_ERROR(bc::encode_bc1(img, out->bytes.data(), out->bytes.size(), {}));
+        } else {
+          bc::Bc7Options o;
+          o.quality = 0;
+          CALF_RETURN_IF_ERROR(bc::encode_bc7(img, out->bytes.data(), out->bytes.size(), o));
+        }
+        CALF_RETURN_IF_ERROR(bc::decode_image(f, out->bytes.data(), out->bytes.size(), w, h,
+                                              rgba.data(), rgba.size(), size_t{w} * 4));
+      }
+      for (size_t i = 0; i < n; ++i) {
+        for (int c = 0; c < 3; ++c) out->shown[3 * i + c] = lut[rgba[4 * i + c]];
+      }
+      return Status::Ok();
+    }
+    case ColourCoding::kBc6h: {
+      const bc::ImageF img{rgb.data(), w, h, size_t{w} * 3, 3};
+      out->bytes.assign(bc::encode_bound(bc::Format::kBc6hUnsigned, w, h), 0);
+      bc::Bc6hOptions o;
+      o.quality = 0;
+      CALF_RETURN_IF_ERROR(bc::encode_bc6h(img, out->bytes.data(), out->bytes.size(), o));
+      std::vector<uint16_t> half(n * 3);
+      CALF_RETURN_IF_ERROR(bc::decode_image(bc::Format::kBc6hUnsigned, out->bytes.data(),
+                                            out->bytes.size(), w, h, half.data(), half.size() * 2,
+                                            size_t{w} * 6));
+      for (size_t i = 0; i < n * 3; ++i) out->shown[i] = bc::half_to_float(half[i]);
+      return Status::Ok();
+    }
+    case ColourCoding::kRgba16f: {
+      out->bytes.resize(n * 8);
+      for (size_t i = 0; i < n; ++i) {
+        for (int c = 0; c < 4; ++c) {
+          const uint16_t hv = c < 3 ? half_from_colour(rgb[3 * i + c]) : uint16_t{0x3C00};
+          out->bytes[8 * i + 2 * c] = static_cast<uint8_t>(hv);
+          out->bytes[8 * i + 2 * c + 1] = static_cast<uint8_t>(hv >> 8);
+          if (c < 3) out->shown[3 * i + c] = bc::half_to_float(hv);
+        }
+      }
+      return Status::Ok();
+    }
+    case ColourCoding::kAuto: break;
+  }
+  return Status(ErrorId::kInternal, "unresolved colour format");
+}
+
+// The chunk payload of one coded keyframe (SPEC §11.1 "Colour keyframe chunk").
+void append_colour_payload(ColourCoding coding, const std::vector<uint8_t>& bytes,
+                           std::vector<uint8_t>& out) {
+  switch (coding) {
+    case ColourCoding::kBc1: lf::append_block_split(out, bytes, 8, false); break;
+    case ColourCoding::kRgba8: lf::append_planes(out, bytes, 4); break;
+    case ColourCoding::kRgba16f: {
+      // Little-endian halves -> high bytes of every value, then low bytes.
+      std::vector<uint8_t> swapped(bytes.size());
+      for (size_t i = 0; i + 1 < bytes.size(); i += 2) {
+        swapped[i] = bytes[i + 1];
+        swapped[i + 1] = bytes[i];
+      }
+      lf::append_planes(out, swapped, 2);
+      break;
+    }
+    default: out.insert(out.end(), bytes.begin(), bytes.end()); break;
+  }
+}
+
+void colour_task(const Context& ctx, uint32_t face, uint32_t cell, TaskOut& out) {
+  const ViewData& v = *ctx.view;
+  const PixelRect r = ctx.cells.cell_rect(cell % ctx.cells.cells_per_side(),
+                                          cell / ctx.cells.cells_per_side());
+  const size_t n = static_cast<size_t>(r.width) * r.height;
+  const uint32_t frames = v.frames;
+  std::vector<float> original(n * 3);
+  std::vector<uint16_t> previous_half, current_half(n * 3);
+  std::vector<CodedFrame> coded(frames);
+  std::vector<float> shown_all(n * 3 * frames);
+  for (uint32_t f = 0; f < frames; ++f) {
+    for (uint32_t y = 0; y < r.height; ++y) {
+      const uint16_t* src = &v.colour[v.index(f, face, r.x, r.y + y) * 3];
+      std::copy(src, src + r.width * 3, &current_half[size_t{y} * r.width * 3]);
+    }
+    if (f > 0 && current_half == previous_half) {
+      coded[f] = coded[f - 1];  // static content: the same bytes, no second encode
+    } else {
+      for (size_t i = 0; i < n * 3; ++i) original[i] = bc::half_to_float(current_half[i]);
+      out.status = code_colour_frame(ctx.colour, original, r.width, r.height, &coded[f]);
+      if (!out.status.ok()) return;
+    }
+    std::copy(coded[f].shown.begin(), coded[f].shown.end(), &shown_all[f * n * 3]);
+    std::swap(previous_half, current_half);
+    current_half.resize(n * 3);
+  }
+  // Alg. 2 against the frames as the spatial codec shows them (see the header: what Q means).
+  const ShownKeyframeFn shown = [&](uint32_t f) -> Expected<std::span<const float>> {
+    return std::span<const float>(coded[f].shown);
+  };
+  const CellQualityFn quality = ctx.hdr ? CellQualityFn(psnr_log2) : CellQualityFn(psnr_srgb);
+  KeyframeOptions ko;
+  ko.min_quality_db = ctx.options->min_psnr_db;
+  auto k = select_cell_keyframes(shown_all, frames, static_cast<uint32_t>(n), shown, quality, ko);
+  if (!k.ok()) {
+    out.status = k.status();
+    return;
+  }
+  TaskStats& s = out.stats;
+  s.keyframes += k->keyframes.size();
+  s.min_quality = std::min(s.min_quality, k->min_quality_db);
+  const uint64_t raw_texel = ctx.hdr ? 8 : 4;
+  s.colour.raw += n * raw_texel * frames;
+
+  std::vector<uint8_t> raw;
+  lf::put_u32(raw, static_cast<uint32_t>(k->keyframes.size()));
+  for (uint32_t kf : k->keyframes) lf::put_u32(raw, kf);
+  raw.insert(raw.end(), k->t.begin(), k->t.end());
+  s.colour.temporal += raw.size() + k->keyframes.size() * n * raw_texel;
+  ChunkKeys keys;
+  keys.stream = static_cast<uint16_t>(LightfieldStream::kTParams);
+  keys.face = face;
+  keys.region = cell;
+  keys.first_frame = 0;
+  keys.frame_count = frames;
+  out.status = add_chunk(ctx, out, keys, raw, s.colour);
+  if (!out.status.ok()) return;
+  for (size_t i = 0; i < k->keyframes.size(); ++i) {
+    const uint32_t kf = k->keyframes[i];
+    const uint32_t end = i + 1 < k->keyframes.size() ? k->keyframes[i + 1] : frames;
+    raw.clear();
+    append_colour_payload(ctx.colour, coded[kf].bytes, raw);
+    keys.stream = static_cast<uint16_t>(LightfieldStream::kColour);
+    keys.first_frame = kf;
+    keys.frame_count = end - kf;
+    out.status = add_chunk(ctx, out, keys, raw, s.colour);
+    if (!out.status.ok()) return;
+  }
+}
+
+// ---- Depth and material: keyframes + rectangle P-frames (Alg. 3) ----
+
+// A tile's frames as interleaved bytes: depth [hi, lo] per texel, material [reflect, refract,
+// ior] per texel.
+struct TileFrames {
+  uint32_t width = 0, height = 0, bytes_per_texel = 0, frames = 0;
+  std::vector<uint8_t> data;  // [frame][y][x][byte]
+  const uint8_t* texel(uint32_t f, uint32_t x, uint32_t y) const {
+    return &data[((static_cast<size_t>(f) * height + y) * width + x) * bytes_per_texel];
+  }
+};
+
+ChangeMask material_change_mask(const TileFrames& t, uint32_t first, uint32_t current,
+                                uint32_t window) {
+  ChangeMask mask;
+  mask.width = t.width;
+  mask.height = t.height;
+  mask.bits.assign(static_cast<size_t>(t.width) * t.height, 0);
+  const uint32_t from = current - std::min(window, current - first);
+  for (uint32_t y = 0; y < t.height; ++y) {
+    for (uint32_t x = 0; x < t.width; ++x) {
+      for (uint32_t j = from; j < current; ++j) {
+        if (std::memcmp(t.texel(current, x, y), t.texel(j, x, y), t.bytes_per_texel) != 0) {
+          mask.bits[static_cast<size_t>(y) * t.width + x] = 1;
+          break;
+        }
+      }
+    }
+  }
+  return mask;
+}
+
+enum class RegionCoding : uint8_t { kRaw, kBc5, kBc1 };
+
+// Codes frames [first, first + count) of a tile into one chunk (SPEC §11.1 "Region chunk").
+// `decoded` is the decoder's tile state (bytes_per_texel == 2 only), for the BC5 error report.
+Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth, RegionCoding coding,
+                         uint32_t first, uint32_t count, std::vector<uint8_t>& raw,
+                         TaskStats& s, StreamBytes& bytes, std::vector<uint16_t>* decoded) {
+  const LightfieldEncodeOptions& o = *ctx.options;
+  std::vector<std::vector<PixelRect>> rects(count);
+  std::vector<std::span<const uint16_t>> depth_frames;
+  std::vector<uint16_t> depth_codes;
+  if (is_depth) {
+    depth_codes.resize(static_cast<size_t>(count) * t.width * t.height);
+    for (uint32_t f = 0; f < count; ++f) {
+      for (size_t i = 0; i < static_cast<size_t>(t.width) * t.height; ++i) {
+        const uint8_t* p = &t.data[((first + f) * static_cast<size_t>(t.width) * t.height + i) * 2];
+        depth_codes[f * static_cast<size_t>(t.width) * t.height + i] =
+            static_cast<uint16_t>(p[0] << 8 | p[1]);
+      }
+    }
+    for (uint32_t f = 0; f < count; ++f) {
+      depth_frames.push_back(std::span<const uint16_t>(depth_codes).subspan(
+          f * static_cast<size_t>(t.width) * t.height, static_cast<size_t>(t.width) * t.height));
+    }
+  }
+  AabbOptions ao;
+  ao.max_boxes = o.max_aabbs;
+  ao.alignment = coding == RegionCoding::kRaw ? 1 : 4;
+  rects[0].push_back({0, 0, t.width, t.height});
+  for (uint32_t f = 1; f < count; ++f) {
+    ChangeMask mask;
+    if (is_depth) {
+      // The window never reaches before the group's keyframe: the decoder starts there.
+      CALF_ASSIGN_OR_RETURN(mask, depth_change_mask(std::span(depth_frames).first(f + 1), t.width,
+                                                    t.height, f, o.depth_window, 0));
+    } else {
+      mask = material_change_mask(t, first, first + f, o.depth_window);
+    }
+    CALF_ASSIGN_OR_RETURN(rects[f], fit_change_boxes(mask, ao));
+  }
+  raw.clear();
+  lf::put_u32(raw, count);
+  for (uint32_t f = 0; f < count; ++f) lf::put_u32(raw, static_cast<uint32_t>(rects[f].size()));
+  for (uint32_t f = 0; f < count; ++f) {
+    for (const PixelRect& r : rects[f]) {
+      lf::put_u16(raw, static_cast<uint16_t>(r.x));
+      lf::put_u16(raw, static_cast<uint16_t>(r.y));
+      lf::put_u16(raw, static_cast<uint16_t>(r.width));
+      lf::put_u16(raw, static_cast<uint16_t>(r.height));
+    }
+  }
+  const size_t header = raw.size();
+  uint64_t covered = 0;
+  std::vector<uint8_t> texels, blocks, rect_bytes, decoded_rect;
+  for (uint32_t f = 0; f < count; ++f) {
+    if (f == 0) {
+      s.depth_keyframes += is_depth ? 1 : 0;
+    } else if (is_depth) {
+      s.pframes += 1;
+      s.empty_pframes += rects[f].empty() ? 1 : 0;
+    }
+    for (const PixelRect& r : rects[f]) {
+      covered += static_cast<uint64_t>(r.width) * r.height;
+      rect_bytes.clear();
+      for (uint32_t y = 0; y < r.height; ++y) {
+        const uint8_t* p = t.texel(first + f, r.x, r.y + y);
+        rect_bytes.insert(rect_bytes.end(), p, p + size_t{r.width} * t.bytes_per_texel);
+      }
+      if (coding == RegionCoding::kRaw) {
+        texels.insert(texels.end(), rect_bytes.begin(), rect_bytes.end());
+        continue;
+      }
+      const bc::Format bf = coding == RegionCoding::kBc5 ? bc::Format::kBc5 : bc::Format::kBc1;
+      std::vector<uint8_t> rect_blocks(bc::encode_bound(bf, r.width, r.height));
+      const bc::Image8 img{rect_bytes.data(), r.width, r.height,
+                           size_t{r.width} * t.bytes_per_texel, t.bytes_per_texel};
+      if (coding == RegionCoding::kBc5) {
+        CALF_RETURN_IF_ERROR(bc::encode_bc5(img, rect_blocks.data(), rect_blocks.size(), {}));
+      } else {
+        CALF_RETURN_IF_ERROR(bc::encode_bc1(img, rect_blocks.data(), rect_blocks.size(), {}));
+      }
+      if (decoded != nullptr) {
+        decoded_rect.resize(size_t{r.width} * r.height * 2);
+        CALF_RETURN_IF_ERROR(bc::decode_image(bf, rect_blocks.data(), rect_blocks.size(), r.width,
+                                              r.height, decoded_rect.data(), decoded_rect.size(),
+                                              size_t{r.width} * 2));
+        for (uint32_t y = 0; y < r.height; ++y) {
+          for (uint32_t x = 0; x < r.width; ++x) {
+            const uint8_t* p = &decoded_rect[(size_t{y} * r.width + x) * 2];
+            (*decoded)[size_t{r.y + y} * t.width + r.x + x] = static_cast<uint16_t>(p[0] << 8 | p[1]);
+          }
+        }
+      }
+      blocks.insert(blocks.end(), rect_blocks.begin(), rect_blocks.end());
+    }
+    if (decoded != nullptr && ctx.view->range) {
+      // BC5 error of this frame as the decoder reconstructs it.
+      const double step = ctx.view->range->relative_step();
+      const std::span<const uint16_t> truth = depth_frames[f];
+      for (size_t i = 0; i < truth.size(); ++i) {
+        const uint16_t a = truth[i], b = (*decoded)[i];
+        if ((a == kLog16Sky) != (b == kLog16Sky)) {
+          s.sky_mismatches += 1;
+          continue;
+        }
+        if (a == kLog16Sky) continue;
+        const double rel = std::abs(std::expm1((static_cast<double>(b) - a) * step));
+        s.max_rel = std::max(s.max_rel, rel);
+        s.sum_rel += rel;
+        s.finite_texels += 1;
+      }
+    }
+  }
+  if (coding == RegionCoding::kRaw) {
+    lf::append_planes(raw, texels, t.bytes_per_texel);
+  } else {
+    lf::append_block_split(raw, blocks, coding == RegionCoding::kBc5 ? 16 : 8,
+                           coding == RegionCoding::kBc5);
+  }
+  bytes.raw += static_cast<uint64_t>(count) * t.width * t.height * t.bytes_per_texel;
+  bytes.temporal += header + covered * t.bytes_per_texel;
+  (void)bytes;
+  return Status::Ok();
+}
+
+void region_task(const Context& ctx, uint32_t face, uint32_t tile, bool is_depth, TaskOut& out) {
+  const ViewData& v = *ctx.view;
+  const PixelRect r = ctx.tiles.cell_rect(tile % ctx.tiles.cells_per_side(),
+                                          tile / ctx.tiles.cells_per_side());
+  TileFrames t;
+  t.width = r.width;
+  t.height = r.height;
+  t.bytes_per_texel = is_depth ? 2 : 3;
+  t.frames = v.frames;
+  t.data.resize(static_cast<size_t>(v.frames) * r.width * r.height * t.bytes_per_texel);
+  size_t o = 0;
+  for (uint32_t f = 0; f < v.frames; ++f) {
+    for (uint32_t y = 0; y < r.height; ++y) {
+      for (uint32_t x = 0; x < r.width; ++x) {
+        const size_t i = v.index(f, face, r.x + x, r.y + y);
+        if (is_depth) {
+          t.data[o++] = static_cast<uint8_t>(v.depth[i] >> 8);
+          t.data[o++] = static_cast<uint8_t>(v.depth[i]);
+        } else {
+          for (int c = 0; c < 3; ++c) t.data[o++] = v.material[i * 3 + c];
+        }
+      }
+    }
+  }
+  const bool lossy = ctx.options->depth == DepthCoding::kBc5;
+  const RegionCoding coding = !lossy ? RegionCoding::kRaw
+                              : is_depth ? RegionCoding::kBc5
+                                         : RegionCoding::kBc1;
+  std::vector<uint16_t> decoded;
+  if (is_depth && lossy) decoded.assign(static_cast<size_t>(r.width) * r.height, 0);
+  StreamBytes& bytes = is_depth ? out.stats.depth : out.stats.material;
+  std::vector<uint8_t> raw;
+  const uint32_t k = ctx.options->depth_keyframe_interval;
+  for (uint32_t first = 0; first < v.frames; first += k) {
+    const uint32_t count = std::min(k, v.frames - first);
+    out.status = code_region_group(ctx, t, is_depth, coding, first, count, raw, out.stats, bytes,
+                                   decoded.empty() ? nullptr : &decoded);
+    if (!out.status.ok()) return;
+    ChunkKeys keys;
+    keys.stream = static_cast<uint16_t>(is_depth ? LightfieldStream::kDepth
+                                                 : LightfieldStream::kMaterial);
+    keys.face = face;
+    keys.region = tile;
+    keys.first_frame = first;
+    keys.frame_count = count;
+    out.status = add_chunk(ctx, out, keys, raw, bytes);
+    if (!out.status.ok()) return;
+  }
+}
+
+void add_into(StreamBytes& a, const StreamBytes& b) {
+  a.raw += b.raw;
+  a.temporal += b.temporal;
+  a.spatial += b.spatial;
+  a.stored += b.stored;
+  a.chunks += b.chunks;
+}
+
+std::pair<uint32_t, uint32_t> fps_rational(double fps) {
+  uint64_t num = static_cast<uint64_t>(std::llround(fps * 1000.0));
+  uint64_t den = 1000;
+  if (num == 0) num = 1;
+  const uint64_t g = std::gcd(num, den);
+  num /= g;
+  den /= g;
+  num = std::min<uint64_t>(num, UINT32_MAX);
+  return {static_cast<uint32_t>(num), static_cast<uint32_t>(den)};
+}
+
+}  // namespace
+
+double psnr_log2(std::span<const float> reference, std::span<const float> test) {
+  constexpr float kFloor = 1.0f / 16384.0f;  // 2^-14, the smallest normal half
+  double sum = 0;
+  for (size_t i = 0; i < reference.size(); ++i) {
+    const double d = std::log2(std::max(reference[i], kFloor)) - std::log2(std::max(test[i], kFloor));
+    sum += d * d;
+  }
+  if (sum == 0 || reference.empty()) return kInf;
+  return 10.0 * std::log10(64.0 * static_cast<double>(reference.size()) / sum);
+}
+
+Status spatial_colour_reference(ColourCoding coding, std::span<const float> rgb, uint32_t w,
+                                uint32_t h, std::vector<float>* shown) {
+  CodedFrame coded;
+  CALF_RETURN_IF_ERROR(code_colour_frame(coding, rgb, w, h, &coded));
+  *shown = std::move(coded.shown);
+  return Status::Ok();
+}
+
+Expected<LightfieldEncodeStats> encode_lightfield(const capture::CaptureSetReader& input,
+                                                  container::Writer& writer,
+                                                  const LightfieldEncodeOptions& options) {
+  CALF_RETURN_IF_ERROR(validate(options));
+  const capture::CaptureManifest& m = input.manifest();
+  CALF_RETURN_IF_ERROR(input.check_files());
+  CALF_ASSIGN_OR_RETURN(FaceGrid cells, FaceGrid::with_cell_size(m.face_size, options.cell_size));
+  CALF_ASSIGN_OR_RETURN(FaceGrid tiles,
+                        FaceGrid::with_tiles_per_side(m.face_size, options.depth_tiles_per_side));
+
+  // HDR or LDR: decided over the whole set (a pre-pass that also validates every image) unless
+  // the format is given. LDR input never pays for a HDR format.
+  LightfieldEncodeStats stats;
+  ColourCoding colour = options.colour;
+  if (colour == ColourCoding::kAuto) {
+    capture::ViewFrame vf;
+    bool hdr = false;
+    for (uint32_t v = 0; v < m.viewpoints.size() && !hdr; ++v) {
+      for (uint32_t f = 0; f < m.frame_count && !hdr; ++f) {
+        CALF_RETURN_IF_ERROR(input.read(v, f, &vf));
+        hdr = std::any_of(vf.color.begin(), vf.color.end(), [](float c) { return c > 1.0f; });
+      }
+    }
+    colour = hdr ? ColourCoding::kBc6h : ColourCoding::kBc1;
+  }
+  stats.hdr = colour == ColourCoding::kBc6h || colour == ColourCoding::kRgba16f;
+  switch (colour) {
+    case ColourCoding::kBc1: stats.colour_format = pf(PixelFormat::kBc1); break;
+    case ColourCoding::kBc7: stats.colour_format = pf(PixelFormat::kBc7); break;
+    case ColourCoding::kBc6h: stats.colour_format = pf(PixelFormat::kBc6h); break;
+    case ColourCoding::kRgba8: stats.colour_format = pf(PixelFormat::kRgba8); break;
+    default: stats.colour_format = pf(PixelFormat::kRgba16f); break;
+  }
+  const bool lossy_depth = options.depth == DepthCoding::kBc5;
+  stats.depth_format = pf(lossy_depth ? PixelFormat::kBc5 : PixelFormat::kR16);
+  const uint16_t material_format = pf(lossy_depth ? PixelFormat::kBc1 : PixelFormat::kRgba8);
+
+  container::LightfieldTrackHeader header;
+  header.frame_count = m.frame_count;
+  std::tie(header.fps_numerator, header.fps_denominator) = fps_rational(m.fps);
+  header.view_count = static_cast<uint32_t>(m.viewpoints.size());
+  header.face_size = m.face_size;
+  header.cell_size = cells.cell_size();
+  header.depth_tile_size = tiles.cell_size();
+  header.colour_format = stats.colour_format;
+  header.depth_format = stats.depth_format;
+  header.material_format = 0;
+  header.flags = stats.hdr ? 1 : 0;
+  CALF_ASSIGN_OR_RETURN(uint16_t track, writer.add_track(header));
+
+  tbb::task_arena arena(options.threads == 0 ? tbb::task_arena::automatic
+                                             : static_cast<int>(options.threads));
+  stats.min_colour_quality_db = kInf;
+  double sum_rel = 0;
+  uint64_t finite_texels = 0;
+  const uint64_t total = uint64_t{6} * m.viewpoints.size();
+  ViewData view;
+  for (uint32_t v = 0; v < m.viewpoints.size(); ++v) {
+    CALF_RETURN_IF_ERROR(read_view(input, v, &view));
+    if (view.has_material) stats.material_views += 1;
+
+    // The view's index chunk (SPEC §11.1 "View index chunk").
+    std::vector<uint8_t> index;
+    lf::put_u32(index, kLayoutVersion);
+    lf::put_f64(index, m.viewpoints[v].position.x);
+    lf::put_f64(index, m.viewpoints[v].position.y);
+    lf::put_f64(index, m.viewpoints[v].position.z);
+    lf::put_f32(index, view.range ? view.range->z_near() : 1.0f);
+    lf::put_f32(index, view.range ? view.range->z_far() : 2.0f);
+    lf::put_u32(index, (view.range ? 1u : 0u) | (view.has_material ? 2u : 0u));
+    lf::put_u32(index, options.depth_keyframe_interval);
+    lf::put_u32(index, options.depth_window);
+    lf::put_f32(index, static_cast<float>(options.min_psnr_db));
+    ChunkKeys ikeys;
+    ikeys.track = track;
+    ikeys.stream = static_cast<uint16_t>(LightfieldStream::kIndex);
+    ikeys.view = v;
+    CALF_ASSIGN_OR_RETURN(StoredChunk ic,
+                          container::compress_chunk(index, Compression::kNone, options.levels));
+    stats.index_bytes += ic.bytes.size();
+    CALF_RETURN_IF_ERROR(writer.add_stored_chunk(ikeys, ic).status());
+
+    const Context ctx{&options, &view, v, track, colour, stats.hdr, cells, tiles};
+    for (uint32_t face = 0; face < 6; ++face) {
+      // Tasks of one face in file order: cells, depth tiles, material tiles.
+      const uint32_t nc = cells.cell_count(), nt = tiles.cell_count();
+      const uint32_t nm = view.has_material ? nt : 0;
+      std::vector<TaskOut> outs(nc + nt + nm);
+      arena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<uint32_t>(0, nc + nt + nm, 1),
+                          [&](const tbb::blocked_range<uint32_t>& range) {
+                            for (uint32_t i = range.begin(); i < range.end(); ++i) {
+                              if (i < nc) {
+                                colour_task(ctx, face, i, outs[i]);
+                              } else if (i < nc + nt) {
+                                region_task(ctx, face, i - nc, true, outs[i]);
+                              } else {
+                                region_task(ctx, face, i - nc - nt, false, outs[i]);
+                              }
+                            }
+                          });
+      });
+      for (TaskOut& o : outs) {
+        CALF_RETURN_IF_ERROR(o.status);
+        for (const Pending& p : o.chunks) CALF_RETURN_IF_ERROR(writer.add_stored_chunk(p.keys, p.chunk).status());
+        const TaskStats& s = o.stats;
+        add_into(stats.colour, s.colour);
+        add_into(stats.depth, s.depth);
+        add_into(stats.material, s.material);
+        stats.colour_keyframes += s.keyframes;
+        stats.depth_keyframes += s.depth_keyframes;
+        stats.depth_pframes += s.pframes;
+        stats.depth_empty_pframes += s.empty_pframes;
+        stats.min_colour_quality_db = std::min(stats.min_colour_quality_db, s.min_quality);
+        stats.depth_max_rel_error = std::max(stats.depth_max_rel_error, s.max_rel);
+        sum_rel += s.sum_rel;
+        finite_texels += s.finite_texels;
+        stats.depth_sky_mismatches += s.sky_mismatches;
+      }
+      stats.colour_cells += nc;
+      stats.depth_tiles += nt;
+      if (options.progress) options.progress(uint64_t{6} * v + face + 1, total);
+    }
+  }
+  stats.depth_mean_rel_error = finite_texels ? sum_rel / static_cast<double>(finite_texels) : 0;
+  if (stats.material_views > 0) {
+    stats.material_format = material_format;
+    header.material_format = material_format;
+    CALF_RETURN_IF_ERROR(writer.set_track_header(track, header));
+  }
+  return stats;
+}
+
+Expected<LightfieldEncodeStats> encode_lightfield_file(const std::filesystem::path& capture_dir,
+                                                       const std::string& out_path,
+                                                       const LightfieldEncodeOptions& options) {
+  CALF_RETURN_IF_ERROR(validate(options));
+  CALF_ASSIGN_OR_RETURN(capture::CaptureSetReader input, capture::CaptureSetReader::open(capture_dir));
+  CALF_ASSIGN_OR_RETURN(container::Writer writer, container::Writer::create(out_path, options.levels));
+  CALF_ASSIGN_OR_RETURN(LightfieldEncodeStats stats, encode_lightfield(input, writer, options));
+  CALF_RETURN_IF_ERROR(writer.set_metadata("encoder", std::string("calf-encode ") + kVersionString));
+  if (!input.manifest().scene.empty()) {
+    CALF_RETURN_IF_ERROR(writer.set_metadata("source_scene", input.manifest().scene));
+  }
+  CALF_RETURN_IF_ERROR(writer.finish());
+  return stats;
+}
+
+}  // namespace calf

@@ -1,0 +1,150 @@
+// calf-encode: a capture set in, a .calf with a lightfield track out (paper 002, Sec. 5;
+// format/SPEC.md §11.1). Errors are one line with a stable id and exit status 1 (no output file is
+// left behind); usage errors exit 2.
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "calf/encoder/lightfield_encode.h"
+
+namespace {
+
+int fail(const calf::Status& status) {
+  std::string line = status.to_string();
+  const size_t newline = line.find('\n');
+  if (newline != std::string::npos) line = line.substr(0, newline);
+  std::fprintf(stderr, "calf-encode: %s\n", line.c_str());
+  return 1;
+}
+
+double peak_rss_mib() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_maxrss) / 1024.0;  // Linux: KiB
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "calf-encode: encode a capture set (format/CAPTURE.md) into a .calf lightfield track "
+      "(format/SPEC.md 11.1).\nColour: per-cell keyframes + 8-bit t (Alg. 2); depth: log-16 "
+      "keyframes + rectangle P-frames (Alg. 3); material coded like depth when present."};
+  calf::LightfieldEncodeOptions o;
+  std::string manifest, out;
+  std::string colour = "auto", depth = "raw16", super = "zstd";
+  bool quiet = false;
+  app.add_option("MANIFEST", manifest,
+                 "capture set: its manifest.json or the directory holding it")
+      ->required();
+  app.add_option("-o,--output", out, "output .calf (written whole or not at all)")->required();
+  app.add_option("--threads", o.threads, "worker threads, 0 = all cores; output is identical for any count (default 0)")
+      ->default_val(0);
+  app.add_option("--cell", o.cell_size, "colour cell side in px, multiple of 4 (default 64)")
+      ->default_val(64);
+  app.add_option("--psnr", o.min_psnr_db,
+                 "Q: min dB of every interpolated frame vs. the frame as the spatial codec shows it; "
+                 "sRGB PSNR for LDR, log2-PSNR (8-stop peak) for HDR (default 50)")
+      ->default_val(50.0);
+  app.add_option("--color-format", colour,
+                 "auto (BC1 for LDR input, BC6H for HDR), bc1, bc7, bc6h, rgba8, rgba16f (default auto)")
+      ->check(CLI::IsMember({"auto", "bc1", "bc7", "bc6h", "rgba8", "rgba16f"}))
+      ->default_val("auto");
+  app.add_option("--depth-format", depth,
+                 "raw16 (exact after log-16 quantisation; material raw) or bc5 (hi/lo bytes, lossy; "
+                 "material BC1; the error is printed) (default raw16)")
+      ->check(CLI::IsMember({"raw16", "bc5"}))
+      ->default_val("raw16");
+  app.add_option("--depth-window", o.depth_window,
+                 "W: a P-frame holds texels differing from any of the previous W frames (default 2)")
+      ->default_val(2);
+  app.add_option("--max-aabbs", o.max_aabbs, "A: most rectangles per depth P-frame (default 2)")
+      ->default_val(2);
+  app.add_option("--depth-keyframe-interval", o.depth_keyframe_interval,
+                 "a depth / material keyframe every K frames (default 30)")
+      ->default_val(30);
+  app.add_option("--supercompression", super, "per chunk: zstd (level 19), lzma2 (preset 6), none (default zstd)")
+      ->check(CLI::IsMember({"zstd", "lzma2", "none"}))
+      ->default_val("zstd");
+  app.add_flag("-q,--quiet", quiet, "no progress line");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+
+  const std::map<std::string, calf::ColourCoding> colours = {
+      {"auto", calf::ColourCoding::kAuto},   {"bc1", calf::ColourCoding::kBc1},
+      {"bc7", calf::ColourCoding::kBc7},     {"bc6h", calf::ColourCoding::kBc6h},
+      {"rgba8", calf::ColourCoding::kRgba8}, {"rgba16f", calf::ColourCoding::kRgba16f}};
+  o.colour = colours.at(colour);
+  o.depth = depth == "bc5" ? calf::DepthCoding::kBc5 : calf::DepthCoding::kRaw16;
+  o.supercompression = super == "lzma2"  ? calf::container::Compression::kLzma2
+                       : super == "none" ? calf::container::Compression::kNone
+                                         : calf::container::Compression::kZstd;
+
+  std::filesystem::path dir = manifest;
+  if (dir.filename() == "manifest.json") dir = dir.parent_path();
+  if (dir.empty()) dir = ".";
+
+  const bool tty = isatty(2) != 0;
+  const auto start = std::chrono::steady_clock::now();
+  int next_percent = 0;
+  if (!quiet) {
+    o.progress = [&](uint64_t done, uint64_t total) {
+      const double elapsed =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double eta = elapsed / static_cast<double>(done) * static_cast<double>(total - done);
+      const int percent = static_cast<int>(100 * done / total);
+      if (!tty && percent < next_percent && done != total) return;
+      next_percent = percent + 10;
+      std::fprintf(stderr, "%scalf-encode: view-face %llu/%llu (%d%%) elapsed %.1f s, ETA %.1f s%s",
+                   tty ? "\r" : "", static_cast<unsigned long long>(done),
+                   static_cast<unsigned long long>(total), percent, elapsed, eta,
+                   tty && done != total ? "" : "\n");
+      std::fflush(stderr);
+    };
+  }
+  auto stats = calf::encode_lightfield_file(dir, out, o);
+  if (!stats.ok()) return fail(stats.status());
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  auto line = [](const char* name, const calf::StreamBytes& b) {
+    std::fprintf(stderr,
+                 "  %-8s raw %llu  temporal %llu  +spatial %llu  +%s %llu  (%.1fx)  %llu chunks\n",
+                 name, static_cast<unsigned long long>(b.raw),
+                 static_cast<unsigned long long>(b.temporal),
+                 static_cast<unsigned long long>(b.spatial), "super",
+                 static_cast<unsigned long long>(b.stored),
+                 b.stored ? static_cast<double>(b.raw) / static_cast<double>(b.stored) : 0.0,
+                 static_cast<unsigned long long>(b.chunks));
+  };
+  std::fprintf(stderr, "calf-encode: wrote %s in %.2f s (colour %s, %s)\n", out.c_str(), seconds,
+               calf::container::pixel_format_name(stats->colour_format), stats->hdr ? "HDR" : "LDR");
+  line("colour", stats->colour);
+  line("depth", stats->depth);
+  if (stats->material_views) line("material", stats->material);
+  std::fprintf(stderr,
+               "  colour: %llu cells, %llu keyframes, min temporal quality %.2f dB; depth: %llu "
+               "P-frames (%llu empty)\n",
+               static_cast<unsigned long long>(stats->colour_cells),
+               static_cast<unsigned long long>(stats->colour_keyframes),
+               stats->min_colour_quality_db,
+               static_cast<unsigned long long>(stats->depth_pframes),
+               static_cast<unsigned long long>(stats->depth_empty_pframes));
+  if (o.depth == calf::DepthCoding::kBc5) {
+    std::fprintf(stderr,
+                 "  BC5 depth error: max relative %.3g, mean relative %.3g, sky mismatches %llu\n",
+                 stats->depth_max_rel_error, stats->depth_mean_rel_error,
+                 static_cast<unsigned long long>(stats->depth_sky_mismatches));
+  }
+  std::fprintf(stderr, "calf-encode: peak RSS %.1f MiB\n", peak_rss_mib());
+  return 0;
+}
