@@ -1,0 +1,290 @@
+// Paper 002 Table 1 for the lightfield track: for each capture set, the bytes of the colour and
+// depth streams at each stage of the encoder (raw, temporal, +spatial (BCn), +zstd, +LZMA2) and
+// their ratios to raw, taken from the encoder's own per-stream accounting (LightfieldEncodeStats),
+// plus, in the same run, general-purpose peers on the raw streams: `xz -9` and `zstd -19` of the
+// raw colour stream (RGBA8 sRGB for LDR input, RGBA16F for HDR, as StreamBytes::raw counts it) and
+// of the raw log-16 depth stream (per-view z_near / z_far from the data, as the encoder quantises).
+// Also encode seconds and peak RSS (getrusage). Prints markdown.
+//
+//   bench-lightfield_table1 --capture DIR [--capture DIR ...] [--threads N]
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "calf/capture/capture_set.h"
+#include "calf/encoder/lightfield_encode.h"
+#include "calf/format/bc.h"
+#include "calf/format/log_depth.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace calf;
+
+double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+uint64_t peak_rss_kib(int who) {
+  rusage u{};
+  getrusage(who, &u);
+  return static_cast<uint64_t>(u.ru_maxrss);
+}
+std::string bytes(uint64_t b) {
+  std::string s = std::to_string(b), out;
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (i && (s.size() - i) % 3 == 0) out += ',';
+    out += s[i];
+  }
+  return out;
+}
+std::string ratio(uint64_t raw, std::optional<uint64_t> b) {
+  if (!b || *b == 0) return "—";
+  return fmt::format("{:.1f}×", static_cast<double>(raw) / static_cast<double>(*b));
+}
+std::string cell(std::optional<uint64_t> b) { return b ? bytes(*b) : "—"; }
+
+// Writes the raw colour and log-16 depth streams of `dir` (view-major, frame, texel; colour RGBA
+// interleaved; depth little-endian u16) to two files.
+Status write_raw_streams(const capture::CaptureSetReader& in, bool hdr, const fs::path& colour_path,
+                         const fs::path& depth_path) {
+  std::ofstream colour(colour_path, std::ios::binary), depth(depth_path, std::ios::binary);
+  const auto& m = in.manifest();
+  capture::ViewFrame vf;
+  std::vector<float> z;
+  std::vector<uint8_t> buf;
+  for (uint32_t v = 0; v < m.viewpoints.size(); ++v) {
+    z.clear();
+    float lo = std::numeric_limits<float>::infinity(), hi = 0;
+    for (uint32_t f = 0; f < m.frame_count; ++f) {
+      CALF_RETURN_IF_ERROR(in.read(v, f, &vf));
+      const size_t n = vf.texel_count();
+      buf.clear();
+      for (size_t i = 0; i < n; ++i) {
+        if (hdr) {
+          for (int c = 0; c < 4; ++c) {
+            const uint16_t h =
+                c == 3 ? bc::float_to_half(1.0f)
+                       : bc::float_to_half(std::min(vf.color[3 * i + c], 65504.0f));
+            buf.push_back(static_cast<uint8_t>(h & 0xff));
+            buf.push_back(static_cast<uint8_t>(h >> 8));
+          }
+        } else {
+          for (int c = 0; c < 3; ++c) {
+            float s = vf.color[3 * i + c];
+            s = !(s > 0) ? 0.0f
+                : s >= 1 ? 1.0f
+                : s <= 0.0031308f ? 12.92f * s
+                                  : 1.055f * std::pow(s, 1.0f / 2.4f) - 0.055f;
+            buf.push_back(static_cast<uint8_t>(std::lround(s * 255.0f)));
+          }
+          buf.push_back(255);
+        }
+        const float d = vf.depth[i];
+        z.push_back(d);
+        if (std::isfinite(d)) {
+          lo = std::min(lo, d);
+          hi = std::max(hi, d);
+        }
+      }
+      colour.write(reinterpret_cast<const char*>(buf.data()), static_cast<std::streamsize>(buf.size()));
+    }
+    std::optional<LogDepthRange> range;
+    if (hi > 0) {
+      CALF_ASSIGN_OR_RETURN(LogDepthRange r, LogDepthRange::covering(lo, hi));
+      range = r;
+    }
+    buf.clear();
+    for (float d : z) {
+      const uint16_t code = range ? range->encode_unchecked(d) : kLog16Sky;
+      buf.push_back(static_cast<uint8_t>(code & 0xff));
+      buf.push_back(static_cast<uint8_t>(code >> 8));
+    }
+    depth.write(reinterpret_cast<const char*>(buf.data()), static_cast<std::streamsize>(buf.size()));
+  }
+  colour.close();
+  depth.close();
+  if (!colour || !depth) return Status(ErrorId::kFileWrite, "writing the raw streams failed");
+  return Status::Ok();
+}
+
+bool have_tool(const char* name) {
+  return std::system(fmt::format("command -v {} >/dev/null 2>&1", name).c_str()) == 0;
+}
+
+struct Peer {
+  std::optional<uint64_t> size;
+  double seconds = 0;
+};
+// Runs `tool args < file | wc -c` and returns the compressed size.
+Peer run_peer(const std::string& tool_args, const fs::path& file) {
+  Peer p;
+  const std::string cmd = fmt::format("{} -c '{}' | wc -c", tool_args, file.string());
+  const double t0 = now_s();
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return p;
+  unsigned long long n = 0;
+  const bool got = std::fscanf(pipe, "%llu", &n) == 1;
+  const int rc = pclose(pipe);
+  p.seconds = now_s() - t0;
+  if (got && rc == 0) p.size = n;
+  return p;
+}
+
+struct EncodeRun {
+  LightfieldEncodeStats stats;
+  double seconds = 0;
+  uint64_t file_bytes = 0;
+};
+Expected<EncodeRun> encode(const fs::path& capture, const fs::path& out, uint32_t threads,
+                           container::Compression sc) {
+  LightfieldEncodeOptions o;
+  o.threads = threads;
+  o.supercompression = sc;
+  EncodeRun r;
+  const double t0 = now_s();
+  CALF_ASSIGN_OR_RETURN(r.stats, encode_lightfield_file(capture, out.string(), o));
+  r.seconds = now_s() - t0;
+  r.file_bytes = fs::file_size(out);
+  fs::remove(out);
+  return r;
+}
+
+const char* format_name(uint16_t f) {
+  using container::PixelFormat;
+  switch (static_cast<PixelFormat>(f)) {
+    case PixelFormat::kBc1: return "BC1";
+    case PixelFormat::kBc5: return "BC5";
+    case PixelFormat::kBc6h: return "BC6H";
+    case PixelFormat::kBc7: return "BC7";
+    case PixelFormat::kRgba8: return "RGBA8";
+    case PixelFormat::kRgba16f: return "RGBA16F";
+    case PixelFormat::kR16: return "raw16";
+    default: return "?";
+  }
+}
+
+int run_one(const fs::path& dir, uint32_t threads, bool have_xz, bool have_zstd) {
+  auto in = capture::CaptureSetReader::open(dir);
+  if (!in.ok()) {
+    fmt::print(stderr, "{}: {}\n", dir.string(), in.status().to_string());
+    return 1;
+  }
+  const auto& m = in->manifest();
+  const fs::path tmp = fs::temp_directory_path() / fmt::format("calf-table1-{}", ::getpid());
+  fs::create_directories(tmp);
+  auto z = encode(dir, tmp / "zstd.calf", threads, container::Compression::kZstd);
+  const uint64_t rss_after_zstd = peak_rss_kib(RUSAGE_SELF);
+  auto x = z.ok() ? encode(dir, tmp / "lzma2.calf", threads, container::Compression::kLzma2)
+                  : Expected<EncodeRun>(z.status());
+  const uint64_t rss_after_lzma = peak_rss_kib(RUSAGE_SELF);
+  if (!z.ok() || !x.ok()) {
+    fmt::print(stderr, "{}: {}\n", dir.string(), (z.ok() ? x : z).status().to_string());
+    fs::remove_all(tmp);
+    return 1;
+  }
+  const LightfieldEncodeStats& s = z->stats;
+  const LightfieldEncodeStats& sx = x->stats;
+
+  // Peers on the raw streams.
+  Peer xz_c, xz_d, zs_c, zs_d;
+  std::string raw_note;
+  const fs::path rc = tmp / "colour.raw", rd = tmp / "depth.raw";
+  Status st = write_raw_streams(*in, s.hdr, rc, rd);
+  if (!st.ok()) {
+    raw_note = "raw streams not written: " + st.to_string();
+  } else {
+    if (fs::file_size(rc) != s.colour.raw || fs::file_size(rd) != s.depth.raw) {
+      raw_note = fmt::format("note: raw files {} / {} bytes differ from the encoder's raw counts",
+                             fs::file_size(rc), fs::file_size(rd));
+    }
+    if (have_xz) {
+      xz_c = run_peer("xz -9 -T1", rc);
+      xz_d = run_peer("xz -9 -T1", rd);
+    }
+    if (have_zstd) {
+      zs_c = run_peer("zstd -19 -q -T1", rc);
+      zs_d = run_peer("zstd -19 -q -T1", rd);
+    }
+  }
+  fs::remove_all(tmp);
+
+  const std::string scene = m.scene.empty() ? dir.filename().string() : m.scene;
+  fmt::print("### {} — {} views × {} frames, face {}, cell 64, {} input\n\n", scene,
+             m.viewpoints.size(), m.frame_count, m.face_size, s.hdr ? "HDR" : "LDR");
+  fmt::print("Capture `{}`; colour {} (raw = {}), depth {} (raw = log-16 u16); threads {}.\n\n",
+             dir.string(), format_name(s.colour_format), s.hdr ? "RGBA16F" : "RGBA8 sRGB",
+             format_name(s.depth_format), threads);
+  fmt::print("| stage | colour bytes | colour ratio | depth bytes | depth ratio |\n");
+  fmt::print("|---|---:|---:|---:|---:|\n");
+  auto row = [&](const char* name, std::optional<uint64_t> c, std::optional<uint64_t> d) {
+    fmt::print("| {} | {} | {} | {} | {} |\n", name, cell(c), ratio(s.colour.raw, c), cell(d),
+               ratio(s.depth.raw, d));
+  };
+  row("raw", s.colour.raw, s.depth.raw);
+  row("temporal (keyframes / P-frames)", s.colour.temporal, s.depth.temporal);
+  row("+spatial (BCn)", s.colour.spatial, s.depth.spatial);
+  row("+zstd (level 19, per chunk)", s.colour.stored, s.depth.stored);
+  row("+LZMA2 (preset 6, per chunk)", sx.colour.stored, sx.depth.stored);
+  row("peer: `zstd -19` of raw", zs_c.size, zs_d.size);
+  row("peer: `xz -9` of raw", xz_c.size, xz_d.size);
+  fmt::print("\n");
+  if (!have_xz) fmt::print("- `xz` not installed: peer skipped.\n");
+  if (!have_zstd) fmt::print("- `zstd` not installed: peer skipped.\n");
+  if (!raw_note.empty()) fmt::print("- {}\n", raw_note);
+  fmt::print("- encode: {:.2f} s (zstd), {:.2f} s (LZMA2); file {} / {} bytes; peak RSS {:.1f} MiB "
+             "after the zstd encode, {:.1f} MiB after both (process peak, includes reading the "
+             "raw streams later: {:.1f} MiB)\n",
+             z->seconds, x->seconds, bytes(z->file_bytes), bytes(x->file_bytes),
+             rss_after_zstd / 1024.0, rss_after_lzma / 1024.0,
+             peak_rss_kib(RUSAGE_SELF) / 1024.0);
+  fmt::print("- peers: zstd -19 {:.2f} s + {:.2f} s, xz -9 {:.2f} s + {:.2f} s (colour + depth); "
+             "largest child peak RSS {:.1f} MiB\n",
+             zs_c.seconds, zs_d.seconds, xz_c.seconds, xz_d.seconds,
+             peak_rss_kib(RUSAGE_CHILDREN) / 1024.0);
+  fmt::print("- colour: {} cells, {} keyframes of {} cell-frames, min temporal quality {:.1f} dB; "
+             "depth: {} tiles, {} keyframes, {} P-frames ({} empty); index {} bytes\n",
+             s.colour_cells, s.colour_keyframes, s.colour_cells * m.frame_count,
+             s.min_colour_quality_db, s.depth_tiles, s.depth_keyframes, s.depth_pframes,
+             s.depth_empty_pframes, bytes(s.index_bytes));
+  if (s.material_views > 0) {
+    fmt::print("- material ({} views, {}): raw {}, temporal {}, +spatial {}, +zstd {}, +LZMA2 {}\n",
+               s.material_views, format_name(s.material_format), bytes(s.material.raw),
+               bytes(s.material.temporal), bytes(s.material.spatial), bytes(s.material.stored),
+               bytes(sx.material.stored));
+  } else {
+    fmt::print("- material: none (no view sees a reflective or refractive texel)\n");
+  }
+  fmt::print("\n");
+  std::fflush(stdout);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Paper 002 Table 1 for the lightfield track of each capture set, with xz / zstd peers"};
+  std::vector<std::string> captures;
+  uint32_t threads = 0;
+  app.add_option("--capture", captures, "capture-set directory (repeatable)")->required();
+  app.add_option("--threads", threads, "encoder threads, 0 = all cores (default 0)");
+  CLI11_PARSE(app, argc, argv);
+  const bool have_xz = have_tool("xz"), have_zstd = have_tool("zstd");
+  int rc = 0;
+  for (const auto& c : captures) rc |= run_one(c, threads, have_xz, have_zstd);
+  return rc;
+}
