@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 ./tools/setup.sh
 BUILD=build/release
 cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$BUILD"
+cmake --build "$BUILD" --target calf-capture calf-encode calf-info calf-verify
 OUT=build/demo
 rm -rf "$OUT"
 mkdir -p "$OUT"
