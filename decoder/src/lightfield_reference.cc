@@ -6,6 +6,7 @@
 #include <string>
 
 #include "calf/format/bc.h"
+#include "calf/format/colour.h"
 #include "calf/format/grid.h"
 
 namespace calf::decoder {
@@ -132,7 +133,7 @@ Status decode_colour_payload(uint16_t format, std::span<const uint8_t> p, uint32
                                           blocks.size(), w, h, rgba.data(), rgba.size(),
                                           size_t{w} * 4));
     for (size_t i = 0; i < n; ++i) {
-      for (int c = 0; c < 3; ++c) rgb[3 * i + c] = srgb8_to_linear(rgba[4 * i + c]);
+      for (int c = 0; c < 3; ++c) rgb[3 * i + c] = linear_from_srgb8(rgba[4 * i + c]);
     }
     return Status::Ok();
   }
@@ -147,7 +148,7 @@ Status decode_colour_payload(uint16_t format, std::span<const uint8_t> p, uint32
   if (format == static_cast<uint16_t>(PixelFormat::kRgba8)) {
     if (p.size() != n * 4) return wrong(n * 4);
     for (size_t i = 0; i < n; ++i) {
-      for (int c = 0; c < 3; ++c) rgb[3 * i + c] = srgb8_to_linear(p[c * n + i]);
+      for (int c = 0; c < 3; ++c) rgb[3 * i + c] = linear_from_srgb8(p[c * n + i]);
     }
     return Status::Ok();
   }
@@ -262,18 +263,6 @@ Status apply_region_chunk(std::span<const uint8_t> raw, uint32_t frame_count, ui
 }
 
 }  // namespace
-
-float srgb8_to_linear(uint8_t v) {
-  static const std::array<float, 256> table = [] {
-    std::array<float, 256> t{};
-    for (int i = 0; i < 256; ++i) {
-      const double c = i / 255.0;
-      t[i] = static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
-    }
-    return t;
-  }();
-  return table[v];
-}
 
 Expected<LightfieldReference> LightfieldReference::open(const container::Reader& reader,
                                                         uint16_t track) {

@@ -17,20 +17,6 @@ namespace {
 
 using internal::BitWriter;
 
-int unquantize(int x, int bits, bool is_signed) {
-  if (!is_signed) {
-    if (bits >= 15) return x;
-    if (x == 0) return 0;
-    if (x == (1 << bits) - 1) return 0xffff;
-    return ((x << 15) + 0x4000) >> (bits - 1);
-  }
-  if (bits >= 16) return x;
-  const bool negative = x < 0;
-  if (negative) x = -x;
-  int q = x == 0 ? 0 : x >= (1 << (bits - 1)) - 1 ? 0x7fff : ((x << 15) + 0x4000) >> (bits - 1);
-  return negative ? -q : q;
-}
-
 // Decoded value (as target-space integer) of an interpolated unquantised value.
 int finish(int v, bool is_signed) {
   if (!is_signed) return (v * 31) >> 6;
@@ -49,7 +35,7 @@ int quantize(float u, int bits, bool is_signed) {
   int best = q0;
   float best_d = std::numeric_limits<float>::max();
   for (int q = std::max(lo, q0 - 1); q <= std::min(hi, q0 + 1); ++q) {
-    const float d = std::fabs(static_cast<float>(unquantize(q, bits, is_signed)) - u);
+    const float d = std::fabs(static_cast<float>(bc6h_unquantize(q, bits, is_signed)) - u);
     if (d < best_d) best_d = d, best = q;
   }
   return best;
@@ -109,7 +95,7 @@ long assign(const Texels& tx, const int* members, int count, int bits, int index
   const uint8_t* w = weights_for_bits(index_bits);
   int e[2][3], pal[16][3];
   for (int j = 0; j < 2; ++j)
-    for (int c = 0; c < 3; ++c) e[j][c] = unquantize(f.q[j][c], bits, tx.is_signed);
+    for (int c = 0; c < 3; ++c) e[j][c] = bc6h_unquantize(f.q[j][c], bits, tx.is_signed);
   for (int k = 0; k < n; ++k)
     for (int c = 0; c < 3; ++c)
       pal[k][c] = finish((e[0][c] * (64 - w[k]) + e[1][c] * w[k] + 32) >> 6, tx.is_signed);

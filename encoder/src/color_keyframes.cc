@@ -1,5 +1,7 @@
 #include "calf/encoder/color_keyframes.h"
 
+#include "calf/format/colour.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,12 +12,6 @@ namespace calf {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-
-float srgb_from_linear(float v) {
-  if (!(v > 0.0f)) return 0.0f;
-  if (v >= 1.0f) return 1.0f;
-  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-}
 
 // Alg. 2's state for one cell: original frames, the keyframes as shown (cached), scratch space.
 class CellSearch {

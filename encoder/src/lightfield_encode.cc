@@ -1,5 +1,7 @@
 #include "calf/encoder/lightfield_encode.h"
 
+#include "calf/format/colour.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -39,26 +41,6 @@ uint16_t pf(PixelFormat f) { return static_cast<uint16_t>(f); }
 
 // ---- Colour conversions (SPEC §11.1: 8-bit colour formats hold sRGB-encoded values) ----
 
-float srgb_encode(float v) {
-  if (!(v > 0.0f)) return 0.0f;
-  if (v >= 1.0f) return 1.0f;
-  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-}
-uint8_t srgb8_from_linear(float v) {
-  return static_cast<uint8_t>(std::lround(srgb_encode(v) * 255.0f));
-}
-// The decoder's table: sRGB byte -> linear float (the same formula as decoder/lightfield).
-const std::array<float, 256>& srgb8_to_linear_table() {
-  static const std::array<float, 256> table = [] {
-    std::array<float, 256> t{};
-    for (int i = 0; i < 256; ++i) {
-      const double c = i / 255.0;
-      t[i] = static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
-    }
-    return t;
-  }();
-  return table;
-}
 uint16_t half_from_colour(float v) {
   return bc::float_to_half(std::min(v, 65504.0f));  // input is validated finite and >= 0
 }
@@ -219,7 +201,6 @@ struct CodedFrame {
 Status code_colour_frame(ColourCoding coding, std::span<const float> rgb, uint32_t w, uint32_t h,
                          CodedFrame* out) {
   const size_t n = static_cast<size_t>(w) * h;
-  const auto& lut = srgb8_to_linear_table();
   out->shown.resize(n * 3);
   switch (coding) {
     case ColourCoding::kBc1:
@@ -247,7 +228,7 @@ Status code_colour_frame(ColourCoding coding, std::span<const float> rgb, uint32
                                               rgba.data(), rgba.size(), size_t{w} * 4));
       }
       for (size_t i = 0; i < n; ++i) {
-        for (int c = 0; c < 3; ++c) out->shown[3 * i + c] = lut[rgba[4 * i + c]];
+        for (int c = 0; c < 3; ++c) out->shown[3 * i + c] = linear_from_srgb8(rgba[4 * i + c]);
       }
       return Status::Ok();
     }

@@ -4,9 +4,9 @@
 // (kBc6hLayouts), so the layout is the specification's text rather than 14 hand-written readers.
 #include <cstring>
 
+#include "bc_bits.h"
 #include "calf/format/bc.h"
 #include "calf/format/bc_tables.h"
-#include "bc_bits.h"
 
 namespace calf::bc {
 namespace {
@@ -47,6 +47,10 @@ uint16_t finish(int v, bool is_signed) {
 }
 
 }  // namespace
+
+int bc6h_unquantize(int x, int bits, bool is_signed) {
+  return unquantize(x, bits, is_signed);
+}
 
 void decode_bc6h_block(const uint8_t* block, bool is_signed, uint16_t* rgb_half) {
   const int k = bc6h_mode_index(block[0]);

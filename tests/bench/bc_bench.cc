@@ -28,6 +28,7 @@
 #include "calf/capture/capture_set.h"
 #include "calf/encoder/bc_encode.h"
 #include "calf/format/bc.h"
+#include "calf/format/colour.h"
 
 namespace {
 
@@ -88,11 +89,6 @@ void render(uint32_t x, uint32_t y, float sun, float* rgb) {
   }
 }
 
-uint8_t to_srgb8(float v) {
-  v = std::clamp(v, 0.0f, 1.0f);
-  const float s = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1 / 2.4f) - 0.055f;
-  return static_cast<uint8_t>(std::lround(s * 255));
-}
 
 // An image of the test set: w x h texels, RGBA8 (LDR) or RGB float (HDR). `group` is
 // "synthetic" or "capture" (means are printed per group).
@@ -141,7 +137,7 @@ bool load_capture(const std::string& dir, uint32_t max_views, std::vector<Ldr>* 
       size_t over = 0;
       for (size_t i = 0; i < texels; ++i) {
         for (int c = 0; c < 3; ++c) {
-          l.px[i * 4 + c] = to_srgb8(vf.color[i * 3 + c]);
+          l.px[i * 4 + c] = calf::srgb8_from_linear(vf.color[i * 3 + c]);
           peak = std::max(peak, vf.color[i * 3 + c]);
         }
         over += std::max({vf.color[i * 3], vf.color[i * 3 + 1], vf.color[i * 3 + 2]}) > 1.0f;
@@ -173,7 +169,7 @@ std::vector<Ldr> ldr_set() {
       for (int c = 0; c < 3; ++c) set[3].px[p + c] = static_cast<uint8_t>(rng());
       float rgb[3];
       render(x, y, 100.0f, rgb);
-      for (int c = 0; c < 3; ++c) set[4].px[p + c] = to_srgb8(rgb[c]);
+      for (int c = 0; c < 3; ++c) set[4].px[p + c] = calf::srgb8_from_linear(rgb[c]);
     }
   return set;
 }

@@ -115,6 +115,12 @@ void decode_block(Format f, const uint8_t* block, void* out);
 Status decode_image(Format f, const uint8_t* blocks, size_t blocks_size, uint32_t width,
                     uint32_t height, void* out, size_t out_size, size_t out_row_stride);
 
+// ---- BC6H endpoint arithmetic, shared with the encoder's endpoint search ----
+
+// Unquantises a `bits`-bit endpoint value (already sign-extended when `is_signed`) to the 16-bit
+// interpolation domain, as the specification's pseudocode does.
+int bc6h_unquantize(int x, int bits, bool is_signed);
+
 // ---- Half floats (IEEE 754 binary16), as BC6H stores and decodes them. ----
 
 // Exact conversion of a half bit pattern to float (subnormals, Inf and NaN included).
