@@ -11,27 +11,29 @@ FaceGrid::FaceGrid(uint32_t face_size, uint32_t cell_size)
       cell_size_(std::min(cell_size, face_size)),
       per_side_((face_size + cell_size_ - 1) / cell_size_) {}
 
+namespace {
+
+// Every grid size (face, cell, tile count) is validated against the same range.
+Status check_grid_size(const char* what, uint32_t value) {
+  if (value == 0 || value > kMaxFaceSize) {
+    return Status(ErrorId::kGridSize, std::string(what) + " " + std::to_string(value) +
+                                          " must be in [1, " + std::to_string(kMaxFaceSize) + "]");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 Expected<FaceGrid> FaceGrid::with_cell_size(uint32_t face_size, uint32_t cell_size) {
-  if (face_size == 0 || face_size > kMaxFaceSize) {
-    return Status(ErrorId::kGridSize, "face size " + std::to_string(face_size) +
-                                          " must be in [1, " + std::to_string(kMaxFaceSize) + "]");
-  }
-  if (cell_size == 0 || cell_size > kMaxFaceSize) {
-    return Status(ErrorId::kGridSize, "cell size " + std::to_string(cell_size) +
-                                          " must be in [1, " + std::to_string(kMaxFaceSize) + "]");
-  }
+  CALF_RETURN_IF_ERROR(check_grid_size("face size", face_size));
+  CALF_RETURN_IF_ERROR(check_grid_size("cell size", cell_size));
   return FaceGrid(face_size, cell_size);
 }
 
 Expected<FaceGrid> FaceGrid::with_tiles_per_side(uint32_t face_size, uint32_t tiles_per_side) {
-  if (tiles_per_side == 0 || tiles_per_side > kMaxFaceSize) {
-    return Status(ErrorId::kGridSize, "tiles per side " + std::to_string(tiles_per_side) +
-                                          " must be in [1, " + std::to_string(kMaxFaceSize) + "]");
-  }
-  if (face_size == 0 || face_size > kMaxFaceSize) {
-    return Status(ErrorId::kGridSize, "face size " + std::to_string(face_size) +
-                                          " must be in [1, " + std::to_string(kMaxFaceSize) + "]");
-  }
+  CALF_RETURN_IF_ERROR(check_grid_size("tiles per side", tiles_per_side));
+  // Checked here too so that a zero face is reported as such, not as a zero cell size.
+  CALF_RETURN_IF_ERROR(check_grid_size("face size", face_size));
   const uint32_t side = (face_size + tiles_per_side - 1) / tiles_per_side;
   return with_cell_size(face_size, (side + 3u) & ~3u);
 }
