@@ -23,8 +23,12 @@ int finish(int v, bool is_signed) {
   return v < 0 ? -(((-v) * 31) >> 5) : (v * 31) >> 5;
 }
 
-int min_q(int bits, bool is_signed) { return is_signed ? -((1 << (bits - 1)) - 1) : 0; }
-int max_q(int bits, bool is_signed) { return is_signed ? (1 << (bits - 1)) - 1 : (1 << bits) - 1; }
+int min_q(int bits, bool is_signed) {
+  return is_signed ? -((1 << (bits - 1)) - 1) : 0;
+}
+int max_q(int bits, bool is_signed) {
+  return is_signed ? (1 << (bits - 1)) - 1 : (1 << bits) - 1;
+}
 
 // Nearest endpoint value of `bits` precision to the unquantised target u.
 int quantize(float u, int bits, bool is_signed) {
@@ -129,7 +133,8 @@ RegionFit fit_region(const Texels& tx, const int* members, int count, const floa
     for (int m = 0; m < count; ++m) {
       const float t = w[f.index[members[m]]] / 64.0f, s = 1.0f - t;
       aa += s * s, ab += s * t, bb += t * t;
-      for (int c = 0; c < 3; ++c) ax[c] += s * tx.u[members[m]][c], bx[c] += t * tx.u[members[m]][c];
+      for (int c = 0; c < 3; ++c)
+        ax[c] += s * tx.u[members[m]][c], bx[c] += t * tx.u[members[m]][c];
     }
     const float det = aa * bb - ab * ab;
     if (std::fabs(det) < 1e-6f) break;
@@ -341,20 +346,19 @@ Status encode_bc6h(const ImageF& image, uint8_t* out, size_t out_size, const Bc6
             return Status(ErrorId::kBcNonFinite, where());
           }
           if ((!options.is_signed && v < 0) || std::fabs(v) > 65504.0f) {
-            return Status(ErrorId::kBcOutOfRange, where() + ", expected " +
-                                                      (options.is_signed ? "-65504" : "0") +
-                                                      "..65504");
+            return Status(
+                ErrorId::kBcOutOfRange,
+                where() + ", expected " + (options.is_signed ? "-65504" : "0") + "..65504");
           }
         }
       }
     }
   }
-  const uint32_t bw = blocks_along(image.width);
-  internal::for_each_block(image.width, image.height, options.threads,
-                           [&](uint32_t bx, uint32_t by) {
+  internal::for_each_block(image.width, image.height, options.threads, out, 16,
+                           [&](uint32_t bx, uint32_t by, uint8_t* block) {
                              float px[48];
                              internal::gatherf(image, bx, by, px);
-                             encode_bc6h_block(px, out + (size_t{by} * bw + bx) * 16, options);
+                             encode_bc6h_block(px, block, options);
                            });
   return Status::Ok();
 }

@@ -26,9 +26,9 @@ struct FitSpec {
 };
 
 struct SubsetFit {
-  int q[2][4] = {};    // stored endpoint values (without p-bit)
-  int p[2] = {};       // p-bits
-  int e[2][4] = {};    // decoded 8-bit endpoints
+  int q[2][4] = {};  // stored endpoint values (without p-bit)
+  int p[2] = {};     // p-bits
+  int e[2][4] = {};  // decoded 8-bit endpoints
   uint8_t index[16] = {};
   long err = std::numeric_limits<long>::max();
 };
@@ -249,7 +249,8 @@ void try_mode(const ModeSpec& m, int partition, const int (*px)[4], int refineme
     std::swap(f.q[0], f.q[1]);
     std::swap(f.p[0], f.p[1]);
     for (int i = 0; i < 16; ++i)
-      if (subset_of(m.subsets, partition, i) == sub) index[i] = static_cast<uint8_t>(top - index[i]);
+      if (subset_of(m.subsets, partition, i) == sub)
+        index[i] = static_cast<uint8_t>(top - index[i]);
   }
   Candidate c;
   c.err = err;
@@ -302,8 +303,7 @@ void try_mode5(const int (*px)[4], int refinements, Candidate& best) {
 
 // The `keep` shapes of `subsets` subsets with the smallest estimate, best first (ties: lower
 // shape number first, so the order is deterministic).
-int rank_partitions(const int (*px)[4], int subsets, int shapes, int channels, int keep,
-                    int* out) {
+int rank_partitions(const int (*px)[4], int subsets, int shapes, int channels, int keep, int* out) {
   float score[64];
   int order[64];
   for (int p = 0; p < shapes; ++p) {
@@ -350,22 +350,22 @@ void encode_bc7_block(const uint8_t* rgba, uint8_t* out16, const Bc7Options& opt
     } else if (q >= 1) {
       try_mode5(px, refinements, best);
       const int n = rank_partitions(px, 2, 64, 4, kShapes2[q], shapes);
-      for (int k = 0; k < n && best.err > 0; ++k) try_mode(kMode7, shapes[k], px, refinements, best);
+      for (int k = 0; k < n && best.err > 0; ++k)
+        try_mode(kMode7, shapes[k], px, refinements, best);
     }
   }
   std::memcpy(out16, best.block, 16);
 }
 
 Status encode_bc7(const Image8& image, uint8_t* out, size_t out_size, const Bc7Options& options) {
-  CALF_RETURN_IF_ERROR(internal::check_image(Format::kBc7, image.pixels, image.width,
-                                             image.height, image.row_stride, 1, image.channels,
-                                             3, 4, out_size, options.quality, 2, options.threads));
-  const uint32_t bw = blocks_along(image.width);
-  internal::for_each_block(image.width, image.height, options.threads,
-                           [&](uint32_t bx, uint32_t by) {
+  CALF_RETURN_IF_ERROR(internal::check_image(Format::kBc7, image.pixels, image.width, image.height,
+                                             image.row_stride, 1, image.channels, 3, 4, out_size,
+                                             options.quality, 2, options.threads));
+  internal::for_each_block(image.width, image.height, options.threads, out, 16,
+                           [&](uint32_t bx, uint32_t by, uint8_t* block) {
                              uint8_t px[64];
                              internal::gather8(image, bx, by, px);
-                             encode_bc7_block(px, out + (size_t{by} * bw + bx) * 16, options);
+                             encode_bc7_block(px, block, options);
                            });
   return Status::Ok();
 }

@@ -17,9 +17,12 @@ namespace {
 
 int bc1_flags(int quality) {
   switch (quality) {
-    case 0: return squish::kDxt1 | squish::kColourRangeFit;
-    case 1: return squish::kDxt1 | squish::kColourClusterFit;
-    default: return squish::kDxt1 | squish::kColourIterativeClusterFit;
+    case 0:
+      return squish::kDxt1 | squish::kColourRangeFit;
+    case 1:
+      return squish::kDxt1 | squish::kColourClusterFit;
+    default:
+      return squish::kDxt1 | squish::kColourIterativeClusterFit;
   }
 }
 
@@ -62,7 +65,8 @@ void bc4_refine(const uint8_t* v, uint8_t* block) {
   for (int i = 0; i < 16; ++i) {
     lo = std::min<int>(lo, v[i]);
     hi = std::max<int>(hi, v[i]);
-    if (v[i] != 0 && v[i] != 255) lo_in = std::min<int>(lo_in, v[i]), hi_in = std::max<int>(hi_in, v[i]);
+    if (v[i] != 0 && v[i] != 255)
+      lo_in = std::min<int>(lo_in, v[i]), hi_in = std::max<int>(hi_in, v[i]);
   }
   if (lo_in > hi_in) lo_in = hi_in = lo;
   uint8_t cand[8];
@@ -75,7 +79,7 @@ void bc4_refine(const uint8_t* v, uint8_t* block) {
   };
   for (int da = -2; da <= 2; ++da) {
     for (int db = -2; db <= 2; ++db) {
-      if (hi + da > lo + db) consider(hi + da, lo + db);         // 8-level: a > b
+      if (hi + da > lo + db) consider(hi + da, lo + db);               // 8-level: a > b
       if (lo_in + db <= hi_in + da) consider(lo_in + db, hi_in + da);  // 6-level + 0/255
     }
   }
@@ -101,45 +105,42 @@ void encode_bc4_block(const uint8_t* r, uint8_t* out8, const Bc4Options& options
 }
 
 Status encode_bc1(const Image8& image, uint8_t* out, size_t out_size, const Bc1Options& options) {
-  CALF_RETURN_IF_ERROR(internal::check_image(Format::kBc1, image.pixels, image.width,
-                                             image.height, image.row_stride, 1, image.channels,
-                                             3, 4, out_size, options.quality, 2, options.threads));
-  const uint32_t bw = blocks_along(image.width);
-  internal::for_each_block(image.width, image.height, options.threads,
-                           [&](uint32_t bx, uint32_t by) {
+  CALF_RETURN_IF_ERROR(internal::check_image(Format::kBc1, image.pixels, image.width, image.height,
+                                             image.row_stride, 1, image.channels, 3, 4, out_size,
+                                             options.quality, 2, options.threads));
+  internal::for_each_block(image.width, image.height, options.threads, out, 8,
+                           [&](uint32_t bx, uint32_t by, uint8_t* block) {
                              uint8_t px[64];
                              internal::gather8(image, bx, by, px);
-                             encode_bc1_block(px, out + (size_t{by} * bw + bx) * 8, options);
+                             encode_bc1_block(px, block, options);
                            });
   return Status::Ok();
 }
 
 Status encode_bc4(const Image8& image, uint8_t* out, size_t out_size, const Bc4Options& options) {
-  CALF_RETURN_IF_ERROR(internal::check_image(Format::kBc4, image.pixels, image.width,
-                                             image.height, image.row_stride, 1, image.channels,
-                                             1, 4, out_size, options.quality, 1, options.threads));
-  const uint32_t bw = blocks_along(image.width);
-  internal::for_each_block(image.width, image.height, options.threads,
-                           [&](uint32_t bx, uint32_t by) {
+  CALF_RETURN_IF_ERROR(internal::check_image(Format::kBc4, image.pixels, image.width, image.height,
+                                             image.row_stride, 1, image.channels, 1, 4, out_size,
+                                             options.quality, 1, options.threads));
+  internal::for_each_block(image.width, image.height, options.threads, out, 8,
+                           [&](uint32_t bx, uint32_t by, uint8_t* block) {
                              uint8_t px[64], r[16];
                              internal::gather8(image, bx, by, px);
                              for (int i = 0; i < 16; ++i) r[i] = px[4 * i];
-                             encode_bc4_block(r, out + (size_t{by} * bw + bx) * 8, options);
+                             encode_bc4_block(r, block, options);
                            });
   return Status::Ok();
 }
 
 Status encode_bc5(const Image8& image, uint8_t* out, size_t out_size, const Bc4Options& options) {
-  CALF_RETURN_IF_ERROR(internal::check_image(Format::kBc5, image.pixels, image.width,
-                                             image.height, image.row_stride, 1, image.channels,
-                                             2, 4, out_size, options.quality, 1, options.threads));
-  const uint32_t bw = blocks_along(image.width);
-  internal::for_each_block(image.width, image.height, options.threads,
-                           [&](uint32_t bx, uint32_t by) {
+  CALF_RETURN_IF_ERROR(internal::check_image(Format::kBc5, image.pixels, image.width, image.height,
+                                             image.row_stride, 1, image.channels, 2, 4, out_size,
+                                             options.quality, 1, options.threads));
+  internal::for_each_block(image.width, image.height, options.threads, out, 16,
+                           [&](uint32_t bx, uint32_t by, uint8_t* block) {
                              uint8_t px[64], r[16], g[16];
                              internal::gather8(image, bx, by, px);
                              for (int i = 0; i < 16; ++i) r[i] = px[4 * i], g[i] = px[4 * i + 1];
-                             uint8_t* dst = out + (size_t{by} * bw + bx) * 16;
+                             uint8_t* dst = block;
                              // BC5 = BC4(R) then BC4(G); the same fitter as squish's kBc5.
                              encode_bc4_block(r, dst, options);
                              encode_bc4_block(g, dst + 8, options);
