@@ -23,7 +23,7 @@
 #include "calf/format/grid.h"
 #include "calf/format/log_depth.h"
 #include "calf/format/version.h"
-#include "lightfield_layout.h"
+#include "calf/format/lightfield_layout.h"
 
 namespace calf {
 namespace {
@@ -35,7 +35,6 @@ using container::PixelFormat;
 using container::StoredChunk;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr uint32_t kLayoutVersion = 1;
 
 uint16_t pf(PixelFormat f) { return static_cast<uint16_t>(f); }
 
@@ -91,10 +90,6 @@ struct ViewData {
   }
 };
 
-uint8_t material_code(float v) {
-  return static_cast<uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
-}
-
 Status read_view(const capture::CaptureSetReader& input, uint32_t view, ViewData* out) {
   const capture::CaptureManifest& m = input.manifest();
   out->frames = m.frame_count;
@@ -127,9 +122,9 @@ Status read_view(const capture::CaptureSetReader& input, uint32_t view, ViewData
     if (m.material) {
       uint8_t* mc = &out->material[f * out->texels * 3];
       for (size_t i = 0; i < out->texels; ++i) {
-        mc[3 * i] = material_code(vf.material[3 * i]);
-        mc[3 * i + 1] = material_code(vf.material[3 * i + 1]);
-        mc[3 * i + 2] = material_code((vf.material[3 * i + 2] - 1.0f) / 2.0f);
+        mc[3 * i] = lf::material_weight_code(vf.material[3 * i]);
+        mc[3 * i + 1] = lf::material_weight_code(vf.material[3 * i + 1]);
+        mc[3 * i + 2] = lf::material_ior_code(vf.material[3 * i + 2]);
         if (mc[3 * i] != 0 || mc[3 * i + 1] != 0) out->has_material = true;
       }
     }
@@ -661,17 +656,18 @@ Expected<LightfieldEncodeStats> encode_lightfield(const capture::CaptureSetReade
     if (view.has_material) stats.material_views += 1;
 
     // The view's index chunk (SPEC §11.1 "View index chunk").
-    std::vector<uint8_t> index;
-    lf::put_u32(index, kLayoutVersion);
-    lf::put_f64(index, m.viewpoints[v].position.x);
-    lf::put_f64(index, m.viewpoints[v].position.y);
-    lf::put_f64(index, m.viewpoints[v].position.z);
-    lf::put_f32(index, view.range ? view.range->z_near() : 1.0f);
-    lf::put_f32(index, view.range ? view.range->z_far() : 2.0f);
-    lf::put_u32(index, (view.range ? 1u : 0u) | (view.has_material ? 2u : 0u));
-    lf::put_u32(index, options.depth_keyframe_interval);
-    lf::put_u32(index, options.depth_window);
-    lf::put_f32(index, static_cast<float>(options.min_psnr_db));
+    lf::ViewIndex vi;
+    vi.position[0] = m.viewpoints[v].position.x;
+    vi.position[1] = m.viewpoints[v].position.y;
+    vi.position[2] = m.viewpoints[v].position.z;
+    vi.z_near = view.range ? view.range->z_near() : 1.0f;
+    vi.z_far = view.range ? view.range->z_far() : 2.0f;
+    vi.has_depth = view.range.has_value();
+    vi.has_material = view.has_material;
+    vi.depth_keyframe_interval = options.depth_keyframe_interval;
+    vi.depth_window = options.depth_window;
+    vi.min_psnr_db = static_cast<float>(options.min_psnr_db);
+    const std::vector<uint8_t> index = lf::serialize_view_index(vi);
     ChunkKeys ikeys;
     ikeys.track = track;
     ikeys.stream = static_cast<uint16_t>(LightfieldStream::kIndex);

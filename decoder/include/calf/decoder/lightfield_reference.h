@@ -12,19 +12,13 @@
 #include <vector>
 
 #include "calf/format/container.h"
+#include "calf/format/lightfield_layout.h"
 #include "calf/format/status.h"
 
 namespace calf::decoder {
 
-// A view's index chunk (SPEC §11.1 "View index chunk").
-struct LightfieldViewInfo {
-  double position[3] = {0, 0, 0};
-  float z_near = 1, z_far = 2;
-  bool has_depth = false;     // the view saw a finite depth (else every code is sky)
-  bool has_material = false;  // material chunks exist for this view
-  uint32_t depth_keyframe_interval = 1, depth_window = 1;
-  float min_psnr_db = 0;  // informative: the encoder's Q
-};
+// A view's index chunk (SPEC §11.1.3).
+using LightfieldViewInfo = lf::ViewIndex;
 
 // One decoded face. colour: face_size^2 * 3 linear floats (row-major); depth: face_size^2 codes;
 // material: face_size^2 * 3 codes (reflect, refract, ior) or empty.
@@ -48,10 +42,7 @@ class LightfieldReference {
   Status decode_face(uint32_t view, uint32_t face, uint32_t frame, LightfieldFace* out) const;
 
   // The interpolation weights and keyframes of one colour cell (its t chunk), for tests and tools.
-  struct CellTimeline {
-    std::vector<uint32_t> keyframes;
-    std::vector<uint8_t> t;
-  };
+  using CellTimeline = lf::CellTimeline;
   Expected<CellTimeline> cell_timeline(uint32_t view, uint32_t face, uint32_t cell) const;
   // The rectangle counts of every frame of one depth tile (keyframes included), for tests.
   Expected<std::vector<uint32_t>> depth_rect_counts(uint32_t view, uint32_t face,
@@ -64,8 +55,5 @@ class LightfieldReference {
   container::LightfieldTrackHeader header_;
   std::vector<LightfieldViewInfo> views_;
 };
-
-// sRGB byte -> linear float, as every 8-bit colour format of the track is interpreted.
-float srgb8_to_linear(uint8_t v);
 
 }  // namespace calf::decoder

@@ -104,6 +104,7 @@ enum class ErrorKind : uint8_t {
   X(kLightfieldChunk, 202, kCorrupt, "a lightfield chunk is missing or contradicts its layout") \
   X(kLightfieldFormat, 203, kUnsupported, "a lightfield track uses a format the decoder lacks") \
   /* decoder: 300-399 */                                                                        \
+  X(kDecoderArgument, 300, kInvalidArgument, "a decoder option, frame, view or eye is invalid") \
   /* player: 400-499 */                                                                         \
   X(kPlayerViewSet, 400, kInvalidArgument, "a view's face size or position is invalid")         \
   X(kPlayerRect, 401, kInvalidArgument, "a texture update rect or its source buffer is invalid") \

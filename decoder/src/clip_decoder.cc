@@ -1,0 +1,454 @@
+#include "calf/decoder/clip_decoder.h"
+
+#include <algorithm>
+#include <chrono>
+#include <iterator>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <unordered_set>
+#include <optional>
+#include <string>
+
+#include "calf/format/lightfield_layout.h"
+#include "chunk_cache.h"
+
+namespace calf::decoder {
+namespace {
+
+using container::LightfieldStream;
+using container::PixelFormat;
+
+Status bad_argument(const std::string& what) { return Status(ErrorId::kDecoderArgument, what); }
+Status corrupt(const std::string& what) { return Status(ErrorId::kLightfieldChunk, what); }
+
+std::string where(uint32_t view, uint32_t face, uint32_t region) {
+  return "view " + std::to_string(view) + " face " + std::to_string(face) + " region " +
+         std::to_string(region);
+}
+
+bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+double length(const Vec3& v) { return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z); }
+
+Status check_eye(const EyeView& e, size_t i) {
+  const std::string name = "eye " + std::to_string(i) + ": ";
+  if (!finite(e.position) || !finite(e.forward) || !finite(e.up)) return bad_argument(name + "not finite");
+  if (length(e.forward) == 0 || length(e.up) == 0) return bad_argument(name + "zero forward or up");
+  if (!(e.fov_y > 0 && e.fov_y < std::numbers::pi) || !(e.aspect > 0) || !std::isfinite(e.aspect)) {
+    return bad_argument(name + "field of view or aspect out of range");
+  }
+  if (!(e.near > 0) || !(e.far > e.near) || !std::isfinite(e.far)) {
+    return bad_argument(name + "needs 0 < near < far < inf");
+  }
+  return Status::Ok();
+}
+
+// A chunk of one (stream, view, face, region) and the frames it serves.
+struct ChunkRef {
+  uint32_t first_frame = 0, frame_count = 0, id = 0;
+};
+
+}  // namespace
+
+struct ClipDecoder::Impl {
+  const container::Reader* reader = nullptr;
+  uint16_t track = 0;
+  container::LightfieldTrackHeader header;
+  std::vector<LightfieldViewInfo> views;
+  ClipDecoderOptions options;
+  FaceGrid cells = *FaceGrid::with_cell_size(1, 1);
+  FaceGrid tiles = *FaceGrid::with_cell_size(1, 1);
+  lf::RegionCoding depth_coding = lf::RegionCoding::kR16;
+  std::optional<lf::RegionCoding> material_coding;
+  std::unique_ptr<ChunkCache> cache;
+
+  // Chunks by (stream, view, face, region), sorted by first frame.
+  std::map<std::array<uint32_t, 4>, std::vector<ChunkRef>> chunks;
+
+  struct CellState {
+    std::optional<lf::CellTimeline> timeline;
+    int64_t slot_keyframe[2] = {-1, -1};  // the keyframe ordinal each slot holds
+  };
+  struct TileState {
+    int64_t frame = -1;  // the frame the renderer's texels of the tile hold
+  };
+  // Indexed [view][face * count + index].
+  std::vector<std::vector<CellState>> cell_state;
+  std::vector<std::vector<TileState>> depth_state, material_state;
+
+  // The frame being built: update payloads in one arena, spans fixed at the end.
+  std::vector<uint8_t> arena;
+  std::vector<std::pair<size_t, size_t>> spans;
+  std::vector<ChunkBytes> in_use;  // keeps this frame's chunks alive
+  std::vector<uint32_t> prefetch_ids;
+
+  const std::vector<ChunkRef>* find(LightfieldStream s, uint32_t v, uint32_t f, uint32_t r) const {
+    auto it = chunks.find({static_cast<uint32_t>(s), v, f, r});
+    return it == chunks.end() ? nullptr : &it->second;
+  }
+
+  // The one chunk of the list starting at `first` (exact) or serving `frame`.
+  Expected<uint32_t> chunk_serving(LightfieldStream s, uint32_t v, uint32_t f, uint32_t r,
+                                   uint32_t frame, bool exact_start) const {
+    const std::vector<ChunkRef>* list = find(s, v, f, r);
+    if (list != nullptr) {
+      auto it = std::upper_bound(list->begin(), list->end(), frame,
+                                 [](uint32_t fr, const ChunkRef& c) { return fr < c.first_frame; });
+      if (it != list->begin()) {
+        const ChunkRef& c = *std::prev(it);
+        const bool serves = exact_start ? c.first_frame == frame
+                                        : frame - c.first_frame < std::max(c.frame_count, 1u);
+        if (serves) return c.id;
+      }
+    }
+    return corrupt(where(v, f, r) + ": no chunk of stream " + std::to_string(static_cast<int>(s)) +
+                   (exact_start ? " starts at frame " : " serves frame ") + std::to_string(frame));
+  }
+
+  Expected<ChunkBytes> fetch(uint32_t id, FrameStats& stats) {
+    bool here = false;
+    CALF_ASSIGN_OR_RETURN(ChunkBytes bytes, cache->get(id, &here));
+    stats.chunks_needed += 1;
+    stats.chunks_read_on_demand += here ? 1 : 0;
+    in_use.push_back(bytes);
+    return bytes;
+  }
+
+  void emit(FrameUpdates* out, UpdateTarget target, uint32_t view, uint32_t face, uint32_t slot,
+            PixelRect rect, PixelFormat format, const std::vector<uint8_t>& bytes) {
+    TextureUpdate u;
+    u.target = target;
+    u.view = view;
+    u.face = static_cast<CubeFace>(face);
+    u.slot = slot;
+    u.rect = rect;
+    u.format = format;
+    spans.emplace_back(arena.size(), bytes.size());
+    arena.insert(arena.end(), bytes.begin(), bytes.end());
+    out->updates.push_back(u);
+    uint64_t& counter = target == UpdateTarget::kColour  ? out->stats.colour_bytes
+                        : target == UpdateTarget::kDepth ? out->stats.depth_bytes
+                                                         : out->stats.material_bytes;
+    counter += bytes.size();
+  }
+
+  Status open_tables();
+  Status update_cell(uint32_t view, uint32_t face, uint32_t cell, uint32_t frame,
+                     FrameUpdates* out);
+  Status update_tile(bool depth, uint32_t view, uint32_t face, uint32_t tile, uint32_t frame,
+                     FrameUpdates* out);
+  void queue_prefetch(bool depth_like, uint32_t view, uint32_t face, uint32_t index,
+                      uint32_t frame);
+};
+
+Status ClipDecoder::Impl::open_tables() {
+  const uint32_t cell_count = cells.cell_count(), tile_count = tiles.cell_count();
+  const auto& all = reader->chunks();
+  for (uint32_t id = 0; id < all.size(); ++id) {
+    const container::ChunkKeys& k = all[id].keys;
+    if (k.track != track || k.stream == static_cast<uint16_t>(LightfieldStream::kIndex)) continue;
+    const bool cell_stream = k.stream == static_cast<uint16_t>(LightfieldStream::kColour) ||
+                             k.stream == static_cast<uint16_t>(LightfieldStream::kTParams);
+    const bool known = cell_stream || k.stream == static_cast<uint16_t>(LightfieldStream::kDepth) ||
+                       k.stream == static_cast<uint16_t>(LightfieldStream::kMaterial);
+    if (!known) continue;  // streams of later minor versions are skipped
+    if (k.view >= header.view_count || k.face >= 6 ||
+        k.region >= (cell_stream ? cell_count : tile_count)) {
+      return corrupt("chunk " + std::to_string(id) + ": " + where(k.view, k.face, k.region) +
+                     " lies outside the track's grid");
+    }
+    chunks[{k.stream, k.view, k.face, k.region}].push_back({k.first_frame, k.frame_count, id});
+  }
+  for (auto& [key, list] : chunks) {
+    std::sort(list.begin(), list.end(),
+              [](const ChunkRef& a, const ChunkRef& b) { return a.first_frame < b.first_frame; });
+    for (size_t i = 1; i < list.size(); ++i) {
+      if (list[i].first_frame == list[i - 1].first_frame) {
+        return corrupt(where(key[1], key[2], key[3]) + ": two chunks of stream " +
+                       std::to_string(key[0]) + " start at frame " +
+                       std::to_string(list[i].first_frame));
+      }
+    }
+  }
+  cell_state.assign(header.view_count, std::vector<CellState>(size_t{6} * cell_count));
+  depth_state.assign(header.view_count, std::vector<TileState>(size_t{6} * tile_count));
+  material_state.assign(header.view_count, std::vector<TileState>(size_t{6} * tile_count));
+  return Status::Ok();
+}
+
+Status ClipDecoder::Impl::update_cell(uint32_t view, uint32_t face, uint32_t cell, uint32_t frame,
+                                      FrameUpdates* out) {
+  CellState& s = cell_state[view][size_t{face} * cells.cell_count() + cell];
+  if (!s.timeline) {
+    CALF_ASSIGN_OR_RETURN(uint32_t id, chunk_serving(LightfieldStream::kTParams, view, face, cell,
+                                                     0, true));
+    CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out->stats));
+    CALF_ASSIGN_OR_RETURN(lf::CellTimeline tl, lf::parse_t_chunk(*raw, header.frame_count,
+                                                                 where(view, face, cell) + " t"));
+    s.timeline = std::move(tl);
+  }
+  const lf::CellTimeline& tl = *s.timeline;
+  const uint32_t i = tl.bracket(frame);
+  const bool has_next = i + 1 < tl.keyframes.size();
+  // Frames after the last keyframe hold it (SPEC §11.1.4), whatever their t byte says.
+  const uint8_t t = has_next ? tl.t[frame] : 0;
+  const PixelRect rect = cells.cell_rect(cell % cells.cells_per_side(), cell / cells.cells_per_side());
+  std::vector<uint8_t> gpu[2];
+  bool load[2] = {false, false};
+  for (uint32_t k = i; k <= i + 1; ++k) {
+    if (k > i && (t == 0 || !has_next)) break;
+    const uint32_t slot = k % 2;
+    if (s.slot_keyframe[slot] == k) continue;
+    CALF_ASSIGN_OR_RETURN(uint32_t id, chunk_serving(LightfieldStream::kColour, view, face, cell,
+                                                     tl.keyframes[k], true));
+    CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out->stats));
+    CALF_RETURN_IF_ERROR(lf::colour_payload_gpu_bytes(header.colour_format, *raw, rect.width,
+                                                      rect.height, gpu[slot],
+                                                      where(view, face, cell) + " colour"));
+    load[slot] = true;
+  }
+  // Only now that every chunk the cell needs is good does its state change.
+  for (uint32_t k = i; k <= i + 1; ++k) {
+    const uint32_t slot = k % 2;
+    if (!load[slot]) continue;
+    emit(out, UpdateTarget::kColour, view, face, slot, rect,
+         static_cast<PixelFormat>(header.colour_format), gpu[slot]);
+    s.slot_keyframe[slot] = k;
+  }
+  CellParams p;
+  p.view = view;
+  p.face = static_cast<CubeFace>(face);
+  p.cell = cell;
+  p.t = t;
+  p.a_slot = static_cast<uint8_t>(i % 2);
+  out->cells.push_back(p);
+  return Status::Ok();
+}
+
+Status ClipDecoder::Impl::update_tile(bool depth, uint32_t view, uint32_t face, uint32_t tile,
+                                      uint32_t frame, FrameUpdates* out) {
+  TileState& s = (depth ? depth_state : material_state)[view][size_t{face} * tiles.cell_count() + tile];
+  if (s.frame == frame) return Status::Ok();
+  const LightfieldStream stream = depth ? LightfieldStream::kDepth : LightfieldStream::kMaterial;
+  CALF_ASSIGN_OR_RETURN(uint32_t id, chunk_serving(stream, view, face, tile, frame, false));
+  const container::ChunkKeys& keys = reader->chunks()[id].keys;
+  CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out->stats));
+  const PixelRect r = tiles.cell_rect(tile % tiles.cells_per_side(), tile / tiles.cells_per_side());
+  const lf::RegionCoding coding = depth ? depth_coding : *material_coding;
+  CALF_ASSIGN_OR_RETURN(
+      lf::RegionChunk chunk,
+      lf::parse_region_chunk(*raw, keys.frame_count, r.width, r.height, coding,
+                             where(view, face, tile) + (depth ? " depth" : " material")));
+  // Sec. 7.1: from the tile's current frame when it lies in this chunk's group and before the
+  // target, else from the group keyframe; then P-frames at most W apart, each valid on top of any
+  // frame of the W before it (SPEC §11.1.3 depth_window).
+  const uint32_t first = keys.first_frame, target = frame - first;
+  const uint32_t window = views[view].depth_window;
+  std::vector<uint32_t> steps;
+  uint32_t at;
+  if (s.frame >= first && s.frame < frame) {
+    at = static_cast<uint32_t>(s.frame) - first;
+  } else {
+    steps.push_back(0);
+    at = 0;
+  }
+  while (at < target) {
+    at = target - at > window ? at + window : target;
+    steps.push_back(at);
+  }
+  const UpdateTarget which = depth ? UpdateTarget::kDepth : UpdateTarget::kMaterial;
+  const PixelFormat format = lf::region_gpu_format(coding);
+  std::vector<uint8_t> gpu;
+  for (uint32_t step : steps) {
+    for (uint32_t k = chunk.first_rect[step]; k < chunk.first_rect[step + 1]; ++k) {
+      const lf::RegionRect& rr = chunk.rects[k];
+      lf::region_rect_gpu_bytes(chunk, k, gpu);
+      emit(out, which, view, face, 0, PixelRect{r.x + rr.x, r.y + rr.y, rr.w, rr.h}, format, gpu);
+    }
+  }
+  s.frame = frame;
+  return Status::Ok();
+}
+
+void ClipDecoder::Impl::queue_prefetch(bool cell, uint32_t view, uint32_t face, uint32_t index,
+                                       uint32_t frame) {
+  if (cell) {
+    const CellState& s = cell_state[view][size_t{face} * cells.cell_count() + index];
+    if (!s.timeline) return;
+    const lf::CellTimeline& tl = *s.timeline;
+    const uint32_t i = tl.bracket(frame);
+    for (uint32_t k = i; k < std::min<size_t>(i + 2, tl.keyframes.size()); ++k) {
+      if (s.slot_keyframe[k % 2] == k) continue;
+      auto id = chunk_serving(LightfieldStream::kColour, view, face, index, tl.keyframes[k], true);
+      if (id.ok()) prefetch_ids.push_back(*id);
+    }
+    return;
+  }
+  for (LightfieldStream st : {LightfieldStream::kDepth, LightfieldStream::kMaterial}) {
+    auto id = chunk_serving(st, view, face, index, frame, false);
+    if (id.ok()) prefetch_ids.push_back(*id);
+  }
+}
+
+ClipDecoder::ClipDecoder(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+ClipDecoder::ClipDecoder(ClipDecoder&&) noexcept = default;
+ClipDecoder& ClipDecoder::operator=(ClipDecoder&&) noexcept = default;
+ClipDecoder::~ClipDecoder() = default;
+
+const container::LightfieldTrackHeader& ClipDecoder::header() const { return impl_->header; }
+const LightfieldViewInfo& ClipDecoder::view(uint32_t v) const { return impl_->views[v]; }
+const ClipDecoderOptions& ClipDecoder::options() const { return impl_->options; }
+
+Expected<ClipDecoder> ClipDecoder::open(const container::Reader& reader, uint16_t track,
+                                        const ClipDecoderOptions& options) {
+  if (options.cache_bytes < (size_t{1} << 20)) return bad_argument("cache_bytes below 1 MiB");
+  if (options.prefetch_frames > 64) return bad_argument("prefetch_frames above 64");
+  CALF_ASSIGN_OR_RETURN(LightfieldReference ref, LightfieldReference::open(reader, track));
+  auto impl = std::make_unique<Impl>();
+  impl->reader = &reader;
+  impl->track = track;
+  impl->header = ref.header();
+  impl->options = options;
+  for (uint32_t v = 0; v < impl->header.view_count; ++v) impl->views.push_back(ref.view(v));
+  CALF_ASSIGN_OR_RETURN(impl->cells,
+                        FaceGrid::with_cell_size(impl->header.face_size, impl->header.cell_size));
+  CALF_ASSIGN_OR_RETURN(impl->tiles, FaceGrid::with_cell_size(impl->header.face_size,
+                                                              impl->header.depth_tile_size));
+  CALF_ASSIGN_OR_RETURN(impl->depth_coding, lf::depth_coding(impl->header.depth_format));
+  if (impl->header.material_format != 0) {
+    CALF_ASSIGN_OR_RETURN(impl->material_coding, lf::material_coding(impl->header.material_format));
+  }
+  CALF_RETURN_IF_ERROR(impl->open_tables());
+  impl->cache = std::make_unique<ChunkCache>(reader, options.cache_bytes, options.background_thread);
+  return ClipDecoder(std::move(impl));
+}
+
+void ClipDecoder::reset() {
+  Impl& d = *impl_;
+  for (auto& view : d.cell_state) {
+    for (auto& c : view) c.slot_keyframe[0] = c.slot_keyframe[1] = -1;
+  }
+  for (auto* states : {&d.depth_state, &d.material_state}) {
+    for (auto& view : *states) {
+      for (auto& t : view) t.frame = -1;
+    }
+  }
+}
+
+Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
+                            std::span<const uint32_t> active_views, FrameUpdates* out) {
+  Impl& d = *impl_;
+  const auto start = std::chrono::steady_clock::now();
+  if (frame >= d.header.frame_count) {
+    return bad_argument("frame " + std::to_string(frame) + " of a clip of " +
+                        std::to_string(d.header.frame_count));
+  }
+  std::vector<uint32_t> active(active_views.begin(), active_views.end());
+  if (active.empty()) {
+    for (uint32_t v = 0; v < d.header.view_count; ++v) active.push_back(v);
+  }
+  std::vector<bool> seen(d.header.view_count, false);
+  for (uint32_t v : active) {
+    if (v >= d.header.view_count || seen[v]) {
+      return bad_argument("active view " + std::to_string(v) + " is out of range or repeated");
+    }
+    seen[v] = true;
+  }
+  std::vector<Frustum> frusta;
+  for (size_t i = 0; i < eyes.size(); ++i) {
+    CALF_RETURN_IF_ERROR(check_eye(eyes[i], i));
+    frusta.push_back(eye_frustum(eyes[i]));
+  }
+
+  out->frame = frame;
+  out->updates.clear();
+  out->cells.clear();
+  out->tiles.clear();
+  out->stats = FrameStats{};
+  FrameStats& stats = out->stats;
+  stats.frame = frame;
+  d.arena.clear();
+  d.spans.clear();
+  d.in_use.clear();
+  d.prefetch_ids.clear();
+  auto report = [&](const Status& s) {
+    if (stats.errors++ == 0) stats.first_error = s.to_string();
+  };
+
+  CullStats cull;
+  std::vector<uint32_t> all_cells(d.cells.cell_count()), all_tiles(d.tiles.cell_count());
+  for (uint32_t i = 0; i < all_cells.size(); ++i) all_cells[i] = i;
+  for (uint32_t i = 0; i < all_tiles.size(); ++i) all_tiles[i] = i;
+  for (uint32_t v : active) {
+    const LightfieldViewInfo& info = d.views[v];
+    const Vec3 p{info.position[0], info.position[1], info.position[2]};
+    // Sky texels stand for points at infinity; a viewer sees nothing beyond its far plane, so
+    // for each viewer a cell frustum reaching past that viewer's far plane (seen from this
+    // viewpoint) is as good. The far cap depends on the viewer, so each viewer is culled on its
+    // own and the visible sets are united: several viewers see exactly the union of each.
+    std::vector<double> z_far(eyes.size());
+    for (size_t i = 0; i < eyes.size(); ++i) {
+      const Vec3& e = eyes[i].position;
+      const Vec3 to{e.x - p.x, e.y - p.y, e.z - p.z};
+      z_far[i] = std::max<double>(info.z_far, length(to) + eyes[i].far);
+    }
+    const bool has_material = info.has_material && d.material_coding.has_value();
+    for (uint32_t f = 0; f < 6; ++f) {
+      const CubeFace face = static_cast<CubeFace>(f);
+      auto visible = [&](const FaceGrid& grid, const std::vector<uint32_t>& all) {
+        if (!d.options.view_dependent) return all;
+        std::vector<uint32_t> united;
+        for (size_t i = 0; i < eyes.size(); ++i) {
+          const std::span<const Frustum> one(&frusta[i], 1);
+          const std::vector<uint32_t> by_eye =
+              d.options.brute_force_culling
+                  ? visible_cells_brute_force(p, face, grid, info.z_near, z_far[i], one, &cull)
+                  : visible_cells_hierarchical(p, face, grid, info.z_near, z_far[i], one,
+                                               d.options.quadtree_levels, &cull);
+          std::vector<uint32_t> merged;
+          std::set_union(united.begin(), united.end(), by_eye.begin(), by_eye.end(),
+                         std::back_inserter(merged));
+          united.swap(merged);
+        }
+        return united;
+      };
+      const std::vector<uint32_t> vis_cells = visible(d.cells, all_cells);
+      const std::vector<uint32_t> vis_tiles = visible(d.tiles, all_tiles);
+      stats.total_cells += d.cells.cell_count();
+      stats.total_tiles += d.tiles.cell_count();
+      stats.visible_cells += static_cast<uint32_t>(vis_cells.size());
+      stats.visible_tiles += static_cast<uint32_t>(vis_tiles.size());
+      for (uint32_t c : vis_cells) {
+        if (Status s = d.update_cell(v, f, c, frame, out); !s.ok()) report(s);
+      }
+      for (uint32_t t : vis_tiles) {
+        out->tiles.push_back(TileRef{v, face, t});
+        if (Status s = d.update_tile(true, v, f, t, frame, out); !s.ok()) report(s);
+        if (has_material) {
+          if (Status s = d.update_tile(false, v, f, t, frame, out); !s.ok()) report(s);
+        }
+      }
+      for (uint32_t ahead = 1; ahead <= d.options.prefetch_frames; ++ahead) {
+        if (frame + ahead >= d.header.frame_count) break;
+        for (uint32_t c : vis_cells) d.queue_prefetch(true, v, f, c, frame + ahead);
+        for (uint32_t t : vis_tiles) d.queue_prefetch(false, v, f, t, frame + ahead);
+      }
+    }
+  }
+  for (size_t i = 0; i < out->updates.size(); ++i) {
+    out->updates[i].bytes = std::span<const uint8_t>(d.arena).subspan(d.spans[i].first,
+                                                                     d.spans[i].second);
+  }
+  stats.updates = static_cast<uint32_t>(out->updates.size());
+  stats.culling_tests = cull.tests;
+  // Nearest frames first; a chunk serving several of them once.
+  std::unordered_set<uint32_t> queued;
+  std::erase_if(d.prefetch_ids, [&](uint32_t id) { return !queued.insert(id).second; });
+  d.cache->prefetch(d.prefetch_ids);
+  stats.cached_bytes = d.cache->cached_bytes();
+  stats.decode_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return Status::Ok();
+}
+
+}  // namespace calf::decoder

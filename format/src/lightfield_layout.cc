@@ -1,0 +1,386 @@
+#include "calf/format/lightfield_layout.h"
+
+#include <algorithm>
+
+#include "calf/format/bc.h"
+
+namespace calf::lf {
+namespace {
+
+using container::PixelFormat;
+
+Status corrupt(const std::string& what) { return Status(ErrorId::kLightfieldChunk, what); }
+
+uint64_t blocks_of(uint32_t w, uint32_t h) {
+  return uint64_t{bc::blocks_along(w)} * bc::blocks_along(h);
+}
+
+bool is(uint16_t format, PixelFormat f) { return format == static_cast<uint16_t>(f); }
+
+}  // namespace
+
+void append_block_split(std::vector<uint8_t>& out, std::span<const uint8_t> blocks,
+                        size_t block_bytes, bool is_bc5) {
+  if (block_bytes == 8) {
+    const size_t n = blocks.size() / 8;
+    for (size_t b = 0; b < n; ++b) out.insert(out.end(), &blocks[b * 8], &blocks[b * 8] + 4);
+    for (size_t b = 0; b < n; ++b) out.insert(out.end(), &blocks[b * 8 + 4], &blocks[b * 8] + 8);
+  } else if (is_bc5) {
+    const size_t n = blocks.size() / 16;
+    for (size_t b = 0; b < n; ++b) {
+      const uint8_t* p = &blocks[b * 16];
+      out.insert(out.end(), {p[0], p[1], p[8], p[9]});
+    }
+    for (size_t b = 0; b < n; ++b) {
+      const uint8_t* p = &blocks[b * 16];
+      out.insert(out.end(), p + 2, p + 8);
+      out.insert(out.end(), p + 10, p + 16);
+    }
+  } else {
+    out.insert(out.end(), blocks.begin(), blocks.end());
+  }
+}
+
+void append_planes(std::vector<uint8_t>& out, std::span<const uint8_t> texels,
+                   size_t bytes_per_texel) {
+  const size_t n = texels.size() / bytes_per_texel;
+  for (size_t c = 0; c < bytes_per_texel; ++c) {
+    for (size_t i = 0; i < n; ++i) out.push_back(texels[i * bytes_per_texel + c]);
+  }
+}
+
+uint8_t material_weight_code(float weight) {
+  // NaN compares false with everything: clamp it to 0 explicitly.
+  const float w = weight >= 0.0f ? std::min(weight, 1.0f) : 0.0f;
+  return static_cast<uint8_t>(std::lround(w * 255.0f));
+}
+
+uint8_t material_ior_code(float ior) { return material_weight_code((ior - 1.0f) / 2.0f); }
+
+// ---- ByteCursor ----
+
+Status ByteCursor::ends_inside(const char* type) const {
+  return corrupt(what_ + ": ends inside a " + type + " at byte " + std::to_string(pos_));
+}
+
+Expected<uint16_t> ByteCursor::u16() {
+  if (left() < 2) return ends_inside("u16");
+  const uint16_t v = static_cast<uint16_t>(b_[pos_] | b_[pos_ + 1] << 8);
+  pos_ += 2;
+  return v;
+}
+
+Expected<uint32_t> ByteCursor::u32() {
+  if (left() < 4) return ends_inside("u32");
+  uint32_t v = 0;
+  for (int i = 0; i < 4; ++i) v |= static_cast<uint32_t>(b_[pos_ + i]) << (8 * i);
+  pos_ += 4;
+  return v;
+}
+
+Expected<float> ByteCursor::f32() {
+  CALF_ASSIGN_OR_RETURN(uint32_t v, u32());
+  float f;
+  std::memcpy(&f, &v, 4);
+  return f;
+}
+
+Expected<double> ByteCursor::f64() {
+  if (left() < 8) return ends_inside("f64");
+  CALF_ASSIGN_OR_RETURN(uint32_t lo, u32());
+  CALF_ASSIGN_OR_RETURN(uint32_t hi, u32());
+  const uint64_t v = static_cast<uint64_t>(hi) << 32 | lo;
+  double d;
+  std::memcpy(&d, &v, 8);
+  return d;
+}
+
+// ---- View index ----
+
+std::vector<uint8_t> serialize_view_index(const ViewIndex& index) {
+  std::vector<uint8_t> out;
+  out.reserve(kViewIndexBytes);
+  put_u32(out, kLayoutVersion);
+  for (double p : index.position) put_f64(out, p);
+  put_f32(out, index.z_near);
+  put_f32(out, index.z_far);
+  put_u32(out, (index.has_depth ? 1u : 0u) | (index.has_material ? 2u : 0u));
+  put_u32(out, index.depth_keyframe_interval);
+  put_u32(out, index.depth_window);
+  put_f32(out, index.min_psnr_db);
+  return out;
+}
+
+Expected<ViewIndex> parse_view_index(std::span<const uint8_t> raw, const std::string& what) {
+  if (raw.size() != kViewIndexBytes) {
+    return corrupt(what + ": " + std::to_string(raw.size()) + " bytes, expected " +
+                   std::to_string(kViewIndexBytes));
+  }
+  ByteCursor c(raw, what);
+  CALF_ASSIGN_OR_RETURN(uint32_t version, c.u32());
+  if (version != kLayoutVersion) return corrupt(what + ": layout version " + std::to_string(version));
+  ViewIndex v;
+  for (double& p : v.position) {
+    CALF_ASSIGN_OR_RETURN(p, c.f64());
+    if (!std::isfinite(p)) return corrupt(what + ": viewpoint position is not finite");
+  }
+  CALF_ASSIGN_OR_RETURN(v.z_near, c.f32());
+  CALF_ASSIGN_OR_RETURN(v.z_far, c.f32());
+  if (!(v.z_near > 0.0f) || !(v.z_far > v.z_near) || !std::isfinite(v.z_far)) {
+    return corrupt(what + ": depth range [" + std::to_string(v.z_near) + ", " +
+                   std::to_string(v.z_far) + "] is not 0 < z_near < z_far < inf");
+  }
+  CALF_ASSIGN_OR_RETURN(uint32_t flags, c.u32());
+  if ((flags & ~3u) != 0) return corrupt(what + ": reserved flag bits set");
+  v.has_depth = (flags & 1) != 0;
+  v.has_material = (flags & 2) != 0;
+  CALF_ASSIGN_OR_RETURN(v.depth_keyframe_interval, c.u32());
+  CALF_ASSIGN_OR_RETURN(v.depth_window, c.u32());
+  if (v.depth_keyframe_interval == 0 || v.depth_window == 0) {
+    return corrupt(what + ": depth keyframe interval and window must be >= 1");
+  }
+  CALF_ASSIGN_OR_RETURN(v.min_psnr_db, c.f32());
+  return v;
+}
+
+// ---- t chunk ----
+
+uint32_t CellTimeline::bracket(uint32_t frame) const {
+  // keyframes[0] == 0 <= frame, so the result is at least 0.
+  const auto it = std::upper_bound(keyframes.begin(), keyframes.end(), frame);
+  return static_cast<uint32_t>(it - keyframes.begin()) - 1;
+}
+
+Expected<CellTimeline> parse_t_chunk(std::span<const uint8_t> raw, uint32_t frame_count,
+                                     const std::string& what) {
+  ByteCursor c(raw, what);
+  CALF_ASSIGN_OR_RETURN(uint32_t k, c.u32());
+  if (k == 0 || k > frame_count || c.left() != uint64_t{k} * 4 + frame_count) {
+    return corrupt(what + ": " + std::to_string(k) + " keyframes in " + std::to_string(raw.size()) +
+                   " bytes for " + std::to_string(frame_count) + " frames");
+  }
+  CellTimeline tl;
+  tl.keyframes.resize(k);
+  for (uint32_t i = 0; i < k; ++i) {
+    CALF_ASSIGN_OR_RETURN(tl.keyframes[i], c.u32());
+    if ((i == 0 && tl.keyframes[i] != 0) || (i > 0 && tl.keyframes[i] <= tl.keyframes[i - 1]) ||
+        tl.keyframes[i] >= frame_count) {
+      return corrupt(what + ": keyframes not increasing from 0 below the frame count");
+    }
+  }
+  const auto rest = c.rest();
+  tl.t.assign(rest.begin(), rest.end());
+  return tl;
+}
+
+// ---- Region chunks ----
+
+Expected<RegionCoding> depth_coding(uint16_t depth_format) {
+  if (is(depth_format, PixelFormat::kR16)) return RegionCoding::kR16;
+  if (is(depth_format, PixelFormat::kBc5)) return RegionCoding::kBc5;
+  return Status(ErrorId::kLightfieldFormat, "depth format " + std::to_string(depth_format) + " (" +
+                                                container::pixel_format_name(depth_format) + ")");
+}
+
+Expected<RegionCoding> material_coding(uint16_t material_format) {
+  if (is(material_format, PixelFormat::kRgba8)) return RegionCoding::kRgb8;
+  if (is(material_format, PixelFormat::kBc1)) return RegionCoding::kBc1;
+  return Status(ErrorId::kLightfieldFormat,
+                "material format " + std::to_string(material_format) + " (" +
+                    container::pixel_format_name(material_format) + ")");
+}
+
+bool region_coding_is_block(RegionCoding coding) {
+  return coding == RegionCoding::kBc5 || coding == RegionCoding::kBc1;
+}
+
+container::PixelFormat region_gpu_format(RegionCoding coding) {
+  switch (coding) {
+    case RegionCoding::kR16: return PixelFormat::kR16;
+    case RegionCoding::kBc5: return PixelFormat::kBc5;
+    case RegionCoding::kRgb8: return PixelFormat::kRgba8;
+    case RegionCoding::kBc1: return PixelFormat::kBc1;
+  }
+  return PixelFormat::kNone;
+}
+
+namespace {
+size_t unit_bytes(RegionCoding coding) {
+  switch (coding) {
+    case RegionCoding::kR16: return 2;
+    case RegionCoding::kBc5: return 16;
+    case RegionCoding::kRgb8: return 3;
+    case RegionCoding::kBc1: return 8;
+  }
+  return 0;
+}
+}  // namespace
+
+Expected<RegionChunk> parse_region_chunk(std::span<const uint8_t> raw, uint32_t frame_count,
+                                         uint32_t tile_width, uint32_t tile_height,
+                                         RegionCoding coding, const std::string& what) {
+  ByteCursor c(raw, what);
+  RegionChunk chunk;
+  chunk.coding = coding;
+  chunk.tile_width = tile_width;
+  chunk.tile_height = tile_height;
+  CALF_ASSIGN_OR_RETURN(chunk.frame_count, c.u32());
+  if (chunk.frame_count != frame_count || frame_count == 0) {
+    return corrupt(what + ": frame count " + std::to_string(chunk.frame_count) +
+                   ", the chunk's key says " + std::to_string(frame_count));
+  }
+  if (c.left() / 4 < frame_count) return corrupt(what + ": rectangle counts run past the chunk");
+  chunk.first_rect.resize(size_t{frame_count} + 1);
+  uint64_t total = 0;
+  for (uint32_t f = 0; f < frame_count; ++f) {
+    chunk.first_rect[f] = static_cast<uint32_t>(total);
+    CALF_ASSIGN_OR_RETURN(uint32_t n, c.u32());
+    total += n;
+    if (total > c.left() / 8) return corrupt(what + ": rectangles run past the chunk");
+  }
+  chunk.first_rect[frame_count] = static_cast<uint32_t>(total);
+  chunk.rects.resize(total);
+  const bool block = region_coding_is_block(coding);
+  for (RegionRect& r : chunk.rects) {
+    CALF_ASSIGN_OR_RETURN(r.x, c.u16());
+    CALF_ASSIGN_OR_RETURN(r.y, c.u16());
+    CALF_ASSIGN_OR_RETURN(r.w, c.u16());
+    CALF_ASSIGN_OR_RETURN(r.h, c.u16());
+    if (r.w == 0 || r.h == 0 || uint32_t{r.x} + r.w > tile_width ||
+        uint32_t{r.y} + r.h > tile_height) {
+      return corrupt(what + ": rectangle (" + std::to_string(r.x) + ", " + std::to_string(r.y) +
+                     ", " + std::to_string(r.w) + ", " + std::to_string(r.h) + ") leaves the " +
+                     std::to_string(tile_width) + "x" + std::to_string(tile_height) + " tile");
+    }
+    if (block && (r.x % 4 != 0 || r.y % 4 != 0)) {
+      return corrupt(what + ": block-coded rectangle at (" + std::to_string(r.x) + ", " +
+                     std::to_string(r.y) + ") is not 4-aligned");
+    }
+    r.first_unit = chunk.units;
+    chunk.units += block ? blocks_of(r.w, r.h) : uint64_t{r.w} * r.h;
+  }
+  const RegionRect* first = chunk.rects.empty() ? nullptr : &chunk.rects[0];
+  if (chunk.first_rect[1] != 1 || first->x != 0 || first->y != 0 || first->w != tile_width ||
+      first->h != tile_height) {
+    return corrupt(what + ": the first frame is not one whole-tile rectangle");
+  }
+  chunk.payload = c.rest();
+  const uint64_t expected = chunk.units * unit_bytes(coding);
+  if (chunk.payload.size() != expected) {
+    return corrupt(what + ": payload of " + std::to_string(chunk.payload.size()) +
+                   " bytes, expected " + std::to_string(expected));
+  }
+  return chunk;
+}
+
+void region_rect_gpu_bytes(const RegionChunk& chunk, size_t index, std::vector<uint8_t>& out) {
+  const RegionRect& r = chunk.rects[index];
+  const std::span<const uint8_t> p = chunk.payload;
+  const uint64_t units = chunk.units;
+  switch (chunk.coding) {
+    case RegionCoding::kR16: {
+      const size_t n = size_t{r.w} * r.h;
+      out.resize(n * 2);
+      for (size_t i = 0; i < n; ++i) {
+        // Planes hold the high byte, then the low byte; GPU bytes are little-endian.
+        out[2 * i] = p[units + r.first_unit + i];
+        out[2 * i + 1] = p[r.first_unit + i];
+      }
+      return;
+    }
+    case RegionCoding::kRgb8: {
+      const size_t n = size_t{r.w} * r.h;
+      out.resize(n * 4);
+      for (size_t i = 0; i < n; ++i) {
+        for (size_t c = 0; c < 3; ++c) out[4 * i + c] = p[c * units + r.first_unit + i];
+        out[4 * i + 3] = 255;
+      }
+      return;
+    }
+    case RegionCoding::kBc5: {
+      const size_t n = blocks_of(r.w, r.h);
+      out.resize(n * 16);
+      for (size_t b = 0; b < n; ++b) {
+        const uint8_t* e = &p[(r.first_unit + b) * 4];
+        const uint8_t* ix = &p[units * 4 + (r.first_unit + b) * 12];
+        uint8_t* d = &out[b * 16];
+        d[0] = e[0];
+        d[1] = e[1];
+        std::memcpy(d + 2, ix, 6);
+        d[8] = e[2];
+        d[9] = e[3];
+        std::memcpy(d + 10, ix + 6, 6);
+      }
+      return;
+    }
+    case RegionCoding::kBc1: {
+      const size_t n = blocks_of(r.w, r.h);
+      out.resize(n * 8);
+      for (size_t b = 0; b < n; ++b) {
+        std::memcpy(&out[b * 8], &p[(r.first_unit + b) * 4], 4);
+        std::memcpy(&out[b * 8 + 4], &p[units * 4 + (r.first_unit + b) * 4], 4);
+      }
+      return;
+    }
+  }
+}
+
+// ---- Colour keyframes ----
+
+Status check_colour_format(uint16_t colour_format) {
+  for (PixelFormat f : {PixelFormat::kBc1, PixelFormat::kBc7, PixelFormat::kBc6h,
+                        PixelFormat::kRgba8, PixelFormat::kRgba16f}) {
+    if (is(colour_format, f)) return Status::Ok();
+  }
+  return Status(ErrorId::kLightfieldFormat, "colour format " + std::to_string(colour_format) +
+                                                " (" + container::pixel_format_name(colour_format) +
+                                                ")");
+}
+
+Status colour_payload_gpu_bytes(uint16_t colour_format, std::span<const uint8_t> payload,
+                                uint32_t width, uint32_t height, std::vector<uint8_t>& out,
+                                const std::string& what) {
+  const size_t n = size_t{width} * height;
+  const size_t nb = blocks_of(width, height);
+  auto check = [&](size_t expected) -> Status {
+    if (payload.size() == expected) return Status::Ok();
+    return corrupt(what + ": colour payload of " + std::to_string(payload.size()) +
+                   " bytes, expected " + std::to_string(expected));
+  };
+  if (is(colour_format, PixelFormat::kBc1)) {
+    CALF_RETURN_IF_ERROR(check(nb * 8));
+    out.resize(nb * 8);
+    for (size_t b = 0; b < nb; ++b) {
+      std::memcpy(&out[b * 8], &payload[b * 4], 4);
+      std::memcpy(&out[b * 8 + 4], &payload[nb * 4 + b * 4], 4);
+    }
+    return Status::Ok();
+  }
+  if (is(colour_format, PixelFormat::kBc7) || is(colour_format, PixelFormat::kBc6h)) {
+    CALF_RETURN_IF_ERROR(check(nb * 16));
+    out.assign(payload.begin(), payload.end());
+    return Status::Ok();
+  }
+  if (is(colour_format, PixelFormat::kRgba8)) {
+    CALF_RETURN_IF_ERROR(check(n * 4));
+    out.resize(n * 4);
+    for (size_t i = 0; i < n; ++i) {
+      for (size_t c = 0; c < 4; ++c) out[4 * i + c] = payload[c * n + i];
+    }
+    return Status::Ok();
+  }
+  if (is(colour_format, PixelFormat::kRgba16f)) {
+    CALF_RETURN_IF_ERROR(check(n * 8));
+    const size_t values = n * 4;
+    out.resize(n * 8);
+    for (size_t k = 0; k < values; ++k) {
+      out[2 * k] = payload[values + k];  // low byte plane
+      out[2 * k + 1] = payload[k];       // high byte plane
+    }
+    return Status::Ok();
+  }
+  const Status bad = check_colour_format(colour_format);
+  return Status(bad.id(), what + ": " + bad.message());
+}
+
+}  // namespace calf::lf

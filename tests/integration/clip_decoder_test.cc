@@ -1,0 +1,537 @@
+// Property tests of the view-dependent decoder (decoder/include/calf/decoder/clip_decoder.h) on
+// random clips encoded by the real encoder: the state its updates build (applied by CpuTextures)
+// must equal the reference full-frame decoder (lightfield_reference.h) on every visible cell and
+// tile, whatever path led to the frame — playing 0..N, seeking straight to N, wandering there
+// through random frames, one viewer or several, hierarchical or brute-force culling, with or
+// without the background thread.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <tuple>
+#include <unistd.h>
+#include <random>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "calf/capture/capture_set.h"
+#include "calf/decoder/clip_decoder.h"
+#include "calf/decoder/cpu_textures.h"
+#include "calf/decoder/lightfield_reference.h"
+#include "calf/encoder/lightfield_encode.h"
+#include "calf/format/container.h"
+#include "calf/format/container_io.h"
+
+namespace calf::decoder {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ClipSpec {
+  uint32_t face = 16, frames = 12, views = 2, seed = 1;
+  bool material = false, hdr = false;
+  LightfieldEncodeOptions options;
+};
+
+// Smooth colour with per-seed moving squares (colour and depth), a fading face, sky patches and,
+// optionally, material on one face: enough motion for several keyframes per cell and non-empty
+// depth P-frames, with static regions in between.
+capture::ViewFrame make_frame(const ClipSpec& s, uint32_t view, uint32_t frame) {
+  std::mt19937 rng(s.seed * 7919 + view);
+  std::uniform_int_distribution<int> pos(0, static_cast<int>(s.face) - 1);
+  const int sx = pos(rng), sy = pos(rng), dx = 1 + static_cast<int>(rng() % 3);
+  const int size = 3 + static_cast<int>(rng() % 5);
+  capture::ViewFrame vf;
+  vf.resize(s.face, s.material);
+  const float inf = std::numeric_limits<float>::infinity();
+  for (uint32_t face = 0; face < 6; ++face) {
+    for (uint32_t y = 0; y < s.face; ++y) {
+      for (uint32_t x = 0; x < s.face; ++x) {
+        const size_t i = vf.texel_index(static_cast<CubeFace>(face), x, y);
+        float r = 0.2f + 0.5f * x / s.face, g = 0.3f + 0.4f * y / s.face;
+        float b = 0.1f * face + 0.05f * view;
+        float z = 2.0f + 0.1f * face + 0.05f * x + 0.03f * y + 0.5f * view;
+        const int mx = (sx + dx * static_cast<int>(frame)) % static_cast<int>(s.face);
+        if ((face == s.seed % 6 || face == 0) && static_cast<int>(x) >= mx &&
+            static_cast<int>(x) < mx + size && static_cast<int>(y) >= sy &&
+            static_cast<int>(y) < sy + size) {
+          r = 0.9f;
+          g = 0.1f + 0.05f * (frame % 3);
+          z = 1.0f + 0.02f * frame;
+        }
+        if (face == 2) {
+          r *= 1.0f - 0.04f * static_cast<float>(frame);
+          g *= 1.0f - 0.03f * static_cast<float>(frame);
+        }
+        if (face == 3 && y < s.face / 2) z = inf;
+        if (s.hdr && face == 4) r *= 30.0f;
+        vf.color[3 * i] = r;
+        vf.color[3 * i + 1] = g;
+        vf.color[3 * i + 2] = b;
+        vf.depth[i] = z;
+        if (s.material) {
+          const bool mirror = face == 1 && x < s.face / 2 + (frame % 4);
+          vf.material[3 * i] = mirror ? 0.8f : 0.0f;
+          vf.material[3 * i + 1] = 0.0f;
+          vf.material[3 * i + 2] = mirror ? 1.5f : 1.0f;
+        }
+      }
+    }
+  }
+  return vf;
+}
+
+// An encoded clip held in memory, with its reader.
+struct Clip {
+  std::vector<uint8_t> bytes;
+  std::unique_ptr<container::Reader> reader;
+};
+
+Clip make_clip(const ClipSpec& s) {
+  // Appends, not operator+ chains: GCC 12 -O3 reports a false -Wrestrict on those.
+  std::string name = "calf_clipdec_";
+  name.append(std::to_string(::getpid())).append("_").append(std::to_string(s.seed));
+  const fs::path dir = fs::temp_directory_path() / name;
+  fs::remove_all(dir);
+  capture::CaptureManifest m;
+  m.frame_count = s.frames;
+  m.face_size = s.face;
+  m.fps = 24;
+  m.material = s.material;
+  m.view_volume = {{-1, -1, -1}, {1, 1, 1}};
+  for (uint32_t v = 0; v < s.views; ++v) {
+    std::string view_name = "v";
+    view_name.append(std::to_string(v));
+    m.viewpoints.push_back({view_name, {0.5 * v - 0.25, 0.1 * v, 0}});
+  }
+  Clip clip;
+  {
+    auto w = capture::CaptureSetWriter::create(dir, m);
+    EXPECT_TRUE(w.ok()) << w.status().to_string();
+    for (uint32_t v = 0; v < s.views; ++v) {
+      for (uint32_t f = 0; f < s.frames; ++f) {
+        EXPECT_TRUE(w->write(v, f, make_frame(s, v, f)).ok());
+      }
+    }
+    EXPECT_TRUE(w->finish().ok());
+    auto in = capture::CaptureSetReader::open(dir);
+    EXPECT_TRUE(in.ok()) << in.status().to_string();
+    auto writer = container::Writer::create(container::memory_sink(&clip.bytes));
+    EXPECT_TRUE(writer.ok());
+    auto stats = encode_lightfield(*in, *writer, s.options);
+    EXPECT_TRUE(stats.ok()) << stats.status().to_string();
+    EXPECT_TRUE(writer->finish().ok());
+  }
+  fs::remove_all(dir);
+  auto r = container::Reader::open(container::memory_source(clip.bytes));
+  EXPECT_TRUE(r.ok()) << r.status().to_string();
+  clip.reader = std::make_unique<container::Reader>(std::move(*r));
+  return clip;
+}
+
+ClipSpec random_spec(uint32_t seed) {
+  std::mt19937 rng(seed);
+  ClipSpec s;
+  s.seed = seed;
+  s.views = 1 + rng() % 3;
+  s.material = rng() % 2 == 0;
+  s.hdr = rng() % 4 == 0;
+  LightfieldEncodeOptions& o = s.options;
+  o.cell_size = (rng() % 2 == 0) ? 4 : 8;
+  o.min_psnr_db = 35 + rng() % 20;
+  o.depth = rng() % 2 == 0 ? DepthCoding::kRaw16 : DepthCoding::kBc5;
+  o.depth_tiles_per_side = 1 + rng() % 4;
+  o.depth_keyframe_interval = 1 + rng() % 8;
+  o.depth_window = 1 + rng() % 3;
+  o.max_aabbs = 1 + rng() % 3;
+  const ColourCoding ldr[] = {ColourCoding::kBc1, ColourCoding::kRgba8, ColourCoding::kBc7};
+  o.colour = s.hdr ? (rng() % 2 ? ColourCoding::kBc6h : ColourCoding::kRgba16f) : ldr[rng() % 3];
+  return s;
+}
+
+EyeView random_eye(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  EyeView e;
+  e.position = {u(rng), u(rng), u(rng)};
+  do {
+    e.forward = {u(rng), u(rng), u(rng)};
+  } while (std::abs(e.forward.x) + std::abs(e.forward.y) + std::abs(e.forward.z) < 0.1);
+  e.up = {u(rng), u(rng), u(rng)};
+  if (std::abs(e.up.x) + std::abs(e.up.y) + std::abs(e.up.z) < 0.1) e.up = {0, 1, 0};
+  e.fov_y = 0.6 + 0.8 * (u(rng) + 1) / 2;
+  e.aspect = 1.0 + (u(rng) + 1) / 2;
+  e.near = 0.05;
+  e.far = 6 + 10 * (u(rng) + 1);
+  return e;
+}
+
+// Compares, for every visible cell and tile of `fu`, the applied state with the reference decoder
+// at `frame`. Returns the number of texels compared.
+size_t expect_matches_reference(const Clip& clip, const CpuTextures& tex, const FrameUpdates& fu,
+                                uint32_t frame, const std::string& context) {
+  auto ref = LightfieldReference::open(*clip.reader, 0);
+  EXPECT_TRUE(ref.ok());
+  const auto& h = ref->header();
+  auto tiles = FaceGrid::with_cell_size(h.face_size, h.depth_tile_size);
+  std::map<std::pair<uint32_t, int>, LightfieldFace> faces;
+  auto face_of = [&](uint32_t v, CubeFace f) -> const LightfieldFace& {
+    auto key = std::make_pair(v, cube_face_index(f));
+    if (!faces.count(key)) {
+      EXPECT_TRUE(ref->decode_face(v, cube_face_index(f), frame, &faces[key]).ok());
+    }
+    return faces[key];
+  };
+  size_t compared = 0;
+  const uint32_t n = h.face_size;
+  for (const CellParams& c : fu.cells) {
+    const LightfieldFace& want = face_of(c.view, c.face);
+    const std::vector<float> got = tex.colour(c.view, c.face);
+    const PixelRect r = *tex.cells().cell_rect(c.cell);
+    for (uint32_t y = r.y; y < r.y + r.height; ++y) {
+      for (uint32_t x = r.x; x < r.x + r.width; ++x) {
+        for (int k = 0; k < 3; ++k) {
+          const size_t i = (size_t{y} * n + x) * 3 + k;
+          if (got[i] != want.colour[i]) {
+            ADD_FAILURE() << context << ": colour view " << c.view << " face "
+                          << cube_face_index(c.face) << " texel (" << x << ", " << y << ") "
+                          << got[i] << " != " << want.colour[i];
+            return compared;
+          }
+        }
+        ++compared;
+      }
+    }
+  }
+  for (const TileRef& t : fu.tiles) {
+    const LightfieldFace& want = face_of(t.view, t.face);
+    const auto depth = tex.depth(t.view, t.face);
+    const auto material = tex.material(t.view, t.face);
+    const PixelRect r = *tiles->cell_rect(t.tile);
+    for (uint32_t y = r.y; y < r.y + r.height; ++y) {
+      for (uint32_t x = r.x; x < r.x + r.width; ++x) {
+        const size_t i = size_t{y} * n + x;
+        if (depth[i] != want.depth[i]) {
+          ADD_FAILURE() << context << ": depth view " << t.view << " face "
+                        << cube_face_index(t.face) << " texel (" << x << ", " << y << ") "
+                        << depth[i] << " != " << want.depth[i];
+          return compared;
+        }
+        if (!want.material.empty()) {
+          for (int k = 0; k < 3; ++k) {
+            if (material[3 * i + k] != want.material[3 * i + k]) {
+              ADD_FAILURE() << context << ": material view " << t.view << " texel (" << x << ", "
+                            << y << ")";
+              return compared;
+            }
+          }
+        }
+        ++compared;
+      }
+    }
+  }
+  return compared;
+}
+
+FrameUpdates advance_ok(ClipDecoder& d, CpuTextures& tex, uint32_t frame,
+                        const std::vector<EyeView>& eyes, const std::vector<uint32_t>& active = {}) {
+  FrameUpdates fu;
+  const Status s = d.advance(frame, eyes, active, &fu);
+  EXPECT_TRUE(s.ok()) << s.to_string();
+  EXPECT_EQ(fu.stats.errors, 0u) << fu.stats.first_error;
+  EXPECT_TRUE(tex.apply(fu).ok());
+  return fu;
+}
+
+ClipDecoder open_decoder(const Clip& clip, ClipDecoderOptions o = {}) {
+  auto d = ClipDecoder::open(*clip.reader, 0, o);
+  EXPECT_TRUE(d.ok()) << d.status().to_string();
+  return std::move(*d);
+}
+
+CpuTextures textures_for(const ClipDecoder& d) {
+  std::vector<LightfieldViewInfo> views;
+  for (uint32_t v = 0; v < d.header().view_count; ++v) views.push_back(d.view(v));
+  return CpuTextures(d.header(), views);
+}
+
+// Playing every frame with everything visible reproduces the reference decoder exactly.
+TEST(ClipDecoder, PlayingWithoutCullingEqualsReferenceOnEveryFrame) {
+  for (uint32_t seed = 1; seed <= 6; ++seed) {
+    const ClipSpec spec = random_spec(seed);
+    const Clip clip = make_clip(spec);
+    ClipDecoderOptions o;
+    o.view_dependent = false;
+    ClipDecoder d = open_decoder(clip, o);
+    CpuTextures tex = textures_for(d);
+    for (uint32_t f = 0; f < spec.frames; ++f) {
+      const FrameUpdates fu = advance_ok(d, tex, f, {});
+      EXPECT_EQ(fu.stats.visible_cells, fu.stats.total_cells);
+      const size_t n = expect_matches_reference(clip, tex, fu, f, "seed " + std::to_string(seed));
+      EXPECT_EQ(n, size_t{spec.views} * 6 * spec.face * spec.face * 2);
+    }
+  }
+}
+
+// Seeking to N (fresh decoder), playing 0..N and wandering through random frames before N give
+// the same state for every cell and tile visible at N, equal to the reference.
+TEST(ClipDecoder, SeekingEqualsPlayingEqualsReference) {
+  size_t visible_somewhere = 0;
+  for (uint32_t seed = 11; seed <= 18; ++seed) {
+    const ClipSpec spec = random_spec(seed);
+    const Clip clip = make_clip(spec);
+    std::mt19937 rng(seed);
+    for (int trial = 0; trial < 3; ++trial) {
+      std::vector<EyeView> eyes = {random_eye(rng)};
+      const uint32_t target = rng() % spec.frames;
+      ClipDecoder play = open_decoder(clip), seek = open_decoder(clip), wander = open_decoder(clip);
+      CpuTextures tp = textures_for(play), ts = textures_for(seek), tw = textures_for(wander);
+      FrameUpdates last;
+      for (uint32_t f = 0; f <= target; ++f) last = advance_ok(play, tp, f, eyes);
+      const FrameUpdates direct = advance_ok(seek, ts, target, eyes);
+      for (int hop = 0; hop < 5; ++hop) {
+        advance_ok(wander, tw, rng() % spec.frames, {random_eye(rng)});
+      }
+      const FrameUpdates wandered = advance_ok(wander, tw, target, eyes);
+      EXPECT_EQ(last.cells.size(), direct.cells.size());
+      EXPECT_TRUE(last.tiles == direct.tiles && direct.tiles == wandered.tiles);
+      const std::string ctx = "seed " + std::to_string(seed) + " frame " + std::to_string(target);
+      visible_somewhere += expect_matches_reference(clip, tp, last, target, ctx + " play");
+      expect_matches_reference(clip, ts, direct, target, ctx + " seek");
+      expect_matches_reference(clip, tw, wandered, target, ctx + " wander");
+      // A fresh seek uploads no more than playing did in total, and usually far less.
+      EXPECT_LE(direct.stats.update_bytes(), last.stats.update_bytes() + direct.stats.update_bytes());
+    }
+  }
+  EXPECT_GT(visible_somewhere, 0u) << "no trial saw anything: the test would prove nothing";
+}
+
+// The visible set for several viewers is the union of each one's, and the state on it is right.
+TEST(ClipDecoder, SeveralViewersGiveTheUnionOfEachViewer) {
+  for (uint32_t seed = 21; seed <= 26; ++seed) {
+    const ClipSpec spec = random_spec(seed);
+    const Clip clip = make_clip(spec);
+    std::mt19937 rng(seed);
+    const std::vector<EyeView> eyes = {random_eye(rng), random_eye(rng), random_eye(rng)};
+    const uint32_t frame = rng() % spec.frames;
+    std::set<std::tuple<uint32_t, int, uint32_t>> cells_union, tiles_union;
+    for (const EyeView& e : eyes) {
+      ClipDecoder d = open_decoder(clip);
+      CpuTextures tex = textures_for(d);
+      const FrameUpdates fu = advance_ok(d, tex, frame, {e});
+      for (const CellParams& c : fu.cells) cells_union.insert({c.view, cube_face_index(c.face), c.cell});
+      for (const TileRef& t : fu.tiles) tiles_union.insert({t.view, cube_face_index(t.face), t.tile});
+    }
+    ClipDecoder all = open_decoder(clip);
+    CpuTextures tex = textures_for(all);
+    const FrameUpdates fu = advance_ok(all, tex, frame, eyes);
+    std::set<std::tuple<uint32_t, int, uint32_t>> cells, tiles;
+    for (const CellParams& c : fu.cells) cells.insert({c.view, cube_face_index(c.face), c.cell});
+    for (const TileRef& t : fu.tiles) tiles.insert({t.view, cube_face_index(t.face), t.tile});
+    EXPECT_EQ(cells, cells_union) << "seed " << seed;
+    EXPECT_EQ(tiles, tiles_union) << "seed " << seed;
+    expect_matches_reference(clip, tex, fu, frame, "seed " + std::to_string(seed));
+  }
+}
+
+// Hierarchical culling, brute force, every level count, background thread or not, any prefetch
+// and cache size: byte-identical updates.
+TEST(ClipDecoder, UpdatesDoNotDependOnCullingPathThreadOrCache) {
+  const ClipSpec spec = random_spec(31);
+  const Clip clip = make_clip(spec);
+  std::mt19937 rng(31);
+  std::vector<std::vector<EyeView>> eyes;
+  std::vector<uint32_t> frames;
+  for (int i = 0; i < 10; ++i) {
+    eyes.push_back({random_eye(rng), random_eye(rng)});
+    frames.push_back(rng() % spec.frames);
+  }
+  auto run = [&](ClipDecoderOptions o) {
+    ClipDecoder d = open_decoder(clip, o);
+    std::vector<uint8_t> log;
+    for (size_t i = 0; i < frames.size(); ++i) {
+      FrameUpdates fu;
+      EXPECT_TRUE(d.advance(frames[i], eyes[i], {}, &fu).ok());
+      for (const TextureUpdate& u : fu.updates) {
+        const uint32_t head[] = {static_cast<uint32_t>(u.target), u.view, uint32_t(cube_face_index(u.face)),
+                                 u.slot, u.rect.x, u.rect.y, u.rect.width, u.rect.height};
+        log.insert(log.end(), reinterpret_cast<const uint8_t*>(head),
+                   reinterpret_cast<const uint8_t*>(head) + sizeof(head));
+        log.insert(log.end(), u.bytes.begin(), u.bytes.end());
+      }
+      for (const CellParams& c : fu.cells) log.insert(log.end(), {c.t, c.a_slot});
+    }
+    return log;
+  };
+  const std::vector<uint8_t> base = run({});
+  EXPECT_GT(base.size(), 1000u);
+  ClipDecoderOptions o;
+  o.brute_force_culling = true;
+  EXPECT_EQ(run(o), base);
+  for (uint32_t levels = 1; levels <= 4; ++levels) {
+    o = {};
+    o.quadtree_levels = levels;
+    EXPECT_EQ(run(o), base) << levels;
+  }
+  o = {};
+  o.background_thread = false;
+  o.prefetch_frames = 0;
+  EXPECT_EQ(run(o), base);
+  o = {};
+  o.cache_bytes = size_t{1} << 20;
+  o.prefetch_frames = 64;
+  EXPECT_EQ(run(o), base);
+}
+
+// Sec. 7.1: a seek restarts depth from the group keyframe and then steps W frames at a time.
+TEST(ClipDecoder, DepthSeekStepsThroughTheWindow) {
+  ClipSpec spec;
+  spec.seed = 41;
+  spec.views = 1;
+  spec.frames = 12;
+  spec.options.cell_size = 8;
+  spec.options.depth_keyframe_interval = 12;
+  spec.options.depth_window = 3;
+  spec.options.max_aabbs = 1;
+  const Clip clip = make_clip(spec);
+  auto ref = LightfieldReference::open(*clip.reader, 0);
+  ASSERT_TRUE(ref.ok());
+  for (uint32_t target = 0; target < spec.frames; ++target) {
+    ClipDecoderOptions o;
+    o.view_dependent = false;
+    ClipDecoder d = open_decoder(clip, o);
+    CpuTextures tex = textures_for(d);
+    const FrameUpdates fu = advance_ok(d, tex, target, {});
+    expect_matches_reference(clip, tex, fu, target, "frame " + std::to_string(target));
+    // Expected depth updates: per tile the keyframe rect, then the rects of frames W, 2W, ...,
+    // target (the last step shorter), counted from the encoder's rectangle table.
+    uint64_t expected = 0;
+    const uint32_t tiles_per_face = spec.options.depth_tiles_per_side * spec.options.depth_tiles_per_side;
+    for (uint32_t face = 0; face < 6; ++face) {
+      for (uint32_t tile = 0; tile < tiles_per_face; ++tile) {
+        auto counts = ref->depth_rect_counts(0, face, tile);
+        ASSERT_TRUE(counts.ok());
+        expected += (*counts)[0];
+        for (uint32_t at = 0; at < target;) {
+          at = std::min(target, at + 3);
+          expected += (*counts)[at];
+        }
+      }
+    }
+    uint64_t depth_updates = 0;
+    for (const TextureUpdate& u : fu.updates) depth_updates += u.target == UpdateTarget::kDepth;
+    EXPECT_EQ(depth_updates, expected) << "frame " << target;
+  }
+}
+
+// Nothing visible without viewers; a viewer looking away from a view sees fewer cells.
+TEST(ClipDecoder, VisibilityFollowsTheViewers) {
+  ClipSpec spec;
+  spec.seed = 51;
+  spec.options.cell_size = 4;
+  const Clip clip = make_clip(spec);
+  ClipDecoder d = open_decoder(clip);
+  FrameUpdates fu;
+  ASSERT_TRUE(d.advance(0, {}, {}, &fu).ok());
+  EXPECT_EQ(fu.stats.visible_cells, 0u);
+  EXPECT_TRUE(fu.updates.empty());
+  EyeView narrow;
+  narrow.position = {0, 0, 0};
+  narrow.forward = {1, 0, 0};
+  narrow.fov_y = 0.3;
+  narrow.far = 3;
+  ASSERT_TRUE(d.advance(0, std::vector<EyeView>{narrow}, {}, &fu).ok());
+  EXPECT_GT(fu.stats.visible_cells, 0u);
+  EXPECT_LT(fu.stats.visible_cells, fu.stats.total_cells / 2);
+  EXPECT_GT(fu.stats.culling_tests, 0u);
+  EXPECT_GT(fu.stats.mbps_at_24fps(), 0.0);
+  // Only the active view is decoded.
+  ASSERT_TRUE(d.advance(1, std::vector<EyeView>{narrow}, std::vector<uint32_t>{1}, &fu).ok());
+  for (const TextureUpdate& u : fu.updates) EXPECT_EQ(u.view, 1u);
+  EXPECT_EQ(fu.stats.total_cells, 6 * 16u);
+}
+
+TEST(ClipDecoder, BadArgumentsAreE300AndChangeNothing) {
+  ClipSpec spec;
+  spec.seed = 61;
+  const Clip clip = make_clip(spec);
+  ClipDecoderOptions bad;
+  bad.cache_bytes = 1000;
+  EXPECT_EQ(ClipDecoder::open(*clip.reader, 0, bad).status().id(), ErrorId::kDecoderArgument);
+  ClipDecoder d = open_decoder(clip);
+  FrameUpdates fu;
+  EXPECT_EQ(d.advance(spec.frames, {}, {}, &fu).id(), ErrorId::kDecoderArgument);
+  EXPECT_EQ(d.advance(0, {}, std::vector<uint32_t>{0, 0}, &fu).id(), ErrorId::kDecoderArgument);
+  EXPECT_EQ(d.advance(0, {}, std::vector<uint32_t>{7}, &fu).id(), ErrorId::kDecoderArgument);
+  EyeView e;
+  e.far = e.near;
+  EXPECT_EQ(d.advance(0, std::vector<EyeView>{e}, {}, &fu).id(), ErrorId::kDecoderArgument);
+  e = EyeView{};
+  e.position.x = std::nan("");
+  EXPECT_EQ(d.advance(0, std::vector<EyeView>{e}, {}, &fu).id(), ErrorId::kDecoderArgument);
+  EXPECT_EQ(ClipDecoder::open(*clip.reader, 5).status().id(), ErrorId::kInvalidArgument);
+}
+
+// A damaged chunk is reported in the frame's stats; the cells needing it keep their last good
+// state, every other cell decodes, and the decoder goes on.
+TEST(ClipDecoder, CorruptChunkIsReportedAndLastGoodStateKept) {
+  ClipSpec spec;
+  spec.seed = 71;
+  spec.views = 1;
+  spec.options.min_psnr_db = 60;  // many keyframes
+  Clip clip = make_clip(spec);
+  // Damage the stored bytes of the last colour keyframe chunk of some cell (hash mismatch).
+  const auto& chunks = clip.reader->chunks();
+  int64_t victim = -1;
+  for (uint32_t id = 0; id < chunks.size(); ++id) {
+    if (chunks[id].keys.stream == static_cast<uint16_t>(container::LightfieldStream::kColour) &&
+        chunks[id].keys.first_frame > 0 && chunks[id].stored_size > 0) {
+      victim = id;
+    }
+  }
+  ASSERT_GE(victim, 0);
+  const container::ChunkKeys keys = chunks[victim].keys;
+  std::vector<uint8_t> damaged = clip.bytes;
+  damaged[chunks[victim].offset] ^= 0x5A;
+  auto reader = container::Reader::open(container::memory_source(damaged));
+  ASSERT_TRUE(reader.ok());
+  ClipDecoderOptions o;
+  o.view_dependent = false;
+  auto d = ClipDecoder::open(*reader, 0, o);
+  ASSERT_TRUE(d.ok());
+  CpuTextures tex = textures_for(*d);
+  FrameUpdates fu;
+  std::vector<float> before;
+  uint32_t reported = 0;
+  for (uint32_t f = 0; f < spec.frames; ++f) {
+    ASSERT_TRUE(d->advance(f, {}, {}, &fu).ok());
+    ASSERT_TRUE(tex.apply(fu).ok());
+    const CubeFace face = static_cast<CubeFace>(keys.face);
+    if (fu.stats.errors > 0) {
+      ++reported;
+      EXPECT_NE(fu.stats.first_error.find("CALF-E"), std::string::npos) << fu.stats.first_error;
+      // The damaged cell is absent from the frame's parameters and its texels are unchanged.
+      for (const CellParams& c : fu.cells) {
+        EXPECT_FALSE(c.face == face && c.cell == keys.region);
+      }
+      const PixelRect r = *tex.cells().cell_rect(keys.region);
+      const std::vector<float> now = tex.colour(0, face);
+      for (uint32_t y = r.y; y < r.y + r.height; ++y) {
+        for (uint32_t x = r.x; x < r.x + r.width; ++x) {
+          const size_t i = (size_t{y} * spec.face + x) * 3;
+          ASSERT_EQ(now[i], before[i]);
+        }
+      }
+      EXPECT_EQ(fu.cells.size(), fu.stats.total_cells - 1u);
+    } else {
+      expect_matches_reference(clip, tex, fu, f, "frame " + std::to_string(f));
+    }
+    before = tex.colour(0, face);
+  }
+  EXPECT_GT(reported, 0u) << "the damaged keyframe was never needed";
+}
+
+}  // namespace
+}  // namespace calf::decoder
