@@ -4,7 +4,6 @@
 #include <chrono>
 #include <iterator>
 #include <cmath>
-#include <map>
 #include <numbers>
 #include <unordered_set>
 #include <optional>
@@ -62,8 +61,13 @@ struct ClipDecoder::Impl {
   std::optional<lf::RegionCoding> material_coding;
   std::unique_ptr<ChunkCache> cache;
 
-  // Chunks by (stream, view, face, region), sorted by first frame.
-  std::map<std::array<uint32_t, 4>, std::vector<ChunkRef>> chunks;
+  // Chunks by (stream, view, face, region), sorted by first frame; a flat table because it is
+  // consulted per visible cell and tile every frame.
+  uint32_t regions_per_face = 1;
+  std::vector<std::vector<ChunkRef>> chunks;
+  size_t slot(uint32_t stream, uint32_t v, uint32_t f, uint32_t r) const {
+    return ((size_t{stream} * header.view_count + v) * 6 + f) * regions_per_face + r;
+  }
 
   struct CellState {
     std::optional<lf::CellTimeline> timeline;
@@ -83,8 +87,7 @@ struct ClipDecoder::Impl {
   std::vector<uint32_t> prefetch_ids;
 
   const std::vector<ChunkRef>* find(LightfieldStream s, uint32_t v, uint32_t f, uint32_t r) const {
-    auto it = chunks.find({static_cast<uint32_t>(s), v, f, r});
-    return it == chunks.end() ? nullptr : &it->second;
+    return &chunks[slot(static_cast<uint32_t>(s), v, f, r)];
   }
 
   // The one chunk of the list starting at `first` (exact) or serving `frame`.
@@ -144,6 +147,17 @@ struct ClipDecoder::Impl {
 Status ClipDecoder::Impl::open_tables() {
   const uint32_t cell_count = cells.cell_count(), tile_count = tiles.cell_count();
   const auto& all = reader->chunks();
+  regions_per_face = std::max(cell_count, tile_count);
+  // A valid track has a t chunk per cell and a depth chunk per tile of every face of every view;
+  // checking that first also bounds the table below by the file's own size.
+  const uint64_t regions = uint64_t{header.view_count} * 6 * regions_per_face;
+  if (regions > all.size()) {
+    return corrupt(std::to_string(header.view_count) + " views of 6 x " +
+                   std::to_string(regions_per_face) + " regions need more than the file's " +
+                   std::to_string(all.size()) + " chunks");
+  }
+  constexpr uint32_t kStreams = 5;  // index, colour, depth, material, t (SPEC §11.1)
+  chunks.assign(size_t{kStreams} * header.view_count * 6 * regions_per_face, {});
   for (uint32_t id = 0; id < all.size(); ++id) {
     const container::ChunkKeys& k = all[id].keys;
     if (k.track != track || k.stream == static_cast<uint16_t>(LightfieldStream::kIndex)) continue;
@@ -157,15 +171,16 @@ Status ClipDecoder::Impl::open_tables() {
       return corrupt("chunk " + std::to_string(id) + ": " + where(k.view, k.face, k.region) +
                      " lies outside the track's grid");
     }
-    chunks[{k.stream, k.view, k.face, k.region}].push_back({k.first_frame, k.frame_count, id});
+    chunks[slot(k.stream, k.view, k.face, k.region)].push_back({k.first_frame, k.frame_count, id});
   }
-  for (auto& [key, list] : chunks) {
+  for (size_t at = 0; at < chunks.size(); ++at) {
+    std::vector<ChunkRef>& list = chunks[at];
     std::sort(list.begin(), list.end(),
               [](const ChunkRef& a, const ChunkRef& b) { return a.first_frame < b.first_frame; });
     for (size_t i = 1; i < list.size(); ++i) {
       if (list[i].first_frame == list[i - 1].first_frame) {
-        return corrupt(where(key[1], key[2], key[3]) + ": two chunks of stream " +
-                       std::to_string(key[0]) + " start at frame " +
+        return corrupt("chunks " + std::to_string(list[i - 1].id) + " and " +
+                       std::to_string(list[i].id) + " have the same keys and start at frame " +
                        std::to_string(list[i].first_frame));
       }
     }

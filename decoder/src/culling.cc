@@ -63,6 +63,22 @@ Frustum::Frustum(const std::array<Vec3, 4>& n, const std::array<Vec3, 4>& f) {
   normals_[5] = cross(sub(f[1], f[0]), sub(f[3], f[0]));
   edges_[4] = sub(n[1], n[0]);
   edges_[5] = sub(n[3], n[0]);
+  // Orient every normal inward (toward the centroid) and keep the plane offsets, for the cheap
+  // "a corner of one lies inside the other" proof of intersection.
+  Vec3 centroid;
+  for (const Vec3& c : corners_) centroid = add(centroid, scale(c, 1.0 / 8));
+  const Vec3 on_face[6] = {n[0], n[1], n[2], n[3], n[0], f[0]};
+  for (int i = 0; i < 6; ++i) {
+    if (dot(normals_[i], sub(centroid, on_face[i])) < 0) normals_[i] = scale(normals_[i], -1);
+    offsets_[i] = dot(normals_[i], on_face[i]);
+  }
+}
+
+bool Frustum::contains(const Vec3& p) const {
+  for (int i = 0; i < 6; ++i) {
+    if (dot(normals_[i], p) < offsets_[i]) return false;
+  }
+  return true;
 }
 
 bool frusta_intersect(const Frustum& a, const Frustum& b) {
@@ -71,6 +87,13 @@ bool frusta_intersect(const Frustum& a, const Frustum& b) {
   }
   for (const Vec3& axis : b.face_normals()) {
     if (separated_on(axis, a, b)) return false;
+  }
+  // A shared point settles it without the 36 edge-pair axes (the costly part for visible cells).
+  for (const Vec3& p : a.corners()) {
+    if (b.contains(p)) return true;
+  }
+  for (const Vec3& p : b.corners()) {
+    if (a.contains(p)) return true;
   }
   for (const Vec3& ea : a.edge_directions()) {
     for (const Vec3& eb : b.edge_directions()) {
@@ -144,7 +167,7 @@ struct Search {
     std::vector<uint32_t> hit;
     for (uint32_t e : candidates) {
       if (stats) ++stats->tests;
-      if (frusta_intersect(f, eyes[e])) hit.push_back(e);
+      if (frusta_intersect(eyes[e], f)) hit.push_back(e);  // eye planes first: they reject most
     }
     return hit;
   }
@@ -193,7 +216,7 @@ std::vector<uint32_t> visible_cells_brute_force(const Vec3& viewpoint, CubeFace 
           cell_frustum(viewpoint, face, grid.face_size(), grid.cell_rect(cx, cy), z_near, z_far);
       for (const Frustum& eye : eyes) {
         if (stats) ++stats->tests;
-        if (frusta_intersect(f, eye)) {
+        if (frusta_intersect(eye, f)) {
           out.push_back(grid.cell_index(cx, cy));
           break;
         }

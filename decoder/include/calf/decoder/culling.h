@@ -40,14 +40,17 @@ class Frustum {
   Frustum(const std::array<Vec3, 4>& near_corners, const std::array<Vec3, 4>& far_corners);
 
   const std::array<Vec3, 8>& corners() const { return corners_; }
-  // Outward-or-inward face normals (sign does not matter to the separating-axis test).
+  // Face normals, pointing inward (the separating-axis test ignores the sign).
   const std::array<Vec3, 6>& face_normals() const { return normals_; }
   // The distinct edge directions: 4 side edges and the 2 directions of the cap edges.
   const std::array<Vec3, 6>& edge_directions() const { return edges_; }
+  // Whether `p` lies inside or on the frustum (no tolerance: used only to prove intersection).
+  bool contains(const Vec3& p) const;
 
  private:
   std::array<Vec3, 8> corners_{};
-  std::array<Vec3, 6> normals_{};
+  std::array<Vec3, 6> normals_{};  // oriented inward
+  std::array<double, 6> offsets_{};  // inside: dot(normal, p) >= offset
   std::array<Vec3, 6> edges_{};
 };
 

@@ -1,0 +1,307 @@
+// Paper 002 Tables 3 and 4 for calf's view-dependent decoder (decoder/include/calf/decoder/
+// clip_decoder.h), on encoded clips:
+//
+// Table 3 — per active-view count (5, 9, all) and with / without view-dependent decoding: the
+//   bitrate of the texture updates at 24 fps (colour; depth + material), the decode time per
+//   frame (ClipDecoder::advance: culling, chunk fetch from the cache / file, zstd or LZMA2
+//   decompression, layout undoing), the time a memcpy of the same update bytes takes and the ratio.
+//   The eye sits at the centroid of the viewpoints (inside the view volume) and looks in
+//   `--directions` horizontal directions in turn; for each it plays the whole clip `--repeats`
+//   times (the wrap back to frame 0 is a seek). The first frame of each direction is left out
+//   of the means (it uploads everything visible from nothing). Active views: the nearest to the
+//   eye (ties by index).
+// Table 4 — quadtree leaf levels 1-4 (2x2 ... 16x16 cells per face): per frame, the share of cells
+//   visible and the frustum tests of the regular method (every cell) and of the hierarchical one,
+//   9 active views (or all, if fewer), one eye, same poses.
+// Peers, in the same run where ffmpeg is installed (tests/bench/ffmpeg_peers.h): the depth frames
+//   the 9-view decode serves (all six faces of each active view, log-16 codes, stacked into one
+//   image per frame), encoded losslessly with FFV1 and with x265, and the time ffmpeg takes to
+//   decode them per frame (process start-up included and reported apart).
+//
+//   bench-decoder_tables --clip FILE.calf [--clip ...] [--directions 8] [--repeats 2] [--no-peers]
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "calf/decoder/clip_decoder.h"
+#include "calf/decoder/culling.h"
+#include "calf/decoder/lightfield_reference.h"
+#include "calf/format/container.h"
+#include "calf/format/grid.h"
+#include "ffmpeg_peers.h"
+
+namespace {
+
+using namespace calf;
+using namespace calf::decoder;
+
+double now_ms() {
+  return std::chrono::duration<double, std::milli>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+struct Poses {
+  Vec3 centre;
+  std::vector<EyeView> eyes;  // one per direction
+};
+
+Poses make_poses(const ClipDecoder& d, uint32_t directions) {
+  Poses p;
+  const uint32_t n = d.header().view_count;
+  double far = 1;
+  for (uint32_t v = 0; v < n; ++v) {
+    p.centre.x += d.view(v).position[0] / n;
+    p.centre.y += d.view(v).position[1] / n;
+    p.centre.z += d.view(v).position[2] / n;
+    far = std::max(far, 2.0 * d.view(v).z_far);
+  }
+  for (uint32_t i = 0; i < directions; ++i) {
+    const double yaw = 2 * std::numbers::pi * i / directions;
+    EyeView e;
+    e.position = p.centre;
+    e.forward = {std::sin(yaw), -0.1, -std::cos(yaw)};
+    e.fov_y = std::numbers::pi / 2;
+    e.aspect = 1;
+    e.near = 0.05;
+    e.far = far;
+    p.eyes.push_back(e);
+  }
+  return p;
+}
+
+std::vector<uint32_t> nearest_views(const ClipDecoder& d, const Vec3& eye, uint32_t count) {
+  std::vector<uint32_t> order(d.header().view_count);
+  for (uint32_t v = 0; v < order.size(); ++v) order[v] = v;
+  auto dist = [&](uint32_t v) {
+    const double* q = d.view(v).position;
+    return std::hypot(q[0] - eye.x, q[1] - eye.y, q[2] - eye.z);
+  };
+  std::stable_sort(order.begin(), order.end(),
+                   [&](uint32_t a, uint32_t b) { return dist(a) < dist(b); });
+  order.resize(std::min<size_t>(count, order.size()));
+  return order;
+}
+
+struct Table3Row {
+  bool vd = false;
+  uint32_t views = 0;
+  double colour_mbps = 0, depth_mbps = 0, decode_ms = 0, memcpy_ms = 0, visible_pct = 0;
+  uint32_t errors = 0;
+  uint64_t frames = 0;
+};
+
+Table3Row run_table3(const container::Reader& reader, const Poses& poses, bool vd,
+                     const std::vector<uint32_t>& active, uint32_t repeats) {
+  Table3Row row;
+  row.vd = vd;
+  row.views = static_cast<uint32_t>(active.size());
+  ClipDecoderOptions o;
+  o.view_dependent = vd;
+  auto d = ClipDecoder::open(reader, 0, o);
+  if (!d.ok()) {
+    std::fprintf(stderr, "%s\n", d.status().to_string().c_str());
+    std::exit(1);
+  }
+  const uint32_t frames = d->header().frame_count;
+  std::vector<uint8_t> sink;
+  FrameUpdates fu;
+  double colour = 0, depth = 0, visible = 0;
+  for (const EyeView& eye : poses.eyes) {
+    d->reset();
+    bool first = true;
+    for (uint32_t r = 0; r < repeats; ++r) {
+      for (uint32_t f = 0; f < frames; ++f) {
+        const Status s = d->advance(f, std::span<const EyeView>(&eye, 1), active, &fu);
+        if (!s.ok()) {
+          std::fprintf(stderr, "%s\n", s.to_string().c_str());
+          std::exit(1);
+        }
+        // The same bytes copied once, as a GPU upload from mapped memory would at best.
+        const uint64_t bytes = fu.stats.update_bytes();
+        if (sink.size() < bytes) sink.resize(bytes);
+        const double t0 = now_ms();
+        size_t at = 0;
+        for (const TextureUpdate& u : fu.updates) {
+          std::memcpy(sink.data() + at, u.bytes.data(), u.bytes.size());
+          at += u.bytes.size();
+        }
+        const double copy_ms = now_ms() - t0;
+        row.errors += fu.stats.errors;
+        if (first) {
+          first = false;
+          continue;
+        }
+        row.frames += 1;
+        colour += fu.stats.colour_bytes;
+        depth += fu.stats.depth_bytes + fu.stats.material_bytes;
+        row.decode_ms += fu.stats.decode_ms;
+        row.memcpy_ms += copy_ms;
+        visible += fu.stats.total_cells ? double(fu.stats.visible_cells) / fu.stats.total_cells : 0;
+      }
+    }
+  }
+  const double n = std::max<double>(1, row.frames);
+  row.colour_mbps = colour / n * 8 * 24 / 1e6;
+  row.depth_mbps = depth / n * 8 * 24 / 1e6;
+  row.decode_ms /= n;
+  row.memcpy_ms /= n;
+  row.visible_pct = 100 * visible / n;
+  return row;
+}
+
+struct Table4Row {
+  uint32_t level = 0;
+  double visible_pct = 0, regular = 0, hierarchical = 0;
+};
+
+Table4Row run_table4(const ClipDecoder& d, const Poses& poses, const std::vector<uint32_t>& active,
+                     uint32_t level) {
+  Table4Row row;
+  row.level = level;
+  auto grid = FaceGrid::with_tiles_per_side(d.header().face_size, 1u << level);
+  if (!grid.ok()) return row;
+  double visible = 0, total = 0;
+  for (const EyeView& eye : poses.eyes) {
+    const Frustum f = eye_frustum(eye);
+    const std::span<const Frustum> frusta(&f, 1);
+    CullStats regular, hierarchical;
+    for (uint32_t v : active) {
+      const LightfieldViewInfo& info = d.view(v);
+      const Vec3 p{info.position[0], info.position[1], info.position[2]};
+      // The decoder's far cap (clip_decoder.cc): past the viewer's far plane from this viewpoint.
+      const double z_far = std::max<double>(
+          info.z_far, std::hypot(eye.position.x - p.x, eye.position.y - p.y, eye.position.z - p.z) +
+                          eye.far);
+      for (int face = 0; face < 6; ++face) {
+        const CubeFace cf = static_cast<CubeFace>(face);
+        (void)visible_cells_brute_force(p, cf, *grid, info.z_near, z_far, frusta, &regular);
+        visible += visible_cells_hierarchical(p, cf, *grid, info.z_near, z_far, frusta, 0,
+                                              &hierarchical)
+                       .size();
+        total += grid->cell_count();
+      }
+    }
+    row.regular += regular.tests;
+    row.hierarchical += hierarchical.tests;
+  }
+  const double n = static_cast<double>(poses.eyes.size());
+  row.regular /= n;
+  row.hierarchical /= n;
+  row.visible_pct = 100 * visible / std::max(1.0, total);
+  return row;
+}
+
+void run_peers(const container::Reader& reader, const std::vector<uint32_t>& active,
+               double calf_ms_per_frame) {
+  auto ref = LightfieldReference::open(reader, 0);
+  if (!ref.ok()) return;
+  const auto& h = ref->header();
+  const uint32_t w = h.face_size, faces = static_cast<uint32_t>(active.size()) * 6;
+  std::vector<uint16_t> codes(size_t{w} * w * faces * h.frame_count);
+  LightfieldFace face;
+  size_t at = 0;
+  for (uint32_t f = 0; f < h.frame_count; ++f) {
+    for (uint32_t v : active) {
+      for (uint32_t c = 0; c < 6; ++c) {
+        if (!ref->decode_face(v, c, f, &face).ok()) return;
+        std::copy(face.depth.begin(), face.depth.end(), codes.begin() + at);
+        at += face.depth.size();
+      }
+    }
+  }
+  std::printf("\nDepth peers: the same %u frames of %u faces (%u x %u each, stacked), lossless. "
+              "ffmpeg's decode ms/frame includes its process start-up; 'marginal' leaves it out "
+              "(all frames minus the first, per frame)\n\n",
+              h.frame_count, faces, w, w);
+  std::printf("| method | bytes | ratio to raw 16-bit | exact | decode ms/frame | marginal ms/frame |\n"
+              "|---|---:|---:|---|---:|---:|\n");
+  const double raw = static_cast<double>(codes.size()) * 2;
+  std::printf("| calf (all faces, no VD, decode incl. colour) | — | — | yes | %.3f | — |\n",
+              calf_ms_per_frame);
+  for (const bench::PeerResult& p :
+       {bench::ffv1_depth(codes, w, w * faces, h.frame_count),
+        bench::x265_lossless_depth(codes, w, w * faces, h.frame_count)}) {
+    if (!p.available) {
+      std::printf("| %s | n/a | | | | | (%s)\n", p.method.c_str(), p.note.c_str());
+      continue;
+    }
+    std::printf("| %s | %llu | %.1f× | %s | %.3f | %.3f |\n", p.method.c_str(),
+                static_cast<unsigned long long>(p.bytes), raw / std::max<double>(1, p.bytes),
+                p.exact ? "yes" : "NO", p.decode_ms_per_frame, p.marginal_ms_per_frame);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Paper 002 Tables 3 and 4 for the view-dependent decoder, with ffmpeg peers"};
+  std::vector<std::string> clips;
+  uint32_t directions = 8, repeats = 2;
+  bool no_peers = false;
+  app.add_option("--clip", clips, "encoded .calf clip (repeatable)")->required();
+  app.add_option("--directions", directions, "horizontal look directions (default 8)")
+      ->check(CLI::Range(1, 360));
+  app.add_option("--repeats", repeats, "plays of the clip per direction (default 2)")
+      ->check(CLI::Range(1, 100));
+  app.add_flag("--no-peers", no_peers, "skip the ffmpeg FFV1 / x265 depth peers");
+  CLI11_PARSE(app, argc, argv);
+
+  for (const std::string& path : clips) {
+    auto reader = container::Reader::open(path);
+    if (!reader.ok()) {
+      std::fprintf(stderr, "%s\n", reader.status().to_string().c_str());
+      return 1;
+    }
+    auto probe = ClipDecoder::open(*reader, 0);
+    if (!probe.ok()) {
+      std::fprintf(stderr, "%s: %s\n", path.c_str(), probe.status().to_string().c_str());
+      return 1;
+    }
+    const auto& h = probe->header();
+    const Poses poses = make_poses(*probe, directions);
+    std::printf("\n## %s\n\n%u views, face %u, cell %u, depth tile %u, %u frames; eye at the "
+                "viewpoints' centroid, fov 90°, %u directions x %u plays\n\n",
+                path.c_str(), h.view_count, h.face_size, h.cell_size, h.depth_tile_size,
+                h.frame_count, directions, repeats);
+    std::printf("Table 3\n\n| VD | active views | colour Mbps @24fps | depth+material Mbps | "
+                "cells visible %% | decode ms/frame | memcpy ms/frame | decode / memcpy |\n"
+                "|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    std::vector<uint32_t> counts;
+    for (uint32_t c : {5u, 9u, h.view_count}) {
+      const uint32_t k = std::min(c, h.view_count);
+      if (std::find(counts.begin(), counts.end(), k) == counts.end()) counts.push_back(k);
+    }
+    double nine_no_vd_ms = 0;
+    for (uint32_t k : counts) {
+      const std::vector<uint32_t> active = nearest_views(*probe, poses.centre, k);
+      for (bool vd : {false, true}) {
+        const Table3Row r = run_table3(*reader, poses, vd, active, repeats);
+        if (!vd && k == std::min(9u, h.view_count)) nine_no_vd_ms = r.decode_ms;
+        std::printf("| %s | %u | %.2f | %.2f | %.1f | %.3f | %.4f | %.0f× |%s\n", vd ? "yes" : "no",
+                    k, r.colour_mbps, r.depth_mbps, r.visible_pct, r.decode_ms, r.memcpy_ms,
+                    r.decode_ms / std::max(1e-9, r.memcpy_ms),
+                    r.errors ? fmt::format(" {} chunk errors", r.errors).c_str() : "");
+      }
+    }
+    const std::vector<uint32_t> nine = nearest_views(*probe, poses.centre, 9);
+    std::printf("\nTable 4 (%zu active views, one eye)\n\n| leaf level | cells per face | "
+                "visibility %% | tests regular | tests hierarchical |\n|---|---:|---:|---:|---:|\n",
+                nine.size());
+    for (uint32_t level = 1; level <= 4; ++level) {
+      const Table4Row r = run_table4(*probe, poses, nine, level);
+      std::printf("| %u | %u | %.1f | %.0f | %.0f |\n", level, (1u << level) * (1u << level),
+                  r.visible_pct, r.regular, r.hierarchical);
+    }
+    if (!no_peers) run_peers(*reader, nine, nine_no_vd_ms);
+  }
+  return 0;
+}
