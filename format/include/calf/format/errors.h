@@ -111,6 +111,11 @@ enum class ErrorKind : uint8_t {
   X(kPlayerNoMaterial, 402, kInvalidArgument, "material written to a view without material")    \
   X(kPlayerOptions, 403, kInvalidArgument, "a render option or the eye is outside its range")   \
   X(kPlayerGl, 404, kUnsupported, "an OpenGL context or a required GL feature is missing")    \
+  X(kViewSelectOptions, 450, kInvalidArgument, "a view-selection option is out of range")       \
+  X(kViewSelectViewpoint, 451, kInvalidArgument, "a viewpoint position is not finite")         \
+  X(kViewSelectEye, 452, kInvalidArgument, "the eye pose given to view selection is invalid")  \
+  X(kViewSelectFrameTime, 453, kInvalidArgument, "a frame time is negative or not finite")     \
+  X(kViewSelectLimit, 454, kLimit, "more viewpoints than view selection accepts")              \
   /* end of the list: every line above ends with a backslash */
 
 enum class ErrorId : uint16_t {

@@ -1,0 +1,346 @@
+// View selection (paper 002 Sec. 6.3). The what and why are in the public header and in
+// docs/RENDERING.md ("View selection"); comments here explain the choices inside.
+#include "calf/player/view_selection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <limits>
+#include <string>
+
+#include "sampling.h"
+
+namespace calf::player {
+namespace {
+
+using internal::cross;
+using internal::dot;
+using internal::length;
+using internal::operator-;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr uint32_t kMaxGrowthBackoff = 32;
+
+bool finite(const Vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+// Shortest faithful text of a number ("0.5", "nan", "1e+300"), for messages.
+std::string num(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.9g", x);
+  return buf;
+}
+
+std::string vec_string(const Vec3& v) {
+  char buf[104];
+  std::snprintf(buf, sizeof buf, "(%.9g, %.9g, %.9g)", v.x, v.y, v.z);
+  return buf;
+}
+
+// The angle between two non-zero vectors in radians, [0, pi]. atan2 of |a x b| and a . b stays
+// accurate near 0 and pi, where acos of a normalised dot product loses half its digits — and
+// the culling thresholds of a few degrees sit exactly there.
+double angle_between(const Vec3& a, const Vec3& b) {
+  return std::atan2(length(cross(a, b)), dot(a, b));
+}
+
+Status option_error(const char* field, double value, const char* range) {
+  return Status(ErrorId::kViewSelectOptions, std::string("view selection option ") + field + " = " +
+                                                 num(value) + " is outside " + range);
+}
+
+Status check_options(const ViewSelectionOptions& o) {
+  if (o.priority != ViewPriority::kDistance && o.priority != ViewPriority::kAngle) {
+    return option_error("priority", static_cast<double>(o.priority), "{distance, angle}");
+  }
+  if (!finite(o.reference_point)) {
+    return Status(ErrorId::kViewSelectOptions,
+                  "view selection option reference_point = " + vec_string(o.reference_point) +
+                      " is not finite");
+  }
+  // `!(x >= lo && x <= hi)` so that NaN fails every range check.
+  if (!(o.redundancy_angle_deg >= 0 && o.redundancy_angle_deg <= 180)) {
+    return option_error("redundancy_angle_deg", o.redundancy_angle_deg, "[0, 180]");
+  }
+  if (!(o.view_cone_deg > 0 && o.view_cone_deg <= 180)) {
+    return option_error("view_cone_deg", o.view_cone_deg, "(0, 180]");
+  }
+  if (o.max_active < 1 || o.max_active > kMaxViewpoints) {
+    return option_error("max_active", o.max_active, "[1, 65536]");
+  }
+  if (o.min_active < 1 || o.min_active > o.max_active) {
+    return option_error("min_active", o.min_active, "[1, max_active]");
+  }
+  if (!(o.incumbent_margin >= 0 && o.incumbent_margin < 1)) {
+    return option_error("incumbent_margin", o.incumbent_margin, "[0, 1)");
+  }
+  if (!(o.target_frame_ms >= 0 && std::isfinite(o.target_frame_ms))) {
+    return option_error("target_frame_ms", o.target_frame_ms, "[0, inf)");
+  }
+  if (!(o.fixed_cost_ms >= 0 && std::isfinite(o.fixed_cost_ms))) {
+    return option_error("fixed_cost_ms", o.fixed_cost_ms, "[0, inf)");
+  }
+  if (!(o.over_budget_tolerance >= 0 && o.over_budget_tolerance <= 1)) {
+    return option_error("over_budget_tolerance", o.over_budget_tolerance, "[0, 1]");
+  }
+  if (!(o.grow_headroom >= 0 && o.grow_headroom < 1)) {
+    return option_error("grow_headroom", o.grow_headroom, "[0, 1)");
+  }
+  if (o.grow_after_frames < 1) return option_error("grow_after_frames", 0, "[1, 2^32)");
+  if (!(o.cost_smoothing > 0 && o.cost_smoothing <= 1)) {
+    return option_error("cost_smoothing", o.cost_smoothing, "(0, 1]");
+  }
+  return Status::Ok();
+}
+
+struct Ranked {
+  uint32_t view;
+  double key;       // priority key after the incumbent discount; smaller ranks first
+  double distance;  // |P - eye|, the first tie-break
+};
+
+}  // namespace
+
+Expected<ViewSelector> ViewSelector::make(std::vector<Vec3> viewpoints,
+                                          const ViewSelectionOptions& options) {
+  CALF_RETURN_IF_ERROR(check_options(options));
+  if (viewpoints.size() > kMaxViewpoints) {
+    return Status(ErrorId::kViewSelectLimit, std::to_string(viewpoints.size()) +
+                                                 " viewpoints exceed the selector's limit of " +
+                                                 std::to_string(kMaxViewpoints));
+  }
+  for (size_t i = 0; i < viewpoints.size(); ++i) {
+    if (!finite(viewpoints[i])) {
+      return Status(ErrorId::kViewSelectViewpoint, "viewpoint " + std::to_string(i) + " position " +
+                                                       vec_string(viewpoints[i]) +
+                                                       " is not finite");
+    }
+  }
+  ViewSelector s;
+  s.viewpoints_ = std::move(viewpoints);
+  s.options_ = options;
+  s.was_active_.assign(s.viewpoints_.size(), 0);
+  s.reset();
+  return s;
+}
+
+void ViewSelector::reset() {
+  slots_.clear();
+  std::fill(was_active_.begin(), was_active_.end(), 0);
+  last_active_count_ = 0;
+  limit_ = options_.max_active;
+  per_view_ms_ = 0;
+  under_budget_frames_ = 0;
+  frames_since_growth_ = 0;
+  growth_on_probation_ = false;
+  growth_backoff_ = 1;
+}
+
+Status ViewSelector::set_options(const ViewSelectionOptions& options) {
+  CALF_RETURN_IF_ERROR(check_options(options));
+  options_ = options;
+  limit_ = options_.target_frame_ms > 0
+               ? std::clamp(limit_, options_.min_active, options_.max_active)
+               : options_.max_active;
+  return Status::Ok();
+}
+
+Expected<ViewSelection> ViewSelector::select(const Vec3& position, const Vec3& forward) {
+  const ViewSelectionOptions& o = options_;
+  const bool cone_on = o.view_cone_deg < 180;
+  if (!finite(position) || !finite(forward)) {
+    return Status(ErrorId::kViewSelectEye, "eye position " + vec_string(position) + " or forward " +
+                                               vec_string(forward) + " is not finite");
+  }
+  if (cone_on && length(forward) == 0) {
+    return Status(ErrorId::kViewSelectEye,
+                  "eye forward is (0, 0, 0) but cone culling (view_cone_deg " +
+                      num(o.view_cone_deg) + ") needs a direction");
+  }
+
+  // 1. Rank.
+  const size_t n = viewpoints_.size();
+  const Vec3 eye_from_ref = position - o.reference_point;
+  const bool eye_at_ref = length(eye_from_ref) == 0;
+  std::vector<Ranked> ranked(n);
+  for (uint32_t i = 0; i < n; ++i) {
+    const double distance = length(viewpoints_[i] - position);
+    double key = distance;
+    if (o.priority == ViewPriority::kAngle) {
+      const Vec3 view_from_ref = viewpoints_[i] - o.reference_point;
+      // Undefined angles (eye or view at the reference point) count as 0: the distance
+      // tie-break then decides, which is the only meaningful order left.
+      key = eye_at_ref || length(view_from_ref) == 0 ? 0.0
+                                                     : angle_between(eye_from_ref, view_from_ref);
+    }
+    if (was_active_[i]) key *= 1.0 - o.incumbent_margin;
+    // Coordinates near the double range can overflow to inf - inf; a NaN key would break the
+    // sort's ordering, so it ranks last (ties then break by index).
+    ranked[i] = {i, std::isnan(key) ? kInf : key, std::isnan(distance) ? kInf : distance};
+  }
+  std::sort(ranked.begin(), ranked.end(), [](const Ranked& a, const Ranked& b) {
+    if (a.key != b.key) return a.key < b.key;
+    if (a.distance != b.distance) return a.distance < b.distance;
+    return a.view < b.view;
+  });
+
+  ViewSelection sel;
+  const bool controller_on = o.target_frame_ms > 0;
+  sel.performance_limit = controller_on ? std::min(limit_, o.max_active) : o.max_active;
+  const uint32_t cap = sel.performance_limit;
+  const double cone_rad = o.view_cone_deg * kPi / 180.0;
+  const double redundancy_rad = o.redundancy_angle_deg * kPi / 180.0;
+
+  // 2.-4. Cull, walking the ranking. Angle culling compares against views kept so far (not
+  // against views it dropped: a view close only to a dropped view is not redundant with anything
+  // the renderer will use). The walk stops at max_active kept views, so a frame costs
+  // O(n log n + n * max_active) whatever the number of viewpoints.
+  std::vector<uint32_t> kept;
+  kept.reserve(std::min<size_t>(n, o.max_active));
+  for (size_t r = 0; r < n; ++r) {
+    const uint32_t v = ranked[r].view;
+    const Vec3 dir = viewpoints_[v] - position;
+    const bool at_eye = ranked[r].distance == 0;
+    if (cone_on && !at_eye && angle_between(forward, dir) > cone_rad) {
+      ++sel.culled_by_cone;
+      continue;
+    }
+    if (kept.size() == o.max_active) {
+      ++sel.culled_by_max_active;
+      continue;
+    }
+    bool redundant = false;
+    if (redundancy_rad > 0 && !at_eye) {
+      for (uint32_t k : kept) {
+        const Vec3 kdir = viewpoints_[k] - position;
+        if (length(kdir) > 0 && angle_between(dir, kdir) < redundancy_rad) {
+          redundant = true;
+          break;
+        }
+      }
+    }
+    if (redundant) {
+      ++sel.culled_by_angle;
+      continue;
+    }
+    kept.push_back(v);
+  }
+  if (kept.size() > cap) {
+    sel.culled_by_performance = static_cast<uint32_t>(kept.size() - cap);
+    kept.resize(cap);
+  }
+  // 5. Never an empty frame when there is something to show: only the cone can empty the set
+  // (angle culling always keeps the first view it sees), and then the nearest view stays.
+  if (kept.empty() && n > 0) {
+    const auto nearest = std::min_element(ranked.begin(), ranked.end(), [](auto& a, auto& b) {
+      return a.distance != b.distance ? a.distance < b.distance : a.view < b.view;
+    });
+    kept.push_back(nearest->view);
+    --sel.culled_by_cone;
+  }
+  sel.active = kept;
+
+  // 6. Slots. Survivors stay where they are; entering views fill the lowest holes, then append.
+  std::vector<uint8_t> now_active(n, 0);
+  for (uint32_t v : kept) now_active[v] = 1;
+  std::vector<uint32_t> slots = slots_;
+  for (uint32_t& s : slots) {
+    if (s != kNoView && !now_active[s]) {
+      sel.left.push_back(s);
+      s = kNoView;
+    }
+  }
+  // A smaller max_active (set_options) leaves survivors beyond the slot capacity: move them down
+  // into holes, as if they had entered (their layer changes, so they need an upload).
+  std::vector<uint32_t> to_place;
+  for (size_t s = o.max_active; s < slots.size(); ++s) {
+    if (slots[s] != kNoView) to_place.push_back(slots[s]);
+    slots[s] = kNoView;
+  }
+  for (uint32_t v : kept) {
+    if (!was_active_[v]) to_place.push_back(v);
+  }
+  size_t hole = 0;
+  std::vector<uint32_t> entered_slots;
+  for (uint32_t v : to_place) {
+    while (hole < slots.size() && slots[hole] != kNoView) ++hole;
+    if (hole == slots.size()) slots.push_back(kNoView);
+    slots[hole] = v;
+    entered_slots.push_back(static_cast<uint32_t>(hole));
+  }
+  while (!slots.empty() && slots.back() == kNoView) slots.pop_back();
+  std::sort(entered_slots.begin(), entered_slots.end());
+  for (uint32_t s : entered_slots) sel.entered.push_back(slots[s]);
+  std::sort(sel.left.begin(), sel.left.end());
+  sel.slots = slots;
+
+  slots_ = std::move(slots);
+  was_active_ = std::move(now_active);
+  last_active_count_ = static_cast<uint32_t>(kept.size());
+  return sel;
+}
+
+Status ViewSelector::report_frame_time(double frame_ms) {
+  if (!(frame_ms >= 0) || !std::isfinite(frame_ms)) {
+    return Status(ErrorId::kViewSelectFrameTime, "reported frame time " + num(frame_ms) +
+                                                     " ms is not a finite non-negative number");
+  }
+  const ViewSelectionOptions& o = options_;
+  if (o.target_frame_ms <= 0 || last_active_count_ == 0) return Status::Ok();
+  const uint32_t n = last_active_count_;
+
+  // Per-view cost: the frame's variable part shared out over the views that caused it.
+  const double sample = std::max(0.0, frame_ms - o.fixed_cost_ms) / n;
+  per_view_ms_ =
+      per_view_ms_ > 0 ? per_view_ms_ + o.cost_smoothing * (sample - per_view_ms_) : sample;
+  if (frames_since_growth_ < UINT32_MAX) ++frames_since_growth_;
+  if (growth_on_probation_ && frames_since_growth_ > o.grow_after_frames) {
+    growth_on_probation_ = false;  // the growth held: trust the model again
+    growth_backoff_ = 1;
+  }
+
+  if (frame_ms > o.target_frame_ms * (1 + o.over_budget_tolerance)) {
+    under_budget_frames_ = 0;
+    // The count the model says fits the target; never more than n - 1, since n is too many
+    // (the running estimate may lag behind a sudden jump in cost).
+    uint32_t fit = o.min_active;
+    if (per_view_ms_ > 0 && o.target_frame_ms > o.fixed_cost_ms) {
+      const double f = std::floor((o.target_frame_ms - o.fixed_cost_ms) / per_view_ms_);
+      fit = static_cast<uint32_t>(std::min<double>(f, kMaxViewpoints));
+    }
+    const uint32_t fewer = n > o.min_active ? n - 1 : o.min_active;
+    limit_ = std::clamp(std::min(fit, fewer), o.min_active, o.max_active);
+    if (growth_on_probation_) {
+      // The latest growth broke the budget: wait longer before the next one.
+      growth_backoff_ = std::min(growth_backoff_ * 2, kMaxGrowthBackoff);
+      growth_on_probation_ = false;
+    }
+    return Status::Ok();
+  }
+  if (frame_ms >= o.target_frame_ms || limit_ > n || limit_ >= o.max_active) {
+    // Inside the tolerance band, or the limit is not what bounds the count (culling left fewer
+    // views), or nothing to grow to: hold.
+    under_budget_frames_ = 0;
+    return Status::Ok();
+  }
+  // A frame counts towards growth only if the model says one more view would still fit with
+  // headroom: frames just under the target must not pile up credit for a later jump.
+  const double predicted = o.fixed_cost_ms + (n + 1) * per_view_ms_;
+  if (predicted > o.target_frame_ms * (1 - o.grow_headroom)) {
+    under_budget_frames_ = 0;
+    return Status::Ok();
+  }
+  ++under_budget_frames_;
+  if (under_budget_frames_ >= static_cast<uint64_t>(o.grow_after_frames) * growth_backoff_) {
+    limit_ = n + 1;
+    under_budget_frames_ = 0;
+    frames_since_growth_ = 0;
+    growth_on_probation_ = true;
+  }
+  return Status::Ok();
+}
+
+}  // namespace calf::player
