@@ -65,7 +65,7 @@ Expected<RenderOptions> march_range_for(const ViewSet& views, const Vec3& eye,
     near = std::min(near, static_cast<double>(v.range().z_near()) / 4);
   }
   options.far = far;
-  options.near = std::min(near, far / (1 << 20));
+  options.near = std::max(near, far / (1 << 20));
   return options;
 }
 
@@ -94,6 +94,14 @@ Expected<CpuRenderer> CpuRenderer::make(const ViewSet& views, const RenderOption
   if (!(o.cam_decay >= 0) || !std::isfinite(o.cam_decay)) {
     return option_error("cam_decay must be finite and >= 0");
   }
+  if (o.surface_hints > 4) return option_error("surface_hints is above 4");
+  if (o.surface_hint_vetoes > 65536) return option_error("surface_hint_vetoes is above 65536");
+  if (!(o.surface_hint_margin >= 0) || !std::isfinite(o.surface_hint_margin)) {
+    return option_error("surface_hint_margin must be finite and >= 0");
+  }
+  if (!(o.color_depth_tolerance >= 0) || !std::isfinite(o.color_depth_tolerance)) {
+    return option_error("color_depth_tolerance must be finite and >= 0");
+  }
   if (!std::isfinite(o.min_view_distance)) return option_error("min_view_distance is not finite");
   if (o.threads < 1 || o.threads > 256) return option_error("threads is outside [1, 256]");
   if (!(o.rr_start > 0) || !std::isfinite(o.rr_start)) {
@@ -119,44 +127,66 @@ Expected<CpuRenderer> CpuRenderer::make(const ViewSet& views, const RenderOption
   return r;
 }
 
+namespace {
+
+// How far in front of its surface view v sees the point at offset x from its centre (r = |x|),
+// in the view's log-16 code units: > 0 in front (empty for this view), <= 0 at or behind the
+// surface; +inf where the view sees sky. The depth compared with is depth_footprint's rule
+// (see RenderOptions), or the interpolated depth where the taps form one smooth surface.
+double code_margin(const View& v, const Vec3& x, double r, double footprint,
+                   double smooth_log_ratio) {
+  const internal::BilinearTaps taps = internal::bilinear_taps(
+      texel_coord_from_direction(to_direction(x), v.face_size()), v.face_size());
+  uint16_t c[4], lo = kLog16Sky, hi = 0;
+  for (int k = 0; k < 4; ++k) {
+    c[k] = v.depth_code_at(taps.texel[k].face, taps.texel[k].x, taps.texel[k].y);
+    lo = std::min(lo, c[k]);
+    hi = std::max(hi, c[k]);
+  }
+  // Compared in code space: code > nonlin(r) * 65534 is exactly decode(code) > r, one log
+  // instead of one exp, and needs no special case for r outside [z_near, z_far].
+  const double rcode = v.range().normalized_from_depth(r) * kLog16MaxFinite;
+  if (hi != kLog16Sky && (hi - lo) * v.range().relative_step() <= smooth_log_ratio) {
+    // One smooth surface around the direction: interpolate it (log-depth codes interpolate
+    // geometrically), which removes the staircase of per-texel constant depths.
+    double code = 0;
+    for (int k = 0; k < 4; ++k) code += taps.weight[k] * c[k];
+    return code - rcode;
+  }
+  // A depth discontinuity (or sky): the nearest surface among the texels whose centres lie
+  // within depth_footprint of the direction; the nearest texel always counts.
+  uint16_t code = kLog16Sky;
+  int nearest = 0;
+  for (int k = 0; k < 4; ++k) {
+    if (taps.weight[k] > taps.weight[nearest]) nearest = k;
+    if (taps.offset[k] < footprint - 1e-9) code = std::min(code, c[k]);
+  }
+  code = std::min(code, c[nearest]);
+  return code == kLog16Sky ? kInf : code - rcode;
+}
+
+}  // namespace
+
 // BetweenViewpointAndGeometry (footnote 2) over the active views: true as soon as one view that
-// is not too near sees p in front of its stored surface (or sees sky there).
+// is not too near sees p in front of its stored surface (or sees sky there) by more than the
+// relative depth `margin` (0 for the plain test).
 bool CpuRenderer::empty_at(const Vec3& p) const {
+  return empty_beyond(p, 0, 0);
+}
+
+bool CpuRenderer::empty_beyond(const Vec3& p, double margin, uint32_t vetoes_ignored) const {
   bool consulted = false;
+  uint32_t vetoes = 0;
   for (const View* v : active_) {
     const Vec3 x = p - v->position();
     const double r = length(x);
     if (r <= min_view_distance_) continue;
     consulted = true;
-    const internal::BilinearTaps taps = internal::bilinear_taps(
-        texel_coord_from_direction(to_direction(x), v->face_size()), v->face_size());
-    uint16_t c[4], lo = kLog16Sky, hi = 0;
-    for (int k = 0; k < 4; ++k) {
-      c[k] = v->depth_code_at(taps.texel[k].face, taps.texel[k].x, taps.texel[k].y);
-      lo = std::min(lo, c[k]);
-      hi = std::max(hi, c[k]);
+    if (code_margin(*v, x, r, options_.depth_footprint, smooth_log_ratio_) >
+            margin / v->range().relative_step() &&
+        ++vetoes > vetoes_ignored) {
+      return true;
     }
-    // Compared in code space: code > nonlin(r) * 65534 is exactly decode(code) > r, one log
-    // instead of one exp, and needs no special case for r outside [z_near, z_far].
-    const double rcode = v->range().normalized_from_depth(r) * kLog16MaxFinite;
-    if (hi != kLog16Sky && (hi - lo) * v->range().relative_step() <= smooth_log_ratio_) {
-      // One smooth surface around the direction: interpolate it (log-depth codes interpolate
-      // geometrically), which removes the staircase of per-texel constant depths.
-      double code = 0;
-      for (int k = 0; k < 4; ++k) code += taps.weight[k] * c[k];
-      if (code > rcode) return true;
-      continue;
-    }
-    // A depth discontinuity (or sky): the nearest surface among the texels whose centres lie
-    // within depth_footprint of the direction; the nearest texel always counts.
-    uint16_t code = kLog16Sky;
-    int nearest = 0;
-    for (int k = 0; k < 4; ++k) {
-      if (taps.weight[k] > taps.weight[nearest]) nearest = k;
-      if (taps.offset[k] < options_.depth_footprint - 1e-9) code = std::min(code, c[k]);
-    }
-    code = std::min(code, c[nearest]);
-    if (code == kLog16Sky || code > rcode) return true;
   }
   return !consulted;
 }
@@ -165,31 +195,98 @@ bool CpuRenderer::empty_at(const Vec3& p) const {
 bool CpuRenderer::intersect(const Vec3& o, const Vec3& d, double start, Hit* hit) const {
   const double log_ratio = std::log(options_.far / options_.near);
   const auto lin = [&](double x) { return options_.near * std::exp(x * log_ratio); };
+  if (options_.tight_march_start) {
+    // Nearer than z_near_j to P_j, view j sees every point as empty (or, within
+    // min_view_distance, no surface can be there): nothing to find before this.
+    for (const View* v : active_) {
+      start = std::max(start, static_cast<double>(v->range().z_near()) - length(o - v->position()));
+    }
+  }
   const double x0 = std::log(std::max(start, options_.near) / options_.near) / log_ratio;
   if (!(x0 < 1)) return false;
   const double step = (1 - x0) / options_.steps;
-  for (uint32_t i = 0; i <= options_.steps; ++i) {
-    const double x = i == options_.steps ? 1.0 : x0 + i * step;
-    if (empty_at(o + d * lin(x))) continue;
-    double lo = x - step, hi = x;
-    if (i == 0) {
-      lo = hi;  // already behind a surface at the first sample: nothing to refine
-    } else {
-      for (uint32_t k = 0; k < options_.refine_steps; ++k) {
-        const double mid = 0.5 * (lo + hi);
-        (empty_at(o + d * lin(mid)) ? lo : hi) = mid;
+  // Surface hints: the views nearest the ray origin. Where one of them goes from seeing a sample
+  // in front of its surface to seeing the next one behind it, while both samples are empty, the
+  // ray crossed that view's surface between them: a surface too thin for the step, or the
+  // shadow edge of something in front of it. The crossing, located by bisection on that view
+  // alone, is a hit unless more than surface_hint_vetoes views see it in front of their surface
+  // by more than the hint margin (the shadow edge of a foreground object is seen through by
+  // several views; a thin part carved by one view's texel grid is not).
+  constexpr uint32_t kMaxHints = 4;
+  const View* hint[kMaxHints] = {};
+  const uint32_t hints = std::min<uint32_t>(
+      {options_.surface_hints, kMaxHints, static_cast<uint32_t>(active_.size())});
+  {
+    double dist[kMaxHints];
+    for (uint32_t h = 0; h < hints; ++h) dist[h] = kInf;
+    for (const View* v : active_) {
+      double dv = length(o - v->position());
+      const View* cand = v;
+      for (uint32_t h = 0; h < hints; ++h) {
+        if (dv < dist[h]) {
+          std::swap(dv, dist[h]);
+          std::swap(cand, hint[h]);
+        }
       }
     }
-    hit->z = lin(0.5 * (lo + hi));
-    hit->p = o + d * hit->z;
-    return true;
+  }
+  // -1: the view does not vote here (too near its centre), 0: behind its surface, 1: in front.
+  const auto side = [&](const View* v, double x) {
+    const Vec3 rel = o + d * lin(x) - v->position();
+    const double r = length(rel);
+    if (r <= min_view_distance_) return -1;
+    // The nearest texel's depth: the view's own best estimate of its surface along the ray
+    // (the conservative footprint minimum would put the crossing in front of slanted surfaces,
+    // where the other views then rightly see empty space).
+    return code_margin(*v, rel, r, 0.5, 0) > 0 ? 1 : 0;
+  };
+  int prev[kMaxHints] = {};
+  for (uint32_t i = 0; i <= options_.steps; ++i) {
+    const double x = i == options_.steps ? 1.0 : x0 + i * step;
+    if (!empty_at(o + d * lin(x))) {
+      double lo = x - step, hi = x;
+      if (i == 0) {
+        lo = hi;  // already behind a surface at the first sample: nothing to refine
+      } else {
+        for (uint32_t k = 0; k < options_.refine_steps; ++k) {
+          const double mid = 0.5 * (lo + hi);
+          (empty_at(o + d * lin(mid)) ? lo : hi) = mid;
+        }
+      }
+      hit->z = lin(0.5 * (lo + hi));
+      hit->p = o + d * hit->z;
+      return true;
+    }
+    double found = kInf;
+    for (uint32_t h = 0; h < hints; ++h) {
+      const int now = side(hint[h], x);
+      if (i > 0 && prev[h] == 1 && now == 0) {
+        double lo = x - step, hi = x;
+        for (uint32_t k = 0; k < options_.refine_steps; ++k) {
+          const double mid = 0.5 * (lo + hi);
+          (side(hint[h], mid) == 1 ? lo : hi) = mid;
+        }
+        const double xc = 0.5 * (lo + hi);
+        if (xc < found && !empty_beyond(o + d * lin(xc), options_.surface_hint_margin,
+                                        options_.surface_hint_vetoes)) {
+          found = xc;
+        }
+      }
+      prev[h] = now;
+    }
+    if (found < kInf) {
+      hit->z = lin(found);
+      hit->p = o + d * hit->z;
+      return true;
+    }
   }
   return false;
 }
 
 // SampleColor over the active views and their blend (CalculateColor). Weights are kept as
 // logarithms and normalised by the largest, so no view's weight underflows to zero.
-void CpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* rgb, int* best_view) const {
+void CpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* rgb, int* best_view,
+                                double* best_rgb) const {
   const double hit_distance = std::max(length(p - o), 1e-12);
   double sum[3] = {0, 0, 0}, wsum = 0, best = -kInf;
   struct Contribution {
@@ -225,7 +322,10 @@ void CpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* rgb, int* 
       for (int t = 0; t < 4; ++t) {
         a[t] = taps.weight[t];
         if (options_.depth_aware_color) {
-          a[t] *= diff[t] == kInf ? 0.0 : std::exp(-options_.depth_decay * (diff[t] - dmin));
+          a[t] *= diff[t] == kInf
+                      ? 0.0
+                      : std::exp(-options_.depth_decay *
+                                 std::max(0.0, diff[t] - dmin - options_.color_depth_tolerance));
         }
         asum += a[t];
       }
@@ -240,6 +340,7 @@ void CpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* rgb, int* 
     if (k.log_w > best) {
       best = k.log_w;
       *best_view = static_cast<int>(vi);
+      if (best_rgb) std::copy(k.c, k.c + 3, best_rgb);
     }
     contributions.push_back(k);
   }

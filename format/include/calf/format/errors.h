@@ -111,11 +111,19 @@ enum class ErrorKind : uint8_t {
   X(kPlayerNoMaterial, 402, kInvalidArgument, "material written to a view without material")    \
   X(kPlayerOptions, 403, kInvalidArgument, "a render option or the eye is outside its range")   \
   X(kPlayerGl, 404, kUnsupported, "an OpenGL context or a required GL feature is missing")    \
+  X(kPlayerGlLayout, 410, kInvalidArgument, "a GL texture layout cannot be held")           \
+  X(kPlayerGlUpdate, 411, kInvalidArgument, "a texture update does not fit the GL textures")  \
+  X(kPlayerGlCall, 412, kInternal, "a GL call reported an error")                             \
+  X(kPlayerCaptureViews, 430, kInvalidArgument, "a capture view-frame cannot become player views") \
+  X(kImageCompare, 431, kInvalidArgument, "images to compare are empty, unequal or too small") \
+  X(kImageCompareOption, 432, kInvalidArgument, "an image metric or heat-map option is invalid") \
   X(kViewSelectOptions, 450, kInvalidArgument, "a view-selection option is out of range")       \
   X(kViewSelectViewpoint, 451, kInvalidArgument, "a viewpoint position is not finite")         \
   X(kViewSelectEye, 452, kInvalidArgument, "the eye pose given to view selection is invalid")  \
   X(kViewSelectFrameTime, 453, kInvalidArgument, "a frame time is negative or not finite")     \
   X(kViewSelectLimit, 454, kLimit, "more viewpoints than view selection accepts")              \
+  X(kPlaybackClip, 460, kInvalidArgument, "the file has nothing calf-play can play")            \
+  X(kPlaybackOption, 461, kInvalidArgument, "a calf-play option or eye path is unusable")        \
   /* end of the list: every line above ends with a backslash */
 
 enum class ErrorId : uint16_t {

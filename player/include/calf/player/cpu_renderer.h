@@ -13,7 +13,13 @@
 // one view was consulted (the literal algorithm would call a sample that every view ignored a hit;
 // calf treats it as empty). The hit is refined by `refine_steps` bisections between the last
 // empty sample and the hit sample, in the same log-depth space, and placed at the middle of the
-// final interval. No hit up to far: the ray sees the sky.
+// final interval. No hit up to far: the ray sees the sky. Two additions (docs/RENDERING.md,
+// "Quality"): the march starts at max_j (z_near_j - |o - P_j|), before which every point is empty
+// (`tight_march_start`), and the view nearest the ray origin acts as a surface hint: where it sees
+// one empty sample in front of its surface and the next behind it, the crossing of its surface
+// is a hit unless more than `surface_hint_vetoes` views see it as empty beyond a small margin,
+// which finds parts thinner than a step (`surface_hints`, off by default until the GL renderer
+// has it).
 //
 // Colour (Alg. 4 SampleColor / CalculateColor). At the hit p each active view j contributes its
 // colour c_j in direction p - P_j with weight w_j = w_depth * w_cam:
@@ -24,17 +30,20 @@
 // angle in radians) wins. |ln(d_j / r)| is the paper's |nonlin(d_tex) - nonlin(r)| times each
 // view's ln(z_far / z_near), so views with different depth ranges are weighed on one scale.
 // Colour texels are sampled bilinearly (optionally depth-aware: each of the four taps is weighted
-// by its own depth agreement, so silhouettes do not bleed foreground into background); taps that
-// fall off a face are fetched from the neighbouring face through the cube conventions.
+// by its own depth agreement beyond `color_depth_tolerance`, so silhouettes do not bleed
+// foreground into background); taps that fall off a face are fetched from the neighbouring face
+// through the cube conventions.
 // Sky: the colour of the views whose depth is sky in the ray direction (sky is at infinity, so
 // every viewpoint sees it in the same direction), bilinear over sky taps.
 //
 // RR variant (Alg. 4 *_RR, Sec. 6.1), when `rr` is set and views carry material: at a hit the
-// material (reflect, refract, IOR) is blended like colour, the normal comes from the depths
-// around the best view's texel, and one reflection and one refraction ray are marched from p
+// material (reflect, refract, IOR) is the best-weighted view's nearest texel, the normal comes
+// from the depths around that texel, and one reflection and one refraction ray are marched from p
 // (starting `rr_start` = z_e from it) and shaded recursively up to `rr_max_depth` bounces:
 // c = w_rfl c_rfl + w_rfr c_rfr + (1 - w_rfl - w_rfr) c_diffuse; a secondary ray that hits
-// nothing gives its weight back to the diffuse colour (Alg. 4 lines 55 and 62).
+// nothing takes the sky colour in its direction. With `rr_replace_view_reflection` the captured
+// colour, which already holds the capturing view's own reflection, keeps its diffuse
+// part and only the reflection / refraction is swapped for the eye's (see the option).
 //
 // Deterministic: every pixel is computed independently in double precision; the image is the same
 // bit for bit whatever the thread count.
@@ -96,10 +105,12 @@ struct RenderOptions {
   // the direction from a viewpoint to a point at its very centre is meaningless. >= 0.
   // Negative: use `near`.
   double min_view_distance = -1;
-  // w_depth decay per unit of |ln(d_j / r)| (a relative depth disagreement): 50 gives a view whose
-  // surface is 2 % off weight e^-1 relative to one that matches. > 0. Decays faster than w_cam,
-  // as the paper asks.
-  double depth_decay = 50;
+  // w_depth decay per unit of |ln(d_j / r)| (a relative depth disagreement): 500 gives a view
+  // whose surface is 0.2 % off weight e^-1 relative to one that matches, so a view that sees the
+  // other side of a thin part (a wing 1 % of the distance thick) hardly counts. > 0. Decays
+  // faster than w_cam, as the paper asks. (Was 50: +2.2 dB between viewpoints on turntable,
+  // docs/RENDERING.md "Quality".)
+  double depth_decay = 500;
   // w_cam decay per unit of |o - P_j| / |p - o| (the eye-to-viewpoint distance in units of the hit
   // distance). >= 0; 0 weighs all agreeing views equally.
   double cam_decay = 20;
@@ -107,6 +118,37 @@ struct RenderOptions {
   bool bilinear_color = true;
   // With bilinear colour: weigh each tap by its own depth agreement (true) or plain bilinear.
   bool depth_aware_color = true;
+  // Depth-aware colour: taps whose relative depth disagreement |ln(d_t / r)| exceeds the best
+  // tap's by at most this much count as the same surface and keep their bilinear weight; only
+  // the excess is penalised (depth_decay per unit). 0 penalises every difference, which on
+  // slanted surfaces (neighbouring texels at different depths) skews bilinear weights towards the
+  // nearest texel and shifts colour edges. >= 0.
+  double color_depth_tolerance = 0.1;
+  // Start each march where the first surface can be: no point nearer to view j's centre than
+  // z_near_j can be behind its surface, so the march starts at max_j (z_near_j - |o - P_j|)
+  // (over the active views, at least the ray's own start) and spends its steps beyond.
+  bool tight_march_start = true;
+  // Surface hints (0..4): the march also follows this many views nearest the ray origin (the
+  // "hint" views; ties by index). For a hint view, a sample is in front of its surface when its
+  // nearest texel's depth in direction p - P_h is farther than |p - P_h| (or sky); a view within
+  // min_view_distance of p abstains. Where a hint view sees an empty sample in front of its
+  // surface and the next (also empty) sample behind it, the ray crossed the hint's surface in
+  // between: the crossing is located by `refine_steps` bisections on that view alone and placed
+  // at the middle of the final interval, and it is the hit unless more than
+  // `surface_hint_vetoes` active views see it as empty by more than the relative depth
+  // `surface_hint_margin` (in code units: margin / relative_step of that view).
+  // Of several hints crossing in one interval the nearest confirmed crossing wins. This finds
+  // parts thinner than a step (wings, chains, leaves) that the plain march steps over, and at a
+  // viewpoint puts the hit exactly on that view's surface. 0: the paper's march alone.
+  // Default 0 while the GL renderer lacks it (it refuses other values); 1 is the tuned value
+  // (docs/RENDERING.md "Quality": +7 dB at turntable's viewpoints).
+  uint32_t surface_hints = 0;
+  double surface_hint_margin = 0.005;
+  // How many views may see a hint crossing as empty space beyond the margin without refuting
+  // it (0..65536). Thin parts are often carved away by one view whose texels straddle them; a
+  // crossing that is really empty space (the shadow edge, seen from the hint view, of an object
+  // in front) is refuted by several views. Counted views are the footprint test's (empty_at).
+  uint32_t surface_hint_vetoes = 1;
   // Indices into the ViewSet of the views to use, in any order; empty = all views.
   std::vector<uint32_t> active_views;
   // Worker threads over image rows (1..256). The result does not depend on it.
@@ -119,6 +161,14 @@ struct RenderOptions {
   double rr_start = 0.05;
   // Bounces of reflection / refraction followed (1..8).
   uint32_t rr_max_depth = 1;
+  // A captured colour is the full shading the view saw: on a mirror or glass surface it already
+  // holds that view's reflection / refraction. true: the best view's colour with its own
+  // reflection / refraction (traced from its viewpoint through the same surface point and normal)
+  // replaced by the eye's, c = c_view + w_rfl (c_rfl,eye - c_rfl,view) + w_rfr (...), so at a
+  // viewpoint the view is reproduced and elsewhere only the view-dependent part moves. false:
+  // Alg. 4 as written, c = w_rfl c_rfl + w_rfr c_rfr + (1 - w_rfl - w_rfr) c_blend. Default false
+  // while the GL renderer lacks it; true is the tuned value (docs/RENDERING.md "Quality").
+  bool rr_replace_view_reflection = false;
 };
 
 // A rendered frame: linear RGB float (3 per pixel, HDR kept) and the radial distance from the eye
@@ -137,7 +187,8 @@ struct RaySample {
 };
 
 // A march range covering the views as seen from `eye`: far = max_j (|eye - P_j| + z_far_j)
-// (nothing any view stores lies beyond), near = min_j z_near_j / 4, at most far / 2^20.
+// (nothing any view stores lies beyond), near = min_j z_near_j / 4 but no nearer
+// than far / 2^20 (a tiny z_near must not stretch the log steps).
 // Errors: CALF-E403 for an empty view set.
 Expected<RenderOptions> march_range_for(const ViewSet& views, const Vec3& eye,
                                         RenderOptions options);
@@ -164,8 +215,12 @@ class CpuRenderer {
     double z = 0;  // its distance from the ray origin
   };
   bool empty_at(const Vec3& p) const;
+  bool empty_beyond(const Vec3& p, double margin, uint32_t vetoes_ignored) const;
   bool intersect(const Vec3& origin, const Vec3& dir, double start, Hit* hit) const;
-  void shade_surface(const Vec3& origin, const Vec3& p, double* rgb, int* best_view) const;
+  void shade_surface(const Vec3& origin, const Vec3& p, double* rgb, int* best_view,
+                     double* best_rgb = nullptr) const;
+  void secondary(const Vec3& p, const Vec3& dir_in, const Vec3& normal, bool refraction, double ior,
+                 uint32_t depth, double* rgb) const;
   void shade_sky(const Vec3& origin, const Vec3& dir, double* rgb) const;
   void shade_rr(const Vec3& origin, const Vec3& dir, const Hit& hit, uint32_t depth,
                 double* rgb) const;

@@ -1,0 +1,78 @@
+// The OpenGL 4.5 ray-march renderer of paper 002 Alg. 4 (and its RR variant, Sec. 6.1): the
+// player's product renderer. It implements exactly the algorithm of the scalar CPU reference
+// (calf/player/cpu_renderer.h, docs/RENDERING.md): the same RenderOptions, the same Camera model,
+// the same texel taps, footprint test, refinement, weights, sky and RR rules — one GLSL function
+// per CPU function — and is tested against it (tests/integration/gl_renderer_test.cc: PSNR between
+// the two images of the same frame >= 45 dB).
+//
+// It reads the viewpoint textures of a GlViews (calf/player/gl_views.h), which the decoder's
+// FrameUpdates (or updates_from_view_set()) fill; a cell's colour is the keyframe blend
+// mix(slot a, slot 1 - a, t / 255) done per texel in the shader.
+//
+// A frame is one full-screen fragment pass into a framebuffer object holding RGBA32F: rgb the
+// linear colour (HDR kept), alpha the radial distance from the eye to the surface (+inf for sky),
+// read back into the CPU renderer's RenderedImage so the two compare directly.
+//
+// Differences from the CPU reference, all below the test's bound: the GPU computes in float (the
+// CPU in double), in coordinates relative to the eye (so precision does not depend on where the
+// scene sits); the RR variant walks its ray tree with an explicit stack instead of recursion (the
+// sum is the same, its order differs). Images are deterministic for a given driver.
+//
+// All calls need the GL context of the GlViews to be current.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "calf/format/status.h"
+#include "calf/player/cpu_renderer.h"
+#include "calf/player/gl_views.h"
+
+namespace calf::player {
+
+// march_range_for() of cpu_renderer.h for a GL texture layout: far = max_j(|eye - P_j| +
+// z_far_j), near = min_j z_near_j / 4 but no nearer
+// than far / 2^20 (a tiny z_near must not stretch the log steps). Errors: CALF-E403 for no views.
+Expected<RenderOptions> march_range_for(const GlTextureLayout& layout, const Vec3& eye,
+                                        RenderOptions options);
+
+class GlRenderer {
+ public:
+  // Compiles the shaders for `views` (which must outlive the renderer) and validates `options`
+  // as CpuRenderer::make does (CALF-E403 naming the option; `threads` is ignored). Errors:
+  // CALF-E404 when a shader does not compile or link (the driver's log follows).
+  static Expected<std::unique_ptr<GlRenderer>> make(const GlViews& views,
+                                                    const RenderOptions& options);
+  ~GlRenderer();
+  GlRenderer(const GlRenderer&) = delete;
+  GlRenderer& operator=(const GlRenderer&) = delete;
+
+  // New options for the next frames (active views, march range, ...); nothing is recompiled.
+  // Errors as make(); the old options stay on error.
+  Status set_options(const RenderOptions& options);
+  const RenderOptions& options() const { return options_; }
+
+  // Renders `camera` into `out` (resized): colour and radial distance per pixel, row 0 at the
+  // top, as CpuRenderer::render. Errors: CALF-E403 for an invalid camera (as the CPU renderer),
+  // CALF-E412 when GL reports an error.
+  Status render(const Camera& camera, RenderedImage* out);
+
+  // Draws `camera` into the framebuffer bound to GL_DRAW_FRAMEBUFFER, viewport (0, 0, width,
+  // height) of the camera, output 0 = (rgb, radial distance): for a player that composites the
+  // result itself. Leaves program, textures and buffer bindings changed.
+  Status draw(const Camera& camera);
+
+ private:
+  GlRenderer(const GlViews& views, const RenderOptions& options);
+  Status build_program();
+  Status ensure_target(uint32_t width, uint32_t height);
+
+  const GlViews* views_;
+  const GlFunctions* gl_;
+  RenderOptions options_;
+  GLuint program_ = 0, vao_ = 0, view_buffer_ = 0;
+  GLuint fbo_ = 0, target_ = 0;
+  uint32_t target_width_ = 0, target_height_ = 0;
+};
+
+}  // namespace calf::player

@@ -1,0 +1,450 @@
+#include "gl_raymarch_shader.h"
+
+namespace calf::player::internal {
+
+const char* const kGlFullscreenVertex = R"glsl(
+void main() {
+  // (-1, -1), (3, -1), (-1, 3): one triangle covering the viewport.
+  vec2 p = vec2(float((gl_VertexID & 1) << 2) - 1.0, float((gl_VertexID & 2) << 1) - 1.0);
+  gl_Position = vec4(p, 0.0, 1.0);
+}
+)glsl";
+
+// The structure follows the CPU reference function for function (names in comments), so a change
+// there is mirrored here in the same place. Positions are relative to the eye: the CPU works in
+// double, the GPU in float, and eye-relative coordinates keep the float error independent of
+// where the scene sits.
+const char* const kGlRaymarchFragment = R"glsl(
+struct CalfView {
+  vec3 position;  // relative to the eye
+  float log_near;
+  float step;      // ln depth per code
+  float inv_step;
+  float z_near;
+  float z_far;
+  uint face_size;
+  uint cell_size;
+  uint layer;        // 6 * view index
+  int material_layer;  // -1: no material
+};
+// A uniform block, not a storage buffer: llvmpipe loads it as uniform data (measured 20 % faster
+// than the same records in an SSBO). Sized by CALF_MAX_VIEWS, defined by the host.
+layout(std140, binding = 0) uniform CalfViews { CalfView views[CALF_MAX_VIEWS]; };
+
+layout(binding = 0) uniform sampler2DArray colour_tex;
+#ifdef CALF_DEPTH_BC5
+layout(binding = 1) uniform sampler2DArray depth_tex;
+#else
+layout(binding = 1) uniform usampler2DArray depth_tex;
+#endif
+layout(binding = 2) uniform usampler2DArray cell_tex;
+layout(binding = 3) uniform sampler2DArray material_tex;
+
+uniform uint view_count;         // active views, in views[]
+uniform uint colour_slots;       // 2 keyframe slots per face, or 1
+uniform uint steps;              // N_step
+uniform uint refine_steps;
+uniform float march_near;        // RenderOptions::near
+uniform float march_log_ratio;   // ln(far / near)
+uniform float min_view_distance;
+uniform float footprint_limit;   // depth_footprint - 1e-9
+uniform float smooth_log_ratio;  // ln(1 + smooth_depth_ratio)
+uniform float depth_decay;
+uniform float cam_decay;
+uniform float color_depth_tolerance;
+uniform bool tight_march_start;
+uniform bool bilinear_color;
+uniform bool depth_aware_color;
+uniform bool rr;
+uniform float rr_start;
+uniform uint rr_max_depth;
+uniform uvec2 image_size;
+uniform vec3 cam_forward;        // unit forward
+uniform vec3 cam_right;          // unit right * tan(fov_y / 2) * aspect
+uniform vec3 cam_up;             // unit up * tan(fov_y / 2)
+
+layout(location = 0) out vec4 out_colour;  // rgb, radial hit distance (+inf: sky)
+
+const float INF = uintBitsToFloat(0x7F800000u);
+const int RR_STACK = 16;  // a depth-first walk holds at most rr_max_depth + 1 <= 9 rays
+
+// ---- texel fetches (sampling.cc) ----
+
+// Texel index from a texel-space coordinate, clamped to the face (texel_from_direction).
+int clamp_texel(float u, uint n) {
+  if (!(u > 0.0)) return 0;
+  float f = floor(u);
+  return f >= float(n) ? int(n) - 1 : int(f);
+}
+
+// texel_beyond_face: (x, y, face) of a texel that may lie one texel off the face, re-projected
+// onto the neighbouring face through the conventions.
+ivec3 texel_beyond_face(int face, int x, int y, uint n) {
+  if (x >= 0 && y >= 0 && x < int(n) && y < int(n)) return ivec3(x, y, face);
+  vec3 d = calf_direction_from_st(face, (vec2(x, y) + 0.5) / float(n));
+  int f = calf_face_from_direction(d);
+  vec2 uv = calf_texel_coord_from_st(calf_st_from_direction(d, f), n);
+  return ivec3(clamp_texel(uv.x, n), clamp_texel(uv.y, n), f);
+}
+
+struct Taps {
+  ivec3 texel[4];
+  float weight[4];
+  float offset[4];
+};
+
+// bilinear_taps: the four texel centres around texel-space position uv of `face`.
+Taps bilinear_taps(int face, vec2 uv, uint n) {
+  vec2 c = uv - 0.5;
+  vec2 f0 = floor(c);
+  vec2 a = c - f0;
+  ivec2 i0 = ivec2(f0);
+  Taps t;
+  t.texel[0] = texel_beyond_face(face, i0.x, i0.y, n);
+  t.texel[1] = texel_beyond_face(face, i0.x + 1, i0.y, n);
+  t.texel[2] = texel_beyond_face(face, i0.x, i0.y + 1, n);
+  t.texel[3] = texel_beyond_face(face, i0.x + 1, i0.y + 1, n);
+  t.weight[0] = (1.0 - a.x) * (1.0 - a.y);
+  t.weight[1] = a.x * (1.0 - a.y);
+  t.weight[2] = (1.0 - a.x) * a.y;
+  t.weight[3] = a.x * a.y;
+  t.offset[0] = max(a.x, a.y);
+  t.offset[1] = max(1.0 - a.x, a.y);
+  t.offset[2] = max(a.x, 1.0 - a.y);
+  t.offset[3] = max(1.0 - a.x, 1.0 - a.y);
+  return t;
+}
+
+// Where direction x of view v points: face and texel-space position (texel_coord_from_direction).
+int face_of(vec3 x) { return calf_face_from_direction(x); }
+vec2 texel_coord(vec3 x, int face, uint n) {
+  return calf_texel_coord_from_st(calf_st_from_direction(x, face), n);
+}
+
+uint depth_code(CalfView v, ivec3 t) {
+#ifdef CALF_DEPTH_BC5
+  vec2 rg = texelFetch(depth_tex, ivec3(t.xy, int(v.layer) + t.z), 0).rg;
+  return uint(round(rg.r * 255.0)) * 256u + uint(round(rg.g * 255.0));
+#else
+  return texelFetch(depth_tex, ivec3(t.xy, int(v.layer) + t.z), 0).r;
+#endif
+}
+
+// LogDepthRange::decode for a finite code.
+float depth_of_code(CalfView v, uint code) {
+  if (code == 0u) return v.z_near;
+  if (code == CALF_LOG16_MAX_FINITE) return v.z_far;
+  return exp(v.log_near + float(code) * v.step);
+}
+
+// |ln(decode(code) / r)| given ln r.
+float log_disagreement(CalfView v, uint code, float log_r) {
+  return abs(v.log_near + float(code) * v.step - log_r);
+}
+
+// The colour a view shows at a texel: its cell's keyframe slots blended by t (SPEC §11.1.4).
+vec3 colour_at(CalfView v, ivec3 t) {
+  int face_layer = int(v.layer) + t.z;
+  uint cell = texelFetch(cell_tex, ivec3(t.xy / int(v.cell_size), face_layer), 0).r;
+  uint w = cell & 255u;
+  int a = int((cell >> 8) & 1u);
+  int base = face_layer * int(colour_slots);
+  vec3 ca = texelFetch(colour_tex, ivec3(t.xy, base + a), 0).rgb;
+  if (w == 0u) return ca;
+  vec3 cb = texelFetch(colour_tex, ivec3(t.xy, base + 1 - a), 0).rgb;
+  return mix(ca, cb, float(w) / 255.0);
+}
+
+// ---- code_margin (cpu_renderer.cc): how far in front of its surface view v sees the point at
+// offset x (r = |x|), in code units: > 0 in front, <= 0 at or behind, +inf where v sees sky ----
+float code_margin(CalfView v, vec3 x, float r) {
+  int face = face_of(x);
+  Taps taps = bilinear_taps(face, texel_coord(x, face, v.face_size), v.face_size);
+  uint c[4];
+  uint lo = CALF_LOG16_SKY, hi = 0u;
+  for (int t = 0; t < 4; ++t) {
+    c[t] = depth_code(v, taps.texel[t]);
+    lo = min(lo, c[t]);
+    hi = max(hi, c[t]);
+  }
+  float rcode = (log(r) - v.log_near) * v.inv_step;
+  if (hi != CALF_LOG16_SKY && float(hi - lo) * v.step <= smooth_log_ratio) {
+    float code = 0.0;
+    for (int t = 0; t < 4; ++t) code += taps.weight[t] * float(c[t]);
+    return code - rcode;
+  }
+  uint code = CALF_LOG16_SKY;
+  int nearest = 0;
+  for (int t = 0; t < 4; ++t) {
+    if (taps.weight[t] > taps.weight[nearest]) nearest = t;
+    if (taps.offset[t] < footprint_limit) code = min(code, c[t]);
+  }
+  code = min(code, c[nearest]);
+  return code == CALF_LOG16_SKY ? INF : float(code) - rcode;
+}
+
+// ---- CpuRenderer::empty_at / empty_beyond: BetweenViewpointAndGeometry over the active views,
+// true as soon as one view that is not too near sees p in front of its surface by more than the
+// relative depth `margin` ----
+bool empty_beyond(vec3 p, float margin) {
+  bool consulted = false;
+  for (uint k = 0u; k < view_count; ++k) {
+    CalfView v = views[k];
+    vec3 x = p - v.position;
+    float r = length(x);
+    if (r <= min_view_distance) continue;
+    consulted = true;
+    if (code_margin(v, x, r) > margin * v.inv_step) return true;
+  }
+  return !consulted;
+}
+
+bool empty_at(vec3 p) { return empty_beyond(p, 0.0); }
+
+// ---- CpuRenderer::intersect: RayIntersection ----
+float lin(float x) { return march_near * exp(x * march_log_ratio); }
+
+bool intersect(vec3 o, vec3 d, float start, out float z_hit) {
+  z_hit = INF;
+  if (tight_march_start) {
+    // Nearer than z_near_j to P_j, view j sees every point as empty: nothing to find before.
+    for (uint k = 0u; k < view_count; ++k) {
+      start = max(start, views[k].z_near - length(o - views[k].position));
+    }
+  }
+  float x0 = log(max(start, march_near) / march_near) / march_log_ratio;
+  if (!(x0 < 1.0)) return false;
+  float step = (1.0 - x0) / float(steps);
+  // The march (samples i = 0..steps) and the bisection (refine_steps halvings of [lo, hi]) in one
+  // loop, so that empty_at() is instantiated once: the driver inlines every call, and llvmpipe's
+  // compile time grows with the code.
+  uint i = 0u, k = 0u;
+  bool refining = false;
+  float lo = 0.0, hi = 0.0;
+  for (;;) {
+    float x = refining ? 0.5 * (lo + hi) : (i == steps ? 1.0 : x0 + float(i) * step);
+    bool empty = empty_at(o + d * lin(x));
+    if (refining) {
+      if (empty) lo = x; else hi = x;
+      if (++k >= refine_steps) break;
+    } else if (empty) {
+      if (++i > steps) return false;
+    } else {
+      lo = x - step;
+      hi = x;
+      if (i == 0u) lo = hi;  // already behind a surface at the first sample: nothing to refine
+      if (i == 0u || refine_steps == 0u) break;
+      refining = true;
+    }
+  }
+  z_hit = lin(0.5 * (lo + hi));
+  return true;
+}
+
+// ---- CpuRenderer::shade_surface: SampleColor + CalculateColor ----
+// The weighted mean is accumulated online, rescaled whenever a larger log weight arrives: the
+// same exp(log_w - best) normalisation as the CPU's two passes, without an array of views.
+vec3 shade_surface(vec3 o, vec3 p, out int best_view) {
+  float hit_distance = max(length(p - o), 1e-12);
+  vec3 sum = vec3(0.0);
+  float wsum = 0.0, best = -INF;
+  best_view = -1;
+  for (uint k = 0u; k < view_count; ++k) {
+    CalfView v = views[k];
+    vec3 x = p - v.position;
+    float r = length(x);
+    if (r <= min_view_distance) continue;
+    int face = face_of(x);
+    vec2 uv = texel_coord(x, face, v.face_size);
+    ivec3 nearest = ivec3(clamp_texel(uv.x, v.face_size), clamp_texel(uv.y, v.face_size), face);
+    uint ncode = depth_code(v, nearest);
+    if (ncode == CALF_LOG16_SKY) continue;
+    float log_r = log(r);
+    float log_w = -depth_decay * log_disagreement(v, ncode, log_r);
+    vec3 c = vec3(0.0);
+    if (!bilinear_color) {
+      c = colour_at(v, nearest);
+    } else {
+      Taps taps = bilinear_taps(face, uv, v.face_size);
+      float diff[4];
+      float dmin = INF;
+      for (int t = 0; t < 4; ++t) {
+        uint code = depth_code(v, taps.texel[t]);
+        diff[t] = code == CALF_LOG16_SKY ? INF : log_disagreement(v, code, log_r);
+        if (taps.weight[t] > 0.0) dmin = min(dmin, diff[t]);
+      }
+      float a[4];
+      float asum = 0.0;
+      for (int t = 0; t < 4; ++t) {
+        a[t] = taps.weight[t];
+        if (depth_aware_color) {
+          a[t] *= diff[t] == INF
+                      ? 0.0
+                      : exp(-depth_decay * max(0.0, diff[t] - dmin - color_depth_tolerance));
+        }
+        asum += a[t];
+      }
+      for (int t = 0; t < 4; ++t) c += a[t] / asum * colour_at(v, taps.texel[t]);
+      if (depth_aware_color) log_w = -depth_decay * dmin + log(asum);
+    }
+    log_w -= cam_decay * length(o - v.position) / hit_distance;
+    if (log_w > best) {
+      float rescale = exp(best - log_w);
+      sum *= rescale;
+      wsum *= rescale;
+      best = log_w;
+      best_view = int(k);
+    }
+    float w = exp(log_w - best);
+    sum += w * c;
+    wsum += w;
+  }
+  return wsum > 0.0 ? sum / wsum : vec3(0.0);
+}
+
+// ---- CpuRenderer::shade_sky ----
+vec3 shade_sky(vec3 d) {
+  for (int pass = 0; pass < 2; ++pass) {
+    vec3 sum = vec3(0.0);
+    int n = 0;
+    for (uint k = 0u; k < view_count; ++k) {
+      CalfView v = views[k];
+      int face = face_of(d);
+      vec2 uv = texel_coord(d, face, v.face_size);
+      ivec3 nearest = ivec3(clamp_texel(uv.x, v.face_size), clamp_texel(uv.y, v.face_size), face);
+      bool sky = depth_code(v, nearest) == CALF_LOG16_SKY;
+      if (pass == 0 && !sky) continue;
+      vec3 c = vec3(0.0);
+      if (!bilinear_color) {
+        c = colour_at(v, nearest);
+      } else {
+        Taps taps = bilinear_taps(face, uv, v.face_size);
+        float a[4];
+        float asum = 0.0;
+        for (int t = 0; t < 4; ++t) {
+          bool tap_sky = depth_code(v, taps.texel[t]) == CALF_LOG16_SKY;
+          a[t] = taps.weight[t] * (pass == 0 && depth_aware_color && !tap_sky ? 0.0 : 1.0);
+          asum += a[t];
+        }
+        for (int t = 0; t < 4; ++t) c += a[t] / asum * colour_at(v, taps.texel[t]);
+      }
+      sum += c;
+      ++n;
+    }
+    if (n > 0) return sum / float(n);
+  }
+  return vec3(0.0);
+}
+
+// ---- cpu_renderer_rr.cc ----
+
+// texel_point: the scene point (eye-relative) a texel of v stands for; false for sky.
+bool texel_point(CalfView v, ivec3 t, out vec3 q) {
+  q = vec3(0.0);
+  uint code = depth_code(v, t);
+  if (code == CALF_LOG16_SKY) return false;
+  vec3 dir = calf_direction_from_st(t.z, (vec2(t.xy) + 0.5) / float(v.face_size));
+  q = v.position + dir * depth_of_code(v, code);
+  return true;
+}
+
+// tangent: along one texel axis, the one-sided difference toward the nearer neighbour.
+bool tangent(CalfView v, ivec3 t, ivec2 dxy, vec3 centre, out vec3 along) {
+  along = vec3(0.0);
+  vec3 a, b;
+  bool ha = texel_point(v, texel_beyond_face(t.z, t.x + dxy.x, t.y + dxy.y, v.face_size), a);
+  bool hb = texel_point(v, texel_beyond_face(t.z, t.x - dxy.x, t.y - dxy.y, v.face_size), b);
+  if (!ha && !hb) return false;
+  if (ha && (!hb || length(a - centre) <= length(b - centre))) {
+    along = a - centre;
+  } else {
+    along = centre - b;
+  }
+  return true;
+}
+
+struct RrRay {
+  vec3 o, d;     // origin, unit direction
+  float start;   // march start (near for eye rays, z_e for secondary rays)
+  uint depth;    // bounces so far
+  float weight;  // product of the reflect / refract weights on the way here
+};
+
+// CpuRenderer::trace and shade_rr without recursion: c = w_rfl c_rfl + w_rfr c_rfr +
+// (1 - w_rfl - w_rfr) c_diffuse is linear in the children, so each ray adds its own share times
+// the product of the weights above it and pushes its secondary rays; a ray that hits nothing adds
+// the sky. The eye ray is the first ray of the walk, so intersect(), shade_surface() and
+// shade_sky() are each instantiated once (see intersect()). Returns the eye ray's hit distance.
+float trace(vec3 o, vec3 d, out vec3 rgb) {
+  RrRay stack[RR_STACK];
+  int top = 0;
+  stack[top++] = RrRay(o, d, march_near, 0u, 1.0);
+  rgb = vec3(0.0);
+  float eye_z = INF;
+  while (top > 0) {
+    RrRay ray = stack[--top];
+    float z;
+    if (!intersect(ray.o, ray.d, ray.start, z)) {
+      rgb += ray.weight * shade_sky(ray.d);
+      continue;
+    }
+    if (ray.depth == 0u) eye_z = z;
+    vec3 p = ray.o + ray.d * z;
+    int best;
+    vec3 diffuse = shade_surface(ray.o, p, best);
+    if (!rr || best < 0 || ray.depth >= rr_max_depth) {
+      rgb += ray.weight * diffuse;
+      continue;
+    }
+    // Material and normal from the view that weighs most at p (nearest texel).
+    CalfView v = views[best];
+    vec3 x = p - v.position;
+    int face = face_of(x);
+    vec2 uv = texel_coord(x, face, v.face_size);
+    ivec3 t = ivec3(clamp_texel(uv.x, v.face_size), clamp_texel(uv.y, v.face_size), face);
+    vec3 m = vec3(0.0, 0.0, 1.0);
+    if (v.material_layer >= 0) {
+      vec3 codes = texelFetch(material_tex, ivec3(t.xy, v.material_layer + t.z), 0).rgb;
+      m = vec3(codes.r, codes.g, 1.0 + 2.0 * codes.b);
+    }
+    vec3 centre, tu, tv;
+    if ((!(m.x > 0.0) && !(m.y > 0.0)) || !texel_point(v, t, centre) ||
+        !tangent(v, t, ivec2(1, 0), centre, tu) || !tangent(v, t, ivec2(0, 1), centre, tv) ||
+        !(length(cross(tu, tv)) > 0.0)) {
+      rgb += ray.weight * diffuse;
+      continue;
+    }
+    vec3 n = normalize(cross(tu, tv));
+    if (dot(n, ray.d) > 0.0) n = -n;  // face the incoming ray
+    rgb += ray.weight * (1.0 - m.x - m.y) * diffuse;
+    // Refraction first on the stack, so that the reflection is walked first, like the CPU.
+    for (int kind = 1; kind >= 0; --kind) {
+      float w = kind == 0 ? m.x : m.y;
+      if (!(w > 0.0)) continue;
+      vec3 dir = normalize(ray.d - n * (2.0 * dot(ray.d, n)));
+      if (kind == 1) {
+        // GLSL refract() with eta = 1 / ior; total internal reflection keeps the reflection.
+        float eta = 1.0 / m.z;
+        float c = dot(n, ray.d);
+        float k = 1.0 - eta * eta * (1.0 - c * c);
+        if (!(k < 0.0)) dir = normalize(ray.d * eta - n * (eta * c + sqrt(k)));
+      }
+      stack[top++] = RrRay(p, dir, rr_start, ray.depth + 1u, ray.weight * w);
+    }
+  }
+  return eye_z;
+}
+
+void main() {
+  uint i = uint(gl_FragCoord.x);
+  uint j = image_size.y - 1u - uint(gl_FragCoord.y);  // row 0 at the top, like the CPU image
+  float a = 2.0 * (float(i) + 0.5) / float(image_size.x) - 1.0;
+  float b = 1.0 - 2.0 * (float(j) + 0.5) / float(image_size.y);
+  vec3 d = normalize(cam_forward + a * cam_right + b * cam_up);
+  vec3 rgb;
+  float z = trace(vec3(0.0), d, rgb);
+  out_colour = vec4(rgb, z);
+}
+)glsl";
+
+}  // namespace calf::player::internal

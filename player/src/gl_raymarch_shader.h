@@ -1,0 +1,31 @@
+// Private to the player: the GLSL sources of the ray-march renderer (gl_raymarch_shader.cc).
+#pragma once
+
+namespace calf::player::internal {
+
+// A full-screen triangle from gl_VertexID (no vertex buffers).
+extern const char* const kGlFullscreenVertex;
+
+// Alg. 4 as the CPU reference implements it (cpu_renderer.cc, cpu_renderer_rr.cc), one function
+// per CPU function. Pasted after "#version 450 core", "#define CALF_MAX_VIEWS <kGlMaxActiveViews>",
+// an optional "#define CALF_DEPTH_BC5" and kGlslConventions.
+extern const char* const kGlRaymarchFragment;
+
+// The most views one frame can use (the uniform block holds this many records).
+inline constexpr unsigned kGlMaxActiveViews = 256;
+
+// std140 layout of one active view in the shader's view block (struct CalfView there).
+struct GlViewRecord {
+  float position[3];  // P_j relative to the eye
+  float log_near;     // ln z_near
+  float step;         // ln(z_far / z_near) / 65534: ln depth per code
+  float inv_step;     // 1 / step
+  float z_near, z_far;
+  unsigned face_size;
+  unsigned cell_size;
+  unsigned layer;      // 6 * view index: depth / cells layer of face 0
+  int material_layer;  // 6 * material index, -1 without material
+};
+static_assert(sizeof(GlViewRecord) == 48, "must match the std140 struct in the shader");
+
+}  // namespace calf::player::internal

@@ -1,0 +1,346 @@
+#include "calf/player/gl_renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "calf/player/glsl_conventions.h"
+#include "gl_errors.h"
+#include "gl_raymarch_shader.h"
+#include "sampling.h"
+
+namespace calf::player {
+
+using internal::cross;
+using internal::GlViewRecord;
+using internal::kGlMissing;
+using internal::length;
+using internal::normalize;
+using internal::operator-;
+using internal::operator*;
+
+namespace {
+
+Status option_error(const std::string& what) {
+  return Status(ErrorId::kPlayerOptions, what);
+}
+
+// The checks of CpuRenderer::make, so that both renderers accept the same options.
+Status check_options(const RenderOptions& o, size_t view_count) {
+  if (o.steps < 1 || o.steps > 65536) {
+    return option_error("steps " + std::to_string(o.steps) + " is outside [1, 65536]");
+  }
+  if (!(o.near > 0) || !(o.far > o.near) || !std::isfinite(o.far)) {
+    return option_error("march range near " + std::to_string(o.near) + ", far " +
+                        std::to_string(o.far) + " is not 0 < near < far < inf");
+  }
+  if (!(o.depth_footprint >= 0 && o.depth_footprint <= 1)) {
+    return option_error("depth_footprint must be in [0, 1]");
+  }
+  if (!(o.smooth_depth_ratio >= 0) || !std::isfinite(o.smooth_depth_ratio)) {
+    return option_error("smooth_depth_ratio must be finite and >= 0");
+  }
+  if (o.refine_steps > 64) return option_error("refine_steps is above 64");
+  if (!(o.depth_decay > 0) || !std::isfinite(o.depth_decay)) {
+    return option_error("depth_decay must be finite and > 0");
+  }
+  if (!(o.cam_decay >= 0) || !std::isfinite(o.cam_decay)) {
+    return option_error("cam_decay must be finite and >= 0");
+  }
+  // Not mirrored in the shader yet (an experiment of the CPU reference): refused, so that the two
+  // renderers never silently differ.
+  if (o.surface_hints != 0) return option_error("surface_hints is not implemented by GL (use 0)");
+  if (!(o.color_depth_tolerance >= 0) || !std::isfinite(o.color_depth_tolerance)) {
+    return option_error("color_depth_tolerance must be finite and >= 0");
+  }
+  if (!std::isfinite(o.min_view_distance)) return option_error("min_view_distance is not finite");
+  if (!(o.rr_start > 0) || !std::isfinite(o.rr_start)) {
+    return option_error("rr_start (z_e) must be finite and > 0");
+  }
+  if (o.rr_max_depth < 1 || o.rr_max_depth > 8) {
+    return option_error("rr_max_depth is outside [1, 8]");
+  }
+  const size_t active = o.active_views.empty() ? view_count : o.active_views.size();
+  if (active > internal::kGlMaxActiveViews) {
+    return option_error(std::to_string(active) + " active views, the GL renderer takes at most " +
+                        std::to_string(internal::kGlMaxActiveViews));
+  }
+  for (uint32_t i : o.active_views) {
+    if (i >= view_count) {
+      return option_error("active view " + std::to_string(i) + " is not below the view count " +
+                          std::to_string(view_count));
+    }
+  }
+  return Status::Ok();
+}
+
+bool finite(const Vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+// The camera's frame scaled for the ray formula of cpu_renderer.h, or an error as the CPU
+// renderer gives it.
+Status camera_axes(const Camera& c, Vec3* forward, Vec3* right, Vec3* up) {
+  const auto bad = [] {
+    return option_error("camera position, forward or up is not finite, zero or parallel");
+  };
+  if (!finite(c.position) || !finite(c.forward) || !finite(c.up) || length(c.forward) == 0) {
+    return bad();
+  }
+  const Vec3 f = normalize(c.forward);
+  const Vec3 r = cross(f, c.up);
+  const double len = length(r);
+  if (!(len > 1e-12 * std::max(1.0, length(c.up)))) return bad();
+  if (!(c.fov_y > 0) || !(c.fov_y < 3.141592653589793)) {
+    return option_error("camera fov_y " + std::to_string(c.fov_y) + " is outside (0, pi)");
+  }
+  if (c.width < 1 || c.height < 1 || c.width > kMaxFaceSize || c.height > kMaxFaceSize) {
+    return option_error("image size " + std::to_string(c.width) + " x " + std::to_string(c.height) +
+                        " is outside 1..16384");
+  }
+  const Vec3 ru = r * (1.0 / len);
+  const double h = std::tan(c.fov_y / 2);
+  const double aspect = static_cast<double>(c.width) / c.height;
+  *forward = f;
+  *right = ru * (h * aspect);
+  *up = cross(ru, f) * h;
+  return Status::Ok();
+}
+
+Expected<GLuint> compile(const GlFunctions& gl, GLenum type, const std::string& source,
+                         const char* what) {
+  const GLuint shader = gl.CreateShader(type);
+  const char* text = source.c_str();
+  gl.ShaderSource(shader, 1, &text, nullptr);
+  gl.CompileShader(shader);
+  GLint ok = 0;
+  gl.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    std::vector<char> log(8192, '\0');
+    gl.GetShaderInfoLog(shader, static_cast<GLsizei>(log.size()), nullptr, log.data());
+    gl.DeleteShader(shader);
+    return Status(kGlMissing,
+                  std::string("the ") + what + " shader does not compile: " + log.data());
+  }
+  return shader;
+}
+
+}  // namespace
+
+Expected<RenderOptions> march_range_for(const GlTextureLayout& layout, const Vec3& eye,
+                                        RenderOptions options) {
+  if (layout.views.empty()) return option_error("march range of an empty view set");
+  double far = 0, near = std::numeric_limits<double>::infinity();
+  for (const GlViewInfo& v : layout.views) {
+    far = std::max(far, length(eye - v.position) + v.range.z_far());
+    near = std::min(near, static_cast<double>(v.range.z_near()) / 4);
+  }
+  options.far = far;
+  options.near = std::max(near, far / (1 << 20));
+  return options;
+}
+
+GlRenderer::GlRenderer(const GlViews& views, const RenderOptions& options)
+    : views_(&views), gl_(&views.gl()), options_(options) {}
+
+GlRenderer::~GlRenderer() {
+  if (program_ != 0) gl_->DeleteProgram(program_);
+  if (vao_ != 0) gl_->DeleteVertexArrays(1, &vao_);
+  if (view_buffer_ != 0) gl_->DeleteBuffers(1, &view_buffer_);
+  if (fbo_ != 0) gl_->DeleteFramebuffers(1, &fbo_);
+  if (target_ != 0) gl_->DeleteTextures(1, &target_);
+}
+
+Expected<std::unique_ptr<GlRenderer>> GlRenderer::make(const GlViews& views,
+                                                       const RenderOptions& options) {
+  CALF_RETURN_IF_ERROR(check_options(options, views.layout().views.size()));
+  std::unique_ptr<GlRenderer> r(new GlRenderer(views, options));
+  CALF_RETURN_IF_ERROR(r->build_program());
+  return r;
+}
+
+Status GlRenderer::set_options(const RenderOptions& options) {
+  CALF_RETURN_IF_ERROR(check_options(options, views_->layout().views.size()));
+  options_ = options;
+  return Status::Ok();
+}
+
+Status GlRenderer::build_program() {
+  const GlFunctions& gl = *gl_;
+  const std::string version = "#version 450 core\n";
+  CALF_ASSIGN_OR_RETURN(
+      const GLuint vs,
+      compile(gl, GL_VERTEX_SHADER, version + internal::kGlFullscreenVertex, "vertex"));
+  std::string defines =
+      "#define CALF_MAX_VIEWS " + std::to_string(internal::kGlMaxActiveViews) + "\n";
+  if (views_->depth_is_bc5()) defines += "#define CALF_DEPTH_BC5\n";
+  const Expected<GLuint> fs =
+      compile(gl, GL_FRAGMENT_SHADER,
+              version + defines + kGlslConventions + internal::kGlRaymarchFragment, "ray-march");
+  if (!fs.ok()) {
+    gl.DeleteShader(vs);
+    return fs.status();
+  }
+  program_ = gl.CreateProgram();
+  gl.AttachShader(program_, vs);
+  gl.AttachShader(program_, *fs);
+  gl.LinkProgram(program_);
+  gl.DeleteShader(vs);
+  gl.DeleteShader(*fs);
+  GLint ok = 0;
+  gl.GetProgramiv(program_, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    std::vector<char> log(8192, '\0');
+    gl.GetProgramInfoLog(program_, static_cast<GLsizei>(log.size()), nullptr, log.data());
+    return Status(kGlMissing, std::string("the ray-march program does not link: ") + log.data());
+  }
+  gl.GenVertexArrays(1, &vao_);
+  gl.GenBuffers(1, &view_buffer_);
+  return check_gl_error(gl, "building the ray-march program");
+}
+
+Status GlRenderer::ensure_target(uint32_t width, uint32_t height) {
+  if (target_ != 0 && width == target_width_ && height == target_height_) return Status::Ok();
+  const GlFunctions& gl = *gl_;
+  if (target_ != 0) gl.DeleteTextures(1, &target_);
+  if (fbo_ == 0) gl.GenFramebuffers(1, &fbo_);
+  gl.GenTextures(1, &target_);
+  gl.BindTexture(GL_TEXTURE_2D, target_);
+  gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, static_cast<GLsizei>(width),
+                  static_cast<GLsizei>(height));
+  gl.BindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, target_, 0);
+  const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
+  CALF_RETURN_IF_ERROR(check_gl_error(gl, "creating the RGBA32F render target"));
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    return Status(kGlMissing, "an RGBA32F framebuffer of " + std::to_string(width) + " x " +
+                                  std::to_string(height) + " is not complete");
+  }
+  target_width_ = width;
+  target_height_ = height;
+  return Status::Ok();
+}
+
+Status GlRenderer::draw(const Camera& camera) {
+  Vec3 forward, right, up;
+  CALF_RETURN_IF_ERROR(camera_axes(camera, &forward, &right, &up));
+  const GlFunctions& gl = *gl_;
+  const GlTextureLayout& layout = views_->layout();
+  const RenderOptions& o = options_;
+
+  // The active views, eye-relative, in the order given.
+  std::vector<uint32_t> active = o.active_views;
+  if (active.empty()) {
+    for (uint32_t v = 0; v < layout.views.size(); ++v) active.push_back(v);
+  }
+  std::vector<GlViewRecord> records;
+  for (uint32_t v : active) {
+    const GlViewInfo& info = layout.views[v];
+    const Vec3 rel = info.position - camera.position;
+    const double log_near = std::log(static_cast<double>(info.range.z_near()));
+    const double step = info.range.relative_step();
+    records.push_back(
+        {{static_cast<float>(rel.x), static_cast<float>(rel.y), static_cast<float>(rel.z)},
+         static_cast<float>(log_near),
+         static_cast<float>(step),
+         static_cast<float>(1.0 / step),
+         info.range.z_near(),
+         info.range.z_far(),
+         info.face_size,
+         info.cell_size,
+         6 * v,
+         views_->material_base(v)});
+  }
+  // The whole block is backed, also past the active views (GL leaves a short buffer undefined).
+  const size_t active_count = records.size();
+  records.resize(internal::kGlMaxActiveViews);
+  gl.BindBuffer(GL_UNIFORM_BUFFER, view_buffer_);
+  gl.BufferData(GL_UNIFORM_BUFFER, static_cast<GLsizeiptr>(records.size() * sizeof(GlViewRecord)),
+                records.data(), GL_STREAM_DRAW);
+  gl.BindBufferBase(GL_UNIFORM_BUFFER, 0, view_buffer_);
+
+  const GlViews::Textures& tex = views_->textures();
+  const GLuint units[4] = {tex.colour, tex.depth, tex.cells, tex.material};
+  for (GLenum unit = 0; unit < 4; ++unit) {
+    gl.ActiveTexture(GL_TEXTURE0 + unit);
+    gl.BindTexture(GL_TEXTURE_2D_ARRAY, units[unit]);
+  }
+  gl.ActiveTexture(GL_TEXTURE0);
+
+  gl.UseProgram(program_);
+  const auto loc = [&](const char* name) { return gl.GetUniformLocation(program_, name); };
+  const auto f = [](double x) { return static_cast<float>(x); };
+  gl.Uniform1ui(loc("view_count"), static_cast<GLuint>(active_count));
+  gl.Uniform1ui(loc("colour_slots"), views_->colour_slots());
+  gl.Uniform1ui(loc("steps"), o.steps);
+  gl.Uniform1ui(loc("refine_steps"), o.refine_steps);
+  gl.Uniform1f(loc("march_near"), f(o.near));
+  gl.Uniform1f(loc("march_log_ratio"), f(std::log(o.far / o.near)));
+  gl.Uniform1f(loc("min_view_distance"), f(o.min_view_distance < 0 ? o.near : o.min_view_distance));
+  gl.Uniform1f(loc("footprint_limit"), f(o.depth_footprint - 1e-9));
+  gl.Uniform1f(loc("smooth_log_ratio"), f(std::log1p(o.smooth_depth_ratio)));
+  gl.Uniform1f(loc("depth_decay"), f(o.depth_decay));
+  gl.Uniform1f(loc("cam_decay"), f(o.cam_decay));
+  gl.Uniform1f(loc("color_depth_tolerance"), f(o.color_depth_tolerance));
+  gl.Uniform1i(loc("tight_march_start"), o.tight_march_start ? 1 : 0);
+  gl.Uniform1i(loc("bilinear_color"), o.bilinear_color ? 1 : 0);
+  gl.Uniform1i(loc("depth_aware_color"), o.depth_aware_color ? 1 : 0);
+  gl.Uniform1i(loc("rr"), o.rr ? 1 : 0);
+  gl.Uniform1f(loc("rr_start"), f(o.rr_start));
+  gl.Uniform1ui(loc("rr_max_depth"), o.rr_max_depth);
+  gl.Uniform2ui(loc("image_size"), camera.width, camera.height);
+  gl.Uniform3f(loc("cam_forward"), f(forward.x), f(forward.y), f(forward.z));
+  gl.Uniform3f(loc("cam_right"), f(right.x), f(right.y), f(right.z));
+  gl.Uniform3f(loc("cam_up"), f(up.x), f(up.y), f(up.z));
+
+  for (GLenum cap : {GL_DEPTH_TEST, GL_BLEND, GL_SCISSOR_TEST, GL_CULL_FACE, GL_STENCIL_TEST}) {
+    gl.Disable(cap);
+  }
+  gl.Viewport(0, 0, static_cast<GLsizei>(camera.width), static_cast<GLsizei>(camera.height));
+  gl.BindVertexArray(vao_);
+  gl.DrawArrays(GL_TRIANGLES, 0, 3);
+  gl.BindVertexArray(0);
+  return check_gl_error(gl, "drawing the ray-march pass");
+}
+
+Status GlRenderer::render(const Camera& camera, RenderedImage* out) {
+  Vec3 forward, right, up;
+  CALF_RETURN_IF_ERROR(camera_axes(camera, &forward, &right, &up));
+  const GlFunctions& gl = *gl_;
+  CALF_RETURN_IF_ERROR(ensure_target(camera.width, camera.height));
+  gl.BindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  const GLenum buffer = GL_COLOR_ATTACHMENT0;
+  gl.DrawBuffers(1, &buffer);
+  CALF_RETURN_IF_ERROR(draw(camera));
+
+  const size_t w = camera.width, h = camera.height;
+  std::vector<float> rgba(4 * w * h);
+  gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+  gl.PixelStorei(GL_PACK_ROW_LENGTH, 0);
+  gl.PixelStorei(GL_PACK_SKIP_PIXELS, 0);
+  gl.PixelStorei(GL_PACK_SKIP_ROWS, 0);
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
+  gl.ReadPixels(0, 0, static_cast<GLsizei>(w), static_cast<GLsizei>(h), GL_RGBA, GL_FLOAT,
+                rgba.data());
+  gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+  CALF_RETURN_IF_ERROR(check_gl_error(gl, "reading back the frame"));
+  out->width = camera.width;
+  out->height = camera.height;
+  out->color.resize(3 * w * h);
+  out->depth.resize(w * h);
+  // GL rows run bottom-up; the image's row 0 is the top.
+  for (size_t j = 0; j < h; ++j) {
+    const float* row = &rgba[4 * w * (h - 1 - j)];
+    for (size_t i = 0; i < w; ++i) {
+      const size_t k = j * w + i;
+      for (int ch = 0; ch < 3; ++ch) out->color[3 * k + ch] = row[4 * i + ch];
+      out->depth[k] = row[4 * i + 3];
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace calf::player

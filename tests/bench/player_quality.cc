@@ -1,0 +1,459 @@
+// Reconstruction quality of the CPU reference renderer (paper 002 Alg. 4, plain and RR) on a
+// capture set read directly (uncompressed), against ground truth (issue 8; docs/RENDERING.md
+// "Quality"). Three measurements, each per pose and as means:
+//
+//   between   the poses of a ground-truth eye path (calf-capture --ground-truth): inside the view
+//             volume, away from the viewpoints; reconstruction vs calf-capture's rendering.
+//   vp-gt     the same comparison at the viewpoints, for an eye path whose poses sit on the
+//             viewpoints (--viewpoint-gt; write one with --write-viewpoint-path, render it with
+//             calf-capture --eye-path).
+//   vp-reproj at each viewpoint, reconstruction vs the view's own cube map re-projected to the
+//             pose (reproject_view: what a plain 360° player shows there). Independent of the
+//             capture resolution and of the ray tracer's noise: only the renderer's own errors.
+//
+// A viewpoint pose looks where pose (v mod P) of the eye path looks: at the surface point its
+// centre pixel shows (its ground-truth depth), or along its forward when that pixel is sky; same
+// time, field of view and up.
+//
+// vp-gt also prints "360": the re-projection itself against the ground truth, the bound that the
+// capture sets on any renderer at the viewpoint. --supersample K compares K x K box-filtered
+// images (ground truth rendered K times larger with calf-capture --gt-size, reconstructions
+// rendered at that size): anti-aliased comparisons, free of the point-sampling mismatch at edges.
+//
+//   bench-player_quality --capture DIR --eye-path GT/eye_path.json [--viewpoint-gt FILE]
+//                        [--steps N] [--threads N] [--variants plain,rr] [--out DIR] ...
+// Every RenderOptions knob has an option (--help). PSNR / SSIM are image_compare.h's
+// (sRGB-encoded, clamped; SSIM on luma); per pose, then mean and worst pose. "depth ok" is the
+// share of pixels whose depth is within 2 % of the reference's (or sky in both). The commands
+// that produced docs/RENDERING.md's tables are listed there.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include "calf/capture/capture_set.h"
+#include "calf/capture/eye_path.h"
+#include "calf/format/colour.h"
+#include "calf/player/capture_views.h"
+#include "calf/player/cpu_renderer.h"
+#include "calf/player/image_compare.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace calf;
+using namespace calf::player;
+
+[[noreturn]] void die(const Status& s) {
+  std::fprintf(stderr, "bench-player_quality: %s\n", s.to_string().c_str());
+  std::exit(1);
+}
+template <typename T>
+T need(Expected<T> e) {
+  if (!e.ok()) die(e.status());
+  return std::move(*e);
+}
+
+double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Views per capture frame, loaded on first use.
+class FrameCache {
+ public:
+  explicit FrameCache(const capture::CaptureSetReader& r) : reader_(r) {}
+  const ViewSet& at(uint32_t frame) {
+    auto it = cache_.find(frame);
+    if (it == cache_.end()) {
+      if (cache_.size() >= 4) cache_.clear();  // bounded memory on long paths
+      it = cache_.emplace(frame, need(load_capture_views(reader_, frame))).first;
+    }
+    return it->second;
+  }
+
+ private:
+  const capture::CaptureSetReader& reader_;
+  std::map<uint32_t, ViewSet> cache_;
+};
+
+struct Pose {
+  capture::EyePose pose;
+  RenderedImage reference;  // colour + depth to compare with
+  int viewpoint = -1;       // the viewpoint it sits on, or -1
+};
+
+struct Score {
+  double psnr = 0, ssim = 0, depth_ok = 0, ms = 0;
+};
+
+double depth_ok_share(const RenderedImage& a, const RenderedImage& b) {
+  size_t ok = 0;
+  for (size_t k = 0; k < a.depth.size(); ++k) {
+    const bool sa = std::isinf(a.depth[k]), sb = std::isinf(b.depth[k]);
+    ok += (sa && sb) || (!sa && !sb && std::fabs(a.depth[k] / b.depth[k] - 1) < 0.02f);
+  }
+  return static_cast<double>(ok) / a.depth.size();
+}
+
+double nearest_viewpoint(const capture::CaptureManifest& m, const capture::Point3& p) {
+  double best = INFINITY;
+  for (const capture::Viewpoint& v : m.viewpoints) {
+    best = std::min(best, std::hypot(p.x - v.position.x, p.y - v.position.y, p.z - v.position.z));
+  }
+  return best;
+}
+
+RenderedImage from_ground_truth(const capture::PerspectiveImage& gt) {
+  RenderedImage r;
+  r.width = gt.width;
+  r.height = gt.height;
+  r.color = gt.color;
+  r.depth = gt.depth;
+  return r;
+}
+
+// Poses (and their ground truth) of an eye path with images.
+std::vector<Pose> read_path_poses(const fs::path& file, const capture::EyePath& path,
+                                  const capture::CaptureManifest& m) {
+  std::vector<Pose> out;
+  for (uint32_t i = 0; i < path.poses.size(); ++i) {
+    Pose p;
+    p.pose = path.poses[i];
+    const fs::path image = file.parent_path() / capture::eye_image_file_name(path, i);
+    p.reference = from_ground_truth(need(capture::read_perspective_image(image)));
+    if (p.reference.width != path.width || p.reference.height != path.height) {
+      die(Status(ErrorId::kImageCompare, image.string() + ": size differs from the eye path's"));
+    }
+    for (size_t v = 0; v < m.viewpoints.size(); ++v) {
+      const capture::Point3& q = m.viewpoints[v].position;
+      if (q == p.pose.position) p.viewpoint = static_cast<int>(v);
+    }
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+// One pose per viewpoint, looking at what eye-path pose (v mod P) looks at (see the top comment).
+capture::EyePath viewpoint_path(const capture::CaptureManifest& m, const capture::EyePath& path,
+                                const std::vector<Pose>& gt) {
+  capture::EyePath out;
+  out.width = path.width;
+  out.height = path.height;
+  for (size_t v = 0; v < m.viewpoints.size(); ++v) {
+    const Pose& src = gt[v % gt.size()];
+    capture::EyePose p = src.pose;
+    const capture::Point3 at = m.viewpoints[v].position;
+    const float z = src.reference.depth[size_t{path.height / 2} * path.width + path.width / 2];
+    if (std::isfinite(z)) {
+      const capture::Point3 target{src.pose.position.x + src.pose.forward.x * z,
+                                   src.pose.position.y + src.pose.forward.y * z,
+                                   src.pose.position.z + src.pose.forward.z * z};
+      const double dx = target.x - at.x, dy = target.y - at.y, dz = target.z - at.z;
+      const double len = std::sqrt(dx * dx + dy * dy + dz * dz);
+      if (len > 1e-6) p.forward = {dx / len, dy / len, dz / len};
+    }
+    p.position = at;
+    out.poses.push_back(p);
+  }
+  return out;
+}
+
+// reference | render | heat map side by side, each scaled `k` times (nearest), for looking at.
+Status write_montage(const fs::path& file, const RenderedImage& ref, const RenderedImage& img,
+                     uint32_t k) {
+  const std::vector<float> err = need(error_map(rgb_ref(img), rgb_ref(ref)));
+  const uint32_t w = ref.width, h = ref.height;
+  std::vector<float> out(size_t{3} * 3 * w * k * h * k);
+  for (uint32_t y = 0; y < h * k; ++y) {
+    for (uint32_t x = 0; x < 3 * w * k; ++x) {
+      const uint32_t panel = x / (w * k), sx = (x % (w * k)) / k, sy = y / k;
+      const size_t src = size_t{sy} * w + sx, dst = 3 * (size_t{y} * 3 * w * k + x);
+      for (int c = 0; c < 3; ++c) {
+        out[dst + c] = panel == 0   ? ref.color[3 * src + c]
+                       : panel == 1 ? img.color[3 * src + c]
+                                    : linear_from_srgb8(heat_color(err[src] / 0.1)[c]);
+      }
+    }
+  }
+  return write_png(file, {3 * w * k, h * k, out});
+}
+
+// Every k x k block averaged (linear colour; depth: the block's centre sample), for comparing
+// anti-aliased images: a ground truth rendered k times larger and a reconstruction rendered
+// at the same size, both filtered the same way (--supersample).
+RenderedImage box_down(const RenderedImage& in, uint32_t k) {
+  if (k == 1) return in;
+  RenderedImage out;
+  out.width = in.width / k;
+  out.height = in.height / k;
+  out.color.assign(size_t{3} * out.width * out.height, 0.0f);
+  out.depth.assign(size_t{out.width} * out.height, 0.0f);
+  for (uint32_t y = 0; y < out.height; ++y) {
+    for (uint32_t x = 0; x < out.width; ++x) {
+      const size_t o = size_t{y} * out.width + x;
+      double c[3] = {0, 0, 0};
+      for (uint32_t j = 0; j < k; ++j) {
+        for (uint32_t i = 0; i < k; ++i) {
+          const size_t s = size_t{y * k + j} * in.width + x * k + i;
+          for (int ch = 0; ch < 3; ++ch) c[ch] += in.color[3 * s + ch];
+        }
+      }
+      for (int ch = 0; ch < 3; ++ch) out.color[3 * o + ch] = static_cast<float>(c[ch] / (k * k));
+      out.depth[o] = in.depth[size_t{y * k + k / 2} * in.width + x * k + k / 2];
+    }
+  }
+  return out;
+}
+
+uint32_t g_supersample = 1;
+
+struct Variant {
+  std::string name;
+  RenderOptions options;
+};
+
+// Renders every pose with every variant, prints a row per pose and the means; returns the means.
+std::vector<Score> measure(const char* section, std::vector<Pose>& poses, FrameCache& frames,
+                           const capture::CaptureManifest& m, const std::vector<Variant>& variants,
+                           const fs::path& out_dir, bool with_360) {
+  std::printf("\n### %s (%zu poses)\n\n| pose | frame | eye-viewpoint |", section, poses.size());
+  if (with_360) std::printf(" 360 PSNR | SSIM |");
+  for (const Variant& v : variants)
+    std::printf(" %s PSNR | SSIM | depth ok | ms |", v.name.c_str());
+  std::printf("\n|---|---|---|");
+  if (with_360) std::printf("---|---|");
+  for (size_t i = 0; i < variants.size(); ++i) std::printf("---|---|---|---|");
+  std::printf("\n");
+  std::vector<Score> mean(variants.size()), worst(variants.size(), Score{INFINITY, INFINITY, 0, 0});
+  Score mean_360;
+  for (size_t pi = 0; pi < poses.size(); ++pi) {
+    Pose& p = poses[pi];
+    const uint32_t frame = capture_frame_at(m, p.pose.time);
+    const ViewSet& views = frames.at(frame);
+    const Camera cam = camera_from_pose(p.pose, p.reference.width, p.reference.height);
+    const RenderedImage reference = box_down(p.reference, g_supersample);
+    std::printf("| %zu | %u | %.3f |", pi, frame, nearest_viewpoint(m, p.pose.position));
+    if (with_360) {
+      // What a plain 360° player shows at this viewpoint: the bound set by the capture itself.
+      if (p.viewpoint < 0)
+        die(Status(ErrorId::kInvalidArgument, "a --viewpoint-gt pose is not on a viewpoint"));
+      const RenderedImage r =
+          box_down(reproject_view(views.views[p.viewpoint], cam), g_supersample);
+      const double q = need(psnr(rgb_ref(r), rgb_ref(reference)));
+      const double t = need(ssim(rgb_ref(r), rgb_ref(reference)));
+      std::printf(" %.2f | %.4f |", q, t);
+      mean_360.psnr += q / poses.size();
+      mean_360.ssim += t / poses.size();
+    }
+    for (size_t vi = 0; vi < variants.size(); ++vi) {
+      const RenderOptions o = need(march_range_for(views, cam.position, variants[vi].options));
+      const CpuRenderer renderer = need(CpuRenderer::make(views, o));
+      RenderedImage img;
+      const double t0 = now_s();
+      if (Status s = renderer.render(cam, &img); !s.ok()) die(s);
+      img = box_down(img, g_supersample);
+      Score s;
+      s.ms = 1e3 * (now_s() - t0);
+      s.psnr = need(psnr(rgb_ref(img), rgb_ref(reference)));
+      s.ssim = need(ssim(rgb_ref(img), rgb_ref(reference)));
+      s.depth_ok = depth_ok_share(img, reference);
+      std::printf(" %.2f | %.4f | %.1f%% | %.0f |", s.psnr, s.ssim, 100 * s.depth_ok, s.ms);
+      mean[vi].psnr += s.psnr / poses.size();
+      mean[vi].ssim += s.ssim / poses.size();
+      mean[vi].depth_ok += s.depth_ok / poses.size();
+      mean[vi].ms += s.ms / poses.size();
+      worst[vi].psnr = std::min(worst[vi].psnr, s.psnr);
+      worst[vi].ssim = std::min(worst[vi].ssim, s.ssim);
+      if (!out_dir.empty()) {
+        const std::string stem = fmt::format("{}_{:03}_{}", section, pi, variants[vi].name);
+        if (Status e = write_png(out_dir / (stem + ".png"), rgb_ref(img)); !e.ok()) die(e);
+        if (Status e = write_heat_map_png(out_dir / (stem + "_heat.png"), rgb_ref(img),
+                                          rgb_ref(reference));
+            !e.ok()) {
+          die(e);
+        }
+        if (Status e = write_montage(out_dir / (stem + "_montage.png"), reference, img, 3);
+            !e.ok()) {
+          die(e);
+        }
+      }
+    }
+    if (!out_dir.empty()) {
+      const fs::path ref = out_dir / fmt::format("{}_{:03}_reference.png", section, pi);
+      if (Status e = write_png(ref, rgb_ref(reference)); !e.ok()) die(e);
+    }
+    std::printf("\n");
+    std::fflush(stdout);
+  }
+  std::printf("| **mean** | | |");
+  if (with_360) std::printf(" %.2f | %.4f |", mean_360.psnr, mean_360.ssim);
+  for (const Score& s : mean) {
+    std::printf(" **%.2f** | **%.4f** | %.1f%% | %.0f |", s.psnr, s.ssim, 100 * s.depth_ok, s.ms);
+  }
+  std::printf("\n| worst | | |");
+  if (with_360) std::printf(" | |");
+  for (const Score& s : worst) std::printf(" %.2f | %.4f | | |", s.psnr, s.ssim);
+  std::printf("\n");
+  return mean;
+}
+
+std::vector<uint32_t> parse_list(const std::string& text) {
+  std::vector<uint32_t> out;
+  size_t at = 0;
+  while (at < text.size()) {
+    size_t comma = text.find(',', at);
+    if (comma == std::string::npos) comma = text.size();
+    const std::string item = text.substr(at, comma - at);
+    char* end = nullptr;
+    const unsigned long v = std::strtoul(item.c_str(), &end, 10);
+    if (item.empty() || *end != 0 || v > 0xFFFFFFFFul) {
+      die(Status(ErrorId::kInvalidArgument, "'" + text + "' is not a list of indices"));
+    }
+    out.push_back(static_cast<uint32_t>(v));
+    at = comma + 1;
+  }
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Reconstruction quality of the CPU renderer on a capture set (issue 8).",
+               "bench-player_quality"};
+  std::string capture_dir, eye_path_file, vp_gt_file, write_vp_file, out_dir, poses_arg;
+  std::string variants_arg = "plain,rr", active_arg;
+  // The tuned configuration of docs/RENDERING.md "Quality": RenderOptions' defaults plus the two
+  // additions that are off by default until the GL renderer has them.
+  RenderOptions base;
+  base.surface_hints = 1;
+  base.rr_replace_view_reflection = true;
+  bool no_reproject = false;
+  app.add_option("--capture", capture_dir, "capture set directory (manifest.json)")->required();
+  app.add_option("--eye-path", eye_path_file,
+                 "ground-truth eye path with images (calf-capture --ground-truth): between "
+                 "viewpoints");
+  app.add_option("--viewpoint-gt", vp_gt_file,
+                 "ground-truth eye path rendered at the viewpoints (from --write-viewpoint-path)");
+  app.add_option("--write-viewpoint-path", write_vp_file,
+                 "write an eye path with one pose per viewpoint (needs --eye-path) and exit");
+  app.add_option("--steps", base.steps, "N_step")->capture_default_str();
+  app.add_option("--refine", base.refine_steps, "bisection steps")->capture_default_str();
+  app.add_option("--footprint", base.depth_footprint, "depth_footprint")->capture_default_str();
+  app.add_option("--smooth", base.smooth_depth_ratio, "smooth_depth_ratio")->capture_default_str();
+  app.add_option("--depth-decay", base.depth_decay, "w_depth decay")->capture_default_str();
+  app.add_option("--cam-decay", base.cam_decay, "w_cam decay")->capture_default_str();
+  app.add_option("--color-tolerance", base.color_depth_tolerance, "color_depth_tolerance")
+      ->capture_default_str();
+  app.add_option("--tight-start", base.tight_march_start, "tight_march_start (0/1)")
+      ->capture_default_str();
+  app.add_option("--hints", base.surface_hints, "surface_hints")->capture_default_str();
+  app.add_option("--hint-margin", base.surface_hint_margin, "surface_hint_margin")
+      ->capture_default_str();
+  app.add_option("--hint-vetoes", base.surface_hint_vetoes, "surface_hint_vetoes")
+      ->capture_default_str();
+  app.add_option("--bilinear", base.bilinear_color, "bilinear_color (0/1)")->capture_default_str();
+  app.add_option("--rr-replace", base.rr_replace_view_reflection, "rr_replace_view_reflection")
+      ->capture_default_str();
+  app.add_option("--rr-start", base.rr_start, "z_e of secondary rays")->capture_default_str();
+  app.add_option("--rr-depth", base.rr_max_depth, "RR bounces")->capture_default_str();
+  app.add_option("--threads", base.threads, "render threads")->capture_default_str();
+  app.add_option("--variants", variants_arg, "comma-separated: plain, rr")->capture_default_str();
+  app.add_option("--poses", poses_arg, "comma-separated pose indices of --eye-path (default all)");
+  app.add_option("--active", active_arg, "comma-separated active view indices (default all)");
+  app.add_option("--supersample", g_supersample,
+                 "compare k x k box-filtered images: ground truth rendered k times the size, "
+                 "reconstructions rendered at that size (1..8)")
+      ->capture_default_str();
+  app.add_flag("--no-reproject", no_reproject, "skip the vp-reproj measurement");
+  app.add_option("--out", out_dir, "write renders, references and heat maps (PNG) here");
+  CLI11_PARSE(app, argc, argv);
+
+  if (g_supersample < 1 || g_supersample > 8) {
+    die(Status(ErrorId::kInvalidArgument, "--supersample must be in 1..8"));
+  }
+  if (!active_arg.empty()) base.active_views = parse_list(active_arg);
+  const capture::CaptureSetReader reader = need(capture::CaptureSetReader::open(capture_dir));
+  const capture::CaptureManifest& m = reader.manifest();
+  std::vector<Variant> variants;
+  for (size_t at = 0; at < variants_arg.size();) {
+    size_t comma = variants_arg.find(',', at);
+    if (comma == std::string::npos) comma = variants_arg.size();
+    Variant v{variants_arg.substr(at, comma - at), base};
+    if (v.name != "plain" && v.name != "rr") {
+      die(Status(ErrorId::kInvalidArgument, "--variants: unknown variant '" + v.name + "'"));
+    }
+    v.options.rr = v.name == "rr";
+    if (!(v.options.rr && !m.material)) variants.push_back(v);  // RR without material = plain
+    at = comma + 1;
+  }
+  if (!out_dir.empty()) fs::create_directories(out_dir);
+
+  std::vector<Pose> between;
+  capture::EyePath path;
+  if (!eye_path_file.empty()) {
+    path = need(capture::read_eye_path(eye_path_file));
+    between = read_path_poses(eye_path_file, path, m);
+  }
+  if (!write_vp_file.empty()) {
+    if (between.empty())
+      die(Status(ErrorId::kInvalidArgument, "--write-viewpoint-path needs --eye-path"));
+    capture::EyePath vp = viewpoint_path(m, path, between);
+    if (Status s = capture::write_file_atomically(write_vp_file, capture::serialize_eye_path(vp));
+        !s.ok()) {
+      die(s);
+    }
+    std::printf(
+        "wrote %zu viewpoint poses to %s; render them with\n  calf-capture --scene %s "
+        "--eye-path %s --out DIR\n",
+        vp.poses.size(), write_vp_file.c_str(), m.scene.c_str(), write_vp_file.c_str());
+    return 0;
+  }
+  if (!poses_arg.empty()) {
+    std::vector<Pose> picked;
+    for (uint32_t i : parse_list(poses_arg)) {
+      if (i < between.size()) picked.push_back(between[i]);
+    }
+    between = std::move(picked);
+  }
+
+  std::printf(
+      "## %s: %zu views, face %u, %u frames; steps %u, refine %u, footprint %.2f, smooth "
+      "%.2f, depth_decay %.0f, cam_decay %.0f, colour tolerance %.2f, tight start %d, "
+      "hints %u (margin %.3f, vetoes %u), rr_start %.3f, rr replace %d, supersample %u, "
+      "threads %u\n",
+      m.scene.c_str(), m.viewpoints.size(), m.face_size, m.frame_count, base.steps,
+      base.refine_steps, base.depth_footprint, base.smooth_depth_ratio, base.depth_decay,
+      base.cam_decay, base.color_depth_tolerance, base.tight_march_start, base.surface_hints,
+      base.surface_hint_margin, base.surface_hint_vetoes, base.rr_start,
+      base.rr_replace_view_reflection, g_supersample, base.threads);
+  FrameCache frames(reader);
+  if (!between.empty()) measure("between", between, frames, m, variants, out_dir, false);
+  if (!vp_gt_file.empty()) {
+    const capture::EyePath vp = need(capture::read_eye_path(vp_gt_file));
+    std::vector<Pose> at_vp = read_path_poses(vp_gt_file, vp, m);
+    measure("vp-gt", at_vp, frames, m, variants, out_dir, true);
+  }
+  if (!no_reproject && !between.empty()) {
+    // The viewpoint poses, with each view's own re-projected cube map as the reference.
+    std::vector<Pose> at_vp;
+    const capture::EyePath vp = viewpoint_path(m, path, between);
+    for (size_t v = 0; v < vp.poses.size(); ++v) {
+      Pose p;
+      p.pose = vp.poses[v];
+      p.viewpoint = static_cast<int>(v);
+      const ViewSet& views = frames.at(capture_frame_at(m, p.pose.time));
+      p.reference = reproject_view(views.views[v], camera_from_pose(p.pose, vp.width, vp.height));
+      at_vp.push_back(std::move(p));
+    }
+    measure("vp-reproj", at_vp, frames, m, variants, out_dir, false);
+  }
+  return 0;
+}
