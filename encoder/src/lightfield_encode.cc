@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <numeric>
@@ -739,6 +740,12 @@ Expected<LightfieldEncodeStats> encode_lightfield_file(const std::filesystem::pa
   if (!input.manifest().scene.empty()) {
     CALF_RETURN_IF_ERROR(writer.set_metadata("source_scene", input.manifest().scene));
   }
+  // The box the eye may move in (format/CAPTURE.md view_volume): the player warns outside it.
+  const capture::Box3& box = input.manifest().view_volume;
+  char volume[160];
+  std::snprintf(volume, sizeof volume, "%.17g %.17g %.17g %.17g %.17g %.17g", box.min.x, box.min.y,
+                box.min.z, box.max.x, box.max.y, box.max.z);
+  CALF_RETURN_IF_ERROR(writer.set_metadata("view_volume", volume));
   CALF_RETURN_IF_ERROR(writer.finish());
   return stats;
 }

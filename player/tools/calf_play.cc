@@ -1,0 +1,216 @@
+// calf-play: plays a .calf lightfield clip (paper 002 Sec. 6): in a GLFW window with fly / orbit
+// cameras and a Dear ImGui HUD, or headless through OSMesa along an eye path, writing frames and
+// comparing them with calf-capture's ground truth. Errors are one line with a stable id and exit
+// status 1; usage errors exit 2.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "calf/capture/eye_path.h"
+#include "calf/player/gl_context.h"
+#include "calf/player/image_compare.h"
+#include "calf/player/play_window.h"
+#include "calf/player/playback.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace calf;
+using namespace calf::player;
+
+int fail(const Status& status) {
+  std::string line = status.to_string();
+  line = line.substr(0, line.find('\n'));
+  std::fprintf(stderr, "calf-play: %s\n", line.c_str());
+  return 1;
+}
+
+Camera camera_for(const capture::EyePath& path, const capture::EyePose& p) {
+  Camera c;
+  c.position = {p.position.x, p.position.y, p.position.z};
+  c.forward = {p.forward.x, p.forward.y, p.forward.z};
+  c.up = {p.up.x, p.up.y, p.up.z};
+  c.fov_y = p.fov_y_degrees * M_PI / 180.0;
+  c.width = path.width;
+  c.height = path.height;
+  return c;
+}
+
+struct HeadlessArgs {
+  std::string eye_path, out, compare, format = "png";
+  bool heat_maps = true;
+};
+
+// Plays `path` pose by pose; poses sharing a time (a stereo pair) are prepared together.
+int run_headless(Playback& play, const HeadlessArgs& a) {
+  fs::path gt_dir;
+  capture::EyePath path;
+  if (!a.compare.empty()) gt_dir = a.compare;
+  const fs::path path_file =
+      !a.eye_path.empty() ? fs::path(a.eye_path) : gt_dir / capture::kEyePathFileName;
+  auto loaded = capture::read_eye_path(path_file);
+  if (!loaded.ok()) return fail(loaded.status());
+  path = std::move(*loaded);
+  if (!gt_dir.empty() && path.image_pattern.empty()) {
+    return fail(Status(ErrorId::kPlaybackOption,
+                       path_file.string() + " names no ground-truth images to compare with"));
+  }
+  if (!a.out.empty()) {
+    std::error_code ec;
+    fs::create_directories(a.out, ec);
+    if (ec) return fail(Status(ErrorId::kFileWrite, a.out + ": " + ec.message()));
+  }
+  if (play.options().render.rr && !play.has_material()) {
+    std::fprintf(stderr, "calf-play: notice: the clip has no material stream; --rr is ignored\n");
+  }
+  double sum_psnr = 0, sum_ssim = 0, sum_decode = 0, sum_render = 0, sum_mbps = 0;
+  uint32_t compared = 0, outside = 0;
+  RenderedImage image;
+  for (size_t i = 0; i < path.poses.size();) {
+    size_t j = i + 1;
+    while (j < path.poses.size() && path.poses[j].time == path.poses[i].time) ++j;
+    std::vector<Camera> eyes;
+    for (size_t k = i; k < j; ++k) eyes.push_back(camera_for(path, path.poses[k]));
+    const uint32_t frame = play.frame_at_time(path.poses[i].time);
+    if (Status s = play.prepare(frame, eyes); !s.ok()) return fail(s);
+    const auto& st = play.last_stats();
+    if (st.errors > 0) {
+      std::fprintf(stderr, "calf-play: warning: frame %u: %u damaged chunk(s), last good state "
+                   "kept: %s\n", frame, st.errors, st.first_error.c_str());
+    }
+    for (size_t k = i; k < j; ++k) {
+      const Camera& cam = eyes[k - i];
+      if (!play.inside_view_volume(cam.position) && outside++ == 0) {
+        std::fprintf(stderr, "calf-play: warning: pose %zu is outside the clip's view volume; "
+                     "expect holes and stretched parallax\n", k);
+      }
+      if (Status s = play.render(cam, &image); !s.ok()) return fail(s);
+      char name[32];
+      std::snprintf(name, sizeof name, "frame_%05zu", k);
+      if (!a.out.empty()) {
+        if (a.format == "png" || a.format == "both") {
+          if (Status s = write_png(fs::path(a.out) / (std::string(name) + ".png"), rgb_ref(image)); !s.ok()) return fail(s);
+        }
+        if (a.format == "exr" || a.format == "both") {
+          if (Status s = write_exr(fs::path(a.out) / (std::string(name) + ".exr"), image); !s.ok()) return fail(s);
+        }
+      }
+      std::printf("pose %zu frame %u: %zu views, %u/%u cells, %.2f Mbps@24, decode %.2f ms, "
+                  "render %.1f ms", k, frame, play.last_selection().active.size(),
+                  st.visible_cells, st.total_cells, st.mbps_at_24fps(), st.decode_ms,
+                  play.last_render_ms());
+      sum_decode += st.decode_ms;
+      sum_render += play.last_render_ms();
+      sum_mbps += st.mbps_at_24fps();
+      if (!gt_dir.empty()) {
+        auto gt = capture::read_perspective_image(gt_dir / capture::eye_image_file_name(path, k));
+        if (!gt.ok()) return fail(gt.status());
+        auto p = psnr(rgb_ref(image), rgb_ref(*gt));
+        if (!p.ok()) return fail(p.status());
+        auto s = ssim(rgb_ref(image), rgb_ref(*gt));
+        if (!s.ok()) return fail(s.status());
+        std::printf(", PSNR %.2f dB, SSIM %.4f", *p, *s);
+        sum_psnr += std::min(*p, 100.0);  // an exact frame counts as 100 dB, not infinity
+        sum_ssim += *s;
+        ++compared;
+        if (!a.out.empty() && a.heat_maps) {
+          const fs::path heat = fs::path(a.out) / (std::string("heat_") + (name + 6) + ".png");
+          if (Status hs = write_heat_map_png(heat, rgb_ref(image), rgb_ref(*gt)); !hs.ok()) return fail(hs);
+        }
+      }
+      std::printf("\n");
+    }
+    i = j;
+  }
+  const double n = static_cast<double>(path.poses.size());
+  std::printf("%zu poses: mean decode %.2f ms, mean render %.1f ms, mean %.2f Mbps@24\n",
+              path.poses.size(), sum_decode / n, sum_render / n, sum_mbps / n);
+  if (compared > 0) {
+    std::printf("mean PSNR %.2f dB, mean SSIM %.4f\n", sum_psnr / compared, sum_ssim / compared);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "calf-play: play a .calf lightfield clip (paper 002 Sec. 6): ray-march reconstruction from "
+      "the nearest viewpoints' colour + depth cube maps, decoded view-dependently.\n"
+      "Window: drag to look, WASD/QE to fly, O orbit, R reflections/refractions (RR), V priority, "
+      "+/- active views, Shift+S stereo, space pause, H HUD, Esc quit.\n"
+      "Headless (--headless): renders an eye path (calf-capture writes one with --ground-truth) "
+      "through OSMesa, writes frames to --out and, with --compare, prints PSNR / SSIM per pose "
+      "and a final 'mean PSNR <x> dB, mean SSIM <y>' line."};
+  std::string clip;
+  HeadlessArgs h;
+  bool headless = false;
+  std::string renderer = "gl", priority = "distance";
+  PlaybackOptions o;
+  WindowOptions w;
+  app.add_option("CLIP", clip, "the .calf file (its first lightfield track is played)")->required();
+  app.add_flag("--headless", headless, "render --eye-path (or the --compare directory's path) "
+               "without a window, through OSMesa");
+  app.add_option("--eye-path", h.eye_path, "eye-path JSON (format/CAPTURE.md) to render; default "
+                 "with --compare: GT_DIR/eye_path.json");
+  app.add_option("--out", h.out, "directory for rendered frames (frame_NNNNN.png / .exr) and error "
+                 "heat maps (heat_NNNNN.png)");
+  app.add_option("--format", h.format, "frame files: png (8-bit sRGB), exr (half RGB + float Z, "
+                 "the ground-truth layout) or both (default png)")
+      ->check(CLI::IsMember({"png", "exr", "both"}));
+  app.add_option("--compare", h.compare, "ground-truth directory written by calf-capture "
+                 "--ground-truth: per-pose PSNR / SSIM and heat maps");
+  app.add_flag("!--no-heat-maps", h.heat_maps, "with --compare and --out: do not write heat maps");
+  app.add_option("--renderer", renderer, "gl (OpenGL 4.5 ray-march, the product) or cpu (the scalar "
+                 "reference; headless only) (default gl)")
+      ->check(CLI::IsMember({"gl", "cpu"}));
+  app.add_option("--steps", o.render.steps, "ray-march steps in log depth (default 64)")
+      ->check(CLI::Range(1, 65536));
+  app.add_flag("--rr", o.render.rr, "reflection / refraction rays from the material stream "
+               "(Alg. 4 _RR); ignored with a notice when the clip has no material");
+  app.add_option("--views", o.selection.max_active, "most active viewpoints per frame (default 9)")
+      ->check(CLI::Range(1, 65536));
+  app.add_option("--priority", priority, "view priority: distance or angle (default distance)")
+      ->check(CLI::IsMember({"distance", "angle"}));
+  app.add_option("--frame-ms", o.selection.target_frame_ms, "frame-time target of performance "
+                 "culling in ms, 0 = off (default 11.1; headless default 0: quality first)");
+  app.add_flag("--no-view-dependent", [&](int64_t) { o.decoder.view_dependent = false; },
+               "decode every cell of the active views, not only the visible ones");
+  app.add_option("--width", w.width, "window width (default 1280)");
+  app.add_option("--height", w.height, "window height (default 720)");
+  app.add_option("--fov", w.fov_y_degrees, "window: vertical field of view in degrees (default 75)")
+      ->check(CLI::Range(10.0, 170.0));
+  app.add_flag("--stereo", w.stereo, "window: side-by-side stereo (toggle with Shift+S)");
+  app.add_option("--ipd", w.ipd, "window: distance between the eyes in scene units (default 0.064)");
+  app.add_option("--frames", w.max_frames, "window: quit after this many frames (0 = never)");
+  CLI11_PARSE(app, argc, argv);
+
+  o.use_gl = renderer == "gl";
+  o.selection.priority = priority == "angle" ? ViewPriority::kAngle : ViewPriority::kDistance;
+  if (headless && app.count("--frame-ms") == 0) o.selection.target_frame_ms = 0;
+  if (headless) {
+    if (h.eye_path.empty() && h.compare.empty()) {
+      return fail(Status(ErrorId::kPlaybackOption, "--headless needs --eye-path or --compare"));
+    }
+    std::unique_ptr<OsMesaContext> context;
+    const GlFunctions* gl = nullptr;
+    if (o.use_gl) {
+      auto c = OsMesaContext::make();
+      if (!c.ok()) return fail(c.status());
+      context = std::move(*c);
+      gl = &context->gl();
+    }
+    auto play = Playback::open(clip, o, gl);
+    if (!play.ok()) return fail(play.status());
+    return run_headless(**play, h);
+  }
+  if (!o.use_gl) {
+    return fail(Status(ErrorId::kPlaybackOption, "--renderer cpu works only with --headless"));
+  }
+  if (Status s = run_window(clip, o, w); !s.ok()) return fail(s);
+  return 0;
+}
