@@ -72,8 +72,7 @@ Expected<RenderOptions> march_range_for(const ViewSet& views, const Vec3& eye,
 CpuRenderer::CpuRenderer(const ViewSet& views, const RenderOptions& options)
     : views_(&views), options_(options) {}
 
-Expected<CpuRenderer> CpuRenderer::make(const ViewSet& views, const RenderOptions& o) {
-  if (views.views.empty()) return option_error("the view set is empty");
+Status validate_render_options(const RenderOptions& o, size_t view_count) {
   if (o.steps < 1 || o.steps > 65536) {
     return option_error("steps " + std::to_string(o.steps) + " is outside [1, 65536]");
   }
@@ -110,17 +109,23 @@ Expected<CpuRenderer> CpuRenderer::make(const ViewSet& views, const RenderOption
   if (o.rr_max_depth < 1 || o.rr_max_depth > 8) {
     return option_error("rr_max_depth is outside [1, 8]");
   }
+  for (uint32_t i : o.active_views) {
+    if (i >= view_count) {
+      return option_error("active view " + std::to_string(i) + " is not below the view count " +
+                          std::to_string(view_count));
+    }
+  }
+  return Status::Ok();
+}
+
+Expected<CpuRenderer> CpuRenderer::make(const ViewSet& views, const RenderOptions& o) {
+  if (views.views.empty()) return option_error("the view set is empty");
+  CALF_RETURN_IF_ERROR(validate_render_options(o, views.views.size()));
   CpuRenderer r(views, o);
   if (o.active_views.empty()) {
     for (const View& v : views.views) r.active_.push_back(&v);
   } else {
-    for (uint32_t i : o.active_views) {
-      if (i >= views.views.size()) {
-        return option_error("active view " + std::to_string(i) + " is not below the view count " +
-                            std::to_string(views.views.size()));
-      }
-      r.active_.push_back(&views.views[i]);
-    }
+    for (uint32_t i : o.active_views) r.active_.push_back(&views.views[i]);
   }
   r.smooth_log_ratio_ = std::log1p(std::max(o.smooth_depth_ratio, 0.0));
   r.min_view_distance_ = o.min_view_distance < 0 ? o.near : o.min_view_distance;

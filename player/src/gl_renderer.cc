@@ -27,51 +27,16 @@ Status option_error(const std::string& what) {
   return Status(ErrorId::kPlayerOptions, what);
 }
 
-// The checks of CpuRenderer::make, so that both renderers accept the same options.
+// The CPU renderer's checks (both renderers accept the same options), plus the GL limits.
 Status check_options(const RenderOptions& o, size_t view_count) {
-  if (o.steps < 1 || o.steps > 65536) {
-    return option_error("steps " + std::to_string(o.steps) + " is outside [1, 65536]");
-  }
-  if (!(o.near > 0) || !(o.far > o.near) || !std::isfinite(o.far)) {
-    return option_error("march range near " + std::to_string(o.near) + ", far " +
-                        std::to_string(o.far) + " is not 0 < near < far < inf");
-  }
-  if (!(o.depth_footprint >= 0 && o.depth_footprint <= 1)) {
-    return option_error("depth_footprint must be in [0, 1]");
-  }
-  if (!(o.smooth_depth_ratio >= 0) || !std::isfinite(o.smooth_depth_ratio)) {
-    return option_error("smooth_depth_ratio must be finite and >= 0");
-  }
-  if (o.refine_steps > 64) return option_error("refine_steps is above 64");
-  if (!(o.depth_decay > 0) || !std::isfinite(o.depth_decay)) {
-    return option_error("depth_decay must be finite and > 0");
-  }
-  if (!(o.cam_decay >= 0) || !std::isfinite(o.cam_decay)) {
-    return option_error("cam_decay must be finite and >= 0");
-  }
+  CALF_RETURN_IF_ERROR(validate_render_options(o, view_count));
   // Not mirrored in the shader yet (an experiment of the CPU reference): refused, so that the two
   // renderers never silently differ.
   if (o.surface_hints != 0) return option_error("surface_hints is not implemented by GL (use 0)");
-  if (!(o.color_depth_tolerance >= 0) || !std::isfinite(o.color_depth_tolerance)) {
-    return option_error("color_depth_tolerance must be finite and >= 0");
-  }
-  if (!std::isfinite(o.min_view_distance)) return option_error("min_view_distance is not finite");
-  if (!(o.rr_start > 0) || !std::isfinite(o.rr_start)) {
-    return option_error("rr_start (z_e) must be finite and > 0");
-  }
-  if (o.rr_max_depth < 1 || o.rr_max_depth > 8) {
-    return option_error("rr_max_depth is outside [1, 8]");
-  }
   const size_t active = o.active_views.empty() ? view_count : o.active_views.size();
   if (active > internal::kGlMaxActiveViews) {
     return option_error(std::to_string(active) + " active views, the GL renderer takes at most " +
                         std::to_string(internal::kGlMaxActiveViews));
-  }
-  for (uint32_t i : o.active_views) {
-    if (i >= view_count) {
-      return option_error("active view " + std::to_string(i) + " is not below the view count " +
-                          std::to_string(view_count));
-    }
   }
   return Status::Ok();
 }

@@ -193,6 +193,10 @@ struct RaySample {
 Expected<RenderOptions> march_range_for(const ViewSet& views, const Vec3& eye,
                                         RenderOptions options);
 
+// The checks every renderer applies to its options (CALF-E403 naming the option): ranges of
+// every field and active view indices below `view_count`.
+Status validate_render_options(const RenderOptions& options, size_t view_count);
+
 class CpuRenderer {
  public:
   // Validates the options against the views (CALF-E403 naming the bad option). The renderer keeps
