@@ -338,6 +338,8 @@ Expected<ClipDecoder> ClipDecoder::open(const container::Reader& reader, uint16_
   return ClipDecoder(std::move(impl));
 }
 
+void ClipDecoder::set_view_dependent(bool on) { impl_->options.view_dependent = on; }
+
 void ClipDecoder::reset() {
   Impl& d = *impl_;
   for (auto& view : d.cell_state) {

@@ -451,6 +451,14 @@ TEST(ClipDecoder, VisibilityFollowsTheViewers) {
   ASSERT_TRUE(d.advance(1, std::vector<EyeView>{narrow}, std::vector<uint32_t>{1}, &fu).ok());
   for (const TextureUpdate& u : fu.updates) EXPECT_EQ(u.view, 1u);
   EXPECT_EQ(fu.stats.total_cells, 6 * 16u);
+  // Switching view-dependent decoding off (a renderer tracing secondary rays) decodes everything
+  // from the next frame on, and the state is the reference's.
+  d.set_view_dependent(false);
+  CpuTextures tex = textures_for(d);
+  d.reset();
+  fu = advance_ok(d, tex, 2, std::vector<EyeView>{narrow});
+  EXPECT_EQ(fu.stats.visible_cells, fu.stats.total_cells);
+  expect_matches_reference(clip, tex, fu, 2, "view-dependent off");
 }
 
 TEST(ClipDecoder, BadArgumentsAreE300AndChangeNothing) {

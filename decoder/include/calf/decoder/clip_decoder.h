@@ -149,6 +149,11 @@ class ClipDecoder {
   Status advance(uint32_t frame, std::span<const EyeView> eyes,
                  std::span<const uint32_t> active_views, FrameUpdates* out);
 
+  // Turns view-dependent decoding on or off from the next advance() (e.g. a renderer that traces
+  // secondary rays reads texels outside the viewers' frusta). Cells that were culled are brought
+  // up to date as soon as they are decoded again; nothing is lost.
+  void set_view_dependent(bool on);
+
   // Forgets what the renderer holds (e.g. after it lost its textures): the next advance() uploads
   // everything visible again.
   void reset();
