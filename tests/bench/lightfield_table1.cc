@@ -29,6 +29,7 @@
 #include "calf/capture/capture_set.h"
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/format/bc.h"
+#include "calf/format/colour.h"
 #include "calf/format/log_depth.h"
 
 namespace {
@@ -84,14 +85,7 @@ Status write_raw_streams(const capture::CaptureSetReader& in, bool hdr, const fs
             buf.push_back(static_cast<uint8_t>(h >> 8));
           }
         } else {
-          for (int c = 0; c < 3; ++c) {
-            float s = vf.color[3 * i + c];
-            s = !(s > 0) ? 0.0f
-                : s >= 1 ? 1.0f
-                : s <= 0.0031308f ? 12.92f * s
-                                  : 1.055f * std::pow(s, 1.0f / 2.4f) - 0.055f;
-            buf.push_back(static_cast<uint8_t>(std::lround(s * 255.0f)));
-          }
+          for (int c = 0; c < 3; ++c) buf.push_back(srgb8_from_linear(vf.color[3 * i + c]));
           buf.push_back(255);
         }
         const float d = vf.depth[i];
