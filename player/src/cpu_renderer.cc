@@ -56,17 +56,24 @@ Vec3 camera_ray(const Camera& camera, uint32_t i, uint32_t j) {
   return normalize(f + r * (a * h * aspect) + u * (b * h));
 }
 
-Expected<RenderOptions> march_range_for(const ViewSet& views, const Vec3& eye,
+Expected<RenderOptions> march_range_for(std::span<const MarchView> views, const Vec3& eye,
                                         RenderOptions options) {
-  if (views.views.empty()) return option_error("march range of an empty view set");
+  if (views.empty()) return option_error("march range of an empty view set");
   double far = 0, near = kInf;
-  for (const View& v : views.views) {
-    far = std::max(far, length(eye - v.position()) + v.range().z_far());
-    near = std::min(near, static_cast<double>(v.range().z_near()) / 4);
+  for (const MarchView& v : views) {
+    far = std::max(far, length(eye - v.position) + v.z_far);
+    near = std::min(near, v.z_near / 4);
   }
   options.far = far;
   options.near = std::max(near, far / (1 << 20));
   return options;
+}
+
+Expected<RenderOptions> march_range_for(const ViewSet& views, const Vec3& eye,
+                                        RenderOptions options) {
+  std::vector<MarchView> m;
+  for (const View& v : views.views) m.push_back({v.position(), v.range().z_near(), v.range().z_far()});
+  return march_range_for(m, eye, std::move(options));
 }
 
 CpuRenderer::CpuRenderer(const ViewSet& views, const RenderOptions& options)

@@ -96,15 +96,9 @@ Expected<GLuint> compile(const GlFunctions& gl, GLenum type, const std::string& 
 
 Expected<RenderOptions> march_range_for(const GlTextureLayout& layout, const Vec3& eye,
                                         RenderOptions options) {
-  if (layout.views.empty()) return option_error("march range of an empty view set");
-  double far = 0, near = std::numeric_limits<double>::infinity();
-  for (const GlViewInfo& v : layout.views) {
-    far = std::max(far, length(eye - v.position) + v.range.z_far());
-    near = std::min(near, static_cast<double>(v.range.z_near()) / 4);
-  }
-  options.far = far;
-  options.near = std::max(near, far / (1 << 20));
-  return options;
+  std::vector<MarchView> m;
+  for (const GlViewInfo& v : layout.views) m.push_back({v.position, v.range.z_near(), v.range.z_far()});
+  return calf::player::march_range_for(m, eye, std::move(options));
 }
 
 GlRenderer::GlRenderer(const GlViews& views, const RenderOptions& options)

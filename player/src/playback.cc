@@ -218,21 +218,14 @@ Status Playback::Impl::load_view_set() {
 }
 
 RenderOptions Playback::Impl::frame_options(const Vec3& eye) const {
-  RenderOptions r = options.render;
-  if (options.fixed_march_range) return r;
-  // far = max_j (|eye - P_j| + z_far_j), near = min_j z_near_j / 4, but no nearer than
-  // far / 2^20 (so a tiny z_near cannot stretch the log steps), over every view of the clip, so
-  // the range does not jump when the active set changes.
-  double far = 0, near = INFINITY;
+  if (options.fixed_march_range) return options.render;
+  // march_range_for's rule over every view of the clip, so the range does not jump when the
+  // active set changes.
+  std::vector<MarchView> m;
   for (uint32_t v = 0; v < viewpoints.size(); ++v) {
-    const auto& info = decoder->view(v);
-    const Vec3& p = viewpoints[v];
-    far = std::max(far, std::hypot(eye.x - p.x, eye.y - p.y, eye.z - p.z) + info.z_far);
-    near = std::min(near, info.z_near / 4.0);
+    m.push_back({viewpoints[v], decoder->view(v).z_near, decoder->view(v).z_far});
   }
-  r.far = far;
-  r.near = std::max(near, far / (1 << 20));
-  return r;
+  return *march_range_for(m, eye, options.render);  // never empty: a clip has >= 1 view
 }
 
 Status Playback::render(const EyeCamera& camera, RenderedImage* out) {

@@ -22,6 +22,8 @@ namespace calf::player {
 namespace {
 
 using testing::make_views;
+using testing::corner_views;
+using testing::room_with_spheres;
 using testing::Scene;
 
 constexpr double kPi = 3.141592653589793;
@@ -42,21 +44,6 @@ OsMesaContext* context() {
 
 #define REQUIRE_GL() \
   if (context() == nullptr) GTEST_SKIP() << "no OSMesa GL 4.5 core context";
-
-Scene room_with_spheres() {
-  Scene s;
-  s.spheres = {{{0, -0.5, -2.2}, 0.8}, {{1.6, 0.6, -1.2}, 0.45}};
-  return s;
-}
-
-std::vector<Vec3> corner_views(const Vec3& c, double side) {
-  std::vector<Vec3> v;
-  const double h = side / 2;
-  for (int i = 0; i < 8; ++i) {
-    v.push_back({c.x + ((i & 1) ? -h : h), c.y + ((i & 2) ? -h : h), c.z + ((i & 4) ? -h : h)});
-  }
-  return v;
-}
 
 // PSNR of `test` against `ref` with the reference's largest value as peak (1 for LDR images).
 double psnr_vs(const std::vector<float>& ref, const std::vector<float>& test) {

@@ -17,26 +17,11 @@ namespace {
 using testing::ground_truth;
 using testing::make_views;
 using testing::psnr;
+using testing::corner_views;
+using testing::room_with_spheres;
 using testing::Scene;
 
 constexpr double kPi = 3.141592653589793;
-
-Scene room_with_spheres() {
-  Scene s;
-  s.spheres = {{{0, -0.5, -2.2}, 0.8}, {{1.6, 0.6, -1.2}, 0.45}};
-  return s;
-}
-
-// Eight viewpoints on the corners of a cube of side `side` around `centre`, first the nearest
-// corners to +x+y+z (the order in which the "more views" test adds them).
-std::vector<Vec3> corner_views(const Vec3& c, double side) {
-  std::vector<Vec3> v;
-  const double h = side / 2;
-  for (int i = 0; i < 8; ++i) {
-    v.push_back({c.x + ((i & 1) ? -h : h), c.y + ((i & 2) ? -h : h), c.z + ((i & 4) ? -h : h)});
-  }
-  return v;
-}
 
 RenderedImage render(const ViewSet& views, const Camera& cam, RenderOptions o) {
   o = *march_range_for(views, cam.position, o);

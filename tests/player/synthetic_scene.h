@@ -199,4 +199,22 @@ inline double psnr(const std::vector<float>& a, const std::vector<float>& b) {
   return mse == 0 ? 200.0 : 10 * std::log10(1.0 / mse);
 }
 
+// Two spheres in the default room, the scene most renderer tests use.
+inline Scene room_with_spheres() {
+  Scene s;
+  s.spheres = {{{0, -0.5, -2.2}, 0.8}, {{1.6, 0.6, -1.2}, 0.45}};
+  return s;
+}
+
+// Eight viewpoints on the corners of a cube of side `side` around `c`, first the nearest
+// corners to +x+y+z.
+inline std::vector<Vec3> corner_views(const Vec3& c, double side) {
+  std::vector<Vec3> v;
+  const double h = side / 2;
+  for (int i = 0; i < 8; ++i) {
+    v.push_back({c.x + ((i & 1) ? -h : h), c.y + ((i & 2) ? -h : h), c.z + ((i & 4) ? -h : h)});
+  }
+  return v;
+}
+
 }  // namespace calf::player::testing

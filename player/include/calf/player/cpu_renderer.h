@@ -50,6 +50,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "calf/decoder/culling.h"
@@ -190,6 +191,13 @@ struct RaySample {
 // (nothing any view stores lies beyond), near = min_j z_near_j / 4 but no nearer
 // than far / 2^20 (a tiny z_near must not stretch the log steps).
 // Errors: CALF-E403 for an empty view set.
+// The same rule over any views: each given by its position and radial depth range.
+struct MarchView {
+  Vec3 position;
+  double z_near = 1, z_far = 2;
+};
+Expected<RenderOptions> march_range_for(std::span<const MarchView> views, const Vec3& eye,
+                                        RenderOptions options);
 Expected<RenderOptions> march_range_for(const ViewSet& views, const Vec3& eye,
                                         RenderOptions options);
 
