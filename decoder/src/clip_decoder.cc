@@ -396,13 +396,24 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
   std::vector<uint32_t> all_cells(d.cells.cell_count()), all_tiles(d.tiles.cell_count());
   for (uint32_t i = 0; i < all_cells.size(); ++i) all_cells[i] = i;
   for (uint32_t i = 0; i < all_tiles.size(); ++i) all_tiles[i] = i;
+  auto cull_cells = [&](const Vec3& apex, CubeFace face, const FaceGrid& grid, double z_near,
+                        double z_far, std::span<const Frustum> eye) {
+    return d.options.brute_force_culling
+               ? visible_cells_brute_force(apex, face, grid, z_near, z_far, eye, &cull)
+               : visible_cells_hierarchical(apex, face, grid, z_near, z_far, eye,
+                                            d.options.quadtree_levels, &cull);
+  };
   for (uint32_t v : active) {
     const LightfieldViewInfo& info = d.views[v];
     const Vec3 p{info.position[0], info.position[1], info.position[2]};
-    // Sky texels stand for points at infinity; a viewer sees nothing beyond its far plane, so
-    // for each viewer a cell frustum reaching past that viewer's far plane (seen from this
-    // viewpoint) is as good. The far cap depends on the viewer, so each viewer is culled on its
-    // own and the visible sets are united: several viewers see exactly the union of each.
+    // Geometry: a cell frustum reaching past each viewer's far plane (seen from this viewpoint)
+    // holds every point the viewer can see through it. The far cap depends on the viewer, so each
+    // viewer is culled on its own and the visible sets are united: several viewers see exactly the
+    // union of each.
+    // Sky: it is at infinity, so the renderer reads every view's sky in the eye ray's own
+    // direction, not at a point in the viewer's frustum. A cell whose directions meet the
+    // viewer's is therefore needed too: its frustum placed at the eye, tested against the eye's
+    // frustum with a far cap beyond the eye's (so every shared direction has a shared point).
     std::vector<double> z_far(eyes.size());
     for (size_t i = 0; i < eyes.size(); ++i) {
       const Vec3& e = eyes[i].position;
@@ -417,15 +428,16 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
         std::vector<uint32_t> united;
         for (size_t i = 0; i < eyes.size(); ++i) {
           const std::span<const Frustum> one(&frusta[i], 1);
-          const std::vector<uint32_t> by_eye =
-              d.options.brute_force_culling
-                  ? visible_cells_brute_force(p, face, grid, info.z_near, z_far[i], one, &cull)
-                  : visible_cells_hierarchical(p, face, grid, info.z_near, z_far[i], one,
-                                               d.options.quadtree_levels, &cull);
-          std::vector<uint32_t> merged;
-          std::set_union(united.begin(), united.end(), by_eye.begin(), by_eye.end(),
-                         std::back_inserter(merged));
-          united.swap(merged);
+          const Vec3& e = eyes[i].position;
+          const double sky_near = eyes[i].near, sky_far = 2 * eyes[i].far;
+          for (const std::vector<uint32_t>& by_eye :
+               {cull_cells(p, face, grid, info.z_near, z_far[i], one),
+                cull_cells(e, face, grid, sky_near, sky_far, one)}) {
+            std::vector<uint32_t> merged;
+            std::set_union(united.begin(), united.end(), by_eye.begin(), by_eye.end(),
+                           std::back_inserter(merged));
+            united.swap(merged);
+          }
         }
         return united;
       };

@@ -461,6 +461,38 @@ TEST(ClipDecoder, VisibilityFollowsTheViewers) {
   expect_matches_reference(clip, tex, fu, 2, "view-dependent off");
 }
 
+// Sky is at infinity: the renderer reads each view's sky in the eye ray's own direction. A view
+// far to the side of a narrow viewer must therefore still decode the cells in the directions the
+// viewer looks along, although no point of the viewer's frustum lies in them (seen from the view).
+// Before this rule those cells were culled and rendered black sky bands.
+TEST(ClipDecoder, CellsInTheViewersDirectionsAreDecodedForSky) {
+  ClipSpec spec;
+  spec.seed = 52;
+  spec.options.cell_size = 4;
+  const Clip clip = make_clip(spec);
+  ClipDecoder d = open_decoder(clip);
+  EyeView side;
+  side.position = {0, 10, 0};  // 10 above view 0 at (-0.25, 0, 0); its frustum stays near y = 10
+  side.forward = {1, 0, 0};
+  side.fov_y = 0.3;
+  side.far = 3;
+  FrameUpdates fu;
+  ASSERT_TRUE(d.advance(0, std::vector<EyeView>{side}, std::vector<uint32_t>{0}, &fu).ok());
+  // The +X face's centre texel of view 0 looks along (1, 0, 0); it lies in cell (2, 2) of the
+  // 16-texel face's 4-texel grid.
+  const Expected<FaceGrid> grid = FaceGrid::with_cell_size(spec.face, 4);
+  ASSERT_TRUE(grid.ok());
+  const uint32_t centre = grid->cell_index_at_texel(8, 8);
+  ASSERT_EQ(centre, 2 * 4 + 2u);
+  bool found = false;
+  for (const CellParams& c : fu.cells) {
+    found |= c.view == 0 && c.face == CubeFace::kPosX && c.cell == centre;
+  }
+  EXPECT_TRUE(found) << "cell " << centre << " of view 0's +X face was culled";
+  // Directions behind the viewer stay culled: the -X face is never visible.
+  for (const CellParams& c : fu.cells) EXPECT_NE(c.face, CubeFace::kNegX);
+}
+
 TEST(ClipDecoder, BadArgumentsAreE300AndChangeNothing) {
   ClipSpec spec;
   spec.seed = 61;
