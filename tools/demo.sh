@@ -3,29 +3,87 @@
 # pipeline on a built-in sample: ray-trace a capture set of the animated `interior` scene, encode
 # it into a .calf clip, summarise and fully verify the clip, render ground truth along the scene's
 # eye path and play the clip headless along it (GL through OSMesa), comparing every frame with the
-# ground truth. A second run skips installed packages and rebuilds incrementally. (The one-screen
-# report and the contact sheet are issue 9's.)
+# ground truth. Ends with a one-screen report and a contact sheet PNG (ground truth | calf | error
+# heat map). Every step's full output is kept in build/demo/logs/. A second run skips installed
+# packages and rebuilds incrementally.
+#
+# Environment: CALF_DEMO_SCENE (default interior; see calf-capture --list-scenes),
+# CALF_DEMO_FACE (capture face size, default 64), CALF_DEMO_FRAMES (default 8),
+# CALF_DEMO_GT (ground-truth size WxH, default 128x128).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./tools/setup.sh
 BUILD=build/release
 cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$BUILD" --target calf-capture calf-encode calf-info calf-verify calf-play
+
+SCENE=${CALF_DEMO_SCENE:-interior}
+FACE=${CALF_DEMO_FACE:-64}
+FRAMES=${CALF_DEMO_FRAMES:-8}
+GT=${CALF_DEMO_GT:-128x128}
 OUT=build/demo
+LOGS=$OUT/logs
+CLIP=$OUT/$SCENE.calf
+SHEET=$OUT/contact_sheet.png
 rm -rf "$OUT"
-mkdir -p "$OUT"
-echo "== calf-capture: interior scene, 9 viewpoints, 6 x 64^2 faces, 8 frames"
-"$BUILD"/calf-capture --scene interior --out "$OUT/capture" --face-size 64 --frames 8
-echo "== calf-encode: BC6H colour (the scene is HDR), raw16 depth, zstd"
-"$BUILD"/calf-encode "$OUT/capture/manifest.json" -o "$OUT/interior.calf"
-echo "== calf-info"
-"$BUILD"/calf-info "$OUT/interior.calf"
-echo "== calf-verify"
-"$BUILD"/calf-verify "$OUT/interior.calf"
-echo "== calf-capture --ground-truth: 8 poses along the scene's eye path, 128 x 128"
-"$BUILD"/calf-capture --scene interior --ground-truth --out "$OUT/ground-truth" --frames 8 \
-  --gt-size 128x128
-echo "== calf-play --headless: the clip along that path, compared with the ground truth"
-"$BUILD"/calf-play "$OUT/interior.calf" --headless --compare "$OUT/ground-truth" --out "$OUT/play"
-echo "demo: capture set in $OUT/capture, clip in $OUT/interior.calf, frames and error heat maps" \
-  "in $OUT/play"
+mkdir -p "$LOGS"
+
+now() { date +%s.%N; }
+seconds_since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.1f", b - a }'; }
+# run NAME COMMAND...: runs a step with its output in $LOGS/NAME.log; on failure shows the log's
+# end and stops the demo with the step's exit status.
+run() {
+  local name=$1 t0 status=0
+  shift
+  t0=$(now)
+  printf '%-34s' "== $name"
+  "$@" >"$LOGS/$name.log" 2>&1 || status=$?
+  if [ "$status" -ne 0 ]; then
+    echo "FAILED (exit $status)"
+    tail -n 20 "$LOGS/$name.log" >&2
+    echo "demo: $name failed; full output in $LOGS/$name.log" >&2
+    exit "$status"
+  fi
+  LAST_SECONDS=$(seconds_since "$t0")
+  echo "done in $LAST_SECONDS s"
+}
+# line_of FILE REGEX: the first line of FILE matching REGEX, or "n/a".
+line_of() { grep -m1 -E "$2" "$1" || echo "n/a"; }
+
+echo "calf demo: scene $SCENE, ${FACE}² cube faces, $FRAMES frames, ground truth $GT"
+run calf-capture "$BUILD"/calf-capture --scene "$SCENE" --out "$OUT/capture" --face-size "$FACE" \
+  --frames "$FRAMES"
+CAPTURE_S=$LAST_SECONDS
+run calf-encode "$BUILD"/calf-encode "$OUT/capture/manifest.json" -o "$CLIP"
+ENCODE_S=$LAST_SECONDS
+run calf-info "$BUILD"/calf-info "$CLIP"
+run calf-verify "$BUILD"/calf-verify "$CLIP"
+run ground-truth "$BUILD"/calf-capture --scene "$SCENE" --ground-truth --out "$OUT/ground-truth" \
+  --frames "$FRAMES" --gt-size "$GT"
+run calf-play "$BUILD"/calf-play "$CLIP" --headless --compare "$OUT/ground-truth" \
+  --out "$OUT/play" --contact-sheet "$SHEET"
+
+PLAY=$LOGS/calf-play.log
+ENC=$LOGS/calf-encode.log
+CAPTURE_BYTES=$(du -sb "$OUT/capture" | cut -f1)
+CLIP_BYTES=$(stat -c %s "$CLIP")
+VIEWS=$(grep -c '"name"' "$OUT/capture/manifest.json" || true)
+echo
+echo "================================ calf demo report ================================"
+printf 'scene     %s: %s viewpoints x 6 faces of %s², %s frames (calf-capture %s s)\n' \
+  "$SCENE" "$VIEWS" "$FACE" "$FRAMES" "$CAPTURE_S"
+awk -v c="$CAPTURE_BYTES" -v k="$CLIP_BYTES" -v clip="$CLIP" 'BEGIN {
+  printf "clip      %s: %.2f MB, %.1fx smaller than the capture set'"'"'s %.1f MB of EXR\n",
+         clip, k / 1e6, c / k, c / 1e6 }'
+echo "          per stream: raw -> temporal -> spatial (BCn, log-16) -> zstd bytes, ratio to raw"
+grep -E '^  (colour|depth|material) +raw' "$ENC" | sed 's/^  /            /' || true
+echo "encode    $ENCODE_S s wall: $(line_of "$ENC" 'wrote .* in' | sed -E 's/.* in ([0-9.]+ s.*)/\1/'),"\
+  "$(line_of "$ENC" 'peak RSS' | sed 's/^calf-encode: //')"
+SUMMARY=$(line_of "$PLAY" '^[0-9]+ poses: ')
+echo "playback  ${SUMMARY}"
+echo "          (GL 4.5 through OSMesa / llvmpipe on the CPU; the first render compiles shaders)"
+echo "quality   $(line_of "$PLAY" '^mean PSNR') against ground truth at $GT"
+echo "          $(line_of "$PLAY" '^worst pose')"
+echo "sheet     $SHEET (rows: poses along the path; ground truth | calf | error heat map)"
+echo "files     capture set $OUT/capture, frames and heat maps $OUT/play, logs $LOGS"
+echo "=================================================================================="

@@ -8,6 +8,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "calf/format/colour.h"
+#include "calf/player/contact_sheet.h"
 #include "calf/player/image_compare.h"
 
 namespace calf::player {
@@ -15,8 +16,8 @@ namespace calf::player {
 namespace {
 
 // Writes 8-bit RGB pixels (row-major from the top row) as a PNG to `path` via `path`.tmp.
-Status write_png_rgb8(const std::filesystem::path& path, uint32_t width, uint32_t height,
-                      const std::vector<uint8_t>& pixels) {
+Status write_rgb8_png_file(const std::filesystem::path& path, uint32_t width, uint32_t height,
+                          const std::vector<uint8_t>& pixels) {
   const std::string final_name = path.string();
   const std::string temp_name = final_name + ".tmp";
   std::error_code ignored;
@@ -66,7 +67,17 @@ Status write_png(const std::filesystem::path& path, const RgbImageRef& image) {
   }
   std::vector<uint8_t> pixels(3 * n);
   for (size_t i = 0; i < 3 * n; ++i) pixels[i] = srgb8_from_linear(image.rgb[i]);
-  return write_png_rgb8(path, image.width, image.height, pixels);
+  return write_rgb8_png_file(path, image.width, image.height, pixels);
+}
+
+Status write_png_rgb8(const std::filesystem::path& path, const Rgb8Image& image) {
+  const size_t n = size_t{image.width} * image.height;
+  if (n == 0 || image.rgb.size() < 3 * n) {
+    return Status(ErrorId::kImageCompare, path.string() +
+                                              ": the image is empty or its buffer is "
+                                              "shorter than its size");
+  }
+  return write_rgb8_png_file(path, image.width, image.height, image.rgb);
 }
 
 Status write_heat_map_png(const std::filesystem::path& path, const RgbImageRef& a,
@@ -83,7 +94,7 @@ Status write_heat_map_png(const std::filesystem::path& path, const RgbImageRef& 
     const std::array<uint8_t, 3> c = heat_color((*errors)[i] / full_scale);
     for (int ch = 0; ch < 3; ++ch) pixels[3 * i + ch] = c[ch];
   }
-  return write_png_rgb8(path, a.width, a.height, pixels);
+  return write_rgb8_png_file(path, a.width, a.height, pixels);
 }
 
 Status write_exr(const std::filesystem::path& path, const RenderedImage& image) {

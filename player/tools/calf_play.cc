@@ -2,6 +2,7 @@
 // cameras and a Dear ImGui HUD, or headless through OSMesa along an eye path, writing frames and
 // comparing them with calf-capture's ground truth. Errors are one line with a stable id and exit
 // status 1; usage errors exit 2.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -11,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "calf/capture/eye_path.h"
+#include "calf/player/contact_sheet.h"
 #include "calf/player/gl_context.h"
 #include "calf/player/image_compare.h"
 #include "calf/player/play_window.h"
@@ -41,8 +43,22 @@ Camera camera_for(const capture::EyePath& path, const capture::EyePose& p) {
 }
 
 struct HeadlessArgs {
-  std::string eye_path, out, compare, format = "png";
+  std::string eye_path, out, compare, format = "png", contact_sheet;
+  uint32_t sheet_rows = 8;
   bool heat_maps = true;
+};
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : (v[m - 1] + v[m]) / 2;
+}
+
+// The images of the poses chosen for the contact sheet, kept until the end of the path.
+struct SheetTile {
+  RenderedImage rendered;
+  capture::PerspectiveImage ground_truth;
 };
 
 // Plays `path` pose by pose; poses sharing a time (a stereo pair) are prepared together.
@@ -67,8 +83,15 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
   if (play.options().render.rr && !play.has_material()) {
     std::fprintf(stderr, "calf-play: notice: the clip has no material stream; --rr is ignored\n");
   }
-  double sum_psnr = 0, sum_ssim = 0, sum_decode = 0, sum_render = 0, sum_mbps = 0;
+  double sum_psnr = 0, sum_ssim = 0, sum_decode = 0, sum_mbps = 0;
+  double min_psnr = INFINITY, min_ssim = INFINITY;
+  size_t min_psnr_pose = 0, min_ssim_pose = 0;
+  std::vector<double> decode_ms, render_ms;
   uint32_t compared = 0, outside = 0;
+  const std::vector<size_t> sheet_poses =
+      a.contact_sheet.empty() ? std::vector<size_t>{}
+                              : contact_sheet_poses(path.poses.size(), a.sheet_rows);
+  std::vector<SheetTile> sheet;
   RenderedImage image;
   for (size_t i = 0; i < path.poses.size();) {
     size_t j = i + 1;
@@ -104,8 +127,9 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
                   st.visible_cells, st.total_cells, st.mbps_at_24fps(), st.decode_ms,
                   play.last_render_ms());
       sum_decode += st.decode_ms;
-      sum_render += play.last_render_ms();
       sum_mbps += st.mbps_at_24fps();
+      decode_ms.push_back(st.decode_ms);
+      render_ms.push_back(play.last_render_ms());
       if (!gt_dir.empty()) {
         auto gt = capture::read_perspective_image(gt_dir / capture::eye_image_file_name(path, k));
         if (!gt.ok()) return fail(gt.status());
@@ -117,9 +141,14 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
         sum_psnr += std::min(*p, 100.0);  // an exact frame counts as 100 dB, not infinity
         sum_ssim += *s;
         ++compared;
+        if (*p < min_psnr) min_psnr = *p, min_psnr_pose = k;
+        if (*s < min_ssim) min_ssim = *s, min_ssim_pose = k;
         if (!a.out.empty() && a.heat_maps) {
           const fs::path heat = fs::path(a.out) / (std::string("heat_") + (name + 6) + ".png");
           if (Status hs = write_heat_map_png(heat, rgb_ref(image), rgb_ref(*gt)); !hs.ok()) return fail(hs);
+        }
+        if (std::binary_search(sheet_poses.begin(), sheet_poses.end(), k)) {
+          sheet.push_back({image, std::move(*gt)});
         }
       }
       std::printf("\n");
@@ -127,10 +156,27 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
     i = j;
   }
   const double n = static_cast<double>(path.poses.size());
-  std::printf("%zu poses: mean decode %.2f ms, mean render %.1f ms, mean %.2f Mbps@24\n",
-              path.poses.size(), sum_decode / n, sum_render / n, sum_mbps / n);
+  // The first render compiles shaders and fills caches: it is reported apart from the rest.
+  const double first_render = render_ms.empty() ? 0 : render_ms.front();
+  const double later_render =
+      render_ms.size() > 1 ? median({render_ms.begin() + 1, render_ms.end()}) : first_render;
+  std::printf("%zu poses: mean decode %.2f ms (median %.2f), render first %.1f ms then median "
+              "%.1f ms, mean %.2f Mbps@24\n",
+              path.poses.size(), sum_decode / n, median(decode_ms), first_render, later_render,
+              sum_mbps / n);
   if (compared > 0) {
     std::printf("mean PSNR %.2f dB, mean SSIM %.4f\n", sum_psnr / compared, sum_ssim / compared);
+    std::printf("worst pose: PSNR %.2f dB (pose %zu), SSIM %.4f (pose %zu)\n", min_psnr,
+                min_psnr_pose, min_ssim, min_ssim_pose);
+  }
+  if (!sheet.empty()) {
+    std::vector<ContactSheetRow> rows;
+    for (const SheetTile& t : sheet) rows.push_back({rgb_ref(t.ground_truth), rgb_ref(t.rendered)});
+    auto composed = compose_contact_sheet(rows);
+    if (!composed.ok()) return fail(composed.status());
+    if (Status s = write_png_rgb8(a.contact_sheet, *composed); !s.ok()) return fail(s);
+    std::printf("contact sheet: %s (%zu poses; ground truth | calf | error heat map, red = "
+                "error 0.1 of full scale or more)\n", a.contact_sheet.c_str(), rows.size());
   }
   return 0;
 }
@@ -165,6 +211,11 @@ int main(int argc, char** argv) {
   app.add_option("--compare", h.compare, "ground-truth directory written by calf-capture "
                  "--ground-truth: per-pose PSNR / SSIM and heat maps");
   app.add_flag("!--no-heat-maps", h.heat_maps, "with --compare and --out: do not write heat maps");
+  app.add_option("--contact-sheet", h.contact_sheet, "with --compare: write a PNG with one row per "
+                 "pose: ground truth | calf | error heat map");
+  app.add_option("--sheet-rows", h.sheet_rows, "poses on the contact sheet, spread evenly along "
+                 "the path, first and last included (default 8)")
+      ->check(CLI::Range(1, 256));
   app.add_option("--renderer", renderer, "gl (OpenGL 4.5 ray-march, the product) or cpu (the scalar "
                  "reference; headless only) (default gl)")
       ->check(CLI::IsMember({"gl", "cpu"}));
@@ -196,6 +247,9 @@ int main(int argc, char** argv) {
     if (h.eye_path.empty() && h.compare.empty()) {
       return fail(Status(ErrorId::kPlaybackOption, "--headless needs --eye-path or --compare"));
     }
+    if (!h.contact_sheet.empty() && h.compare.empty()) {
+      return fail(Status(ErrorId::kPlaybackOption, "--contact-sheet needs --compare"));
+    }
     std::unique_ptr<OsMesaContext> context;
     const GlFunctions* gl = nullptr;
     if (o.use_gl) {
@@ -210,6 +264,9 @@ int main(int argc, char** argv) {
   }
   if (!o.use_gl) {
     return fail(Status(ErrorId::kPlaybackOption, "--renderer cpu works only with --headless"));
+  }
+  if (!h.contact_sheet.empty()) {
+    return fail(Status(ErrorId::kPlaybackOption, "--contact-sheet works only with --headless"));
   }
   if (Status s = run_window(clip, o, w); !s.ok()) return fail(s);
   return 0;
