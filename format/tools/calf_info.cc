@@ -190,7 +190,10 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   auto reader = Reader::open(path);
   if (!reader.ok()) {
-    fmt::print(stderr, "{}\n", reader.status().with_context(path).to_string());
+    // Errors opening the file already name it; later ones (header, directory) get it added.
+    const calf::Status& s = reader.status();
+    fmt::print(stderr, "calf-info: {}\n",
+               (s.message().find(path) == std::string::npos ? s.with_context(path) : s).to_string());
     return 1;
   }
   if (json)

@@ -26,7 +26,10 @@ int main(int argc, char** argv) {
   for (const auto& path : files) {
     auto reader = calf::container::Reader::open(path);
     if (!reader.ok()) {
-      fmt::print("{}\n", reader.status().with_context(path).to_string());
+      // Errors opening the file already name it; later ones (header, directory) get it added.
+      const calf::Status& s = reader.status();
+      fmt::print("{}\n",
+                 (s.message().find(path) == std::string::npos ? s.with_context(path) : s).to_string());
       rc = 1;
       continue;
     }
