@@ -74,14 +74,21 @@ function(calf_check_layering)
   endforeach()
 endfunction()
 
-# calf_add_test(source LIBS...): one GoogleTest executable per test file, named after the file;
-# every test case in it becomes its own ctest entry.
+# calf_add_test(source [TEST_PREFIX prefix] LIBS...): one GoogleTest executable per test file,
+# named after the file; every test case in it becomes its own ctest entry, its name preceded by
+# `prefix` when given (e.g. "extreme." so that `ctest -R extreme` selects one group).
 include(GoogleTest)
 function(calf_add_test source)
+  cmake_parse_arguments(T "" "TEST_PREFIX" "" ${ARGN})
   get_filename_component(name ${source} NAME_WE)
   add_executable(${name} ${source})
-  target_link_libraries(${name} PRIVATE ${ARGN} GTest::gtest GTest::gtest_main calf_options)
-  gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST
+  target_link_libraries(${name} PRIVATE ${T_UNPARSED_ARGUMENTS} GTest::gtest GTest::gtest_main
+                        calf_options)
+  set(prefix "")
+  if(T_TEST_PREFIX)
+    set(prefix TEST_PREFIX ${T_TEST_PREFIX})
+  endif()
+  gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST ${prefix}
                        PROPERTIES ENVIRONMENT "CALF_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
 endfunction()
 
