@@ -109,6 +109,32 @@ TEST(EyePath, Errors) {
                "'poses[0].forward[1]'");
 }
 
+// A directory or a missing file given as an eye path (or as a capture set's manifest) is a clear
+// open error naming it (libstdc++'s filebuf throws on reading a directory; nothing may escape).
+TEST(EyePath, NonFilesAreOpenErrorsNamingThePath) {
+  const auto dir = std::filesystem::temp_directory_path() / "calf_eye_path_test_dir";
+  std::filesystem::create_directories(dir);
+  auto r = read_eye_path(dir);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().id(), ErrorId::kFileOpen);
+  EXPECT_NE(r.status().message().find(dir.string() + ": cannot open (a directory)"),
+            std::string::npos)
+      << r.status().message();
+  // A capture set whose manifest.json is a directory: the same error, not an exception.
+  std::filesystem::create_directories(dir / "manifest.json");
+  auto set = CaptureSetReader::open(dir);
+  ASSERT_FALSE(set.ok());
+  EXPECT_EQ(set.status().id(), ErrorId::kFileOpen);
+  EXPECT_NE(set.status().message().find("manifest.json: cannot open (a directory)"),
+            std::string::npos)
+      << set.status().message();
+  std::filesystem::remove_all(dir);
+  r = read_eye_path(dir / "eye_path.json");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().id(), ErrorId::kFileOpen);
+  EXPECT_NE(r.status().message().find("eye_path.json: cannot open"), std::string::npos);
+}
+
 TEST(EyePath, GroundTruthImageRoundTrip) {
   PerspectiveImage img;
   img.width = 5;

@@ -82,6 +82,28 @@ Status validate_view_frame(const ViewFrame& f, std::string_view context) {
   return Status::Ok();
 }
 
+Expected<std::string> read_small_file(const std::filesystem::path& path,
+                                      std::string_view what_if_missing) {
+  // istreambuf_iterator would let libstdc++'s filebuf throw on a directory (EISDIR); a regular
+  // file check first, then istream::read, which turns read errors into badbit.
+  std::error_code ec;
+  const bool regular = std::filesystem::is_regular_file(path, ec);
+  std::ifstream in;
+  if (regular) in.open(path, std::ios::binary);
+  if (!regular || !in) {
+    const char* why = std::filesystem::is_directory(path, ec) ? ": cannot open (a directory)"
+                                                               : ": cannot open";
+    return Status(ErrorId::kFileOpen, path.string() + why + std::string(what_if_missing));
+  }
+  std::string text;
+  char buffer[1 << 14];
+  while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
+    text.append(buffer, static_cast<size_t>(in.gcount()));
+  }
+  if (in.bad()) return Status(ErrorId::kFileRead, path.string() + ": read failed");
+  return text;
+}
+
 Status write_file_atomically(const std::filesystem::path& path, std::string_view bytes) {
   const std::string temp = path.string() + ".tmp";
   {
@@ -111,13 +133,8 @@ Status write_file_atomically(const std::filesystem::path& path, std::string_view
 
 Expected<CaptureSetReader> CaptureSetReader::open(const std::filesystem::path& directory) {
   std::filesystem::path manifest_path = directory / kManifestFileName;
-  std::ifstream in(manifest_path, std::ios::binary);
-  if (!in) {
-    return Status(ErrorId::kFileOpen, manifest_path.string() +
-                                          ": cannot open (not a capture set, or an incomplete one)");
-  }
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) return Status(ErrorId::kFileRead, manifest_path.string() + ": read failed");
+  CALF_ASSIGN_OR_RETURN(std::string text,
+                        read_small_file(manifest_path, " (not a capture set, or an incomplete one)"));
   CALF_ASSIGN_OR_RETURN(CaptureManifest m, parse_manifest(text, manifest_path.string()));
   return CaptureSetReader(directory, std::move(m));
 }

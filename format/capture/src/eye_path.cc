@@ -2,8 +2,6 @@
 #include "calf/capture/eye_path.h"
 
 #include <cmath>
-#include <fstream>
-#include <iterator>
 
 #include "exr_io.h"
 #include "json_fields.h"
@@ -180,10 +178,7 @@ Expected<EyePath> parse_eye_path(std::string_view json, std::string_view source)
 }
 
 Expected<EyePath> read_eye_path(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return Status(ErrorId::kFileOpen, file.string() + ": cannot open");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) return Status(ErrorId::kFileRead, file.string() + ": read failed");
+  CALF_ASSIGN_OR_RETURN(std::string text, read_small_file(file));
   return parse_eye_path(text, file.string());
 }
 

@@ -177,4 +177,10 @@ class CaptureSetWriter {
 // image writers.
 Status write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
 
+// Reads a whole small file (a manifest, an eye path) into a string. Errors: CALF-E002 when it
+// cannot be opened or is not a regular file (a directory, a FIFO), CALF-E003 when a read fails,
+// each naming the file; `what_if_missing` is appended to the open error (e.g. why it is needed).
+Expected<std::string> read_small_file(const std::filesystem::path& path,
+                                      std::string_view what_if_missing = {});
+
 }  // namespace calf::capture
