@@ -102,6 +102,9 @@ Status validate_render_options(const RenderOptions& o, size_t view_count) {
   }
   if (o.surface_hints > 4) return option_error("surface_hints is above 4");
   if (o.surface_hint_vetoes > 65536) return option_error("surface_hint_vetoes is above 65536");
+  if (o.surface_hint_substeps < 1 || o.surface_hint_substeps > 64) {
+    return option_error("surface_hint_substeps is outside [1, 64]");
+  }
   if (!(o.surface_hint_margin >= 0) || !std::isfinite(o.surface_hint_margin)) {
     return option_error("surface_hint_margin must be finite and >= 0");
   }
@@ -249,8 +252,11 @@ bool CpuRenderer::intersect(const Vec3& o, const Vec3& d, double start, Hit* hit
     if (r <= min_view_distance_) return -1;
     // The nearest texel's depth: the view's own best estimate of its surface along the ray
     // (the conservative footprint minimum would put the crossing in front of slanted surfaces,
-    // where the other views then rightly see empty space).
-    return code_margin(*v, rel, r, 0.5, 0) > 0 ? 1 : 0;
+    // where the other views then rightly see empty space). One fetch, also on the GPU.
+    const Texel t = texel_from_direction(to_direction(rel), v->face_size());
+    const uint16_t code = v->depth_code_at(t.face, t.x, t.y);
+    if (code == kLog16Sky) return 1;
+    return code > v->range().normalized_from_depth(r) * kLog16MaxFinite ? 1 : 0;
   };
   int prev[kMaxHints] = {};
   for (uint32_t i = 0; i <= options_.steps; ++i) {
@@ -269,22 +275,32 @@ bool CpuRenderer::intersect(const Vec3& o, const Vec3& d, double start, Hit* hit
       hit->p = o + d * hit->z;
       return true;
     }
+    // The hint views are followed at `surface_hint_substeps` points per step (one fetch each),
+    // so that a crossing pair (in front, behind) closer than a step is still seen; each hint
+    // offers its first crossing of the step.
     double found = kInf;
+    const uint32_t sub = options_.surface_hint_substeps;
+    const double sub_step = step / sub;
     for (uint32_t h = 0; h < hints; ++h) {
-      const int now = side(hint[h], x);
-      if (i > 0 && prev[h] == 1 && now == 0) {
-        double lo = x - step, hi = x;
-        for (uint32_t k = 0; k < options_.refine_steps; ++k) {
-          const double mid = 0.5 * (lo + hi);
-          (side(hint[h], mid) == 1 ? lo : hi) = mid;
+      bool crossed = false;
+      for (uint32_t s = i == 0 ? sub : 1; s <= sub; ++s) {
+        const double xs = s == sub ? x : x - step + s * sub_step;
+        const int now = side(hint[h], xs);
+        if (i > 0 && !crossed && prev[h] == 1 && now == 0) {
+          crossed = true;
+          double lo = xs - sub_step, hi = xs;
+          for (uint32_t k = 0; k < options_.refine_steps; ++k) {
+            const double mid = 0.5 * (lo + hi);
+            (side(hint[h], mid) == 1 ? lo : hi) = mid;
+          }
+          const double xc = 0.5 * (lo + hi);
+          if (xc < found && !empty_beyond(o + d * lin(xc), options_.surface_hint_margin,
+                                          options_.surface_hint_vetoes)) {
+            found = xc;
+          }
         }
-        const double xc = 0.5 * (lo + hi);
-        if (xc < found && !empty_beyond(o + d * lin(xc), options_.surface_hint_margin,
-                                        options_.surface_hint_vetoes)) {
-          found = xc;
-        }
+        prev[h] = now;
       }
-      prev[h] = now;
     }
     if (found < kInf) {
       hit->z = lin(found);
@@ -415,6 +431,12 @@ RaySample CpuRenderer::trace(const Vec3& origin, const Vec3& direction) const {
   s.depth = hit.z;
   if (options_.rr) {
     shade_rr(origin, direction, hit, 0, s.rgb);
+    // With replacement a ray's colour is c_view + sum of w (c_eye - c_view): negative where a
+    // view saw a brighter reflection than the eye does. Intermediate bounces stay linear (the
+    // GL renderer sums the ray tree in any order); the pixel is clamped.
+    if (options_.rr_replace_view_reflection) {
+      for (double& c : s.rgb) c = std::max(c, 0.0);
+    }
   } else {
     int best;
     shade_surface(origin, hit.p, s.rgb, &best);

@@ -55,7 +55,11 @@ uniform float color_depth_tolerance;
 uniform bool tight_march_start;
 uniform bool bilinear_color;
 uniform bool depth_aware_color;
+uniform float surface_hint_margin;  // relative depth a vetoing view must see beyond
+uniform uint surface_hint_vetoes;   // vetoes a hint crossing survives
+uniform uint surface_hint_substeps; // hint tests per step
 uniform bool rr;
+uniform bool rr_replace_view_reflection;
 uniform float rr_start;
 uniform uint rr_max_depth;
 uniform uvec2 image_size;
@@ -66,7 +70,9 @@ uniform vec3 cam_up;             // unit up * tan(fov_y / 2)
 layout(location = 0) out vec4 out_colour;  // rgb, radial hit distance (+inf: sky)
 
 const float INF = uintBitsToFloat(0x7F800000u);
-const int RR_STACK = 16;  // a depth-first walk holds at most rr_max_depth + 1 <= 9 rays
+// A depth-first walk pops one ray and pushes at most 4 (reflection and refraction, for the eye
+// and, with replacement, for the view): at most 3 rr_max_depth + 4 <= 28 rays wait at a time.
+const int RR_STACK = 28;
 
 // ---- texel fetches (sampling.cc) ----
 
@@ -186,23 +192,36 @@ float code_margin(CalfView v, vec3 x, float r) {
 // ---- CpuRenderer::empty_at / empty_beyond: BetweenViewpointAndGeometry over the active views,
 // true as soon as one view that is not too near sees p in front of its surface by more than the
 // relative depth `margin` ----
-bool empty_beyond(vec3 p, float margin) {
+bool empty_beyond(vec3 p, float margin, uint vetoes_ignored) {
   bool consulted = false;
+  uint vetoes = 0u;
   for (uint k = 0u; k < view_count; ++k) {
     CalfView v = views[k];
     vec3 x = p - v.position;
     float r = length(x);
     if (r <= min_view_distance) continue;
     consulted = true;
-    if (code_margin(v, x, r) > margin * v.inv_step) return true;
+    if (code_margin(v, x, r) > margin * v.inv_step && ++vetoes > vetoes_ignored) return true;
   }
   return !consulted;
 }
 
-bool empty_at(vec3 p) { return empty_beyond(p, 0.0); }
-
 // ---- CpuRenderer::intersect: RayIntersection ----
 float lin(float x) { return march_near * exp(x * march_log_ratio); }
+
+// The hint test of intersect()'s `side`: -1 view h does not vote at the sample (too near its
+// centre), 0 behind its surface, 1 in front (nearest texel; sky counts as in front).
+int hint_side(uint h, vec3 o, vec3 d, float x) {
+  CalfView v = views[h];
+  vec3 rel = o + d * lin(x) - v.position;
+  float r = length(rel);
+  if (r <= min_view_distance) return -1;
+  int face = face_of(rel);
+  vec2 uv = texel_coord(rel, face, v.face_size);
+  uint code = depth_code(v, ivec3(clamp_texel(uv.x, v.face_size),
+                                  clamp_texel(uv.y, v.face_size), face));
+  return code == CALF_LOG16_SKY || float(code) > (log(r) - v.log_near) * v.inv_step ? 1 : 0;
+}
 
 bool intersect(vec3 o, vec3 d, float start, out float z_hit) {
   z_hit = INF;
@@ -215,26 +234,123 @@ bool intersect(vec3 o, vec3 d, float start, out float z_hit) {
   float x0 = log(max(start, march_near) / march_near) / march_log_ratio;
   if (!(x0 < 1.0)) return false;
   float step = (1.0 - x0) / float(steps);
-  // The march (samples i = 0..steps) and the bisection (refine_steps halvings of [lo, hi]) in one
-  // loop, so that empty_at() is instantiated once: the driver inlines every call, and llvmpipe's
-  // compile time grows with the code.
+#if CALF_HINTS > 0
+  // Surface hints: the views nearest the ray origin, nearest first (ties: lower index). Their
+  // count is compiled in (CALF_HINTS = RenderOptions::surface_hints), so that the per-hint state
+  // lives in registers: llvmpipe spills dynamically indexed arrays to memory.
+  uint hints = min(uint(CALF_HINTS), view_count);
+  uint hint[CALF_HINTS];
+  float hint_dist[CALF_HINTS];
+  int prev[CALF_HINTS];
+  float crossing[CALF_HINTS];
+  for (int h = 0; h < CALF_HINTS; ++h) {
+    hint[h] = 0u;
+    hint_dist[h] = INF;
+    prev[h] = 0;
+    crossing[h] = INF;
+  }
+  for (uint k = 0u; k < view_count; ++k) {
+    float dv = length(o - views[k].position);
+    uint cand = k;
+    for (int h = 0; h < CALF_HINTS; ++h) {
+      if (dv < hint_dist[h]) {
+        float td = hint_dist[h];
+        hint_dist[h] = dv;
+        dv = td;
+        uint tk = hint[h];
+        hint[h] = cand;
+        cand = tk;
+      }
+    }
+  }
+  uint h_next = 0u;
+  float found = INF;
+#endif
+  // The march (samples i = 0..steps), the bisection of a hit (refine_steps halvings of [lo, hi])
+  // and the confirmation of hint crossings (empty_beyond with the hint margin, one crossing per
+  // pass) in one loop, so that empty_beyond() is instantiated once: the driver inlines every
+  // call, and llvmpipe's compile time grows with the code.
+  const int MARCH = 0, REFINE = 1, CONFIRM = 2;
+  int state = MARCH;
   uint i = 0u, k = 0u;
-  bool refining = false;
   float lo = 0.0, hi = 0.0;
   for (;;) {
-    float x = refining ? 0.5 * (lo + hi) : (i == steps ? 1.0 : x0 + float(i) * step);
-    bool empty = empty_at(o + d * lin(x));
-    if (refining) {
+    float x;
+    float margin = 0.0;
+    uint vetoes_ignored = 0u;
+#if CALF_HINTS > 0
+    if (state == CONFIRM) {
+      // The next crossing of this interval that would be nearer than one already confirmed.
+      while (h_next < hints && !(crossing[h_next] < found)) ++h_next;
+      if (h_next == hints) {
+        if (found < INF) {
+          z_hit = lin(found);
+          return true;
+        }
+        state = MARCH;
+        if (++i > steps) return false;
+        continue;
+      }
+      x = crossing[h_next];
+      margin = surface_hint_margin;
+      vetoes_ignored = surface_hint_vetoes;
+    } else
+#endif
+    if (state == REFINE) {
+      x = 0.5 * (lo + hi);
+    } else {
+      x = i == steps ? 1.0 : x0 + float(i) * step;
+    }
+    bool empty = empty_beyond(o + d * lin(x), margin, vetoes_ignored);
+#if CALF_HINTS > 0
+    if (state == CONFIRM) {
+      if (!empty) found = x;
+      ++h_next;
+      continue;
+    }
+#endif
+    if (state == REFINE) {
       if (empty) lo = x; else hi = x;
       if (++k >= refine_steps) break;
-    } else if (empty) {
-      if (++i > steps) return false;
-    } else {
+    } else if (!empty) {
       lo = x - step;
       hi = x;
       if (i == 0u) lo = hi;  // already behind a surface at the first sample: nothing to refine
       if (i == 0u || refine_steps == 0u) break;
-      refining = true;
+      state = REFINE;
+    } else {
+#if CALF_HINTS > 0
+      // An empty sample: where a hint view went from in front of its surface to behind it
+      // between two of its substeps, locate the first such crossing of the step by bisection on
+      // that view alone.
+      bool any = false;
+      float sub_step = step / float(surface_hint_substeps);
+      for (int h = 0; h < CALF_HINTS; ++h) {
+        crossing[h] = INF;
+        if (uint(h) >= hints) continue;
+        for (uint s = i == 0u ? surface_hint_substeps : 1u; s <= surface_hint_substeps; ++s) {
+          float xs = s == surface_hint_substeps ? x : x - step + float(s) * sub_step;
+          int now = hint_side(hint[h], o, d, xs);
+          if (i > 0u && crossing[h] == INF && prev[h] == 1 && now == 0) {
+            float clo = xs - sub_step, chi = xs;
+            for (uint b = 0u; b < refine_steps; ++b) {
+              float mid = 0.5 * (clo + chi);
+              if (hint_side(hint[h], o, d, mid) == 1) clo = mid; else chi = mid;
+            }
+            crossing[h] = 0.5 * (clo + chi);
+            any = true;
+          }
+          prev[h] = now;
+        }
+      }
+      if (any) {
+        state = CONFIRM;
+        h_next = 0u;
+        found = INF;
+        continue;
+      }
+#endif
+      if (++i > steps) return false;
     }
   }
   z_hit = lin(0.5 * (lo + hi));
@@ -244,11 +360,13 @@ bool intersect(vec3 o, vec3 d, float start, out float z_hit) {
 // ---- CpuRenderer::shade_surface: SampleColor + CalculateColor ----
 // The weighted mean is accumulated online, rescaled whenever a larger log weight arrives: the
 // same exp(log_w - best) normalisation as the CPU's two passes, without an array of views.
-vec3 shade_surface(vec3 o, vec3 p, out int best_view) {
+// best_colour: the colour of the best-weighted view (rr_replace_view_reflection starts from it).
+vec3 shade_surface(vec3 o, vec3 p, out int best_view, out vec3 best_colour) {
   float hit_distance = max(length(p - o), 1e-12);
   vec3 sum = vec3(0.0);
   float wsum = 0.0, best = -INF;
   best_view = -1;
+  best_colour = vec3(0.0);
   for (uint k = 0u; k < view_count; ++k) {
     CalfView v = views[k];
     vec3 x = p - v.position;
@@ -294,6 +412,7 @@ vec3 shade_surface(vec3 o, vec3 p, out int best_view) {
       wsum *= rescale;
       best = log_w;
       best_view = int(k);
+      best_colour = c;
     }
     float w = exp(log_w - best);
     sum += w * c;
@@ -348,14 +467,20 @@ bool texel_point(CalfView v, ivec3 t, out vec3 q) {
   return true;
 }
 
-// tangent: along one texel axis, the one-sided difference toward the nearer neighbour.
+// tangent: along one texel axis, the central difference where both neighbours continue the
+// surface evenly, else the one-sided difference toward the nearer neighbour.
 bool tangent(CalfView v, ivec3 t, ivec2 dxy, vec3 centre, out vec3 along) {
   along = vec3(0.0);
   vec3 a, b;
   bool ha = texel_point(v, texel_beyond_face(t.z, t.x + dxy.x, t.y + dxy.y, v.face_size), a);
   bool hb = texel_point(v, texel_beyond_face(t.z, t.x - dxy.x, t.y - dxy.y, v.face_size), b);
   if (!ha && !hb) return false;
-  if (ha && (!hb || length(a - centre) <= length(b - centre))) {
+  float la = ha ? length(a - centre) : 0.0, lb = hb ? length(b - centre) : 0.0;
+  if (ha && hb && la <= 2.0 * lb && lb <= 2.0 * la) {
+    along = a - b;
+    return true;
+  }
+  if (ha && (!hb || la <= lb)) {
     along = a - centre;
   } else {
     along = centre - b;
@@ -367,14 +492,32 @@ struct RrRay {
   vec3 o, d;     // origin, unit direction
   float start;   // march start (near for eye rays, z_e for secondary rays)
   uint depth;    // bounces so far
-  float weight;  // product of the reflect / refract weights on the way here
+  float weight;  // product of the (signed) weights on the way here
 };
 
-// CpuRenderer::trace and shade_rr without recursion: c = w_rfl c_rfl + w_rfr c_rfr +
-// (1 - w_rfl - w_rfr) c_diffuse is linear in the children, so each ray adds its own share times
-// the product of the weights above it and pushes its secondary rays; a ray that hits nothing adds
-// the sky. The eye ray is the first ray of the walk, so intersect(), shade_surface() and
-// shade_sky() are each instantiated once (see intersect()). Returns the eye ray's hit distance.
+// The direction CpuRenderer::secondary() gives a ray arriving along unit d_in at a surface with
+// unit normal n (either orientation): the reflection, or with `refraction` GLSL refract() with
+// eta = 1 / ior where there is no total internal reflection.
+vec3 secondary_direction(vec3 d_in, vec3 n, bool refraction, float ior) {
+  if (dot(n, d_in) > 0.0) n = -n;  // face the incoming ray
+  vec3 dir = normalize(d_in - n * (2.0 * dot(d_in, n)));
+  if (refraction) {
+    float eta = 1.0 / ior;
+    float c = dot(n, d_in);
+    float k = 1.0 - eta * eta * (1.0 - c * c);
+    if (!(k < 0.0)) dir = normalize(d_in * eta - n * (eta * c + sqrt(k)));
+  }
+  return dir;
+}
+
+// CpuRenderer::trace and shade_rr without recursion. A ray's colour is linear in its children's:
+//   Alg. 4:       c = w_rfl c_rfl + w_rfr c_rfr + (1 - w_rfl - w_rfr) c_diffuse
+//   replacement:  c = c_view + w_rfl (c_rfl - c_rfl,view) + w_rfr (c_rfr - c_rfr,view)
+// so each ray adds its own term times the product of the weights above it and pushes its
+// secondary rays (with replacement also those along the best view's direction, weighted -w); a
+// ray that hits nothing adds the sky. The eye ray is the first ray of the walk, so intersect(),
+// shade_surface() and shade_sky() are each instantiated once (see intersect()). Returns the eye
+// ray's hit distance.
 float trace(vec3 o, vec3 d, out vec3 rgb) {
   RrRay stack[RR_STACK];
   int top = 0;
@@ -391,7 +534,8 @@ float trace(vec3 o, vec3 d, out vec3 rgb) {
     if (ray.depth == 0u) eye_z = z;
     vec3 p = ray.o + ray.d * z;
     int best;
-    vec3 diffuse = shade_surface(ray.o, p, best);
+    vec3 own;
+    vec3 diffuse = shade_surface(ray.o, p, best, own);
     if (!rr || best < 0 || ray.depth >= rr_max_depth) {
       rgb += ray.weight * diffuse;
       continue;
@@ -416,22 +560,22 @@ float trace(vec3 o, vec3 d, out vec3 rgb) {
     }
     vec3 n = normalize(cross(tu, tv));
     if (dot(n, ray.d) > 0.0) n = -n;  // face the incoming ray
-    rgb += ray.weight * (1.0 - m.x - m.y) * diffuse;
-    // Refraction first on the stack, so that the reflection is walked first, like the CPU.
+    vec3 view_dir = normalize(x);
+    rgb += ray.weight * (rr_replace_view_reflection ? own : (1.0 - m.x - m.y) * diffuse);
+    // Pushed in reverse, so that the walk visits them in the CPU's order: reflection then
+    // refraction, each for the eye then for the view.
     for (int kind = 1; kind >= 0; --kind) {
       float w = kind == 0 ? m.x : m.y;
       if (!(w > 0.0)) continue;
-      vec3 dir = normalize(ray.d - n * (2.0 * dot(ray.d, n)));
-      if (kind == 1) {
-        // GLSL refract() with eta = 1 / ior; total internal reflection keeps the reflection.
-        float eta = 1.0 / m.z;
-        float c = dot(n, ray.d);
-        float k = 1.0 - eta * eta * (1.0 - c * c);
-        if (!(k < 0.0)) dir = normalize(ray.d * eta - n * (eta * c + sqrt(k)));
+      if (rr_replace_view_reflection) {
+        stack[top++] = RrRay(p, secondary_direction(view_dir, n, kind == 1, m.z), rr_start,
+                             ray.depth + 1u, -ray.weight * w);
       }
-      stack[top++] = RrRay(p, dir, rr_start, ray.depth + 1u, ray.weight * w);
+      stack[top++] = RrRay(p, secondary_direction(ray.d, n, kind == 1, m.z), rr_start,
+                           ray.depth + 1u, ray.weight * w);
     }
   }
+  if (rr && rr_replace_view_reflection) rgb = max(rgb, vec3(0.0));  // as CpuRenderer::trace
   return eye_z;
 }
 

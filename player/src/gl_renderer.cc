@@ -30,9 +30,6 @@ Status option_error(const std::string& what) {
 // The CPU renderer's checks (both renderers accept the same options), plus the GL limits.
 Status check_options(const RenderOptions& o, size_t view_count) {
   CALF_RETURN_IF_ERROR(validate_render_options(o, view_count));
-  // Not mirrored in the shader yet (an experiment of the CPU reference): refused, so that the two
-  // renderers never silently differ.
-  if (o.surface_hints != 0) return option_error("surface_hints is not implemented by GL (use 0)");
   const size_t active = o.active_views.empty() ? view_count : o.active_views.size();
   if (active > internal::kGlMaxActiveViews) {
     return option_error(std::to_string(active) + " active views, the GL renderer takes at most " +
@@ -122,6 +119,21 @@ Expected<std::unique_ptr<GlRenderer>> GlRenderer::make(const GlViews& views,
 
 Status GlRenderer::set_options(const RenderOptions& options) {
   CALF_RETURN_IF_ERROR(check_options(options, views_->layout().views.size()));
+  if (options.surface_hints != options_.surface_hints) {
+    // The hint count is compiled into the shader (see build_program): a new program.
+    const RenderOptions old = options_;
+    const GLuint old_program = program_;
+    options_ = options;
+    program_ = 0;
+    if (Status s = build_program(); !s.ok()) {
+      if (program_ != 0) gl_->DeleteProgram(program_);
+      program_ = old_program;
+      options_ = old;
+      return s;
+    }
+    gl_->DeleteProgram(old_program);
+    return Status::Ok();
+  }
   options_ = options;
   return Status::Ok();
 }
@@ -135,6 +147,7 @@ Status GlRenderer::build_program() {
   std::string defines =
       "#define CALF_MAX_VIEWS " + std::to_string(internal::kGlMaxActiveViews) + "\n";
   if (views_->depth_is_bc5()) defines += "#define CALF_DEPTH_BC5\n";
+  defines += "#define CALF_HINTS " + std::to_string(options_.surface_hints) + "\n";
   const Expected<GLuint> fs =
       compile(gl, GL_FRAGMENT_SHADER,
               version + defines + kGlslConventions + internal::kGlRaymarchFragment, "ray-march");
@@ -155,8 +168,8 @@ Status GlRenderer::build_program() {
     gl.GetProgramInfoLog(program_, static_cast<GLsizei>(log.size()), nullptr, log.data());
     return Status(kGlMissing, std::string("the ray-march program does not link: ") + log.data());
   }
-  gl.GenVertexArrays(1, &vao_);
-  gl.GenBuffers(1, &view_buffer_);
+  if (vao_ == 0) gl.GenVertexArrays(1, &vao_);
+  if (view_buffer_ == 0) gl.GenBuffers(1, &view_buffer_);
   return check_gl_error(gl, "building the ray-march program");
 }
 
@@ -246,7 +259,11 @@ Status GlRenderer::draw(const Camera& camera) {
   gl.Uniform1i(loc("tight_march_start"), o.tight_march_start ? 1 : 0);
   gl.Uniform1i(loc("bilinear_color"), o.bilinear_color ? 1 : 0);
   gl.Uniform1i(loc("depth_aware_color"), o.depth_aware_color ? 1 : 0);
+  gl.Uniform1f(loc("surface_hint_margin"), f(o.surface_hint_margin));
+  gl.Uniform1ui(loc("surface_hint_vetoes"), o.surface_hint_vetoes);
+  gl.Uniform1ui(loc("surface_hint_substeps"), o.surface_hint_substeps);
   gl.Uniform1i(loc("rr"), o.rr ? 1 : 0);
+  gl.Uniform1i(loc("rr_replace_view_reflection"), o.rr_replace_view_reflection ? 1 : 0);
   gl.Uniform1f(loc("rr_start"), f(o.rr_start));
   gl.Uniform1ui(loc("rr_max_depth"), o.rr_max_depth);
   gl.Uniform2ui(loc("image_size"), camera.width, camera.height);

@@ -223,6 +223,17 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 65536));
   app.add_flag("--rr", o.render.rr, "reflection / refraction rays from the material stream "
                "(Alg. 4 _RR); ignored with a notice when the clip has no material");
+  app.add_flag("!--no-rr-replace", o.render.rr_replace_view_reflection,
+               "with --rr: Alg. 4 as written, c = w c_rfl + ... + (1 - w) c_blend, instead of the "
+               "default: the best view's colour with its own reflection / refraction replaced by "
+               "the eye's (docs/RENDERING.md)");
+  app.add_option("--hints", o.render.surface_hints,
+                 "surface hint views followed along the march "
+                 "(0 = the paper's march alone; default 1)")
+      ->check(CLI::Range(0, 4));
+  app.add_option("--hint-substeps", o.render.surface_hint_substeps,
+                 "hint tests per march step (default 4)")
+      ->check(CLI::Range(1, 64));
   app.add_option("--views", o.selection.max_active, "most active viewpoints per frame (default 9)")
       ->check(CLI::Range(1, 65536));
   app.add_option("--priority", priority, "view priority: distance or angle (default distance)")

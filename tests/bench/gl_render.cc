@@ -69,6 +69,9 @@ int main(int argc, char** argv) {
   CLI::App app{"GL ray-march renderer frame time under OSMesa, with the CPU reference as peer"};
   std::vector<uint32_t> sizes = {256, 512}, view_counts = {4, 9};
   uint32_t face = 256, steps = 64, repeats = 5, cpu_threads = 2, cpu_max_size = 256;
+  RenderOptions defaults;
+  uint32_t hints = defaults.surface_hints, hint_substeps = defaults.surface_hint_substeps;
+  bool rr_replace = defaults.rr_replace_view_reflection;
   app.add_option("--sizes", sizes, "square image sizes")->capture_default_str();
   app.add_option("--views", view_counts, "view counts (1..9)")->capture_default_str();
   app.add_option("--face", face, "view face size, texels")->capture_default_str();
@@ -76,6 +79,11 @@ int main(int argc, char** argv) {
   app.add_option("--repeats", repeats, "timed frames after the first")->capture_default_str();
   app.add_option("--cpu-threads", cpu_threads, "threads of the CPU peer")->capture_default_str();
   app.add_option("--cpu-max-size", cpu_max_size, "largest size the CPU peer renders (0: none)")
+      ->capture_default_str();
+  app.add_option("--hints", hints, "RenderOptions::surface_hints")->capture_default_str();
+  app.add_option("--hint-substeps", hint_substeps, "RenderOptions::surface_hint_substeps")
+      ->capture_default_str();
+  app.add_option("--rr-replace", rr_replace, "RenderOptions::rr_replace_view_reflection (0/1)")
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
@@ -85,8 +93,11 @@ int main(int argc, char** argv) {
     return 1;
   }
   const GlFunctions& gl = (*ctx)->gl();
-  fmt::print("renderer: {} (GL {}.{}); faces {}^2, {} steps, {} repeats\n", gl.renderer,
-             gl.major_version, gl.minor_version, face, steps, repeats + 1);
+  fmt::print(
+      "renderer: {} (GL {}.{}); faces {}^2, {} steps, {} hints x {} substeps, RR replace {}, "
+      "{} repeats\n",
+      gl.renderer, gl.major_version, gl.minor_version, face, steps, hints, hint_substeps,
+      rr_replace ? 1 : 0, repeats + 1);
   fmt::print("{:>5} {:>5} {:>5} | {:>8} {:>8} {:>8} {:>8} {:>7} {:>8} | {:>8} {:>6}\n", "size",
              "views", "mode", "first ms", "median", "min", "max", "Mpix/s", "cpu-time", "peer ms",
              "GL/CPU");
@@ -110,6 +121,9 @@ int main(int argc, char** argv) {
         RenderOptions o;
         o.steps = steps;
         o.rr = rr;
+        o.surface_hints = hints;
+        o.surface_hint_substeps = hint_substeps;
+        o.rr_replace_view_reflection = rr_replace;
         o = *march_range_for(up->layout, cam.position, o);
         Expected<std::unique_ptr<GlRenderer>> r = GlRenderer::make(**gv, o);
         if (!r.ok()) {

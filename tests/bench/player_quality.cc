@@ -24,8 +24,10 @@
 //                        [--steps N] [--threads N] [--variants plain,rr] [--out DIR] ...
 // Every RenderOptions knob has an option (--help). PSNR / SSIM are image_compare.h's
 // (sRGB-encoded, clamped; SSIM on luma); per pose, then mean and worst pose. "depth ok" is the
-// share of pixels whose depth is within 2 % of the reference's (or sky in both). The commands
-// that produced docs/RENDERING.md's tables are listed there.
+// share of pixels whose depth is within 2 % of the reference's (or sky in both). --breakdown
+// splits the squared error by what the ground truth shows at each pixel (sky, grown, hole, edge,
+// wrong depth, surface, mirror, glass; see ErrorClass). The commands that produced
+// docs/RENDERING.md's tables are listed there.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -214,6 +216,105 @@ RenderedImage box_down(const RenderedImage& in, uint32_t k) {
 }
 
 uint32_t g_supersample = 1;
+bool g_breakdown = false;
+
+// Where the squared error of a reconstruction sits, by what the ground truth shows at each pixel
+// (--breakdown; docs/RENDERING.md "Quality"):
+//   sky         ground truth sky, reconstruction sky
+//   grown       ground truth sky, reconstruction a surface (an object grown into the sky)
+//   hole        ground truth a surface, reconstruction sky (a thin part or an edge lost)
+//   edge        both a surface, depth within 2 %, and the ground truth has a depth edge (sky or a
+//               depth step > 5 %) among its 8 neighbours: silhouettes and occlusion boundaries
+//   wrong depth both a surface, depth off by > 2 % (a different surface: edge-on parts, fill-in)
+//   surface     the rest: the right surface away from edges (shading, texture, noise)
+//   mirror      `surface` pixels whose point a view with material sees as reflective only
+//   glass       ... as refractive (mirror-box's spheres): the view-dependent part
+enum ErrorClass { kSky, kGrown, kHole, kEdge, kWrongDepth, kSurface, kMirror, kGlass, kClassCount };
+const char* const kClassNames[kClassCount] = {"sky",         "grown",   "hole",   "edge",
+                                              "wrong depth", "surface", "mirror", "glass"};
+
+struct Breakdown {
+  double pixels[kClassCount] = {};
+  double se[kClassCount] = {};  // squared error of the sRGB-encoded, clamped values
+};
+
+// kMirror / kGlass when the ground-truth point in direction `dir` at `depth` from `eye` is
+// reflective / refractive according to the first view with material that sees it (depth within
+// 2 %), else kSurface.
+ErrorClass specular_class(const ViewSet& views, const Vec3& eye, const Vec3& dir, double depth) {
+  const Vec3 q{eye.x + dir.x * depth, eye.y + dir.y * depth, eye.z + dir.z * depth};
+  for (const View& v : views.views) {
+    if (!v.has_material()) continue;
+    const Vec3 x{q.x - v.position().x, q.y - v.position().y, q.z - v.position().z};
+    const double r = std::sqrt(x.x * x.x + x.y * x.y + x.z * x.z);
+    const Texel t = texel_from_direction({x.x, x.y, x.z}, v.face_size());
+    const uint16_t code = v.depth_code_at(t.face, t.x, t.y);
+    if (code == kLog16Sky || std::fabs(v.range().decode(code) / r - 1) > 0.02) continue;
+    const Material m = v.material_at(t.face, t.x, t.y);
+    return m.refract > 0 ? kGlass : m.reflect > 0 ? kMirror : kSurface;
+  }
+  return kSurface;
+}
+
+void add_breakdown(const RenderedImage& img, const RenderedImage& ref, const ViewSet& views,
+                   const Camera& cam, Breakdown* b) {
+  const uint32_t w = ref.width, h = ref.height;
+  const auto encoded = [](float linear) {
+    return srgb_from_linear(std::clamp(linear, 0.0f, 1.0f));
+  };
+  for (uint32_t j = 0; j < h; ++j) {
+    for (uint32_t i = 0; i < w; ++i) {
+      const size_t k = size_t{j} * w + i;
+      double se = 0;
+      for (int c = 0; c < 3; ++c) {
+        const double d = encoded(img.color[3 * k + c]) - encoded(ref.color[3 * k + c]);
+        se += d * d;
+      }
+      const float zr = ref.depth[k], zi = img.depth[k];
+      ErrorClass cls;
+      if (std::isinf(zr)) {
+        cls = std::isinf(zi) ? kSky : kGrown;
+      } else if (std::isinf(zi)) {
+        cls = kHole;
+      } else if (std::fabs(zi / zr - 1) > 0.02f) {
+        cls = kWrongDepth;
+      } else {
+        bool edge = false;
+        for (int dj = -1; dj <= 1 && !edge; ++dj) {
+          for (int di = -1; di <= 1 && !edge; ++di) {
+            const int64_t x = int64_t{i} + di, y = int64_t{j} + dj;
+            if (x < 0 || y < 0 || x >= w || y >= h) continue;
+            const float zn = ref.depth[size_t(y) * w + size_t(x)];
+            edge = std::isinf(zn) || std::fabs(zn / zr - 1) > 0.05f;
+          }
+        }
+        cls = edge ? kEdge : specular_class(views, cam.position, camera_ray(cam, i, j), zr);
+      }
+      b->pixels[cls] += 1;
+      b->se[cls] += se;
+    }
+  }
+}
+
+// Per class: share of pixels, share of the squared error, and the PSNR the image would have if
+// only that class's error remained.
+void print_breakdown(const std::string& name, const Breakdown& b) {
+  double pixels = 0, se = 0;
+  for (int c = 0; c < kClassCount; ++c) {
+    pixels += b.pixels[c];
+    se += b.se[c];
+  }
+  std::printf(
+      "\n%s error by ground-truth pixel class (PSNR if only this class's error remained):\n\n"
+      "| class | pixels | share of squared error | PSNR alone |\n|---|---|---|---|\n",
+      name.c_str());
+  for (int c = 0; c < kClassCount; ++c) {
+    if (b.pixels[c] == 0) continue;
+    const double alone = b.se[c] > 0 ? 10 * std::log10(3 * pixels / b.se[c]) : INFINITY;
+    std::printf("| %s | %.2f %% | %.1f %% | %.2f dB |\n", kClassNames[c],
+                100 * b.pixels[c] / pixels, 100 * b.se[c] / se, alone);
+  }
+}
 
 struct Variant {
   std::string name;
@@ -233,6 +334,7 @@ std::vector<Score> measure(const char* section, std::vector<Pose>& poses, FrameC
   for (size_t i = 0; i < variants.size(); ++i) std::printf("---|---|---|---|");
   std::printf("\n");
   std::vector<Score> mean(variants.size()), worst(variants.size(), Score{INFINITY, INFINITY, 0, 0});
+  std::vector<Breakdown> breakdown(variants.size());
   Score mean_360;
   for (size_t pi = 0; pi < poses.size(); ++pi) {
     Pose& p = poses[pi];
@@ -265,6 +367,9 @@ std::vector<Score> measure(const char* section, std::vector<Pose>& poses, FrameC
       s.psnr = need(psnr(rgb_ref(img), rgb_ref(reference)));
       s.ssim = need(ssim(rgb_ref(img), rgb_ref(reference)));
       s.depth_ok = depth_ok_share(img, reference);
+      if (g_breakdown && g_supersample == 1) {
+        add_breakdown(img, reference, views, cam, &breakdown[vi]);
+      }
       std::printf(" %.2f | %.4f | %.1f%% | %.0f |", s.psnr, s.ssim, 100 * s.depth_ok, s.ms);
       mean[vi].psnr += s.psnr / poses.size();
       mean[vi].ssim += s.ssim / poses.size();
@@ -302,6 +407,11 @@ std::vector<Score> measure(const char* section, std::vector<Pose>& poses, FrameC
   if (with_360) std::printf(" | |");
   for (const Score& s : worst) std::printf(" %.2f | %.4f | | |", s.psnr, s.ssim);
   std::printf("\n");
+  if (g_breakdown && g_supersample == 1) {
+    for (size_t vi = 0; vi < variants.size(); ++vi) {
+      print_breakdown(std::string(section) + " " + variants[vi].name, breakdown[vi]);
+    }
+  }
   return mean;
 }
 
@@ -330,11 +440,8 @@ int main(int argc, char** argv) {
                "bench-player_quality"};
   std::string capture_dir, eye_path_file, vp_gt_file, write_vp_file, out_dir, poses_arg;
   std::string variants_arg = "plain,rr", active_arg;
-  // The tuned configuration of docs/RENDERING.md "Quality": RenderOptions' defaults plus the two
-  // additions that are off by default until the GL renderer has them.
+  // RenderOptions' defaults: the tuned configuration of docs/RENDERING.md "Quality".
   RenderOptions base;
-  base.surface_hints = 1;
-  base.rr_replace_view_reflection = true;
   bool no_reproject = false;
   app.add_option("--capture", capture_dir, "capture set directory (manifest.json)")->required();
   app.add_option("--eye-path", eye_path_file,
@@ -359,6 +466,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--hint-vetoes", base.surface_hint_vetoes, "surface_hint_vetoes")
       ->capture_default_str();
+  app.add_option("--hint-substeps", base.surface_hint_substeps, "surface_hint_substeps")
+      ->capture_default_str();
   app.add_option("--bilinear", base.bilinear_color, "bilinear_color (0/1)")->capture_default_str();
   app.add_option("--rr-replace", base.rr_replace_view_reflection, "rr_replace_view_reflection")
       ->capture_default_str();
@@ -373,6 +482,9 @@ int main(int argc, char** argv) {
                  "reconstructions rendered at that size (1..8)")
       ->capture_default_str();
   app.add_flag("--no-reproject", no_reproject, "skip the vp-reproj measurement");
+  app.add_flag("--breakdown", g_breakdown,
+               "print where the squared error sits: sky, grown, hole, edge, wrong depth, surface, "
+               "mirror, glass pixels (not with --supersample)");
   app.add_option("--out", out_dir, "write renders, references and heat maps (PNG) here");
   CLI11_PARSE(app, argc, argv);
 
@@ -427,12 +539,12 @@ int main(int argc, char** argv) {
   std::printf(
       "## %s: %zu views, face %u, %u frames; steps %u, refine %u, footprint %.2f, smooth "
       "%.2f, depth_decay %.0f, cam_decay %.0f, colour tolerance %.2f, tight start %d, "
-      "hints %u (margin %.3f, vetoes %u), rr_start %.3f, rr replace %d, supersample %u, "
-      "threads %u\n",
+      "hints %u (margin %.3f, vetoes %u, substeps %u), rr_start %.3f, rr replace %d, "
+      "supersample %u, threads %u\n",
       m.scene.c_str(), m.viewpoints.size(), m.face_size, m.frame_count, base.steps,
       base.refine_steps, base.depth_footprint, base.smooth_depth_ratio, base.depth_decay,
       base.cam_decay, base.color_depth_tolerance, base.tight_march_start, base.surface_hints,
-      base.surface_hint_margin, base.surface_hint_vetoes, base.rr_start,
+      base.surface_hint_margin, base.surface_hint_vetoes, base.surface_hint_substeps, base.rr_start,
       base.rr_replace_view_reflection, g_supersample, base.threads);
   FrameCache frames(reader);
   if (!between.empty()) measure("between", between, frames, m, variants, out_dir, false);

@@ -1,17 +1,20 @@
 // The GL ray-march renderer (calf/player/gl_renderer.h) against the CPU reference on the same
 // views, under OSMesa (llvmpipe): PSNR between the two images of the same frame >= 45 dB and the
-// same hit distances, for plain and RR rendering, nearest and bilinear colour, one, several and a
-// subset of views, HDR colour, every depth-test variant; determinism; option and camera errors.
+// same hit distances, for plain and RR rendering (Alg. 4 and with the view's reflection replaced),
+// nearest and bilinear colour, one, several and a subset of views, HDR colour, every depth-test
+// variant, surface hints; determinism; option and camera errors.
 // Renders stay at <= 128^2 with few views: llvmpipe is slow. Figures are printed for the report.
 #include "calf/player/gl_renderer.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "../player/synthetic_scene.h"
 #include "calf/player/cpu_renderer.h"
@@ -29,8 +32,12 @@ using testing::Scene;
 constexpr double kPi = 3.141592653589793;
 // GL and CPU images of the same frame differ by float rounding only: 68-90 dB on every scene here.
 // The brief's acceptance bound is 45 dB; this second bound catches algorithmic slips that 45 dB
-// would let through.
+// would let through. It is taken over the pixels where both renderers hit the same surface:
+// float and double can land on different sides of a threshold decision (a hint crossing
+// confirmed by a margin, a texel boundary), and such a ray then shows another surface. Those
+// isolated flips are bounded separately (kMaxFlipShare).
 constexpr double kFloatAgreementDb = 65;
+constexpr double kMaxFlipShare = 0.001;
 
 // One OSMesa context for the whole test program (contexts are expensive under llvmpipe).
 OsMesaContext* context() {
@@ -59,6 +66,8 @@ double psnr_vs(const std::vector<float>& ref, const std::vector<float>& test) {
 struct Comparison {
   double psnr = 0;         // GL against CPU
   double depth_agree = 0;  // share of pixels with the same sky / hit and depth within 0.1 %
+  double psnr_same_hit = 0;  // GL against CPU over those pixels
+  size_t flips = 0;          // the other pixels
   size_t hits = 0;         // pixels the CPU renderer saw a surface at
   RenderedImage gl, cpu;
 };
@@ -96,12 +105,33 @@ Comparison compare(const ViewSet& views, const Camera& cam, RenderOptions o) {
     agree += std::isinf(a) ? std::isinf(b) && b > 0 : std::fabs(b / a - 1) < 1e-3;
   }
   c.depth_agree = static_cast<double>(agree) / c.cpu.depth.size();
+  c.flips = c.cpu.depth.size() - agree;
+  std::vector<float> same_cpu, same_gl;
+  for (size_t k = 0; k < c.cpu.depth.size(); ++k) {
+    const float a = c.cpu.depth[k], b = c.gl.depth[k];
+    if (std::isinf(a) ? !(std::isinf(b) && b > 0) : !(std::fabs(b / a - 1) < 1e-3)) continue;
+    for (int ch = 0; ch < 3; ++ch) {
+      same_cpu.push_back(c.cpu.color[3 * k + ch]);
+      same_gl.push_back(c.gl.color[3 * k + ch]);
+    }
+  }
+  c.psnr_same_hit = same_cpu.empty() ? 0 : psnr_vs(same_cpu, same_gl);
   return c;
 }
 
 void report(const char* what, const Comparison& c) {
-  std::printf("%-44s GL vs CPU PSNR %6.2f dB, depth agrees on %.2f %% (%zu hits)\n", what, c.psnr,
-              100 * c.depth_agree, c.hits);
+  std::printf(
+      "%-44s GL vs CPU PSNR %6.2f dB (%6.2f dB on the same hits), depth agrees on %.2f %% "
+      "(%zu hits)\n",
+      what, c.psnr, c.psnr_same_hit, 100 * c.depth_agree, c.hits);
+}
+
+// The float-rounding bound: kFloatAgreementDb where both hit the same surface, and at most
+// kMaxFlipShare of the pixels (and at least one allowed) on different surfaces.
+void expect_float_agreement(const Comparison& c, const std::string& what = "") {
+  EXPECT_GE(c.psnr_same_hit, kFloatAgreementDb) << what;
+  EXPECT_LE(c.flips, std::max<size_t>(1, static_cast<size_t>(kMaxFlipShare * c.cpu.depth.size())))
+      << what;
 }
 
 Camera between_views_camera(uint32_t size) {
@@ -120,7 +150,7 @@ TEST(GlRenderer, MatchesCpuBetweenViewpoints) {
   const Comparison c = compare(views, cam, {});
   report("8 views, 128^2, defaults", c);
   EXPECT_GE(c.psnr, 45.0);
-  EXPECT_GE(c.psnr, kFloatAgreementDb);
+  expect_float_agreement(c);
   EXPECT_GE(c.depth_agree, 0.995);
   EXPECT_GE(c.hits, size_t{cam.width} * cam.height * 9 / 10);
 }
@@ -180,6 +210,18 @@ TEST(GlRenderer, MatchesCpuForColourAndDepthTestVariants) {
   o.min_view_distance = 0.6;
   o.depth_decay = 10;
   variants.push_back({"min_view_distance 0.6, depth_decay 10", o});
+  o = {};
+  o.surface_hints = 0;
+  variants.push_back({"no surface hints (the paper's march)", o});
+  o = {};
+  o.surface_hint_substeps = 1;
+  variants.push_back({"surface hints tested at the samples only", o});
+  o = {};
+  o.surface_hints = 3;
+  o.surface_hint_vetoes = 0;
+  o.surface_hint_margin = 0.02;
+  o.steps = 12;  // coarse steps: many thin parts are found by the hints alone
+  variants.push_back({"surface hints 3, 0 vetoes, margin 0.02, 12 steps", o});
   variants.push_back({"defaults", {}});
   for (const Variant& v : variants) {
     const Comparison c = compare(views, cam, v.o);
@@ -187,9 +229,44 @@ TEST(GlRenderer, MatchesCpuForColourAndDepthTestVariants) {
     EXPECT_GE(c.psnr, 45.0) << v.name;
     // The two differ by float rounding only (measured 74-88 dB): far below 70 dB something
     // differs in the algorithm itself.
-    EXPECT_GE(c.psnr, kFloatAgreementDb) << v.name;
+    expect_float_agreement(c, v.name);
     EXPECT_GE(c.depth_agree, 0.99) << v.name;
   }
+}
+
+// Surface hints (RenderOptions::surface_hints) with coarse steps, where the plain march steps over
+// thin parts and the hints find them: the hints change the image (else agreement would prove
+// nothing), and GL follows the CPU with them, also with several hints, no vetoes and an eye on a
+// viewpoint (the hint view is then the view at the eye).
+TEST(GlRenderer, MatchesCpuWithSurfaceHints) {
+  REQUIRE_GL();
+  const ViewSet views = tinted_views(40);
+  Camera cam = between_views_camera(80);
+  RenderOptions o;
+  o.steps = 6;
+  o.surface_hints = 0;
+  const Comparison plain = compare(views, cam, o);
+  o.surface_hints = 1;
+  const Comparison hinted = compare(views, cam, o);
+  report("6 steps, surface hints 1", hinted);
+  EXPECT_LT(psnr_vs(hinted.cpu.color, plain.cpu.color), 40.0);
+  expect_float_agreement(hinted);
+  EXPECT_GE(hinted.depth_agree, 0.99);
+  o.surface_hints = 4;
+  o.surface_hint_vetoes = 0;
+  o.surface_hint_substeps = 9;
+  const Comparison four = compare(views, cam, o);
+  report("6 steps, surface hints 4, 0 vetoes, 9 substeps", four);
+  EXPECT_LT(psnr_vs(four.cpu.color, hinted.cpu.color), 60.0);
+  expect_float_agreement(four);
+  EXPECT_GE(four.depth_agree, 0.99);
+  cam.position = views.views[2].position();
+  o = {};
+  o.surface_hints = 1;
+  const Comparison at_view = compare(views, cam, o);
+  report("surface hints 1, eye on a viewpoint", at_view);
+  expect_float_agreement(at_view);
+  EXPECT_GE(at_view.depth_agree, 0.99);
 }
 
 // One view, the eye on it: the GL image reproduces the view's own face (mirrored), like the CPU.
@@ -203,7 +280,7 @@ TEST(GlRenderer, MatchesCpuWithOneViewAtItsViewpoint) {
   const Comparison c = compare(views, cam, {});
   report("1 view, eye at the viewpoint", c);
   EXPECT_GE(c.psnr, 45.0);
-  EXPECT_GE(c.psnr, kFloatAgreementDb);
+  expect_float_agreement(c);
   EXPECT_GE(c.depth_agree, 0.99);
 }
 
@@ -221,14 +298,14 @@ TEST(GlRenderer, MatchesCpuWithActiveSubsetAndMixedFaceSizes) {
   const Comparison c = compare(views, cam, o);
   report("active views {6, 1, 3}, faces 24/32/40", c);
   EXPECT_GE(c.psnr, 45.0);
-  EXPECT_GE(c.psnr, kFloatAgreementDb);
+  expect_float_agreement(c);
   EXPECT_GE(c.depth_agree, 0.99);
   // The subset matters: all eight views give a different image.
   o.active_views.clear();
   const Comparison all = compare(views, cam, o);
   report("all 8 views, faces 24/32/40", all);
   EXPECT_GE(all.psnr, 45.0);
-  EXPECT_GE(all.psnr, kFloatAgreementDb);
+  expect_float_agreement(all);
   EXPECT_LT(psnr_vs(all.cpu.color, c.cpu.color), 45.0);
 }
 
@@ -256,10 +333,11 @@ TEST(GlRenderer, MatchesCpuWithHdrColour) {
   report("4 views, HDR colour (PSNR against peak)", c);
   EXPECT_GT(peak, 8.0f);
   EXPECT_GE(c.psnr, 45.0);
-  EXPECT_GE(c.psnr, kFloatAgreementDb);
+  expect_float_agreement(c);
 }
 
-// RR on the CPU test's mirror floor: reflection rays from the material faces.
+// RR as Alg. 4 writes it (no replacement of the view's own reflection) on the CPU test's mirror
+// floor: reflection rays from the material faces.
 TEST(GlRenderer, MatchesCpuWithRrOnAMirrorFloor) {
   REQUIRE_GL();
   Scene scene;
@@ -274,10 +352,11 @@ TEST(GlRenderer, MatchesCpuWithRrOnAMirrorFloor) {
   cam.width = cam.height = 64;
   RenderOptions o;
   o.rr = true;
+  o.rr_replace_view_reflection = false;
   const Comparison rr = compare(views, cam, o);
   report("RR, mirror floor, 4 views", rr);
   EXPECT_GE(rr.psnr, 45.0);
-  EXPECT_GE(rr.psnr, kFloatAgreementDb);
+  expect_float_agreement(rr);
   EXPECT_GE(rr.depth_agree, 0.99);
   // Reflections changed the image (the floor shows the room, not its own colour).
   o.rr = false;
@@ -289,7 +368,7 @@ TEST(GlRenderer, MatchesCpuWithRrOnAMirrorFloor) {
   const Comparison two = compare(views, cam, o);
   report("RR, 2 bounces", two);
   EXPECT_GE(two.psnr, 45.0);
-  EXPECT_GE(two.psnr, kFloatAgreementDb);
+  expect_float_agreement(two);
   ViewSet glass = make_views(scene, pos, 32, /*material=*/true);
   for (View& v : glass.views) {
     for (int f = 0; f < kCubeFaceCount; ++f) {
@@ -317,10 +396,60 @@ TEST(GlRenderer, MatchesCpuWithRrOnAMirrorFloor) {
   const Comparison g = compare(quantised, cam, o);
   report("RR, all 20 % mirror 60 % glass, 3 bounces", g);
   EXPECT_GE(g.psnr, 45.0);
-  EXPECT_GE(g.psnr, kFloatAgreementDb);
+  expect_float_agreement(g);
   // The float material renders within quantisation of it on the CPU.
   const Comparison gf = compare(glass, cam, o);
   EXPECT_GE(psnr_vs(gf.cpu.color, g.gl.color), 35.0);
+}
+
+// RR with the view's own reflection / refraction replaced by the eye's
+// (RenderOptions::rr_replace_view_reflection): twice the secondary rays, signed weights, the
+// pixel clamped at 0. It changes the image, GL follows the CPU, for 1 and 3 bounces, mirror and
+// glass, and with surface hints.
+TEST(GlRenderer, MatchesCpuWithRrViewReflectionReplaced) {
+  REQUIRE_GL();
+  Scene scene;
+  scene.room_half = 3;
+  scene.mirror_floor = true;
+  scene.spheres = {{{0.4, -2.2, -1.5}, 0.6}};
+  const std::vector<Vec3> pos = {{-0.6, 0, 0}, {0.6, 0, 0}, {0, 0.6, 0.5}, {0, -0.6, 0.5}};
+  const ViewSet views = make_views(scene, pos, 40, /*material=*/true);
+  Camera cam;
+  cam.position = {0.05, 0.1, 0.2};
+  cam.forward = {0, -0.8, -1};
+  cam.width = cam.height = 56;
+  RenderOptions o;
+  o.rr = true;
+  o.rr_replace_view_reflection = false;
+  const Comparison alg4 = compare(views, cam, o);
+  o.rr_replace_view_reflection = true;
+  const Comparison rep = compare(views, cam, o);
+  report("RR replacement, mirror floor", rep);
+  EXPECT_LT(psnr_vs(rep.cpu.color, alg4.cpu.color), 45.0);
+  expect_float_agreement(rep);
+  EXPECT_GE(rep.depth_agree, 0.99);
+  o.surface_hints = 1;
+  const Comparison hinted = compare(views, cam, o);
+  report("RR replacement + surface hints 1", hinted);
+  expect_float_agreement(hinted);
+  // Quantised glass and mirror everywhere, 3 bounces: up to 4 secondary rays per hit.
+  ViewSet quantised = make_views(scene, pos, 24, /*material=*/true);
+  for (View& v : quantised.views) {
+    for (int f = 0; f < kCubeFaceCount; ++f) {
+      std::vector<float> m(24 * 24 * 3);
+      for (size_t k = 0; k < m.size(); k += 3) {
+        m[k] = 51 / 255.0f, m[k + 1] = 153 / 255.0f, m[k + 2] = 1 + 128 / 255.0f;
+      }
+      ASSERT_TRUE(v.write_material_rect(cube_face_from_index(f), {0, 0, 24, 24}, m).ok());
+    }
+  }
+  o.surface_hints = 0;
+  o.rr_max_depth = 3;
+  cam.width = cam.height = 40;
+  const Comparison g = compare(quantised, cam, o);
+  report("RR replacement, 20 % mirror 60 % glass, 3 bounces", g);
+  expect_float_agreement(g);
+  EXPECT_GE(g.depth_agree, 0.99);
 }
 
 TEST(GlRenderer, IsDeterministicAndReusable) {
@@ -343,6 +472,23 @@ TEST(GlRenderer, IsDeterministicAndReusable) {
   ASSERT_EQ(a.color.size(), b.color.size());
   EXPECT_EQ(std::memcmp(a.color.data(), b.color.data(), a.color.size() * 4), 0);
   EXPECT_EQ(std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * 4), 0);
+  // The hint count is compiled into the shader: set_options relinks, and the result is the image
+  // of a renderer made with those options.
+  RenderOptions no_hints = o;
+  no_hints.surface_hints = 0;
+  no_hints.steps = 5;  // coarse: the hints matter
+  ASSERT_TRUE(r->set_options(no_hints).ok());
+  RenderedImage d, e, plain;
+  ASSERT_TRUE(r->render(cam, &plain).ok());
+  ASSERT_TRUE((*GlRenderer::make(*gv, no_hints))->render(cam, &e).ok());
+  EXPECT_EQ(std::memcmp(plain.color.data(), e.color.data(), plain.color.size() * 4), 0);
+  RenderOptions hints = no_hints;
+  hints.surface_hints = 2;
+  ASSERT_TRUE(r->set_options(hints).ok());
+  ASSERT_TRUE(r->render(cam, &d).ok());
+  ASSERT_TRUE((*GlRenderer::make(*gv, hints))->render(cam, &e).ok());
+  EXPECT_EQ(std::memcmp(d.color.data(), e.color.data(), d.color.size() * 4), 0);
+  EXPECT_NE(std::memcmp(d.depth.data(), plain.depth.data(), d.depth.size() * 4), 0);
 }
 
 TEST(GlRenderer, RejectsBadOptionsAndCameras) {
@@ -365,7 +511,10 @@ TEST(GlRenderer, RejectsBadOptionsAndCameras) {
   o.rr_max_depth = 9;
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
   o = {};
-  o.surface_hints = 1;  // a CPU-only experiment: refused rather than silently ignored
+  o.surface_hints = 5;
+  EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
+  o = {};
+  o.surface_hint_substeps = 0;
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
   o = {};
   o.active_views.assign(257, 0);  // more than the shader's view block holds

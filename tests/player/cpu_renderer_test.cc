@@ -162,6 +162,54 @@ TEST(CpuRenderer, ResolvesAPointOccludedInOneViewButSeenByAnother) {
   EXPECT_GE(good, occluded * 95 / 100);
 }
 
+// Thin parts: small spheres 2 units in front of the eye, 4 units before the room's back wall,
+// marched with coarse steps (8 steps over the range the views span, ~20 % of depth each), so that
+// the plain march (Alg. 4 alone) steps over most of them. Surface hints find the crossing of the
+// nearest view's surface and, tested at substeps, also the crossings a whole step would hide. The
+// found pixels have the spheres' depth (analytic ground truth), and the spheres do not grow over
+// the wall.
+TEST(CpuRenderer, SurfaceHintsFindPartsThinnerThanAStep) {
+  Scene scene;
+  for (int k = 0; k < 5; ++k)
+    scene.spheres.push_back({{-0.6 + 0.3 * k, 0.06 * k - 0.1, -2.0}, 0.04});
+  const std::vector<Vec3> pos = {{-0.5, 0, 0}, {0.5, 0, 0}, {0, 0.5, 0}, {0, -0.5, 0}};
+  const ViewSet views = make_views(scene, pos, 96);
+  Camera cam;
+  cam.position = {0.08, 0.05, 0.1};
+  cam.forward = {0, 0, -1};
+  cam.fov_y = 40 * kPi / 180;
+  cam.width = cam.height = 96;
+  const RenderedImage gt = ground_truth(scene, cam);
+  const auto found = [&](uint32_t hints, uint32_t substeps) {
+    RenderOptions o;
+    o.steps = 8;
+    o.surface_hints = hints;
+    o.surface_hint_substeps = substeps;
+    const RenderedImage img = render(views, cam, o);
+    size_t on_sphere = 0, right = 0, grown = 0;
+    for (size_t k = 0; k < gt.depth.size(); ++k) {
+      if (gt.depth[k] > 3) {
+        grown += img.depth[k] < 3;
+        continue;
+      }
+      ++on_sphere;
+      right += std::fabs(img.depth[k] / gt.depth[k] - 1) < 0.02;
+    }
+    std::printf(
+        "8 steps, %u hints, %u substeps: %zu of %zu sphere pixels found, %zu wall pixels "
+        "covered\n",
+        hints, substeps, right, on_sphere, grown);
+    EXPECT_GE(on_sphere, 100u);
+    EXPECT_LE(grown, on_sphere / 2);  // silhouettes grow by up to a pixel, not more
+    return static_cast<double>(right) / on_sphere;
+  };
+  const double plain = found(0, 1), hinted = found(1, 1), sub = found(1, 4);
+  EXPECT_LT(plain, 0.5);
+  EXPECT_GT(hinted, plain + 0.2);
+  EXPECT_GE(sub, hinted);
+  EXPECT_GE(sub, 0.7);  // the misses left are silhouette pixels of 4 cm spheres
+}
+
 TEST(CpuRenderer, ImageDoesNotDependOnThreadCount) {
   const Scene scene = room_with_spheres();
   const ViewSet views = make_views(scene, corner_views({0, 0, 0.5}, 1.0), 24);
@@ -264,6 +312,11 @@ TEST(CpuRenderer, RejectsBadOptionsAndCameras) {
   o = {};
   o.depth_decay = std::nan("");
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
+  o = {};
+  o.surface_hint_substeps = 0;
+  EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
+  o.surface_hint_substeps = 65;
+  EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
   EXPECT_EQ(CpuRenderer::make(ViewSet{}, {}).status().id(), ErrorId::kPlayerOptions);
   const CpuRenderer r = *CpuRenderer::make(views, {});
   RenderedImage img;
@@ -299,8 +352,54 @@ TEST(CpuRenderer, RrVariantBeatsPlainOnAMirrorFloor) {
   o.rr = true;
   o.rr_start = 0.05;
   const double rr = psnr(render(views, cam, o).color, gt.color);
-  std::printf("mirror floor between viewpoints: plain %.2f dB, RR %.2f dB\n", plain, rr);
+  o.rr_replace_view_reflection = false;
+  const double alg4 = psnr(render(views, cam, o).color, gt.color);
+  std::printf(
+      "mirror floor between viewpoints: plain %.2f dB, RR %.2f dB (Alg. 4 as written "
+      "%.2f dB)\n",
+      plain, rr, alg4);
   EXPECT_GT(rr, plain - 0.5);
+  EXPECT_GT(rr, alg4 - 0.5);
+}
+
+// At a viewpoint the eye's and the view's secondary rays coincide, so replacing the view's own
+// reflection leaves the view's image: RR with replacement reproduces the mirror floor as the view
+// captured it, where Alg. 4 as written counts the reflection the view captured twice. Colours stay
+// non-negative (the pixel is clamped).
+TEST(CpuRenderer, RrReplacementReproducesTheViewAtItsViewpoint) {
+  Scene scene;
+  scene.room_half = 3;
+  scene.mirror_floor = true;
+  scene.spheres = {{{0.4, -2.2, -1.5}, 0.6}};
+  constexpr uint32_t n = 48;
+  const std::vector<Vec3> pos = {{-0.6, 0, 0}, {0.6, 0, 0}, {0, 0.6, 0.5}, {0, -0.6, 0.5}};
+  const ViewSet views = make_views(scene, pos, n, /*material=*/true);
+  Camera cam;
+  cam.position = pos[0];
+  cam.forward = {0, -1, 0};  // the -Y face: the mirror floor
+  cam.up = {0, 0, -1};
+  cam.width = cam.height = n;
+  cam.fov_y = kPi / 2;
+  // The eye's frame: right = forward x up = (1, 0, 0), up (0, 0, -1): pixel (i, j) looks along
+  // (a, -1, b), the -Y face's texel (i, n - 1 - j) (s = x, t = -z on that face).
+  std::vector<float> want;
+  for (uint32_t j = 0; j < n; ++j) {
+    for (uint32_t i = 0; i < n; ++i) {
+      const float* c = views.views[0].color_at(CubeFace::kNegY, i, n - 1 - j);
+      want.insert(want.end(), c, c + 3);
+    }
+  }
+  RenderOptions o;
+  o.rr = true;
+  const RenderedImage replaced = render(views, cam, o);
+  o.rr_replace_view_reflection = false;
+  const RenderedImage alg4 = render(views, cam, o);
+  const double p_replaced = psnr(replaced.color, want), p_alg4 = psnr(alg4.color, want);
+  std::printf("RR at a viewpoint against the view's face: replacement %.2f dB, Alg. 4 %.2f dB\n",
+              p_replaced, p_alg4);
+  EXPECT_GE(p_replaced, 40.0);
+  EXPECT_LT(p_alg4, p_replaced - 10);
+  for (float c : replaced.color) ASSERT_GE(c, 0.0f);
 }
 
 }  // namespace

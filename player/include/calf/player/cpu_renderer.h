@@ -16,10 +16,10 @@
 // final interval. No hit up to far: the ray sees the sky. Two additions (docs/RENDERING.md,
 // "Quality"): the march starts at max_j (z_near_j - |o - P_j|), before which every point is empty
 // (`tight_march_start`), and the view nearest the ray origin acts as a surface hint: where it sees
-// one empty sample in front of its surface and the next behind it, the crossing of its surface
-// is a hit unless more than `surface_hint_vetoes` views see it as empty beyond a small margin,
-// which finds parts thinner than a step (`surface_hints`, off by default until the GL renderer
-// has it).
+// one point in front of its surface and the next behind it (tested at `surface_hint_substeps`
+// points per step), the crossing of its surface is a hit unless more than `surface_hint_vetoes`
+// views see it as empty beyond a small margin, which finds parts thinner than a step
+// (`surface_hints`, default 1).
 //
 // Colour (Alg. 4 SampleColor / CalculateColor). At the hit p each active view j contributes its
 // colour c_j in direction p - P_j with weight w_j = w_depth * w_cam:
@@ -41,8 +41,8 @@
 // from the depths around that texel, and one reflection and one refraction ray are marched from p
 // (starting `rr_start` = z_e from it) and shaded recursively up to `rr_max_depth` bounces:
 // c = w_rfl c_rfl + w_rfr c_rfr + (1 - w_rfl - w_rfr) c_diffuse; a secondary ray that hits
-// nothing takes the sky colour in its direction. With `rr_replace_view_reflection` the captured
-// colour, which already holds the capturing view's own reflection, keeps its diffuse
+// nothing takes the sky colour in its direction. With `rr_replace_view_reflection` (default) the
+// captured colour, which already holds the capturing view's own reflection, keeps its diffuse
 // part and only the reflection / refraction is swapped for the eye's (see the option).
 //
 // Deterministic: every pixel is computed independently in double precision; the image is the same
@@ -132,24 +132,30 @@ struct RenderOptions {
   // Surface hints (0..4): the march also follows this many views nearest the ray origin (the
   // "hint" views; ties by index). For a hint view, a sample is in front of its surface when its
   // nearest texel's depth in direction p - P_h is farther than |p - P_h| (or sky); a view within
-  // min_view_distance of p abstains. Where a hint view sees an empty sample in front of its
-  // surface and the next (also empty) sample behind it, the ray crossed the hint's surface in
-  // between: the crossing is located by `refine_steps` bisections on that view alone and placed
+  // min_view_distance of p abstains. Where a hint view sees one point in front of its surface
+  // and the next behind it (points: `surface_hint_substeps` per step, after an empty sample),
+  // the ray crossed the hint's surface in between: the crossing is located by `refine_steps`
+  // bisections on that view alone (within that substep) and placed
   // at the middle of the final interval, and it is the hit unless more than
   // `surface_hint_vetoes` active views see it as empty by more than the relative depth
   // `surface_hint_margin` (in code units: margin / relative_step of that view).
   // Of several hints crossing in one interval the nearest confirmed crossing wins. This finds
   // parts thinner than a step (wings, chains, leaves) that the plain march steps over, and at a
   // viewpoint puts the hit exactly on that view's surface. 0: the paper's march alone.
-  // Default 0 while the GL renderer lacks it (it refuses other values); 1 is the tuned value
-  // (docs/RENDERING.md "Quality": +7 dB at turntable's viewpoints).
-  uint32_t surface_hints = 0;
+  // Default 1, the tuned value (docs/RENDERING.md "Quality": +7 dB at turntable's viewpoints).
+  // The GL renderer compiles the count into its shader (changing it relinks the program).
+  uint32_t surface_hints = 1;
   double surface_hint_margin = 0.005;
   // How many views may see a hint crossing as empty space beyond the margin without refuting
   // it (0..65536). Thin parts are often carved away by one view whose texels straddle them; a
   // crossing that is really empty space (the shadow edge, seen from the hint view, of an object
   // in front) is refuted by several views. Counted views are the footprint test's (empty_at).
   uint32_t surface_hint_vetoes = 1;
+  // The hint views are tested at this many evenly spaced points per step (1..64; 1 = at the
+  // samples only), one texel fetch each: a thin part whose front and back a hint view sees
+  // within one step (a silhouette grazed by the ray, a fin) shows as a crossing between two
+  // substeps. Each hint offers its first crossing of a step.
+  uint32_t surface_hint_substeps = 4;
   // Indices into the ViewSet of the views to use, in any order; empty = all views.
   std::vector<uint32_t> active_views;
   // Worker threads over image rows (1..256). The result does not depend on it.
@@ -167,9 +173,10 @@ struct RenderOptions {
   // reflection / refraction (traced from its viewpoint through the same surface point and normal)
   // replaced by the eye's, c = c_view + w_rfl (c_rfl,eye - c_rfl,view) + w_rfr (...), so at a
   // viewpoint the view is reproduced and elsewhere only the view-dependent part moves. false:
-  // Alg. 4 as written, c = w_rfl c_rfl + w_rfr c_rfr + (1 - w_rfl - w_rfr) c_blend. Default false
-  // while the GL renderer lacks it; true is the tuned value (docs/RENDERING.md "Quality").
-  bool rr_replace_view_reflection = false;
+  // Alg. 4 as written, c = w_rfl c_rfl + w_rfr c_rfr + (1 - w_rfl - w_rfr) c_blend. The pixel
+  // is clamped at 0 (the differences may make it negative). Default true, the tuned value
+  // (docs/RENDERING.md "Quality").
+  bool rr_replace_view_reflection = true;
 };
 
 // A rendered frame: linear RGB float (3 per pixel, HDR kept) and the radial distance from the eye

@@ -16,7 +16,9 @@
 // Differences from the CPU reference, all below the test's bound: the GPU computes in float (the
 // CPU in double), in coordinates relative to the eye (so precision does not depend on where the
 // scene sits); the RR variant walks its ray tree with an explicit stack instead of recursion (the
-// sum is the same, its order differs). Images are deterministic for a given driver.
+// sum is the same, its order differs). Images are deterministic for a given driver. Isolated rays
+// can differ where float and double fall on different sides of a threshold decision (a hint
+// crossing confirmed by its margin, the view that weighs most); tests/integration bound both.
 //
 // All calls need the GL context of the GlViews to be current.
 #pragma once
@@ -47,8 +49,10 @@ class GlRenderer {
   GlRenderer(const GlRenderer&) = delete;
   GlRenderer& operator=(const GlRenderer&) = delete;
 
-  // New options for the next frames (active views, march range, ...); nothing is recompiled.
-  // Errors as make(); the old options stay on error.
+  // New options for the next frames (active views, march range, ...). Nothing is recompiled,
+  // except when surface_hints changes: the hint count is compiled into the shader (its per-hint
+  // state then stays in registers; llvmpipe's first frame after it pays the compile, ~2 s).
+  // Errors as make(); the old options (and program) stay on error.
   Status set_options(const RenderOptions& options);
   const RenderOptions& options() const { return options_; }
 
