@@ -1,0 +1,48 @@
+// calf-bench: which points a scene's sweep measures. The base configuration first, then for each
+// chosen knob the base with that knob set to each of its values; a value that gives the base
+// configuration again (Q 50, cell 32, ...) is not measured twice: its table row is the base
+// point's.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "sweep.h"
+
+namespace calf::bench {
+
+// The values each knob takes, and the base they vary around.
+struct SweepValues {
+  EncodeConfig base_encode;  // calf-encode's defaults, with cell 32
+  PlayConfig base_play;      // calf-play's defaults (9 views, 64 steps)
+  std::vector<Knob> knobs;   // which knobs to sweep (table order is all_knobs()'s)
+  std::vector<double> q = {35, 40, 45, 50, 55};
+  std::vector<uint32_t> cells = {16, 32, 64};
+  std::vector<uint32_t> windows = {1, 2, 4};
+  std::vector<uint32_t> aabbs = {1, 2, 4};
+  std::vector<DepthCoding> depth = {DepthCoding::kRaw16, DepthCoding::kBc5};
+  std::vector<ColourCoding> colour = {ColourCoding::kAuto, ColourCoding::kBc1, ColourCoding::kBc7};
+  std::vector<container::Compression> super = {container::Compression::kZstd,
+                                               container::Compression::kLzma2};
+  std::vector<uint32_t> views = {1, 2, 4, 0};  // 0 = all of the scene's views
+  std::vector<uint32_t> steps = {16, 32, 64, 128};
+};
+
+// A scene's points and, per knob, the rows of its table (indices into `points`, in the order of
+// the knob's values; the base point's index where a value is the base's).
+struct ScenePlan {
+  std::vector<SweepPoint> points;  // points[0] is the base
+  std::vector<std::pair<Knob, std::vector<size_t>>> tables;
+};
+
+// The plan for a scene with `view_count` viewpoints (the view knob's "all" and values above the
+// count become the count).
+ScenePlan plan_scene(const SweepValues& values, uint32_t view_count);
+
+// Parses a comma-separated knob list ("q,cell,views" or "all"); the error names the bad item
+// and lists the known knobs.
+bool parse_knobs(const std::string& text, std::vector<Knob>* out, std::string* error);
+
+}  // namespace calf::bench
