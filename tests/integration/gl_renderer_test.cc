@@ -336,20 +336,48 @@ TEST(GlRenderer, MatchesCpuWithHdrColour) {
   expect_float_agreement(c);
 }
 
+// The RR tests' room: a mirror floor and one sphere, four views around the eye, which looks down
+// at the floor from between them.
+struct MirrorFloorRoom {
+  Scene scene;
+  std::vector<Vec3> positions;
+  Camera camera;
+};
+
+MirrorFloorRoom mirror_floor_room(uint32_t eye_size) {
+  MirrorFloorRoom room;
+  room.scene.room_half = 3;
+  room.scene.mirror_floor = true;
+  room.scene.spheres = {{{0.4, -2.2, -1.5}, 0.6}};
+  room.positions = {{-0.6, 0, 0}, {0.6, 0, 0}, {0, 0.6, 0.5}, {0, -0.6, 0.5}};
+  room.camera.position = {0.05, 0.1, 0.2};
+  room.camera.forward = {0, -0.8, -1};
+  room.camera.width = room.camera.height = eye_size;
+  return room;
+}
+
+// Views of the room whose every material texel is (reflect, refract, ior): mirror and glass
+// everywhere.
+ViewSet views_with_uniform_material(const MirrorFloorRoom& room, uint32_t face, float reflect,
+                                    float refract, float ior) {
+  ViewSet views = make_views(room.scene, room.positions, face, /*material=*/true);
+  std::vector<float> m(size_t{face} * face * 3);
+  for (size_t k = 0; k < m.size(); k += 3) m[k] = reflect, m[k + 1] = refract, m[k + 2] = ior;
+  for (View& v : views.views) {
+    for (int f = 0; f < kCubeFaceCount; ++f) {
+      EXPECT_TRUE(v.write_material_rect(cube_face_from_index(f), {0, 0, face, face}, m).ok());
+    }
+  }
+  return views;
+}
+
 // RR as Alg. 4 writes it (no replacement of the view's own reflection) on the CPU test's mirror
 // floor: reflection rays from the material faces.
 TEST(GlRenderer, MatchesCpuWithRrOnAMirrorFloor) {
   REQUIRE_GL();
-  Scene scene;
-  scene.room_half = 3;
-  scene.mirror_floor = true;
-  scene.spheres = {{{0.4, -2.2, -1.5}, 0.6}};
-  const std::vector<Vec3> pos = {{-0.6, 0, 0}, {0.6, 0, 0}, {0, 0.6, 0.5}, {0, -0.6, 0.5}};
-  const ViewSet views = make_views(scene, pos, 48, /*material=*/true);
-  Camera cam;
-  cam.position = {0.05, 0.1, 0.2};
-  cam.forward = {0, -0.8, -1};
-  cam.width = cam.height = 64;
+  const MirrorFloorRoom room = mirror_floor_room(64);
+  const ViewSet views = make_views(room.scene, room.positions, 48, /*material=*/true);
+  Camera cam = room.camera;
   RenderOptions o;
   o.rr = true;
   o.rr_replace_view_reflection = false;
@@ -369,28 +397,11 @@ TEST(GlRenderer, MatchesCpuWithRrOnAMirrorFloor) {
   report("RR, 2 bounces", two);
   EXPECT_GE(two.psnr, 45.0);
   expect_float_agreement(two);
-  ViewSet glass = make_views(scene, pos, 32, /*material=*/true);
-  for (View& v : glass.views) {
-    for (int f = 0; f < kCubeFaceCount; ++f) {
-      std::vector<float> m(32 * 32 * 3);
-      for (size_t k = 0; k < m.size(); k += 3) {
-        m[k] = 0.2f, m[k + 1] = 0.6f, m[k + 2] = 1.5f;
-      }
-      ASSERT_TRUE(v.write_material_rect(cube_face_from_index(f), {0, 0, 32, 32}, m).ok());
-    }
-  }
+  const ViewSet glass = views_with_uniform_material(room, 32, 0.2f, 0.6f, 1.5f);
   // The CPU keeps the float material; the GL state holds its 8-bit codes. Give the CPU the same
   // quantised values (0.2 -> 51/255, 0.6 -> 153/255, ior 1.5 -> code 64 -> 1 + 128/255).
-  ViewSet quantised = make_views(scene, pos, 32, /*material=*/true);
-  for (View& v : quantised.views) {
-    for (int f = 0; f < kCubeFaceCount; ++f) {
-      std::vector<float> m(32 * 32 * 3);
-      for (size_t k = 0; k < m.size(); k += 3) {
-        m[k] = 51 / 255.0f, m[k + 1] = 153 / 255.0f, m[k + 2] = 1 + 128 / 255.0f;
-      }
-      ASSERT_TRUE(v.write_material_rect(cube_face_from_index(f), {0, 0, 32, 32}, m).ok());
-    }
-  }
+  const ViewSet quantised =
+      views_with_uniform_material(room, 32, 51 / 255.0f, 153 / 255.0f, 1 + 128 / 255.0f);
   o.rr_max_depth = 3;  // every hit spawns two rays: up to 8 leaves per pixel
   cam.width = cam.height = 48;
   const Comparison g = compare(quantised, cam, o);
@@ -408,16 +419,9 @@ TEST(GlRenderer, MatchesCpuWithRrOnAMirrorFloor) {
 // glass, and with surface hints.
 TEST(GlRenderer, MatchesCpuWithRrViewReflectionReplaced) {
   REQUIRE_GL();
-  Scene scene;
-  scene.room_half = 3;
-  scene.mirror_floor = true;
-  scene.spheres = {{{0.4, -2.2, -1.5}, 0.6}};
-  const std::vector<Vec3> pos = {{-0.6, 0, 0}, {0.6, 0, 0}, {0, 0.6, 0.5}, {0, -0.6, 0.5}};
-  const ViewSet views = make_views(scene, pos, 40, /*material=*/true);
-  Camera cam;
-  cam.position = {0.05, 0.1, 0.2};
-  cam.forward = {0, -0.8, -1};
-  cam.width = cam.height = 56;
+  const MirrorFloorRoom room = mirror_floor_room(56);
+  const ViewSet views = make_views(room.scene, room.positions, 40, /*material=*/true);
+  Camera cam = room.camera;
   RenderOptions o;
   o.rr = true;
   o.rr_replace_view_reflection = false;
@@ -433,16 +437,8 @@ TEST(GlRenderer, MatchesCpuWithRrViewReflectionReplaced) {
   report("RR replacement + surface hints 1", hinted);
   expect_float_agreement(hinted);
   // Quantised glass and mirror everywhere, 3 bounces: up to 4 secondary rays per hit.
-  ViewSet quantised = make_views(scene, pos, 24, /*material=*/true);
-  for (View& v : quantised.views) {
-    for (int f = 0; f < kCubeFaceCount; ++f) {
-      std::vector<float> m(24 * 24 * 3);
-      for (size_t k = 0; k < m.size(); k += 3) {
-        m[k] = 51 / 255.0f, m[k + 1] = 153 / 255.0f, m[k + 2] = 1 + 128 / 255.0f;
-      }
-      ASSERT_TRUE(v.write_material_rect(cube_face_from_index(f), {0, 0, 24, 24}, m).ok());
-    }
-  }
+  const ViewSet quantised =
+      views_with_uniform_material(room, 24, 51 / 255.0f, 153 / 255.0f, 1 + 128 / 255.0f);
   o.surface_hints = 0;
   o.rr_max_depth = 3;
   cam.width = cam.height = 40;
