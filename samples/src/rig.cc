@@ -1,7 +1,10 @@
 // Camera rigs and the --rig syntax.
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
+#include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "calf/samples/scene.h"
@@ -31,11 +34,12 @@ capture::Box3 bounds(const std::vector<capture::Viewpoint>& views) {
   return b;
 }
 
+// The shortest text that reads back as exactly v, so that a description makes the same rig
+// (std::to_string's six decimals turned 1e-300 into 0).
 std::string num(double v) {
-  std::string s = std::to_string(v);
-  while (s.size() > 1 && s.back() == '0') s.pop_back();
-  if (!s.empty() && s.back() == '.') s.pop_back();
-  return s;
+  char buf[32];
+  std::to_chars_result r = std::to_chars(buf, buf + sizeof(buf), v);
+  return std::string(buf, r.ptr);
 }
 
 // Parses a comma-separated list of finite numbers; false on anything else.
@@ -61,6 +65,27 @@ bool is_count(double v, double max) { return v >= 1 && v <= max && v == std::flo
 Status rig_error(std::string_view text, const std::string& why) {
   return Status(ErrorId::kRigSyntax, "--rig '" + std::string(text) + "': " + why +
                                          "; accepted forms:\n" + kRigSyntaxHelp);
+}
+
+// What a capture manifest requires of the rig's numbers (validate_manifest): finite positions
+// and view volume, no two viewpoints at one position. Finite arguments can still overflow
+// (box:1e308,0,0,1e308,1,1) or repeat a position (list:0,0,0/0,0,0); say so at the --rig text.
+Expected<Rig> checked_rig(std::string_view text, Rig rig) {
+  auto finite = [](const capture::Point3& p) {
+    return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+  };
+  if (!finite(rig.view_volume.min) || !finite(rig.view_volume.max)) {
+    return rig_error(text, "the view volume overflows (numbers too large)");
+  }
+  std::set<std::tuple<double, double, double>> seen;
+  for (const capture::Viewpoint& v : rig.viewpoints) {
+    if (!finite(v.position)) return rig_error(text, "a viewpoint overflows (numbers too large)");
+    if (!seen.insert({v.position.x, v.position.y, v.position.z}).second) {
+      return rig_error(text, "two viewpoints at (" + num(v.position.x) + ", " +
+                                 num(v.position.y) + ", " + num(v.position.z) + ")");
+    }
+  }
+  return rig;
 }
 
 }  // namespace
@@ -167,13 +192,13 @@ Expected<Rig> parse_rig(std::string_view text) {
       if (slash == args.npos) break;
       at = slash + 1;
     }
-    return list_rig(positions);
+    return checked_rig(text, list_rig(positions));
   }
   if (!parse_numbers(args, &v)) return rig_error(text, "expected comma-separated numbers");
   if (kind == "box") {
     if (v.size() != 6) return rig_error(text, "box takes 6 numbers");
     if (!(v[3] > 0 && v[4] > 0 && v[5] > 0)) return rig_error(text, "half-sizes must be > 0");
-    return box_rig({v[0], v[1], v[2]}, {v[3], v[4], v[5]});
+    return checked_rig(text, box_rig({v[0], v[1], v[2]}, {v[3], v[4], v[5]}));
   }
   if (kind == "ring" || kind == "sphere") {
     if (v.size() != 5) return rig_error(text, std::string(kind) + " takes 5 numbers");
@@ -181,7 +206,7 @@ Expected<Rig> parse_rig(std::string_view text) {
     if (!(v[1] > 0)) return rig_error(text, "the radius must be > 0");
     uint32_t n = static_cast<uint32_t>(v[0]);
     glm::dvec3 c(v[2], v[3], v[4]);
-    return kind == "ring" ? ring_rig(n, v[1], c) : sphere_rig(n, v[1], c);
+    return checked_rig(text, kind == "ring" ? ring_rig(n, v[1], c) : sphere_rig(n, v[1], c));
   }
   if (kind == "grid") {
     if (v.size() != 9) return rig_error(text, "grid takes 9 numbers");
@@ -197,7 +222,7 @@ Expected<Rig> parse_rig(std::string_view text) {
         return rig_error(text, "an axis with several views needs distinct ends");
       }
     }
-    return grid_rig(n, lo, hi);
+    return checked_rig(text, grid_rig(n, lo, hi));
   }
   return rig_error(text, "unknown rig kind '" + std::string(kind) + "'");
 }

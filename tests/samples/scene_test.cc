@@ -55,12 +55,35 @@ TEST(Rig, Forms) {
   ASSERT_EQ(list->viewpoints.size(), 2u);
   EXPECT_EQ(list->viewpoints[1].position, (capture::Point3{1, 1, -2.5}));
   EXPECT_EQ(list->view_volume.max, (capture::Point3{1, 1, 0}));
-  // A rig's description parses back to the same rig.
-  for (const Rig* r : {&*box, &*ring, &*sphere, &*grid, &*list}) {
+  // Numbers that six decimals would round away (a grid 1e-300 wide, a ring of radius 1e-7).
+  auto tiny = parse_rig("grid:3,1,1,0,0,0,1e-300,0,0");
+  ASSERT_TRUE(tiny.ok()) << tiny.status().to_string();
+  auto thin = parse_rig("ring:5,1e-7,0.1,0.2,0.3");
+  ASSERT_TRUE(thin.ok()) << thin.status().to_string();
+  // A rig's description parses back to the same rig, position for position.
+  for (const Rig* r : {&*box, &*ring, &*sphere, &*grid, &*list, &*tiny, &*thin}) {
     auto again = parse_rig(r->description);
     ASSERT_TRUE(again.ok()) << r->description;
-    EXPECT_EQ(again->viewpoints.size(), r->viewpoints.size());
+    EXPECT_EQ(again->viewpoints, r->viewpoints) << r->description;
+    EXPECT_EQ(again->view_volume, r->view_volume) << r->description;
+    EXPECT_EQ(again->description, r->description);
   }
+  EXPECT_EQ(box->description, "box:0,1.6,0,0.5,0.3,0.5");
+}
+
+// Finite numbers whose rig a capture manifest would refuse are --rig errors naming the problem.
+TEST(Rig, OverflowingOrRepeatedViewpointsAreSyntaxErrors) {
+  for (const char* bad : {"box:1e308,0,0,1e308,1,1", "grid:2,1,1,-1e308,0,0,1e308,0,0",
+                          "ring:4,1e308,1e308,0,0", "list:0,0,0/0,0,0", "list:1,2,3/4,5,6/1,2,3",
+                          "grid:3,1,1,0,0,0,5e-324,0,0"}) {
+    auto r = parse_rig(bad);
+    ASSERT_FALSE(r.ok()) << bad;
+    EXPECT_EQ(r.status().id(), ErrorId::kRigSyntax) << bad;
+    EXPECT_NE(r.status().message().find(bad), std::string::npos) << r.status().message();
+  }
+  auto twice = parse_rig("list:0,0,0/0,0,0");
+  EXPECT_NE(twice.status().message().find("two viewpoints at (0, 0, 0)"), std::string::npos)
+      << twice.status().message();
 }
 
 TEST(Rig, SyntaxErrors) {
