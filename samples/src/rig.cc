@@ -2,9 +2,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
-#include <set>
 #include <string>
-#include <tuple>
 #include <vector>
 
 #include "calf/samples/scene.h"
@@ -67,24 +65,16 @@ Status rig_error(std::string_view text, const std::string& why) {
                                          "; accepted forms:\n" + kRigSyntaxHelp);
 }
 
-// What a capture manifest requires of the rig's numbers (validate_manifest): finite positions
-// and view volume, no two viewpoints at one position. Finite arguments can still overflow
-// (box:1e308,0,0,1e308,1,1) or repeat a position (list:0,0,0/0,0,0); say so at the --rig text.
+// Finite arguments can still make a rig no capture set may have: an overflow to infinity
+// (box:1e308,0,0,1e308,1,1) or one position twice (list:0,0,0/0,0,0). The manifest's own rules
+// (validate_manifest) decide, reported at the --rig text rather than when the set is written.
 Expected<Rig> checked_rig(std::string_view text, Rig rig) {
-  auto finite = [](const capture::Point3& p) {
-    return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-  };
-  if (!finite(rig.view_volume.min) || !finite(rig.view_volume.max)) {
-    return rig_error(text, "the view volume overflows (numbers too large)");
-  }
-  std::set<std::tuple<double, double, double>> seen;
-  for (const capture::Viewpoint& v : rig.viewpoints) {
-    if (!finite(v.position)) return rig_error(text, "a viewpoint overflows (numbers too large)");
-    if (!seen.insert({v.position.x, v.position.y, v.position.z}).second) {
-      return rig_error(text, "two viewpoints at (" + num(v.position.x) + ", " +
-                                 num(v.position.y) + ", " + num(v.position.z) + ")");
-    }
-  }
+  capture::CaptureManifest m;
+  m.frame_count = 1;
+  m.face_size = 1;
+  m.viewpoints = rig.viewpoints;
+  m.view_volume = rig.view_volume;
+  if (Status st = capture::validate_manifest(m); !st.ok()) return rig_error(text, st.message());
   return rig;
 }
 
