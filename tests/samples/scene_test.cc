@@ -82,7 +82,8 @@ TEST(Rig, OverflowingOrRepeatedViewpointsAreSyntaxErrors) {
     EXPECT_NE(r.status().message().find(bad), std::string::npos) << r.status().message();
   }
   auto twice = parse_rig("list:0,0,0/0,0,0");
-  EXPECT_NE(twice.status().message().find("(0, 0, 0) is used by an earlier viewpoint"), std::string::npos)
+  EXPECT_NE(twice.status().message().find("(0, 0, 0) is used by an earlier viewpoint"),
+            std::string::npos)
       << twice.status().message();
 }
 
