@@ -22,9 +22,10 @@
 #include "calf/encoder/depth_aabb.h"
 #include "calf/format/bc.h"
 #include "calf/format/grid.h"
+#include "calf/format/lightfield_layout.h"
 #include "calf/format/log_depth.h"
 #include "calf/format/version.h"
-#include "calf/format/lightfield_layout.h"
+#include "lightfield_internal.h"
 
 namespace calf {
 namespace {
@@ -37,42 +38,10 @@ using container::StoredChunk;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-uint16_t pf(PixelFormat f) { return static_cast<uint16_t>(f); }
-
 // ---- Colour conversions (SPEC §11.1: 8-bit colour formats hold sRGB-encoded values) ----
 
 uint16_t half_from_colour(float v) {
   return bc::float_to_half(std::min(v, 65504.0f));  // input is validated finite and >= 0
-}
-
-// ---- Options ----
-
-Status validate(const LightfieldEncodeOptions& o) {
-  auto bad = [](const std::string& what) { return Status(ErrorId::kEncoderOption, what); };
-  if (o.cell_size < 4 || o.cell_size > kMaxFaceSize || o.cell_size % 4 != 0) {
-    return bad("--cell " + std::to_string(o.cell_size) + ": expected a multiple of 4 in [4, 16384]");
-  }
-  if (!(o.min_psnr_db > 0 && o.min_psnr_db <= 200)) {
-    return bad("--psnr " + std::to_string(o.min_psnr_db) + ": expected (0, 200] dB");
-  }
-  if (o.depth_tiles_per_side < 1 || o.depth_tiles_per_side > 64) {
-    return bad("depth tiles per side " + std::to_string(o.depth_tiles_per_side) +
-               ": expected [1, 64]");
-  }
-  if (o.depth_window < 1 || o.depth_window > 65535) {
-    return bad("--depth-window " + std::to_string(o.depth_window) + ": expected [1, 65535]");
-  }
-  if (o.max_aabbs < 1 || o.max_aabbs > 64) {
-    return bad("--max-aabbs " + std::to_string(o.max_aabbs) + ": expected [1, 64]");
-  }
-  if (o.depth_keyframe_interval < 1) {
-    return bad("--depth-keyframe-interval 0: expected >= 1");
-  }
-  if (o.threads > 1024) return bad("--threads " + std::to_string(o.threads) + ": expected [0, 1024]");
-  if (static_cast<uint16_t>(o.supercompression) >= container::kCompressionCount) {
-    return bad("unknown supercompression");
-  }
-  return Status::Ok();
 }
 
 // ---- One view in memory ----
@@ -91,7 +60,10 @@ struct ViewData {
   }
 };
 
-Status read_view(const capture::CaptureSetReader& input, uint32_t view, ViewData* out) {
+// Reads every frame of `view` and checks that the images still say what the analysis saw
+// (`expected`): the depth codes are taken in the analysis's range.
+Status read_view(const capture::CaptureSetReader& input, uint32_t view,
+                 const LightfieldViewFacts& expected, ViewData* out) {
   const capture::CaptureManifest& m = input.manifest();
   out->frames = m.frame_count;
   out->face_size = m.face_size;
@@ -100,41 +72,34 @@ Status read_view(const capture::CaptureSetReader& input, uint32_t view, ViewData
   out->material.clear();
   if (m.material) out->material.assign(out->texels * 3 * m.frame_count, 0);
   std::vector<float> depth(out->texels * m.frame_count);
-  float lo = std::numeric_limits<float>::infinity(), hi = 0;
+  lightfield_internal::ViewFactsBuilder facts;
   capture::ViewFrame vf;
-  out->has_material = false;
   for (uint32_t f = 0; f < m.frame_count; ++f) {
-    CALF_RETURN_IF_ERROR(input.read(view, f, &vf));
-    if (vf.face_size != m.face_size || vf.has_material != m.material) {
-      return Status(ErrorId::kEncoderInput, input.image_path(view, f).string() +
-                                                ": face size or material differs from the manifest");
-    }
+    CALF_RETURN_IF_ERROR(lightfield_internal::read_frame(input, view, f, &vf));
+    facts.add(vf);
     uint16_t* c = &out->colour[f * out->texels * 3];
     for (size_t i = 0; i < out->texels * 3; ++i) c[i] = half_from_colour(vf.color[i]);
-    float* d = &depth[f * out->texels];
-    for (size_t i = 0; i < out->texels; ++i) {
-      const float z = vf.depth[i];
-      d[i] = z;
-      if (std::isfinite(z)) {
-        lo = std::min(lo, z);
-        hi = std::max(hi, z);
-      }
-    }
+    std::copy(vf.depth.begin(), vf.depth.end(), &depth[f * out->texels]);
     if (m.material) {
       uint8_t* mc = &out->material[f * out->texels * 3];
       for (size_t i = 0; i < out->texels; ++i) {
         mc[3 * i] = lf::material_weight_code(vf.material[3 * i]);
         mc[3 * i + 1] = lf::material_weight_code(vf.material[3 * i + 1]);
         mc[3 * i + 2] = lf::material_ior_code(vf.material[3 * i + 2]);
-        if (mc[3 * i] != 0 || mc[3 * i + 1] != 0) out->has_material = true;
       }
     }
   }
-  out->range.reset();
+  CALF_ASSIGN_OR_RETURN(const LightfieldViewFacts seen, facts.finish());
+  if (!lightfield_internal::same_facts(seen, expected)) {
+    return Status(ErrorId::kEncoderInput,
+                  "view " + std::to_string(view) + " (" + input.image_path(view, 0).string() +
+                      ", ...): its depth range, material or HDR colour changed since the analysis");
+  }
+  out->range = expected.depth_range;
+  out->has_material = expected.has_material;
   out->depth.assign(depth.size(), kLog16Sky);
-  if (hi > 0) {
-    CALF_ASSIGN_OR_RETURN(LogDepthRange r, LogDepthRange::covering(lo, hi));
-    out->range = r;
+  if (out->range) {
+    const LogDepthRange& r = *out->range;
     for (size_t i = 0; i < depth.size(); ++i) out->depth[i] = r.encode_unchecked(depth[i]);
   }
   if (!out->has_material) out->material.clear();
@@ -166,7 +131,6 @@ struct Context {
   const LightfieldEncodeOptions* options;
   const ViewData* view;
   uint32_t view_index;
-  uint16_t track;
   ColourCoding colour;  // resolved (never kAuto)
   bool hdr;
   FaceGrid cells, tiles;
@@ -174,8 +138,7 @@ struct Context {
 
 Status add_chunk(const Context& ctx, TaskOut& out, ChunkKeys keys, const std::vector<uint8_t>& raw,
                  StreamBytes& bytes) {
-  keys.track = ctx.track;
-  keys.view = ctx.view_index;
+  keys.view = ctx.view_index;  // keys.track: set by LightfieldTrackWriter
   CALF_ASSIGN_OR_RETURN(StoredChunk c, container::compress_chunk(raw, ctx.options->supercompression,
                                                                  ctx.options->levels));
   bytes.spatial += raw.size();
@@ -555,23 +518,17 @@ void region_task(const Context& ctx, uint32_t face, uint32_t tile, bool is_depth
   }
 }
 
+double mean_rel_error(const LightfieldEncodeStats& s) {
+  return s.depth_finite_texels ? s.depth_sum_rel_error / static_cast<double>(s.depth_finite_texels)
+                               : 0;
+}
+
 void add_into(StreamBytes& a, const StreamBytes& b) {
   a.raw += b.raw;
   a.temporal += b.temporal;
   a.spatial += b.spatial;
   a.stored += b.stored;
   a.chunks += b.chunks;
-}
-
-std::pair<uint32_t, uint32_t> fps_rational(double fps) {
-  uint64_t num = static_cast<uint64_t>(std::llround(fps * 1000.0));
-  uint64_t den = 1000;
-  if (num == 0) num = 1;
-  const uint64_t g = std::gcd(num, den);
-  num /= g;
-  den /= g;
-  num = std::min<uint64_t>(num, UINT32_MAX);
-  return {static_cast<uint32_t>(num), static_cast<uint32_t>(den)};
 }
 
 }  // namespace
@@ -595,144 +552,184 @@ Status spatial_colour_reference(ColourCoding coding, std::span<const float> rgb,
   return Status::Ok();
 }
 
-Expected<LightfieldEncodeStats> encode_lightfield(const capture::CaptureSetReader& input,
-                                                  container::Writer& writer,
-                                                  const LightfieldEncodeOptions& options) {
-  CALF_RETURN_IF_ERROR(validate(options));
+Expected<LightfieldViewEncoding> encode_lightfield_view(const capture::CaptureSetReader& input,
+                                                        const LightfieldAnalysis& analysis,
+                                                        uint32_t v,
+                                                        const LightfieldEncodeOptions& options) {
+  CALF_RETURN_IF_ERROR(lightfield_internal::validate_options(options));
   const capture::CaptureManifest& m = input.manifest();
-  CALF_RETURN_IF_ERROR(input.check_files());
+  if (v >= m.viewpoints.size()) {
+    return Status(ErrorId::kEncoderInput, "view " + std::to_string(v) + " of a capture set of " +
+                                              std::to_string(m.viewpoints.size()) + " views");
+  }
+  // The analysis is a pure function of (manifest, facts, options): planning it again tells
+  // whether it belongs to this capture set and these options.
+  CALF_ASSIGN_OR_RETURN(const LightfieldAnalysis plan, plan_lightfield(m, analysis.views, options));
+  CALF_ASSIGN_OR_RETURN(const std::vector<uint8_t> planned,
+                        container::encode_track_header(plan.header));
+  CALF_ASSIGN_OR_RETURN(const std::vector<uint8_t> given,
+                        container::encode_track_header(analysis.header));
+  if (planned != given || plan.colour != analysis.colour || plan.hdr != analysis.hdr) {
+    return Status(ErrorId::kEncoderInput,
+                  "the analysis was made for another capture set or other options");
+  }
   CALF_ASSIGN_OR_RETURN(FaceGrid cells, FaceGrid::with_cell_size(m.face_size, options.cell_size));
   CALF_ASSIGN_OR_RETURN(FaceGrid tiles,
                         FaceGrid::with_tiles_per_side(m.face_size, options.depth_tiles_per_side));
 
-  // HDR or LDR: decided over the whole set (a pre-pass that also validates every image) unless
-  // the format is given. LDR input never pays for a HDR format.
-  LightfieldEncodeStats stats;
-  ColourCoding colour = options.colour;
-  if (colour == ColourCoding::kAuto) {
-    capture::ViewFrame vf;
-    bool hdr = false;
-    for (uint32_t v = 0; v < m.viewpoints.size() && !hdr; ++v) {
-      for (uint32_t f = 0; f < m.frame_count && !hdr; ++f) {
-        CALF_RETURN_IF_ERROR(input.read(v, f, &vf));
-        hdr = std::any_of(vf.color.begin(), vf.color.end(), [](float c) { return c > 1.0f; });
-      }
-    }
-    colour = hdr ? ColourCoding::kBc6h : ColourCoding::kBc1;
-  }
-  stats.hdr = colour == ColourCoding::kBc6h || colour == ColourCoding::kRgba16f;
-  switch (colour) {
-    case ColourCoding::kBc1: stats.colour_format = pf(PixelFormat::kBc1); break;
-    case ColourCoding::kBc7: stats.colour_format = pf(PixelFormat::kBc7); break;
-    case ColourCoding::kBc6h: stats.colour_format = pf(PixelFormat::kBc6h); break;
-    case ColourCoding::kRgba8: stats.colour_format = pf(PixelFormat::kRgba8); break;
-    default: stats.colour_format = pf(PixelFormat::kRgba16f); break;
-  }
-  const bool lossy_depth = options.depth == DepthCoding::kBc5;
-  stats.depth_format = pf(lossy_depth ? PixelFormat::kBc5 : PixelFormat::kR16);
-  const uint16_t material_format = pf(lossy_depth ? PixelFormat::kBc1 : PixelFormat::kRgba8);
+  LightfieldViewEncoding out;
+  out.view = v;
+  LightfieldEncodeStats& stats = out.stats;
+  stats.colour_format = analysis.header.colour_format;
+  stats.depth_format = analysis.header.depth_format;
+  stats.material_format = analysis.header.material_format;
+  stats.hdr = analysis.hdr;
+  stats.min_colour_quality_db = kInf;
+  ViewData view;
+  CALF_RETURN_IF_ERROR(read_view(input, v, analysis.views[v], &view));
+  if (view.has_material) stats.material_views += 1;
 
-  container::LightfieldTrackHeader header;
-  header.frame_count = m.frame_count;
-  std::tie(header.fps_numerator, header.fps_denominator) = fps_rational(m.fps);
-  header.view_count = static_cast<uint32_t>(m.viewpoints.size());
-  header.face_size = m.face_size;
-  header.cell_size = cells.cell_size();
-  header.depth_tile_size = tiles.cell_size();
-  header.colour_format = stats.colour_format;
-  header.depth_format = stats.depth_format;
-  header.material_format = 0;
-  header.flags = stats.hdr ? 1 : 0;
-  CALF_ASSIGN_OR_RETURN(uint16_t track, writer.add_track(header));
+  // The view's index chunk (SPEC §11.1 "View index chunk").
+  lf::ViewIndex vi;
+  vi.position[0] = m.viewpoints[v].position.x;
+  vi.position[1] = m.viewpoints[v].position.y;
+  vi.position[2] = m.viewpoints[v].position.z;
+  vi.z_near = view.range ? view.range->z_near() : 1.0f;
+  vi.z_far = view.range ? view.range->z_far() : 2.0f;
+  vi.has_depth = view.range.has_value();
+  vi.has_material = view.has_material;
+  vi.depth_keyframe_interval = options.depth_keyframe_interval;
+  vi.depth_window = options.depth_window;
+  vi.min_psnr_db = static_cast<float>(options.min_psnr_db);
+  const std::vector<uint8_t> index = lf::serialize_view_index(vi);
+  ChunkKeys ikeys;
+  ikeys.stream = static_cast<uint16_t>(LightfieldStream::kIndex);
+  ikeys.view = v;
+  CALF_ASSIGN_OR_RETURN(StoredChunk ic,
+                        container::compress_chunk(index, Compression::kNone, options.levels));
+  stats.index_bytes += ic.bytes.size();
+  out.chunks.push_back({ikeys, std::move(ic)});
 
   tbb::task_arena arena(options.threads == 0 ? tbb::task_arena::automatic
                                              : static_cast<int>(options.threads));
-  stats.min_colour_quality_db = kInf;
-  double sum_rel = 0;
-  uint64_t finite_texels = 0;
   const uint64_t total = uint64_t{6} * m.viewpoints.size();
-  ViewData view;
-  for (uint32_t v = 0; v < m.viewpoints.size(); ++v) {
-    CALF_RETURN_IF_ERROR(read_view(input, v, &view));
-    if (view.has_material) stats.material_views += 1;
-
-    // The view's index chunk (SPEC §11.1 "View index chunk").
-    lf::ViewIndex vi;
-    vi.position[0] = m.viewpoints[v].position.x;
-    vi.position[1] = m.viewpoints[v].position.y;
-    vi.position[2] = m.viewpoints[v].position.z;
-    vi.z_near = view.range ? view.range->z_near() : 1.0f;
-    vi.z_far = view.range ? view.range->z_far() : 2.0f;
-    vi.has_depth = view.range.has_value();
-    vi.has_material = view.has_material;
-    vi.depth_keyframe_interval = options.depth_keyframe_interval;
-    vi.depth_window = options.depth_window;
-    vi.min_psnr_db = static_cast<float>(options.min_psnr_db);
-    const std::vector<uint8_t> index = lf::serialize_view_index(vi);
-    ChunkKeys ikeys;
-    ikeys.track = track;
-    ikeys.stream = static_cast<uint16_t>(LightfieldStream::kIndex);
-    ikeys.view = v;
-    CALF_ASSIGN_OR_RETURN(StoredChunk ic,
-                          container::compress_chunk(index, Compression::kNone, options.levels));
-    stats.index_bytes += ic.bytes.size();
-    CALF_RETURN_IF_ERROR(writer.add_stored_chunk(ikeys, ic).status());
-
-    const Context ctx{&options, &view, v, track, colour, stats.hdr, cells, tiles};
-    for (uint32_t face = 0; face < 6; ++face) {
-      // Tasks of one face in file order: cells, depth tiles, material tiles.
-      const uint32_t nc = cells.cell_count(), nt = tiles.cell_count();
-      const uint32_t nm = view.has_material ? nt : 0;
-      std::vector<TaskOut> outs(nc + nt + nm);
-      arena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range<uint32_t>(0, nc + nt + nm, 1),
-                          [&](const tbb::blocked_range<uint32_t>& range) {
-                            for (uint32_t i = range.begin(); i < range.end(); ++i) {
-                              if (i < nc) {
-                                colour_task(ctx, face, i, outs[i]);
-                              } else if (i < nc + nt) {
-                                region_task(ctx, face, i - nc, true, outs[i]);
-                              } else {
-                                region_task(ctx, face, i - nc - nt, false, outs[i]);
-                              }
+  const Context ctx{&options, &view, v, analysis.colour, analysis.hdr, cells, tiles};
+  for (uint32_t face = 0; face < 6; ++face) {
+    // Tasks of one face in file order: cells, depth tiles, material tiles.
+    const uint32_t nc = cells.cell_count(), nt = tiles.cell_count();
+    const uint32_t nm = view.has_material ? nt : 0;
+    std::vector<TaskOut> outs(nc + nt + nm);
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<uint32_t>(0, nc + nt + nm, 1),
+                        [&](const tbb::blocked_range<uint32_t>& range) {
+                          for (uint32_t i = range.begin(); i < range.end(); ++i) {
+                            if (i < nc) {
+                              colour_task(ctx, face, i, outs[i]);
+                            } else if (i < nc + nt) {
+                              region_task(ctx, face, i - nc, true, outs[i]);
+                            } else {
+                              region_task(ctx, face, i - nc - nt, false, outs[i]);
                             }
-                          });
-      });
-      for (TaskOut& o : outs) {
-        CALF_RETURN_IF_ERROR(o.status);
-        for (const Pending& p : o.chunks) CALF_RETURN_IF_ERROR(writer.add_stored_chunk(p.keys, p.chunk).status());
-        const TaskStats& s = o.stats;
-        add_into(stats.colour, s.colour);
-        add_into(stats.depth, s.depth);
-        add_into(stats.material, s.material);
-        stats.colour_keyframes += s.keyframes;
-        stats.depth_keyframes += s.depth_keyframes;
-        stats.depth_pframes += s.pframes;
-        stats.depth_empty_pframes += s.empty_pframes;
-        stats.min_colour_quality_db = std::min(stats.min_colour_quality_db, s.min_quality);
-        stats.depth_max_rel_error = std::max(stats.depth_max_rel_error, s.max_rel);
-        sum_rel += s.sum_rel;
-        finite_texels += s.finite_texels;
-        stats.depth_sky_mismatches += s.sky_mismatches;
-      }
-      stats.colour_cells += nc;
-      stats.depth_tiles += nt;
-      if (options.progress) options.progress(uint64_t{6} * v + face + 1, total);
+                          }
+                        });
+    });
+    for (TaskOut& o : outs) {
+      CALF_RETURN_IF_ERROR(o.status);
+      for (Pending& p : o.chunks) out.chunks.push_back({p.keys, std::move(p.chunk)});
+      const TaskStats& s = o.stats;
+      add_into(stats.colour, s.colour);
+      add_into(stats.depth, s.depth);
+      add_into(stats.material, s.material);
+      stats.colour_keyframes += s.keyframes;
+      stats.depth_keyframes += s.depth_keyframes;
+      stats.depth_pframes += s.pframes;
+      stats.depth_empty_pframes += s.empty_pframes;
+      stats.min_colour_quality_db = std::min(stats.min_colour_quality_db, s.min_quality);
+      stats.depth_max_rel_error = std::max(stats.depth_max_rel_error, s.max_rel);
+      stats.depth_sum_rel_error += s.sum_rel;
+      stats.depth_finite_texels += s.finite_texels;
+      stats.depth_sky_mismatches += s.sky_mismatches;
     }
+    stats.colour_cells += nc;
+    stats.depth_tiles += nt;
+    if (options.progress) options.progress(uint64_t{6} * v + face + 1, total);
   }
-  stats.depth_mean_rel_error = finite_texels ? sum_rel / static_cast<double>(finite_texels) : 0;
-  if (stats.material_views > 0) {
-    stats.material_format = material_format;
-    header.material_format = material_format;
-    CALF_RETURN_IF_ERROR(writer.set_track_header(track, header));
+  stats.depth_mean_rel_error = mean_rel_error(stats);
+  return out;
+}
+
+Expected<LightfieldTrackWriter> LightfieldTrackWriter::begin(container::Writer& writer,
+                                                             const LightfieldAnalysis& analysis) {
+  CALF_ASSIGN_OR_RETURN(uint16_t track, writer.add_track(analysis.header));
+  LightfieldEncodeStats stats;
+  stats.colour_format = analysis.header.colour_format;
+  stats.depth_format = analysis.header.depth_format;
+  stats.material_format = analysis.header.material_format;
+  stats.hdr = analysis.hdr;
+  stats.min_colour_quality_db = kInf;
+  return LightfieldTrackWriter(writer, track, analysis.header.view_count, stats);
+}
+
+Status LightfieldTrackWriter::append(const LightfieldViewEncoding& view) {
+  if (view.view != next_view_ || next_view_ >= view_count_) {
+    return Status(ErrorId::kEncoderInput, "view " + std::to_string(view.view) +
+                                              " appended where view " + std::to_string(next_view_) +
+                                              " of " + std::to_string(view_count_) + " comes next");
   }
-  return stats;
+  for (const LightfieldChunk& c : view.chunks) {
+    ChunkKeys keys = c.keys;
+    keys.track = track_;
+    CALF_RETURN_IF_ERROR(writer_->add_stored_chunk(keys, c.chunk).status());
+  }
+  next_view_ += 1;
+  LightfieldEncodeStats& t = stats_;
+  const LightfieldEncodeStats& s = view.stats;
+  add_into(t.colour, s.colour);
+  add_into(t.depth, s.depth);
+  add_into(t.material, s.material);
+  t.index_bytes += s.index_bytes;
+  t.colour_cells += s.colour_cells;
+  t.colour_keyframes += s.colour_keyframes;
+  t.depth_tiles += s.depth_tiles;
+  t.depth_keyframes += s.depth_keyframes;
+  t.depth_pframes += s.depth_pframes;
+  t.depth_empty_pframes += s.depth_empty_pframes;
+  t.material_views += s.material_views;
+  t.min_colour_quality_db = std::min(t.min_colour_quality_db, s.min_colour_quality_db);
+  t.depth_max_rel_error = std::max(t.depth_max_rel_error, s.depth_max_rel_error);
+  t.depth_sum_rel_error += s.depth_sum_rel_error;
+  t.depth_finite_texels += s.depth_finite_texels;
+  t.depth_sky_mismatches += s.depth_sky_mismatches;
+  t.depth_mean_rel_error = mean_rel_error(t);
+  return Status::Ok();
+}
+
+Expected<LightfieldEncodeStats> LightfieldTrackWriter::finish() const {
+  if (next_view_ != view_count_) {
+    return Status(ErrorId::kEncoderInput, "the track has " + std::to_string(next_view_) +
+                                              " of its " + std::to_string(view_count_) + " views");
+  }
+  return stats_;
+}
+
+Expected<LightfieldEncodeStats> encode_lightfield(const capture::CaptureSetReader& input,
+                                                  container::Writer& writer,
+                                                  const LightfieldEncodeOptions& options) {
+  CALF_ASSIGN_OR_RETURN(const LightfieldAnalysis analysis, analyse_lightfield(input, options));
+  CALF_ASSIGN_OR_RETURN(LightfieldTrackWriter track,
+                        LightfieldTrackWriter::begin(writer, analysis));
+  for (uint32_t v = 0; v < analysis.header.view_count; ++v) {
+    CALF_ASSIGN_OR_RETURN(const LightfieldViewEncoding view,
+                          encode_lightfield_view(input, analysis, v, options));
+    CALF_RETURN_IF_ERROR(track.append(view));
+  }
+  return track.finish();
 }
 
 Expected<LightfieldEncodeStats> encode_lightfield_file(const std::filesystem::path& capture_dir,
                                                        const std::string& out_path,
                                                        const LightfieldEncodeOptions& options) {
-  CALF_RETURN_IF_ERROR(validate(options));
+  CALF_RETURN_IF_ERROR(lightfield_internal::validate_options(options));
   CALF_ASSIGN_OR_RETURN(capture::CaptureSetReader input, capture::CaptureSetReader::open(capture_dir));
   CALF_ASSIGN_OR_RETURN(container::Writer writer, container::Writer::create(out_path, options.levels));
   CALF_ASSIGN_OR_RETURN(LightfieldEncodeStats stats, encode_lightfield(input, writer, options));

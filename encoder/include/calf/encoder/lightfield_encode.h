@@ -21,21 +21,40 @@
 // format's own PSNR is below Q, and a static cell would never be one keyframe. LDR cells use
 // PSNR on sRGB (psnr_srgb); HDR cells use log2-PSNR (psnr_log2 below).
 //
-// Determinism: the output bytes depend on the input and the options only, never on `threads`
-// (cells and tiles are coded independently into per-task buffers, then appended in a fixed order).
-// Memory: one view is held at a time (all its frames: ~13 bytes per texel per frame), never all
-// views.
+// Two passes. Encoding is split so that the views of one clip can be coded apart (threads,
+// processes or machines) and merged into the very bytes a single run writes:
+//
+//   1. analysis   analyse_lightfield() reads every image once and decides everything global —
+//                 HDR or LDR colour, each view's depth range and material presence, whether the
+//                 track has a material stream — into a LightfieldAnalysis holding the final track
+//                 header. Where the images are spread out, run analyse_lightfield_view() beside
+//                 each view's images and combine the facts with plan_lightfield().
+//   2. views      encode_lightfield_view() codes one view into its chunks, a pure function of the
+//                 analysis, that view's images and the options; views are independent.
+//   3. assembly   LightfieldTrackWriter adds the track with the analysis's header and appends the
+//                 views' chunks in view order. No header field is patched afterwards.
+//
+// encode_lightfield() runs the three steps in one process, one view at a time.
+//
+// Determinism: the output bytes depend on the input and the options only, never on `threads` nor
+// on where or in which order the views were coded (cells and tiles are coded independently into
+// per-task buffers, then appended in a fixed order).
+// Memory: encode_lightfield() holds one view at a time (all its frames: ~13 bytes per texel per
+// frame, plus that view's compressed chunks), never all views; the analysis holds one frame per
+// thread.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "calf/capture/capture_set.h"
 #include "calf/format/container.h"
+#include "calf/format/log_depth.h"
 #include "calf/format/status.h"
 
 namespace calf {
@@ -85,11 +104,118 @@ struct LightfieldEncodeStats {
   // every frame, as relative depth error |z' / z - 1|, and texels whose sky-ness changed.
   double depth_max_rel_error = 0, depth_mean_rel_error = 0;
   uint64_t depth_sky_mismatches = 0;
+  // The terms of the mean (sum of |z' / z - 1| over that many texels), kept so that the figures
+  // of views coded apart merge exactly as LightfieldTrackWriter does.
+  double depth_sum_rel_error = 0;
+  uint64_t depth_finite_texels = 0;
 };
 
-// Encodes every view of `input` into a new lightfield track of `writer` (does not finish it).
-// Errors: kEncoderOption; the capture reader's (file, face and pixel named); kEncoderInput;
-// container and block-codec errors passed through.
+// ---- Pass 1: analysis ----
+
+// What the images of one view say, for the decisions global to the track.
+struct LightfieldViewFacts {
+  // The log-16 range covering every finite depth of every frame (LogDepthRange::covering); none
+  // when the view sees only sky. Written in the view's index chunk (z_near, z_far, has_depth).
+  std::optional<LogDepthRange> depth_range;
+  // Some texel of some frame reflects or refracts (a non-zero 8-bit weight code): the view has
+  // material chunks, and the track a material stream.
+  bool has_material = false;
+  // Some colour value of some frame exceeds 1: the view asks for a HDR colour format.
+  bool hdr = false;
+};
+
+// Everything global to a lightfield track, decided before any view is coded.
+struct LightfieldAnalysis {
+  // The final track header: formats, grid sizes, frame and view counts, the HDR flag, and
+  // material_format (kNone unless some view has material). Written as is.
+  container::LightfieldTrackHeader header;
+  // The colour format (never kAuto): options.colour, or for kAuto BC6H when some view is HDR
+  // and BC1 otherwise.
+  ColourCoding colour = ColourCoding::kBc1;
+  bool hdr = false;                        // colour is BC6H or RGBA16F (header.flags bit 0)
+  std::vector<LightfieldViewFacts> views;  // one per viewpoint, in manifest order
+};
+
+// Reads every frame of view `view` (each validated by the capture reader) and returns its facts.
+// Errors: the capture reader's; kEncoderInput for a frame whose face size or material presence
+// differs from the manifest; kDepthRange when the measured depths admit no range.
+Expected<LightfieldViewFacts> analyse_lightfield_view(const capture::CaptureSetReader& input,
+                                                      uint32_t view);
+
+// The analysis from the manifest, every view's facts (manifest order) and the options: a pure
+// function, so machines that analysed different views agree on it. Errors: kEncoderOption;
+// kEncoderInput (facts not one per viewpoint, a face too small for the grid).
+Expected<LightfieldAnalysis> plan_lightfield(const capture::CaptureManifest& manifest,
+                                             std::span<const LightfieldViewFacts> views,
+                                             const LightfieldEncodeOptions& options);
+
+// Pass 1 in one call: checks the options and that every image exists, analyses every view
+// (options.threads views at a time; the first failing view in view order is reported) and plans.
+Expected<LightfieldAnalysis> analyse_lightfield(const capture::CaptureSetReader& input,
+                                                const LightfieldEncodeOptions& options);
+
+// ---- Pass 2: one view ----
+
+// One chunk of a view, compressed, with its keys; keys.track is left 0 (the assembly sets it).
+struct LightfieldChunk {
+  container::ChunkKeys keys;
+  container::StoredChunk chunk;
+};
+
+// The chunks of one view in file order (SPEC §11.1: its index chunk, then per face in GL order
+// the colour cells' t and keyframe chunks, the depth tiles' chunks, the material tiles' chunks)
+// and that view's figures (counts and bytes of this view only; formats and hdr as the track's).
+struct LightfieldViewEncoding {
+  uint32_t view = 0;
+  std::vector<LightfieldChunk> chunks;
+  LightfieldEncodeStats stats;
+};
+
+// Codes view `view` of `input` as `analysis` decided: reads its frames again, checks that they
+// still say what the analysis saw, and codes its cells and tiles (options.threads at a time).
+// `options` must be those the analysis was planned with. Calls options.progress after each face
+// with (6 * view + face + 1, 6 * view_count). Errors: kEncoderOption; kEncoderInput (view out of
+// range, an analysis planned for another capture set or other options, an image that changed
+// since the analysis); the capture reader's; container and block-codec errors passed through.
+Expected<LightfieldViewEncoding> encode_lightfield_view(const capture::CaptureSetReader& input,
+                                                        const LightfieldAnalysis& analysis,
+                                                        uint32_t view,
+                                                        const LightfieldEncodeOptions& options);
+
+// ---- Assembly ----
+
+// Writes one lightfield track: the analysis's header first, then each view's chunks as they are
+// appended, in view order 0, 1, ..., view_count - 1. The bytes equal encode_lightfield()'s
+// whoever coded the views. Holds a reference to the writer, which must outlive it.
+class LightfieldTrackWriter {
+ public:
+  // Adds the track to `writer` (container errors passed through).
+  static Expected<LightfieldTrackWriter> begin(container::Writer& writer,
+                                               const LightfieldAnalysis& analysis);
+  uint16_t track() const { return track_; }
+  // Appends the next view's chunks (kEncoderInput when `view.view` is not the next view).
+  Status append(const LightfieldViewEncoding& view);
+  // The track's figures, once every view is appended (kEncoderInput before). Does not finish
+  // the writer.
+  Expected<LightfieldEncodeStats> finish() const;
+
+ private:
+  LightfieldTrackWriter(container::Writer& writer, uint16_t track, uint32_t view_count,
+                        LightfieldEncodeStats stats)
+      : writer_(&writer), track_(track), view_count_(view_count), stats_(stats) {}
+  container::Writer* writer_;
+  uint16_t track_;
+  uint32_t view_count_;
+  uint32_t next_view_ = 0;
+  LightfieldEncodeStats stats_;
+};
+
+// ---- The whole encode ----
+
+// Encodes every view of `input` into a new lightfield track of `writer` (does not finish it):
+// analyse_lightfield(), then encode_lightfield_view() and LightfieldTrackWriter::append() view by
+// view. Errors: kEncoderOption; the capture reader's (file, face and pixel named);
+// kEncoderInput; container and block-codec errors passed through.
 Expected<LightfieldEncodeStats> encode_lightfield(const capture::CaptureSetReader& input,
                                                   container::Writer& writer,
                                                   const LightfieldEncodeOptions& options);
