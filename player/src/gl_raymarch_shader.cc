@@ -17,8 +17,8 @@ void main() {
 const char* const kGlRaymarchFragment = R"glsl(
 struct CalfView {
   vec3 position;  // relative to the eye
-  float log_near;
-  float step;      // ln depth per code
+  float log_near;  // the CalfLogRange of the view (glsl_conventions.h), spread over the record
+  float step;      // so that the record packs into 48 bytes
   float inv_step;
   float z_near;
   float z_far;
@@ -136,16 +136,14 @@ uint depth_code(CalfView v, ivec3 t) {
 #endif
 }
 
-// LogDepthRange::decode for a finite code.
-float depth_of_code(CalfView v, uint code) {
-  if (code == 0u) return v.z_near;
-  if (code == CALF_LOG16_MAX_FINITE) return v.z_far;
-  return exp(v.log_near + float(code) * v.step);
+// The view's log-16 range, for the conventions' depth functions.
+CalfLogRange log_range(CalfView v) {
+  return CalfLogRange(v.z_near, v.z_far, v.log_near, v.step, v.inv_step);
 }
 
 // |ln(decode(code) / r)| given ln r.
 float log_disagreement(CalfView v, uint code, float log_r) {
-  return abs(v.log_near + float(code) * v.step - log_r);
+  return abs(calf_log_depth_from_code(code, log_range(v)) - log_r);
 }
 
 // The colour a view shows at a texel: its cell's keyframe slots blended by t (SPEC §11.1.4).
@@ -173,7 +171,7 @@ float code_margin(CalfView v, vec3 x, float r) {
     lo = min(lo, c[t]);
     hi = max(hi, c[t]);
   }
-  float rcode = (log(r) - v.log_near) * v.inv_step;
+  float rcode = calf_code_from_log_depth(log(r), log_range(v));
   if (hi != CALF_LOG16_SKY && float(hi - lo) * v.step <= smooth_log_ratio) {
     float code = 0.0;
     for (int t = 0; t < 4; ++t) code += taps.weight[t] * float(c[t]);
@@ -220,7 +218,8 @@ int hint_side(uint h, vec3 o, vec3 d, float x) {
   vec2 uv = texel_coord(rel, face, v.face_size);
   uint code = depth_code(v, ivec3(clamp_texel(uv.x, v.face_size),
                                   clamp_texel(uv.y, v.face_size), face));
-  return code == CALF_LOG16_SKY || float(code) > (log(r) - v.log_near) * v.inv_step ? 1 : 0;
+  if (code == CALF_LOG16_SKY) return 1;
+  return float(code) > calf_code_from_log_depth(log(r), log_range(v)) ? 1 : 0;
 }
 
 bool intersect(vec3 o, vec3 d, float start, out float z_hit) {
@@ -463,7 +462,7 @@ bool texel_point(CalfView v, ivec3 t, out vec3 q) {
   uint code = depth_code(v, t);
   if (code == CALF_LOG16_SKY) return false;
   vec3 dir = calf_direction_from_st(t.z, (vec2(t.xy) + 0.5) / float(v.face_size));
-  q = v.position + dir * depth_of_code(v, code);
+  q = v.position + dir * calf_depth_from_code(code, log_range(v));
   return true;
 }
 

@@ -17,9 +17,9 @@ inline constexpr unsigned kGlMaxActiveViews = 256;
 // std140 layout of one active view in the shader's view block (struct CalfView there).
 struct GlViewRecord {
   float position[3];  // P_j relative to the eye
-  float log_near;     // ln z_near
-  float step;         // ln(z_far / z_near) / 65534: ln depth per code
-  float inv_step;     // 1 / step
+  float log_near;     // ln z_near        } the view's GlslLogRange (glsl_log_range()), which the
+  float step;         // ln depth per code } shader hands to the conventions' depth functions as
+  float inv_step;     // 1 / step          } a CalfLogRange
   float z_near, z_far;
   unsigned face_size;
   unsigned cell_size;

@@ -211,15 +211,14 @@ Status GlRenderer::draw(const Camera& camera) {
   for (uint32_t v : active) {
     const GlViewInfo& info = layout.views[v];
     const Vec3 rel = info.position - camera.position;
-    const double log_near = std::log(static_cast<double>(info.range.z_near()));
-    const double step = info.range.relative_step();
+    const GlslLogRange range = glsl_log_range(info.range);
     records.push_back(
         {{static_cast<float>(rel.x), static_cast<float>(rel.y), static_cast<float>(rel.z)},
-         static_cast<float>(log_near),
-         static_cast<float>(step),
-         static_cast<float>(1.0 / step),
-         info.range.z_near(),
-         info.range.z_far(),
+         range.log_near,
+         range.step,
+         range.inv_step,
+         range.z_near,
+         range.z_far,
          info.face_size,
          info.cell_size,
          6 * v,

@@ -1,6 +1,16 @@
 #include "calf/player/glsl_conventions.h"
 
+#include <cmath>
+
 namespace calf::player {
+
+GlslLogRange glsl_log_range(const LogDepthRange& range) {
+  // The same double expressions as LogDepthRange's constructor, rounded to float once.
+  const double step = range.relative_step();
+  return {range.z_near(), range.z_far(),
+          static_cast<float>(std::log(static_cast<double>(range.z_near()))),
+          static_cast<float>(step), static_cast<float>(1.0 / step)};
+}
 
 // Mirrors format/src/cube.cc (kFaceAxes: OpenGL 4.5 core Table 8.19) and format/src/log_depth.cc.
 // Keep the two in step: the integration test fails when they drift.
@@ -49,33 +59,28 @@ vec2 calf_texel_coord_from_st(vec2 st, uint n) {
   return st * float(n);
 }
 
-float calf_depth_from_code(uint code, float z_near, float z_far) {
+struct CalfLogRange {
+  float z_near;
+  float z_far;
+  float log_near;  // ln z_near
+  float step;      // ln(z_far / z_near) / 65534: ln depth per code
+  float inv_step;  // 1 / step
+};
+
+float calf_log_depth_from_code(uint code, CalfLogRange r) {
+  return r.log_near + float(code) * r.step;
+}
+
+float calf_depth_from_code(uint code, CalfLogRange r) {
   if (code == CALF_LOG16_SKY) return uintBitsToFloat(0x7F800000u);
-  if (code == 0u) return z_near;
-  if (code == CALF_LOG16_MAX_FINITE) return z_far;
-  float log_near = log(z_near);
-  float step = (log(z_far) - log_near) / 65534.0;
-  return exp(log_near + float(code) * step);
+  // The ends are exact, as in C++: z_near and z_far are stored, not recomputed.
+  if (code == 0u) return r.z_near;
+  if (code == CALF_LOG16_MAX_FINITE) return r.z_far;
+  return exp(calf_log_depth_from_code(code, r));
 }
 
-uint calf_code_from_depth(float z, float z_near, float z_far) {
-  if (isnan(z) || (isinf(z) && z > 0.0)) return CALF_LOG16_SKY;  // -inf codes as 0, like C++
-  if (!(z > z_near)) return 0u;
-  if (z >= z_far) return CALF_LOG16_MAX_FINITE;
-  float log_near = log(z_near);
-  float inv_step = 65534.0 / (log(z_far) - log_near);
-  float code = floor((log(z) - log_near) * inv_step + 0.5);
-  return code >= 65534.0 ? CALF_LOG16_MAX_FINITE : uint(code);
-}
-
-float calf_normalized_from_depth(float z, float z_near, float z_far) {
-  float log_near = log(z_near);
-  return (log(z) - log_near) / (log(z_far) - log_near);
-}
-
-float calf_depth_from_normalized(float x, float z_near, float z_far) {
-  float log_near = log(z_near);
-  return exp(log_near + x * (log(z_far) - log_near));
+float calf_code_from_log_depth(float log_z, CalfLogRange r) {
+  return (log_z - r.log_near) * r.inv_step;
 }
 )glsl";
 

@@ -1,6 +1,7 @@
 // The GLSL mirror of the conventions (calf/player/glsl_conventions.h) against the C++ ones, run
 // as a compute shader in an OSMesa GL 4.5 core context: cube-face lookups on thousands of
-// directions including exact seams and corners, the inverse mapping, and every log-16 code.
+// directions including exact seams and corners, the inverse mapping, and every log-16 code of
+// the depth functions the ray-march shader calls.
 #include <GL/gl.h>
 #include <GL/glext.h>
 #include <GL/osmesa.h>
@@ -43,7 +44,7 @@ struct Gl {
   PFNGLMEMORYBARRIERPROC MemoryBarrier;
   PFNGLGETUNIFORMLOCATIONPROC GetUniformLocation;
   PFNGLUNIFORM1UIPROC Uniform1ui;
-  PFNGLUNIFORM2FPROC Uniform2f;
+  PFNGLUNIFORM1FPROC Uniform1f;
 };
 
 class Context {
@@ -71,7 +72,7 @@ class Context {
             CALF_GL(GetProgramInfoLog) CALF_GL(UseProgram) CALF_GL(GenBuffers)
                 CALF_GL(BindBufferBase) CALF_GL(BindBuffer) CALF_GL(BufferData)
                     CALF_GL(GetBufferSubData) CALF_GL(DispatchCompute) CALF_GL(MemoryBarrier)
-                        CALF_GL(GetUniformLocation) CALF_GL(Uniform1ui) CALF_GL(Uniform2f)
+                        CALF_GL(GetUniformLocation) CALF_GL(Uniform1ui) CALF_GL(Uniform1f)
 #undef CALF_GL
                             ok_ = true;
   }
@@ -238,24 +239,24 @@ void main() {
   EXPECT_LE(worst_dir, 1e-6);
 }
 
+// The depth functions the ray-march shader calls, on every code of three ranges, with the range
+// constants as the GL renderer passes them (glsl_log_range()).
 TEST(GlslConventions, LogDepthMatchesCppForEveryCode) {
   REQUIRE_GL();
   std::string log;
   const GLuint prog = compute_program(R"(
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer In { float depth_in[]; };
-layout(std430, binding = 1) writeonly buffer Dec { float decoded[]; };
-layout(std430, binding = 2) writeonly buffer Enc { uint encoded[]; };
-layout(std430, binding = 3) writeonly buffer Norm { vec2 norm[]; };
+layout(std430, binding = 1) writeonly buffer Dec { vec2 decoded[]; };
+layout(std430, binding = 2) writeonly buffer Enc { float code_of[]; };
 uniform uint count;
-uniform vec2 range;
+uniform CalfLogRange range;
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= count) return;
-  decoded[i] = calf_depth_from_code(i, range.x, range.y);
-  encoded[i] = calf_code_from_depth(depth_in[i], range.x, range.y);
-  float x = calf_normalized_from_depth(depth_in[i], range.x, range.y);
-  norm[i] = vec2(x, calf_depth_from_normalized(x, range.x, range.y));
+  float log_z = i == CALF_LOG16_SKY ? 0.0 : calf_log_depth_from_code(i, range);
+  decoded[i] = vec2(calf_depth_from_code(i, range), log_z);
+  code_of[i] = calf_code_from_log_depth(log(depth_in[i]), range);
 }
 )",
                                       &log);
@@ -264,58 +265,70 @@ void main() {
   for (const auto& [zn, zf] :
        {std::pair{0.1f, 100.0f}, std::pair{1e-4f, 1e6f}, std::pair{2.0f, 2.002f}}) {
     const LogDepthRange range = *LogDepthRange::make(zn, zf);
+    const GlslLogRange shader_range = glsl_log_range(range);
     const size_t n = 65536;
     std::vector<float> depth(n);
     for (size_t c = 0; c < n; ++c) depth[c] = range.decode(static_cast<uint16_t>(c));
     ssbo(0, n * 4, depth.data());
-    const GLuint dec = ssbo(1, n * 4, nullptr);
+    const GLuint dec = ssbo(1, n * 8, nullptr);
     const GLuint enc = ssbo(2, n * 4, nullptr);
-    const GLuint nrm = ssbo(3, n * 8, nullptr);
     gl.UseProgram(prog);
     gl.Uniform1ui(gl.GetUniformLocation(prog, "count"), static_cast<GLuint>(n));
-    gl.Uniform2f(gl.GetUniformLocation(prog, "range"), zn, zf);
+    const auto set = [&](const char* name, float v) {
+      const GLint loc = gl.GetUniformLocation(prog, name);
+      ASSERT_GE(loc, 0) << name;
+      gl.Uniform1f(loc, v);
+    };
+    set("range.z_near", shader_range.z_near);
+    set("range.z_far", shader_range.z_far);
+    set("range.log_near", shader_range.log_near);
+    set("range.step", shader_range.step);
+    set("range.inv_step", shader_range.inv_step);
     gl.DispatchCompute(static_cast<GLuint>(n / 64), 1, 1);
     gl.MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    const std::vector<float> decoded = read_back<float>(dec, n);
-    const std::vector<uint32_t> encoded = read_back<uint32_t>(enc, n);
-    const std::vector<float> norm = read_back<float>(nrm, 2 * n);
-    double worst_rel = 0, worst_norm = 0;
+    const std::vector<float> decoded = read_back<float>(dec, 2 * n);
+    const std::vector<float> code_of = read_back<float>(enc, n);
+    const double log_ratio = std::log(double{zf} / zn);
+    double worst_rel = 0, worst_log = 0, worst_code = 0;
     size_t off_by_one = 0, wrong = 0;
     for (size_t c = 0; c < n; ++c) {
       if (c == kLog16Sky) {
-        EXPECT_TRUE(std::isinf(decoded[c]) && decoded[c] > 0);
-        EXPECT_EQ(encoded[c], kLog16Sky);
+        EXPECT_TRUE(std::isinf(decoded[2 * c]) && decoded[2 * c] > 0);
         continue;
       }
-      worst_rel = std::max(worst_rel, std::fabs(double{decoded[c]} / depth[c] - 1));
-      // Codes: the GLSL encoder gets every code back, up to float rounding at half-code
-      // boundaries (one code off at most).
-      const int64_t diff = int64_t{encoded[c]} - int64_t(c);
+      worst_rel = std::max(worst_rel, std::fabs(double{decoded[2 * c]} / depth[c] - 1));
+      // ln z against the exact log-16 value (Eq. 13), not against ln of the float depth.
+      const double exact_log = std::log(double{zn}) + static_cast<double>(c) * log_ratio / 65534;
+      worst_log = std::max(worst_log, std::fabs(decoded[2 * c + 1] - exact_log));
+      // The continuous code of each code's own depth: c again, up to float resolution; rounded
+      // (what the shader's comparisons amount to) one code off at most, at half-code boundaries.
+      const double cpp_code = range.normalized_from_depth(depth[c]) * 65534;
+      worst_code = std::max(worst_code, std::fabs(code_of[c] - cpp_code));
+      const int64_t diff = static_cast<int64_t>(std::floor(double{code_of[c]} + 0.5)) - int64_t(c);
       off_by_one += diff != 0 && std::abs(diff) <= 1;
       wrong += std::abs(diff) > 1;
-      const double x = range.normalized_from_depth(depth[c]);
-      worst_norm = std::max({worst_norm, std::fabs(norm[2 * c] - x),
-                             std::fabs(double{norm[2 * c + 1]} / depth[c] - 1)});
     }
     EXPECT_EQ(decoded[0], zn);
-    EXPECT_EQ(decoded[kLog16MaxFinite], zf);
+    EXPECT_EQ(decoded[2 * kLog16MaxFinite], zf);
     std::printf(
-        "range [%g, %g]: max rel decode diff %.3g, codes off by one %zu, more %zu, "
-        "max nonlin/lin diff %.3g\n",
-        zn, zf, worst_rel, off_by_one, wrong, worst_norm);
+        "range [%g, %g]: max rel decode diff %.3g, max ln z diff %.3g, codes off by one %zu, more "
+        "%zu, max continuous code diff %.3g\n",
+        zn, zf, worst_rel, worst_log, off_by_one, wrong, worst_code);
     EXPECT_LE(worst_rel, 4e-6);
     // A float depth resolves relative steps of 2^-23; where one code is finer than that (the
     // narrow range: 1.5e-8 per code) codes can only come back within float resolution, and
-    // ln(z) - ln(z_near) cancels float digits (the normalised depth's error grows as
-    // ulp(ln z) / ln(z_far / z_near)). The GL renderer compares in code space, where this is
-    // far below one ray-march step.
+    // ln(z) - ln(z_near) cancels float digits (the continuous code's error grows as
+    // ulp(ln z) / step). The GL renderer compares in code space, where this is far below one
+    // ray-march step.
     const double ulp = std::ldexp(1.0, -23);
-    const double log_ratio = std::log(double{zf} / zn);
+    const double ln_scale = std::fabs(std::log(double{zn})) + log_ratio + 1;
+    EXPECT_LE(worst_log, 4 * ulp * ln_scale);
     if (range.relative_step() > 4 * ulp) {  // else: reported above, not bounded
       EXPECT_EQ(wrong, 0u);
       EXPECT_LE(off_by_one, n / 100);
     }
-    EXPECT_LE(worst_norm, 4e-6 + 8 * ulp * (std::fabs(std::log(double{zf})) + 1) / log_ratio);
+    EXPECT_LE(worst_code / 65534,
+              4e-6 + 8 * ulp * (std::fabs(std::log(double{zf})) + 1) / log_ratio);
   }
 }
 

@@ -1,6 +1,8 @@
 // The GLSL side of calf's conventions: cube-face direction <-> (face, s, t) with the seam
 // tie-break of calf/format/cube.h, and the log-16 depth mapping of calf/format/log_depth.h, with
-// the same formulas in the same order. tests/integration/glsl_conventions_test.cc runs this source
+// the same formulas in the same order. This is the one GLSL copy: the ray-march shader
+// (gl_raymarch_shader.cc) is compiled after it and calls these functions for every cube-face
+// lookup and every depth code, and tests/integration/glsl_conventions_test.cc runs the same source
 // under OSMesa on thousands of directions (seams and corners included) and on every depth code,
 // and compares with the C++ functions.
 //
@@ -12,21 +14,35 @@
 //   vec3  calf_direction_from_st(int face, vec2 st) unit direction; st outside [0, 1] continues
 //                                                   the face's plane
 //   vec2  calf_texel_coord_from_st(vec2 st, uint n) texel space: centres at half-integers
-//   float calf_depth_from_code(uint code, float z_near, float z_far)   +inf for the sky code
-//   uint  calf_code_from_depth(float z, float z_near, float z_far)     encode_unchecked()
-//   float calf_normalized_from_depth(float z, float z_near, float z_far)  Alg. 4 nonlin()
-//   float calf_depth_from_normalized(float x, float z_near, float z_far)  Alg. 4 lin()
+//   struct CalfLogRange { float z_near, z_far, log_near, step, inv_step; }
+//                                                   one view's range with LogDepthRange's
+//                                                   constants; fill it from glsl_log_range()
+//   float calf_depth_from_code(uint code, CalfLogRange r)      decode(): +inf for the sky code,
+//                                                              z_near and z_far exact at the ends
+//   float calf_log_depth_from_code(uint code, CalfLogRange r)  ln z of a finite code
+//   float calf_code_from_log_depth(float log_z, CalfLogRange r) the continuous code of ln z
+//                                                   (neither rounded nor clamped):
+//                                                   normalized_from_depth(z) * 65534
 //   const uint CALF_LOG16_SKY = 65535u, CALF_LOG16_MAX_FINITE = 65534u
 //
-// Precision: GLSL computes in float where C++ uses double. Face choice is identical for the same
-// float direction (comparisons of the same values); s and t agree to a few float ulps; decoded
-// depths to a relative 4e-6 (float exp/log); codes from calf_code_from_depth may differ by one
-// from the C++ encoder for depths within float rounding of a half-code boundary. The test states
-// and checks these bounds.
+// Precision: GLSL computes in float where C++ uses double; the range constants are computed in
+// double on the host and rounded once. Face choice is identical for the same float direction
+// (comparisons of the same values); s and t agree to a few float ulps; decoded depths to a
+// relative 4e-6 (float exp); continuous codes to float resolution of ln z. The test states and
+// checks these bounds.
 #pragma once
+
+#include "calf/format/log_depth.h"
 
 namespace calf::player {
 
 extern const char* const kGlslConventions;
+
+// The CalfLogRange a shader receives for `range`: z_near and z_far as stored, ln z_near, the
+// relative step and its inverse computed in double and rounded to float once.
+struct GlslLogRange {
+  float z_near, z_far, log_near, step, inv_step;
+};
+GlslLogRange glsl_log_range(const LogDepthRange& range);
 
 }  // namespace calf::player
