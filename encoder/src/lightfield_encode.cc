@@ -518,17 +518,54 @@ void region_task(const Context& ctx, uint32_t face, uint32_t tile, bool is_depth
   }
 }
 
-double mean_rel_error(const LightfieldEncodeStats& s) {
-  return s.depth_finite_texels ? s.depth_sum_rel_error / static_cast<double>(s.depth_finite_texels)
-                               : 0;
-}
-
 void add_into(StreamBytes& a, const StreamBytes& b) {
   a.raw += b.raw;
   a.temporal += b.temporal;
   a.spatial += b.spatial;
   a.stored += b.stored;
   a.chunks += b.chunks;
+}
+
+// A task's figures in the track's terms, so that one merge (add_figures) serves tasks and views.
+LightfieldEncodeStats figures_of(const TaskStats& task) {
+  LightfieldEncodeStats f;
+  f.colour = task.colour;
+  f.depth = task.depth;
+  f.material = task.material;
+  f.colour_keyframes = task.keyframes;
+  f.depth_keyframes = task.depth_keyframes;
+  f.depth_pframes = task.pframes;
+  f.depth_empty_pframes = task.empty_pframes;
+  f.min_colour_quality_db = task.min_quality;
+  f.depth_max_rel_error = task.max_rel;
+  f.depth_sum_rel_error = task.sum_rel;
+  f.depth_finite_texels = task.finite_texels;
+  f.depth_sky_mismatches = task.sky_mismatches;
+  return f;
+}
+
+// Adds the counts and bytes of `part` to `total` (formats and hdr are the track's, not summed).
+void add_figures(LightfieldEncodeStats& total, const LightfieldEncodeStats& part) {
+  add_into(total.colour, part.colour);
+  add_into(total.depth, part.depth);
+  add_into(total.material, part.material);
+  total.index_bytes += part.index_bytes;
+  total.colour_cells += part.colour_cells;
+  total.colour_keyframes += part.colour_keyframes;
+  total.depth_tiles += part.depth_tiles;
+  total.depth_keyframes += part.depth_keyframes;
+  total.depth_pframes += part.depth_pframes;
+  total.depth_empty_pframes += part.depth_empty_pframes;
+  total.material_views += part.material_views;
+  total.min_colour_quality_db = std::min(total.min_colour_quality_db, part.min_colour_quality_db);
+  total.depth_max_rel_error = std::max(total.depth_max_rel_error, part.depth_max_rel_error);
+  total.depth_sum_rel_error += part.depth_sum_rel_error;
+  total.depth_finite_texels += part.depth_finite_texels;
+  total.depth_sky_mismatches += part.depth_sky_mismatches;
+  total.depth_mean_rel_error =
+      total.depth_finite_texels
+          ? total.depth_sum_rel_error / static_cast<double>(total.depth_finite_texels)
+          : 0;
 }
 
 }  // namespace
@@ -636,25 +673,12 @@ Expected<LightfieldViewEncoding> encode_lightfield_view(const capture::CaptureSe
     for (TaskOut& o : outs) {
       CALF_RETURN_IF_ERROR(o.status);
       for (Pending& p : o.chunks) out.chunks.push_back({p.keys, std::move(p.chunk)});
-      const TaskStats& s = o.stats;
-      add_into(stats.colour, s.colour);
-      add_into(stats.depth, s.depth);
-      add_into(stats.material, s.material);
-      stats.colour_keyframes += s.keyframes;
-      stats.depth_keyframes += s.depth_keyframes;
-      stats.depth_pframes += s.pframes;
-      stats.depth_empty_pframes += s.empty_pframes;
-      stats.min_colour_quality_db = std::min(stats.min_colour_quality_db, s.min_quality);
-      stats.depth_max_rel_error = std::max(stats.depth_max_rel_error, s.max_rel);
-      stats.depth_sum_rel_error += s.sum_rel;
-      stats.depth_finite_texels += s.finite_texels;
-      stats.depth_sky_mismatches += s.sky_mismatches;
+      add_figures(stats, figures_of(o.stats));
     }
     stats.colour_cells += nc;
     stats.depth_tiles += nt;
     if (options.progress) options.progress(uint64_t{6} * v + face + 1, total);
   }
-  stats.depth_mean_rel_error = mean_rel_error(stats);
   return out;
 }
 
@@ -682,25 +706,7 @@ Status LightfieldTrackWriter::append(const LightfieldViewEncoding& view) {
     CALF_RETURN_IF_ERROR(writer_->add_stored_chunk(keys, c.chunk).status());
   }
   next_view_ += 1;
-  LightfieldEncodeStats& t = stats_;
-  const LightfieldEncodeStats& s = view.stats;
-  add_into(t.colour, s.colour);
-  add_into(t.depth, s.depth);
-  add_into(t.material, s.material);
-  t.index_bytes += s.index_bytes;
-  t.colour_cells += s.colour_cells;
-  t.colour_keyframes += s.colour_keyframes;
-  t.depth_tiles += s.depth_tiles;
-  t.depth_keyframes += s.depth_keyframes;
-  t.depth_pframes += s.depth_pframes;
-  t.depth_empty_pframes += s.depth_empty_pframes;
-  t.material_views += s.material_views;
-  t.min_colour_quality_db = std::min(t.min_colour_quality_db, s.min_colour_quality_db);
-  t.depth_max_rel_error = std::max(t.depth_max_rel_error, s.depth_max_rel_error);
-  t.depth_sum_rel_error += s.depth_sum_rel_error;
-  t.depth_finite_texels += s.depth_finite_texels;
-  t.depth_sky_mismatches += s.depth_sky_mismatches;
-  t.depth_mean_rel_error = mean_rel_error(t);
+  add_figures(stats_, view.stats);
   return Status::Ok();
 }
 

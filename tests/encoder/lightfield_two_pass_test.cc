@@ -6,10 +6,10 @@
 
 #include <filesystem>
 #include <fstream>
-#include <limits>
 #include <string>
 #include <vector>
 
+#include "../integration/synthetic_capture.h"
 #include "calf/capture/capture_set.h"
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/format/container.h"
@@ -18,7 +18,7 @@ namespace calf {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr float kSky = std::numeric_limits<float>::infinity();
+using testing_support::kSky;
 constexpr uint32_t kFace = 8, kFrames = 4, kViews = 3;
 
 // View 0 sees a mirror on face 1 and depths 2.0 ... 2.75 (2.0 only at frame 0); view 1 no
@@ -65,27 +65,14 @@ class LightfieldTwoPass : public ::testing::Test {
   void TearDown() override { fs::remove_all(root_); }
 
   fs::path make_capture(const std::string& name, int hdr_view) {
-    capture::CaptureManifest m;
-    m.frame_count = kFrames;
-    m.face_size = kFace;
-    m.fps = 24;
-    m.material = true;
-    m.view_volume = {{-1, -1, -1}, {1, 1, 1}};
-    for (uint32_t v = 0; v < kViews; ++v) {
-      std::string id = "v";
-      id.append(std::to_string(v));
-      m.viewpoints.push_back({id, {0.25 * v, 0.5, -0.125 * v}});
-    }
+    testing_support::SceneSpec spec;
+    spec.face = kFace;
+    spec.frames = kFrames;
+    spec.views = kViews;
+    spec.material = true;
     const fs::path dir = root_ / name;
-    auto w = capture::CaptureSetWriter::create(dir, m);
-    EXPECT_TRUE(w.ok()) << w.status().to_string();
-    for (uint32_t v = 0; v < kViews; ++v) {
-      for (uint32_t f = 0; f < kFrames; ++f) {
-        const Status st = w->write(v, f, make_frame(v, f, hdr_view));
-        EXPECT_TRUE(st.ok()) << st.to_string();
-      }
-    }
-    const Status st = w->finish();
+    const Status st = testing_support::write_capture(
+        dir, spec, [&](uint32_t v, uint32_t f) { return make_frame(v, f, hdr_view); });
     EXPECT_TRUE(st.ok()) << st.to_string();
     return dir;
   }

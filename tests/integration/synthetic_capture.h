@@ -68,8 +68,11 @@ inline capture::ViewFrame make_frame(const SceneSpec& s, uint32_t view, uint32_t
   return vf;
 }
 
-// Writes the capture set of `s` into `dir` (created; must not exist yet).
-inline Status write_synthetic_capture(const std::filesystem::path& dir, const SceneSpec& s) {
+// Writes a capture set of s.views viewpoints, s.frames frames of s.face texels (material channels
+// when s.material) whose view-frames come from `frame(view, frame)`, into `dir` (created; must not
+// exist yet).
+template <class FrameFn>
+inline Status write_capture(const std::filesystem::path& dir, const SceneSpec& s, FrameFn frame) {
   capture::CaptureManifest m;
   m.frame_count = s.frames;
   m.face_size = s.face;
@@ -84,10 +87,14 @@ inline Status write_synthetic_capture(const std::filesystem::path& dir, const Sc
   auto w = capture::CaptureSetWriter::create(dir, m);
   CALF_RETURN_IF_ERROR(w.status());
   for (uint32_t v = 0; v < s.views; ++v) {
-    for (uint32_t f = 0; f < s.frames; ++f)
-      CALF_RETURN_IF_ERROR(w->write(v, f, make_frame(s, v, f)));
+    for (uint32_t f = 0; f < s.frames; ++f) CALF_RETURN_IF_ERROR(w->write(v, f, frame(v, f)));
   }
   return w->finish();
+}
+
+// Writes the capture set of `s` (make_frame) into `dir` (created; must not exist yet).
+inline Status write_synthetic_capture(const std::filesystem::path& dir, const SceneSpec& s) {
+  return write_capture(dir, s, [&](uint32_t v, uint32_t f) { return make_frame(s, v, f); });
 }
 
 }  // namespace calf::testing_support
