@@ -42,7 +42,8 @@ capture::ViewFrame make_frame(const SceneSpec& s, uint32_t view, uint32_t frame)
     for (uint32_t y = 0; y < s.face; ++y) {
       for (uint32_t x = 0; x < s.face; ++x) {
         const size_t i = vf.texel_index(static_cast<CubeFace>(face), x, y);
-        float r = 0.2f + 0.5f * x / s.face, g = 0.3f + 0.4f * y / s.face, b = 0.1f * face + 0.05f * view;
+        float r = 0.2f + 0.5f * x / s.face, g = 0.3f + 0.4f * y / s.face,
+              b = 0.1f * face + 0.05f * view;
         float z = 2.0f + 0.1f * face + 0.05f * x + 0.03f * y + 0.5f * view;
         if (face == 0) {
           const uint32_t sx = 1 + 2 * f;
