@@ -18,65 +18,15 @@
 #include "calf/format/container.h"
 #include "calf/format/grid.h"
 #include "calf/format/log_depth.h"
+#include "synthetic_capture.h"
 
 namespace calf {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr float kSky = std::numeric_limits<float>::infinity();
+using testing_support::kSky;
 
-struct SceneSpec {
-  uint32_t face = 16, frames = 5, views = 2;
-  bool animated = true;
-  bool hdr = false;
-  bool material = false;
-};
-
-// A small animated scene: smooth colour everywhere, a square that moves across face 0 (colour and
-// depth), a slow global fade on face 2, sky on the top half of face 3, everything else static.
-capture::ViewFrame make_frame(const SceneSpec& s, uint32_t view, uint32_t frame) {
-  capture::ViewFrame vf;
-  vf.resize(s.face, s.material);
-  const uint32_t f = s.animated ? frame : 0;
-  for (uint32_t face = 0; face < 6; ++face) {
-    for (uint32_t y = 0; y < s.face; ++y) {
-      for (uint32_t x = 0; x < s.face; ++x) {
-        const size_t i = vf.texel_index(static_cast<CubeFace>(face), x, y);
-        float r = 0.2f + 0.5f * x / s.face, g = 0.3f + 0.4f * y / s.face,
-              b = 0.1f * face + 0.05f * view;
-        float z = 2.0f + 0.1f * face + 0.05f * x + 0.03f * y + 0.5f * view;
-        if (face == 0) {
-          const uint32_t sx = 1 + 2 * f;
-          if (x >= sx && x < sx + 5 && y >= 4 && y < 9) {
-            r = 0.9f;
-            g = 0.1f;
-            z = 1.0f;
-          }
-        }
-        if (face == 2) {
-          r *= 1.0f - 0.05f * static_cast<float>(f);
-          g *= 1.0f - 0.03f * static_cast<float>(f);
-        }
-        if (face == 3 && y < s.face / 2) z = kSky;
-        if (s.hdr && face == 4) {
-          r *= 40.0f;
-          g *= 20.0f;
-        }
-        vf.color[3 * i] = r;
-        vf.color[3 * i + 1] = g;
-        vf.color[3 * i + 2] = b;
-        vf.depth[i] = z;
-        if (s.material) {
-          const bool mirror = face == 1 && x < 6;
-          vf.material[3 * i] = mirror ? 0.8f : 0.0f;
-          vf.material[3 * i + 1] = 0.0f;
-          vf.material[3 * i + 2] = mirror ? 1.5f : 1.0f;
-        }
-      }
-    }
-  }
-  return vf;
-}
+using testing_support::SceneSpec;
 
 class LightfieldRoundTrip : public ::testing::Test {
  protected:
@@ -90,27 +40,8 @@ class LightfieldRoundTrip : public ::testing::Test {
   void TearDown() override { fs::remove_all(root_); }
 
   fs::path make_capture(const SceneSpec& s, const std::string& name) {
-    capture::CaptureManifest m;
-    m.frame_count = s.frames;
-    m.face_size = s.face;
-    m.fps = 24;
-    m.material = s.material;
-    m.view_volume = {{-1, -1, -1}, {1, 1, 1}};
-    for (uint32_t v = 0; v < s.views; ++v) {
-      std::string id = "v";  // append, not operator+: GCC 12 -O3 misfires -Wrestrict on it
-      id.append(std::to_string(v));
-      m.viewpoints.push_back({id, {0.5 * v, 0, 0}});
-    }
     const fs::path dir = root_ / name;
-    auto w = capture::CaptureSetWriter::create(dir, m);
-    EXPECT_TRUE(w.ok()) << w.status().to_string();
-    for (uint32_t v = 0; v < s.views; ++v) {
-      for (uint32_t f = 0; f < s.frames; ++f) {
-        Status st = w->write(v, f, make_frame(s, v, f));
-        EXPECT_TRUE(st.ok()) << st.to_string();
-      }
-    }
-    Status st = w->finish();
+    Status st = testing_support::write_synthetic_capture(dir, s);
     EXPECT_TRUE(st.ok()) << st.to_string();
     return dir;
   }
