@@ -26,12 +26,11 @@ std::string where(uint32_t view, uint32_t face, uint32_t region) {
          std::to_string(region);
 }
 
-bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-double length(const Vec3& v) { return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z); }
-
 Status check_eye(const EyeView& e, size_t i) {
   const std::string name = "eye " + std::to_string(i) + ": ";
-  if (!finite(e.position) || !finite(e.forward) || !finite(e.up)) return bad_argument(name + "not finite");
+  if (!is_finite(e.position) || !is_finite(e.forward) || !is_finite(e.up)) {
+    return bad_argument(name + "not finite");
+  }
   if (length(e.forward) == 0 || length(e.up) == 0) return bad_argument(name + "zero forward or up");
   if (!(e.fov_y > 0 && e.fov_y < std::numbers::pi) || !(e.aspect > 0) || !std::isfinite(e.aspect)) {
     return bad_argument(name + "field of view or aspect out of range");
@@ -416,9 +415,7 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
     // frustum with a far cap beyond the eye's (so every shared direction has a shared point).
     std::vector<double> z_far(eyes.size());
     for (size_t i = 0; i < eyes.size(); ++i) {
-      const Vec3& e = eyes[i].position;
-      const Vec3 to{e.x - p.x, e.y - p.y, e.z - p.z};
-      z_far[i] = std::max<double>(info.z_far, length(to) + eyes[i].far);
+      z_far[i] = std::max<double>(info.z_far, length(eyes[i].position - p) + eyes[i].far);
     }
     const bool has_material = info.has_material && d.material_coding.has_value();
     for (uint32_t f = 0; f < 6; ++f) {

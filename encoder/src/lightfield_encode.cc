@@ -744,7 +744,7 @@ Expected<LightfieldEncodeStats> encode_lightfield_file(const std::filesystem::pa
     CALF_RETURN_IF_ERROR(writer.set_metadata("source_scene", input.manifest().scene));
   }
   // The box the eye may move in (format/CAPTURE.md view_volume): the player warns outside it.
-  const capture::Box3& box = input.manifest().view_volume;
+  const Box3& box = input.manifest().view_volume;
   char volume[160];
   std::snprintf(volume, sizeof volume, "%.17g %.17g %.17g %.17g %.17g %.17g", box.min.x, box.min.y,
                 box.min.z, box.max.x, box.max.y, box.max.z);

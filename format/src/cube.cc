@@ -26,13 +26,11 @@ constexpr FaceAxes kFaceAxes[kCubeFaceCount] = {
     {2, -1, 0, -1, 1, -1},  // -Z: sc = -x, tc = -y
 };
 
-double component(const Direction& d, int axis) {
-  return axis == 0 ? d.x : axis == 1 ? d.y : d.z;
-}
-
-Direction normalized(double x, double y, double z) {
-  const double len = std::sqrt(x * x + y * y + z * z);
-  return {x / len, y / len, z / len};
+// Divides by the length (not a multiply by its reciprocal, as normalize() does): the bits every
+// capture and frozen conformance file were made with.
+Vec3 normalized(double x, double y, double z) {
+  const Vec3 v{x, y, z};
+  return v / length(v);
 }
 
 }  // namespace
@@ -43,7 +41,7 @@ const char* cube_face_name(CubeFace face) {
   return i >= 0 && i < kCubeFaceCount ? kNames[i] : "?";
 }
 
-FaceCoord face_coord_from_direction(const Direction& d) {
+FaceCoord face_coord_from_direction(const Vec3& d) {
   const double ax = std::fabs(d.x), ay = std::fabs(d.y), az = std::fabs(d.z);
   const bool valid =
       std::isfinite(ax) && std::isfinite(ay) && std::isfinite(az) && (ax > 0 || ay > 0 || az > 0);
@@ -67,7 +65,7 @@ FaceCoord face_coord_from_direction(const Direction& d) {
   return {cube_face_from_index(face), 0.5 * (sc * inv + 1.0), 0.5 * (tc * inv + 1.0)};
 }
 
-Direction direction_from_face_coord(const FaceCoord& c) {
+Vec3 direction_from_face_coord(const FaceCoord& c) {
   const FaceAxes& f = kFaceAxes[cube_face_index(c.face)];
   double v[3];
   v[f.major_axis] = f.major_sign;
@@ -76,22 +74,22 @@ Direction direction_from_face_coord(const FaceCoord& c) {
   return normalized(v[0], v[1], v[2]);
 }
 
-Direction direction_from_texel_coord(const FaceTexelCoord& c, uint32_t face_size) {
+Vec3 direction_from_texel_coord(const FaceTexelCoord& c, uint32_t face_size) {
   const double n = face_size;
   return direction_from_face_coord({c.face, c.u / n, c.v / n});
 }
 
-Direction direction_from_texel(CubeFace face, uint32_t x, uint32_t y, uint32_t face_size) {
+Vec3 direction_from_texel(CubeFace face, uint32_t x, uint32_t y, uint32_t face_size) {
   return direction_from_texel_coord({face, x + 0.5, y + 0.5}, face_size);
 }
 
-FaceTexelCoord texel_coord_from_direction(const Direction& d, uint32_t face_size) {
+FaceTexelCoord texel_coord_from_direction(const Vec3& d, uint32_t face_size) {
   const FaceCoord c = face_coord_from_direction(d);
   const double n = face_size;
   return {c.face, c.s * n, c.t * n};
 }
 
-Texel texel_from_direction(const Direction& d, uint32_t face_size) {
+Texel texel_from_direction(const Vec3& d, uint32_t face_size) {
   const FaceTexelCoord c = texel_coord_from_direction(d, face_size);
   const auto clamp_texel = [face_size](double u) -> uint32_t {
     if (!(u > 0)) return 0;  // also catches NaN

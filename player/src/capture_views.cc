@@ -88,8 +88,7 @@ Expected<ViewSet> load_capture_views(const capture::CaptureSetReader& reader, ui
   capture::ViewFrame image;
   for (uint32_t v = 0; v < m.viewpoints.size(); ++v) {
     CALF_RETURN_IF_ERROR(reader.read(v, frame, &image));
-    const capture::Point3& p = m.viewpoints[v].position;
-    CALF_ASSIGN_OR_RETURN(View view, view_from_capture_frame(image, {p.x, p.y, p.z},
+    CALF_ASSIGN_OR_RETURN(View view, view_from_capture_frame(image, m.viewpoints[v].position,
                                                              reader.image_path(v, frame).string()));
     views.views.push_back(std::move(view));
   }
@@ -102,17 +101,6 @@ uint32_t capture_frame_at(const capture::CaptureManifest& manifest, double time)
   return static_cast<uint32_t>(std::min(f, static_cast<double>(manifest.frame_count - 1)));
 }
 
-Camera camera_from_pose(const capture::EyePose& pose, uint32_t width, uint32_t height) {
-  Camera c;
-  c.position = {pose.position.x, pose.position.y, pose.position.z};
-  c.forward = {pose.forward.x, pose.forward.y, pose.forward.z};
-  c.up = {pose.up.x, pose.up.y, pose.up.z};
-  c.fov_y = pose.fov_y_degrees * (3.141592653589793 / 180);
-  c.width = width;
-  c.height = height;
-  return c;
-}
-
 RenderedImage reproject_view(const View& view, const Camera& camera) {
   RenderedImage out;
   out.width = camera.width;
@@ -121,10 +109,10 @@ RenderedImage reproject_view(const View& view, const Camera& camera) {
   out.color.assign(3 * pixels, 0.0f);
   out.depth.assign(pixels, 0.0f);
   const uint32_t n = view.face_size();
+  const CameraFrame frame = camera_frame(camera);
   for (uint32_t j = 0; j < camera.height; ++j) {
     for (uint32_t i = 0; i < camera.width; ++i) {
-      const Vec3 d = camera_ray(camera, i, j);
-      const Direction dir{d.x, d.y, d.z};
+      const Vec3 dir = camera_ray(camera, frame, i, j);
       const internal::BilinearTaps taps =
           internal::bilinear_taps(texel_coord_from_direction(dir, n), n);
       const size_t k = size_t{j} * camera.width + i;

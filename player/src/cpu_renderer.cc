@@ -10,51 +10,15 @@
 #include "sampling.h"
 
 namespace calf::player {
-
-using internal::cross;
-using internal::dot;
-using internal::length;
-using internal::normalize;
-using internal::to_direction;
-using internal::operator+;
-using internal::operator-;
-using internal::operator*;
-
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-bool finite(const Vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
 
 Status option_error(const std::string& what) {
   return Status(ErrorId::kPlayerOptions, what);
 }
 
-// A camera's orthonormal frame, or false when forward / up are degenerate.
-bool camera_frame(const Camera& c, Vec3* f, Vec3* r, Vec3* u) {
-  if (!finite(c.forward) || !finite(c.up) || length(c.forward) == 0) return false;
-  *f = normalize(c.forward);
-  const Vec3 right = cross(*f, c.up);
-  const double len = length(right);
-  if (!(len > 1e-12 * std::max(1.0, length(c.up)))) return false;
-  *r = right * (1.0 / len);
-  *u = cross(*r, *f);
-  return true;
-}
-
 }  // namespace
-
-Vec3 camera_ray(const Camera& camera, uint32_t i, uint32_t j) {
-  Vec3 f, r, u;
-  camera_frame(camera, &f, &r, &u);
-  const double h = std::tan(camera.fov_y / 2);
-  const double a = 2.0 * (i + 0.5) / camera.width - 1.0;
-  const double b = 1.0 - 2.0 * (j + 0.5) / camera.height;
-  const double aspect = static_cast<double>(camera.width) / camera.height;
-  return normalize(f + r * (a * h * aspect) + u * (b * h));
-}
 
 Expected<RenderOptions> march_range_for(std::span<const MarchView> views, const Vec3& eye,
                                         RenderOptions options) {
@@ -150,8 +114,8 @@ namespace {
 // (see RenderOptions), or the interpolated depth where the taps form one smooth surface.
 double code_margin(const View& v, const Vec3& x, double r, double footprint,
                    double smooth_log_ratio) {
-  const internal::BilinearTaps taps = internal::bilinear_taps(
-      texel_coord_from_direction(to_direction(x), v.face_size()), v.face_size());
+  const internal::BilinearTaps taps =
+      internal::bilinear_taps(texel_coord_from_direction(x, v.face_size()), v.face_size());
   uint16_t c[4], lo = kLog16Sky, hi = 0;
   for (int k = 0; k < 4; ++k) {
     c[k] = v.depth_code_at(taps.texel[k].face, taps.texel[k].x, taps.texel[k].y);
@@ -253,7 +217,7 @@ bool CpuRenderer::intersect(const Vec3& o, const Vec3& d, double start, Hit* hit
     // The nearest texel's depth: the view's own best estimate of its surface along the ray
     // (the conservative footprint minimum would put the crossing in front of slanted surfaces,
     // where the other views then rightly see empty space). One fetch, also on the GPU.
-    const Texel t = texel_from_direction(to_direction(rel), v->face_size());
+    const Texel t = texel_from_direction(rel, v->face_size());
     const uint16_t code = v->depth_code_at(t.face, t.x, t.y);
     if (code == kLog16Sky) return 1;
     return code > v->range().normalized_from_depth(r) * kLog16MaxFinite ? 1 : 0;
@@ -329,8 +293,8 @@ void CpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* rgb, int* 
     const Vec3 x = p - v.position();
     const double r = length(x);
     if (r <= min_view_distance_) continue;
-    const FaceTexelCoord c = texel_coord_from_direction(to_direction(x), v.face_size());
-    const Texel nearest = texel_from_direction(to_direction(x), v.face_size());
+    const FaceTexelCoord c = texel_coord_from_direction(x, v.face_size());
+    const Texel nearest = texel_from_direction(x, v.face_size());
     const uint16_t ncode = v.depth_code_at(nearest.face, nearest.x, nearest.y);
     if (ncode == kLog16Sky) continue;  // this view sees past p: it has no colour for it
     const double ndiff = std::fabs(std::log(v.range().decode(ncode) / r));
@@ -387,7 +351,7 @@ void CpuRenderer::shade_sky(const Vec3& /*origin*/, const Vec3& d, double* rgb) 
     double sum[3] = {0, 0, 0};
     int n = 0;
     for (const View* v : active_) {
-      const Texel nearest = texel_from_direction(to_direction(d), v->face_size());
+      const Texel nearest = texel_from_direction(d, v->face_size());
       const bool sky = v->depth_code_at(nearest.face, nearest.x, nearest.y) == kLog16Sky;
       if (pass == 0 && !sky) continue;
       double c[3] = {0, 0, 0};
@@ -395,8 +359,8 @@ void CpuRenderer::shade_sky(const Vec3& /*origin*/, const Vec3& d, double* rgb) 
         const float* col = v->color_at(nearest.face, nearest.x, nearest.y);
         for (int ch = 0; ch < 3; ++ch) c[ch] = col[ch];
       } else {
-        const internal::BilinearTaps taps = internal::bilinear_taps(
-            texel_coord_from_direction(to_direction(d), v->face_size()), v->face_size());
+        const internal::BilinearTaps taps =
+            internal::bilinear_taps(texel_coord_from_direction(d, v->face_size()), v->face_size());
         double a[4], asum = 0;
         for (int t = 0; t < 4; ++t) {
           const bool tap_sky =
@@ -445,18 +409,8 @@ RaySample CpuRenderer::trace(const Vec3& origin, const Vec3& direction) const {
 }
 
 Status CpuRenderer::render(const Camera& camera, RenderedImage* out) const {
-  Vec3 f, r, u;
-  if (!finite(camera.position) || !camera_frame(camera, &f, &r, &u)) {
-    return option_error("camera position, forward or up is not finite, zero or parallel");
-  }
-  if (!(camera.fov_y > 0) || !(camera.fov_y < 3.141592653589793)) {
-    return option_error("camera fov_y " + std::to_string(camera.fov_y) + " is outside (0, pi)");
-  }
-  if (camera.width < 1 || camera.height < 1 || camera.width > kMaxFaceSize ||
-      camera.height > kMaxFaceSize) {
-    return option_error("image size " + std::to_string(camera.width) + " x " +
-                        std::to_string(camera.height) + " is outside 1..16384");
-  }
+  CALF_RETURN_IF_ERROR(validate_camera(camera));
+  const CameraFrame frame = camera_frame(camera);
   out->width = camera.width;
   out->height = camera.height;
   const size_t pixels = size_t{camera.width} * camera.height;
@@ -467,7 +421,7 @@ Status CpuRenderer::render(const Camera& camera, RenderedImage* out) const {
   const auto work = [&](uint32_t first) {
     for (uint32_t j = first; j < camera.height; j += options_.threads) {
       for (uint32_t i = 0; i < camera.width; ++i) {
-        const RaySample s = trace(camera.position, camera_ray(camera, i, j));
+        const RaySample s = trace(camera.position, camera_ray(camera, frame, i, j));
         const size_t k = size_t{j} * camera.width + i;
         for (int ch = 0; ch < 3; ++ch) out->color[3 * k + ch] = static_cast<float>(s.rgb[ch]);
         out->depth[k] = static_cast<float>(s.depth);

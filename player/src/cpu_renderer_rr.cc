@@ -8,24 +8,14 @@
 
 namespace calf::player {
 
-using internal::cross;
-using internal::dot;
-using internal::length;
-using internal::normalize;
-using internal::to_direction;
-using internal::to_vec;
-using internal::operator+;
-using internal::operator-;
-using internal::operator*;
-
 namespace {
 
 // The scene point a texel of `v` stands for, or false for sky.
 bool texel_point(const View& v, const Texel& t, Vec3* q) {
   const uint16_t code = v.depth_code_at(t.face, t.x, t.y);
   if (code == kLog16Sky) return false;
-  *q = v.position() +
-       to_vec(direction_from_texel(t.face, t.x, t.y, v.face_size())) * v.range().decode(code);
+  *q =
+      v.position() + direction_from_texel(t.face, t.x, t.y, v.face_size()) * v.range().decode(code);
   return true;
 }
 
@@ -108,7 +98,7 @@ void CpuRenderer::shade_rr(const Vec3& o, const Vec3& d, const Hit& hit, uint32_
   // categorical at object edges, where blending weights would invent half-mirrors.
   const View& v = *active_[best];
   const Vec3 x = hit.p - v.position();
-  const Texel t = texel_from_direction(to_direction(x), v.face_size());
+  const Texel t = texel_from_direction(x, v.face_size());
   const Material m = v.material_at(t.face, t.x, t.y);
   if (!(m.reflect > 0) && !(m.refract > 0)) return;
   Vec3 n;

@@ -13,13 +13,8 @@
 
 namespace calf::player {
 
-using internal::cross;
 using internal::GlViewRecord;
 using internal::kGlMissing;
-using internal::length;
-using internal::normalize;
-using internal::operator-;
-using internal::operator*;
 
 namespace {
 
@@ -38,36 +33,16 @@ Status check_options(const RenderOptions& o, size_t view_count) {
   return Status::Ok();
 }
 
-bool finite(const Vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
-// The camera's frame scaled for the ray formula of cpu_renderer.h, or an error as the CPU
-// renderer gives it.
+// The camera's frame scaled for the ray formula of calf/format/camera.h: the shader's ray is
+// normalize(forward + a * right + b * up) with a, b in [-1, 1] at the image edges.
 Status camera_axes(const Camera& c, Vec3* forward, Vec3* right, Vec3* up) {
-  const auto bad = [] {
-    return option_error("camera position, forward or up is not finite, zero or parallel");
-  };
-  if (!finite(c.position) || !finite(c.forward) || !finite(c.up) || length(c.forward) == 0) {
-    return bad();
-  }
-  const Vec3 f = normalize(c.forward);
-  const Vec3 r = cross(f, c.up);
-  const double len = length(r);
-  if (!(len > 1e-12 * std::max(1.0, length(c.up)))) return bad();
-  if (!(c.fov_y > 0) || !(c.fov_y < 3.141592653589793)) {
-    return option_error("camera fov_y " + std::to_string(c.fov_y) + " is outside (0, pi)");
-  }
-  if (c.width < 1 || c.height < 1 || c.width > kMaxFaceSize || c.height > kMaxFaceSize) {
-    return option_error("image size " + std::to_string(c.width) + " x " + std::to_string(c.height) +
-                        " is outside 1..16384");
-  }
-  const Vec3 ru = r * (1.0 / len);
+  CALF_RETURN_IF_ERROR(validate_camera(c));
+  const CameraFrame frame = camera_frame(c);
   const double h = std::tan(c.fov_y / 2);
   const double aspect = static_cast<double>(c.width) / c.height;
-  *forward = f;
-  *right = ru * (h * aspect);
-  *up = cross(ru, f) * h;
+  *forward = frame.forward;
+  *right = frame.right * (h * aspect);
+  *up = frame.up * h;
   return Status::Ok();
 }
 

@@ -29,14 +29,10 @@ std::string glfw_error() {
   return text ? text : "unknown GLFW error";
 }
 
-Vec3 add(const Vec3& a, const Vec3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-Vec3 scale(const Vec3& a, double s) { return {a.x * s, a.y * s, a.z * s}; }
-Vec3 cross(const Vec3& a, const Vec3& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
+// Unit `a`, or straight ahead (-Z) when `a` is zero (looking straight up or down).
 Vec3 normalized(const Vec3& a) {
-  const double l = std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z);
-  return l > 0 ? scale(a, 1 / l) : Vec3{0, 0, -1};
+  const double l = length(a);
+  return l > 0 ? a * (1 / l) : Vec3{0, 0, -1};
 }
 
 struct CameraState {
@@ -48,7 +44,7 @@ struct CameraState {
   Vec3 forward() const {
     return {std::sin(yaw) * std::cos(pitch), std::sin(pitch), -std::cos(yaw) * std::cos(pitch)};
   }
-  Vec3 eye() const { return orbit ? add(centre, scale(forward(), -radius)) : position; }
+  Vec3 eye() const { return orbit ? centre + forward() * -radius : position; }
 };
 
 }  // namespace
@@ -100,7 +96,7 @@ Status run_window(const std::string& clip_path, const PlaybackOptions& options,
   gl.GenTextures(1, &display);
   CameraState cam;
   const auto& [lo, hi] = play->view_volume();
-  cam.centre = scale(add(lo, hi), 0.5);
+  cam.centre = (lo + hi) * 0.5;
   cam.position = cam.centre;
   cam.radius = std::max(0.5, std::hypot(hi.x - lo.x, hi.y - lo.y, hi.z - lo.z));
   bool stereo = wo.stereo, paused = false, show_hud = true;
@@ -162,10 +158,10 @@ Status run_window(const std::string& clip_path, const PlaybackOptions& options,
         if (held(GLFW_KEY_W)) cam.radius = std::max(0.05, cam.radius - speed);
         if (held(GLFW_KEY_S) && !shift) cam.radius += speed;
       } else {
-        if (held(GLFW_KEY_W)) cam.position = add(cam.position, scale(f, speed));
-        if (held(GLFW_KEY_S) && !shift) cam.position = add(cam.position, scale(f, -speed));
-        if (held(GLFW_KEY_D)) cam.position = add(cam.position, scale(right, speed));
-        if (held(GLFW_KEY_A)) cam.position = add(cam.position, scale(right, -speed));
+        if (held(GLFW_KEY_W)) cam.position += f * speed;
+        if (held(GLFW_KEY_S) && !shift) cam.position += f * -speed;
+        if (held(GLFW_KEY_D)) cam.position += right * speed;
+        if (held(GLFW_KEY_A)) cam.position += right * -speed;
         if (held(GLFW_KEY_E)) cam.position.y += speed;
         if (held(GLFW_KEY_Q)) cam.position.y -= speed;
       }
@@ -188,7 +184,7 @@ Status run_window(const std::string& clip_path, const PlaybackOptions& options,
     for (uint32_t e = 0; e < eyes_n; ++e) {
       Camera c;
       const double offset = stereo ? (e == 0 ? -0.5 : 0.5) * wo.ipd : 0;
-      c.position = add(cam.eye(), scale(right, offset));
+      c.position = cam.eye() + right * offset;
       c.forward = cam.orbit ? f : f;
       c.up = {0, 1, 0};
       c.fov_y = wo.fov_y_degrees * M_PI / 180;

@@ -18,7 +18,7 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 }
 
 // The view volume from the clip's metadata ("x0 y0 z0 x1 y1 z1"), if present and well formed.
-std::optional<std::pair<Vec3, Vec3>> parse_volume(const std::string* text) {
+std::optional<Box3> parse_volume(const std::string* text) {
   if (text == nullptr) return std::nullopt;
   std::istringstream in(*text);
   double v[6];
@@ -26,7 +26,7 @@ std::optional<std::pair<Vec3, Vec3>> parse_volume(const std::string* text) {
     if (!(in >> x) || !std::isfinite(x)) return std::nullopt;
   }
   if (v[0] > v[3] || v[1] > v[4] || v[2] > v[5]) return std::nullopt;
-  return std::make_pair(Vec3{v[0], v[1], v[2]}, Vec3{v[3], v[4], v[5]});
+  return Box3{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
 }
 
 }  // namespace
@@ -37,7 +37,7 @@ struct Playback::Impl {
   PlaybackOptions options;
   std::optional<ViewSelector> selector;
   std::vector<Vec3> viewpoints;
-  std::pair<Vec3, Vec3> volume;
+  Box3 volume;
   bool has_material = false;
 
   // GL path.
@@ -83,18 +83,16 @@ Expected<std::unique_ptr<Playback>> Playback::open(const std::string& clip_path,
   impl->decoder.emplace(std::move(d));
   const auto& h = impl->decoder->header();
   std::vector<decoder::LightfieldViewInfo> views;
-  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  Box3 bounds{{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
   for (uint32_t v = 0; v < h.view_count; ++v) {
     const auto& info = impl->decoder->view(v);
     views.push_back(info);
     const Vec3 p{info.position[0], info.position[1], info.position[2]};
     impl->viewpoints.push_back(p);
-    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    bounds = box_union(bounds, p);
     impl->has_material = impl->has_material || info.has_material;
   }
-  impl->volume = parse_volume(impl->reader->find_metadata("view_volume"))
-                     .value_or(std::make_pair(lo, hi));
+  impl->volume = parse_volume(impl->reader->find_metadata("view_volume")).value_or(bounds);
   CALF_ASSIGN_OR_RETURN(ViewSelector sel, ViewSelector::make(impl->viewpoints, options.selection));
   impl->selector.emplace(std::move(sel));
 
@@ -130,7 +128,7 @@ uint32_t Playback::frame_at_time(double seconds) const {
 }
 
 bool Playback::has_material() const { return impl_->has_material; }
-const std::pair<Vec3, Vec3>& Playback::view_volume() const { return impl_->volume; }
+const Box3& Playback::view_volume() const { return impl_->volume; }
 const std::vector<Vec3>& Playback::viewpoints() const { return impl_->viewpoints; }
 
 bool Playback::inside_view_volume(const Vec3& p) const {
@@ -159,24 +157,15 @@ Status Playback::prepare(uint32_t frame, std::span<const EyeCamera> eyes) {
   if (eyes.empty()) return Status(ErrorId::kPlayerOptions, "prepare() needs at least one eye");
   Vec3 mid, forward;
   for (const EyeCamera& e : eyes) {
-    mid = {mid.x + e.position.x / eyes.size(), mid.y + e.position.y / eyes.size(),
-           mid.z + e.position.z / eyes.size()};
-    forward = {forward.x + e.forward.x, forward.y + e.forward.y, forward.z + e.forward.z};
+    mid += e.position / static_cast<double>(eyes.size());
+    forward += e.forward;
   }
   CALF_ASSIGN_OR_RETURN(d.selection, d.selector->select(mid, forward));
   // The viewers' frusta, out to the march range's far end: nothing farther is ever sampled.
   std::vector<EyeView> frusta;
   for (const EyeCamera& e : eyes) {
     const RenderOptions r = d.frame_options(e.position);
-    EyeView v;
-    v.position = e.position;
-    v.forward = e.forward;
-    v.up = e.up;
-    v.fov_y = e.fov_y;
-    v.aspect = static_cast<double>(e.width) / e.height;
-    v.near = r.near;
-    v.far = r.far;
-    frusta.push_back(v);
+    frusta.push_back(eye_view(e, r.near, r.far));
   }
   // Reflection / refraction rays leave the eyes' frusta and read any texel of the active views:
   // with RR on, every cell is kept current (with culling, stale cells cost ~0.8 dB on mirror-box).

@@ -9,7 +9,7 @@ Texel texel_beyond_face(CubeFace face, int64_t x, int64_t y, uint32_t n) {
     return {face, static_cast<uint32_t>(x), static_cast<uint32_t>(y)};
   }
   // The texel centre continued in the face's plane, looked up again: lands on the neighbour.
-  const Direction d = direction_from_texel_coord(
+  const Vec3 d = direction_from_texel_coord(
       {face, static_cast<double>(x) + 0.5, static_cast<double>(y) + 0.5}, n);
   return texel_from_direction(d, n);
 }

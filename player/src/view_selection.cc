@@ -14,18 +14,9 @@
 namespace calf::player {
 namespace {
 
-using internal::cross;
-using internal::dot;
-using internal::length;
-using internal::operator-;
-
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr uint32_t kMaxGrowthBackoff = 32;
-
-bool finite(const Vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
 
 // Shortest faithful text of a number ("0.5", "nan", "1e+300"), for messages.
 std::string num(double x) {
@@ -40,13 +31,6 @@ std::string vec_string(const Vec3& v) {
   return buf;
 }
 
-// The angle between two non-zero vectors in radians, [0, pi]. atan2 of |a x b| and a . b stays
-// accurate near 0 and pi, where acos of a normalised dot product loses half its digits — and
-// the culling thresholds of a few degrees sit exactly there.
-double angle_between(const Vec3& a, const Vec3& b) {
-  return std::atan2(length(cross(a, b)), dot(a, b));
-}
-
 Status option_error(const char* field, double value, const char* range) {
   return Status(ErrorId::kViewSelectOptions, std::string("view selection option ") + field + " = " +
                                                  num(value) + " is outside " + range);
@@ -56,7 +40,7 @@ Status check_options(const ViewSelectionOptions& o) {
   if (o.priority != ViewPriority::kDistance && o.priority != ViewPriority::kAngle) {
     return option_error("priority", static_cast<double>(o.priority), "{distance, angle}");
   }
-  if (!finite(o.reference_point)) {
+  if (!is_finite(o.reference_point)) {
     return Status(ErrorId::kViewSelectOptions,
                   "view selection option reference_point = " + vec_string(o.reference_point) +
                       " is not finite");
@@ -113,7 +97,7 @@ Expected<ViewSelector> ViewSelector::make(std::vector<Vec3> viewpoints,
                                                  std::to_string(kMaxViewpoints));
   }
   for (size_t i = 0; i < viewpoints.size(); ++i) {
-    if (!finite(viewpoints[i])) {
+    if (!is_finite(viewpoints[i])) {
       return Status(ErrorId::kViewSelectViewpoint, "viewpoint " + std::to_string(i) + " position " +
                                                        vec_string(viewpoints[i]) +
                                                        " is not finite");
@@ -151,7 +135,7 @@ Status ViewSelector::set_options(const ViewSelectionOptions& options) {
 Expected<ViewSelection> ViewSelector::select(const Vec3& position, const Vec3& forward) {
   const ViewSelectionOptions& o = options_;
   const bool cone_on = o.view_cone_deg < 180;
-  if (!finite(position) || !finite(forward)) {
+  if (!is_finite(position) || !is_finite(forward)) {
     return Status(ErrorId::kViewSelectEye, "eye position " + vec_string(position) + " or forward " +
                                                vec_string(forward) + " is not finite");
   }

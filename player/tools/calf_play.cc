@@ -31,17 +31,6 @@ int fail(const Status& status) {
   return 1;
 }
 
-Camera camera_for(const capture::EyePath& path, const capture::EyePose& p) {
-  Camera c;
-  c.position = {p.position.x, p.position.y, p.position.z};
-  c.forward = {p.forward.x, p.forward.y, p.forward.z};
-  c.up = {p.up.x, p.up.y, p.up.z};
-  c.fov_y = p.fov_y_degrees * M_PI / 180.0;
-  c.width = path.width;
-  c.height = path.height;
-  return c;
-}
-
 struct HeadlessArgs {
   std::string eye_path, out, compare, format = "png", contact_sheet;
   uint32_t sheet_rows = 8;
@@ -97,7 +86,7 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
     size_t j = i + 1;
     while (j < path.poses.size() && path.poses[j].time == path.poses[i].time) ++j;
     std::vector<Camera> eyes;
-    for (size_t k = i; k < j; ++k) eyes.push_back(camera_for(path, path.poses[k]));
+    for (size_t k = i; k < j; ++k) eyes.push_back(capture::camera_from_pose(path, k));
     const uint32_t frame = play.frame_at_time(path.poses[i].time);
     if (Status s = play.prepare(frame, eyes); !s.ok()) return fail(s);
     const auto& st = play.last_stats();

@@ -14,7 +14,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-std::string point_text(const capture::Point3& p) {
+std::string point_text(const Vec3& p) {
   char buf[96];
   std::snprintf(buf, sizeof buf, "(%g, %g, %g)", p.x, p.y, p.z);
   return buf;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "calf/samples/scene.h"
+#include "glm_vec.h"
 
 namespace calf::samples {
 
@@ -19,16 +20,9 @@ const char* const kRigSyntaxHelp =
 
 namespace {
 
-capture::Point3 point(const glm::dvec3& p) { return {p.x, p.y, p.z}; }
-
-capture::Box3 bounds(const std::vector<capture::Viewpoint>& views) {
-  capture::Box3 b{views[0].position, views[0].position};
-  for (const capture::Viewpoint& v : views) {
-    b.min = {std::min(b.min.x, v.position.x), std::min(b.min.y, v.position.y),
-             std::min(b.min.z, v.position.z)};
-    b.max = {std::max(b.max.x, v.position.x), std::max(b.max.y, v.position.y),
-             std::max(b.max.z, v.position.z)};
-  }
+Box3 bounds(const std::vector<capture::Viewpoint>& views) {
+  Box3 b{views[0].position, views[0].position};
+  for (const capture::Viewpoint& v : views) b = box_union(b, v.position);
   return b;
 }
 
@@ -82,14 +76,14 @@ Expected<Rig> checked_rig(std::string_view text, Rig rig) {
 
 Rig box_rig(const glm::dvec3& c, const glm::dvec3& h) {
   Rig rig;
-  rig.viewpoints.push_back({"centre", point(c)});
+  rig.viewpoints.push_back({"centre", to_vec3(c)});
   for (int i = 0; i < 8; ++i) {
     glm::dvec3 s((i & 1) ? 1 : -1, (i & 2) ? 1 : -1, (i & 4) ? 1 : -1);
     std::string name = std::string("corner") + (s.x > 0 ? "+x" : "-x") + (s.y > 0 ? "+y" : "-y") +
                        (s.z > 0 ? "+z" : "-z");
-    rig.viewpoints.push_back({name, point(c + s * h)});
+    rig.viewpoints.push_back({name, to_vec3(c + s * h)});
   }
-  rig.view_volume = {point(c - h), point(c + h)};
+  rig.view_volume = {to_vec3(c - h), to_vec3(c + h)};
   rig.description = "box:" + num(c.x) + "," + num(c.y) + "," + num(c.z) + "," + num(h.x) + "," +
                     num(h.y) + "," + num(h.z);
   return rig;
@@ -100,9 +94,9 @@ Rig ring_rig(uint32_t n, double r, const glm::dvec3& c) {
   for (uint32_t i = 0; i < n; ++i) {
     double a = 2 * M_PI * i / n;
     rig.viewpoints.push_back(
-        {"ring" + std::to_string(i), point(c + glm::dvec3(r * std::cos(a), 0, r * std::sin(a)))});
+        {"ring" + std::to_string(i), to_vec3(c + glm::dvec3(r * std::cos(a), 0, r * std::sin(a)))});
   }
-  rig.view_volume = {point(c - glm::dvec3(r, r / 4, r)), point(c + glm::dvec3(r, r / 4, r))};
+  rig.view_volume = {to_vec3(c - glm::dvec3(r, r / 4, r)), to_vec3(c + glm::dvec3(r, r / 4, r))};
   rig.description = "ring:" + std::to_string(n) + "," + num(r) + "," + num(c.x) + "," + num(c.y) +
                     "," + num(c.z);
   return rig;
@@ -117,9 +111,9 @@ Rig sphere_rig(uint32_t n, double r, const glm::dvec3& c) {
     double ring = std::sqrt(std::max(0.0, 1 - y * y));
     double a = golden * i;
     glm::dvec3 d(ring * std::cos(a), y, ring * std::sin(a));
-    rig.viewpoints.push_back({"sphere" + std::to_string(i), point(c + r * d)});
+    rig.viewpoints.push_back({"sphere" + std::to_string(i), to_vec3(c + r * d)});
   }
-  rig.view_volume = {point(c - glm::dvec3(r)), point(c + glm::dvec3(r))};
+  rig.view_volume = {to_vec3(c - glm::dvec3(r)), to_vec3(c + glm::dvec3(r))};
   rig.description = "sphere:" + std::to_string(n) + "," + num(r) + "," + num(c.x) + "," +
                     num(c.y) + "," + num(c.z);
   return rig;
@@ -134,13 +128,13 @@ Rig grid_rig(const glm::uvec3& n, const glm::dvec3& lo, const glm::dvec3& hi) {
     for (uint32_t y = 0; y < n.y; ++y) {
       for (uint32_t x = 0; x < n.x; ++x) {
         glm::dvec3 p(at(x, n.x, lo.x, hi.x), at(y, n.y, lo.y, hi.y), at(z, n.z, lo.z, hi.z));
-        rig.viewpoints.push_back({"grid" + std::to_string(x) + "_" + std::to_string(y) + "_" +
-                                      std::to_string(z),
-                                  point(p)});
+        rig.viewpoints.push_back(
+            {"grid" + std::to_string(x) + "_" + std::to_string(y) + "_" + std::to_string(z),
+             to_vec3(p)});
       }
     }
   }
-  rig.view_volume = {point(glm::min(lo, hi)), point(glm::max(lo, hi))};
+  rig.view_volume = {to_vec3(glm::min(lo, hi)), to_vec3(glm::max(lo, hi))};
   rig.description = "grid:" + std::to_string(n.x) + "," + std::to_string(n.y) + "," +
                     std::to_string(n.z) + "," + num(lo.x) + "," + num(lo.y) + "," + num(lo.z) +
                     "," + num(hi.x) + "," + num(hi.y) + "," + num(hi.z);
@@ -152,7 +146,7 @@ Rig list_rig(const std::vector<glm::dvec3>& positions) {
   rig.description = "list:";
   for (size_t i = 0; i < positions.size(); ++i) {
     const glm::dvec3& p = positions[i];
-    rig.viewpoints.push_back({"view" + std::to_string(i), point(p)});
+    rig.viewpoints.push_back({"view" + std::to_string(i), to_vec3(p)});
     // Appends, not operator+ chains: GCC 12 -O3 reports a false -Wrestrict on those.
     if (i) rig.description.append("/");
     rig.description.append(num(p.x)).append(",").append(num(p.y)).append(",").append(num(p.z));

@@ -5,6 +5,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "calf/samples/scene.h"
+#include "glm_vec.h"
 
 namespace calf::samples {
 
@@ -175,11 +176,11 @@ capture::EyePose look_at_pose(double time, const glm::dvec3& position, const glm
                               double fov_y_degrees) {
   capture::EyePose pose;
   pose.time = time;
-  pose.position = {position.x, position.y, position.z};
+  pose.position = to_vec3(position);
   glm::dvec3 f = glm::normalize(target - position);
   glm::dvec3 up = glm::normalize(glm::dvec3(0, 1, 0) - f * f.y);
-  pose.forward = {f.x, f.y, f.z};
-  pose.up = {up.x, up.y, up.z};
+  pose.forward = to_vec3(f);
+  pose.up = to_vec3(up);
   pose.fov_y_degrees = fov_y_degrees;
   return pose;
 }

@@ -11,6 +11,7 @@
 
 #include "calf/format/cube.h"
 #include "calf/samples/render.h"
+#include "glm_vec.h"
 
 namespace calf::samples {
 
@@ -397,20 +398,19 @@ Expected<std::unique_ptr<FrameTracer>> FrameTracer::create(const Scene& scene, d
   return std::unique_ptr<FrameTracer>(new FrameTracer(std::move(impl)));
 }
 
-RenderStats FrameTracer::render_cube(const capture::Point3& center, uint32_t view, uint32_t frame,
+RenderStats FrameTracer::render_cube(const Vec3& center, uint32_t view, uint32_t frame,
                                      uint32_t face_size, bool with_material,
                                      capture::ViewFrame* out) const {
   out->resize(face_size, with_material);
   const Impl& im = *impl_;
-  const glm::vec3 o(static_cast<float>(center.x), static_cast<float>(center.y),
-                    static_cast<float>(center.z));
+  const glm::vec3 o = to_fvec3(center);
   const uint32_t n = face_size;
   RenderStats stats;
   stats.rays = im.parallel_rows(6 * n, [&](uint32_t row, uint64_t* rays) {
     const uint32_t face = row / n, y = row % n;
     for (uint32_t x = 0; x < n; ++x) {
-      const Direction dd = direction_from_texel(cube_face_from_index(static_cast<int>(face)), x, y, n);
-      const glm::vec3 d(static_cast<float>(dd.x), static_cast<float>(dd.y), static_cast<float>(dd.z));
+      const glm::vec3 d =
+          to_fvec3(direction_from_texel(cube_face_from_index(static_cast<int>(face)), x, y, n));
       const size_t i = (static_cast<size_t>(face) * n + y) * n + x;
       // AO keys leave the frame out: static surfaces get the same samples every frame.
       im.shade_pixel(o, d, pixel_key(im.options.seed, view, face, x, y),
@@ -430,22 +430,18 @@ RenderStats FrameTracer::render_perspective(const capture::EyePose& pose, uint32
   out->color.assign(static_cast<size_t>(width) * height * 3, 0.0f);
   out->depth.assign(static_cast<size_t>(width) * height, 0.0f);
   const Impl& im = *impl_;
-  const glm::dvec3 f(pose.forward.x, pose.forward.y, pose.forward.z);
-  const glm::dvec3 up(pose.up.x, pose.up.y, pose.up.z);
-  const glm::dvec3 right = glm::normalize(glm::cross(f, up));
-  const double tan_half = std::tan(pose.fov_y_degrees * M_PI / 360.0);
-  const double aspect = static_cast<double>(width) / height;
-  const glm::vec3 o(static_cast<float>(pose.position.x), static_cast<float>(pose.position.y),
-                    static_cast<float>(pose.position.z));
+  // The one camera model (calf/format/camera.h), as the renderers place their pixels.
+  const Camera camera = capture::camera_from_pose(pose, width, height);
+  const CameraFrame frame = camera_frame(camera);
+  const glm::vec3 o = to_fvec3(pose.position);
   RenderStats stats;
   stats.rays = im.parallel_rows(height, [&](uint32_t j, uint64_t* rays) {
     for (uint32_t i = 0; i < width; ++i) {
-      double a = 2 * (i + 0.5) / width - 1, b = 1 - 2 * (j + 0.5) / height;
-      glm::dvec3 dd = glm::normalize(f + a * tan_half * aspect * right + b * tan_half * up);
+      const glm::vec3 d = to_fvec3(camera_ray(camera, frame, i, j));
       const size_t k = static_cast<size_t>(j) * width + i;
       // Ground truth uses view id 2^32 - 1 - eye, never a capture view's.
       uint64_t view_id = 0xFFFFFFFFull - static_cast<uint64_t>(pose.eye);
-      im.shade_pixel(o, glm::vec3(dd), pixel_key(im.options.seed, view_id, 0, i, j),
+      im.shade_pixel(o, d, pixel_key(im.options.seed, view_id, 0, i, j),
                      pixel_key(im.options.seed ^ 0xA5A5A5A5ull, view_id, j, i, pose_index),
                      &out->color[3 * k], &out->depth[k], nullptr, rays);
     }
@@ -453,13 +449,12 @@ RenderStats FrameTracer::render_perspective(const capture::EyePose& pose, uint32
   return stats;
 }
 
-bool FrameTracer::inside_geometry(const capture::Point3& point) const {
+bool FrameTracer::inside_geometry(const Vec3& point) const {
   // Winding number along each of 26 probe rays: every back-face crossing (leaving a solid) counts
   // +1, every front-face crossing (entering one) -1. For a union of closed, interpenetrating
   // solids the sum is the number of solids containing the point, whatever is embedded in what;
   // a majority vote over the rays tolerates a few open surfaces.
-  const glm::vec3 o(static_cast<float>(point.x), static_cast<float>(point.y),
-                    static_cast<float>(point.z));
+  const glm::vec3 o = to_fvec3(point);
   int inside_votes = 0;
   uint64_t rays = 0;
   for (int dz = -1; dz <= 1; ++dz) {

@@ -42,7 +42,7 @@ struct Hit {
 // The scene at frame f of n: the floor is the plane y + 0.15 z + 1 = 0 (rising away from the
 // viewer, who looks down -z), cut off at 100 units (sky beyond); a sphere of radius 0.7 rolls
 // from x = -1.6 to 1.6 at z = -4, touching the floor.
-Hit trace(const Direction& d, uint32_t f, uint32_t n) {
+Hit trace(const Vec3& d, uint32_t f, uint32_t n) {
   Hit h;
   const double denom = d.y + 0.15 * d.z;
   if (denom < 0) {
@@ -84,7 +84,7 @@ Clip make_clip(uint32_t size, uint32_t frames) {
   for (uint32_t f = 0; f < frames; ++f) {
     for (uint32_t y = 0; y < size; ++y) {
       for (uint32_t x = 0; x < size; ++x) {
-        const Direction d = direction_from_texel(CubeFace::kNegZ, x, y, size);
+        const Vec3 d = direction_from_texel(CubeFace::kNegZ, x, y, size);
         const Hit h = trace(d, f, frames);
         const size_t i = texels * f + size_t{y} * size + x;
         float rgb[3];

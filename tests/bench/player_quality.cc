@@ -105,7 +105,7 @@ double depth_ok_share(const RenderedImage& a, const RenderedImage& b) {
   return static_cast<double>(ok) / a.depth.size();
 }
 
-double nearest_viewpoint(const capture::CaptureManifest& m, const capture::Point3& p) {
+double nearest_viewpoint(const capture::CaptureManifest& m, const Vec3& p) {
   double best = INFINITY;
   for (const capture::Viewpoint& v : m.viewpoints) {
     best = std::min(best, std::hypot(p.x - v.position.x, p.y - v.position.y, p.z - v.position.z));
@@ -135,7 +135,7 @@ std::vector<Pose> read_path_poses(const fs::path& file, const capture::EyePath& 
       die(Status(ErrorId::kImageCompare, image.string() + ": size differs from the eye path's"));
     }
     for (size_t v = 0; v < m.viewpoints.size(); ++v) {
-      const capture::Point3& q = m.viewpoints[v].position;
+      const Vec3& q = m.viewpoints[v].position;
       if (q == p.pose.position) p.viewpoint = static_cast<int>(v);
     }
     out.push_back(std::move(p));
@@ -152,12 +152,12 @@ capture::EyePath viewpoint_path(const capture::CaptureManifest& m, const capture
   for (size_t v = 0; v < m.viewpoints.size(); ++v) {
     const Pose& src = gt[v % gt.size()];
     capture::EyePose p = src.pose;
-    const capture::Point3 at = m.viewpoints[v].position;
+    const Vec3 at = m.viewpoints[v].position;
     const float z = src.reference.depth[size_t{path.height / 2} * path.width + path.width / 2];
     if (std::isfinite(z)) {
-      const capture::Point3 target{src.pose.position.x + src.pose.forward.x * z,
-                                   src.pose.position.y + src.pose.forward.y * z,
-                                   src.pose.position.z + src.pose.forward.z * z};
+      const Vec3 target{src.pose.position.x + src.pose.forward.x * z,
+                        src.pose.position.y + src.pose.forward.y * z,
+                        src.pose.position.z + src.pose.forward.z * z};
       const double dx = target.x - at.x, dy = target.y - at.y, dz = target.z - at.z;
       const double len = std::sqrt(dx * dx + dy * dy + dz * dz);
       if (len > 1e-6) p.forward = {dx / len, dy / len, dz / len};
@@ -340,7 +340,7 @@ std::vector<Score> measure(const char* section, std::vector<Pose>& poses, FrameC
     Pose& p = poses[pi];
     const uint32_t frame = capture_frame_at(m, p.pose.time);
     const ViewSet& views = frames.at(frame);
-    const Camera cam = camera_from_pose(p.pose, p.reference.width, p.reference.height);
+    const Camera cam = capture::camera_from_pose(p.pose, p.reference.width, p.reference.height);
     const RenderedImage reference = box_down(p.reference, g_supersample);
     std::printf("| %zu | %u | %.3f |", pi, frame, nearest_viewpoint(m, p.pose.position));
     if (with_360) {
@@ -562,7 +562,8 @@ int main(int argc, char** argv) {
       p.pose = vp.poses[v];
       p.viewpoint = static_cast<int>(v);
       const ViewSet& views = frames.at(capture_frame_at(m, p.pose.time));
-      p.reference = reproject_view(views.views[v], camera_from_pose(p.pose, vp.width, vp.height));
+      p.reference =
+          reproject_view(views.views[v], capture::camera_from_pose(p.pose, vp.width, vp.height));
       at_vp.push_back(std::move(p));
     }
     measure("vp-reproj", at_vp, frames, m, variants, out_dir, false);

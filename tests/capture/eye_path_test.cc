@@ -17,7 +17,7 @@ std::string path_json(const std::string& pose, const std::string& top = "") {
          R"("poses": [)" + pose + "]}";
 }
 
-void expect_near(const Point3& a, const Point3& b) {
+void expect_near(const Vec3& a, const Vec3& b) {
   EXPECT_NEAR(a.x, b.x, 1e-12);
   EXPECT_NEAR(a.y, b.y, 1e-12);
   EXPECT_NEAR(a.z, b.z, 1e-12);
@@ -56,6 +56,33 @@ TEST(EyePath, OrientationForms) {
   expect_near(p->poses[2].up, {0, 1, 0});
   EXPECT_EQ(p->poses[2].eye, Eye::kRight);
   EXPECT_EQ(eye_image_file_name(*p, 7), "gt_0007.exr");
+}
+
+// A pose becomes the one camera model with the path's image size; degrees become radians as
+// (degrees * pi) / 180.
+TEST(EyePath, CameraFromPose) {
+  EyePath path;
+  path.width = 640;
+  path.height = 360;
+  EyePose pose;
+  pose.position = {1, 2, 3};
+  pose.forward = {0, 0, -1};
+  pose.up = {0, 1, 0};
+  pose.fov_y_degrees = 90;
+  path.poses = {pose, pose};
+  path.poses[1].fov_y_degrees = 60;
+  const Camera c = camera_from_pose(pose, 8, 4);
+  EXPECT_EQ(c.position, (Vec3{1, 2, 3}));
+  EXPECT_EQ(c.forward, (Vec3{0, 0, -1}));
+  EXPECT_EQ(c.up, (Vec3{0, 1, 0}));
+  EXPECT_DOUBLE_EQ(c.fov_y, 1.5707963267948966);  // pi / 2
+  EXPECT_EQ(c.width, 8u);
+  EXPECT_EQ(c.height, 4u);
+  const Camera d = camera_from_pose(path, 1);
+  EXPECT_DOUBLE_EQ(d.fov_y, 1.0471975511965976);  // pi / 3
+  EXPECT_EQ(d.width, 640u);
+  EXPECT_EQ(d.height, 360u);
+  EXPECT_TRUE(validate_camera(d).ok());
 }
 
 TEST(EyePath, RoundTripIsExact) {

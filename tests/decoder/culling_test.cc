@@ -1,4 +1,5 @@
-// Tests of view-dependent culling (decoder/include/calf/decoder/culling.h).
+// Tests of view-dependent culling (decoder/include/calf/decoder/culling.h). Frusta themselves
+// and their intersection test are tested in tests/format/geometry_test.cc.
 #include "calf/decoder/culling.h"
 
 #include <gtest/gtest.h>
@@ -14,9 +15,6 @@ constexpr double kPi = 3.14159265358979323846;
 
 Vec3 v(double x, double y, double z) {
   return {x, y, z};
-}
-double dot(const Vec3& a, const Vec3& b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
 }
 
 // Point-in-frustum by its face planes, oriented with the centroid inside: an independent check.
@@ -35,29 +33,6 @@ bool contains(const Frustum& f, const Vec3& p, double tolerance = 1e-9) {
   return true;
 }
 
-Frustum box(double x0, double y0, double z0, double x1, double y1, double z1) {
-  return Frustum({v(x0, y0, z0), v(x1, y0, z0), v(x1, y1, z0), v(x0, y1, z0)},
-                 {v(x0, y0, z1), v(x1, y0, z1), v(x1, y1, z1), v(x0, y1, z1)});
-}
-
-TEST(CullingTest, SeparatingAxisBasics) {
-  const Frustum a = box(0, 0, 0, 1, 1, 1);
-  EXPECT_TRUE(frusta_intersect(a, a));
-  EXPECT_TRUE(frusta_intersect(a, box(0.25, 0.25, 0.25, 0.5, 0.5, 0.5)));  // inside
-  EXPECT_TRUE(frusta_intersect(a, box(1, 0, 0, 2, 1, 1)));                 // touching face
-  EXPECT_FALSE(frusta_intersect(a, box(1.001, 0, 0, 2, 1, 1)));
-  EXPECT_FALSE(frusta_intersect(a, box(2, 2, 2, 3, 3, 3)));
-  // A square prism rotated 45 degrees about z beside the box's (1, 1) edge: only its own face
-  // normal along x + y separates it when it is far enough out.
-  const auto diamond = [](double c) {
-    const double r = 0.75;
-    return Frustum({v(c + r, c, -1), v(c, c + r, -1), v(c - r, c, -1), v(c, c - r, -1)},
-                   {v(c + r, c, 2), v(c, c + r, 2), v(c - r, c, 2), v(c, c - r, 2)});
-  };
-  EXPECT_TRUE(frusta_intersect(a, diamond(1.3)));   // x + y edge at 1.85 < 2
-  EXPECT_FALSE(frusta_intersect(a, diamond(1.4)));  // x + y edge at 2.05 > 2
-}
-
 // Every point a cell's texels can stand for (a direction through the cell, a radial depth in the
 // range) lies inside the cell frustum.
 TEST(CullingTest, CellFrustumContainsItsTexels) {
@@ -70,7 +45,7 @@ TEST(CullingTest, CellFrustumContainsItsTexels) {
       const PixelRect r = *grid.cell_rect(c);
       const Frustum fr = cell_frustum(vp, cube_face_from_index(f), 64, r, 0.5, 20);
       for (int k = 0; k < 20; ++k) {
-        const Direction d = direction_from_texel_coord(
+        const Vec3 d = direction_from_texel_coord(
             {cube_face_from_index(f), r.x + u01(rng) * r.width, r.y + u01(rng) * r.height}, 64);
         const double depth = 0.5 * std::pow(40.0, u01(rng));
         ASSERT_TRUE(contains(fr, v(vp.x + d.x * depth, vp.y + d.y * depth, vp.z + d.z * depth)))
@@ -174,7 +149,7 @@ TEST(CullingTest, NeverCullsACellWithAVisiblePoint) {
         const PixelRect r = *grid.cell_rect(c);
         bool seen = false;
         for (int k = 0; k < 200 && !seen; ++k) {
-          const Direction d = direction_from_texel_coord(
+          const Vec3 d = direction_from_texel_coord(
               {face, r.x + u01(rng) * r.width, r.y + u01(rng) * r.height}, 32);
           const double depth = 0.2 * std::pow(30.0, u01(rng));
           const Vec3& o = s.viewpoint;

@@ -19,7 +19,6 @@
 namespace calf::extreme {
 namespace {
 
-using player::Camera;
 using player::Playback;
 using player::PlaybackOptions;
 using player::RenderedImage;

@@ -22,7 +22,6 @@
 namespace calf::extreme {
 namespace {
 
-using player::Camera;
 using player::RenderedImage;
 
 constexpr float kHalfMax = 65504.0f;

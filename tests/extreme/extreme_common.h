@@ -82,18 +82,18 @@ class TempDir {
 // A manifest for `positions.size()` viewpoints with faces of `face_size` texels, `frames` frames
 // at 24 fps, and a view volume of the viewpoints' bounding box grown by `margin`.
 inline capture::CaptureManifest make_manifest(uint32_t face_size, uint32_t frames,
-                                              const std::vector<capture::Point3>& positions,
+                                              const std::vector<Vec3>& positions,
                                               double margin = 0.5) {
   capture::CaptureManifest m;
   m.frame_count = frames;
   m.face_size = face_size;
   m.fps = 24;
-  capture::Box3 box{positions[0], positions[0]};
+  Box3 box{positions[0], positions[0]};
   for (size_t v = 0; v < positions.size(); ++v) {
     std::string name = "v";
     name.append(std::to_string(v));
     m.viewpoints.push_back({name, positions[v]});
-    const capture::Point3& p = positions[v];
+    const Vec3& p = positions[v];
     box.min = {std::min(box.min.x, p.x), std::min(box.min.y, p.y), std::min(box.min.z, p.z)};
     box.max = {std::max(box.max.x, p.x), std::max(box.max.y, p.y), std::max(box.max.z, p.z)};
   }

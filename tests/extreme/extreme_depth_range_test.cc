@@ -19,7 +19,6 @@
 namespace calf::extreme {
 namespace {
 
-using player::Camera;
 using player::Playback;
 using player::PlaybackOptions;
 using player::RenderedImage;
@@ -312,7 +311,7 @@ TEST(FlatDepth, EveryDepthEqualEncodesDecodesAndRendersExactly) {
       ASSERT_EQ(bad_pixels(img), 0u);
       for (uint32_t j = 0; j < cam.height; ++j) {
         for (uint32_t i = 0; i < cam.width; ++i) {
-          const Vec3 d = player::camera_ray(cam, i, j);
+          const Vec3 d = camera_ray(cam, i, j);
           const double od = eye.x * d.x + eye.y * d.y + eye.z * d.z;
           const double oo = eye.x * eye.x + eye.y * eye.y + eye.z * eye.z;
           const double t = -od + std::sqrt(od * od - oo + 9.0);

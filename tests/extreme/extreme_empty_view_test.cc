@@ -18,7 +18,6 @@
 namespace calf::extreme {
 namespace {
 
-using player::Camera;
 using player::Playback;
 using player::PlaybackOptions;
 using player::RenderedImage;

@@ -24,7 +24,6 @@
 namespace calf::extreme {
 namespace {
 
-using player::Camera;
 using player::RenderedImage;
 using player::RenderOptions;
 

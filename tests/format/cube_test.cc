@@ -9,11 +9,8 @@
 namespace calf {
 namespace {
 
-double dot(const Direction& a, const Direction& b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
-}
 // atan2 of |a x b| and a . b stays accurate for tiny angles, where acos(a . b) does not.
-double angle(const Direction& a, const Direction& b) {
+double angle(const Vec3& a, const Vec3& b) {
   const double cx = a.y * b.z - a.z * b.y, cy = a.z * b.x - a.x * b.z, cz = a.x * b.y - a.y * b.x;
   return std::atan2(std::sqrt(cx * cx + cy * cy + cz * cz), dot(a, b));
 }
@@ -22,7 +19,7 @@ double angle(const Direction& a, const Direction& b) {
 // specification's table (written out independently of the implementation's table).
 struct FaceExpectation {
   CubeFace face;
-  Direction centre, s_axis, t_axis;
+  Vec3 centre, s_axis, t_axis;
 };
 const FaceExpectation kExpected[] = {
     {CubeFace::kPosX, {1, 0, 0}, {0, 0, -1}, {0, -1, 0}},
@@ -42,11 +39,11 @@ TEST(CubeTest, FaceOrderMatchesOpenGL) {
 
 TEST(CubeTest, CentresAndOrientationFollowTheGLTable) {
   for (const auto& e : kExpected) {
-    const Direction c = direction_from_face_coord({e.face, 0.5, 0.5});
+    const Vec3 c = direction_from_face_coord({e.face, 0.5, 0.5});
     EXPECT_NEAR(angle(c, e.centre), 0.0, 1e-12) << cube_face_name(e.face);
     // s = 1 leans the direction along s_axis, t = 1 along t_axis.
-    const Direction s1 = direction_from_face_coord({e.face, 1.0, 0.5});
-    const Direction t1 = direction_from_face_coord({e.face, 0.5, 1.0});
+    const Vec3 s1 = direction_from_face_coord({e.face, 1.0, 0.5});
+    const Vec3 t1 = direction_from_face_coord({e.face, 0.5, 1.0});
     EXPECT_NEAR(dot(s1, e.s_axis), std::sqrt(0.5), 1e-12) << cube_face_name(e.face);
     EXPECT_NEAR(dot(t1, e.t_axis), std::sqrt(0.5), 1e-12) << cube_face_name(e.face);
   }
@@ -57,12 +54,12 @@ TEST(CubeTest, RoundTripsAtCentresEdgesAndCorners) {
   for (const auto& e : kExpected) {
     for (double s : coords) {
       for (double t : coords) {
-        const Direction d = direction_from_face_coord({e.face, s, t});
+        const Vec3 d = direction_from_face_coord({e.face, s, t});
         EXPECT_NEAR(std::sqrt(dot(d, d)), 1.0, 1e-12);
         const FaceCoord back = face_coord_from_direction(d);
         // Strictly inside a face the round trip is exact; on the s = 0 or t = 0 edge the
         // direction is on a seam and may belong to the neighbour, but it is the same direction.
-        const Direction again = direction_from_face_coord(back);
+        const Vec3 again = direction_from_face_coord(back);
         EXPECT_NEAR(angle(d, again), 0.0, 1e-12);
         if (s > 0 && t > 0) {
           EXPECT_EQ(back.face, e.face);
@@ -79,7 +76,7 @@ TEST(CubeTest, TexelCentresAreAtHalfIntegers) {
   for (const auto& e : kExpected) {
     for (uint32_t y = 0; y < n; ++y) {
       for (uint32_t x = 0; x < n; ++x) {
-        const Direction d = direction_from_texel(e.face, x, y, n);
+        const Vec3 d = direction_from_texel(e.face, x, y, n);
         const FaceTexelCoord c = texel_coord_from_direction(d, n);
         EXPECT_EQ(c.face, e.face);
         EXPECT_NEAR(c.u, x + 0.5, 1e-9);
@@ -92,7 +89,7 @@ TEST(CubeTest, TexelCentresAreAtHalfIntegers) {
     }
   }
   // Row 0 of +X looks up (toward -t, which is +y), column 0 toward +z.
-  const Direction corner = direction_from_texel(CubeFace::kPosX, 0, 0, n);
+  const Vec3 corner = direction_from_texel(CubeFace::kPosX, 0, 0, n);
   EXPECT_GT(corner.y, 0.0);
   EXPECT_GT(corner.z, 0.0);
 }
@@ -113,7 +110,7 @@ TEST(CubeTest, SeamsAndCornersBelongToOneFaceInXYZOrder) {
     }
   }
   // Repeated lookups of the same seam direction agree (no dependence on anything but the value).
-  const Direction seam{0.0, -0.7, 0.7};
+  const Vec3 seam{0.0, -0.7, 0.7};
   EXPECT_EQ(face_coord_from_direction(seam).face, CubeFace::kNegY);
   EXPECT_EQ(face_coord_from_direction(seam).face, face_coord_from_direction(seam).face);
 }
@@ -131,12 +128,12 @@ TEST(CubeTest, TexelsAcrossSeamsAreNeighboursInDirectionSpace) {
         int du, dv;
       } edges[] = {{0, i, -1, 0}, {n - 1, i, 1, 0}, {i, 0, 0, -1}, {i, n - 1, 0, 1}};
       for (const auto& edge : edges) {
-        const Direction inside = direction_from_texel(e.face, edge.x, edge.y, n);
-        const Direction beyond =
+        const Vec3 inside = direction_from_texel(e.face, edge.x, edge.y, n);
+        const Vec3 beyond =
             direction_from_texel_coord({e.face, edge.x + 0.5 + edge.du, edge.y + 0.5 + edge.dv}, n);
         const Texel across = texel_from_direction(beyond, n);
         ASSERT_NE(across.face, e.face);
-        const Direction neighbour = direction_from_texel(across.face, across.x, across.y, n);
+        const Vec3 neighbour = direction_from_texel(across.face, across.x, across.y, n);
         double closest = 10;
         for (uint32_t y = 0; y < n; ++y) {
           for (uint32_t x = 0; x < n; ++x) {
@@ -145,7 +142,7 @@ TEST(CubeTest, TexelsAcrossSeamsAreNeighboursInDirectionSpace) {
         }
         EXPECT_NEAR(angle(inside, neighbour), closest, 1e-12)
             << cube_face_name(e.face) << " edge texel (" << edge.x << ", " << edge.y << ")";
-        const Direction inward =
+        const Vec3 inward =
             direction_from_texel(e.face, static_cast<uint32_t>(static_cast<int>(edge.x) - edge.du),
                                  static_cast<uint32_t>(static_cast<int>(edge.y) - edge.dv), n);
         EXPECT_LT(angle(inside, neighbour), 1.5 * angle(inside, inward));
@@ -165,9 +162,9 @@ TEST(CubeTest, EveryDirectionOnASphereMapsToATexelThatMapsBack) {
     const double z = 1.0 - 2.0 * (i + 0.5) / count;
     const double r = std::sqrt(1.0 - z * z);
     const double phi = i * 2.399963229728653;
-    const Direction d{r * std::cos(phi), r * std::sin(phi), z};
+    const Vec3 d{r * std::cos(phi), r * std::sin(phi), z};
     const Texel t = texel_from_direction(d, n);
-    const Direction c = direction_from_texel(t.face, t.x, t.y, n);
+    const Vec3 c = direction_from_texel(t.face, t.x, t.y, n);
     EXPECT_LT(angle(d, c), std::atan(std::sqrt(2.0) / n) + 1e-12);
   }
 }

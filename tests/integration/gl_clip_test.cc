@@ -59,7 +59,7 @@ capture::ViewFrame capture_frame(const testing::Scene& s, const Vec3& position) 
     for (uint32_t y = 0; y < kFace; ++y) {
       for (uint32_t x = 0; x < kFace; ++x) {
         const CubeFace face = cube_face_from_index(f);
-        const Direction d = direction_from_texel(face, x, y, kFace);
+        const Vec3 d = direction_from_texel(face, x, y, kFace);
         double rgb[3], z;
         Material m;
         testing::shade(s, position, {d.x, d.y, d.z}, rgb, &z, &m);

@@ -214,7 +214,7 @@ void main() {
   double worst_st = 0, worst_dir = 0;
   size_t face_mismatches = 0;
   for (size_t i = 0; i < n; ++i) {
-    const Direction d{dirs[4 * i], dirs[4 * i + 1], dirs[4 * i + 2]};
+    const Vec3 d{dirs[4 * i], dirs[4 * i + 1], dirs[4 * i + 2]};
     if (d.x == 0 && d.y == 0 && d.z == 0) continue;
     const FaceCoord c = face_coord_from_direction(d);
     if (static_cast<int>(res[4 * i]) != cube_face_index(c.face)) {
@@ -226,7 +226,7 @@ void main() {
     }
     worst_st =
         std::max({worst_st, std::fabs(res[4 * i + 1] - c.s), std::fabs(res[4 * i + 2] - c.t)});
-    const Direction back_cpp = direction_from_face_coord(c);
+    const Vec3 back_cpp = direction_from_face_coord(c);
     worst_dir = std::max({worst_dir, std::fabs(dir_back[4 * i] - back_cpp.x),
                           std::fabs(dir_back[4 * i + 1] - back_cpp.y),
                           std::fabs(dir_back[4 * i + 2] - back_cpp.z)});

@@ -192,7 +192,7 @@ TEST(CaptureViews, CameraFromPose) {
   pose.forward = {0, 0, 1};
   pose.up = {0, 1, 0};
   pose.fov_y_degrees = 60;
-  const Camera c = camera_from_pose(pose, 6, 4);
+  const Camera c = capture::camera_from_pose(pose, 6, 4);
   EXPECT_EQ(c.width, 6u);
   EXPECT_EQ(c.height, 4u);
   EXPECT_NEAR(c.fov_y, kPi / 3, 1e-15);

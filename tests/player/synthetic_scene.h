@@ -139,7 +139,7 @@ inline View make_view(const Scene& s, const Vec3& position, uint32_t n, bool mat
   for (int f = 0; f < 6; ++f) {
     for (uint32_t y = 0; y < n; ++y) {
       for (uint32_t x = 0; x < n; ++x) {
-        const Direction dd = direction_from_texel(cube_face_from_index(f), x, y, n);
+        const Vec3 dd = direction_from_texel(cube_face_from_index(f), x, y, n);
         double rgb[3], z;
         Material m;
         shade(s, position, {dd.x, dd.y, dd.z}, rgb, &z, &m);

@@ -46,7 +46,7 @@ Scene sphere_scene(double d, double r) {
 }
 
 // Exact radial distance along a unit ray from the origin to a sphere, in double.
-double ray_sphere(const Direction& dir, double cx, double r) {
+double ray_sphere(const Vec3& dir, double cx, double r) {
   double b = dir.x * cx;
   double c = cx * cx - r * r;
   return b - std::sqrt(b * b - c);
@@ -72,7 +72,7 @@ TEST(Render, SphereOnPlusXAppearsOnFacePlusXWithExactDepth) {
     for (uint32_t y = 0; y < n; ++y) {
       for (uint32_t x = 0; x < n; ++x) {
         CubeFace cf = cube_face_from_index(face);
-        Direction dir = direction_from_texel(cf, x, y, n);
+        Vec3 dir = direction_from_texel(cf, x, y, n);
         float z = f.depth[f.texel_index(cf, x, y)];
         // The sphere subtends 19.5 degrees: only +X sees it; a texel sees it iff its ray hits.
         double disc = dir.x * d * dir.x * d - (d * d - r * r);
@@ -116,7 +116,7 @@ TEST(Render, RoomDepthIsExactOnEveryTexelAndContinuousAcrossSeams) {
     for (uint32_t y = 0; y < n; ++y) {
       for (uint32_t x = 0; x < n; ++x) {
         CubeFace cf = cube_face_from_index(face);
-        Direction dir = direction_from_texel(cf, x, y, n);
+        Vec3 dir = direction_from_texel(cf, x, y, n);
         double t = INFINITY;
         const double dv[3] = {dir.x, dir.y, dir.z};
         for (int a = 0; a < 3; ++a) {
@@ -185,7 +185,7 @@ TEST(Render, AnimationChangesDepthAndShadingWhereDepthStaysStill) {
   ASSERT_TRUE(scene.ok());
   capture::ViewFrame a, b;
   RenderOptions opt{2, 1, 4, 6, 0};
-  const capture::Point3 centre = scene->default_rig.viewpoints[0].position;
+  const Vec3 centre = scene->default_rig.viewpoints[0].position;
   auto t0 = FrameTracer::create(*scene, 0.0, opt);
   auto t1 = FrameTracer::create(*scene, 10 / scene->fps, opt);
   ASSERT_TRUE(t0.ok() && t1.ok());

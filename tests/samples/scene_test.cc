@@ -19,11 +19,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-double distance(const capture::Point3& a, const capture::Point3& b) {
+double distance(const Vec3& a, const Vec3& b) {
   return std::sqrt((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) + (a.z - b.z) * (a.z - b.z));
 }
 
-bool inside(const capture::Box3& b, const capture::Point3& p) {
+bool inside(const Box3& b, const Vec3& p) {
   return p.x >= b.min.x && p.x <= b.max.x && p.y >= b.min.y && p.y <= b.max.y && p.z >= b.min.z &&
          p.z <= b.max.z;
 }
@@ -32,9 +32,9 @@ TEST(Rig, Forms) {
   auto box = parse_rig("box:0,1.6,0,0.5,0.3,0.5");
   ASSERT_TRUE(box.ok()) << box.status().to_string();
   ASSERT_EQ(box->viewpoints.size(), 9u);
-  EXPECT_EQ(box->viewpoints[0].position, (capture::Point3{0, 1.6, 0}));
+  EXPECT_EQ(box->viewpoints[0].position, (Vec3{0, 1.6, 0}));
   EXPECT_LT(distance(box->viewpoints[8].position, {0.5, 1.9, 0.5}), 1e-12);
-  EXPECT_EQ(box->view_volume.min, (capture::Point3{-0.5, 1.3, -0.5}));
+  EXPECT_EQ(box->view_volume.min, (Vec3{-0.5, 1.3, -0.5}));
   auto ring = parse_rig("ring:8,2,0,1,0");
   ASSERT_TRUE(ring.ok());
   ASSERT_EQ(ring->viewpoints.size(), 8u);
@@ -49,12 +49,12 @@ TEST(Rig, Forms) {
   auto grid = parse_rig("grid:4,2,2,-1,1,-1,1,2,1");
   ASSERT_TRUE(grid.ok());
   EXPECT_EQ(grid->viewpoints.size(), 16u);
-  EXPECT_EQ(grid->viewpoints.back().position, (capture::Point3{1, 2, 1}));
+  EXPECT_EQ(grid->viewpoints.back().position, (Vec3{1, 2, 1}));
   auto list = parse_rig("list:0,1,0/1,1,-2.5");
   ASSERT_TRUE(list.ok());
   ASSERT_EQ(list->viewpoints.size(), 2u);
-  EXPECT_EQ(list->viewpoints[1].position, (capture::Point3{1, 1, -2.5}));
-  EXPECT_EQ(list->view_volume.max, (capture::Point3{1, 1, 0}));
+  EXPECT_EQ(list->viewpoints[1].position, (Vec3{1, 1, -2.5}));
+  EXPECT_EQ(list->view_volume.max, (Vec3{1, 1, 0}));
   // Numbers that six decimals would round away (a grid 1e-300 wide, a ring of radius 1e-7).
   auto tiny = parse_rig("grid:3,1,1,0,0,0,1e-300,0,0");
   ASSERT_TRUE(tiny.ok()) << tiny.status().to_string();
@@ -173,7 +173,7 @@ TEST_F(AssimpTest, ObjCube) {
   // From +X at distance 4, the centre of face -X sees the cube's +X side at distance 3.
   capture::ViewFrame f;
   (*tracer)->render_cube({4, 0, 0}, 0, 0, 16, false, &f);
-  Direction d = direction_from_texel(CubeFace::kNegX, 8, 8, 16);
+  Vec3 d = direction_from_texel(CubeFace::kNegX, 8, 8, 16);
   EXPECT_NEAR(f.depth[f.texel_index(CubeFace::kNegX, 8, 8)], 3.0 / std::fabs(d.x), 1e-5);
   EXPECT_TRUE(std::isinf(f.depth[f.texel_index(CubeFace::kPosX, 8, 8)]));
 }

@@ -58,7 +58,7 @@ SeamStats seam_stats(const capture::ViewFrame& f, bool mirror_across) {
         int du, dv;  // outward step
       } edges[] = {{0, i, -1, 0}, {n - 1, i, 1, 0}, {i, 0, 0, -1}, {i, n - 1, 0, 1}};
       for (const auto& e : edges) {
-        const Direction beyond =
+        const Vec3 beyond =
             direction_from_texel_coord({face, e.x + 0.5 + e.du, e.y + 0.5 + e.dv}, n);
         Texel across = texel_from_direction(beyond, n);
         EXPECT_NE(across.face, face);

@@ -2,6 +2,7 @@
 #include "calf/capture/eye_path.h"
 
 #include <cmath>
+#include <numbers>
 
 #include "exr_io.h"
 #include "json_fields.h"
@@ -15,41 +16,33 @@ using detail::Json;
 
 constexpr const char* kFormatName = "calf-eye-path";
 
-double length(const Point3& p) { return std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z); }
-Point3 scale(const Point3& p, double s) { return {p.x * s, p.y * s, p.z * s}; }
-Point3 sub(const Point3& a, const Point3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-double dot(const Point3& a, const Point3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-Point3 cross(const Point3& a, const Point3& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-
 // Unit forward and an up orthogonal to it; false when either is degenerate or they are parallel.
 // Vectors that are already unit and orthogonal (to 1e-12) are kept bit for bit, so that parsing
 // a serialized path gives back the same numbers.
-bool orthonormalize(Point3* forward, Point3* up) {
+bool orthonormalize(Vec3* forward, Vec3* up) {
   double fl = length(*forward);
   if (!(fl > 1e-12) || !std::isfinite(fl)) return false;
-  if (std::fabs(fl - 1) > 1e-12) *forward = scale(*forward, 1 / fl);
+  if (std::fabs(fl - 1) > 1e-12) *forward = *forward * (1 / fl);
   double ul = length(*up);
   if (!(ul > 1e-12) || !std::isfinite(ul)) return false;
   double along = dot(*up, *forward);
   if (std::fabs(along) > 1e-12 * ul) {
-    Point3 u = sub(*up, scale(*forward, along));
+    Vec3 u = *up - *forward * along;
     double rest = length(u);
     if (!(rest > 1e-6 * ul)) return false;
-    *up = scale(u, 1 / rest);
+    *up = u * (1 / rest);
   } else if (std::fabs(ul - 1) > 1e-12) {
-    *up = scale(*up, 1 / ul);
+    *up = *up * (1 / ul);
   }
   return true;
 }
 
 // Rotates v by the unit quaternion (w, x, y, z).
-Point3 rotate(const double q[4], const Point3& v) {
-  Point3 u{q[1], q[2], q[3]};
-  Point3 t = scale(cross(u, v), 2);
-  Point3 c = cross(u, t);
-  return {v.x + q[0] * t.x + c.x, v.y + q[0] * t.y + c.y, v.z + q[0] * t.z + c.z};
+Vec3 rotate(const double q[4], const Vec3& v) {
+  Vec3 u{q[1], q[2], q[3]};
+  Vec3 t = cross(u, v) * 2.0;
+  Vec3 c = cross(u, t);
+  return v + q[0] * t + c;
 }
 
 Expected<EyePose> parse_pose(const Json& j, const std::string& path, std::string_view source,
@@ -93,8 +86,8 @@ Expected<EyePose> parse_pose(const Json& j, const std::string& path, std::string
     if (r.has("forward")) {
       CALF_ASSIGN_OR_RETURN(pose.forward, r.point("forward"));
     } else {
-      CALF_ASSIGN_OR_RETURN(Point3 target, r.point("look_at"));
-      pose.forward = sub(target, pose.position);
+      CALF_ASSIGN_OR_RETURN(Vec3 target, r.point("look_at"));
+      pose.forward = target - pose.position;
     }
     if (r.has("up")) {
       CALF_ASSIGN_OR_RETURN(pose.up, r.point("up"));
@@ -202,6 +195,22 @@ std::string serialize_eye_path(const EyePath& path) {
   }
   j["poses"] = std::move(poses);
   return j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
+}
+
+Camera camera_from_pose(const EyePose& pose, uint32_t width, uint32_t height) {
+  Camera c;
+  c.position = pose.position;
+  c.forward = pose.forward;
+  c.up = pose.up;
+  // (degrees * pi) / 180, the rounding calf-play and the tracer always used.
+  c.fov_y = pose.fov_y_degrees * std::numbers::pi / 180.0;
+  c.width = width;
+  c.height = height;
+  return c;
+}
+
+Camera camera_from_pose(const EyePath& path, size_t index) {
+  return camera_from_pose(path.poses[index], path.width, path.height);
 }
 
 std::string eye_image_file_name(const EyePath& path, uint32_t index) {

@@ -99,7 +99,7 @@ Expected<bool> FieldReader::boolean(const char* key) const {
   return v->get<bool>();
 }
 
-Expected<Point3> FieldReader::point(const char* key) const {
+Expected<Vec3> FieldReader::point(const char* key) const {
   CALF_ASSIGN_OR_RETURN(const Json* v, get(key));
   if (!v->is_array() || v->size() != 3) {
     return error(field(key), "expected [x, y, z], got " + describe(*v));
@@ -113,7 +113,7 @@ Expected<Point3> FieldReader::point(const char* key) const {
     }
     c[i] = e.get<double>();
   }
-  return Point3{c[0], c[1], c[2]};
+  return Vec3{c[0], c[1], c[2]};
 }
 
 Expected<double> FieldReader::number_or(const char* key, double fallback) const {

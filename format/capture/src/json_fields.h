@@ -46,7 +46,7 @@ class FieldReader {
   Expected<uint32_t> uint(const char* key, uint32_t min, uint32_t max) const;
   Expected<std::string> string(const char* key) const;
   Expected<bool> boolean(const char* key) const;
-  Expected<Point3> point(const char* key) const;  // [x, y, z], finite
+  Expected<Vec3> point(const char* key) const;  // [x, y, z], finite
   // Optional forms: `fallback` when the key is absent.
   Expected<double> number_or(const char* key, double fallback) const;
   Expected<std::string> string_or(const char* key, std::string fallback) const;
@@ -62,8 +62,10 @@ class FieldReader {
   ErrorId id_;
 };
 
-// Point3 as a JSON array [x, y, z].
-inline Json point_json(const Point3& p) { return Json::array({p.x, p.y, p.z}); }
+// Vec3 as a JSON array [x, y, z].
+inline Json point_json(const Vec3& p) {
+  return Json::array({p.x, p.y, p.z});
+}
 
 // Expands a file pattern with one token named `token` ("view", "frame", "pose"): "{name}" gives
 // the decimal value, "{name:0N}" pads it with zeros to N digits (N in 1..9).

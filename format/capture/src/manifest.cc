@@ -18,7 +18,7 @@ using detail::Json;
 
 constexpr const char* kFormatName = "calf-capture-set";
 
-std::string point_text(const Point3& p) {
+std::string point_text(const Vec3& p) {
   // snprintf, not string concatenation: GCC 12 -O3 reports a false -Wrestrict on the latter.
   char buf[96];
   std::snprintf(buf, sizeof buf, "(%g, %g, %g)", p.x, p.y, p.z);

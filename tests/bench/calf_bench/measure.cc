@@ -119,9 +119,9 @@ Status SceneInputs::play(const fs::path& clip, const PlayConfig& config, PointRe
     // Poses sharing a time (a stereo pair) are prepared together, as calf-play does.
     size_t j = i + 1;
     while (j < path.poses.size() && path.poses[j].time == path.poses[i].time) ++j;
-    std::vector<player::Camera> eyes;
+    std::vector<Camera> eyes;
     for (size_t k = i; k < j; ++k) {
-      eyes.push_back(player::camera_from_pose(path.poses[k], path.width, path.height));
+      eyes.push_back(capture::camera_from_pose(path, k));
     }
     const uint32_t frame = play->frame_at_time(path.poses[i].time);
     const double t0 = now_seconds(), c0 = cpu_seconds();

@@ -21,6 +21,8 @@
 
 #include <cstdint>
 
+#include "calf/format/geometry.h"
+
 namespace calf {
 
 enum class CubeFace : uint8_t { kPosX = 0, kNegX = 1, kPosY = 2, kNegY = 3, kPosZ = 4, kNegZ = 5 };
@@ -36,11 +38,9 @@ inline int cube_face_index(CubeFace face) {
   return static_cast<int>(face);
 }
 
-// A direction in scene space. Double precision: the conventions are the reference every fast path
-// is tested against; hot loops may convert to float after the lookup.
-struct Direction {
-  double x = 0, y = 0, z = 0;
-};
+// Directions are calf::Vec3 (calf/format/geometry.h), in double precision: the conventions are
+// the reference every fast path is tested against; hot loops may convert to float after the
+// lookup.
 
 // A position on a face in normalised face coordinates, s and t in [0, 1].
 struct FaceCoord {
@@ -57,27 +57,27 @@ struct FaceTexelCoord {
 
 // The face a direction points into, and where. `d` must be finite and non-zero (a caller bug
 // otherwise: asserted in debug builds; release builds return the centre of +X).
-FaceCoord face_coord_from_direction(const Direction& d);
+FaceCoord face_coord_from_direction(const Vec3& d);
 
 // The unit direction through normalised face coordinates (s, t). Values outside [0, 1] are
 // allowed and continue the face's plane (useful for filtering across seams).
-Direction direction_from_face_coord(const FaceCoord& c);
+Vec3 direction_from_face_coord(const FaceCoord& c);
 
 // The unit direction through the centre of texel (x, y) of a face of `face_size` texels.
-Direction direction_from_texel(CubeFace face, uint32_t x, uint32_t y, uint32_t face_size);
+Vec3 direction_from_texel(CubeFace face, uint32_t x, uint32_t y, uint32_t face_size);
 
 // The unit direction through texel-space position (u, v) of a face of `face_size` texels
 // (texel centres are at half-integers).
-Direction direction_from_texel_coord(const FaceTexelCoord& c, uint32_t face_size);
+Vec3 direction_from_texel_coord(const FaceTexelCoord& c, uint32_t face_size);
 
 // The face and texel-space position a direction points at, on faces of `face_size` texels.
-FaceTexelCoord texel_coord_from_direction(const Direction& d, uint32_t face_size);
+FaceTexelCoord texel_coord_from_direction(const Vec3& d, uint32_t face_size);
 
 // The texel (x, y) containing texel-space position (u, v), clamped to the face.
 struct Texel {
   CubeFace face = CubeFace::kPosX;
   uint32_t x = 0, y = 0;
 };
-Texel texel_from_direction(const Direction& d, uint32_t face_size);
+Texel texel_from_direction(const Vec3& d, uint32_t face_size);
 
 }  // namespace calf

@@ -11,8 +11,8 @@
 //     per-viewpoint z_near / z_far "measured from the data" of DESIGN.md); +inf (sky) is
 //     kLog16Sky. A view-frame that is all sky gets the range [1, 2], which no code uses;
 //   - material (reflect, refract, IOR) when the manifest says "material": true.
-// Eye-path poses become player cameras with the same camera model, so a rendering lines up pixel
-// for pixel with calf-capture's ground truth for the pose.
+// Eye-path poses become cameras with capture::camera_from_pose() (calf/capture/eye_path.h), the
+// one camera model, so a rendering lines up pixel for pixel with calf-capture's ground truth.
 #pragma once
 
 #include <cstdint>
@@ -40,10 +40,6 @@ Expected<ViewSet> load_capture_views(const capture::CaptureSetReader& reader, ui
 // The capture frame to show at scene time `time` seconds: frame f is at f / fps (CAPTURE.md), so
 // the nearest one, round(time * fps), clamped to [0, frame_count - 1] (NaN gives 0).
 uint32_t capture_frame_at(const capture::CaptureManifest& manifest, double time);
-
-// The player camera of an eye-path pose (position, forward, up, vertical field of view) for an
-// image of width x height.
-Camera camera_from_pose(const capture::EyePose& pose, uint32_t width, uint32_t height);
 
 // What a plain 360-degree video player shows with the eye at `view`'s centre: the view's own
 // colour cube map sampled bilinearly along each of `camera`'s rays (seamless across faces, as

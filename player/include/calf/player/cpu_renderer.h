@@ -53,29 +53,12 @@
 #include <span>
 #include <vector>
 
-#include "calf/decoder/culling.h"
+#include "calf/format/camera.h"
+#include "calf/format/geometry.h"
 #include "calf/format/status.h"
 #include "calf/player/view_set.h"
 
 namespace calf::player {
-
-// A perspective eye with the camera model of format/CAPTURE.md ("Eye paths"): the ray through
-// pixel (i, j) of a W x H image (row 0 at the top) is
-//   d = normalize(forward + a * h * (W / H) * right + b * h * up),
-//   a = 2 (i + 0.5) / W - 1,  b = 1 - 2 (j + 0.5) / H,  h = tan(fov_y / 2),
-//   right = normalize(cross(forward, up)),
-// so a reconstruction and calf-capture's ground truth for the same pose align pixel for pixel.
-struct Camera {
-  Vec3 position;
-  Vec3 forward{0, 0, -1};             // need not be unit length; not parallel to up
-  Vec3 up{0, 1, 0};                   // re-orthogonalised against forward
-  double fov_y = 1.5707963267948966;  // vertical field of view in radians, (0, pi)
-  uint32_t width = 64, height = 64;   // pixels, 1..16384 each
-};
-
-// The unit ray direction through pixel (i, j) of `camera` (formula above). The camera must be
-// valid (see CpuRenderer::render).
-Vec3 camera_ray(const Camera& camera, uint32_t i, uint32_t j);
 
 // Every knob of the renderer. Defaults follow the paper where it gives one.
 struct RenderOptions {
@@ -218,8 +201,9 @@ class CpuRenderer {
   // a reference to `views`: they must outlive it and may be updated between frames.
   static Expected<CpuRenderer> make(const ViewSet& views, const RenderOptions& options);
 
-  // Renders `camera` into `out` (resized). CALF-E403 for an invalid camera (non-finite position,
-  // zero or parallel forward / up, fov outside (0, pi), size outside 1..16384).
+  // Renders `camera` (the one camera model, calf/format/camera.h) into `out` (resized).
+  // CALF-E403 for an invalid camera (validate_camera: non-finite position, zero or parallel
+  // forward / up, fov outside (0, pi), size outside 1..16384).
   Status render(const Camera& camera, RenderedImage* out) const;
 
   // One ray from `origin` along unit `direction`: Alg. 4 Main (or Main_RR with options.rr).

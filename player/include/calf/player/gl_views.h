@@ -38,8 +38,8 @@
 #include <vector>
 
 #include "calf/decoder/clip_decoder.h"
-#include "calf/decoder/culling.h"
 #include "calf/format/container.h"
+#include "calf/format/geometry.h"
 #include "calf/format/log_depth.h"
 #include "calf/format/status.h"
 #include "calf/player/gl_context.h"

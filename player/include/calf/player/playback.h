@@ -67,7 +67,7 @@ class Playback {
   // Whether any view carries material (the RR variant needs it).
   bool has_material() const;
   // The box the eye may move in: the clip's `view_volume` metadata, else the viewpoints' bounds.
-  const std::pair<Vec3, Vec3>& view_volume() const;
+  const Box3& view_volume() const;
   bool inside_view_volume(const Vec3& p) const;
   const std::vector<Vec3>& viewpoints() const;
 

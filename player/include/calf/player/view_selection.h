@@ -41,7 +41,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "calf/decoder/culling.h"
+#include "calf/format/geometry.h"
 #include "calf/format/status.h"
 
 namespace calf::player {

@@ -21,8 +21,8 @@
 #include <span>
 #include <vector>
 
-#include "calf/decoder/culling.h"
 #include "calf/format/cube.h"
+#include "calf/format/geometry.h"
 #include "calf/format/grid.h"
 #include "calf/format/log_depth.h"
 #include "calf/format/status.h"

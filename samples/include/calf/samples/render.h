@@ -65,8 +65,8 @@ class FrameTracer {
   // Renders the cube map centred at `center` into `out` (resized to `face_size`, with material
   // channels when `with_material`). `view` and `frame` only seed random numbers. Each texel's ray
   // is calf::direction_from_texel(face, x, y, face_size).
-  RenderStats render_cube(const capture::Point3& center, uint32_t view, uint32_t frame,
-                          uint32_t face_size, bool with_material, capture::ViewFrame* out) const;
+  RenderStats render_cube(const Vec3& center, uint32_t view, uint32_t frame, uint32_t face_size,
+                          bool with_material, capture::ViewFrame* out) const;
 
   // Renders one perspective ground-truth image (the camera convention of eye_path.h).
   RenderStats render_perspective(const capture::EyePose& pose, uint32_t width, uint32_t height,
@@ -75,7 +75,7 @@ class FrameTracer {
   // Whether `point` is inside closed geometry: along most of 26 probe rays (axes, edge and corner
   // directions) the point's winding number (back-face minus front-face crossings) is positive, or
   // a surface lies closer than 1e-4 scene units. Needs consistently wound closed meshes.
-  bool inside_geometry(const capture::Point3& point) const;
+  bool inside_geometry(const Vec3& point) const;
 
  private:
   struct Impl;

@@ -83,7 +83,7 @@ struct Sky {
 // A camera rig: the capture viewpoints and the view volume the viewer may move in.
 struct Rig {
   std::vector<capture::Viewpoint> viewpoints;
-  capture::Box3 view_volume;
+  Box3 view_volume;
   std::string description;  // the --rig text that makes it, e.g. "box:0,1.6,0,0.5,0.3,0.5"
 };
 

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "calf/format/cube.h"
+#include "calf/format/geometry.h"
 #include "calf/format/status.h"
 
 namespace calf::capture {
@@ -35,24 +36,13 @@ inline constexpr uint32_t kCaptureFormatVersion = 1;
 inline constexpr const char* kManifestFileName = "manifest.json";
 inline constexpr const char* kDefaultFilePattern = "view{view:03}_frame{frame:05}.exr";
 
-// A point or vector in scene units (right-handed, +Y up by convention of the sample scenes; the
-// format itself does not care which axis is up).
-struct Point3 {
-  double x = 0, y = 0, z = 0;
-  friend bool operator==(const Point3&, const Point3&) = default;
-};
-
-// An axis-aligned box, min <= max componentwise (a point or a flat box is allowed).
-struct Box3 {
-  Point3 min, max;
-  friend bool operator==(const Box3&, const Box3&) = default;
-};
+// Points are calf::Vec3 and boxes calf::Box3 (calf/format/geometry.h), in scene units.
 
 // One 360-degree camera: a cube map centred at `position` (no orientation: faces are world-axis
 // aligned). `name` is informative ("centre", "corner-+x+y-z"); unique within a set.
 struct Viewpoint {
   std::string name;
-  Point3 position;
+  Vec3 position;
   friend bool operator==(const Viewpoint&, const Viewpoint&) = default;
 };
 

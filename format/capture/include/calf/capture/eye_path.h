@@ -3,11 +3,9 @@
 // An eye path is a list of perspective camera poses over time: where a viewer is, where it looks,
 // with which field of view, and for stereo which eye. calf-capture renders ground truth along one
 // (colour + radial depth per pose); the player renders its reconstruction along the same path and
-// compares. Camera convention (OpenGL): the camera looks along `forward`; image row 0 is the top
-// (towards `up`), column 0 the left. The ray through pixel (i, j) of a W x H image is
-//   d = normalize(forward + a * tan(fov_y / 2) * (W / H) * right + b * tan(fov_y / 2) * up)
-//   a = 2 (i + 0.5) / W - 1,   b = 1 - 2 (j + 0.5) / H,   right = normalize(cross(forward, up))
-// and the depth stored for it is the radial distance from `position` along d (like cube maps).
+// compares. A pose is a calf::Camera (calf/format/camera.h, the one camera model: ray formula,
+// row 0 at the top towards `up`) with the path's image size: camera_from_pose(). The depth stored
+// for a pixel is the radial distance from `position` along its ray (like cube maps).
 #pragma once
 
 #include <cstdint>
@@ -17,6 +15,7 @@
 #include <vector>
 
 #include "calf/capture/capture_set.h"
+#include "calf/format/camera.h"
 #include "calf/format/status.h"
 
 namespace calf::capture {
@@ -29,9 +28,9 @@ const char* eye_name(Eye eye);
 // against forward).
 struct EyePose {
   double time = 0;  // seconds of scene time (frame f of a capture is at f / fps)
-  Point3 position;
-  Point3 forward{0, 0, -1};
-  Point3 up{0, 1, 0};
+  Vec3 position;
+  Vec3 forward{0, 0, -1};
+  Vec3 up{0, 1, 0};
   double fov_y_degrees = 60;  // vertical field of view, in (0, 180)
   Eye eye = Eye::kMono;
   friend bool operator==(const EyePose&, const EyePose&) = default;
@@ -65,6 +64,13 @@ Expected<EyePath> read_eye_path(const std::filesystem::path& path);
 std::string serialize_eye_path(const EyePath& path);
 // The ground-truth image name of pose `index` ("" when the path has no image pattern).
 std::string eye_image_file_name(const EyePath& path, uint32_t index);
+
+// The camera of `pose` for a width x height image: position, forward and up as they are,
+// fov_y = fov_y_degrees * pi / 180 (radians). Every renderer, the ground-truth tracer and the
+// image comparisons take poses through this one function.
+Camera camera_from_pose(const EyePose& pose, uint32_t width, uint32_t height);
+// camera_from_pose(path.poses[index], path.width, path.height); index < path.poses.size().
+Camera camera_from_pose(const EyePath& path, size_t index);
 
 // A perspective ground-truth image: W x H, row-major from the top row.
 struct PerspectiveImage {
