@@ -202,6 +202,39 @@ TEST(SceneFile, ManifestIsReadableJson) {
   EXPECT_EQ(encoded->buffer.substr(0, 16), expected);
 }
 
+// The surfel mode's factory (issue 20): 20 M triangles counting instances. Instances share their
+// prototype, so the file holds one 20,000-triangle part and 1,000 transforms.
+TEST(SceneFile, InstancedTwentyMillionTriangles) {
+  SceneFile s;
+  s.frame_count = 1;
+  s.materials.resize(1);
+  SceneMesh part;
+  const uint32_t n = 100;  // n x n quads
+  for (uint32_t y = 0; y <= n; ++y) {
+    for (uint32_t x = 0; x <= n; ++x)
+      part.positions.insert(part.positions.end(), {1.f * x, 1.f * y, 0});
+  }
+  for (uint32_t y = 0; y < n; ++y) {
+    for (uint32_t x = 0; x < n; ++x) {
+      uint32_t a = y * (n + 1) + x, b = a + 1, c = a + n + 2, d = a + n + 1;
+      part.indices.insert(part.indices.end(), {a, b, c, a, c, d});
+    }
+  }
+  s.meshes.push_back(std::move(part));
+  for (int i = 0; i < 1000; ++i) {
+    s.objects.push_back({"", 0, 0, {{1, 0, 0, 200.f * i, 0, 1, 0, 0, 0, 0, 1, 0}}});
+  }
+  ASSERT_EQ(s.triangle_count(), 20000000u);
+  auto encoded = encode_scene_file(s);
+  ASSERT_TRUE(encoded.ok()) << encoded.status().to_string();
+  EXPECT_EQ(encoded->buffer.size(), 101u * 101 * 12 + 20000 * 12 + 1000 * 48);
+  EXPECT_LT(encoded->manifest.size(), 200000u);
+  auto back = parse(encoded->manifest, encoded->buffer);
+  ASSERT_TRUE(back.ok()) << back.status().to_string();
+  EXPECT_EQ(back->triangle_count(), 20000000u);
+  EXPECT_EQ(back->mesh_triangle_count(), 20000u);
+}
+
 TEST_F(SceneFileTest, HandWrittenMinimalFile) {
   write_minimal();
   auto s = read_scene_file(dir_);
