@@ -235,6 +235,34 @@ TEST(SceneFile, InstancedTwentyMillionTriangles) {
   EXPECT_EQ(back->mesh_triangle_count(), 20000u);
 }
 
+TEST(SceneFile, SamplesAtTimes) {
+  SceneFile s = sample_scene();
+  // Quad states: z = 0 at t = 0, z = 1 at t = 0.5; held outside.
+  std::vector<float> p;
+  positions_at(s.meshes[0], 0.25, &p);
+  ASSERT_EQ(p.size(), 12u);
+  EXPECT_FLOAT_EQ(p[2], 0.5f);
+  EXPECT_FLOAT_EQ(p[3], 1.0f);  // x of vertex 1 stays 1
+  positions_at(s.meshes[0], -1, &p);
+  EXPECT_EQ(p[2], 0.0f);
+  positions_at(s.meshes[0], 0.5, &p);
+  EXPECT_EQ(p[2], 1.0f);
+  positions_at(s.meshes[0], 9, &p);
+  EXPECT_EQ(p[11], 1.0f);
+  positions_at(s.meshes[1], 0.3, &p);  // no states, no vertices
+  EXPECT_TRUE(p.empty());
+  SceneMesh still;
+  still.positions = {1, 2, 3};
+  positions_at(still, 7, &p);
+  EXPECT_EQ(p, (std::vector<float>{1, 2, 3}));
+  EXPECT_EQ(transform_at(s.objects[2], 1), kSceneIdentity);
+  EXPECT_EQ(transform_at(s.objects[0], 2)[3], 2.0f);  // static
+  EXPECT_FLOAT_EQ(transform_at(s.objects[1], 2)[3], 0.2f);
+  EXPECT_FLOAT_EQ(transform_at(s.objects[1], 7)[3], 0.2f);  // clamped to the last frame
+  EXPECT_EQ(sample_at(s.lights[0].positions, 2), (SceneFloat3{0, 3, 0}));
+  EXPECT_EQ(sample_at(s.lights[0].intensities, 2), (SceneFloat3{3, 3, 3.5f}));
+}
+
 TEST_F(SceneFileTest, HandWrittenMinimalFile) {
   write_minimal();
   auto s = read_scene_file(dir_);

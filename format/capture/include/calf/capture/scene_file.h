@@ -22,6 +22,7 @@
 // element at fault. Nothing here throws.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -164,6 +165,22 @@ struct SceneFile {
   size_t mesh_triangle_count() const;  // over meshes (each prototype once)
   friend bool operator==(const SceneFile&, const SceneFile&) = default;
 };
+
+// ---- reading the samples: the one interpretation of SCENE.md's timing rules ----
+
+// The object-to-world transform of `object` at frame f: identity without transforms, the one
+// transform when static, else transforms[f] (f clamped to the last).
+const SceneTransform& transform_at(const SceneObject& object, uint32_t frame);
+
+// The vertex positions of `mesh` at `time` seconds (3 floats per vertex) into `out`: `positions`
+// without states; else linear between the two states around `time`, held before the first and
+// after the last (paper 004, Eqs. 3-4).
+void positions_at(const SceneMesh& mesh, double time, std::vector<float>* out);
+
+// One sample of a per-frame array that holds one entry (constant) or one per frame.
+inline const SceneFloat3& sample_at(const std::vector<SceneFloat3>& samples, uint32_t frame) {
+  return samples[samples.size() == 1 ? 0 : std::min<size_t>(frame, samples.size() - 1)];
+}
 
 // Checks every rule of SCENE.md on an in-memory scene: array sizes (E161), finite values and
 // ranges (E157), indices (E158), counts (E152 / E160), texture paths (E153) and, where pixels are
