@@ -13,6 +13,7 @@
 
 #include "calf/samples/render.h"
 #include "calf/samples/scene.h"
+#include "calf/samples/scene_export.h"
 
 namespace {
 
@@ -61,7 +62,7 @@ int main(int argc, char** argv) {
       "Writes DIR/manifest.json last, so an interrupted run never leaves a set that looks "
       "complete.",
       "calf-capture"};
-  std::string scene_arg, out_dir, rig_arg = "default", eye_path_file;
+  std::string scene_arg, out_dir, rig_arg = "default", eye_path_file, export_dir;
   uint32_t face_size = 256, frames = 0, threads = 0, ao_samples = 8, max_bounces = 6;
   uint64_t seed = 1;
   float noise = 0;
@@ -94,6 +95,9 @@ int main(int argc, char** argv) {
                  "render ground truth along this eye-path JSON (CAPTURE.md) instead");
   app.add_option("--gt-size", gt_size, "image size WxH of --ground-truth images")
       ->capture_default_str();
+  app.add_option("--export-scene", export_dir,
+                 "also write the scene as a scene file (format/SCENE.md: DIR/scene.json last, "
+                 "scene.bin) with --frames frames; without --out, only export");
   app.add_flag("--list-scenes", list, "print the built-in scenes and exit");
   app.add_flag("--quiet", quiet, "no progress or summary lines on stderr");
   try {
@@ -114,8 +118,9 @@ int main(int argc, char** argv) {
     }
     return 0;
   }
-  if (scene_arg.empty() || out_dir.empty()) {
-    std::fprintf(stderr, "calf-capture: --scene and --out are required (see --help)\n");
+  if (scene_arg.empty() || (out_dir.empty() && export_dir.empty())) {
+    std::fprintf(stderr,
+                 "calf-capture: --scene and --out (or --export-scene) are required (see --help)\n");
     return 2;
   }
 
@@ -137,6 +142,11 @@ int main(int argc, char** argv) {
   auto scene = samples::load_scene(scene_arg);
   if (!scene.ok()) return fail(scene.status());
   const uint32_t frame_count = frames ? frames : scene->frame_count;
+  if (!export_dir.empty()) {
+    if (Status s = samples::write_scene(*scene, frame_count, export_dir); !s.ok()) return fail(s);
+    if (!quiet) std::fprintf(stderr, "calf-capture: scene file %s written\n", export_dir.c_str());
+    if (out_dir.empty()) return 0;
+  }
 
   samples::RenderStats stats;
   if (ground_truth || !eye_path_file.empty()) {

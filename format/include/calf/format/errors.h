@@ -7,7 +7,8 @@
 //
 // Ranges:   1- 19 general (arguments, files)      20- 39 conventions (cube, log depth, grids)
 //          40- 99 container (format/SPEC.md)     100-129 BCn block codecs
-//         130-169 capture sets (format/CAPTURE.md) 170-199 calf-capture and sample scenes
+//         130-149 capture sets (format/CAPTURE.md) 150-169 scene files (format/SCENE.md)
+//         170-199 calf-capture and sample scenes
 //         200-299 encoder    300-399 decoder    400-499 player
 #pragma once
 
@@ -88,6 +89,19 @@ enum class ErrorKind : uint8_t {
   X(kCaptureIndex, 140, kInvalidArgument, "a view or frame index is outside the set")           \
   X(kCaptureWriterMisuse, 141, kInvalidArgument, "the capture writer got a bad buffer or call") \
   X(kEyePathField, 142, kCorrupt, "an eye path field is missing or out of range")               \
+  /* scene files: 150-169 (format/SCENE.md) */                                                  \
+  X(kSceneFileSyntax, 150, kCorrupt, "a scene manifest is not valid JSON")                      \
+  X(kSceneFileVersion, 151, kUnsupported, "a scene manifest has an unknown format or version")  \
+  X(kSceneFileField, 152, kCorrupt, "a scene field is missing, mistyped or inconsistent")       \
+  X(kSceneFilePath, 153, kCorrupt, "a scene path is absolute, holds '..' or leaves its folder") \
+  X(kSceneFileMissing, 154, kIo, "a buffer or texture named by a scene is missing")             \
+  X(kSceneFileBufferSize, 155, kNeedMoreData, "a scene buffer's size is not as declared")       \
+  X(kSceneFileView, 156, kCorrupt, "a buffer view is misaligned, outside or overlapping")       \
+  X(kSceneFileValue, 157, kCorrupt, "a scene value is NaN, infinite or outside its range")      \
+  X(kSceneFileIndex, 158, kCorrupt, "a vertex, mesh, material or texture index is invalid")     \
+  X(kSceneFileTexture, 159, kCorrupt, "a scene texture cannot be decoded or is too large")      \
+  X(kSceneFileLimit, 160, kLimit, "a scene exceeds a documented size limit")                    \
+  X(kSceneFileWriterMisuse, 161, kInvalidArgument, "the scene writer got mismatched array sizes")\
   /* calf-capture: 170-199 */                                                                   \
   X(kSceneUnknown, 170, kInvalidArgument, "no built-in scene has that name")                    \
   X(kSceneLoad, 171, kCorrupt, "a scene file could not be imported")                            \

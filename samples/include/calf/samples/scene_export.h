@@ -1,0 +1,27 @@
+// Export of a sample scene as a scene file (format/SCENE.md), so that the builders of the mesh
+// representations read the scene calf-capture rendered without linking samples/.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+
+#include "calf/capture/scene_file.h"
+#include "calf/format/status.h"
+#include "calf/samples/scene.h"
+
+namespace calf::samples {
+
+// Converts `scene` over `frames` frames (frame f at time f / scene.fps): each object becomes one
+// mesh (its triangles and spheres, no normals: the tracer shades with face normals) and one
+// object; its transform is sampled at every frame and stored once when every sample is the same
+// (omitted when it is the identity throughout); lights are sampled likewise. Materials keep albedo
+// (as base colour), emission and the mirror / glass weights; the sky, sun and ambient terms go to
+// the environment; the view region is the default rig's view volume. Sample scenes have no vertex
+// states and no textures. Errors: E177 when frames is 0 or above 1000000, then those of
+// validate_scene_file (E157 for a non-finite transform sample, for instance).
+Expected<capture::SceneFile> export_scene(const Scene& scene, uint32_t frames);
+
+// export_scene, then capture::write_scene_file into `directory`.
+Status write_scene(const Scene& scene, uint32_t frames, const std::filesystem::path& directory);
+
+}  // namespace calf::samples

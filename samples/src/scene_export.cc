@@ -1,0 +1,119 @@
+// samples::Scene -> capture::SceneFile (format/SCENE.md). The scene model holds its animation as
+// functions of time; a scene file holds samples, one per frame, so that any tool can read it.
+#include "calf/samples/scene_export.h"
+
+#include <algorithm>
+#include <string>
+
+namespace calf::samples {
+
+namespace {
+
+capture::SceneFloat3 float3(const glm::vec3& v) {
+  return {v.x, v.y, v.z};
+}
+
+// glm matrices are column-major (m[column][row]); a scene transform is row-major 3 x 4.
+capture::SceneTransform row_major(const glm::mat4& m) {
+  capture::SceneTransform t{};
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) t[static_cast<size_t>(r * 4 + c)] = m[c][r];
+  }
+  return t;
+}
+
+// Samples per frame; one sample when they are all equal.
+template <typename T>
+std::vector<T> collapse(std::vector<T> samples) {
+  if (std::all_of(samples.begin(), samples.end(), [&](const T& s) { return s == samples[0]; })) {
+    samples.resize(1);
+  }
+  return samples;
+}
+
+}  // namespace
+
+Expected<capture::SceneFile> export_scene(const Scene& scene, uint32_t frames) {
+  if (frames < 1 || frames > capture::kSceneMaxFrames) {
+    return Status(ErrorId::kCaptureOption,
+                  "scene export: " + std::to_string(frames) + " frames is outside 1..1000000");
+  }
+  capture::SceneFile out;
+  out.name = scene.name;
+  out.description = scene.description;
+  out.generator = "calf-capture";
+  out.fps = scene.fps;
+  out.frame_count = frames;
+  const capture::Box3& region = scene.default_rig.view_volume;
+  out.view_region_min = {region.min.x, region.min.y, region.min.z};
+  out.view_region_max = {region.max.x, region.max.y, region.max.z};
+  capture::SceneEnvironment& e = out.environment;
+  e.zenith = float3(scene.sky.zenith);
+  e.horizon = float3(scene.sky.horizon);
+  e.ground = float3(scene.sky.ground);
+  e.sun_direction = float3(scene.sky.sun_direction);
+  e.sun_irradiance = float3(scene.sky.sun_irradiance);
+  e.sun_disc_radiance = scene.sky.sun_disc_radiance;
+  e.sun_cos_radius = scene.sky.sun_cos_radius;
+  e.ambient = float3(scene.ambient);
+  e.ao_distance = scene.ao_distance;
+  for (const Material& m : scene.materials) {
+    capture::SceneMaterial sm;
+    sm.base_color = float3(m.albedo);
+    sm.emission = float3(m.emission);
+    sm.reflect = m.reflect;
+    sm.refract = m.refract;
+    sm.ior = m.ior;
+    out.materials.push_back(sm);
+  }
+  auto time_of = [&](uint32_t f) { return static_cast<double>(f) / scene.fps; };
+  for (const Object& o : scene.objects) {
+    capture::SceneMesh mesh;
+    mesh.name = o.name;
+    mesh.positions.reserve(o.mesh.positions.size() * 3);
+    for (const glm::vec3& p : o.mesh.positions)
+      mesh.positions.insert(mesh.positions.end(), {p.x, p.y, p.z});
+    mesh.indices.reserve(o.mesh.triangles.size() * 3);
+    for (const glm::uvec3& t : o.mesh.triangles)
+      mesh.indices.insert(mesh.indices.end(), {t.x, t.y, t.z});
+    for (const Sphere& s : o.spheres) mesh.spheres.push_back({float3(s.center), s.radius});
+    capture::SceneObject object;
+    object.name = o.name;
+    object.mesh = static_cast<uint32_t>(out.meshes.size());
+    object.material = o.material;
+    if (o.transform) {
+      std::vector<capture::SceneTransform> samples(frames);
+      for (uint32_t f = 0; f < frames; ++f) samples[f] = row_major(o.transform(time_of(f)));
+      samples = collapse(std::move(samples));
+      if (!(samples.size() == 1 && samples[0] == capture::kSceneIdentity)) {
+        object.transforms = std::move(samples);
+      }
+    }
+    out.meshes.push_back(std::move(mesh));
+    out.objects.push_back(std::move(object));
+  }
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const PointLight& l = scene.lights[i];
+    capture::SceneLight light;
+    light.name = "light" + std::to_string(i);
+    std::vector<capture::SceneFloat3> positions(frames), intensities(frames);
+    for (uint32_t f = 0; f < frames; ++f) {
+      positions[f] = l.position ? float3(l.position(time_of(f))) : capture::SceneFloat3{0, 0, 0};
+      intensities[f] =
+          l.intensity ? float3(l.intensity(time_of(f))) : capture::SceneFloat3{0, 0, 0};
+    }
+    light.positions = collapse(std::move(positions));
+    light.intensities = collapse(std::move(intensities));
+    out.lights.push_back(std::move(light));
+  }
+  CALF_RETURN_IF_ERROR(
+      capture::validate_scene_file(out).with_context("scene '" + scene.name + "' export"));
+  return out;
+}
+
+Status write_scene(const Scene& scene, uint32_t frames, const std::filesystem::path& directory) {
+  CALF_ASSIGN_OR_RETURN(capture::SceneFile file, export_scene(scene, frames));
+  return capture::write_scene_file(file, directory);
+}
+
+}  // namespace calf::samples
