@@ -44,7 +44,7 @@ Expected<capture::SceneFile> export_scene(const Scene& scene, uint32_t frames) {
   out.generator = "calf-capture";
   out.fps = scene.fps;
   out.frame_count = frames;
-  const capture::Box3& region = scene.default_rig.view_volume;
+  const Box3& region = scene.default_rig.view_volume;
   out.view_region_min = {region.min.x, region.min.y, region.min.z};
   out.view_region_max = {region.max.x, region.max.y, region.max.z};
   capture::SceneEnvironment& e = out.environment;
