@@ -65,7 +65,7 @@ TEST(Playback, ViewVolumeComesFromTheClip) {
   ASSERT_TRUE(play.ok());
   const auto& [lo, hi] = (*play)->view_volume();
   EXPECT_LT(lo.x, hi.x);
-  for (const Vec3& p : (*play)->viewpoints()) EXPECT_TRUE((*play)->inside_view_volume(p));
+  for (const Vec3& p : (*play)->lightfield()->viewpoints()) EXPECT_TRUE((*play)->inside_view_volume(p));
   EXPECT_FALSE((*play)->inside_view_volume({hi.x + 1, hi.y, hi.z}));
 }
 
@@ -73,8 +73,8 @@ TEST(Playback, GlAndCpuRenderTheSameFrames) {
   auto context = OsMesaContext::make();
   if (!context.ok()) GTEST_SKIP() << context.status().to_string();
   PlaybackOptions o;
-  o.render.steps = 48;
-  o.selection.target_frame_ms = 0;
+  o.lightfield.render.steps = 48;
+  o.lightfield.selection.target_frame_ms = 0;
   auto gl = Playback::open(clip_path(), o, &(*context)->gl());
   ASSERT_TRUE(gl.ok()) << gl.status().to_string();
   o.use_gl = false;
@@ -89,8 +89,8 @@ TEST(Playback, GlAndCpuRenderTheSameFrames) {
     cam.height = 32;
     ASSERT_TRUE((*gl)->prepare(frame, std::span<const Camera>(&cam, 1)).ok());
     ASSERT_TRUE((*cpu)->prepare(frame, std::span<const Camera>(&cam, 1)).ok());
-    EXPECT_EQ((*gl)->last_selection().active, (*cpu)->last_selection().active);
-    EXPECT_GT((*gl)->last_stats().visible_cells, 0u);
+    EXPECT_EQ((*gl)->lightfield()->last_selection().active, (*cpu)->lightfield()->last_selection().active);
+    EXPECT_GT((*gl)->lightfield()->last_stats().visible_cells, 0u);
     RenderedImage a, b;
     ASSERT_TRUE((*gl)->render(cam, &a).ok());
     ASSERT_TRUE((*cpu)->render(cam, &b).ok());
