@@ -63,7 +63,7 @@ struct LightfieldRepresentation::Impl {
   // placeholder (the renderer only reads the active views).
   std::optional<decoder::CpuTextures> cpu_textures;
   ViewSet view_set;
-  std::vector<uint8_t> view_built;                      // per clip view: full size and current
+  std::vector<uint8_t> view_built;                         // per clip view: full size and current
   std::vector<std::array<uint8_t, kCubeFaceCount>> dirty;  // per clip view and face: kDirty* bits
 
   decoder::FrameUpdates updates;
@@ -115,8 +115,7 @@ Expected<std::unique_ptr<LightfieldRepresentation>> LightfieldRepresentation::op
     hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
     impl->has_material = impl->has_material || info.has_material;
   }
-  impl->volume =
-      parse_volume(reader.find_metadata("view_volume")).value_or(std::make_pair(lo, hi));
+  impl->volume = parse_volume(reader.find_metadata("view_volume")).value_or(std::make_pair(lo, hi));
   CALF_ASSIGN_OR_RETURN(ViewSelector sel, ViewSelector::make(impl->viewpoints, options.selection));
   impl->selector.emplace(std::move(sel));
   impl->decoder->set_view_dependent(impl->view_dependent_for(options.render));
@@ -146,9 +145,15 @@ Expected<std::unique_ptr<LightfieldRepresentation>> LightfieldRepresentation::op
   return std::unique_ptr<LightfieldRepresentation>(new LightfieldRepresentation(std::move(impl)));
 }
 
-std::string_view LightfieldRepresentation::kind() const { return "lightfield"; }
-uint16_t LightfieldRepresentation::track() const { return impl_->track; }
-RenderBackend LightfieldRepresentation::backend() const { return impl_->backend; }
+std::string_view LightfieldRepresentation::kind() const {
+  return "lightfield";
+}
+uint16_t LightfieldRepresentation::track() const {
+  return impl_->track;
+}
+RenderBackend LightfieldRepresentation::backend() const {
+  return impl_->backend;
+}
 uint32_t LightfieldRepresentation::frame_count() const {
   return impl_->decoder->header().frame_count;
 }
@@ -161,20 +166,30 @@ double LightfieldRepresentation::fps() const {
 const std::pair<Vec3, Vec3>& LightfieldRepresentation::view_volume() const {
   return impl_->volume;
 }
-bool LightfieldRepresentation::has_material() const { return impl_->has_material; }
+bool LightfieldRepresentation::has_material() const {
+  return impl_->has_material;
+}
 const std::vector<Vec3>& LightfieldRepresentation::viewpoints() const {
   return impl_->viewpoints;
 }
-const LightfieldOptions& LightfieldRepresentation::options() const { return impl_->options; }
-ViewSelector& LightfieldRepresentation::selector() { return *impl_->selector; }
+const LightfieldOptions& LightfieldRepresentation::options() const {
+  return impl_->options;
+}
+ViewSelector& LightfieldRepresentation::selector() {
+  return *impl_->selector;
+}
 const decoder::FrameStats& LightfieldRepresentation::last_stats() const {
   return impl_->updates.stats;
 }
 const ViewSelection& LightfieldRepresentation::last_selection() const {
   return impl_->selection;
 }
-double LightfieldRepresentation::last_render_ms() const { return impl_->render_ms; }
-double LightfieldRepresentation::last_upload_ms() const { return impl_->upload_ms; }
+double LightfieldRepresentation::last_render_ms() const {
+  return impl_->render_ms;
+}
+double LightfieldRepresentation::last_upload_ms() const {
+  return impl_->upload_ms;
+}
 
 Status LightfieldRepresentation::report_frame_time(double frame_ms) {
   return impl_->selector->report_frame_time(frame_ms);
@@ -242,7 +257,8 @@ void LightfieldRepresentation::Impl::mark_dirty() {
   for (const decoder::CellParams& c : updates.cells) {
     if (c.view >= dirty.size() || c.cell >= cell_count) continue;  // apply() refuses it
     const decoder::CellParams now = cpu_textures->cell(c.view, c.face, c.cell);
-    if (now.t != c.t || now.a_slot != c.a_slot) dirty[c.view][cube_face_index(c.face)] |= kDirtyColour;
+    if (now.t != c.t || now.a_slot != c.a_slot)
+      dirty[c.view][cube_face_index(c.face)] |= kDirtyColour;
   }
 }
 
@@ -274,12 +290,12 @@ Status LightfieldRepresentation::Impl::refresh_face(uint32_t v, CubeFace face, u
 Status LightfieldRepresentation::Impl::build_view(uint32_t v) {
   const auto& info = decoder->view(v);
   CALF_ASSIGN_OR_RETURN(LogDepthRange range, LogDepthRange::make(info.z_near, info.z_far));
-  CALF_ASSIGN_OR_RETURN(View view, View::make(viewpoints[v], range, cpu_textures->face_size(),
-                                              info.has_material));
+  CALF_ASSIGN_OR_RETURN(
+      View view, View::make(viewpoints[v], range, cpu_textures->face_size(), info.has_material));
   view_set.views[v] = std::move(view);
   for (int f = 0; f < kCubeFaceCount; ++f) {
-    CALF_RETURN_IF_ERROR(refresh_face(v, static_cast<CubeFace>(f),
-                                      kDirtyColour | kDirtyDepth | kDirtyMaterial));
+    CALF_RETURN_IF_ERROR(
+        refresh_face(v, static_cast<CubeFace>(f), kDirtyColour | kDirtyDepth | kDirtyMaterial));
   }
   view_built[v] = 1;
   dirty[v] = {};
@@ -337,22 +353,22 @@ RepresentationStats LightfieldRepresentation::stats() const {
   const ViewSelection& sel = d.selection;
   const ViewSelectionOptions& so = d.selector->options();
   RepresentationStats out;
-  out.title = format("lightfield track %u (%s)", d.track,
-                     d.backend == RenderBackend::kGl ? "gl" : "cpu");
+  out.title =
+      format("lightfield track %u (%s)", d.track, d.backend == RenderBackend::kGl ? "gl" : "cpu");
   out.entries.push_back(
       {"active views", format("%zu (max %u, %s priority)", sel.active.size(), so.max_active,
                               so.priority == ViewPriority::kDistance ? "distance" : "angle")});
   out.entries.push_back({"culled views", format("angle %u, performance %u", sel.culled_by_angle,
                                                 sel.culled_by_performance)});
-  out.entries.push_back({"cells visible", format("%u / %u, tiles %u / %u", st.visible_cells,
-                                                 st.total_cells, st.visible_tiles,
-                                                 st.total_tiles)});
+  out.entries.push_back(
+      {"cells visible", format("%u / %u, tiles %u / %u", st.visible_cells, st.total_cells,
+                               st.visible_tiles, st.total_tiles)});
   out.entries.push_back({"updates", format("%.2f Mbps @24 fps", st.mbps_at_24fps())});
   out.entries.push_back({"decode", format("%.2f ms", st.decode_ms)});
   out.entries.push_back({"upload", format("%.2f ms", d.upload_ms)});
   out.entries.push_back({"render", format("%.1f ms", d.render_ms)});
-  out.entries.push_back({"RR", d.options.render.rr ? (d.has_material ? "on" : "on (no material)")
-                                                    : "off"});
+  out.entries.push_back(
+      {"RR", d.options.render.rr ? (d.has_material ? "on" : "on (no material)") : "off"});
   if (st.errors) out.entries.push_back({"damaged chunks", st.first_error, true});
   return out;
 }

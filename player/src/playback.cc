@@ -35,10 +35,9 @@ Expected<std::unique_ptr<Playback>> Playback::open(const std::string& clip_path,
   for (size_t t = 0; t < impl->reader->tracks().size(); ++t) {
     const auto& header = impl->reader->tracks()[t].header;
     if (std::holds_alternative<container::LightfieldTrackHeader>(header)) {
-      CALF_ASSIGN_OR_RETURN(
-          std::unique_ptr<LightfieldRepresentation> lf,
-          LightfieldRepresentation::open(*impl->reader, static_cast<uint16_t>(t),
-                                         options.lightfield, backend, gl));
+      CALF_ASSIGN_OR_RETURN(std::unique_ptr<LightfieldRepresentation> lf,
+                            LightfieldRepresentation::open(*impl->reader, static_cast<uint16_t>(t),
+                                                           options.lightfield, backend, gl));
       if (impl->lightfield == nullptr) impl->lightfield = lf.get();
       impl->owned.push_back(std::move(lf));
     }
@@ -57,8 +56,12 @@ Expected<std::unique_ptr<Playback>> Playback::open(const std::string& clip_path,
   return std::unique_ptr<Playback>(new Playback(std::move(impl)));
 }
 
-uint32_t Playback::frame_count() const { return impl_->representations.front()->frame_count(); }
-double Playback::fps() const { return impl_->representations.front()->fps(); }
+uint32_t Playback::frame_count() const {
+  return impl_->representations.front()->frame_count();
+}
+double Playback::fps() const {
+  return impl_->representations.front()->fps();
+}
 
 uint32_t Playback::frame_at_time(double seconds) const {
   if (!(seconds > 0)) return 0;  // negative or NaN
@@ -66,7 +69,9 @@ uint32_t Playback::frame_at_time(double seconds) const {
   return static_cast<uint32_t>(std::min<double>(f, frame_count() - 1));
 }
 
-const std::pair<Vec3, Vec3>& Playback::view_volume() const { return impl_->volume; }
+const std::pair<Vec3, Vec3>& Playback::view_volume() const {
+  return impl_->volume;
+}
 
 bool Playback::inside_view_volume(const Vec3& p) const {
   const auto& [lo, hi] = impl_->volume;
@@ -78,9 +83,15 @@ bool Playback::inside_view_volume(const Vec3& p) const {
 std::span<Representation* const> Playback::representations() const {
   return impl_->representations;
 }
-LightfieldRepresentation* Playback::lightfield() const { return impl_->lightfield; }
-const PlaybackOptions& Playback::options() const { return impl_->options; }
-double Playback::last_render_ms() const { return impl_->render_ms; }
+LightfieldRepresentation* Playback::lightfield() const {
+  return impl_->lightfield;
+}
+const PlaybackOptions& Playback::options() const {
+  return impl_->options;
+}
+double Playback::last_render_ms() const {
+  return impl_->render_ms;
+}
 
 std::vector<RepresentationStats> Playback::stats() const {
   std::vector<RepresentationStats> out;

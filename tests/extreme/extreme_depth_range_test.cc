@@ -247,7 +247,7 @@ TEST(DepthRange1e4To1e6, CaptureEncodeDecodeRenderRoundTrip) {
       ro.near = default_near;
       ro.far = 1e6;
     }
-    ASSERT_TRUE((*gpu)->set_render_options(ro).ok());
+    ASSERT_TRUE((*gpu)->lightfield()->set_render_options(ro).ok());
     for (int f = 0; f < 6; ++f) {
       const Camera cam = face_camera(f);
       ASSERT_TRUE((*gpu)->prepare(0, std::span<const Camera>(&cam, 1)).ok());

@@ -49,9 +49,11 @@ class LightfieldRepresentation final : public Representation {
   // needed for RenderBackend::kGl; the GL context it was loaded from must stay current on this
   // thread. Errors: the decoder's; CALF-E403 for invalid render options; CALF-E404 / E410 from
   // the GL side; CALF-E460 when the track is not a lightfield track.
-  static Expected<std::unique_ptr<LightfieldRepresentation>> open(
-      const container::Reader& reader, uint16_t track, const LightfieldOptions& options,
-      RenderBackend backend, const GlFunctions* gl);
+  static Expected<std::unique_ptr<LightfieldRepresentation>> open(const container::Reader& reader,
+                                                                  uint16_t track,
+                                                                  const LightfieldOptions& options,
+                                                                  RenderBackend backend,
+                                                                  const GlFunctions* gl);
   ~LightfieldRepresentation() override;
   LightfieldRepresentation(const LightfieldRepresentation&) = delete;
   LightfieldRepresentation& operator=(const LightfieldRepresentation&) = delete;
