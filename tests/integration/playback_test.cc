@@ -125,7 +125,8 @@ TEST(LightfieldRepresentation, GlAndCpuBackendsAgreeThroughTheInterface) {
   const auto& [lo, hi] = gl.view_volume();
   for (uint32_t frame = 0; frame < 3; ++frame) {
     Camera cam;
-    cam.position = {lo.x + 0.7 * (hi.x - lo.x), lo.y + 0.4 * (hi.y - lo.y), lo.z + 0.2 * (hi.z - lo.z)};
+    cam.position = {lo.x + 0.7 * (hi.x - lo.x), lo.y + 0.4 * (hi.y - lo.y),
+                    lo.z + 0.2 * (hi.z - lo.z)};
     cam.forward = {std::sin(frame * 1.5), 0.05, -std::cos(frame * 1.5)};
     cam.width = 36;
     cam.height = 30;
