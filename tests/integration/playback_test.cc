@@ -66,7 +66,9 @@ TEST(Playback, ViewVolumeComesFromTheClip) {
   ASSERT_TRUE(play.ok());
   const auto& [lo, hi] = (*play)->view_volume();
   EXPECT_LT(lo.x, hi.x);
-  for (const Vec3& p : (*play)->lightfield()->viewpoints()) EXPECT_TRUE((*play)->inside_view_volume(p));
+  for (const Vec3& p : (*play)->lightfield()->viewpoints()) {
+    EXPECT_TRUE((*play)->inside_view_volume(p));
+  }
   EXPECT_FALSE((*play)->inside_view_volume({hi.x + 1, hi.y, hi.z}));
 }
 
@@ -90,7 +92,8 @@ TEST(Playback, GlAndCpuRenderTheSameFrames) {
     cam.height = 32;
     ASSERT_TRUE((*gl)->prepare(frame, std::span<const Camera>(&cam, 1)).ok());
     ASSERT_TRUE((*cpu)->prepare(frame, std::span<const Camera>(&cam, 1)).ok());
-    EXPECT_EQ((*gl)->lightfield()->last_selection().active, (*cpu)->lightfield()->last_selection().active);
+    EXPECT_EQ((*gl)->lightfield()->last_selection().active,
+              (*cpu)->lightfield()->last_selection().active);
     EXPECT_GT((*gl)->lightfield()->last_stats().visible_cells, 0u);
     RenderedImage a, b;
     ASSERT_TRUE((*gl)->render(cam, &a).ok());

@@ -6,8 +6,8 @@
 //
 // Keys: drag with the left button to look (fly) or turn around the volume centre (orbit);
 // W/A/S/D/Q/E move (fly) or zoom (orbit, W/S); O fly <-> orbit; R toggles the RR variant; V
-// distance <-> angle priority; + / - the most active views; Shift+S stereo; space pauses; H hides the
-// HUD; Esc quits.
+// distance <-> angle priority; + / - the most active views; Shift+S stereo; space pauses; H hides
+// the HUD; Esc quits.
 #pragma once
 
 #include <cstdint>
