@@ -38,9 +38,6 @@ std::string format(const char* fmt, auto... args) {
   return buf;
 }
 
-// What a face of a CPU view needs converting again: bits of the decoder's update targets.
-constexpr uint8_t kDirtyColour = 1, kDirtyDepth = 2, kDirtyMaterial = 4;
-
 }  // namespace
 
 struct LightfieldRepresentation::Impl {
@@ -58,14 +55,20 @@ struct LightfieldRepresentation::Impl {
   std::unique_ptr<GlViews> gl_views;
   std::unique_ptr<GlRenderer> gl_renderer;
   // CPU path. The CPU renderer reads linear float views: one View per clip view, indexed like the
-  // clip, so that a view which stays active is never rebuilt; only the faces the frame's updates
-  // changed are converted again from the texture state. A view never active yet is a one-texel
-  // placeholder (the renderer only reads the active views).
+  // clip, so that a view which stays active is never rebuilt; after each frame only what the
+  // updates changed is converted again from the texture state: the rects of depth and material
+  // updates, and the colour cells whose slots an update wrote or whose interpolation parameters
+  // changed. A view never active yet is a one-texel placeholder (the renderer reads only the
+  // active views), built in full when it first becomes active.
   std::optional<decoder::CpuTextures> cpu_textures;
   ViewSet view_set;
-  std::vector<uint8_t> view_built;                         // per clip view: full size and current
-  std::vector<std::array<uint8_t, kCubeFaceCount>> dirty;  // per clip view and face: kDirty* bits
-
+  std::vector<uint8_t> view_built;  // per clip view: full size and current
+  struct CellRef {
+    uint32_t view, face, cell;
+  };
+  std::vector<CellRef> stale_cells;  // colour cells of built views to mix again, no duplicates
+  std::vector<uint8_t> cell_stale;   // per (view, face, cell): listed in stale_cells
+  std::vector<float> scratch;
   decoder::FrameUpdates updates;
   ViewSelection selection;
   double render_ms = 0, upload_ms = 0;
@@ -76,10 +79,11 @@ struct LightfieldRepresentation::Impl {
   bool view_dependent_for(const RenderOptions& r) const {
     return options.decoder.view_dependent && !(r.rr && has_material);
   }
-  void mark_dirty();
-  Status build_view(uint32_t v);
-  Status refresh_face(uint32_t v, CubeFace face, uint8_t what);
+  void mark_stale_cell(uint32_t view, CubeFace face, uint32_t cell);
+  void collect_changed_cells();
   Status refresh_cpu_views();
+  Status build_view(uint32_t v);
+  Status convert_material(uint32_t v, CubeFace face, const PixelRect& rect);
   RenderOptions frame_options(const Vec3& eye) const;
 };
 
@@ -140,7 +144,8 @@ Expected<std::unique_ptr<LightfieldRepresentation>> LightfieldRepresentation::op
       impl->view_set.views.push_back(std::move(placeholder));
     }
     impl->view_built.assign(h.view_count, 0);
-    impl->dirty.assign(h.view_count, {});
+    impl->cell_stale.assign(
+        size_t{h.view_count} * kCubeFaceCount * impl->cpu_textures->cells().cell_count(), 0);
   }
   return std::unique_ptr<LightfieldRepresentation>(new LightfieldRepresentation(std::move(impl)));
 }
@@ -234,87 +239,120 @@ Status LightfieldRepresentation::prepare(uint32_t frame, std::span<const Camera>
   if (d.gl_views) {
     s = d.gl_views->apply(d.updates);
   } else {
-    d.mark_dirty();
+    d.collect_changed_cells();
     s = d.cpu_textures->apply(d.updates);
-    if (s.ok()) s = d.refresh_cpu_views();
+    if (s.ok()) {
+      s = d.refresh_cpu_views();
+    } else {
+      // Part of the frame may be in the texture state: rebuild every view when next active.
+      std::fill(d.view_built.begin(), d.view_built.end(), 0);
+      d.stale_cells.clear();
+      std::fill(d.cell_stale.begin(), d.cell_stale.end(), 0);
+    }
   }
   d.upload_ms = ms_since(t0);
   return s;
 }
 
-// Before the updates are applied: which faces they change. A texture update dirties its target;
-// a cell's interpolation parameters dirty the face's colour only when they differ from what the
-// texture state holds (the decoder sends every visible cell every frame).
-void LightfieldRepresentation::Impl::mark_dirty() {
-  for (const decoder::TextureUpdate& u : updates.updates) {
-    if (u.view >= dirty.size()) continue;  // apply() refuses it
-    const uint8_t bit = u.target == decoder::UpdateTarget::kColour  ? kDirtyColour
-                        : u.target == decoder::UpdateTarget::kDepth ? kDirtyDepth
-                                                                    : kDirtyMaterial;
-    dirty[u.view][cube_face_index(u.face)] |= bit;
-  }
+void LightfieldRepresentation::Impl::mark_stale_cell(uint32_t view, CubeFace face, uint32_t cell) {
+  const uint32_t f = static_cast<uint32_t>(cube_face_index(face));
+  const size_t i = (size_t{view} * kCubeFaceCount + f) * cpu_textures->cells().cell_count() + cell;
+  if (cell_stale[i]) return;
+  cell_stale[i] = 1;
+  stale_cells.push_back({view, f, cell});
+}
+
+// Before the updates are applied: the cells of built views whose interpolation parameters change
+// (the decoder sends every visible cell every frame, most of them unchanged).
+void LightfieldRepresentation::Impl::collect_changed_cells() {
   const uint32_t cell_count = cpu_textures->cells().cell_count();
   for (const decoder::CellParams& c : updates.cells) {
-    if (c.view >= dirty.size() || c.cell >= cell_count) continue;  // apply() refuses it
+    if (c.view >= view_built.size() || !view_built[c.view] || c.cell >= cell_count) continue;
     const decoder::CellParams now = cpu_textures->cell(c.view, c.face, c.cell);
-    if (now.t != c.t || now.a_slot != c.a_slot)
-      dirty[c.view][cube_face_index(c.face)] |= kDirtyColour;
+    if (now.t != c.t || now.a_slot != c.a_slot) mark_stale_cell(c.view, c.face, c.cell);
   }
 }
 
-// Converts the parts `what` of one face of clip view `v` from the texture state.
-Status LightfieldRepresentation::Impl::refresh_face(uint32_t v, CubeFace face, uint8_t what) {
-  View& view = view_set.views[v];
+// Material codes of `rect` of a face, as the renderer's floats, into the CPU view.
+Status LightfieldRepresentation::Impl::convert_material(uint32_t v, CubeFace face,
+                                                        const PixelRect& rect) {
   const uint32_t n = cpu_textures->face_size();
-  const PixelRect whole{0, 0, n, n};
-  if (what & kDirtyColour) {
-    CALF_RETURN_IF_ERROR(view.write_color_rect(face, whole, cpu_textures->colour(v, face)));
-  }
-  if (what & kDirtyDepth) {
-    CALF_RETURN_IF_ERROR(view.write_depth_rect(face, whole, cpu_textures->depth(v, face)));
-  }
-  if ((what & kDirtyMaterial) && view.has_material()) {
-    const auto codes = cpu_textures->material(v, face);
-    std::vector<float> m(codes.size());
-    for (size_t i = 0; i < codes.size(); i += 3) {
-      m[i] = lf::material_weight_from_code(codes[i]);
-      m[i + 1] = lf::material_weight_from_code(codes[i + 1]);
-      m[i + 2] = lf::material_ior_from_code(codes[i + 2]);
+  const auto codes = cpu_textures->material(v, face);
+  scratch.resize(size_t{rect.width} * rect.height * 3);
+  for (uint32_t y = 0; y < rect.height; ++y) {
+    const uint8_t* from = &codes[(size_t{rect.y + y} * n + rect.x) * 3];
+    float* to = &scratch[size_t{y} * rect.width * 3];
+    for (size_t i = 0; i < size_t{rect.width} * 3; i += 3) {
+      to[i] = lf::material_weight_from_code(from[i]);
+      to[i + 1] = lf::material_weight_from_code(from[i + 1]);
+      to[i + 2] = lf::material_ior_from_code(from[i + 2]);
     }
-    CALF_RETURN_IF_ERROR(view.write_material_rect(face, whole, m));
   }
-  return Status::Ok();
+  return view_set.views[v].write_material_rect(face, rect, scratch);
 }
 
 // A view that becomes active for the first time: full size, every face converted.
 Status LightfieldRepresentation::Impl::build_view(uint32_t v) {
   const auto& info = decoder->view(v);
   CALF_ASSIGN_OR_RETURN(LogDepthRange range, LogDepthRange::make(info.z_near, info.z_far));
-  CALF_ASSIGN_OR_RETURN(
-      View view, View::make(viewpoints[v], range, cpu_textures->face_size(), info.has_material));
+  const uint32_t n = cpu_textures->face_size();
+  CALF_ASSIGN_OR_RETURN(View view, View::make(viewpoints[v], range, n, info.has_material));
   view_set.views[v] = std::move(view);
+  const PixelRect whole{0, 0, n, n};
   for (int f = 0; f < kCubeFaceCount; ++f) {
-    CALF_RETURN_IF_ERROR(
-        refresh_face(v, static_cast<CubeFace>(f), kDirtyColour | kDirtyDepth | kDirtyMaterial));
+    const CubeFace face = static_cast<CubeFace>(f);
+    View& out = view_set.views[v];
+    CALF_RETURN_IF_ERROR(out.write_color_rect(face, whole, cpu_textures->colour(v, face)));
+    CALF_RETURN_IF_ERROR(out.write_depth_rect(face, whole, cpu_textures->depth(v, face)));
+    if (out.has_material()) CALF_RETURN_IF_ERROR(convert_material(v, face, whole));
   }
   view_built[v] = 1;
-  dirty[v] = {};
   return Status::Ok();
 }
 
-// The active views, current: built when new, their changed faces converted again. Inactive views
-// keep their dirty marks until they are active again.
+// After the updates are applied: what they changed in built views is converted again from the
+// texture state (which holds the frame's final texels, so overlapping updates need no order);
+// views active for the first time are built in full.
 Status LightfieldRepresentation::Impl::refresh_cpu_views() {
+  const FaceGrid& grid = cpu_textures->cells();
+  const uint32_t n = cpu_textures->face_size();
+  for (const decoder::TextureUpdate& u : updates.updates) {
+    if (!view_built[u.view]) continue;
+    View& view = view_set.views[u.view];
+    const PixelRect& r = u.rect;
+    switch (u.target) {
+      case decoder::UpdateTarget::kColour: {
+        // Every cell the rect touches shows the slot it wrote.
+        const uint32_t per_side = grid.cells_per_side();
+        const uint32_t c0 = grid.cell_index_at_texel(r.x, r.y);
+        const uint32_t c1 = grid.cell_index_at_texel(r.x + r.width - 1, r.y + r.height - 1);
+        for (uint32_t cy = c0 / per_side; cy <= c1 / per_side; ++cy) {
+          for (uint32_t cx = c0 % per_side; cx <= c1 % per_side; ++cx) {
+            mark_stale_cell(u.view, u.face, grid.cell_index(cx, cy));
+          }
+        }
+        break;
+      }
+      case decoder::UpdateTarget::kDepth:
+        CALF_RETURN_IF_ERROR(view.write_depth_rect(
+            u.face, r, cpu_textures->depth(u.view, u.face).subspan(size_t{r.y} * n + r.x), n));
+        break;
+      case decoder::UpdateTarget::kMaterial:
+        if (view.has_material()) CALF_RETURN_IF_ERROR(convert_material(u.view, u.face, r));
+        break;
+    }
+  }
+  const uint32_t per_side = grid.cells_per_side();
+  for (const CellRef& c : stale_cells) {
+    const CubeFace face = static_cast<CubeFace>(c.face);
+    cpu_textures->colour_cell(c.view, face, c.cell, &scratch);
+    CALF_RETURN_IF_ERROR(view_set.views[c.view].write_color_rect(
+        face, grid.cell_rect(c.cell % per_side, c.cell / per_side), scratch));
+    cell_stale[(size_t{c.view} * kCubeFaceCount + c.face) * grid.cell_count() + c.cell] = 0;
+  }
+  stale_cells.clear();
   for (uint32_t v : selection.active) {
-    if (!view_built[v]) {
-      CALF_RETURN_IF_ERROR(build_view(v));
-      continue;
-    }
-    for (int f = 0; f < kCubeFaceCount; ++f) {
-      if (dirty[v][f] == 0) continue;
-      CALF_RETURN_IF_ERROR(refresh_face(v, static_cast<CubeFace>(f), dirty[v][f]));
-      dirty[v][f] = 0;
-    }
+    if (!view_built[v]) CALF_RETURN_IF_ERROR(build_view(v));
   }
   return Status::Ok();
 }
