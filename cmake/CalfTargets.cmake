@@ -22,7 +22,9 @@ endif()
 # calf_layer(NAME DIR dir LINKS deps...): one library per layer. Sources are globbed so that work
 # in different files never edits this list; CONFIGURE_DEPENDS re-globs on every build.
 # Commands: every <dir>/tools/<name>.cc becomes the executable <name> with '_' turned into '-',
-# linked to the layer, CLI11 and fmt.
+# linked to the layer, CLI11 and fmt, together with the command's own sources
+# <dir>/tools/<name>/*.cc (code only that command uses, e.g. calf-play's window), which include
+# their headers as "<name>/x.h".
 function(calf_layer name)
   cmake_parse_arguments(L "" "DIR" "LINKS" ${ARGN})
   set(dir ${CMAKE_CURRENT_SOURCE_DIR}/${L_DIR})
@@ -41,7 +43,8 @@ function(calf_layer name)
   foreach(tool_source ${tools})
     get_filename_component(tool ${tool_source} NAME_WE)
     string(REPLACE "_" "-" exe ${tool})
-    add_executable(${exe} ${tool_source})
+    file(GLOB tool_extra CONFIGURE_DEPENDS ${dir}/tools/${tool}/*.cc)
+    add_executable(${exe} ${tool_source} ${tool_extra})
     target_link_libraries(${exe} PRIVATE ${name} CLI11::CLI11 fmt::fmt calf_options)
     target_include_directories(${exe} PRIVATE ${dir}/tools)
   endforeach()

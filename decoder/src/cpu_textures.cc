@@ -199,6 +199,25 @@ Status CpuTextures::apply(const FrameUpdates& frame) {
   return Status::Ok();
 }
 
+namespace {
+
+// One cell of the displayed colour: per texel mix(slot a, slot 1 - a, t / 255) over `r`, written
+// to dst + ((y - r.y) * dst_row + (x - r.x)) * 3 for texel (x, y).
+void mix_cell(const std::vector<float>& a, const std::vector<float>& b, const CellParams& p,
+              const PixelRect& r, uint32_t face_size, float* dst, size_t dst_row) {
+  // The same arithmetic as the reference decoder (SPEC §11.1.4): w = t / 255 in float.
+  const float w = p.t / 255.0f;
+  for (uint32_t y = 0; y < r.height; ++y) {
+    const size_t from = (size_t{r.y + y} * face_size + r.x) * 3;
+    float* to = dst + y * dst_row * 3;
+    for (size_t i = 0; i < size_t{r.width} * 3; ++i) {
+      to[i] = p.t == 0 ? a[from + i] : (1.0f - w) * a[from + i] + w * b[from + i];
+    }
+  }
+}
+
+}  // namespace
+
 std::vector<float> CpuTextures::colour(uint32_t view, CubeFace face) const {
   const ViewState& s = views_[view];
   const int f = cube_face_index(face);
@@ -207,18 +226,23 @@ std::vector<float> CpuTextures::colour(uint32_t view, CubeFace face) const {
     for (uint32_t cx = 0; cx < cells_.cells_per_side(); ++cx) {
       const PixelRect r = cells_.cell_rect(cx, cy);
       const CellParams& p = s.cells[f][cells_.cell_index(cx, cy)];
-      const std::vector<float>& a = s.slots[f][p.a_slot];
-      const std::vector<float>& b = s.slots[f][1 - p.a_slot];
-      // The same arithmetic as the reference decoder (SPEC §11.1.4): w = t / 255 in float.
-      const float w = p.t / 255.0f;
-      for (uint32_t y = r.y; y < r.y + r.height; ++y) {
-        for (size_t i = (size_t{y} * face_size_ + r.x) * 3; i < (size_t{y} * face_size_ + r.x + r.width) * 3; ++i) {
-          out[i] = p.t == 0 ? a[i] : (1.0f - w) * a[i] + w * b[i];
-        }
-      }
+      mix_cell(s.slots[f][p.a_slot], s.slots[f][1 - p.a_slot], p, r, face_size_,
+               &out[(size_t{r.y} * face_size_ + r.x) * 3], face_size_);
     }
   }
   return out;
+}
+
+void CpuTextures::colour_cell(uint32_t view, CubeFace face, uint32_t cell,
+                              std::vector<float>* rgb) const {
+  const ViewState& s = views_[view];
+  const int f = cube_face_index(face);
+  const uint32_t per_side = cells_.cells_per_side();
+  const PixelRect r = cells_.cell_rect(cell % per_side, cell / per_side);
+  const CellParams& p = s.cells[f][cell];
+  rgb->resize(size_t{r.width} * r.height * 3);
+  mix_cell(s.slots[f][p.a_slot], s.slots[f][1 - p.a_slot], p, r, face_size_, rgb->data(),
+           r.width);
 }
 
 std::span<const float> CpuTextures::colour_slot(uint32_t view, CubeFace face, uint32_t slot) const {

@@ -16,7 +16,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr uint32_t kMaxGrowthBackoff = 32;
 
 // Shortest faithful text of a number ("0.5", "nan", "1e+300"), for messages.
 std::string num(double x) {
@@ -80,6 +79,20 @@ Status check_options(const ViewSelectionOptions& o) {
   return Status::Ok();
 }
 
+// The frame budget's options: the selector's knobs of the same names, its units active views.
+FrameBudgetOptions budget_options(const ViewSelectionOptions& o) {
+  FrameBudgetOptions b;
+  b.target_frame_ms = o.target_frame_ms;
+  b.fixed_cost_ms = o.fixed_cost_ms;
+  b.over_budget_tolerance = o.over_budget_tolerance;
+  b.grow_headroom = o.grow_headroom;
+  b.grow_after_frames = o.grow_after_frames;
+  b.cost_smoothing = o.cost_smoothing;
+  b.min_units = o.min_active;
+  b.max_units = o.max_active;
+  return b;
+}
+
 struct Ranked {
   uint32_t view;
   double key;       // priority key after the incumbent discount; smaller ranks first
@@ -114,21 +127,14 @@ Expected<ViewSelector> ViewSelector::make(std::vector<Vec3> viewpoints,
 void ViewSelector::reset() {
   slots_.clear();
   std::fill(was_active_.begin(), was_active_.end(), 0);
-  last_active_count_ = 0;
-  limit_ = options_.max_active;
-  per_view_ms_ = 0;
-  under_budget_frames_ = 0;
-  frames_since_growth_ = 0;
-  growth_on_probation_ = false;
-  growth_backoff_ = 1;
+  budget_.set_options(budget_options(options_));
+  budget_.reset();
 }
 
 Status ViewSelector::set_options(const ViewSelectionOptions& options) {
   CALF_RETURN_IF_ERROR(check_options(options));
   options_ = options;
-  limit_ = options_.target_frame_ms > 0
-               ? std::clamp(limit_, options_.min_active, options_.max_active)
-               : options_.max_active;
+  budget_.set_options(budget_options(options_));
   return Status::Ok();
 }
 
@@ -172,8 +178,7 @@ Expected<ViewSelection> ViewSelector::select(const Vec3& position, const Vec3& f
   });
 
   ViewSelection sel;
-  const bool controller_on = o.target_frame_ms > 0;
-  sel.performance_limit = controller_on ? std::min(limit_, o.max_active) : o.max_active;
+  sel.performance_limit = budget_.allowed();
   const uint32_t cap = sel.performance_limit;
   const double cone_rad = o.view_cone_deg * kPi / 180.0;
   const double redundancy_rad = o.redundancy_angle_deg * kPi / 180.0;
@@ -263,68 +268,12 @@ Expected<ViewSelection> ViewSelector::select(const Vec3& position, const Vec3& f
 
   slots_ = std::move(slots);
   was_active_ = std::move(now_active);
-  last_active_count_ = static_cast<uint32_t>(kept.size());
+  budget_.record_units(static_cast<uint32_t>(kept.size()));
   return sel;
 }
 
 Status ViewSelector::report_frame_time(double frame_ms) {
-  if (!(frame_ms >= 0) || !std::isfinite(frame_ms)) {
-    return Status(ErrorId::kViewSelectFrameTime, "reported frame time " + num(frame_ms) +
-                                                     " ms is not a finite non-negative number");
-  }
-  const ViewSelectionOptions& o = options_;
-  if (o.target_frame_ms <= 0 || last_active_count_ == 0) return Status::Ok();
-  const uint32_t n = last_active_count_;
-
-  // Per-view cost: the frame's variable part shared out over the views that caused it.
-  const double sample = std::max(0.0, frame_ms - o.fixed_cost_ms) / n;
-  per_view_ms_ =
-      per_view_ms_ > 0 ? per_view_ms_ + o.cost_smoothing * (sample - per_view_ms_) : sample;
-  if (frames_since_growth_ < UINT32_MAX) ++frames_since_growth_;
-  if (growth_on_probation_ && frames_since_growth_ > o.grow_after_frames) {
-    growth_on_probation_ = false;  // the growth held: trust the model again
-    growth_backoff_ = 1;
-  }
-
-  if (frame_ms > o.target_frame_ms * (1 + o.over_budget_tolerance)) {
-    under_budget_frames_ = 0;
-    // The count the model says fits the target; never more than n - 1, since n is too many
-    // (the running estimate may lag behind a sudden jump in cost).
-    uint32_t fit = o.min_active;
-    if (per_view_ms_ > 0 && o.target_frame_ms > o.fixed_cost_ms) {
-      const double f = std::floor((o.target_frame_ms - o.fixed_cost_ms) / per_view_ms_);
-      fit = static_cast<uint32_t>(std::min<double>(f, kMaxViewpoints));
-    }
-    const uint32_t fewer = n > o.min_active ? n - 1 : o.min_active;
-    limit_ = std::clamp(std::min(fit, fewer), o.min_active, o.max_active);
-    if (growth_on_probation_) {
-      // The latest growth broke the budget: wait longer before the next one.
-      growth_backoff_ = std::min(growth_backoff_ * 2, kMaxGrowthBackoff);
-      growth_on_probation_ = false;
-    }
-    return Status::Ok();
-  }
-  if (frame_ms >= o.target_frame_ms || limit_ > n || limit_ >= o.max_active) {
-    // Inside the tolerance band, or the limit is not what bounds the count (culling left fewer
-    // views), or nothing to grow to: hold.
-    under_budget_frames_ = 0;
-    return Status::Ok();
-  }
-  // A frame counts towards growth only if the model says one more view would still fit with
-  // headroom: frames just under the target must not pile up credit for a later jump.
-  const double predicted = o.fixed_cost_ms + (n + 1) * per_view_ms_;
-  if (predicted > o.target_frame_ms * (1 - o.grow_headroom)) {
-    under_budget_frames_ = 0;
-    return Status::Ok();
-  }
-  ++under_budget_frames_;
-  if (under_budget_frames_ >= static_cast<uint64_t>(o.grow_after_frames) * growth_backoff_) {
-    limit_ = n + 1;
-    under_budget_frames_ = 0;
-    frames_since_growth_ = 0;
-    growth_on_probation_ = true;
-  }
-  return Status::Ok();
+  return budget_.report_frame_time(frame_ms);
 }
 
 }  // namespace calf::player

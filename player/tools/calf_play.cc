@@ -15,8 +15,8 @@
 #include "calf/player/contact_sheet.h"
 #include "calf/player/gl_context.h"
 #include "calf/player/image_compare.h"
-#include "calf/player/play_window.h"
 #include "calf/player/playback.h"
+#include "calf_play/play_window.h"
 
 namespace {
 
@@ -69,7 +69,9 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
     fs::create_directories(a.out, ec);
     if (ec) return fail(Status(ErrorId::kFileWrite, a.out + ": " + ec.message()));
   }
-  if (play.options().render.rr && !play.has_material()) {
+  // The light-field figures printed per pose are the first lightfield track's.
+  const LightfieldRepresentation& lf = *play.lightfield();
+  if (lf.options().render.rr && !lf.has_material()) {
     std::fprintf(stderr, "calf-play: notice: the clip has no material stream; --rr is ignored\n");
   }
   double sum_psnr = 0, sum_ssim = 0, sum_decode = 0, sum_mbps = 0;
@@ -89,7 +91,7 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
     for (size_t k = i; k < j; ++k) eyes.push_back(capture::camera_from_pose(path, k));
     const uint32_t frame = play.frame_at_time(path.poses[i].time);
     if (Status s = play.prepare(frame, eyes); !s.ok()) return fail(s);
-    const auto& st = play.last_stats();
+    const auto& st = lf.last_stats();
     if (st.errors > 0) {
       std::fprintf(stderr, "calf-play: warning: frame %u: %u damaged chunk(s), last good state "
                    "kept: %s\n", frame, st.errors, st.first_error.c_str());
@@ -112,7 +114,7 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
         }
       }
       std::printf("pose %zu frame %u: %zu views, %u/%u cells, %.2f Mbps@24, decode %.2f ms, "
-                  "render %.1f ms", k, frame, play.last_selection().active.size(),
+                  "render %.1f ms", k, frame, lf.last_selection().active.size(),
                   st.visible_cells, st.total_cells, st.mbps_at_24fps(), st.decode_ms,
                   play.last_render_ms());
       sum_decode += st.decode_ms;
@@ -185,7 +187,8 @@ int main(int argc, char** argv) {
   HeadlessArgs h;
   bool headless = false;
   std::string renderer = "gl", priority = "distance";
-  PlaybackOptions o;
+  PlaybackOptions play_options;
+  LightfieldOptions& o = play_options.lightfield;  // the knobs below are the light field's
   WindowOptions w;
   app.add_option("CLIP", clip, "the .calf file (its first lightfield track is played)")->required();
   app.add_flag("--headless", headless, "render --eye-path (or the --compare directory's path) "
@@ -240,7 +243,7 @@ int main(int argc, char** argv) {
   app.add_option("--frames", w.max_frames, "window: quit after this many frames (0 = never)");
   CLI11_PARSE(app, argc, argv);
 
-  o.use_gl = renderer == "gl";
+  play_options.use_gl = renderer == "gl";
   o.selection.priority = priority == "angle" ? ViewPriority::kAngle : ViewPriority::kDistance;
   if (headless && app.count("--frame-ms") == 0) o.selection.target_frame_ms = 0;
   if (headless) {
@@ -252,22 +255,22 @@ int main(int argc, char** argv) {
     }
     std::unique_ptr<OsMesaContext> context;
     const GlFunctions* gl = nullptr;
-    if (o.use_gl) {
+    if (play_options.use_gl) {
       auto c = OsMesaContext::make();
       if (!c.ok()) return fail(c.status());
       context = std::move(*c);
       gl = &context->gl();
     }
-    auto play = Playback::open(clip, o, gl);
+    auto play = Playback::open(clip, play_options, gl);
     if (!play.ok()) return fail(play.status());
     return run_headless(**play, h);
   }
-  if (!o.use_gl) {
+  if (!play_options.use_gl) {
     return fail(Status(ErrorId::kPlaybackOption, "--renderer cpu works only with --headless"));
   }
   if (!h.contact_sheet.empty()) {
     return fail(Status(ErrorId::kPlaybackOption, "--contact-sheet works only with --headless"));
   }
-  if (Status s = run_window(clip, o, w); !s.ok()) return fail(s);
+  if (Status s = run_window(clip, play_options, w); !s.ok()) return fail(s);
   return 0;
 }

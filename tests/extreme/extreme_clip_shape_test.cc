@@ -327,12 +327,12 @@ void check_face_size(uint32_t n, uint32_t cell, const Vec3& ray_to_last_texel) {
       if (gl && ctx == nullptr) continue;
       PlaybackOptions po;
       po.use_gl = gl;
-      po.selection.target_frame_ms = 0;
+      po.lightfield.selection.target_frame_ms = 0;
       auto play = Playback::open(clip, po, gl ? &ctx->gl() : nullptr);
       ASSERT_TRUE(play.ok()) << what << ": " << play.status().to_string();
       for (uint32_t frame : {0u, 1u}) {
         ASSERT_TRUE((*play)->prepare(frame, std::span<const Camera>(&cam, 1)).ok());
-        EXPECT_GT((*play)->last_stats().visible_cells, 0u);
+        EXPECT_GT((*play)->lightfield()->last_stats().visible_cells, 0u);
         RenderedImage img;
         ASSERT_TRUE((*play)->render(cam, &img).ok());
         ASSERT_EQ(bad_pixels(img), 0u);

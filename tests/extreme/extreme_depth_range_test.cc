@@ -208,13 +208,13 @@ TEST(DepthRange1e4To1e6, CaptureEncodeDecodeRenderRoundTrip) {
   const double default_near = std::max(1e-4f / 4.0, 1e6 / 1048576.0);
   PlaybackOptions po;
   po.use_gl = false;
-  po.selection.target_frame_ms = 0;
+  po.lightfield.selection.target_frame_ms = 0;
   auto cpu = Playback::open(clip, po, nullptr);
   ASSERT_TRUE(cpu.ok()) << cpu.status().to_string();
   for (int f = 0; f < 6; ++f) {
     const Camera cam = face_camera(f);
     ASSERT_TRUE((*cpu)->prepare(0, std::span<const Camera>(&cam, 1)).ok());
-    EXPECT_GT((*cpu)->last_stats().visible_cells, 0u) << "face " << f;
+    EXPECT_GT((*cpu)->lightfield()->last_stats().visible_cells, 0u) << "face " << f;
     RenderedImage img;
     ASSERT_TRUE((*cpu)->render(cam, &img).ok());
     expect_face(img, scene, f, scene.depth[f] < default_near ? default_near : 0,
@@ -222,9 +222,9 @@ TEST(DepthRange1e4To1e6, CaptureEncodeDecodeRenderRoundTrip) {
   }
   // With the march range set to the data's (near 1e-4 / 4, far 1.01e6; 64 steps of 46 %, 8
   // bisections) every face, the 1e-4 one included, comes back at its depth.
-  po.fixed_march_range = true;
-  po.render.near = 2.5e-5;
-  po.render.far = 1.01e6;
+  po.lightfield.fixed_march_range = true;
+  po.lightfield.render.near = 2.5e-5;
+  po.lightfield.render.far = 1.01e6;
   auto wide = Playback::open(clip, po, nullptr);
   ASSERT_TRUE(wide.ok());
   for (int f = 0; f < 6; ++f) {
@@ -241,12 +241,12 @@ TEST(DepthRange1e4To1e6, CaptureEncodeDecodeRenderRoundTrip) {
   auto gpu = Playback::open(clip, po, &gl->gl());
   ASSERT_TRUE(gpu.ok()) << gpu.status().to_string();
   for (bool data_range : {true, false}) {
-    player::RenderOptions ro = po.render;
+    player::RenderOptions ro = po.lightfield.render;
     if (!data_range) {
       ro.near = default_near;
       ro.far = 1e6;
     }
-    ASSERT_TRUE((*gpu)->set_render_options(ro).ok());
+    ASSERT_TRUE((*gpu)->lightfield()->set_render_options(ro).ok());
     for (int f = 0; f < 6; ++f) {
       const Camera cam = face_camera(f);
       ASSERT_TRUE((*gpu)->prepare(0, std::span<const Camera>(&cam, 1)).ok());
@@ -341,14 +341,14 @@ TEST(FlatDepth, EveryDepthEqualEncodesDecodesAndRendersExactly) {
       if (gl && ctx == nullptr) continue;
       PlaybackOptions po;
       po.use_gl = gl;
-      po.selection.target_frame_ms = 0;
+      po.lightfield.selection.target_frame_ms = 0;
       auto play = Playback::open(clip, po, gl ? &ctx->gl() : nullptr);
       ASSERT_TRUE(play.ok()) << play.status().to_string();
       for (int f = 0; f < 6; ++f) {
         Camera cam = face_camera(f);
         cam.position = eye;
         ASSERT_TRUE((*play)->prepare(0, std::span<const Camera>(&cam, 1)).ok());
-        EXPECT_GT((*play)->last_stats().visible_cells, 0u);
+        EXPECT_GT((*play)->lightfield()->last_stats().visible_cells, 0u);
         RenderedImage img;
         ASSERT_TRUE((*play)->render(cam, &img).ok());
         ASSERT_EQ(bad_pixels(img), 0u);

@@ -190,6 +190,25 @@ size_t expect_matches_reference(const Clip& clip, const CpuTextures& tex, const 
     const LightfieldFace& want = face_of(c.view, c.face);
     const std::vector<float> got = tex.colour(c.view, c.face);
     const PixelRect r = *tex.cells().cell_rect(c.cell);
+    // The one-cell form (what the player's CPU views refresh from) holds the same texels.
+    std::vector<float> cell_rgb;
+    tex.colour_cell(c.view, c.face, c.cell, &cell_rgb);
+    if (cell_rgb.size() != size_t{r.width} * r.height * 3) {
+      ADD_FAILURE() << context << ": colour_cell gave " << cell_rgb.size() << " floats";
+      return compared;
+    }
+    for (uint32_t y = 0; y < r.height; ++y) {
+      for (uint32_t x = 0; x < r.width; ++x) {
+        for (int k = 0; k < 3; ++k) {
+          const size_t i = (size_t{r.y + y} * n + r.x + x) * 3 + k;
+          if (cell_rgb[(size_t{y} * r.width + x) * 3 + k] != want.colour[i]) {
+            ADD_FAILURE() << context << ": colour_cell view " << c.view << " cell " << c.cell
+                          << " texel (" << r.x + x << ", " << r.y + y << ") differs";
+            return compared;
+          }
+        }
+      }
+    }
     for (uint32_t y = r.y; y < r.y + r.height; ++y) {
       for (uint32_t x = r.x; x < r.x + r.width; ++x) {
         for (int k = 0; k < 3; ++k) {

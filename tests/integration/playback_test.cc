@@ -15,6 +15,7 @@
 #include "calf/capture/capture_set.h"
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/player/image_compare.h"
+#include "calf/format/container.h"
 #include "calf/player/playback.h"
 
 namespace calf::player {
@@ -65,7 +66,9 @@ TEST(Playback, ViewVolumeComesFromTheClip) {
   ASSERT_TRUE(play.ok());
   const auto& [lo, hi] = (*play)->view_volume();
   EXPECT_LT(lo.x, hi.x);
-  for (const Vec3& p : (*play)->viewpoints()) EXPECT_TRUE((*play)->inside_view_volume(p));
+  for (const Vec3& p : (*play)->lightfield()->viewpoints()) {
+    EXPECT_TRUE((*play)->inside_view_volume(p));
+  }
   EXPECT_FALSE((*play)->inside_view_volume({hi.x + 1, hi.y, hi.z}));
 }
 
@@ -73,8 +76,8 @@ TEST(Playback, GlAndCpuRenderTheSameFrames) {
   auto context = OsMesaContext::make();
   if (!context.ok()) GTEST_SKIP() << context.status().to_string();
   PlaybackOptions o;
-  o.render.steps = 48;
-  o.selection.target_frame_ms = 0;
+  o.lightfield.render.steps = 48;
+  o.lightfield.selection.target_frame_ms = 0;
   auto gl = Playback::open(clip_path(), o, &(*context)->gl());
   ASSERT_TRUE(gl.ok()) << gl.status().to_string();
   o.use_gl = false;
@@ -89,8 +92,9 @@ TEST(Playback, GlAndCpuRenderTheSameFrames) {
     cam.height = 32;
     ASSERT_TRUE((*gl)->prepare(frame, std::span<const Camera>(&cam, 1)).ok());
     ASSERT_TRUE((*cpu)->prepare(frame, std::span<const Camera>(&cam, 1)).ok());
-    EXPECT_EQ((*gl)->last_selection().active, (*cpu)->last_selection().active);
-    EXPECT_GT((*gl)->last_stats().visible_cells, 0u);
+    EXPECT_EQ((*gl)->lightfield()->last_selection().active,
+              (*cpu)->lightfield()->last_selection().active);
+    EXPECT_GT((*gl)->lightfield()->last_stats().visible_cells, 0u);
     RenderedImage a, b;
     ASSERT_TRUE((*gl)->render(cam, &a).ok());
     ASSERT_TRUE((*cpu)->render(cam, &b).ok());
@@ -99,6 +103,98 @@ TEST(Playback, GlAndCpuRenderTheSameFrames) {
     EXPECT_GE(*p, 45.0) << "frame " << frame;
     std::printf("frame %u: GL vs CPU PSNR %.2f dB\n", frame, *p);
   }
+}
+
+// The representation interface on its own: the light field's GL and CPU backends, opened on the
+// same track and driven only through Representation, agree; the figures are there for a HUD.
+TEST(LightfieldRepresentation, GlAndCpuBackendsAgreeThroughTheInterface) {
+  auto context = OsMesaContext::make();
+  if (!context.ok()) GTEST_SKIP() << context.status().to_string();
+  auto reader = container::Reader::open(clip_path());
+  ASSERT_TRUE(reader.ok()) << reader.status().to_string();
+  LightfieldOptions o;
+  o.render.steps = 48;
+  o.selection.target_frame_ms = 0;
+  auto gl_lf = LightfieldRepresentation::open(*reader, 0, o, RenderBackend::kGl,
+                                              &(*context)->gl());
+  ASSERT_TRUE(gl_lf.ok()) << gl_lf.status().to_string();
+  auto cpu_lf = LightfieldRepresentation::open(*reader, 0, o, RenderBackend::kCpu, nullptr);
+  ASSERT_TRUE(cpu_lf.ok()) << cpu_lf.status().to_string();
+  Representation& gl = **gl_lf;
+  Representation& cpu = **cpu_lf;
+  EXPECT_EQ(gl.kind(), "lightfield");
+  EXPECT_EQ(cpu.backend(), RenderBackend::kCpu);
+  EXPECT_EQ(gl.frame_count(), 3u);
+  const auto& [lo, hi] = gl.view_volume();
+  for (uint32_t frame = 0; frame < 3; ++frame) {
+    Camera cam;
+    cam.position = {lo.x + 0.7 * (hi.x - lo.x), lo.y + 0.4 * (hi.y - lo.y),
+                    lo.z + 0.2 * (hi.z - lo.z)};
+    cam.forward = {std::sin(frame * 1.5), 0.05, -std::cos(frame * 1.5)};
+    cam.width = 36;
+    cam.height = 30;
+    ASSERT_TRUE(gl.prepare(frame, std::span<const Camera>(&cam, 1)).ok());
+    ASSERT_TRUE(cpu.prepare(frame, std::span<const Camera>(&cam, 1)).ok());
+    RenderedImage a, b;
+    ASSERT_TRUE(gl.render(cam, &a).ok());
+    ASSERT_TRUE(cpu.render(cam, &b).ok());
+    ASSERT_EQ(a.depth.size(), size_t{36} * 30);
+    ASSERT_EQ(b.depth.size(), a.depth.size());
+    auto p = psnr(rgb_ref(a), rgb_ref(b));
+    ASSERT_TRUE(p.ok());
+    EXPECT_GE(*p, 45.0) << "frame " << frame;
+    // Radial depth, the compositing key: the backends agree where both see a surface.
+    size_t both = 0, close = 0;
+    for (size_t i = 0; i < a.depth.size(); ++i) {
+      if (!std::isfinite(a.depth[i]) || !std::isfinite(b.depth[i])) continue;
+      ++both;
+      if (std::abs(a.depth[i] - b.depth[i]) <= 0.01f * b.depth[i]) ++close;
+    }
+    EXPECT_GT(both, a.depth.size() / 2);
+    EXPECT_GE(close, both * 95 / 100) << "frame " << frame;
+    std::printf("frame %u: representation GL vs CPU PSNR %.2f dB, depth within 1 %%: %zu / %zu\n",
+                frame, *p, close, both);
+  }
+  const RepresentationStats st = gl.stats();
+  EXPECT_EQ(st.title, "lightfield track 0 (gl)");
+  ASSERT_FALSE(st.entries.empty());
+  EXPECT_EQ(st.entries[0].name, "active views");
+  EXPECT_TRUE(gl.report_frame_time(12.5).ok());
+  EXPECT_EQ(gl.report_frame_time(-1).id(), ErrorId::kViewSelectFrameTime);
+}
+
+// With one playable track, Playback's composite is that track's render, bit for bit.
+TEST(Playback, OneTrackRendersExactlyItsRepresentation) {
+  PlaybackOptions o;
+  o.use_gl = false;
+  auto play = Playback::open(clip_path(), o, nullptr);
+  ASSERT_TRUE(play.ok()) << play.status().to_string();
+  ASSERT_EQ((*play)->representations().size(), 1u);
+  ASSERT_NE((*play)->lightfield(), nullptr);
+  auto reader = container::Reader::open(clip_path());
+  ASSERT_TRUE(reader.ok());
+  auto lf = LightfieldRepresentation::open(*reader, 0, o.lightfield, RenderBackend::kCpu, nullptr);
+  ASSERT_TRUE(lf.ok());
+  const auto& [lo, hi] = (*play)->view_volume();
+  Camera cam;
+  cam.position = {0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), 0.5 * (lo.z + hi.z)};
+  cam.width = 24;
+  cam.height = 20;
+  for (uint32_t frame = 0; frame < 3; ++frame) {
+    ASSERT_TRUE((*play)->prepare(frame, std::span<const Camera>(&cam, 1)).ok());
+    ASSERT_TRUE((*lf)->prepare(frame, std::span<const Camera>(&cam, 1)).ok());
+    RenderedImage a, b;
+    ASSERT_TRUE((*play)->render(cam, &a).ok());
+    ASSERT_TRUE((*lf)->render(cam, &b).ok());
+    EXPECT_EQ(a.color, b.color) << "frame " << frame;
+    ASSERT_EQ(a.depth.size(), b.depth.size());
+    for (size_t i = 0; i < a.depth.size(); ++i) {
+      ASSERT_TRUE(a.depth[i] == b.depth[i] || (std::isinf(a.depth[i]) && std::isinf(b.depth[i])));
+    }
+  }
+  const auto stats = (*play)->stats();
+  ASSERT_EQ(stats.size(), 1u);
+  EXPECT_EQ(stats[0].title, "lightfield track 0 (cpu)");
 }
 
 TEST(Playback, FileWithoutLightfieldIsRefused) {

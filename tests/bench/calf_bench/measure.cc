@@ -102,12 +102,12 @@ Expected<EncodeOutcome> SceneInputs::encode(const EncodeConfig& c, const fs::pat
 
 Status SceneInputs::play(const fs::path& clip, const PlayConfig& config, PointResult* out) const {
   player::PlaybackOptions o;
-  o.render.steps = config.steps;
-  o.selection.max_active = config.views;
-  o.selection.target_frame_ms = 0;  // calf-play --headless: quality first, no performance culling
+  o.lightfield.render.steps = config.steps;
+  o.lightfield.selection.max_active = config.views;
+  o.lightfield.selection.target_frame_ms = 0;  // calf-play --headless: quality first, no performance culling
   o.use_gl = settings_.use_gl;
   const uint32_t cores = std::max(1u, std::thread::hardware_concurrency());
-  o.render.threads = std::min(256u, settings_.threads ? settings_.threads : cores);
+  o.lightfield.render.threads = std::min(256u, settings_.threads ? settings_.threads : cores);
   CALF_ASSIGN_OR_RETURN(std::unique_ptr<player::Playback> play,
                         player::Playback::open(clip.string(), o, settings_.gl));
 
@@ -128,14 +128,14 @@ Status SceneInputs::play(const fs::path& clip, const PlayConfig& config, PointRe
     CALF_RETURN_IF_ERROR(play->prepare(frame, eyes));
     prepare.push_back(1e3 * (now_seconds() - t0));
     prepare_cpu.push_back(1e3 * (cpu_seconds() - c0));
-    const decoder::FrameStats& st = play->last_stats();
+    const decoder::FrameStats& st = play->lightfield()->last_stats();
     if (st.errors > 0) {
       return Status(ErrorId::kInternal,
                     fmt::format("{}: frame {}: {} damaged chunk(s): {}", clip.string(), frame,
                                 st.errors, st.first_error));
     }
     decode.push_back(st.decode_ms);
-    sum_views += static_cast<double>(play->last_selection().active.size());
+    sum_views += static_cast<double>(play->lightfield()->last_selection().active.size());
     sum_mbps += st.mbps_at_24fps();
     for (size_t k = i; k < j; ++k) {
       const double r0 = cpu_seconds();

@@ -46,6 +46,10 @@ class CpuTextures {
   // Linear RGB of `face` of `view` as the renderer shows it: per cell mix(slot a, slot 1 - a,
   // t / 255) with the cell's last (t, a_slot). 3 floats per texel, row-major.
   std::vector<float> colour(uint32_t view, CubeFace face) const;
+  // The same for one colour cell only (cell < cells().cell_count(), unchecked): its rect's texels,
+  // 3 floats each, rows packed (rect width * 3 floats a row), into `rgb` (resized). Bit for bit
+  // the cell's part of colour(), for consumers that refresh only the cells that changed.
+  void colour_cell(uint32_t view, CubeFace face, uint32_t cell, std::vector<float>* rgb) const;
   std::span<const float> colour_slot(uint32_t view, CubeFace face, uint32_t slot) const;
   std::span<const uint16_t> depth(uint32_t view, CubeFace face) const;
   std::span<const uint8_t> material(uint32_t view, CubeFace face) const;  // empty without

@@ -56,6 +56,7 @@
 #include "calf/format/camera.h"
 #include "calf/format/geometry.h"
 #include "calf/format/status.h"
+#include "calf/player/rendered_image.h"
 #include "calf/player/view_set.h"
 
 namespace calf::player {
@@ -160,14 +161,6 @@ struct RenderOptions {
   // is clamped at 0 (the differences may make it negative). Default true, the tuned value
   // (docs/RENDERING.md "Quality").
   bool rr_replace_view_reflection = true;
-};
-
-// A rendered frame: linear RGB float (3 per pixel, HDR kept) and the radial distance from the eye
-// to the surface each pixel shows (+inf for sky), row-major from the top row like ground truth.
-struct RenderedImage {
-  uint32_t width = 0, height = 0;
-  std::vector<float> color;
-  std::vector<float> depth;
 };
 
 // What one ray sees.

@@ -1,57 +1,42 @@
 // Playback of a .calf clip: the loop calf-play runs for each displayed frame, shared by the
-// window, the headless mode and the tests.
+// window, the headless mode and the tests. It holds one representation (representation.h) per
+// playable track — today every lightfield track, played by LightfieldRepresentation — on one
+// backend (GL or the CPU reference), and composites their renders by radial depth: per pixel the
+// nearest surface wins (ties: the earlier track). With one playable track the render is that
+// track's, bit for bit.
 //
-//   prepare(frame, eyes):  view selection (calf/player/view_selection.h) from the eyes' midpoint
-//                          -> the view-dependent decoder (calf/decoder/clip_decoder.h) advances
-//                          the selected views to `frame` for the eyes' frusta -> the updates go
-//                          to the GPU textures (GlViews) or, for the CPU reference renderer, to
-//                          CpuTextures and from there into a ViewSet;
-//   render(camera, image): ray-marches one eye with the selected views (GlRenderer or
-//                          CpuRenderer; the same RenderOptions).
-//
-// The march range (RenderOptions near / far) is derived per frame from the active views and the
-// eye (march_range_for), unless `fixed_march_range` is set. Statistics of the last frame (decoder,
-// selection, times) are kept for the HUD and reports.
+// The clip's timeline is its first playable track's (fps, frame count); a later track with fewer
+// frames shows its last frame past its end.
 #pragma once
 
 #include <cstdint>
 #include <memory>
-#include <optional>
 #include <span>
 #include <string>
+#include <utility>
+#include <vector>
 
-#include "calf/decoder/clip_decoder.h"
-#include "calf/format/container.h"
 #include "calf/format/status.h"
-#include "calf/player/cpu_renderer.h"
 #include "calf/player/gl_context.h"
-#include "calf/player/view_selection.h"
+#include "calf/player/lightfield_representation.h"
+#include "calf/player/representation.h"
 
 namespace calf::player {
 
 struct PlaybackOptions {
-  // Steps, weights, RR, ... ; active_views, near and far are set per frame.
-  RenderOptions render;
-  // Keep the march range in `render` instead of deriving it per frame.
-  bool fixed_march_range = false;
-  ViewSelectionOptions selection;
-  decoder::ClipDecoderOptions decoder;
-  // true: the GL 4.5 renderer (a current context and its functions are needed); false: the scalar
-  // CPU reference renderer.
+  // true: the GL 4.5 renderers (a current context and its functions are needed); false: the
+  // scalar CPU reference renderers.
   bool use_gl = true;
-  // GL only: keep BC5 depth compressed on the GPU (gl_views.h explains the trade).
-  bool keep_bc5_depth = false;
+  // Options of every lightfield track's representation.
+  LightfieldOptions lightfield;
 };
-
-// An eye's view for one frame: the camera (pose, field of view, image size).
-using EyeCamera = Camera;
 
 class Playback {
  public:
-  // Opens `clip_path` (its first lightfield track). `gl` is needed when options.use_gl; the GL
-  // context it was loaded from must stay current on this thread. Errors: the container's and
-  // decoder's; CALF-E403 for invalid render options; CALF-E404 / E410 from the GL side;
-  // CALF-E460 for a file without a lightfield track.
+  // Opens `clip_path` and a representation for each playable track. `gl` is needed when
+  // options.use_gl; the GL context it was loaded from must stay current on this thread. Errors:
+  // the container's and the representations' (LightfieldRepresentation::open); CALF-E460 for a
+  // file without a playable track.
   static Expected<std::unique_ptr<Playback>> open(const std::string& clip_path,
                                                   const PlaybackOptions& options,
                                                   const GlFunctions* gl);
@@ -64,27 +49,29 @@ class Playback {
   // The clip frame shown at `seconds` (frame f covers [f / fps, (f + 1) / fps)), clamped to the
   // clip: a negative time shows frame 0, a time past the end the last frame.
   uint32_t frame_at_time(double seconds) const;
-  // Whether any view carries material (the RR variant needs it).
-  bool has_material() const;
-  // The box the eye may move in: the clip's `view_volume` metadata, else the viewpoints' bounds.
+  // The box the eye may move in: the union of the representations' view volumes.
   const Box3& view_volume() const;
   bool inside_view_volume(const Vec3& p) const;
-  const std::vector<Vec3>& viewpoints() const;
 
-  // Selects views and brings their textures to `frame` for `eyes` (one or more cameras: mono,
-  // stereo, several users). Corrupt chunks are not errors (see last_stats().errors).
-  Status prepare(uint32_t frame, std::span<const EyeCamera> eyes);
-  // Renders `camera` with the views prepare() selected.
-  Status render(const EyeCamera& camera, RenderedImage* out);
+  // Brings every representation to `frame` for `eyes` (one or more cameras: mono, stereo,
+  // several users). CALF-E403 for no eye; the representations' errors.
+  Status prepare(uint32_t frame, std::span<const Camera> eyes);
+  // Renders `camera` with every representation and composites them by depth into `out`.
+  Status render(const Camera& camera, RenderedImage* out);
+  // The wall time in ms between the last two displayed frames, for the representations' frame
+  // budgets; CALF-E453 for a negative or non-finite time.
+  Status report_frame_time(double frame_ms);
 
-  // Changes render options (RR, steps, ...) from the next render; CALF-E403 on invalid ones.
-  Status set_render_options(const RenderOptions& options);
-  const PlaybackOptions& options() const;
-  ViewSelector& selector();
-
-  const decoder::FrameStats& last_stats() const;
-  const ViewSelection& last_selection() const;
+  // The representations, in track order.
+  std::span<Representation* const> representations() const;
+  // The first lightfield track's representation (its view selection, RR switch, decoder
+  // figures), or nullptr when the clip has none.
+  LightfieldRepresentation* lightfield() const;
+  // Every representation's figures of the latest frame, in track order (HUD, reports).
+  std::vector<RepresentationStats> stats() const;
+  // Wall time of the last render(), all representations and the compositing, in ms.
   double last_render_ms() const;
+  const PlaybackOptions& options() const;
 
  private:
   struct Impl;

@@ -22,17 +22,12 @@
 //      that stays never needs a full re-upload (Sec. 6.3: "the order of the active viewpoints is
 //      maintained as much as possible with respect to the previous frame").
 //
-// Performance controller. The caller renders with the selection, then reports that frame's time
-// (report_frame_time). The model is frame_ms = fixed_cost_ms + n * per_view_ms, n the active
-// count; per_view_ms is a running estimate from the reports. When a frame exceeds the target by
-// more than over_budget_tolerance, the limit drops at once to the count the model says fits the
-// target (at least one fewer than now). When the limit is what bounds the count and frames have
-// stayed under the target for grow_after_frames reports, it grows by one view, but only if the
-// model predicts the larger count still leaves grow_headroom below the target. A growth that is
-// followed by an over-budget frame within grow_after_frames doubles the wait before the next
-// growth (up to 32 times), so a wrong model cannot make the count oscillate; a growth that holds
-// resets the wait. With fixed_cost_ms left at 0 the per-view estimate includes the fixed part and
-// is too high: shrinking may take a few frames more, growing is cautious — never too eager.
+// Performance culling asks a frame budget (calf/player/frame_budget.h) how many views the frame
+// may use: the caller renders with the selection, then reports that frame's time
+// (report_frame_time), and the budget's controller (model frame_ms = fixed_cost_ms + n *
+// per_view_ms, n the active count) lowers or raises the limit. The budget's knobs are the
+// ViewSelectionOptions fields below of the same names; its units are active views, bounded by
+// [min_active, max_active].
 //
 // Stereo: pass the midpoint of the two eyes and the mean forward direction.
 // Everything is deterministic: same inputs, same calls, same results.
@@ -43,6 +38,7 @@
 
 #include "calf/format/geometry.h"
 #include "calf/format/status.h"
+#include "calf/player/frame_budget.h"
 
 namespace calf::player {
 
@@ -74,8 +70,9 @@ struct ViewSelectionOptions {
   // Ranking stickiness for views active last frame, [0, 1): their priority key counts
   // (1 - margin) times its value. 0 turns it off.
   double incumbent_margin = 0.05;
-  // Frame-time target in ms (>= 0, finite); 0 turns performance culling off. Default: 90 Hz, the
-  // rate of head-mounted displays the paper aims at (Sec. 7.2).
+  // The frame budget's knobs (FrameBudgetOptions, frame_budget.h, documents them; the ranges are
+  // checked here). Frame-time target in ms (>= 0, finite); 0 turns performance culling off.
+  // Default: 90 Hz, the rate of head-mounted displays the paper aims at (Sec. 7.2).
   double target_frame_ms = 1000.0 / 90.0;
   // The part of a frame's time that does not depend on the active count, in ms (>= 0, finite).
   double fixed_cost_ms = 0.0;
@@ -150,9 +147,11 @@ class ViewSelector {
   const ViewSelectionOptions& options() const { return options_; }
   const std::vector<Vec3>& viewpoints() const { return viewpoints_; }
   // The controller's current limit on the active count.
-  uint32_t performance_limit() const { return limit_; }
+  uint32_t performance_limit() const { return budget_.limit(); }
   // The running per-view cost estimate in ms; 0 before any frame time was reported.
-  double per_view_cost_ms() const { return per_view_ms_; }
+  double per_view_cost_ms() const { return budget_.per_unit_cost_ms(); }
+  // The frame budget performance culling asks (its units are active views).
+  const FrameBudget& budget() const { return budget_; }
 
  private:
   ViewSelector() = default;
@@ -161,15 +160,8 @@ class ViewSelector {
   ViewSelectionOptions options_;
   std::vector<uint32_t> slots_;      // last frame's slot table
   std::vector<uint8_t> was_active_;  // per view: in slots_
-  uint32_t last_active_count_ = 0;   // n of the latest selection, 0 before the first
   bool selected_once_ = false;
-  // Controller state.
-  uint32_t limit_ = 0;
-  double per_view_ms_ = 0;
-  uint32_t under_budget_frames_ = 0;
-  uint32_t frames_since_growth_ = 0;
-  bool growth_on_probation_ = false;  // the latest growth has not yet held grow_after_frames
-  uint32_t growth_backoff_ = 1;       // multiplies grow_after_frames
+  FrameBudget budget_;  // performance culling
 };
 
 }  // namespace calf::player

@@ -1,11 +1,13 @@
-// calf-play's window: a GLFW window (OpenGL 4.5 core) showing a clip played by Playback, with fly
-// and orbit cameras, side-by-side stereo and a Dear ImGui HUD (fps, active views, culled cells,
-// Mbps at 24 fps, decode and render times, the heuristics' knobs).
+// calf-play's window (compiled into calf-play only): a GLFW window (OpenGL 4.5 core) showing a
+// clip played by Playback, with fly and orbit cameras, side-by-side stereo and a Dear ImGui HUD:
+// the fps of displayed frames (wall time between buffer swaps, DisplayClock) and every
+// representation's statistics (for a light field: active views, culled views and cells, Mbps at
+// 24 fps, decode / upload / render times, RR).
 //
 // Keys: drag with the left button to look (fly) or turn around the volume centre (orbit);
 // W/A/S/D/Q/E move (fly) or zoom (orbit, W/S); O fly <-> orbit; R toggles the RR variant; V
-// distance <-> angle priority; + / - the most active views; Shift+S stereo; space pauses; H hides the
-// HUD; Esc quits.
+// distance <-> angle priority; + / - the most active views; Shift+S stereo; space pauses; H hides
+// the HUD; Esc quits.
 #pragma once
 
 #include <cstdint>

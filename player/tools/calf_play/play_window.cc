@@ -1,4 +1,4 @@
-#include "calf/player/play_window.h"
+#include "calf_play/play_window.h"
 
 #include <GLFW/glfw3.h>
 #include <imgui.h>
@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "calf/format/colour.h"
+#include "calf/player/display_clock.h"
 
 namespace calf::player {
 namespace {
@@ -95,6 +96,8 @@ Status run_window(const std::string& clip_path, const PlaybackOptions& options,
   GLuint display = 0;
   gl.GenTextures(1, &display);
   CameraState cam;
+  // The light field's knobs (RR, view selection) act on the clip's first lightfield track.
+  LightfieldRepresentation* lf = play->lightfield();
   const auto& [lo, hi] = play->view_volume();
   cam.centre = (lo + hi) * 0.5;
   cam.position = cam.centre;
@@ -102,7 +105,8 @@ Status run_window(const std::string& clip_path, const PlaybackOptions& options,
   bool stereo = wo.stereo, paused = false, show_hud = true;
   double clip_time = 0;
   auto last = std::chrono::steady_clock::now();
-  double fps = 0;
+  // The HUD's fps and the frame budgets' reports: wall time between displayed frames (swaps).
+  DisplayClock display_clock;
   std::vector<uint8_t> pixels;
   RenderedImage image;
   std::string warning;
@@ -113,7 +117,6 @@ Status run_window(const std::string& clip_path, const PlaybackOptions& options,
     const auto now = std::chrono::steady_clock::now();
     const double dt = std::chrono::duration<double>(now - last).count();
     last = now;
-    fps = fps == 0 ? 1 / std::max(dt, 1e-6) : 0.9 * fps + 0.1 / std::max(dt, 1e-6);
     ImGuiIO& io = ImGui::GetIO();
     // Keys through GLFW (this ImGui predates named keys); pressed = went down this frame.
     auto held = [&](int key) { return glfwGetKey(window, key) == GLFW_PRESS; };
@@ -129,17 +132,17 @@ Status run_window(const std::string& clip_path, const PlaybackOptions& options,
       if (pressed(GLFW_KEY_O)) cam.orbit = !cam.orbit;
       if (pressed(GLFW_KEY_H)) show_hud = !show_hud;
       if (pressed(GLFW_KEY_S) && shift) stereo = !stereo;
-      if (pressed(GLFW_KEY_R)) {
-        RenderOptions r = play->options().render;
+      if (pressed(GLFW_KEY_R) && lf != nullptr) {
+        RenderOptions r = lf->options().render;
         r.rr = !r.rr;
-        if (r.rr && !play->has_material()) warning = "the clip has no material: RR does nothing";
-        (void)play->set_render_options(r);
+        if (r.rr && !lf->has_material()) warning = "the clip has no material: RR does nothing";
+        (void)lf->set_render_options(r);
       }
       const bool key_v = pressed(GLFW_KEY_V);
       const bool more = pressed(GLFW_KEY_EQUAL) | pressed(GLFW_KEY_KP_ADD);
       const bool fewer = pressed(GLFW_KEY_MINUS) | pressed(GLFW_KEY_KP_SUBTRACT);
-      if (key_v || more || fewer) {
-        ViewSelectionOptions s = play->selector().options();
+      if ((key_v || more || fewer) && lf != nullptr) {
+        ViewSelectionOptions s = lf->selector().options();
         if (key_v) {
           s.priority = s.priority == ViewPriority::kDistance ? ViewPriority::kAngle
                                                              : ViewPriority::kDistance;
@@ -150,7 +153,7 @@ Status run_window(const std::string& clip_path, const PlaybackOptions& options,
           s.max_active -= 1;
           s.min_active = std::min(s.min_active, s.max_active);
         }
-        (void)play->selector().set_options(s);
+        (void)lf->selector().set_options(s);
       }
       const double speed = cam.radius * 0.5 * dt;
       const Vec3 f = cam.forward(), right = normalized(cross(f, {0, 1, 0}));
@@ -196,10 +199,8 @@ Status run_window(const std::string& clip_path, const PlaybackOptions& options,
     // Both eyes into one sRGB8 image, shown through ImGui's background draw list.
     const uint32_t width = eye_w * eyes_n, height = eyes[0].height;
     pixels.assign(size_t{width} * height * 4, 255);
-    double render_ms = 0;
     for (uint32_t e = 0; e < eyes_n; ++e) {
       CALF_RETURN_IF_ERROR(play->render(eyes[e], &image));
-      render_ms += play->last_render_ms();
       for (uint32_t y = 0; y < height; ++y) {
         for (uint32_t x = 0; x < eye_w; ++x) {
           const float* c = &image.color[(size_t{y} * eye_w + x) * 3];
@@ -222,25 +223,33 @@ Status run_window(const std::string& clip_path, const PlaybackOptions& options,
         reinterpret_cast<ImTextureID>(static_cast<intptr_t>(display)), ImVec2(0, 0),
         ImVec2(static_cast<float>(fb_w), static_cast<float>(fb_h)));
     if (show_hud) {
-      const decoder::FrameStats& st = play->last_stats();
-      const ViewSelection& sel = play->last_selection();
+      // Generic: each representation says what it has to say (representation.h).
       ImGui::Begin("calf-play");
-      ImGui::Text("%.1f fps   frame %u / %u%s", fps, frame, play->frame_count(),
-                  paused ? "  (paused)" : "");
-      ImGui::Text("active views %zu (max %u, %s priority)", sel.active.size(),
-                  play->selector().options().max_active,
-                  play->selector().options().priority == ViewPriority::kDistance ? "distance"
-                                                                                 : "angle");
-      ImGui::Text("culled views: angle %u, performance %u", sel.culled_by_angle,
-                  sel.culled_by_performance);
-      ImGui::Text("cells visible %u / %u, tiles %u / %u", st.visible_cells, st.total_cells,
-                  st.visible_tiles, st.total_tiles);
-      ImGui::Text("updates %.2f Mbps @24 fps, decode %.2f ms, render %.1f ms",
-                  st.mbps_at_24fps(), st.decode_ms, render_ms);
-      ImGui::Text("camera %s, RR %s, stereo %s", cam.orbit ? "orbit" : "fly",
-                  play->options().render.rr ? "on" : "off", stereo ? "on" : "off");
-      if (!play->inside_view_volume(cam.eye())) ImGui::TextColored({1, 0.6f, 0, 1}, "eye outside the view volume");
-      if (st.errors) ImGui::TextColored({1, 0.3f, 0.3f, 1}, "%s", st.first_error.c_str());
+      const double fps = display_clock.fps();
+      if (fps > 0) {
+        ImGui::Text("%.1f fps (%.1f ms a frame)   frame %u / %u%s", fps,
+                    display_clock.last_frame_ms(), frame, play->frame_count(),
+                    paused ? "  (paused)" : "");
+      } else {
+        ImGui::Text("-- fps   frame %u / %u%s", frame, play->frame_count(),
+                    paused ? "  (paused)" : "");
+      }
+      ImGui::Text("camera %s, stereo %s, render %.1f ms per eye", cam.orbit ? "orbit" : "fly",
+                  stereo ? "on" : "off", play->last_render_ms());
+      for (const RepresentationStats& rs : play->stats()) {
+        ImGui::Separator();
+        ImGui::TextUnformatted(rs.title.c_str());
+        for (const Statistic& st : rs.entries) {
+          if (st.alert) {
+            ImGui::TextColored({1, 0.3f, 0.3f, 1}, "%s: %s", st.name.c_str(), st.value.c_str());
+          } else {
+            ImGui::Text("%s: %s", st.name.c_str(), st.value.c_str());
+          }
+        }
+      }
+      if (!play->inside_view_volume(cam.eye())) {
+        ImGui::TextColored({1, 0.6f, 0, 1}, "eye outside the view volume");
+      }
       if (!warning.empty()) ImGui::TextColored({1, 0.6f, 0, 1}, "%s", warning.c_str());
       ImGui::End();
     }
@@ -250,7 +259,8 @@ Status run_window(const std::string& clip_path, const PlaybackOptions& options,
     dgl.Clear(GL_COLOR_BUFFER_BIT);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     glfwSwapBuffers(window);
-    (void)play->selector().report_frame_time(1000 * dt);
+    display_clock.displayed(std::chrono::steady_clock::now());
+    if (display_clock.has_interval()) (void)play->report_frame_time(display_clock.last_frame_ms());
     if (wo.max_frames != 0 && ++frames >= wo.max_frames) break;
   }
   gl.DeleteTextures(1, &display);
