@@ -104,7 +104,8 @@ Expected<ViewIndex> parse_view_index(std::span<const uint8_t> raw, const std::st
   ViewIndexRecord r;
   container::FieldReader reader = chunk_reader(raw, what);
   CALF_RETURN_IF_ERROR(container::read_fields(r, reader));
-  if (!depth_range_ok(r.z_near, r.z_far)) return corrupt(what + ": " + depth_range_text(r.z_near, r.z_far));
+  if (!depth_range_ok(r.z_near, r.z_far))
+    return corrupt(what + ": " + depth_range_text(r.z_near, r.z_far));
   ViewIndex v;
   std::copy(std::begin(r.position), std::end(r.position), std::begin(v.position));
   v.z_near = r.z_near;

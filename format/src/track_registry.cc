@@ -40,10 +40,10 @@ uint16_t stream_count(uint16_t kind) {
 
 const char* stream_name(uint16_t kind, uint16_t stream) {
   switch (kind) {
-#define CALF_TRACK_KIND_CASE(Name, number, name, section)                   \
-  case number:                                                              \
-    return stream < std::size(Name##TrackHeader::kStreamNames)              \
-               ? Name##TrackHeader::kStreamNames[stream]                    \
+#define CALF_TRACK_KIND_CASE(Name, number, name, section)      \
+  case number:                                                 \
+    return stream < std::size(Name##TrackHeader::kStreamNames) \
+               ? Name##TrackHeader::kStreamNames[stream]       \
                : "";
     CALF_TRACK_KINDS(CALF_TRACK_KIND_CASE)
 #undef CALF_TRACK_KIND_CASE
@@ -54,11 +54,11 @@ const char* stream_name(uint16_t kind, uint16_t stream) {
 Expected<TrackHeader> read_track_header(uint16_t kind, std::span<const uint8_t> blob,
                                         const std::string& context) {
   switch (kind) {
-#define CALF_TRACK_KIND_CASE(Name, number, name, section)                                 \
-  case number: {                                                                          \
-    CALF_ASSIGN_OR_RETURN(Name##TrackHeader h,                                            \
-                          decode_track_header<Name##TrackHeader>(blob, context));         \
-    return TrackHeader(h);                                                                \
+#define CALF_TRACK_KIND_CASE(Name, number, name, section)                         \
+  case number: {                                                                  \
+    CALF_ASSIGN_OR_RETURN(Name##TrackHeader h,                                    \
+                          decode_track_header<Name##TrackHeader>(blob, context)); \
+    return TrackHeader(h);                                                        \
   }
     CALF_TRACK_KINDS(CALF_TRACK_KIND_CASE)
 #undef CALF_TRACK_KIND_CASE

@@ -123,7 +123,9 @@ template <class T>
 concept ByteString = std::is_same_v<T, std::string> || std::is_same_v<T, std::vector<uint8_t>>;
 // A nested record: a structure with a static fields() template.
 template <class T>
-concept Record = requires(T& t, detail::AnyVisitor& v) { T::fields(t, v); };
+concept Record = requires(T& t, detail::AnyVisitor& v) {
+  T::fields(t, v);
+};
 // What an array may hold: integers, floats, records.
 template <class T>
 concept Element = UnsignedField<T> || FloatField<T> || Record<T>;
@@ -194,8 +196,8 @@ class FieldSizer {
     for (const T& e : a) (*this)(e, name, rule...);
   }
   template <Element T, size_t N, class... Rule>
-    requires(!std::is_same_v<T, uint8_t>)
-  constexpr void operator()(const std::array<T, N>& a, const char* name, Rule... rule) {
+  requires(!std::is_same_v<T, uint8_t>) constexpr void operator()(const std::array<T, N>& a,
+                                                                  const char* name, Rule... rule) {
     for (const T& e : a) (*this)(e, name, rule...);
   }
   template <CountedElement T, class... Rule>
@@ -280,8 +282,8 @@ class FieldWriter {
     elements(std::span<const T>(a), name, rule...);
   }
   template <Element T, size_t N, class... Rule>
-    requires(!std::is_same_v<T, uint8_t>)
-  void operator()(const std::array<T, N>& a, const char* name, Rule... rule) {
+  requires(!std::is_same_v<T, uint8_t>) void operator()(const std::array<T, N>& a, const char* name,
+                                                        Rule... rule) {
     elements(std::span<const T>(a), name, rule...);
   }
   template <CountedElement T, class... Rule>
@@ -401,8 +403,8 @@ class FieldReader {
     elements(std::span<T>(a), name, rule...);
   }
   template <Element T, size_t N, class... Rule>
-    requires(!std::is_same_v<T, uint8_t>)
-  void operator()(std::array<T, N>& a, const char* name, Rule... rule) {
+  requires(!std::is_same_v<T, uint8_t>) void operator()(std::array<T, N>& a, const char* name,
+                                                        Rule... rule) {
     elements(std::span<T>(a), name, rule...);
   }
   template <CountedElement T, class... Rule>
@@ -452,7 +454,8 @@ class FieldReader {
   }
   void check(uint64_t v, const char* name, Range r) {
     if (!status_.ok()) return;
-    if (v < r.min) fail(invalid_id_, cat(path_.where(name), " ", v, " is below its minimum ", r.min));
+    if (v < r.min)
+      fail(invalid_id_, cat(path_.where(name), " ", v, " is below its minimum ", r.min));
     if (v > r.max) fail(limit_id_, cat(path_.where(name), " ", v, " exceeds its limit ", r.max));
   }
   // Reads a u32 count, checks it against `r` and against the bytes left for that many elements
@@ -525,8 +528,8 @@ class FieldPrinter {
     elements(std::span<const T>(a), name, rule...);
   }
   template <Element T, size_t N, class... Rule>
-    requires(!std::is_same_v<T, uint8_t>)
-  void operator()(const std::array<T, N>& a, const char* name, Rule... rule) {
+  requires(!std::is_same_v<T, uint8_t>) void operator()(const std::array<T, N>& a, const char* name,
+                                                        Rule... rule) {
     elements(std::span<const T>(a), name, rule...);
   }
   template <CountedElement T, class... Rule>

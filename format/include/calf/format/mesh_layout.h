@@ -14,8 +14,8 @@ namespace calf::container {
 
 // Stream tags (SPEC.md §11.4).
 #define CALF_MESH_STREAMS(X) \
-  X(kIndex, 0, "index") X(kVertices, 1, "vertices") X(kTriangles, 2, "triangles") \
-  X(kVisibility, 3, "visibility")
+  X(kIndex, 0, "index")      \
+  X(kVertices, 1, "vertices") X(kTriangles, 2, "triangles") X(kVisibility, 3, "visibility")
 enum class MeshStream : uint16_t { CALF_MESH_STREAMS(CALF_STREAM_ENUM) };
 
 // Track header (34 bytes), frozen in 1.0; later fields are appended.

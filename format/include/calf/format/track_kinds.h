@@ -15,11 +15,11 @@ namespace calf::container {
 
 // X(Name, number, "name", "SPEC section"). `Name` gives the enumerator k<Name>, the header type
 // <Name>TrackHeader and the stream enum <Name>Stream. Numbers are stable forever; 0 is invalid.
-#define CALF_TRACK_KINDS(X)                 \
-  X(Lightfield, 1, "lightfield", "11.1")   \
-  X(Tiles, 2, "tiles", "11.2")             \
-  X(Surfels, 3, "surfels", "11.3")         \
-  X(Mesh, 4, "mesh", "11.4")               \
+#define CALF_TRACK_KINDS(X)              \
+  X(Lightfield, 1, "lightfield", "11.1") \
+  X(Tiles, 2, "tiles", "11.2")           \
+  X(Surfels, 3, "surfels", "11.3")       \
+  X(Mesh, 4, "mesh", "11.4")             \
   /* end of the list: every line above ends with a backslash */
 
 // Track kinds (SPEC.md §6.1). A reader that meets another kind skips the track, unless the
