@@ -120,12 +120,13 @@ TEST(LightfieldLayout, TChunkRoundTrip) {
 // §11.1.6: F = 2 frames of an 8 x 4 r16 tile: frame 0 the whole tile, frame 1 one 2 x 1 rect at
 // (3, 2); then 2 x (32 + 2) payload bytes.
 Bytes region_chunk() {
-  Bytes b = {0x02, 0x00, 0x00, 0x00,                           // F
-             0x01, 0x00, 0x00, 0x00,                           // R_0
-             0x01, 0x00, 0x00, 0x00,                           // R_1
-             0x00, 0x00, 0x00, 0x00, 0x08, 0x00, 0x04, 0x00,   // (0, 0, 8, 4)
-             0x03, 0x00, 0x02, 0x00, 0x02, 0x00, 0x01, 0x00};  // (3, 2, 2, 1)
-  b.resize(b.size() + 2 * 34, 0x5A);
+  const uint8_t head[28] = {0x02, 0x00, 0x00, 0x00,                           // F
+                            0x01, 0x00, 0x00, 0x00,                           // R_0
+                            0x01, 0x00, 0x00, 0x00,                           // R_1
+                            0x00, 0x00, 0x00, 0x00, 0x08, 0x00, 0x04, 0x00,   // (0, 0, 8, 4)
+                            0x03, 0x00, 0x02, 0x00, 0x02, 0x00, 0x01, 0x00};  // (3, 2, 2, 1)
+  Bytes b(sizeof head + 2 * 34, 0x5A);
+  std::copy(std::begin(head), std::end(head), b.begin());
   return b;
 }
 
