@@ -5,50 +5,52 @@
 
 namespace calf::container {
 
-const char* track_kind_name(uint16_t kind) {
-  switch (kind) {
-#define CALF_TRACK_KIND_CASE(Name, number, name, section) \
-  case number:                                            \
-    return name;
-    CALF_TRACK_KINDS(CALF_TRACK_KIND_CASE)
-#undef CALF_TRACK_KIND_CASE
+namespace {
+
+// One row per registered kind: what the name, section and stream look-ups answer.
+struct KindRow {
+  uint16_t number;
+  const char* name;
+  const char* section;
+  const char* const* streams;  // the header type's kStreamNames
+  uint16_t stream_count;
+};
+
+constexpr KindRow kRows[] = {
+#define CALF_TRACK_KIND_ROW(Name, number, name, section)   \
+  {number, name, section, Name##TrackHeader::kStreamNames, \
+   static_cast<uint16_t>(std::size(Name##TrackHeader::kStreamNames))},
+    CALF_TRACK_KINDS(CALF_TRACK_KIND_ROW)
+#undef CALF_TRACK_KIND_ROW
+};
+
+const KindRow* row(uint16_t kind) {
+  for (const KindRow& r : kRows) {
+    if (r.number == kind) return &r;
   }
-  return "unknown";
+  return nullptr;
+}
+
+}  // namespace
+
+const char* track_kind_name(uint16_t kind) {
+  const KindRow* r = row(kind);
+  return r ? r->name : "unknown";
 }
 
 const char* track_kind_section(uint16_t kind) {
-  switch (kind) {
-#define CALF_TRACK_KIND_CASE(Name, number, name, section) \
-  case number:                                            \
-    return section;
-    CALF_TRACK_KINDS(CALF_TRACK_KIND_CASE)
-#undef CALF_TRACK_KIND_CASE
-  }
-  return "";
+  const KindRow* r = row(kind);
+  return r ? r->section : "";
 }
 
 uint16_t stream_count(uint16_t kind) {
-  switch (kind) {
-#define CALF_TRACK_KIND_CASE(Name, number, name, section) \
-  case number:                                            \
-    return static_cast<uint16_t>(std::size(Name##TrackHeader::kStreamNames));
-    CALF_TRACK_KINDS(CALF_TRACK_KIND_CASE)
-#undef CALF_TRACK_KIND_CASE
-  }
-  return 0;
+  const KindRow* r = row(kind);
+  return r ? r->stream_count : 0;
 }
 
 const char* stream_name(uint16_t kind, uint16_t stream) {
-  switch (kind) {
-#define CALF_TRACK_KIND_CASE(Name, number, name, section)      \
-  case number:                                                 \
-    return stream < std::size(Name##TrackHeader::kStreamNames) \
-               ? Name##TrackHeader::kStreamNames[stream]       \
-               : "";
-    CALF_TRACK_KINDS(CALF_TRACK_KIND_CASE)
-#undef CALF_TRACK_KIND_CASE
-  }
-  return "";
+  const KindRow* r = row(kind);
+  return r && stream < r->stream_count ? r->streams[stream] : "";
 }
 
 Expected<TrackHeader> read_track_header(uint16_t kind, std::span<const uint8_t> blob,

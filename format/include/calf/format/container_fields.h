@@ -130,30 +130,34 @@ concept Record = requires(T& t, detail::AnyVisitor& v) {
 // What an array may hold: integers, floats, records.
 template <class T>
 concept Element = UnsignedField<T> || FloatField<T> || Record<T>;
-// The element type of a counted array; std::vector<uint8_t> is a byte string instead (the same
-// bytes on disk: a u32 count then the bytes).
+// The element type of a counted array or std::array; std::vector<uint8_t> is a byte string and
+// std::array<uint8_t, N> raw bytes instead (the same bytes on disk).
 template <class T>
 concept CountedElement = Element<T> && !std::is_same_v<T, uint8_t>;
 
 // Where a visitor is inside nested records and arrays ("rects[3].w"), kept as pointers and
-// indices so that reading pays nothing for names until a message needs one.
+// indices in place (no allocation), so that reading pays nothing for names until a message needs
+// one. Levels beyond kMaxDepth are counted but print as "...".
 class FieldPath {
  public:
-  void push(const char* name, size_t index = kNoIndex) { parts_.push_back({name, index}); }
-  void pop() { parts_.pop_back(); }
+  static constexpr size_t kMaxDepth = 8;
+  void push(const char* name, size_t index = kNoIndex) {
+    if (depth_ < kMaxDepth) parts_[depth_] = {name, index};
+    ++depth_;
+  }
+  void pop() { --depth_; }
   // The path of field `name` inside the current record.
   std::string where(const char* name) const {
     std::string out;
-    for (const Part& p : parts_) {
-      if (p.index == kNoIndex) {
-        out += p.name;
-        out += '.';
-      } else {
-        out += cat(p.name, '[', p.index, "].");
-      }
+    const size_t n = depth_ < kMaxDepth ? depth_ : kMaxDepth;
+    for (size_t i = 0; i < n; ++i) {
+      const Part& p = parts_[i];
+      out += p.index == kNoIndex ? cat(p.name, '.') : cat(p.name, '[', p.index, "].");
     }
+    if (depth_ > kMaxDepth) out += "...";
     // An array element of integers or floats names itself by its index alone.
-    if (!parts_.empty() && parts_.back().index != kNoIndex && parts_.back().name == name) {
+    if (depth_ > 0 && depth_ <= kMaxDepth && parts_[depth_ - 1].index != kNoIndex &&
+        parts_[depth_ - 1].name == name) {
       out.pop_back();
       return out;
     }
@@ -163,10 +167,11 @@ class FieldPath {
  private:
   static constexpr size_t kNoIndex = SIZE_MAX;
   struct Part {
-    const char* name;
-    size_t index;
+    const char* name = "";
+    size_t index = kNoIndex;
   };
-  std::vector<Part> parts_;
+  std::array<Part, kMaxDepth> parts_{};
+  size_t depth_ = 0;
 };
 
 // Sizer: the encoded size of a structure. constexpr for structures of fixed size.
@@ -196,9 +201,8 @@ class FieldSizer {
   constexpr void operator()(const T (&a)[N], const char* name, Rule... rule) {
     for (const T& e : a) (*this)(e, name, rule...);
   }
-  template <Element T, size_t N, class... Rule>
-  requires(!std::is_same_v<T, uint8_t>) constexpr void operator()(const std::array<T, N>& a,
-                                                                  const char* name, Rule... rule) {
+  template <CountedElement T, size_t N, class... Rule>
+  constexpr void operator()(const std::array<T, N>& a, const char* name, Rule... rule) {
     for (const T& e : a) (*this)(e, name, rule...);
   }
   template <CountedElement T, class... Rule>
@@ -239,11 +243,59 @@ size_t min_size() {
   }
 }
 
+// What the writer, reader and printer visit alike: nested records and fixed arrays, each element
+// visited in place under its path ("points[2].x"). `D` is the visitor (CRTP); constness follows
+// the visited value (const for the writer and printer, mutable for the reader).
+template <class D>
+class CompositeFields {
+ public:
+  template <class T>
+  requires Record<std::remove_const_t<T>>
+  void operator()(T& t, const char* name) {
+    path_.push(name);
+    std::remove_const_t<T>::fields(t, self());
+    path_.pop();
+  }
+  template <class T, size_t N, class... Rule>
+  requires Element<std::remove_const_t<T>>
+  void operator()(T (&a)[N], const char* name, Rule... rule) {
+    elements(std::span<T>(a), name, rule...);
+  }
+  template <CountedElement T, size_t N, class... Rule>
+  void operator()(const std::array<T, N>& a, const char* name, Rule... rule) {
+    elements(std::span<const T>(a), name, rule...);
+  }
+  template <CountedElement T, size_t N, class... Rule>
+  void operator()(std::array<T, N>& a, const char* name, Rule... rule) {
+    elements(std::span<T>(a), name, rule...);
+  }
+
+ protected:
+  // Visits each element of `a` as "name[i]"; stops at the first failure of a reader.
+  template <class T, class... Rule>
+  void elements(std::span<T> a, const char* name, Rule... rule) {
+    for (size_t i = 0; i < a.size() && self().ok(); ++i) {
+      path_.push(name, i);
+      // A record element's fields are named "array[i].field", not "array[i].array.field".
+      if constexpr (Record<std::remove_const_t<T>>)
+        std::remove_const_t<T>::fields(a[i], self());
+      else
+        self()(a[i], name, rule...);
+      path_.pop();
+    }
+  }
+  FieldPath path_;
+
+ private:
+  D& self() { return static_cast<D&>(*this); }
+};
+
 // Writer: appends each field to a byte vector. A value outside its Range, a float its rule
 // forbids, or a Length array of another length is refused with kContainerWriterMisuse (the
 // writer never produces a file its reader would reject); the first refusal is kept.
-class FieldWriter {
+class FieldWriter : public CompositeFields<FieldWriter> {
  public:
+  using CompositeFields::operator();
   explicit FieldWriter(std::vector<uint8_t>& out, std::string context = {})
       : out_(out), context_(std::move(context)) {}
   // Writes values outside their Range too: only for building malformed test files.
@@ -272,21 +324,6 @@ class FieldWriter {
     count(s.size(), name, r);
     bytes(reinterpret_cast<const uint8_t*>(s.data()), s.size());
   }
-  template <Record T>
-  void operator()(const T& t, const char* name) {
-    path_.push(name);
-    T::fields(t, *this);
-    path_.pop();
-  }
-  template <Element T, size_t N, class... Rule>
-  void operator()(const T (&a)[N], const char* name, Rule... rule) {
-    elements(std::span<const T>(a), name, rule...);
-  }
-  template <Element T, size_t N, class... Rule>
-  requires(!std::is_same_v<T, uint8_t>) void operator()(const std::array<T, N>& a, const char* name,
-                                                        Rule... rule) {
-    elements(std::span<const T>(a), name, rule...);
-  }
   template <CountedElement T, class... Rule>
   void operator()(const std::vector<T>& a, const char* name, Range r = {}, Rule... rule) {
     count(a.size(), name, r);
@@ -301,6 +338,7 @@ class FieldWriter {
       elements(std::span<const T>(a), name, rule...);
   }
   const Status& status() const { return status_; }
+  bool ok() const { return status_.ok(); }
 
  private:
   // Appends n bytes (resize + copy: GCC 12 misreads vector::insert of a small array inlined into
@@ -322,18 +360,6 @@ class FieldWriter {
     if (n > UINT32_MAX) misuse(name, cat(" count ", n, " does not fit a u32"));
     put(n, 4);
   }
-  template <class T, class... Rule>
-  void elements(std::span<const T> a, const char* name, Rule... rule) {
-    for (size_t i = 0; i < a.size(); ++i) {
-      path_.push(name, i);
-      // A record element's fields are named "array[i].field", not "array[i].array.field".
-      if constexpr (Record<T>)
-        T::fields(a[i], *this);
-      else
-        (*this)(a[i], name, rule...);
-      path_.pop();
-    }
-  }
   void misuse(const char* name, const std::string& what) {
     if (status_.ok())
       status_ = Status(ErrorId::kContainerWriterMisuse,
@@ -342,7 +368,6 @@ class FieldWriter {
   std::vector<uint8_t>& out_;
   std::string context_;
   Status status_;
-  FieldPath path_;
   bool check_ranges_ = true;
 };
 
@@ -355,8 +380,9 @@ class FieldWriter {
 //    every contradiction is one corrupt-chunk error).
 // A byte string's or counted array's count is checked against its max and against the bytes
 // left BEFORE anything is allocated; so is a Length array's length.
-class FieldReader {
+class FieldReader : public CompositeFields<FieldReader> {
  public:
+  using CompositeFields::operator();
   FieldReader(std::span<const uint8_t> in, ErrorId short_id, ErrorId invalid_id,
               std::string context, ErrorId limit_id = ErrorId::kContainerLimit)
       : in_(in),
@@ -401,21 +427,6 @@ class FieldReader {
              in_.begin() + static_cast<std::ptrdiff_t>(pos_ + n));
     pos_ += n;
   }
-  template <Record T>
-  void operator()(T& t, const char* name) {
-    path_.push(name);
-    T::fields(t, *this);
-    path_.pop();
-  }
-  template <Element T, size_t N, class... Rule>
-  void operator()(T (&a)[N], const char* name, Rule... rule) {
-    elements(std::span<T>(a), name, rule...);
-  }
-  template <Element T, size_t N, class... Rule>
-  requires(!std::is_same_v<T, uint8_t>) void operator()(std::array<T, N>& a, const char* name,
-                                                        Rule... rule) {
-    elements(std::span<T>(a), name, rule...);
-  }
   template <CountedElement T, class... Rule>
   void operator()(std::vector<T>& a, const char* name, Range r = {}, Rule... rule) {
     a.clear();
@@ -440,6 +451,7 @@ class FieldReader {
   }
 
   const Status& status() const { return status_; }
+  bool ok() const { return status_.ok(); }
   size_t position() const { return pos_; }
   size_t remaining() const { return in_.size() - pos_; }
   // The bytes after the last field read.
@@ -476,32 +488,20 @@ class FieldReader {
     if (!need(uint64_t{n} * element_bytes, name)) return 0;
     return n;
   }
-  template <class T, class... Rule>
-  void elements(std::span<T> a, const char* name, Rule... rule) {
-    for (size_t i = 0; i < a.size() && status_.ok(); ++i) {
-      path_.push(name, i);
-      // A record element's fields are named "array[i].field", not "array[i].array.field".
-      if constexpr (Record<T>)
-        T::fields(a[i], *this);
-      else
-        (*this)(a[i], name, rule...);
-      path_.pop();
-    }
-  }
 
   std::span<const uint8_t> in_;
   size_t pos_ = 0;
   ErrorId short_id_, invalid_id_, limit_id_;
   std::string context_;
   Status status_;
-  FieldPath path_;
 };
 
 // Printer: (name, value) pairs for calf-info. Nested fields are named "record.field", array
 // elements "array[i]"; counted arrays also print their count as "array.count"; fixed byte
 // arrays print as hex, byte strings as their length. Floats print exactly (shortest form).
-class FieldPrinter {
+class FieldPrinter : public CompositeFields<FieldPrinter> {
  public:
+  using CompositeFields::operator();
   struct Entry {
     std::string name;
     std::string value;
@@ -526,21 +526,6 @@ class FieldPrinter {
   void operator()(const S& s, const char* name, Range = {}) {
     add(name, cat(s.size(), " bytes"), false);
   }
-  template <Record T>
-  void operator()(const T& t, const char* name) {
-    path_.push(name);
-    T::fields(t, *this);
-    path_.pop();
-  }
-  template <Element T, size_t N, class... Rule>
-  void operator()(const T (&a)[N], const char* name, Rule... rule) {
-    elements(std::span<const T>(a), name, rule...);
-  }
-  template <Element T, size_t N, class... Rule>
-  requires(!std::is_same_v<T, uint8_t>) void operator()(const std::array<T, N>& a, const char* name,
-                                                        Rule... rule) {
-    elements(std::span<const T>(a), name, rule...);
-  }
   template <CountedElement T, class... Rule>
   void operator()(const std::vector<T>& a, const char* name, Range = {}, Rule... rule) {
     add((std::string(name) + ".count").c_str(), std::to_string(a.size()), true);
@@ -554,25 +539,13 @@ class FieldPrinter {
       elements(std::span<const T>(a), name, rule...);
   }
   const std::vector<Entry>& entries() const { return entries_; }
+  bool ok() const { return true; }
 
  private:
   void add(const char* name, std::string value, bool numeric) {
     entries_.push_back({path_.where(name), std::move(value), numeric});
   }
-  template <class T, class... Rule>
-  void elements(std::span<const T> a, const char* name, Rule... rule) {
-    for (size_t i = 0; i < a.size(); ++i) {
-      path_.push(name, i);
-      // A record element's fields are named "array[i].field", not "array[i].array.field".
-      if constexpr (Record<T>)
-        T::fields(a[i], *this);
-      else
-        (*this)(a[i], name, rule...);
-      path_.pop();
-    }
-  }
   std::vector<Entry> entries_;
-  FieldPath path_;
 };
 
 template <class T>
