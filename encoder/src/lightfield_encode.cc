@@ -286,9 +286,8 @@ void colour_task(const Context& ctx, uint32_t face, uint32_t cell, TaskOut& out)
   s.colour.raw += n * raw_texel * frames;
 
   std::vector<uint8_t> raw;
-  lf::put_u32(raw, static_cast<uint32_t>(k->keyframes.size()));
-  for (uint32_t kf : k->keyframes) lf::put_u32(raw, kf);
-  raw.insert(raw.end(), k->t.begin(), k->t.end());
+  out.status = container::write_fields(lf::CellTimeline{k->keyframes, k->t}, raw, "t chunk");
+  if (!out.status.ok()) return;
   s.colour.temporal += raw.size() + k->keyframes.size() * n * raw_texel;
   ChunkKeys keys;
   keys.stream = static_cast<uint16_t>(LightfieldStream::kTParams);
@@ -384,16 +383,18 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
     CALF_ASSIGN_OR_RETURN(rects[f], fit_change_boxes(mask, ao));
   }
   raw.clear();
-  lf::put_u32(raw, count);
-  for (uint32_t f = 0; f < count; ++f) lf::put_u32(raw, static_cast<uint32_t>(rects[f].size()));
+  lf::RegionHead head;
   for (uint32_t f = 0; f < count; ++f) {
+    head.rect_counts.push_back(static_cast<uint32_t>(rects[f].size()));
     for (const PixelRect& r : rects[f]) {
-      lf::put_u16(raw, static_cast<uint16_t>(r.x));
-      lf::put_u16(raw, static_cast<uint16_t>(r.y));
-      lf::put_u16(raw, static_cast<uint16_t>(r.width));
-      lf::put_u16(raw, static_cast<uint16_t>(r.height));
+      lf::RegionRect& disk = head.rects.emplace_back();
+      disk.x = static_cast<uint16_t>(r.x);
+      disk.y = static_cast<uint16_t>(r.y);
+      disk.w = static_cast<uint16_t>(r.width);
+      disk.h = static_cast<uint16_t>(r.height);
     }
   }
+  CALF_RETURN_IF_ERROR(container::write_fields(head, raw, "region chunk"));
   const size_t header = raw.size();
   uint64_t covered = 0;
   std::vector<uint8_t> texels, blocks, rect_bytes, decoded_rect;
@@ -638,7 +639,7 @@ Expected<LightfieldViewEncoding> encode_lightfield_view(const capture::CaptureSe
   vi.depth_keyframe_interval = options.depth_keyframe_interval;
   vi.depth_window = options.depth_window;
   vi.min_psnr_db = static_cast<float>(options.min_psnr_db);
-  const std::vector<uint8_t> index = lf::serialize_view_index(vi);
+  CALF_ASSIGN_OR_RETURN(const std::vector<uint8_t> index, lf::serialize_view_index(vi));
   ChunkKeys ikeys;
   ikeys.stream = static_cast<uint16_t>(LightfieldStream::kIndex);
   ikeys.view = v;

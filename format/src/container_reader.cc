@@ -27,14 +27,6 @@ Status identifier_error(std::span<const uint8_t> got) {
   return Status(ErrorId::kContainerIdentifier, why);
 }
 
-template <class H>
-Status decode_into(const TrackRecord& rec, Track& t, const std::string& context) {
-  CALF_ASSIGN_OR_RETURN(H h, decode_track_header<H>(rec.header, context));
-  t.header = h;
-  t.known = true;
-  return Status::Ok();
-}
-
 }  // namespace
 
 Reader::Reader(Reader&&) noexcept = default;
@@ -143,26 +135,13 @@ Status Reader::load() {
     t.id = static_cast<uint16_t>(i);
     CALF_RETURN_IF_ERROR(read_fields(t.record, dr));
     const std::string context = cat("track ", i, " (", track_kind_name(t.record.kind), ")");
-    switch (static_cast<TrackKind>(t.record.kind)) {
-      case TrackKind::kLightfield:
-        CALF_RETURN_IF_ERROR(decode_into<LightfieldTrackHeader>(t.record, t, context));
-        break;
-      case TrackKind::kTiles:
-        CALF_RETURN_IF_ERROR(decode_into<TilesTrackHeader>(t.record, t, context));
-        break;
-      case TrackKind::kSurfels:
-        CALF_RETURN_IF_ERROR(decode_into<SurfelsTrackHeader>(t.record, t, context));
-        break;
-      case TrackKind::kMesh:
-        CALF_RETURN_IF_ERROR(decode_into<MeshTrackHeader>(t.record, t, context));
-        break;
-      default:
-        if (t.record.flags & kTrackRequired)
-          return Status(ErrorId::kContainerTrackKind,
-                        cat("track ", i, " has kind ", t.record.kind,
-                            ", unknown to this reader, and is marked must-understand"));
-        break;  // an unknown optional track: kept as bytes, skipped by codecs
-    }
+    CALF_ASSIGN_OR_RETURN(t.header, read_track_header(t.record.kind, t.record.header, context));
+    t.known = !std::holds_alternative<std::monostate>(t.header);
+    if (!t.known && (t.record.flags & kTrackRequired))
+      return Status(ErrorId::kContainerTrackKind,
+                    cat("track ", i, " has kind ", t.record.kind,
+                        ", unknown to this reader, and is marked must-understand"));
+    // An unknown optional track: kept as bytes, skipped by codecs.
   }
   chunks_.resize(h.chunk_count);  // <= kMaxChunks; min_dir proved the bytes exist
   for (uint32_t i = 0; i < h.chunk_count; ++i) {

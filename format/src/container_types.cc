@@ -1,4 +1,5 @@
-// Names of the container's enumerations and the UTF-8 check of metadata.
+// Names of the container's enumerations and the UTF-8 check of metadata (track kind and stream
+// names: track_registry.cc).
 #include "calf/format/container_types.h"
 
 namespace calf::container {
@@ -13,42 +14,6 @@ const char* compression_name(Compression c) {
       return "lzma2";
   }
   return "unknown";
-}
-
-const char* track_kind_name(uint16_t kind) {
-  switch (static_cast<TrackKind>(kind)) {
-    case TrackKind::kLightfield:
-      return "lightfield";
-    case TrackKind::kTiles:
-      return "tiles";
-    case TrackKind::kSurfels:
-      return "surfels";
-    case TrackKind::kMesh:
-      return "mesh";
-  }
-  return "unknown";
-}
-
-const char* stream_name(uint16_t kind, uint16_t stream) {
-  switch (static_cast<TrackKind>(kind)) {
-    case TrackKind::kLightfield: {
-      static const char* kNames[] = {"index", "colour", "depth", "material", "t"};
-      return stream < 5 ? kNames[stream] : "";
-    }
-    case TrackKind::kTiles: {
-      static const char* kNames[] = {"index", "atlas", "quads"};
-      return stream < 3 ? kNames[stream] : "";
-    }
-    case TrackKind::kSurfels: {
-      static const char* kNames[] = {"index", "surfels"};
-      return stream < 2 ? kNames[stream] : "";
-    }
-    case TrackKind::kMesh: {
-      static const char* kNames[] = {"index", "vertices", "triangles", "visibility"};
-      return stream < 4 ? kNames[stream] : "";
-    }
-  }
-  return "";
 }
 
 const char* pixel_format_name(uint16_t format) {

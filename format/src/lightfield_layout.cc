@@ -57,57 +57,42 @@ uint8_t material_weight_code(float weight) {
 
 uint8_t material_ior_code(float ior) { return material_weight_code((ior - 1.0f) / 2.0f); }
 
-// ---- ByteCursor ----
-
-Status ByteCursor::ends_inside(const char* type) const {
-  return corrupt(what_ + ": ends inside a " + type + " at byte " + std::to_string(pos_));
-}
-
-Expected<uint16_t> ByteCursor::u16() {
-  if (left() < 2) return ends_inside("u16");
-  const uint16_t v = static_cast<uint16_t>(b_[pos_] | b_[pos_ + 1] << 8);
-  pos_ += 2;
-  return v;
-}
-
-Expected<uint32_t> ByteCursor::u32() {
-  if (left() < 4) return ends_inside("u32");
-  uint32_t v = 0;
-  for (int i = 0; i < 4; ++i) v |= static_cast<uint32_t>(b_[pos_ + i]) << (8 * i);
-  pos_ += 4;
-  return v;
-}
-
-Expected<float> ByteCursor::f32() {
-  CALF_ASSIGN_OR_RETURN(uint32_t v, u32());
-  float f;
-  std::memcpy(&f, &v, 4);
-  return f;
-}
-
-Expected<double> ByteCursor::f64() {
-  if (left() < 8) return ends_inside("f64");
-  CALF_ASSIGN_OR_RETURN(uint32_t lo, u32());
-  CALF_ASSIGN_OR_RETURN(uint32_t hi, u32());
-  const uint64_t v = static_cast<uint64_t>(hi) << 32 | lo;
-  double d;
-  std::memcpy(&d, &v, 8);
-  return d;
-}
-
 // ---- View index ----
 
-std::vector<uint8_t> serialize_view_index(const ViewIndex& index) {
+namespace {
+
+// Every layout field reads as one error id: a chunk's contradiction is "corrupt chunk", whether a
+// count runs past its end, falls below its minimum or exceeds its limit.
+container::FieldReader chunk_reader(std::span<const uint8_t> raw, const std::string& what) {
+  return container::FieldReader(raw, ErrorId::kLightfieldChunk, ErrorId::kLightfieldChunk, what,
+                                ErrorId::kLightfieldChunk);
+}
+
+// The rule the field rules cannot state: a depth range 0 < z_near < z_far.
+bool depth_range_ok(float z_near, float z_far) { return z_near > 0.0f && z_far > z_near; }
+
+std::string depth_range_text(float z_near, float z_far) {
+  return "depth range [" + container::float_text(z_near) + ", " + container::float_text(z_far) +
+         "] is not 0 < z_near < z_far < inf";
+}
+
+}  // namespace
+
+Expected<std::vector<uint8_t>> serialize_view_index(const ViewIndex& index) {
+  ViewIndexRecord r;
+  std::copy(std::begin(index.position), std::end(index.position), std::begin(r.position));
+  r.z_near = index.z_near;
+  r.z_far = index.z_far;
+  r.flags = (index.has_depth ? 1u : 0u) | (index.has_material ? 2u : 0u);
+  r.depth_keyframe_interval = index.depth_keyframe_interval;
+  r.depth_window = index.depth_window;
+  r.min_psnr_db = index.min_psnr_db;
   std::vector<uint8_t> out;
   out.reserve(kViewIndexBytes);
-  put_u32(out, kLayoutVersion);
-  for (double p : index.position) put_f64(out, p);
-  put_f32(out, index.z_near);
-  put_f32(out, index.z_far);
-  put_u32(out, (index.has_depth ? 1u : 0u) | (index.has_material ? 2u : 0u));
-  put_u32(out, index.depth_keyframe_interval);
-  put_u32(out, index.depth_window);
-  put_f32(out, index.min_psnr_db);
+  CALF_RETURN_IF_ERROR(container::write_fields(r, out, "view index"));
+  if (!depth_range_ok(r.z_near, r.z_far))
+    return Status(ErrorId::kContainerWriterMisuse,
+                  "view index: " + depth_range_text(r.z_near, r.z_far));
   return out;
 }
 
@@ -116,30 +101,20 @@ Expected<ViewIndex> parse_view_index(std::span<const uint8_t> raw, const std::st
     return corrupt(what + ": " + std::to_string(raw.size()) + " bytes, expected " +
                    std::to_string(kViewIndexBytes));
   }
-  ByteCursor c(raw, what);
-  CALF_ASSIGN_OR_RETURN(uint32_t version, c.u32());
-  if (version != kLayoutVersion) return corrupt(what + ": layout version " + std::to_string(version));
+  ViewIndexRecord r;
+  container::FieldReader reader = chunk_reader(raw, what);
+  CALF_RETURN_IF_ERROR(container::read_fields(r, reader));
+  if (!depth_range_ok(r.z_near, r.z_far))
+    return corrupt(what + ": " + depth_range_text(r.z_near, r.z_far));
   ViewIndex v;
-  for (double& p : v.position) {
-    CALF_ASSIGN_OR_RETURN(p, c.f64());
-    if (!std::isfinite(p)) return corrupt(what + ": viewpoint position is not finite");
-  }
-  CALF_ASSIGN_OR_RETURN(v.z_near, c.f32());
-  CALF_ASSIGN_OR_RETURN(v.z_far, c.f32());
-  if (!(v.z_near > 0.0f) || !(v.z_far > v.z_near) || !std::isfinite(v.z_far)) {
-    return corrupt(what + ": depth range [" + std::to_string(v.z_near) + ", " +
-                   std::to_string(v.z_far) + "] is not 0 < z_near < z_far < inf");
-  }
-  CALF_ASSIGN_OR_RETURN(uint32_t flags, c.u32());
-  if ((flags & ~3u) != 0) return corrupt(what + ": reserved flag bits set");
-  v.has_depth = (flags & 1) != 0;
-  v.has_material = (flags & 2) != 0;
-  CALF_ASSIGN_OR_RETURN(v.depth_keyframe_interval, c.u32());
-  CALF_ASSIGN_OR_RETURN(v.depth_window, c.u32());
-  if (v.depth_keyframe_interval == 0 || v.depth_window == 0) {
-    return corrupt(what + ": depth keyframe interval and window must be >= 1");
-  }
-  CALF_ASSIGN_OR_RETURN(v.min_psnr_db, c.f32());
+  std::copy(std::begin(r.position), std::end(r.position), std::begin(v.position));
+  v.z_near = r.z_near;
+  v.z_far = r.z_far;
+  v.has_depth = (r.flags & 1) != 0;
+  v.has_material = (r.flags & 2) != 0;
+  v.depth_keyframe_interval = r.depth_keyframe_interval;
+  v.depth_window = r.depth_window;
+  v.min_psnr_db = r.min_psnr_db;
   return v;
 }
 
@@ -153,23 +128,28 @@ uint32_t CellTimeline::bracket(uint32_t frame) const {
 
 Expected<CellTimeline> parse_t_chunk(std::span<const uint8_t> raw, uint32_t frame_count,
                                      const std::string& what) {
-  ByteCursor c(raw, what);
-  CALF_ASSIGN_OR_RETURN(uint32_t k, c.u32());
-  if (k == 0 || k > frame_count || c.left() != uint64_t{k} * 4 + frame_count) {
-    return corrupt(what + ": " + std::to_string(k) + " keyframes in " + std::to_string(raw.size()) +
-                   " bytes for " + std::to_string(frame_count) + " frames");
-  }
   CellTimeline tl;
-  tl.keyframes.resize(k);
+  Status st = Status::Ok();
+  container::FieldReader reader = chunk_reader(raw, what);
+  // The number of t values is the chunk key's frame count; sized only once the chunk can hold
+  // them, so a hostile key allocates nothing.
+  if (raw.size() >= uint64_t{frame_count} + 4) {
+    tl.t.resize(frame_count);
+    st = container::read_fields(tl, reader);
+  }
+  const uint64_t k = tl.keyframes.size();
+  if (raw.size() < uint64_t{frame_count} + 4 || !st.ok() || k > frame_count ||
+      reader.remaining() != 0) {
+    return corrupt(what + ": " + std::to_string(k) + " keyframes in " + std::to_string(raw.size()) +
+                   " bytes for " + std::to_string(frame_count) + " frames" +
+                   (st.ok() ? "" : " (" + st.message() + ")"));
+  }
   for (uint32_t i = 0; i < k; ++i) {
-    CALF_ASSIGN_OR_RETURN(tl.keyframes[i], c.u32());
     if ((i == 0 && tl.keyframes[i] != 0) || (i > 0 && tl.keyframes[i] <= tl.keyframes[i - 1]) ||
         tl.keyframes[i] >= frame_count) {
       return corrupt(what + ": keyframes not increasing from 0 below the frame count");
     }
   }
-  const auto rest = c.rest();
-  tl.t.assign(rest.begin(), rest.end());
   return tl;
 }
 
@@ -219,33 +199,29 @@ size_t unit_bytes(RegionCoding coding) {
 Expected<RegionChunk> parse_region_chunk(std::span<const uint8_t> raw, uint32_t frame_count,
                                          uint32_t tile_width, uint32_t tile_height,
                                          RegionCoding coding, const std::string& what) {
-  ByteCursor c(raw, what);
+  RegionHead head;
+  container::FieldReader reader = chunk_reader(raw, what);
+  CALF_RETURN_IF_ERROR(container::read_fields(head, reader));
   RegionChunk chunk;
   chunk.coding = coding;
   chunk.tile_width = tile_width;
   chunk.tile_height = tile_height;
-  CALF_ASSIGN_OR_RETURN(chunk.frame_count, c.u32());
+  chunk.frame_count = static_cast<uint32_t>(head.rect_counts.size());
   if (chunk.frame_count != frame_count || frame_count == 0) {
     return corrupt(what + ": frame count " + std::to_string(chunk.frame_count) +
                    ", the chunk's key says " + std::to_string(frame_count));
   }
-  if (c.left() / 4 < frame_count) return corrupt(what + ": rectangle counts run past the chunk");
   chunk.first_rect.resize(size_t{frame_count} + 1);
   uint64_t total = 0;
   for (uint32_t f = 0; f < frame_count; ++f) {
     chunk.first_rect[f] = static_cast<uint32_t>(total);
-    CALF_ASSIGN_OR_RETURN(uint32_t n, c.u32());
-    total += n;
-    if (total > c.left() / 8) return corrupt(what + ": rectangles run past the chunk");
+    total += head.rect_counts[f];
   }
+  // The rectangles were read, so total * 8 bytes exist: total fits a u32 for any real chunk.
   chunk.first_rect[frame_count] = static_cast<uint32_t>(total);
-  chunk.rects.resize(total);
+  chunk.rects = std::move(head.rects);
   const bool block = region_coding_is_block(coding);
   for (RegionRect& r : chunk.rects) {
-    CALF_ASSIGN_OR_RETURN(r.x, c.u16());
-    CALF_ASSIGN_OR_RETURN(r.y, c.u16());
-    CALF_ASSIGN_OR_RETURN(r.w, c.u16());
-    CALF_ASSIGN_OR_RETURN(r.h, c.u16());
     if (r.w == 0 || r.h == 0 || uint32_t{r.x} + r.w > tile_width ||
         uint32_t{r.y} + r.h > tile_height) {
       return corrupt(what + ": rectangle (" + std::to_string(r.x) + ", " + std::to_string(r.y) +
@@ -264,7 +240,7 @@ Expected<RegionChunk> parse_region_chunk(std::span<const uint8_t> raw, uint32_t 
       first->h != tile_height) {
     return corrupt(what + ": the first frame is not one whole-tile rectangle");
   }
-  chunk.payload = c.rest();
+  chunk.payload = reader.rest();
   const uint64_t expected = chunk.units * unit_bytes(coding);
   if (chunk.payload.size() != expected) {
     return corrupt(what + ": payload of " + std::to_string(chunk.payload.size()) +

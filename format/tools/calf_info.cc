@@ -46,15 +46,9 @@ std::string field_text(const FieldPrinter::Entry& e) {
   return e.value;
 }
 
+// The track's header fields through the registry (none for a kind it lacks).
 std::vector<FieldPrinter::Entry> header_fields(const Track& t) {
-  return std::visit(
-      [](const auto& h) -> std::vector<FieldPrinter::Entry> {
-        if constexpr (std::is_same_v<std::decay_t<decltype(h)>, std::monostate>)
-          return {};
-        else
-          return print_fields(h);
-      },
-      t.header);
+  return print_track_header(t.header);
 }
 
 std::map<uint16_t, StreamStats> stream_stats(const Reader& r, uint16_t track) {

@@ -33,19 +33,18 @@
 #include "calf/format/container_io.h"
 #include "calf/format/container_types.h"
 #include "calf/format/status.h"
+#include "calf/format/track_registry.h"
 
 namespace calf::container {
 
-// A track as the reader sees it. `header` holds the decoded kind-specific header for the four
-// known kinds; an unknown (optional) kind is kept as `std::monostate` with `known == false`, and
-// its chunks stay readable as bytes, but codecs skip it.
+// A track as the reader sees it. `header` holds the decoded kind-specific header for every kind
+// of the registry (track_kinds.h); an unknown (optional) kind is kept as `std::monostate` with
+// `known == false`, and its chunks stay readable as bytes, but codecs skip it.
 struct Track {
   uint16_t id = 0;
   TrackRecord record;
   bool known = false;
-  std::variant<std::monostate, LightfieldTrackHeader, TilesTrackHeader, SurfelsTrackHeader,
-               MeshTrackHeader>
-      header;
+  TrackHeader header;
 };
 
 // A chunk filter for Reader::find_chunks: unset keys match anything.

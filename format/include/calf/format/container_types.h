@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "calf/format/container_fields.h"
+#include "calf/format/track_kinds.h"
 
 namespace calf::container {
 
@@ -61,22 +62,8 @@ enum class Compression : uint16_t { kNone = 0, kZstd = 1, kLzma2 = 2 };
 inline constexpr uint16_t kCompressionCount = 3;
 const char* compression_name(Compression c);  // "none", "zstd", "lzma2", "unknown"
 
-// Track kinds (SPEC.md "Tracks"). A reader that meets another kind skips the track, unless the
-// track is marked must-understand (kTrackRequired), then it refuses the file.
-enum class TrackKind : uint16_t { kLightfield = 1, kTiles = 2, kSurfels = 3, kMesh = 4 };
-inline constexpr uint16_t kTrackRequired = 1;  // TrackRecord::flags bit 0
-const char* track_kind_name(uint16_t kind);    // "lightfield", ..., "unknown"
-// The name of a stream tag within a track kind ("colour", "depth", ...), or "" if unnamed.
-const char* stream_name(uint16_t kind, uint16_t stream);
-
-// Lightfield stream tags (SPEC.md "Lightfield track"); other kinds in their sections.
-enum class LightfieldStream : uint16_t {
-  kIndex = 0,
-  kColour = 1,
-  kDepth = 2,
-  kMaterial = 3,
-  kTParams = 4
-};
+// Track kinds and their names: track_kinds.h (the registry list); each kind's header, stream
+// tags and chunk layout: format/<kind>_layout.h; the per-kind tables: track_registry.h.
 
 // Pixel formats named by track headers (SPEC.md "Pixel formats"). The container does not
 // range-check them: a decoder refuses a format it lacks, calf-info prints its number.
@@ -213,98 +200,16 @@ struct ChunkEntry {
 };
 static_assert(fixed_size<ChunkEntry>() == 64);
 
-// ---- Track headers (SPEC.md "Track headers"): fields are only ever appended; a reader
-// accepts a longer blob (a later minor version) and ignores the bytes it does not know ----
+// ---- Track headers (SPEC.md §6.1, §11): each kind's header is declared in its layout header
+// (lightfield_layout.h, tiles_layout.h, surfels_layout.h, mesh_layout.h). Fields are only ever
+// appended; a reader accepts a longer blob (a later minor version) and ignores the bytes it does
+// not know ----
 
 // The timing every track kind starts with.
 #define CALF_TRACK_TIMING_FIELDS(s, v)                       \
   v(s.frame_count, "frame_count", Range{1, kMaxFrames});     \
   v(s.fps_numerator, "fps_numerator", Range{1, UINT32_MAX}); \
   v(s.fps_denominator, "fps_denominator", Range{1, UINT32_MAX})
-
-struct LightfieldTrackHeader {
-  static constexpr TrackKind kKind = TrackKind::kLightfield;
-  uint32_t frame_count = 1;
-  uint32_t fps_numerator = 24;
-  uint32_t fps_denominator = 1;
-  uint32_t view_count = 1;
-  uint32_t face_size = 1;        // cube face side, pixels
-  uint32_t cell_size = 1;        // colour cell side, pixels
-  uint32_t depth_tile_size = 1;  // depth tile side, pixels
-  uint16_t colour_format = 0;    // PixelFormat
-  uint16_t depth_format = 0;     // PixelFormat
-  uint16_t material_format = 0;  // PixelFormat, kNone without a material stream
-  uint16_t flags = 0;            // bit 0: colour is HDR
-  template <class Self, class V>
-  static constexpr void fields(Self& s, V& v) {
-    CALF_TRACK_TIMING_FIELDS(s, v);
-    v(s.view_count, "view_count", Range{1, kMaxViews});
-    v(s.face_size, "face_size", Range{1, kMaxDimension});
-    v(s.cell_size, "cell_size", Range{1, kMaxDimension});
-    v(s.depth_tile_size, "depth_tile_size", Range{1, kMaxDimension});
-    v(s.colour_format, "colour_format");
-    v(s.depth_format, "depth_format");
-    v(s.material_format, "material_format");
-    v(s.flags, "flags");
-  }
-};
-
-struct TilesTrackHeader {
-  static constexpr TrackKind kKind = TrackKind::kTiles;
-  uint32_t frame_count = 1;
-  uint32_t fps_numerator = 24;
-  uint32_t fps_denominator = 1;
-  uint32_t tile_count = 0;
-  uint32_t atlas_width = 1;
-  uint32_t atlas_height = 1;
-  uint16_t atlas_format = 0;  // PixelFormat
-  uint16_t flags = 0;
-  template <class Self, class V>
-  static constexpr void fields(Self& s, V& v) {
-    CALF_TRACK_TIMING_FIELDS(s, v);
-    v(s.tile_count, "tile_count");
-    v(s.atlas_width, "atlas_width", Range{1, kMaxDimension});
-    v(s.atlas_height, "atlas_height", Range{1, kMaxDimension});
-    v(s.atlas_format, "atlas_format");
-    v(s.flags, "flags");
-  }
-};
-
-struct SurfelsTrackHeader {
-  static constexpr TrackKind kKind = TrackKind::kSurfels;
-  uint32_t frame_count = 1;
-  uint32_t fps_numerator = 24;
-  uint32_t fps_denominator = 1;
-  uint32_t object_count = 0;
-  uint64_t surfel_count = 0;
-  uint16_t flags = 0;
-  template <class Self, class V>
-  static constexpr void fields(Self& s, V& v) {
-    CALF_TRACK_TIMING_FIELDS(s, v);
-    v(s.object_count, "object_count");
-    v(s.surfel_count, "surfel_count");
-    v(s.flags, "flags");
-  }
-};
-
-struct MeshTrackHeader {
-  static constexpr TrackKind kKind = TrackKind::kMesh;
-  uint32_t frame_count = 1;
-  uint32_t fps_numerator = 24;
-  uint32_t fps_denominator = 1;
-  uint64_t vertex_count = 0;
-  uint64_t triangle_count = 0;
-  uint32_t segment_count = 0;  // view-region perimeter segments
-  uint16_t flags = 0;
-  template <class Self, class V>
-  static constexpr void fields(Self& s, V& v) {
-    CALF_TRACK_TIMING_FIELDS(s, v);
-    v(s.vertex_count, "vertex_count");
-    v(s.triangle_count, "triangle_count");
-    v(s.segment_count, "segment_count");
-    v(s.flags, "flags");
-  }
-};
 
 // Encodes a track header blob (kContainerWriterMisuse when a field is out of range).
 template <class H>

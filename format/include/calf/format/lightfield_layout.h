@@ -1,7 +1,10 @@
-// The byte layout of the lightfield track's chunks (format/SPEC.md §11.1), both directions: the
-// encoder writes through the put_* / append_* helpers, every decoder parses through the parse_*
-// functions and turns payloads into GPU-ready bytes through the *_gpu_bytes functions. This is the
-// one place that knows the block split, the byte planes and the chunk headers.
+// The lightfield track (kind 1, format/SPEC.md §11.1): its track header and stream tags, and the
+// byte layout of its chunks, both directions. The fixed parts of every chunk (view index, t chunk
+// head, region chunk head) are records declared once with the fields visitor
+// (container_fields.h); the encoder writes them with write_fields / the write_* functions, every
+// decoder reads them through the parse_* functions and turns payloads into GPU-ready bytes
+// through the *_gpu_bytes functions. This is the one place that knows the block split, the byte
+// planes and the chunk headers.
 //
 // Parsers check every count, rectangle and size against the chunk before use; a contradiction is
 // CALF-E202 (kLightfieldChunk), a format outside §11.1 CALF-E203 (kLightfieldFormat). Messages
@@ -11,37 +14,60 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <iterator>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "calf/format/container_fields.h"
 #include "calf/format/container_types.h"
 #include "calf/format/status.h"
+
+namespace calf::container {
+
+// Stream tags (SPEC.md §11.1).
+#define CALF_LIGHTFIELD_STREAMS(X)                                                      \
+  X(kIndex, 0, "index") X(kColour, 1, "colour") X(kDepth, 2, "depth")                   \
+  X(kMaterial, 3, "material") X(kTParams, 4, "t")
+enum class LightfieldStream : uint16_t { CALF_LIGHTFIELD_STREAMS(CALF_STREAM_ENUM) };
+
+// Track header (36 bytes, SPEC.md §11.1); later fields are appended.
+struct LightfieldTrackHeader {
+  static constexpr TrackKind kKind = TrackKind::kLightfield;
+  static constexpr const char* kStreamNames[] = {CALF_LIGHTFIELD_STREAMS(CALF_STREAM_NAME)};
+  uint32_t frame_count = 1;
+  uint32_t fps_numerator = 24;
+  uint32_t fps_denominator = 1;
+  uint32_t view_count = 1;
+  uint32_t face_size = 1;        // cube face side, pixels
+  uint32_t cell_size = 1;        // colour cell side, pixels
+  uint32_t depth_tile_size = 1;  // depth tile side, pixels
+  uint16_t colour_format = 0;    // PixelFormat
+  uint16_t depth_format = 0;     // PixelFormat
+  uint16_t material_format = 0;  // PixelFormat, kNone without a material stream
+  uint16_t flags = 0;            // bit 0: colour is HDR
+  template <class Self, class V>
+  static constexpr void fields(Self& s, V& v) {
+    CALF_TRACK_TIMING_FIELDS(s, v);
+    v(s.view_count, "view_count", Range{1, kMaxViews});
+    v(s.face_size, "face_size", Range{1, kMaxDimension});
+    v(s.cell_size, "cell_size", Range{1, kMaxDimension});
+    v(s.depth_tile_size, "depth_tile_size", Range{1, kMaxDimension});
+    v(s.colour_format, "colour_format");
+    v(s.depth_format, "depth_format");
+    v(s.material_format, "material_format");
+    v(s.flags, "flags");
+  }
+};
+static_assert(fixed_size<LightfieldTrackHeader>() == 36);
+static_assert(std::size(LightfieldTrackHeader::kStreamNames) ==
+              static_cast<size_t>(LightfieldStream::kTParams) + 1);
+
+}  // namespace calf::container
 
 namespace calf::lf {
 
 // ---- Writing ----
-
-inline void put_u16(std::vector<uint8_t>& out, uint16_t v) {
-  out.push_back(static_cast<uint8_t>(v));
-  out.push_back(static_cast<uint8_t>(v >> 8));
-}
-inline void put_u32(std::vector<uint8_t>& out, uint32_t v) {
-  for (int i = 0; i < 4; ++i) out.push_back(static_cast<uint8_t>(v >> (8 * i)));
-}
-inline void put_u64(std::vector<uint8_t>& out, uint64_t v) {
-  for (int i = 0; i < 8; ++i) out.push_back(static_cast<uint8_t>(v >> (8 * i)));
-}
-inline void put_f32(std::vector<uint8_t>& out, float f) {
-  uint32_t v;
-  std::memcpy(&v, &f, 4);
-  put_u32(out, v);
-}
-inline void put_f64(std::vector<uint8_t>& out, double f) {
-  uint64_t v;
-  std::memcpy(&v, &f, 8);
-  put_u64(out, v);
-}
 
 // Appends `blocks` (whole BCn blocks) split into their endpoint part and their index part
 // (§11.1 "Block split"): BC1 (8-byte blocks) = bytes 0-3 of every block, then bytes 4-7 of every
@@ -64,29 +90,10 @@ inline float material_ior_from_code(uint8_t code) { return 1.0f + 2.0f * (code /
 
 // ---- Reading ----
 
-// A bounds-checked little-endian cursor over one chunk's raw bytes.
-class ByteCursor {
- public:
-  ByteCursor(std::span<const uint8_t> bytes, std::string what)
-      : b_(bytes), what_(std::move(what)) {}
-  size_t left() const { return b_.size() - pos_; }
-  Expected<uint16_t> u16();
-  Expected<uint32_t> u32();
-  Expected<float> f32();
-  Expected<double> f64();
-  std::span<const uint8_t> rest() const { return b_.subspan(pos_); }
-
- private:
-  Status ends_inside(const char* type) const;
-  std::span<const uint8_t> b_;
-  size_t pos_ = 0;
-  std::string what_;
-};
-
 inline constexpr uint32_t kLayoutVersion = 1;
 inline constexpr size_t kViewIndexBytes = 52;
 
-// A view's index chunk (§11.1.3).
+// A view's index chunk (§11.1.3), as the decoder uses it.
 struct ViewIndex {
   double position[3] = {0, 0, 0};
   float z_near = 1, z_far = 2;
@@ -95,17 +102,52 @@ struct ViewIndex {
   uint32_t depth_keyframe_interval = 1, depth_window = 1;
   float min_psnr_db = 0;  // informative: the encoder's Q
 };
-std::vector<uint8_t> serialize_view_index(const ViewIndex& index);
-// Also refuses z_near / z_far that are not finite with 0 < z_near < z_far, and K or W of 0.
+
+// The view index chunk's bytes (§11.1.3), declared once: ViewIndex with its two booleans as the
+// flag bits of the chunk. A layout version other than 1, a position, z_near or z_far that is not
+// finite, a reserved flag bit or K or W of 0 are refused by the field rules themselves.
+struct ViewIndexRecord {
+  uint32_t layout_version = kLayoutVersion;
+  double position[3] = {0, 0, 0};
+  float z_near = 1, z_far = 2;
+  uint32_t flags = 0;  // bit 0 has_depth, bit 1 has_material
+  uint32_t depth_keyframe_interval = 1, depth_window = 1;
+  float min_psnr_db = 0;
+  template <class Self, class V>
+  static constexpr void fields(Self& s, V& v) {
+    v(s.layout_version, "layout version", container::Range{kLayoutVersion, kLayoutVersion});
+    v(s.position, "position", container::FloatRule::kFinite);
+    v(s.z_near, "z_near", container::FloatRule::kFinite);
+    v(s.z_far, "z_far", container::FloatRule::kFinite);
+    v(s.flags, "flags", container::Range{0, 3});
+    v(s.depth_keyframe_interval, "depth_keyframe_interval", container::Range{1, UINT32_MAX});
+    v(s.depth_window, "depth_window", container::Range{1, UINT32_MAX});
+    v(s.min_psnr_db, "min_psnr_db");
+  }
+};
+static_assert(container::fixed_size<ViewIndexRecord>() == kViewIndexBytes);
+
+// Writes a view's index chunk. Errors: kContainerWriterMisuse for what parse_view_index refuses.
+Expected<std::vector<uint8_t>> serialize_view_index(const ViewIndex& index);
+// Refuses (CALF-E202) a chunk of another size or version, a position, z_near or z_far that is not
+// finite, z_near / z_far outside 0 < z_near < z_far, reserved flag bits, and K or W of 0.
 Expected<ViewIndex> parse_view_index(std::span<const uint8_t> raw, const std::string& what);
 
-// A colour cell's t chunk (§11.1.4).
+// A colour cell's t chunk (§11.1.4): the keyframes as a counted array (u32 K, K x u32), then
+// frame_count t values that fill the rest of the chunk (their number is the chunk key's frame
+// count, not on disk: a reader sizes `t` to it before reading).
 struct CellTimeline {
   std::vector<uint32_t> keyframes;  // strictly increasing from 0, all < frame_count
   std::vector<uint8_t> t;           // frame_count values
   // The index in `keyframes` of the last keyframe <= frame.
   uint32_t bracket(uint32_t frame) const;
+  template <class Self, class V>
+  static constexpr void fields(Self& s, V& v) {
+    v(s.keyframes, "keyframes", container::Range{1, container::kMaxFrames});
+    v(s.t, "t", container::Length{s.t.size()});
+  }
 };
+// Append a t chunk with container::write_fields(timeline, out, what).
 Expected<CellTimeline> parse_t_chunk(std::span<const uint8_t> raw, uint32_t frame_count,
                                      const std::string& what);
 
@@ -121,9 +163,33 @@ Expected<RegionCoding> depth_coding(uint16_t depth_format);
 Expected<RegionCoding> material_coding(uint16_t material_format);
 bool region_coding_is_block(RegionCoding coding);
 
+// One rectangle of a region chunk: on disk u16 x, y, w, h (tile coordinates); `first_unit` is
+// derived by the parser, not stored.
 struct RegionRect {
   uint16_t x = 0, y = 0, w = 0, h = 0;  // tile coordinates
   uint64_t first_unit = 0;  // index of its first texel (raw codings) or block (block codings)
+  template <class Self, class V>
+  static constexpr void fields(Self& s, V& v) {
+    v(s.x, "x");
+    v(s.y, "y");
+    v(s.w, "w");
+    v(s.h, "h");
+  }
+};
+
+// The head of a region chunk (§11.1.6), before its payload: F rectangle counts as a counted array
+// (u32 F, F x u32 R_i), then the sum of R_i rectangles, frame by frame. Append one with
+// container::write_fields(head, out, what), then the payload.
+struct RegionHead {
+  std::vector<uint32_t> rect_counts;  // R_i of each frame of the group
+  std::vector<RegionRect> rects;      // every frame's rectangles in frame order
+  template <class Self, class V>
+  static constexpr void fields(Self& s, V& v) {
+    v(s.rect_counts, "rectangle counts", container::Range{1, container::kMaxFrames});
+    uint64_t total = 0;
+    for (uint32_t n : s.rect_counts) total += n;
+    v(s.rects, "rectangles", container::Length{total});
+  }
 };
 
 // A parsed region chunk; `payload` points into the chunk's bytes, which must outlive it.
