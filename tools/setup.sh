@@ -21,8 +21,9 @@ PACKAGES=(
   libembree-dev libassimp-dev
   # player: GL, window, headless, maths, HUD
   libglm-dev libglfw3-dev libosmesa6-dev libgl-dev libopengl-dev libglx-dev libegl-dev libimgui-dev xvfb xauth
-  # tests and benchmarks; clang + its runtime for the libFuzzer run of tools/test.sh
-  libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
+  # tests and benchmarks; clang + its runtime for the libFuzzer run of tools/test.sh; clang-format
+  # for the style check
+  libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev clang-format
   # measurement peers and plots
   ffmpeg zstd xz-utils gnuplot-nox
 )

@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
-# The README's test command: installs what is missing, builds every target with
-# AddressSanitizer + UndefinedBehaviorSanitizer and warnings as errors, runs every test via ctest.
+# The README's test command: installs what is missing, checks clang-format (tools/check_format.sh),
+# builds every target with AddressSanitizer + UndefinedBehaviorSanitizer and warnings as errors,
+# runs every test via ctest.
 # A second run skips installed packages and rebuilds incrementally.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./tools/setup.sh
+./tools/check_format.sh
 BUILD=build/asan
 cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O2 -g1" \
   -DCALF_SANITIZE=ON -DCALF_WERROR=ON >/dev/null

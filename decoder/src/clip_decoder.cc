@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <chrono>
-#include <iterator>
 #include <cmath>
+#include <iterator>
 #include <numbers>
-#include <unordered_set>
 #include <optional>
 #include <string>
+#include <unordered_set>
 
 #include "calf/format/lightfield_layout.h"
 #include "chunk_cache.h"
@@ -18,8 +18,12 @@ namespace {
 using container::LightfieldStream;
 using container::PixelFormat;
 
-Status bad_argument(const std::string& what) { return Status(ErrorId::kDecoderArgument, what); }
-Status corrupt(const std::string& what) { return Status(ErrorId::kLightfieldChunk, what); }
+Status bad_argument(const std::string& what) {
+  return Status(ErrorId::kDecoderArgument, what);
+}
+Status corrupt(const std::string& what) {
+  return Status(ErrorId::kLightfieldChunk, what);
+}
 
 std::string where(uint32_t view, uint32_t face, uint32_t region) {
   return "view " + std::to_string(view) + " face " + std::to_string(face) + " region " +
@@ -194,8 +198,8 @@ Status ClipDecoder::Impl::update_cell(uint32_t view, uint32_t face, uint32_t cel
                                       FrameUpdates* out) {
   CellState& s = cell_state[view][size_t{face} * cells.cell_count() + cell];
   if (!s.timeline) {
-    CALF_ASSIGN_OR_RETURN(uint32_t id, chunk_serving(LightfieldStream::kTParams, view, face, cell,
-                                                     0, true));
+    CALF_ASSIGN_OR_RETURN(uint32_t id,
+                          chunk_serving(LightfieldStream::kTParams, view, face, cell, 0, true));
     CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out->stats));
     CALF_ASSIGN_OR_RETURN(lf::CellTimeline tl, lf::parse_t_chunk(*raw, header.frame_count,
                                                                  where(view, face, cell) + " t"));
@@ -206,7 +210,8 @@ Status ClipDecoder::Impl::update_cell(uint32_t view, uint32_t face, uint32_t cel
   const bool has_next = i + 1 < tl.keyframes.size();
   // Frames after the last keyframe hold it (SPEC §11.1.4), whatever their t byte says.
   const uint8_t t = has_next ? tl.t[frame] : 0;
-  const PixelRect rect = cells.cell_rect(cell % cells.cells_per_side(), cell / cells.cells_per_side());
+  const PixelRect rect =
+      cells.cell_rect(cell % cells.cells_per_side(), cell / cells.cells_per_side());
   std::vector<uint8_t> gpu[2];
   bool load[2] = {false, false};
   for (uint32_t k = i; k <= i + 1; ++k) {
@@ -241,7 +246,8 @@ Status ClipDecoder::Impl::update_cell(uint32_t view, uint32_t face, uint32_t cel
 
 Status ClipDecoder::Impl::update_tile(bool depth, uint32_t view, uint32_t face, uint32_t tile,
                                       uint32_t frame, FrameUpdates* out) {
-  TileState& s = (depth ? depth_state : material_state)[view][size_t{face} * tiles.cell_count() + tile];
+  TileState& s =
+      (depth ? depth_state : material_state)[view][size_t{face} * tiles.cell_count() + tile];
   if (s.frame == frame) return Status::Ok();
   const LightfieldStream stream = depth ? LightfieldStream::kDepth : LightfieldStream::kMaterial;
   CALF_ASSIGN_OR_RETURN(uint32_t id, chunk_serving(stream, view, face, tile, frame, false));
@@ -309,9 +315,15 @@ ClipDecoder::ClipDecoder(ClipDecoder&&) noexcept = default;
 ClipDecoder& ClipDecoder::operator=(ClipDecoder&&) noexcept = default;
 ClipDecoder::~ClipDecoder() = default;
 
-const container::LightfieldTrackHeader& ClipDecoder::header() const { return impl_->header; }
-const LightfieldViewInfo& ClipDecoder::view(uint32_t v) const { return impl_->views[v]; }
-const ClipDecoderOptions& ClipDecoder::options() const { return impl_->options; }
+const container::LightfieldTrackHeader& ClipDecoder::header() const {
+  return impl_->header;
+}
+const LightfieldViewInfo& ClipDecoder::view(uint32_t v) const {
+  return impl_->views[v];
+}
+const ClipDecoderOptions& ClipDecoder::options() const {
+  return impl_->options;
+}
 
 Expected<ClipDecoder> ClipDecoder::open(const container::Reader& reader, uint16_t track,
                                         const ClipDecoderOptions& options) {
@@ -326,18 +338,21 @@ Expected<ClipDecoder> ClipDecoder::open(const container::Reader& reader, uint16_
   for (uint32_t v = 0; v < impl->header.view_count; ++v) impl->views.push_back(ref.view(v));
   CALF_ASSIGN_OR_RETURN(impl->cells,
                         FaceGrid::with_cell_size(impl->header.face_size, impl->header.cell_size));
-  CALF_ASSIGN_OR_RETURN(impl->tiles, FaceGrid::with_cell_size(impl->header.face_size,
-                                                              impl->header.depth_tile_size));
+  CALF_ASSIGN_OR_RETURN(
+      impl->tiles, FaceGrid::with_cell_size(impl->header.face_size, impl->header.depth_tile_size));
   CALF_ASSIGN_OR_RETURN(impl->depth_coding, lf::depth_coding(impl->header.depth_format));
   if (impl->header.material_format != 0) {
     CALF_ASSIGN_OR_RETURN(impl->material_coding, lf::material_coding(impl->header.material_format));
   }
   CALF_RETURN_IF_ERROR(impl->open_tables());
-  impl->cache = std::make_unique<ChunkCache>(reader, options.cache_bytes, options.background_thread);
+  impl->cache =
+      std::make_unique<ChunkCache>(reader, options.cache_bytes, options.background_thread);
   return ClipDecoder(std::move(impl));
 }
 
-void ClipDecoder::set_view_dependent(bool on) { impl_->options.view_dependent = on; }
+void ClipDecoder::set_view_dependent(bool on) {
+  impl_->options.view_dependent = on;
+}
 
 void ClipDecoder::reset() {
   Impl& d = *impl_;
@@ -462,8 +477,8 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
     }
   }
   for (size_t i = 0; i < out->updates.size(); ++i) {
-    out->updates[i].bytes = std::span<const uint8_t>(d.arena).subspan(d.spans[i].first,
-                                                                     d.spans[i].second);
+    out->updates[i].bytes =
+        std::span<const uint8_t>(d.arena).subspan(d.spans[i].first, d.spans[i].second);
   }
   stats.updates = static_cast<uint32_t>(out->updates.size());
   stats.culling_tests = cull.tests;

@@ -23,7 +23,9 @@ Status unsupported(const char* what, PixelFormat f) {
                     container::pixel_format_name(static_cast<uint16_t>(f)));
 }
 
-size_t texels_of(uint32_t w, uint32_t h) { return size_t{w} * h; }
+size_t texels_of(uint32_t w, uint32_t h) {
+  return size_t{w} * h;
+}
 
 // Decodes whole-block bytes into `texel_bytes` per texel, row-major, through calf/format/bc.h.
 Status decode_blocks(bc::Format f, std::span<const uint8_t> bytes, uint32_t w, uint32_t h,
@@ -46,9 +48,9 @@ Status decode_gpu_colour(PixelFormat format, std::span<const uint8_t> bytes, uin
   switch (format) {
     case PixelFormat::kBc1:
     case PixelFormat::kBc7: {
-      CALF_RETURN_IF_ERROR(decode_blocks(format == PixelFormat::kBc1 ? bc::Format::kBc1
-                                                                     : bc::Format::kBc7,
-                                         bytes, width, height, 4, tmp, "colour"));
+      CALF_RETURN_IF_ERROR(
+          decode_blocks(format == PixelFormat::kBc1 ? bc::Format::kBc1 : bc::Format::kBc7, bytes,
+                        width, height, 4, tmp, "colour"));
       for (size_t i = 0; i < n; ++i) {
         for (int c = 0; c < 3; ++c) rgb[3 * i + c] = linear_from_srgb8(tmp[4 * i + c]);
       }
@@ -79,7 +81,8 @@ Status decode_gpu_colour(PixelFormat format, std::span<const uint8_t> bytes, uin
         }
       }
       return Status::Ok();
-    default: return unsupported("colour", format);
+    default:
+      return unsupported("colour", format);
   }
 }
 
@@ -89,13 +92,15 @@ Status decode_gpu_depth(PixelFormat format, std::span<const uint8_t> bytes, uint
   if (codes.size() < n) return Status(ErrorId::kInvalidArgument, "depth output too small");
   if (format == PixelFormat::kR16) {
     if (bytes.size() != n * 2) return wrong_size("depth", bytes.size(), n * 2);
-    for (size_t i = 0; i < n; ++i) codes[i] = static_cast<uint16_t>(bytes[2 * i] | bytes[2 * i + 1] << 8);
+    for (size_t i = 0; i < n; ++i)
+      codes[i] = static_cast<uint16_t>(bytes[2 * i] | bytes[2 * i + 1] << 8);
     return Status::Ok();
   }
   if (format == PixelFormat::kBc5) {
     std::vector<uint8_t> tmp;
     CALF_RETURN_IF_ERROR(decode_blocks(bc::Format::kBc5, bytes, width, height, 2, tmp, "depth"));
-    for (size_t i = 0; i < n; ++i) codes[i] = static_cast<uint16_t>(tmp[2 * i] << 8 | tmp[2 * i + 1]);
+    for (size_t i = 0; i < n; ++i)
+      codes[i] = static_cast<uint16_t>(tmp[2 * i] << 8 | tmp[2 * i + 1]);
     return Status::Ok();
   }
   return unsupported("depth", format);
@@ -241,8 +246,7 @@ void CpuTextures::colour_cell(uint32_t view, CubeFace face, uint32_t cell,
   const PixelRect r = cells_.cell_rect(cell % per_side, cell / per_side);
   const CellParams& p = s.cells[f][cell];
   rgb->resize(size_t{r.width} * r.height * 3);
-  mix_cell(s.slots[f][p.a_slot], s.slots[f][1 - p.a_slot], p, r, face_size_, rgb->data(),
-           r.width);
+  mix_cell(s.slots[f][p.a_slot], s.slots[f][1 - p.a_slot], p, r, face_size_, rgb->data(), r.width);
 }
 
 std::span<const float> CpuTextures::colour_slot(uint32_t view, CubeFace face, uint32_t slot) const {

@@ -16,7 +16,9 @@ using container::ChunkQuery;
 using container::LightfieldStream;
 using container::PixelFormat;
 
-Status corrupt(const std::string& what) { return Status(ErrorId::kLightfieldChunk, what); }
+Status corrupt(const std::string& what) {
+  return Status(ErrorId::kLightfieldChunk, what);
+}
 
 std::string where(uint32_t view, uint32_t face, uint32_t region) {
   return "view " + std::to_string(view) + " face " + std::to_string(face) + " region " +
@@ -96,28 +98,29 @@ Expected<LightfieldReference> LightfieldReference::open(const container::Reader&
 
 Expected<LightfieldReference::CellTimeline> LightfieldReference::cell_timeline(
     uint32_t view, uint32_t face, uint32_t cell) const {
-  CALF_ASSIGN_OR_RETURN(uint32_t id, find_one(*reader_, track_, LightfieldStream::kTParams, view,
-                                              face, cell, 0, 0));
+  CALF_ASSIGN_OR_RETURN(
+      uint32_t id, find_one(*reader_, track_, LightfieldStream::kTParams, view, face, cell, 0, 0));
   CALF_ASSIGN_OR_RETURN(std::vector<uint8_t> raw, reader_->read_chunk(id));
   return lf::parse_t_chunk(raw, header_.frame_count, where(view, face, cell) + " t chunk");
 }
 
 Expected<std::vector<uint32_t>> LightfieldReference::depth_rect_counts(uint32_t view, uint32_t face,
                                                                        uint32_t tile) const {
-  CALF_ASSIGN_OR_RETURN(FaceGrid tiles, FaceGrid::with_cell_size(header_.face_size,
-                                                                 header_.depth_tile_size));
+  CALF_ASSIGN_OR_RETURN(FaceGrid tiles,
+                        FaceGrid::with_cell_size(header_.face_size, header_.depth_tile_size));
   CALF_ASSIGN_OR_RETURN(PixelRect r, tiles.cell_rect(tile));
   CALF_ASSIGN_OR_RETURN(lf::RegionCoding coding, lf::depth_coding(header_.depth_format));
   std::vector<uint32_t> counts;
   for (uint32_t f = 0; f < header_.frame_count;) {
-    CALF_ASSIGN_OR_RETURN(uint32_t id, find_one(*reader_, track_, LightfieldStream::kDepth, view,
-                                                face, tile, f, f));
+    CALF_ASSIGN_OR_RETURN(
+        uint32_t id, find_one(*reader_, track_, LightfieldStream::kDepth, view, face, tile, f, f));
     CALF_ASSIGN_OR_RETURN(std::vector<uint8_t> raw, reader_->read_chunk(id));
     const uint32_t fc = reader_->chunks()[id].keys.frame_count;
     CALF_ASSIGN_OR_RETURN(lf::RegionChunk chunk,
                           lf::parse_region_chunk(raw, fc, r.width, r.height, coding,
                                                  where(view, face, tile) + " depth"));
-    for (uint32_t i = 0; i < fc; ++i) counts.push_back(chunk.first_rect[i + 1] - chunk.first_rect[i]);
+    for (uint32_t i = 0; i < fc; ++i)
+      counts.push_back(chunk.first_rect[i + 1] - chunk.first_rect[i]);
     f += fc;
   }
   return counts;
@@ -142,13 +145,14 @@ Status LightfieldReference::decode_face(uint32_t view, uint32_t face, uint32_t f
   std::vector<float> a, b;
   std::vector<uint8_t> gpu;
   for (uint32_t cell = 0; cell < cells.cell_count(); ++cell) {
-    const PixelRect r = cells.cell_rect(cell % cells.cells_per_side(), cell / cells.cells_per_side());
+    const PixelRect r =
+        cells.cell_rect(cell % cells.cells_per_side(), cell / cells.cells_per_side());
     CALF_ASSIGN_OR_RETURN(CellTimeline tl, cell_timeline(view, face, cell));
     const uint32_t i = tl.bracket(frame);
     const std::string what = where(view, face, cell) + " colour";
     auto load = [&](uint32_t kf, std::vector<float>& dst) -> Status {
-      CALF_ASSIGN_OR_RETURN(uint32_t id, find_one(*reader_, track_, LightfieldStream::kColour,
-                                                  view, face, cell, kf, kf));
+      CALF_ASSIGN_OR_RETURN(uint32_t id, find_one(*reader_, track_, LightfieldStream::kColour, view,
+                                                  face, cell, kf, kf));
       CALF_ASSIGN_OR_RETURN(std::vector<uint8_t> raw, reader_->read_chunk(id));
       CALF_RETURN_IF_ERROR(
           lf::colour_payload_gpu_bytes(h.colour_format, raw, r.width, r.height, gpu, what));
@@ -180,16 +184,18 @@ Status LightfieldReference::decode_face(uint32_t view, uint32_t face, uint32_t f
     CALF_ASSIGN_OR_RETURN(lf::RegionCoding coding, depth ? lf::depth_coding(h.depth_format)
                                                          : lf::material_coding(h.material_format));
     for (uint32_t tile = 0; tile < tiles.cell_count(); ++tile) {
-      const PixelRect r = tiles.cell_rect(tile % tiles.cells_per_side(), tile / tiles.cells_per_side());
+      const PixelRect r =
+          tiles.cell_rect(tile % tiles.cells_per_side(), tile / tiles.cells_per_side());
       CALF_ASSIGN_OR_RETURN(
-          uint32_t id, find_one(*reader_, track_, depth ? LightfieldStream::kDepth : LightfieldStream::kMaterial,
-                                view, face, tile, frame, -1));
+          uint32_t id,
+          find_one(*reader_, track_, depth ? LightfieldStream::kDepth : LightfieldStream::kMaterial,
+                   view, face, tile, frame, -1));
       const container::ChunkKeys& keys = reader_->chunks()[id].keys;
       CALF_ASSIGN_OR_RETURN(std::vector<uint8_t> raw, reader_->read_chunk(id));
       const std::string what = where(view, face, tile) + (depth ? " depth" : " material");
-      CALF_ASSIGN_OR_RETURN(lf::RegionChunk chunk, lf::parse_region_chunk(raw, keys.frame_count,
-                                                                          r.width, r.height,
-                                                                          coding, what));
+      CALF_ASSIGN_OR_RETURN(
+          lf::RegionChunk chunk,
+          lf::parse_region_chunk(raw, keys.frame_count, r.width, r.height, coding, what));
       const PixelFormat format = lf::region_gpu_format(coding);
       for (uint32_t rect = 0; rect < chunk.first_rect[frame - keys.first_frame + 1]; ++rect) {
         const lf::RegionRect& rr = chunk.rects[rect];

@@ -16,28 +16,26 @@ size_t encode_bound(Format f, uint32_t width, uint32_t height) {
 
 namespace internal {
 
-Status check_image(Format f, const void* pixels, uint32_t width, uint32_t height,
-                   size_t row_stride, size_t row_units, uint32_t channels,
-                   uint32_t min_channels, uint32_t max_channels, size_t out_size, int quality,
-                   int max_quality, int threads) {
+Status check_image(Format f, const void* pixels, uint32_t width, uint32_t height, size_t row_stride,
+                   size_t row_units, uint32_t channels, uint32_t min_channels,
+                   uint32_t max_channels, size_t out_size, int quality, int max_quality,
+                   int threads) {
   const std::string name = format_name(f);
   CALF_ASSIGN_OR_RETURN(const size_t need, compressed_size(f, width, height));
   if (channels < min_channels || channels > max_channels) {
     return Status(ErrorId::kBcOptions, name + " encoder: " + std::to_string(channels) +
-                                           " channels, expected " +
-                                           std::to_string(min_channels) + ".." +
-                                           std::to_string(max_channels));
+                                           " channels, expected " + std::to_string(min_channels) +
+                                           ".." + std::to_string(max_channels));
   }
   if (quality < 0 || quality > max_quality || threads < 0 || threads > 1024) {
     return Status(ErrorId::kBcOptions, name + " encoder: quality " + std::to_string(quality) +
-                                           " (0.." + std::to_string(max_quality) +
-                                           ") or threads " + std::to_string(threads) +
-                                           " (0..1024) out of range");
+                                           " (0.." + std::to_string(max_quality) + ") or threads " +
+                                           std::to_string(threads) + " (0..1024) out of range");
   }
   if (row_stride < size_t{width} * channels) {
     return Status(ErrorId::kBcStride, name + " encoder: row stride " + std::to_string(row_stride) +
-                                          " < " + std::to_string(size_t{width} * channels) +
-                                          " " + (row_units == 1 ? "bytes" : "floats"));
+                                          " < " + std::to_string(size_t{width} * channels) + " " +
+                                          (row_units == 1 ? "bytes" : "floats"));
   }
   if (pixels == nullptr) return Status(ErrorId::kBcBufferSize, name + " encoder: no pixels");
   if (out_size < need) {
@@ -53,7 +51,8 @@ void gather8(const Image8& image, uint32_t bx, uint32_t by, uint8_t* rgba) {
     const uint32_t x = std::min(bx * 4 + i % 4, image.width - 1);
     const uint32_t y = std::min(by * 4 + i / 4, image.height - 1);
     const uint8_t* p = image.pixels + y * image.row_stride + size_t{x} * image.channels;
-    for (uint32_t c = 0; c < 4; ++c) rgba[4 * i + c] = c < image.channels ? p[c] : (c == 3 ? 255 : 0);
+    for (uint32_t c = 0; c < 4; ++c)
+      rgba[4 * i + c] = c < image.channels ? p[c] : (c == 3 ? 255 : 0);
   }
 }
 
@@ -73,9 +72,10 @@ void run_rows(uint32_t rows, int threads, void (*row)(void*, uint32_t), void* ct
   }
   tbb::task_arena arena(threads == 0 ? tbb::task_arena::automatic : threads);
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, rows), [&](const tbb::blocked_range<uint32_t>& r) {
-      for (uint32_t y = r.begin(); y != r.end(); ++y) row(ctx, y);
-    });
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, rows),
+                      [&](const tbb::blocked_range<uint32_t>& r) {
+                        for (uint32_t y = r.begin(); y != r.end(); ++y) row(ctx, y);
+                      });
   });
 }
 

@@ -48,15 +48,16 @@ uint16_t half_from_colour(float v) {
 
 struct ViewData {
   uint32_t frames = 0, face_size = 0;
-  size_t texels = 0;              // per frame, all six faces
-  std::vector<uint16_t> colour;   // half RGB, [frame][texel][3]
-  std::vector<uint16_t> depth;    // log-16 codes, [frame][texel]
-  std::vector<uint8_t> material;  // [frame][texel][3] codes, empty without material
+  size_t texels = 0;                   // per frame, all six faces
+  std::vector<uint16_t> colour;        // half RGB, [frame][texel][3]
+  std::vector<uint16_t> depth;         // log-16 codes, [frame][texel]
+  std::vector<uint8_t> material;       // [frame][texel][3] codes, empty without material
   std::optional<LogDepthRange> range;  // none when the view sees only sky
   bool has_material = false;           // some texel of some frame reflects or refracts
 
   size_t index(uint32_t frame, uint32_t face, uint32_t x, uint32_t y) const {
-    return static_cast<size_t>(frame) * texels + (static_cast<size_t>(face) * face_size + y) * face_size + x;
+    return static_cast<size_t>(frame) * texels +
+           (static_cast<size_t>(face) * face_size + y) * face_size + x;
   }
 };
 
@@ -216,7 +217,8 @@ Status code_colour_frame(ColourCoding coding, std::span<const float> rgb, uint32
       }
       return Status::Ok();
     }
-    case ColourCoding::kAuto: break;
+    case ColourCoding::kAuto:
+      break;
   }
   return Status(ErrorId::kInternal, "unresolved colour format");
 }
@@ -225,8 +227,12 @@ Status code_colour_frame(ColourCoding coding, std::span<const float> rgb, uint32
 void append_colour_payload(ColourCoding coding, const std::vector<uint8_t>& bytes,
                            std::vector<uint8_t>& out) {
   switch (coding) {
-    case ColourCoding::kBc1: lf::append_block_split(out, bytes, 8, false); break;
-    case ColourCoding::kRgba8: lf::append_planes(out, bytes, 4); break;
+    case ColourCoding::kBc1:
+      lf::append_block_split(out, bytes, 8, false);
+      break;
+    case ColourCoding::kRgba8:
+      lf::append_planes(out, bytes, 4);
+      break;
     case ColourCoding::kRgba16f: {
       // Little-endian halves -> high bytes of every value, then low bytes.
       std::vector<uint8_t> swapped(bytes.size());
@@ -237,14 +243,16 @@ void append_colour_payload(ColourCoding coding, const std::vector<uint8_t>& byte
       lf::append_planes(out, swapped, 2);
       break;
     }
-    default: out.insert(out.end(), bytes.begin(), bytes.end()); break;
+    default:
+      out.insert(out.end(), bytes.begin(), bytes.end());
+      break;
   }
 }
 
 void colour_task(const Context& ctx, uint32_t face, uint32_t cell, TaskOut& out) {
   const ViewData& v = *ctx.view;
-  const PixelRect r = ctx.cells.cell_rect(cell % ctx.cells.cells_per_side(),
-                                          cell / ctx.cells.cells_per_side());
+  const PixelRect r =
+      ctx.cells.cell_rect(cell % ctx.cells.cells_per_side(), cell / ctx.cells.cells_per_side());
   const size_t n = static_cast<size_t>(r.width) * r.height;
   const uint32_t frames = v.frames;
   std::vector<float> original(n * 3);
@@ -346,9 +354,10 @@ enum class RegionCoding : uint8_t { kRaw, kBc5, kBc1 };
 
 // Codes frames [first, first + count) of a tile into one chunk (SPEC §11.1 "Region chunk").
 // `decoded` is the decoder's tile state (bytes_per_texel == 2 only), for the BC5 error report.
-Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth, RegionCoding coding,
-                         uint32_t first, uint32_t count, std::vector<uint8_t>& raw,
-                         TaskStats& s, StreamBytes& bytes, std::vector<uint16_t>* decoded) {
+Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
+                         RegionCoding coding, uint32_t first, uint32_t count,
+                         std::vector<uint8_t>& raw, TaskStats& s, StreamBytes& bytes,
+                         std::vector<uint16_t>* decoded) {
   const LightfieldEncodeOptions& o = *ctx.options;
   std::vector<std::vector<PixelRect>> rects(count);
   std::vector<std::span<const uint16_t>> depth_frames;
@@ -363,8 +372,9 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
       }
     }
     for (uint32_t f = 0; f < count; ++f) {
-      depth_frames.push_back(std::span<const uint16_t>(depth_codes).subspan(
-          f * static_cast<size_t>(t.width) * t.height, static_cast<size_t>(t.width) * t.height));
+      depth_frames.push_back(std::span<const uint16_t>(depth_codes)
+                                 .subspan(f * static_cast<size_t>(t.width) * t.height,
+                                          static_cast<size_t>(t.width) * t.height));
     }
   }
   AabbOptions ao;
@@ -433,7 +443,8 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
         for (uint32_t y = 0; y < r.height; ++y) {
           for (uint32_t x = 0; x < r.width; ++x) {
             const uint8_t* p = &decoded_rect[(size_t{y} * r.width + x) * 2];
-            (*decoded)[size_t{r.y + y} * t.width + r.x + x] = static_cast<uint16_t>(p[0] << 8 | p[1]);
+            (*decoded)[size_t{r.y + y} * t.width + r.x + x] =
+                static_cast<uint16_t>(p[0] << 8 | p[1]);
           }
         }
       }
@@ -471,8 +482,8 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
 
 void region_task(const Context& ctx, uint32_t face, uint32_t tile, bool is_depth, TaskOut& out) {
   const ViewData& v = *ctx.view;
-  const PixelRect r = ctx.tiles.cell_rect(tile % ctx.tiles.cells_per_side(),
-                                          tile / ctx.tiles.cells_per_side());
+  const PixelRect r =
+      ctx.tiles.cell_rect(tile % ctx.tiles.cells_per_side(), tile / ctx.tiles.cells_per_side());
   TileFrames t;
   t.width = r.width;
   t.height = r.height;
@@ -494,7 +505,7 @@ void region_task(const Context& ctx, uint32_t face, uint32_t tile, bool is_depth
     }
   }
   const bool lossy = ctx.options->depth == DepthCoding::kBc5;
-  const RegionCoding coding = !lossy ? RegionCoding::kRaw
+  const RegionCoding coding = !lossy     ? RegionCoding::kRaw
                               : is_depth ? RegionCoding::kBc5
                                          : RegionCoding::kBc1;
   std::vector<uint16_t> decoded;
@@ -508,8 +519,8 @@ void region_task(const Context& ctx, uint32_t face, uint32_t tile, bool is_depth
                                    decoded.empty() ? nullptr : &decoded);
     if (!out.status.ok()) return;
     ChunkKeys keys;
-    keys.stream = static_cast<uint16_t>(is_depth ? LightfieldStream::kDepth
-                                                 : LightfieldStream::kMaterial);
+    keys.stream =
+        static_cast<uint16_t>(is_depth ? LightfieldStream::kDepth : LightfieldStream::kMaterial);
     keys.face = face;
     keys.region = tile;
     keys.first_frame = first;
@@ -575,7 +586,8 @@ double psnr_log2(std::span<const float> reference, std::span<const float> test) 
   constexpr float kFloor = 1.0f / 16384.0f;  // 2^-14, the smallest normal half
   double sum = 0;
   for (size_t i = 0; i < reference.size(); ++i) {
-    const double d = std::log2(std::max(reference[i], kFloor)) - std::log2(std::max(test[i], kFloor));
+    const double d =
+        std::log2(std::max(reference[i], kFloor)) - std::log2(std::max(test[i], kFloor));
     sum += d * d;
   }
   if (sum == 0 || reference.empty()) return kInf;
@@ -737,10 +749,13 @@ Expected<LightfieldEncodeStats> encode_lightfield_file(const std::filesystem::pa
                                                        const std::string& out_path,
                                                        const LightfieldEncodeOptions& options) {
   CALF_RETURN_IF_ERROR(lightfield_internal::validate_options(options));
-  CALF_ASSIGN_OR_RETURN(capture::CaptureSetReader input, capture::CaptureSetReader::open(capture_dir));
-  CALF_ASSIGN_OR_RETURN(container::Writer writer, container::Writer::create(out_path, options.levels));
+  CALF_ASSIGN_OR_RETURN(capture::CaptureSetReader input,
+                        capture::CaptureSetReader::open(capture_dir));
+  CALF_ASSIGN_OR_RETURN(container::Writer writer,
+                        container::Writer::create(out_path, options.levels));
   CALF_ASSIGN_OR_RETURN(LightfieldEncodeStats stats, encode_lightfield(input, writer, options));
-  CALF_RETURN_IF_ERROR(writer.set_metadata("encoder", std::string("calf-encode ") + kVersionString));
+  CALF_RETURN_IF_ERROR(
+      writer.set_metadata("encoder", std::string("calf-encode ") + kVersionString));
   if (!input.manifest().scene.empty()) {
     CALF_RETURN_IF_ERROR(writer.set_metadata("source_scene", input.manifest().scene));
   }

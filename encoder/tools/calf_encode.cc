@@ -9,8 +9,8 @@
 #include <map>
 #include <string>
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include "calf/encoder/lightfield_encode.h"
 
@@ -41,36 +41,41 @@ int main(int argc, char** argv) {
   std::string manifest, out;
   std::string colour = "auto", depth = "raw16", super = "zstd";
   bool quiet = false;
-  app.add_option("MANIFEST", manifest,
-                 "capture set: its manifest.json or the directory holding it")
+  app.add_option("MANIFEST", manifest, "capture set: its manifest.json or the directory holding it")
       ->required();
   app.add_option("-o,--output", out, "output .calf (written whole or not at all)")->required();
-  app.add_option("--threads", o.threads, "worker threads, 0 = all cores; output is identical for any count (default 0)")
+  app.add_option("--threads", o.threads,
+                 "worker threads, 0 = all cores; output is identical for any count (default 0)")
       ->default_val(0);
   app.add_option("--cell", o.cell_size, "colour cell side in px, multiple of 4 (default 64)")
       ->default_val(64);
-  app.add_option("--psnr", o.min_psnr_db,
-                 "Q: min dB of every interpolated frame vs. the frame as the spatial codec shows it; "
-                 "sRGB PSNR for LDR, log2-PSNR (8-stop peak) for HDR (default 50)")
+  app.add_option(
+         "--psnr", o.min_psnr_db,
+         "Q: min dB of every interpolated frame vs. the frame as the spatial codec shows it; "
+         "sRGB PSNR for LDR, log2-PSNR (8-stop peak) for HDR (default 50)")
       ->default_val(50.0);
-  app.add_option("--color-format", colour,
-                 "auto (BC1 for LDR input, BC6H for HDR), bc1, bc7, bc6h, rgba8, rgba16f (default auto)")
+  app.add_option(
+         "--color-format", colour,
+         "auto (BC1 for LDR input, BC6H for HDR), bc1, bc7, bc6h, rgba8, rgba16f (default auto)")
       ->check(CLI::IsMember({"auto", "bc1", "bc7", "bc6h", "rgba8", "rgba16f"}))
       ->default_val("auto");
-  app.add_option("--depth-format", depth,
-                 "raw16 (exact after log-16 quantisation; material raw) or bc5 (hi/lo bytes, lossy; "
-                 "material BC1; the error is printed) (default raw16)")
+  app.add_option(
+         "--depth-format", depth,
+         "raw16 (exact after log-16 quantisation; material raw) or bc5 (hi/lo bytes, lossy; "
+         "material BC1; the error is printed) (default raw16)")
       ->check(CLI::IsMember({"raw16", "bc5"}))
       ->default_val("raw16");
-  app.add_option("--depth-window", o.depth_window,
-                 "W: a P-frame holds texels differing from any of the previous W frames (default 2)")
+  app.add_option(
+         "--depth-window", o.depth_window,
+         "W: a P-frame holds texels differing from any of the previous W frames (default 2)")
       ->default_val(2);
   app.add_option("--max-aabbs", o.max_aabbs, "A: most rectangles per depth P-frame (default 2)")
       ->default_val(2);
   app.add_option("--depth-keyframe-interval", o.depth_keyframe_interval,
                  "a depth / material keyframe every K frames (default 30)")
       ->default_val(30);
-  app.add_option("--supercompression", super, "per chunk: zstd (level 19), lzma2 (preset 6), none (default zstd)")
+  app.add_option("--supercompression", super,
+                 "per chunk: zstd (level 19), lzma2 (preset 6), none (default zstd)")
       ->check(CLI::IsMember({"zstd", "lzma2", "none"}))
       ->default_val("zstd");
   app.add_flag("-q,--quiet", quiet, "no progress line");
@@ -117,17 +122,17 @@ int main(int argc, char** argv) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   auto line = [](const char* name, const calf::StreamBytes& b) {
-    std::fprintf(stderr,
-                 "  %-8s raw %llu  temporal %llu  +spatial %llu  +%s %llu  (%.1fx)  %llu chunks\n",
-                 name, static_cast<unsigned long long>(b.raw),
-                 static_cast<unsigned long long>(b.temporal),
-                 static_cast<unsigned long long>(b.spatial), "super",
-                 static_cast<unsigned long long>(b.stored),
-                 b.stored ? static_cast<double>(b.raw) / static_cast<double>(b.stored) : 0.0,
-                 static_cast<unsigned long long>(b.chunks));
+    std::fprintf(
+        stderr, "  %-8s raw %llu  temporal %llu  +spatial %llu  +%s %llu  (%.1fx)  %llu chunks\n",
+        name, static_cast<unsigned long long>(b.raw), static_cast<unsigned long long>(b.temporal),
+        static_cast<unsigned long long>(b.spatial), "super",
+        static_cast<unsigned long long>(b.stored),
+        b.stored ? static_cast<double>(b.raw) / static_cast<double>(b.stored) : 0.0,
+        static_cast<unsigned long long>(b.chunks));
   };
   std::fprintf(stderr, "calf-encode: wrote %s in %.2f s (colour %s, %s)\n", out.c_str(), seconds,
-               calf::container::pixel_format_name(stats->colour_format), stats->hdr ? "HDR" : "LDR");
+               calf::container::pixel_format_name(stats->colour_format),
+               stats->hdr ? "HDR" : "LDR");
   line("colour", stats->colour);
   line("depth", stats->depth);
   if (stats->material_views) line("material", stats->material);
@@ -136,8 +141,7 @@ int main(int argc, char** argv) {
                "P-frames (%llu empty)\n",
                static_cast<unsigned long long>(stats->colour_cells),
                static_cast<unsigned long long>(stats->colour_keyframes),
-               stats->min_colour_quality_db,
-               static_cast<unsigned long long>(stats->depth_pframes),
+               stats->min_colour_quality_db, static_cast<unsigned long long>(stats->depth_pframes),
                static_cast<unsigned long long>(stats->depth_empty_pframes));
   if (o.depth == calf::DepthCoding::kBc5) {
     std::fprintf(stderr,

@@ -10,8 +10,12 @@
 namespace calf::bc {
 namespace {
 
-uint32_t load_u16(const uint8_t* p) { return uint32_t{p[0]} | uint32_t{p[1]} << 8; }
-uint32_t load_u32(const uint8_t* p) { return load_u16(p) | load_u16(p + 2) << 16; }
+uint32_t load_u16(const uint8_t* p) {
+  return uint32_t{p[0]} | uint32_t{p[1]} << 8;
+}
+uint32_t load_u32(const uint8_t* p) {
+  return load_u16(p) | load_u16(p + 2) << 16;
+}
 
 // 5:6:5 -> 8:8:8 by replicating the top bits into the low ones.
 void expand565(uint32_t c, int* rgb) {
@@ -77,8 +81,12 @@ void decode_bc1_block(const uint8_t* block, uint8_t* rgba) {
   }
 }
 
-void decode_bc4_block(const uint8_t* block, uint8_t* r) { decode_bc4_into(block, false, r, 1); }
-void decode_bc4s_block(const uint8_t* block, int8_t* r) { decode_bc4_into(block, true, r, 1); }
+void decode_bc4_block(const uint8_t* block, uint8_t* r) {
+  decode_bc4_into(block, false, r, 1);
+}
+void decode_bc4s_block(const uint8_t* block, int8_t* r) {
+  decode_bc4_into(block, true, r, 1);
+}
 
 void decode_bc5_block(const uint8_t* block, uint8_t* rg) {
   decode_bc4_into(block, false, rg, 2);

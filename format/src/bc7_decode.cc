@@ -4,9 +4,9 @@
 // bit reader): this is the reference against which encoders and any faster path are tested.
 #include <cstring>
 
+#include "bc_bits.h"
 #include "calf/format/bc.h"
 #include "calf/format/bc_tables.h"
-#include "bc_bits.h"
 
 namespace calf::bc {
 namespace {
@@ -17,9 +17,8 @@ struct Bc7Mode {
   int endpoint_pbits, shared_pbits, index_bits, index2_bits;
 };
 constexpr Bc7Mode kModes[8] = {
-    {3, 4, 0, 0, 4, 0, 1, 0, 3, 0}, {2, 6, 0, 0, 6, 0, 0, 1, 3, 0},
-    {3, 6, 0, 0, 5, 0, 0, 0, 2, 0}, {2, 6, 0, 0, 7, 0, 1, 0, 2, 0},
-    {1, 0, 2, 1, 5, 6, 0, 0, 2, 3}, {1, 0, 2, 0, 7, 8, 0, 0, 2, 2},
+    {3, 4, 0, 0, 4, 0, 1, 0, 3, 0}, {2, 6, 0, 0, 6, 0, 0, 1, 3, 0}, {3, 6, 0, 0, 5, 0, 0, 0, 2, 0},
+    {2, 6, 0, 0, 7, 0, 1, 0, 2, 0}, {1, 0, 2, 1, 5, 6, 0, 0, 2, 3}, {1, 0, 2, 0, 7, 8, 0, 0, 2, 2},
     {1, 0, 0, 0, 7, 7, 1, 0, 4, 0}, {2, 6, 0, 0, 5, 5, 1, 0, 2, 0},
 };
 
@@ -49,7 +48,8 @@ void decode_bc7_block(const uint8_t* block, uint8_t* rgba) {
   int ep[6][4];  // endpoint e = 2 * subset + {0, 1}; channels RGBA
   for (int c = 0; c < 3; ++c)
     for (int e = 0; e < ne; ++e) ep[e][c] = static_cast<int>(br.read(m.color_bits));
-  for (int e = 0; e < ne; ++e) ep[e][3] = m.alpha_bits ? static_cast<int>(br.read(m.alpha_bits)) : 255;
+  for (int e = 0; e < ne; ++e)
+    ep[e][3] = m.alpha_bits ? static_cast<int>(br.read(m.alpha_bits)) : 255;
 
   int pbit[6] = {0, 0, 0, 0, 0, 0};
   if (m.endpoint_pbits) {

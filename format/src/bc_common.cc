@@ -10,14 +10,22 @@ namespace calf::bc {
 
 const char* format_name(Format f) {
   switch (f) {
-    case Format::kBc1: return "BC1";
-    case Format::kBc4: return "BC4";
-    case Format::kBc5: return "BC5";
-    case Format::kBc4Signed: return "BC4_SNORM";
-    case Format::kBc5Signed: return "BC5_SNORM";
-    case Format::kBc6hUnsigned: return "BC6H_UF16";
-    case Format::kBc6hSigned: return "BC6H_SF16";
-    case Format::kBc7: return "BC7";
+    case Format::kBc1:
+      return "BC1";
+    case Format::kBc4:
+      return "BC4";
+    case Format::kBc5:
+      return "BC5";
+    case Format::kBc4Signed:
+      return "BC4_SNORM";
+    case Format::kBc5Signed:
+      return "BC5_SNORM";
+    case Format::kBc6hUnsigned:
+      return "BC6H_UF16";
+    case Format::kBc6hSigned:
+      return "BC6H_SF16";
+    case Format::kBc7:
+      return "BC7";
   }
   return "BC?";
 }
@@ -25,24 +33,38 @@ const char* format_name(Format f) {
 Expected<size_t> compressed_size(Format f, uint32_t width, uint32_t height) {
   if (width == 0 || height == 0 || width > kMaxDimension || height > kMaxDimension) {
     return Status(ErrorId::kBcDimensions, std::string(format_name(f)) + " image " +
-                                              std::to_string(width) + "x" +
-                                              std::to_string(height) + ": expected 1..65536");
+                                              std::to_string(width) + "x" + std::to_string(height) +
+                                              ": expected 1..65536");
   }
   return size_t{blocks_along(width)} * blocks_along(height) * block_bytes(f);
 }
 
 void decode_block(Format f, const uint8_t* block, void* out) {
   switch (f) {
-    case Format::kBc1: decode_bc1_block(block, static_cast<uint8_t*>(out)); return;
-    case Format::kBc4: decode_bc4_block(block, static_cast<uint8_t*>(out)); return;
-    case Format::kBc5: decode_bc5_block(block, static_cast<uint8_t*>(out)); return;
-    case Format::kBc4Signed: decode_bc4s_block(block, static_cast<int8_t*>(out)); return;
-    case Format::kBc5Signed: decode_bc5s_block(block, static_cast<int8_t*>(out)); return;
+    case Format::kBc1:
+      decode_bc1_block(block, static_cast<uint8_t*>(out));
+      return;
+    case Format::kBc4:
+      decode_bc4_block(block, static_cast<uint8_t*>(out));
+      return;
+    case Format::kBc5:
+      decode_bc5_block(block, static_cast<uint8_t*>(out));
+      return;
+    case Format::kBc4Signed:
+      decode_bc4s_block(block, static_cast<int8_t*>(out));
+      return;
+    case Format::kBc5Signed:
+      decode_bc5s_block(block, static_cast<int8_t*>(out));
+      return;
     case Format::kBc6hUnsigned:
       decode_bc6h_block(block, false, static_cast<uint16_t*>(out));
       return;
-    case Format::kBc6hSigned: decode_bc6h_block(block, true, static_cast<uint16_t*>(out)); return;
-    case Format::kBc7: decode_bc7_block(block, static_cast<uint8_t*>(out)); return;
+    case Format::kBc6hSigned:
+      decode_bc6h_block(block, true, static_cast<uint16_t*>(out));
+      return;
+    case Format::kBc7:
+      decode_bc7_block(block, static_cast<uint8_t*>(out));
+      return;
   }
   // An enum value outside the list: the caller's bug; decode as zeros rather than leave garbage.
   std::memset(out, 0, 16 * size_t{4});
@@ -116,9 +138,9 @@ uint16_t float_to_half(float f) {
   if (abs < 0x38800000u) {
     // Result is subnormal (or zero): round abs * 2^24 to the nearest integer, ties to even.
     if (abs < 0x33000000u) return sign;  // below half the smallest subnormal: +-0
-    const uint32_t e = abs >> 23;         // 102..112
+    const uint32_t e = abs >> 23;        // 102..112
     const uint32_t m = (abs & 0x7fffffu) | 0x800000u;
-    const uint32_t shift = 126 - e;       // value = m * 2^(e-150); want m * 2^(e-150+24)
+    const uint32_t shift = 126 - e;  // value = m * 2^(e-150); want m * 2^(e-150+24)
     uint32_t r = m >> shift;
     const uint32_t rem = m & ((1u << shift) - 1);
     const uint32_t half = 1u << (shift - 1);

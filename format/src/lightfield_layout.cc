@@ -9,13 +9,17 @@ namespace {
 
 using container::PixelFormat;
 
-Status corrupt(const std::string& what) { return Status(ErrorId::kLightfieldChunk, what); }
+Status corrupt(const std::string& what) {
+  return Status(ErrorId::kLightfieldChunk, what);
+}
 
 uint64_t blocks_of(uint32_t w, uint32_t h) {
   return uint64_t{bc::blocks_along(w)} * bc::blocks_along(h);
 }
 
-bool is(uint16_t format, PixelFormat f) { return format == static_cast<uint16_t>(f); }
+bool is(uint16_t format, PixelFormat f) {
+  return format == static_cast<uint16_t>(f);
+}
 
 }  // namespace
 
@@ -55,7 +59,9 @@ uint8_t material_weight_code(float weight) {
   return static_cast<uint8_t>(std::lround(w * 255.0f));
 }
 
-uint8_t material_ior_code(float ior) { return material_weight_code((ior - 1.0f) / 2.0f); }
+uint8_t material_ior_code(float ior) {
+  return material_weight_code((ior - 1.0f) / 2.0f);
+}
 
 // ---- View index ----
 
@@ -69,7 +75,9 @@ container::FieldReader chunk_reader(std::span<const uint8_t> raw, const std::str
 }
 
 // The rule the field rules cannot state: a depth range 0 < z_near < z_far.
-bool depth_range_ok(float z_near, float z_far) { return z_near > 0.0f && z_far > z_near; }
+bool depth_range_ok(float z_near, float z_far) {
+  return z_near > 0.0f && z_far > z_near;
+}
 
 std::string depth_range_text(float z_near, float z_far) {
   return "depth range [" + container::float_text(z_near) + ", " + container::float_text(z_far) +
@@ -176,10 +184,14 @@ bool region_coding_is_block(RegionCoding coding) {
 
 container::PixelFormat region_gpu_format(RegionCoding coding) {
   switch (coding) {
-    case RegionCoding::kR16: return PixelFormat::kR16;
-    case RegionCoding::kBc5: return PixelFormat::kBc5;
-    case RegionCoding::kRgb8: return PixelFormat::kRgba8;
-    case RegionCoding::kBc1: return PixelFormat::kBc1;
+    case RegionCoding::kR16:
+      return PixelFormat::kR16;
+    case RegionCoding::kBc5:
+      return PixelFormat::kBc5;
+    case RegionCoding::kRgb8:
+      return PixelFormat::kRgba8;
+    case RegionCoding::kBc1:
+      return PixelFormat::kBc1;
   }
   return PixelFormat::kNone;
 }
@@ -187,10 +199,14 @@ container::PixelFormat region_gpu_format(RegionCoding coding) {
 namespace {
 size_t unit_bytes(RegionCoding coding) {
   switch (coding) {
-    case RegionCoding::kR16: return 2;
-    case RegionCoding::kBc5: return 16;
-    case RegionCoding::kRgb8: return 3;
-    case RegionCoding::kBc1: return 8;
+    case RegionCoding::kR16:
+      return 2;
+    case RegionCoding::kBc5:
+      return 16;
+    case RegionCoding::kRgb8:
+      return 3;
+    case RegionCoding::kBc1:
+      return 8;
   }
   return 0;
 }

@@ -186,8 +186,9 @@ int main(int argc, char** argv) {
   if (!reader.ok()) {
     // Errors opening the file already name it; later ones (header, directory) get it added.
     const calf::Status& s = reader.status();
-    fmt::print(stderr, "calf-info: {}\n",
-               (s.message().find(path) == std::string::npos ? s.with_context(path) : s).to_string());
+    fmt::print(
+        stderr, "calf-info: {}\n",
+        (s.message().find(path) == std::string::npos ? s.with_context(path) : s).to_string());
     return 1;
   }
   if (json)

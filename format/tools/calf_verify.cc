@@ -28,8 +28,9 @@ int main(int argc, char** argv) {
     if (!reader.ok()) {
       // Errors opening the file already name it; later ones (header, directory) get it added.
       const calf::Status& s = reader.status();
-      fmt::print("{}\n",
-                 (s.message().find(path) == std::string::npos ? s.with_context(path) : s).to_string());
+      fmt::print(
+          "{}\n",
+          (s.message().find(path) == std::string::npos ? s.with_context(path) : s).to_string());
       rc = 1;
       continue;
     }

@@ -36,7 +36,8 @@ Expected<RenderOptions> march_range_for(std::span<const MarchView> views, const 
 Expected<RenderOptions> march_range_for(const ViewSet& views, const Vec3& eye,
                                         RenderOptions options) {
   std::vector<MarchView> m;
-  for (const View& v : views.views) m.push_back({v.position(), v.range().z_near(), v.range().z_far()});
+  for (const View& v : views.views)
+    m.push_back({v.position(), v.range().z_near(), v.range().z_far()});
   return march_range_for(m, eye, std::move(options));
 }
 

@@ -69,7 +69,8 @@ Expected<GLuint> compile(const GlFunctions& gl, GLenum type, const std::string& 
 Expected<RenderOptions> march_range_for(const GlTextureLayout& layout, const Vec3& eye,
                                         RenderOptions options) {
   std::vector<MarchView> m;
-  for (const GlViewInfo& v : layout.views) m.push_back({v.position, v.range.z_near(), v.range.z_far()});
+  for (const GlViewInfo& v : layout.views)
+    m.push_back({v.position, v.range.z_near(), v.range.z_far()});
   return calf::player::march_range_for(m, eye, std::move(options));
 }
 

@@ -17,7 +17,7 @@ namespace {
 
 // Writes 8-bit RGB pixels (row-major from the top row) as a PNG to `path` via `path`.tmp.
 Status write_rgb8_png_file(const std::filesystem::path& path, uint32_t width, uint32_t height,
-                          const std::vector<uint8_t>& pixels) {
+                           const std::vector<uint8_t>& pixels) {
   const std::string final_name = path.string();
   const std::string temp_name = final_name + ".tmp";
   std::error_code ignored;

@@ -93,30 +93,38 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
     if (Status s = play.prepare(frame, eyes); !s.ok()) return fail(s);
     const auto& st = lf.last_stats();
     if (st.errors > 0) {
-      std::fprintf(stderr, "calf-play: warning: frame %u: %u damaged chunk(s), last good state "
-                   "kept: %s\n", frame, st.errors, st.first_error.c_str());
+      std::fprintf(stderr,
+                   "calf-play: warning: frame %u: %u damaged chunk(s), last good state "
+                   "kept: %s\n",
+                   frame, st.errors, st.first_error.c_str());
     }
     for (size_t k = i; k < j; ++k) {
       const Camera& cam = eyes[k - i];
       if (!play.inside_view_volume(cam.position) && outside++ == 0) {
-        std::fprintf(stderr, "calf-play: warning: pose %zu is outside the clip's view volume; "
-                     "expect holes and stretched parallax\n", k);
+        std::fprintf(stderr,
+                     "calf-play: warning: pose %zu is outside the clip's view volume; "
+                     "expect holes and stretched parallax\n",
+                     k);
       }
       if (Status s = play.render(cam, &image); !s.ok()) return fail(s);
       char name[32];
       std::snprintf(name, sizeof name, "frame_%05zu", k);
       if (!a.out.empty()) {
         if (a.format == "png" || a.format == "both") {
-          if (Status s = write_png(fs::path(a.out) / (std::string(name) + ".png"), rgb_ref(image)); !s.ok()) return fail(s);
+          if (Status s = write_png(fs::path(a.out) / (std::string(name) + ".png"), rgb_ref(image));
+              !s.ok())
+            return fail(s);
         }
         if (a.format == "exr" || a.format == "both") {
-          if (Status s = write_exr(fs::path(a.out) / (std::string(name) + ".exr"), image); !s.ok()) return fail(s);
+          if (Status s = write_exr(fs::path(a.out) / (std::string(name) + ".exr"), image); !s.ok())
+            return fail(s);
         }
       }
-      std::printf("pose %zu frame %u: %zu views, %u/%u cells, %.2f Mbps@24, decode %.2f ms, "
-                  "render %.1f ms", k, frame, lf.last_selection().active.size(),
-                  st.visible_cells, st.total_cells, st.mbps_at_24fps(), st.decode_ms,
-                  play.last_render_ms());
+      std::printf(
+          "pose %zu frame %u: %zu views, %u/%u cells, %.2f Mbps@24, decode %.2f ms, "
+          "render %.1f ms",
+          k, frame, lf.last_selection().active.size(), st.visible_cells, st.total_cells,
+          st.mbps_at_24fps(), st.decode_ms, play.last_render_ms());
       sum_decode += st.decode_ms;
       sum_mbps += st.mbps_at_24fps();
       decode_ms.push_back(st.decode_ms);
@@ -136,7 +144,8 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
         if (*s < min_ssim) min_ssim = *s, min_ssim_pose = k;
         if (!a.out.empty() && a.heat_maps) {
           const fs::path heat = fs::path(a.out) / (std::string("heat_") + (name + 6) + ".png");
-          if (Status hs = write_heat_map_png(heat, rgb_ref(image), rgb_ref(*gt)); !hs.ok()) return fail(hs);
+          if (Status hs = write_heat_map_png(heat, rgb_ref(image), rgb_ref(*gt)); !hs.ok())
+            return fail(hs);
         }
         if (std::binary_search(sheet_poses.begin(), sheet_poses.end(), k)) {
           sheet.push_back({image, std::move(*gt)});
@@ -151,10 +160,11 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
   const double first_render = render_ms.empty() ? 0 : render_ms.front();
   const double later_render =
       render_ms.size() > 1 ? median({render_ms.begin() + 1, render_ms.end()}) : first_render;
-  std::printf("%zu poses: mean decode %.2f ms (median %.2f), render first %.1f ms then median "
-              "%.1f ms, mean %.2f Mbps@24\n",
-              path.poses.size(), sum_decode / n, median(decode_ms), first_render, later_render,
-              sum_mbps / n);
+  std::printf(
+      "%zu poses: mean decode %.2f ms (median %.2f), render first %.1f ms then median "
+      "%.1f ms, mean %.2f Mbps@24\n",
+      path.poses.size(), sum_decode / n, median(decode_ms), first_render, later_render,
+      sum_mbps / n);
   if (compared > 0) {
     std::printf("mean PSNR %.2f dB, mean SSIM %.4f\n", sum_psnr / compared, sum_ssim / compared);
     std::printf("worst pose: PSNR %.2f dB (pose %zu), SSIM %.4f (pose %zu)\n", min_psnr,
@@ -166,8 +176,10 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
     auto composed = compose_contact_sheet(rows);
     if (!composed.ok()) return fail(composed.status());
     if (Status s = write_png_rgb8(a.contact_sheet, *composed); !s.ok()) return fail(s);
-    std::printf("contact sheet: %s (%zu poses; ground truth | calf | error heat map, red = "
-                "error 0.1 of full scale or more)\n", a.contact_sheet.c_str(), rows.size());
+    std::printf(
+        "contact sheet: %s (%zu poses; ground truth | calf | error heat map, red = "
+        "error 0.1 of full scale or more)\n",
+        a.contact_sheet.c_str(), rows.size());
   }
   return 0;
 }
@@ -191,29 +203,38 @@ int main(int argc, char** argv) {
   LightfieldOptions& o = play_options.lightfield;  // the knobs below are the light field's
   WindowOptions w;
   app.add_option("CLIP", clip, "the .calf file (its first lightfield track is played)")->required();
-  app.add_flag("--headless", headless, "render --eye-path (or the --compare directory's path) "
+  app.add_flag("--headless", headless,
+               "render --eye-path (or the --compare directory's path) "
                "without a window, through OSMesa");
-  app.add_option("--eye-path", h.eye_path, "eye-path JSON (format/CAPTURE.md) to render; default "
+  app.add_option("--eye-path", h.eye_path,
+                 "eye-path JSON (format/CAPTURE.md) to render; default "
                  "with --compare: GT_DIR/eye_path.json");
-  app.add_option("--out", h.out, "directory for rendered frames (frame_NNNNN.png / .exr) and error "
+  app.add_option("--out", h.out,
+                 "directory for rendered frames (frame_NNNNN.png / .exr) and error "
                  "heat maps (heat_NNNNN.png)");
-  app.add_option("--format", h.format, "frame files: png (8-bit sRGB), exr (half RGB + float Z, "
+  app.add_option("--format", h.format,
+                 "frame files: png (8-bit sRGB), exr (half RGB + float Z, "
                  "the ground-truth layout) or both (default png)")
       ->check(CLI::IsMember({"png", "exr", "both"}));
-  app.add_option("--compare", h.compare, "ground-truth directory written by calf-capture "
+  app.add_option("--compare", h.compare,
+                 "ground-truth directory written by calf-capture "
                  "--ground-truth: per-pose PSNR / SSIM and heat maps");
   app.add_flag("!--no-heat-maps", h.heat_maps, "with --compare and --out: do not write heat maps");
-  app.add_option("--contact-sheet", h.contact_sheet, "with --compare: write a PNG with one row per "
+  app.add_option("--contact-sheet", h.contact_sheet,
+                 "with --compare: write a PNG with one row per "
                  "pose: ground truth | calf | error heat map");
-  app.add_option("--sheet-rows", h.sheet_rows, "poses on the contact sheet, spread evenly along "
+  app.add_option("--sheet-rows", h.sheet_rows,
+                 "poses on the contact sheet, spread evenly along "
                  "the path, first and last included (default 8)")
       ->check(CLI::Range(1, 256));
-  app.add_option("--renderer", renderer, "gl (OpenGL 4.5 ray-march, the product) or cpu (the scalar "
+  app.add_option("--renderer", renderer,
+                 "gl (OpenGL 4.5 ray-march, the product) or cpu (the scalar "
                  "reference; headless only) (default gl)")
       ->check(CLI::IsMember({"gl", "cpu"}));
   app.add_option("--steps", o.render.steps, "ray-march steps in log depth (default 64)")
       ->check(CLI::Range(1, 65536));
-  app.add_flag("--rr", o.render.rr, "reflection / refraction rays from the material stream "
+  app.add_flag("--rr", o.render.rr,
+               "reflection / refraction rays from the material stream "
                "(Alg. 4 _RR); ignored with a notice when the clip has no material");
   app.add_flag("!--no-rr-replace", o.render.rr_replace_view_reflection,
                "with --rr: Alg. 4 as written, c = w c_rfl + ... + (1 - w) c_blend, instead of the "
@@ -230,16 +251,19 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 65536));
   app.add_option("--priority", priority, "view priority: distance or angle (default distance)")
       ->check(CLI::IsMember({"distance", "angle"}));
-  app.add_option("--frame-ms", o.selection.target_frame_ms, "frame-time target of performance "
+  app.add_option("--frame-ms", o.selection.target_frame_ms,
+                 "frame-time target of performance "
                  "culling in ms, 0 = off (default 11.1; headless default 0: quality first)");
-  app.add_flag("--no-view-dependent", [&](int64_t) { o.decoder.view_dependent = false; },
-               "decode every cell of the active views, not only the visible ones");
+  app.add_flag(
+      "--no-view-dependent", [&](int64_t) { o.decoder.view_dependent = false; },
+      "decode every cell of the active views, not only the visible ones");
   app.add_option("--width", w.width, "window width (default 1280)");
   app.add_option("--height", w.height, "window height (default 720)");
   app.add_option("--fov", w.fov_y_degrees, "window: vertical field of view in degrees (default 75)")
       ->check(CLI::Range(10.0, 170.0));
   app.add_flag("--stereo", w.stereo, "window: side-by-side stereo (toggle with Shift+S)");
-  app.add_option("--ipd", w.ipd, "window: distance between the eyes in scene units (default 0.064)");
+  app.add_option("--ipd", w.ipd,
+                 "window: distance between the eyes in scene units (default 0.064)");
   app.add_option("--frames", w.max_frames, "window: quit after this many frames (0 = never)");
   CLI11_PARSE(app, argc, argv);
 

@@ -8,10 +8,10 @@
 #include <memory>
 #include <system_error>
 
-#include <assimp/Importer.hpp>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <assimp/Importer.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
@@ -71,8 +71,9 @@ struct Hierarchy {
     if (!n.positions.empty()) pos = sample(n.positions, t, lerp);
     if (!n.scalings.empty()) scl = sample(n.scalings, t, lerp);
     if (!n.rotations.empty()) {
-      rot = sample(n.rotations, t,
-                   [](const glm::quat& a, const glm::quat& b, float f) { return glm::slerp(a, b, f); });
+      rot = sample(n.rotations, t, [](const glm::quat& a, const glm::quat& b, float f) {
+        return glm::slerp(a, b, f);
+      });
     }
     return glm::translate(glm::mat4(1), pos) * glm::mat4_cast(glm::normalize(rot)) *
            glm::scale(glm::mat4(1), scl);
@@ -137,8 +138,8 @@ Expected<Scene> load_scene_file(const std::filesystem::path& path) {
   }
   const aiScene* ai = nullptr;
   try {
-    ai = importer.ReadFile(file, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                     aiProcess_SortByPType);
+    ai = importer.ReadFile(
+        file, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
   } catch (const std::exception& e) {
     return Status(ErrorId::kSceneLoad, file + ": " + e.what());
   }
@@ -205,7 +206,9 @@ Expected<Scene> load_scene_file(const std::filesystem::path& path) {
       }
       if (o.mesh.triangles.empty()) continue;
       int node_index = index;
-      o.transform = [hierarchy, node_index](double t) { return hierarchy->global_at(node_index, t); };
+      o.transform = [hierarchy, node_index](double t) {
+        return hierarchy->global_at(node_index, t);
+      };
       scene.objects.push_back(std::move(o));
     }
   }
@@ -242,8 +245,8 @@ Expected<Scene> load_scene_file(const std::filesystem::path& path) {
     p.width = w, p.height = h;
     for (uint32_t f = 0; f < frames; ++f) {
       double a = M_PI / 8 + M_PI / 4 * f / std::max(1u, frames);
-      glm::dvec3 eye = center + glm::dvec3(1.6 * radius * std::cos(a), 0.3 * radius,
-                                           1.6 * radius * std::sin(a));
+      glm::dvec3 eye =
+          center + glm::dvec3(1.6 * radius * std::cos(a), 0.3 * radius, 1.6 * radius * std::sin(a));
       p.poses.push_back(look_at_pose(f / fps, eye, center, 50));
     }
     return p;

@@ -65,7 +65,9 @@ void add_checker(TriangleMesh* light, TriangleMesh* dark, float x0, float x1, fl
   }
 }
 
-glm::mat4 translate(float x, float y, float z) { return glm::translate(glm::mat4(1), {x, y, z}); }
+glm::mat4 translate(float x, float y, float z) {
+  return glm::translate(glm::mat4(1), {x, y, z});
+}
 
 // ---- turntable (Spaceship) ---------------------------------------------------------------------
 
@@ -153,15 +155,27 @@ Scene interior() {
   s.description =
       "a colonnaded hall: bouncing balls and a rotating arm in one corner, a pulsing lamp, "
       "thin hanging chains and a potted plant with thin leaves (Sponza / Robot)";
-  enum : uint32_t { kWall, kFloorA, kFloorB, kStone, kIron, kLeaf, kPot, kWood, kRed, kYellow,
-                    kBlue, kGlow, kRobot };
-  s.materials = {diffuse(0.75f, 0.7f, 0.6f),  diffuse(0.8f, 0.78f, 0.72f),
-                 diffuse(0.3f, 0.28f, 0.25f), diffuse(0.65f, 0.6f, 0.5f),
-                 diffuse(0.15f, 0.15f, 0.17f), diffuse(0.15f, 0.5f, 0.12f),
-                 diffuse(0.55f, 0.3f, 0.2f),  diffuse(0.5f, 0.35f, 0.2f),
-                 diffuse(0.8f, 0.1f, 0.1f),   diffuse(0.85f, 0.75f, 0.1f),
-                 diffuse(0.1f, 0.25f, 0.8f),  emissive(6.0f, 3.0f, 1.0f),
-                 diffuse(0.7f, 0.7f, 0.75f)};
+  enum : uint32_t {
+    kWall,
+    kFloorA,
+    kFloorB,
+    kStone,
+    kIron,
+    kLeaf,
+    kPot,
+    kWood,
+    kRed,
+    kYellow,
+    kBlue,
+    kGlow,
+    kRobot
+  };
+  s.materials = {
+      diffuse(0.75f, 0.7f, 0.6f),  diffuse(0.8f, 0.78f, 0.72f),  diffuse(0.3f, 0.28f, 0.25f),
+      diffuse(0.65f, 0.6f, 0.5f),  diffuse(0.15f, 0.15f, 0.17f), diffuse(0.15f, 0.5f, 0.12f),
+      diffuse(0.55f, 0.3f, 0.2f),  diffuse(0.5f, 0.35f, 0.2f),   diffuse(0.8f, 0.1f, 0.1f),
+      diffuse(0.85f, 0.75f, 0.1f), diffuse(0.1f, 0.25f, 0.8f),   emissive(6.0f, 3.0f, 1.0f),
+      diffuse(0.7f, 0.7f, 0.75f)};
   TriangleMesh walls, floor_a, floor_b, stone, iron, leaves, pot, wood, glow;
   // The room's own floor sits 1 cm below the visible checkerboard.
   add_room(&walls, {-5, -0.01f, -4}, {5, 4, 4});
@@ -193,7 +207,8 @@ Scene interior() {
   // Table with thin legs.
   add_box(&wood, {-4.2f, 0.75f, 2.2f}, {-2.8f, 0.8f, 3.4f});
   for (float x : {-4.15f, -2.85f}) {
-    for (float z : {2.25f, 3.35f}) add_box(&wood, {x - 0.025f, -0.02f, z - 0.025f}, {x + 0.025f, 0.76f, z + 0.025f});
+    for (float z : {2.25f, 3.35f})
+      add_box(&wood, {x - 0.025f, -0.02f, z - 0.025f}, {x + 0.025f, 0.76f, z + 0.025f});
   }
   s.objects.push_back(object("walls", kWall, std::move(walls)));
   s.objects.push_back(object("floor-light", kFloorA, std::move(floor_a)));
@@ -261,19 +276,34 @@ Scene mirror_box() {
   s.description =
       "a coloured box with an orbiting mirror sphere, a sliding glass sphere and a spinning cube; "
       "writes material channels (ReflectionRefractionBox)";
-  enum : uint32_t { kWhite, kRed, kGreen, kFloorA, kFloorB, kMirror, kGlass, kPanel, kBlue,
-                    kYellow };
+  enum : uint32_t {
+    kWhite,
+    kRed,
+    kGreen,
+    kFloorA,
+    kFloorB,
+    kMirror,
+    kGlass,
+    kPanel,
+    kBlue,
+    kYellow
+  };
   Material mirror = diffuse(0.9f, 0.9f, 0.9f);
   mirror.reflect = 0.9f;
   Material glass = diffuse(1, 1, 1);
   glass.refract = 0.92f;
   glass.reflect = 0.08f;
   glass.ior = 1.5f;
-  s.materials = {diffuse(0.75f, 0.75f, 0.75f), diffuse(0.7f, 0.12f, 0.1f),
-                 diffuse(0.12f, 0.6f, 0.15f),  diffuse(0.8f, 0.8f, 0.8f),
-                 diffuse(0.25f, 0.25f, 0.25f), mirror,
-                 glass,                        emissive(12, 11, 10),
-                 diffuse(0.15f, 0.3f, 0.75f),  diffuse(0.8f, 0.7f, 0.2f)};
+  s.materials = {diffuse(0.75f, 0.75f, 0.75f),
+                 diffuse(0.7f, 0.12f, 0.1f),
+                 diffuse(0.12f, 0.6f, 0.15f),
+                 diffuse(0.8f, 0.8f, 0.8f),
+                 diffuse(0.25f, 0.25f, 0.25f),
+                 mirror,
+                 glass,
+                 emissive(12, 11, 10),
+                 diffuse(0.15f, 0.3f, 0.75f),
+                 diffuse(0.8f, 0.7f, 0.2f)};
   TriangleMesh white, red, green, floor_a, floor_b, panel, pillar;
   add_checker(&floor_a, &floor_b, -2, 2, -2, 2, 8, 8);
   add_quad(&white, {-2, 3, -2}, {2, 3, -2}, {2, 3, 2}, {-2, 3, 2});    // ceiling, facing down
@@ -302,7 +332,8 @@ Scene mirror_box() {
   TriangleMesh cube;
   add_box(&cube, {-0.2f, 0.0f, -0.2f}, {0.2f, 0.4f, 0.2f});
   s.objects.push_back(object("cube", kBlue, std::move(cube), [](double t) {
-    return glm::rotate(translate(1.1f, 0, 1.0f), static_cast<float>(kTau / 4 * t), glm::vec3(0, 1, 0));
+    return glm::rotate(translate(1.1f, 0, 1.0f), static_cast<float>(kTau / 4 * t),
+                       glm::vec3(0, 1, 0));
   }));
   s.lights.push_back(constant_light({0, 2.85f, 0}, {8, 7.6f, 7}));
   s.ambient = {0.12f, 0.12f, 0.12f};
@@ -327,7 +358,8 @@ Scene mirror_box() {
 const std::vector<SceneInfo>& builtin_scenes() {
   static const std::vector<SceneInfo> list = {
       {"turntable", "a spaceship on a turntable with crevices and thin parts (paper: Spaceship)"},
-      {"interior", "a hall with animation in one corner, thin geometry, changing light (Sponza/Robot)"},
+      {"interior",
+       "a hall with animation in one corner, thin geometry, changing light (Sponza/Robot)"},
       {"mirror-box", "a box with a moving mirror sphere and glass sphere, material output"},
   };
   return list;

@@ -139,7 +139,8 @@ Expected<RenderStats> render_ground_truth(const Scene& scene, const capture::Eye
   for (uint32_t i = 0; i < path.poses.size(); ++i) {
     auto tracer = FrameTracer::create(scene, path.poses[i].time, options);
     if (!tracer.ok()) return fail(tracer.status());
-    RenderStats s = (*tracer)->render_perspective(path.poses[i], path.width, path.height, i, &image);
+    RenderStats s =
+        (*tracer)->render_perspective(path.poses[i], path.width, path.height, i, &image);
     stats.rays += s.rays;
     std::filesystem::path file = directory / capture::eye_image_file_name(path, i);
     if (Status st = capture::write_perspective_image(file, image); !st.ok()) return fail(st);

@@ -52,7 +52,9 @@ bool parse_numbers(std::string_view text, std::vector<double>* out) {
   return true;
 }
 
-bool is_count(double v, double max) { return v >= 1 && v <= max && v == std::floor(v); }
+bool is_count(double v, double max) {
+  return v >= 1 && v <= max && v == std::floor(v);
+}
 
 Status rig_error(std::string_view text, const std::string& why) {
   return Status(ErrorId::kRigSyntax, "--rig '" + std::string(text) + "': " + why +
@@ -97,8 +99,8 @@ Rig ring_rig(uint32_t n, double r, const glm::dvec3& c) {
         {"ring" + std::to_string(i), to_vec3(c + glm::dvec3(r * std::cos(a), 0, r * std::sin(a)))});
   }
   rig.view_volume = {to_vec3(c - glm::dvec3(r, r / 4, r)), to_vec3(c + glm::dvec3(r, r / 4, r))};
-  rig.description = "ring:" + std::to_string(n) + "," + num(r) + "," + num(c.x) + "," + num(c.y) +
-                    "," + num(c.z);
+  rig.description =
+      "ring:" + std::to_string(n) + "," + num(r) + "," + num(c.x) + "," + num(c.y) + "," + num(c.z);
   return rig;
 }
 
@@ -114,8 +116,8 @@ Rig sphere_rig(uint32_t n, double r, const glm::dvec3& c) {
     rig.viewpoints.push_back({"sphere" + std::to_string(i), to_vec3(c + r * d)});
   }
   rig.view_volume = {to_vec3(c - glm::dvec3(r)), to_vec3(c + glm::dvec3(r))};
-  rig.description = "sphere:" + std::to_string(n) + "," + num(r) + "," + num(c.x) + "," +
-                    num(c.y) + "," + num(c.z);
+  rig.description = "sphere:" + std::to_string(n) + "," + num(r) + "," + num(c.x) + "," + num(c.y) +
+                    "," + num(c.z);
   return rig;
 }
 

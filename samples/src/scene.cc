@@ -48,21 +48,21 @@ Status validate_scene(const Scene& scene) {
     }
     for (const glm::vec3& p : o.mesh.positions) {
       if (!finite(p)) {
-        return Status(ErrorId::kSceneGeometry, where + ": object '" + o.name +
-                                                   "' has a non-finite vertex");
+        return Status(ErrorId::kSceneGeometry,
+                      where + ": object '" + o.name + "' has a non-finite vertex");
       }
     }
     for (const glm::uvec3& t : o.mesh.triangles) {
       if (t.x >= o.mesh.positions.size() || t.y >= o.mesh.positions.size() ||
           t.z >= o.mesh.positions.size()) {
-        return Status(ErrorId::kSceneGeometry, where + ": object '" + o.name +
-                                                   "' has a triangle index out of range");
+        return Status(ErrorId::kSceneGeometry,
+                      where + ": object '" + o.name + "' has a triangle index out of range");
       }
     }
     for (const Sphere& s : o.spheres) {
       if (!finite(s.center) || !(s.radius > 0) || !std::isfinite(s.radius)) {
-        return Status(ErrorId::kSceneGeometry, where + ": object '" + o.name +
-                                                   "' has a sphere with a bad centre or radius");
+        return Status(ErrorId::kSceneGeometry,
+                      where + ": object '" + o.name + "' has a sphere with a bad centre or radius");
       }
     }
     primitives += o.mesh.triangles.size() + o.spheres.size();
@@ -96,7 +96,8 @@ Expected<Scene> load_scene(std::string_view name_or_path) {
   return Status(ErrorId::kSceneUnknown, message);
 }
 
-// ---- geometry helpers ----------------------------------------------------------------------------
+// ---- geometry helpers
+// ----------------------------------------------------------------------------
 
 void add_quad(TriangleMesh* mesh, const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2,
               const glm::vec3& p3) {
@@ -139,7 +140,9 @@ glm::mat4 box_matrix(const glm::vec3& lo, const glm::vec3& hi) {
 
 }  // namespace
 
-void add_box(TriangleMesh* mesh, const glm::mat4& m) { add_unit_box(mesh, m, false); }
+void add_box(TriangleMesh* mesh, const glm::mat4& m) {
+  add_unit_box(mesh, m, false);
+}
 
 void add_box(TriangleMesh* mesh, const glm::vec3& lo, const glm::vec3& hi) {
   add_unit_box(mesh, box_matrix(lo, hi), false);

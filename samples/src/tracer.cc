@@ -58,7 +58,7 @@ struct Geometry {
   bool spheres = false;
   std::vector<glm::vec3> positions;  // world space at the frame's time
   std::vector<glm::uvec3> triangles;
-  std::vector<glm::vec4> balls;      // world centre + radius
+  std::vector<glm::vec4> balls;  // world centre + radius
 };
 
 struct LightAt {
@@ -135,7 +135,8 @@ struct FrameTracer::Impl {
     const Geometry& g = geometries[h.geom];
     if (g.spheres) return glm::normalize(p - glm::vec3(g.balls[h.prim]));
     const glm::uvec3& t = g.triangles[h.prim];
-    glm::vec3 n = glm::cross(g.positions[t.y] - g.positions[t.x], g.positions[t.z] - g.positions[t.x]);
+    glm::vec3 n =
+        glm::cross(g.positions[t.y] - g.positions[t.x], g.positions[t.z] - g.positions[t.x]);
     float len = glm::length(n);
     return len > 0 ? n / len : glm::vec3(0, 1, 0);
   }
@@ -184,7 +185,8 @@ struct FrameTracer::Impl {
       uint32_t open = 0;
       for (uint32_t s = 0; s < options.ao_samples; ++s) {
         // Cosine-distributed direction, stratified in the first dimension.
-        float u1 = (static_cast<float>(s) + rng->uniform()) / static_cast<float>(options.ao_samples);
+        float u1 =
+            (static_cast<float>(s) + rng->uniform()) / static_cast<float>(options.ao_samples);
         float u2 = rng->uniform();
         float r = std::sqrt(u1), phi = 2 * kPi * u2;
         glm::vec3 d = t * (r * std::cos(phi)) + b * (r * std::sin(phi)) +
@@ -197,8 +199,8 @@ struct FrameTracer::Impl {
   }
 
   // Radiance along a ray; `primary` receives the first hit (t = +inf on a miss).
-  glm::vec3 trace(const glm::vec3& o, const glm::vec3& d, uint32_t bounce, Rng* rng,
-                  uint64_t* rays, Hit* primary, bool* hit_any) const {
+  glm::vec3 trace(const glm::vec3& o, const glm::vec3& d, uint32_t bounce, Rng* rng, uint64_t* rays,
+                  Hit* primary, bool* hit_any) const {
     Hit h;
     if (!intersect(o, d, 0, INFINITY, &h, rays)) {
       if (hit_any) *hit_any = false;
@@ -221,7 +223,8 @@ struct FrameTracer::Impl {
       } else {
         glm::vec3 reflected = d - 2 * glm::dot(d, n) * n;
         if (m.reflect > 0) {
-          color += m.reflect * trace(p + n * eps, reflected, bounce + 1, rng, rays, nullptr, nullptr);
+          color +=
+              m.reflect * trace(p + n * eps, reflected, bounce + 1, rng, rays, nullptr, nullptr);
         }
         if (m.refract > 0) {
           float eta = front ? 1 / m.ior : m.ior;
@@ -249,7 +252,8 @@ struct FrameTracer::Impl {
       Rng n(noise_key);
       c *= 1 + options.noise * (2 * n.uniform() - 1);
     }
-    for (int i = 0; i < 3; ++i) rgb[i] = std::clamp(std::isfinite(c[i]) ? c[i] : 0.0f, 0.0f, kMaxRadiance);
+    for (int i = 0; i < 3; ++i)
+      rgb[i] = std::clamp(std::isfinite(c[i]) ? c[i] : 0.0f, 0.0f, kMaxRadiance);
     *depth = hit ? h.t : INFINITY;
     if (material) {
       const Material* m = hit ? &materials[geometries[h.geom].material] : nullptr;
@@ -339,33 +343,34 @@ Expected<std::unique_ptr<FrameTracer>> FrameTracer::create(const Scene& scene, d
       }
       for (const glm::vec3& p : g.positions) {
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-          return Status(ErrorId::kSceneGeometry, "object '" + o.name + "' is not finite at time " +
-                                                     std::to_string(time));
+          return Status(ErrorId::kSceneGeometry,
+                        "object '" + o.name + "' is not finite at time " + std::to_string(time));
         }
       }
       for (const glm::vec4& b : g.balls) {
         if (!std::isfinite(b.x) || !std::isfinite(b.y) || !std::isfinite(b.z) || !(b.w > 0) ||
             !std::isfinite(b.w)) {
-          return Status(ErrorId::kSceneGeometry, "object '" + o.name +
-                                                     "' has a degenerate sphere at time " +
-                                                     std::to_string(time));
+          return Status(
+              ErrorId::kSceneGeometry,
+              "object '" + o.name + "' has a degenerate sphere at time " + std::to_string(time));
         }
       }
       RTCGeometry geom;
       if (!g.spheres) {
         geom = rtcNewGeometry(impl->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
-            geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-            g.positions.size()));
-        auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
-            geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t),
-            g.triangles.size()));
+        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                              RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                              g.positions.size()));
+        auto* idx = static_cast<uint32_t*>(
+            rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                    3 * sizeof(uint32_t), g.triangles.size()));
         if (!v || !idx) {
           rtcReleaseGeometry(geom);
           return Status(ErrorId::kRayTracer, "Embree: cannot allocate buffers");
         }
         for (size_t i = 0; i < g.positions.size(); ++i) {
-          v[3 * i] = g.positions[i].x, v[3 * i + 1] = g.positions[i].y, v[3 * i + 2] = g.positions[i].z;
+          v[3 * i] = g.positions[i].x, v[3 * i + 1] = g.positions[i].y,
+                v[3 * i + 2] = g.positions[i].z;
         }
         for (size_t i = 0; i < g.triangles.size(); ++i) {
           idx[3 * i] = g.triangles[i].x, idx[3 * i + 1] = g.triangles[i].y,
@@ -393,7 +398,8 @@ Expected<std::unique_ptr<FrameTracer>> FrameTracer::create(const Scene& scene, d
                                              : static_cast<int>(options.threads));
   arena.execute([&] { rtcCommitScene(impl->rtc); });
   if (RTCError e = rtcGetDeviceError(impl->device); e != RTC_ERROR_NONE) {
-    return Status(ErrorId::kRayTracer, "Embree: scene build failed with error " + std::to_string(e));
+    return Status(ErrorId::kRayTracer,
+                  "Embree: scene build failed with error " + std::to_string(e));
   }
   return std::unique_ptr<FrameTracer>(new FrameTracer(std::move(impl)));
 }

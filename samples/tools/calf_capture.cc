@@ -8,8 +8,8 @@
 #include <string>
 #include <thread>
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include "calf/samples/render.h"
 #include "calf/samples/scene.h"
@@ -35,7 +35,8 @@ class Progress {
   Progress(const char* what, bool quiet) : what_(what), quiet_(quiet), tty_(isatty(2) != 0) {}
   void operator()(uint64_t done, uint64_t total) {
     if (quiet_) return;
-    double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     double eta = done ? elapsed / static_cast<double>(done) * static_cast<double>(total - done) : 0;
     int percent = static_cast<int>(100 * done / total);
     if (!tty_ && percent < next_percent_ && done != total) return;
@@ -58,7 +59,8 @@ class Progress {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "calf-capture: ray-trace capture sets (format/CAPTURE.md) and ground truth of sample scenes.\n"
+      "calf-capture: ray-trace capture sets (format/CAPTURE.md) and ground truth of sample "
+      "scenes.\n"
       "Writes DIR/manifest.json last, so an interrupted run never leaves a set that looks "
       "complete.",
       "calf-capture"};

@@ -89,7 +89,6 @@ void render(uint32_t x, uint32_t y, float sun, float* rgb) {
   }
 }
 
-
 // An image of the test set: w x h texels, RGBA8 (LDR) or RGB float (HDR). `group` is
 // "synthetic" or "capture" (means are printed per group).
 struct Ldr {

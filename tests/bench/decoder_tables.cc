@@ -28,8 +28,8 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include "calf/decoder/clip_decoder.h"
 #include "calf/decoder/culling.h"
@@ -179,14 +179,14 @@ Table4Row run_table4(const ClipDecoder& d, const Poses& poses, const std::vector
       const Vec3 p{info.position[0], info.position[1], info.position[2]};
       // The decoder's far cap (clip_decoder.cc): past the viewer's far plane from this viewpoint.
       const double z_far = std::max<double>(
-          info.z_far, std::hypot(eye.position.x - p.x, eye.position.y - p.y, eye.position.z - p.z) +
-                          eye.far);
+          info.z_far,
+          std::hypot(eye.position.x - p.x, eye.position.y - p.y, eye.position.z - p.z) + eye.far);
       for (int face = 0; face < 6; ++face) {
         const CubeFace cf = static_cast<CubeFace>(face);
         (void)visible_cells_brute_force(p, cf, *grid, info.z_near, z_far, frusta, &regular);
-        visible += visible_cells_hierarchical(p, cf, *grid, info.z_near, z_far, frusta, 0,
-                                              &hierarchical)
-                       .size();
+        visible +=
+            visible_cells_hierarchical(p, cf, *grid, info.z_near, z_far, frusta, 0, &hierarchical)
+                .size();
         total += grid->cell_count();
       }
     }
@@ -218,12 +218,14 @@ void run_peers(const container::Reader& reader, const std::vector<uint32_t>& act
       }
     }
   }
-  std::printf("\nDepth peers: the same %u frames of %u faces (%u x %u each, stacked), lossless. "
-              "ffmpeg's decode ms/frame includes its process start-up; 'marginal' leaves it out "
-              "(all frames minus the first, per frame)\n\n",
-              h.frame_count, faces, w, w);
-  std::printf("| method | bytes | ratio to raw 16-bit | exact | decode ms/frame | marginal ms/frame |\n"
-              "|---|---:|---:|---|---:|---:|\n");
+  std::printf(
+      "\nDepth peers: the same %u frames of %u faces (%u x %u each, stacked), lossless. "
+      "ffmpeg's decode ms/frame includes its process start-up; 'marginal' leaves it out "
+      "(all frames minus the first, per frame)\n\n",
+      h.frame_count, faces, w, w);
+  std::printf(
+      "| method | bytes | ratio to raw 16-bit | exact | decode ms/frame | marginal ms/frame |\n"
+      "|---|---:|---:|---|---:|---:|\n");
   const double raw = static_cast<double>(codes.size()) * 2;
   std::printf("| calf (all faces, no VD, decode incl. colour) | — | — | yes | %.3f | — |\n",
               calf_ms_per_frame);
@@ -268,13 +270,15 @@ int main(int argc, char** argv) {
     }
     const auto& h = probe->header();
     const Poses poses = make_poses(*probe, directions);
-    std::printf("\n## %s\n\n%u views, face %u, cell %u, depth tile %u, %u frames; eye at the "
-                "viewpoints' centroid, fov 90°, %u directions x %u plays\n\n",
-                path.c_str(), h.view_count, h.face_size, h.cell_size, h.depth_tile_size,
-                h.frame_count, directions, repeats);
-    std::printf("Table 3\n\n| VD | active views | colour Mbps @24fps | depth+material Mbps | "
-                "cells visible %% | decode ms/frame | memcpy ms/frame | decode / memcpy |\n"
-                "|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    std::printf(
+        "\n## %s\n\n%u views, face %u, cell %u, depth tile %u, %u frames; eye at the "
+        "viewpoints' centroid, fov 90°, %u directions x %u plays\n\n",
+        path.c_str(), h.view_count, h.face_size, h.cell_size, h.depth_tile_size, h.frame_count,
+        directions, repeats);
+    std::printf(
+        "Table 3\n\n| VD | active views | colour Mbps @24fps | depth+material Mbps | "
+        "cells visible %% | decode ms/frame | memcpy ms/frame | decode / memcpy |\n"
+        "|---|---:|---:|---:|---:|---:|---:|---:|\n");
     std::vector<uint32_t> counts;
     for (uint32_t c : {5u, 9u, h.view_count}) {
       const uint32_t k = std::min(c, h.view_count);
@@ -293,9 +297,10 @@ int main(int argc, char** argv) {
       }
     }
     const std::vector<uint32_t> nine = nearest_views(*probe, poses.centre, 9);
-    std::printf("\nTable 4 (%zu active views, one eye)\n\n| leaf level | cells per face | "
-                "visibility %% | tests regular | tests hierarchical |\n|---|---:|---:|---:|---:|\n",
-                nine.size());
+    std::printf(
+        "\nTable 4 (%zu active views, one eye)\n\n| leaf level | cells per face | "
+        "visibility %% | tests regular | tests hierarchical |\n|---|---:|---:|---:|---:|\n",
+        nine.size());
     for (uint32_t level = 1; level <= 4; ++level) {
       const Table4Row r = run_table4(*probe, poses, nine, level);
       std::printf("| %u | %u | %.1f | %.0f | %.0f |\n", level, (1u << level) * (1u << level),

@@ -23,8 +23,8 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include "calf/capture/capture_set.h"
 #include "calf/encoder/lightfield_encode.h"
@@ -57,7 +57,9 @@ std::string ratio(uint64_t raw, std::optional<uint64_t> b) {
   if (!b || *b == 0) return "—";
   return fmt::format("{:.1f}×", static_cast<double>(raw) / static_cast<double>(*b));
 }
-std::string cell(std::optional<uint64_t> b) { return b ? bytes(*b) : "—"; }
+std::string cell(std::optional<uint64_t> b) {
+  return b ? bytes(*b) : "—";
+}
 
 // Writes the raw colour and log-16 depth streams of `dir` (view-major, frame, texel; colour RGBA
 // interleaved; depth little-endian u16) to two files.
@@ -78,9 +80,8 @@ Status write_raw_streams(const capture::CaptureSetReader& in, bool hdr, const fs
       for (size_t i = 0; i < n; ++i) {
         if (hdr) {
           for (int c = 0; c < 4; ++c) {
-            const uint16_t h =
-                c == 3 ? bc::float_to_half(1.0f)
-                       : bc::float_to_half(std::min(vf.color[3 * i + c], 65504.0f));
+            const uint16_t h = c == 3 ? bc::float_to_half(1.0f)
+                                      : bc::float_to_half(std::min(vf.color[3 * i + c], 65504.0f));
             buf.push_back(static_cast<uint8_t>(h & 0xff));
             buf.push_back(static_cast<uint8_t>(h >> 8));
           }
@@ -95,7 +96,8 @@ Status write_raw_streams(const capture::CaptureSetReader& in, bool hdr, const fs
           hi = std::max(hi, d);
         }
       }
-      colour.write(reinterpret_cast<const char*>(buf.data()), static_cast<std::streamsize>(buf.size()));
+      colour.write(reinterpret_cast<const char*>(buf.data()),
+                   static_cast<std::streamsize>(buf.size()));
     }
     std::optional<LogDepthRange> range;
     if (hi > 0) {
@@ -108,7 +110,8 @@ Status write_raw_streams(const capture::CaptureSetReader& in, bool hdr, const fs
       buf.push_back(static_cast<uint8_t>(code & 0xff));
       buf.push_back(static_cast<uint8_t>(code >> 8));
     }
-    depth.write(reinterpret_cast<const char*>(buf.data()), static_cast<std::streamsize>(buf.size()));
+    depth.write(reinterpret_cast<const char*>(buf.data()),
+                static_cast<std::streamsize>(buf.size()));
   }
   colour.close();
   depth.close();
@@ -161,14 +164,22 @@ Expected<EncodeRun> encode(const fs::path& capture, const fs::path& out, uint32_
 const char* format_name(uint16_t f) {
   using container::PixelFormat;
   switch (static_cast<PixelFormat>(f)) {
-    case PixelFormat::kBc1: return "BC1";
-    case PixelFormat::kBc5: return "BC5";
-    case PixelFormat::kBc6h: return "BC6H";
-    case PixelFormat::kBc7: return "BC7";
-    case PixelFormat::kRgba8: return "RGBA8";
-    case PixelFormat::kRgba16f: return "RGBA16F";
-    case PixelFormat::kR16: return "raw16";
-    default: return "?";
+    case PixelFormat::kBc1:
+      return "BC1";
+    case PixelFormat::kBc5:
+      return "BC5";
+    case PixelFormat::kBc6h:
+      return "BC6H";
+    case PixelFormat::kBc7:
+      return "BC7";
+    case PixelFormat::kRgba8:
+      return "RGBA8";
+    case PixelFormat::kRgba16f:
+      return "RGBA16F";
+    case PixelFormat::kR16:
+      return "raw16";
+    default:
+      return "?";
   }
 }
 
@@ -240,21 +251,23 @@ int run_one(const fs::path& dir, uint32_t threads, bool have_xz, bool have_zstd)
   if (!have_xz) fmt::print("- `xz` not installed: peer skipped.\n");
   if (!have_zstd) fmt::print("- `zstd` not installed: peer skipped.\n");
   if (!raw_note.empty()) fmt::print("- {}\n", raw_note);
-  fmt::print("- encode: {:.2f} s (zstd), {:.2f} s (LZMA2); file {} / {} bytes; peak RSS {:.1f} MiB "
-             "after the zstd encode, {:.1f} MiB after both (process peak, includes reading the "
-             "raw streams later: {:.1f} MiB)\n",
-             z->seconds, x->seconds, bytes(z->file_bytes), bytes(x->file_bytes),
-             rss_after_zstd / 1024.0, rss_after_lzma / 1024.0,
-             peak_rss_kib(RUSAGE_SELF) / 1024.0);
-  fmt::print("- peers: zstd -19 {:.2f} s + {:.2f} s, xz -9 {:.2f} s + {:.2f} s (colour + depth); "
-             "largest child peak RSS {:.1f} MiB\n",
-             zs_c.seconds, zs_d.seconds, xz_c.seconds, xz_d.seconds,
-             peak_rss_kib(RUSAGE_CHILDREN) / 1024.0);
-  fmt::print("- colour: {} cells, {} keyframes of {} cell-frames, min temporal quality {:.1f} dB; "
-             "depth: {} tiles, {} keyframes, {} P-frames ({} empty); index {} bytes\n",
-             s.colour_cells, s.colour_keyframes, s.colour_cells * m.frame_count,
-             s.min_colour_quality_db, s.depth_tiles, s.depth_keyframes, s.depth_pframes,
-             s.depth_empty_pframes, bytes(s.index_bytes));
+  fmt::print(
+      "- encode: {:.2f} s (zstd), {:.2f} s (LZMA2); file {} / {} bytes; peak RSS {:.1f} MiB "
+      "after the zstd encode, {:.1f} MiB after both (process peak, includes reading the "
+      "raw streams later: {:.1f} MiB)\n",
+      z->seconds, x->seconds, bytes(z->file_bytes), bytes(x->file_bytes), rss_after_zstd / 1024.0,
+      rss_after_lzma / 1024.0, peak_rss_kib(RUSAGE_SELF) / 1024.0);
+  fmt::print(
+      "- peers: zstd -19 {:.2f} s + {:.2f} s, xz -9 {:.2f} s + {:.2f} s (colour + depth); "
+      "largest child peak RSS {:.1f} MiB\n",
+      zs_c.seconds, zs_d.seconds, xz_c.seconds, xz_d.seconds,
+      peak_rss_kib(RUSAGE_CHILDREN) / 1024.0);
+  fmt::print(
+      "- colour: {} cells, {} keyframes of {} cell-frames, min temporal quality {:.1f} dB; "
+      "depth: {} tiles, {} keyframes, {} P-frames ({} empty); index {} bytes\n",
+      s.colour_cells, s.colour_keyframes, s.colour_cells * m.frame_count, s.min_colour_quality_db,
+      s.depth_tiles, s.depth_keyframes, s.depth_pframes, s.depth_empty_pframes,
+      bytes(s.index_bytes));
   if (s.material_views > 0) {
     fmt::print("- material ({} views, {}): raw {}, temporal {}, +spatial {}, +zstd {}, +LZMA2 {}\n",
                s.material_views, format_name(s.material_format), bytes(s.material.raw),
@@ -271,7 +284,8 @@ int run_one(const fs::path& dir, uint32_t threads, bool have_xz, bool have_zstd)
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Paper 002 Table 1 for the lightfield track of each capture set, with xz / zstd peers"};
+  CLI::App app{
+      "Paper 002 Table 1 for the lightfield track of each capture set, with xz / zstd peers"};
   std::vector<std::string> captures;
   uint32_t threads = 0;
   app.add_option("--capture", captures, "capture-set directory (repeatable)")->required();

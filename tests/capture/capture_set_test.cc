@@ -27,8 +27,9 @@ class CaptureSetTest : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::temp_directory_path() /
-           ("calf_capture_set_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-            "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+           ("calf_capture_set_test_" +
+            std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
   }
   void TearDown() override { fs::remove_all(dir_); }
@@ -49,8 +50,10 @@ class CaptureSetTest : public ::testing::Test {
     ViewFrame f;
     f.resize(4, material);
     for (size_t i = 0; i < f.texel_count(); ++i) {
-      for (int c = 0; c < 3; ++c) f.color[3 * i + c] = static_cast<float>((i + c + view) % 8) * 0.25f;
-      f.depth[i] = i >= 5 * 16 ? kInf : 0.5f + static_cast<float>(i) * 0.1f + static_cast<float>(frame);
+      for (int c = 0; c < 3; ++c)
+        f.color[3 * i + c] = static_cast<float>((i + c + view) % 8) * 0.25f;
+      f.depth[i] =
+          i >= 5 * 16 ? kInf : 0.5f + static_cast<float>(i) * 0.1f + static_cast<float>(frame);
       if (material) {
         f.material[3 * i] = (i % 2) ? 0.5f : 0.0f;
         f.material[3 * i + 1] = (i % 3 == 0) ? 0.25f : 0.0f;
@@ -71,15 +74,16 @@ class CaptureSetTest : public ::testing::Test {
 
   // Writes an image directly with OIIO, bypassing the writer's validation.
   static void write_raw(const fs::path& path, int width, int height,
-                        const std::vector<std::string>& channels, float fill,
-                        int bad_channel = -1, int bad_x = 0, int bad_y = 0, float bad = 0) {
+                        const std::vector<std::string>& channels, float fill, int bad_channel = -1,
+                        int bad_x = 0, int bad_y = 0, float bad = 0) {
     auto out = OIIO::ImageOutput::create("exr");
     OIIO::ImageSpec spec(width, height, static_cast<int>(channels.size()), OIIO::TypeDesc::FLOAT);
     spec.channelnames = channels;
     spec.alpha_channel = -1;
     spec.z_channel = -1;
     std::vector<float> px(static_cast<size_t>(width) * height * channels.size(), fill);
-    if (bad_channel >= 0) px[(static_cast<size_t>(bad_y) * width + bad_x) * channels.size() + bad_channel] = bad;
+    if (bad_channel >= 0)
+      px[(static_cast<size_t>(bad_y) * width + bad_x) * channels.size() + bad_channel] = bad;
     ASSERT_TRUE(out->open(path.string(), spec));
     ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, px.data()));
     ASSERT_TRUE(out->close());
@@ -262,8 +266,8 @@ TEST_F(CaptureSetTest, BadColourPixels) {
 
 TEST_F(CaptureSetTest, BadMaterialPixels) {
   // reflect > 1, refract < 0, IOR 0.
-  const std::vector<std::string> ch = {"R", "G", "B", "Z", "material.reflect", "material.refract",
-                                       "material.ior"};
+  const std::vector<std::string> ch = {
+      "R", "G", "B", "Z", "material.reflect", "material.refract", "material.ior"};
   for (auto [channel, bad] : {std::pair{4, 1.5f}, std::pair{5, -0.25f}, std::pair{6, 0.0f}}) {
     fs::remove_all(dir_);
     write_set(true);

@@ -31,14 +31,14 @@ void expect_error(const std::string& json, ErrorId id, const std::string& needle
 }
 
 TEST(EyePath, OrientationForms) {
-  auto p = parse_eye_path(
-      path_json(R"({"time": 0, "position": [0, 1, 0], "forward": [2, 0, 0]},
+  auto p =
+      parse_eye_path(path_json(R"({"time": 0, "position": [0, 1, 0], "forward": [2, 0, 0]},
                    {"time": 0.5, "position": [0, 1, 0], "look_at": [0, 1, -5], "up": [0, 3, 1],
                     "fov_y_degrees": 90, "eye": "left"},
                    {"time": 1, "position": [1, 2, 3], "orientation": [0.7071067811865476, 0, 0.7071067811865476, 0],
                     "eye": "right"})",
-                R"("fov_y_degrees": 45, "image_pattern": "gt_{pose:04}.exr", )"),
-      "p");
+                               R"("fov_y_degrees": 45, "image_pattern": "gt_{pose:04}.exr", )"),
+                     "p");
   ASSERT_TRUE(p.ok()) << p.status().to_string();
   ASSERT_EQ(p->poses.size(), 3u);
   EXPECT_EQ(p->width, 64u);
@@ -118,8 +118,8 @@ TEST(EyePath, Errors) {
                "parallel");
   expect_error(path_json("{" + pos + R"(, "look_at": [0, 0, 0]})"), ErrorId::kEyePathField,
                "parallel");
-  expect_error(path_json("{" + pos + R"(, "orientation": [1, 1, 0, 0]})"),
-               ErrorId::kEyePathField, "not 1");
+  expect_error(path_json("{" + pos + R"(, "orientation": [1, 1, 0, 0]})"), ErrorId::kEyePathField,
+               "not 1");
   expect_error(path_json("{" + pos + R"(, "orientation": [1, 0, 0]})"), ErrorId::kEyePathField,
                "'poses[0].orientation'");
   expect_error(path_json("{" + pos + R"(, "orientation": [1, 0, 0, 0], "up": [0, 1, 0]})"),
@@ -130,8 +130,9 @@ TEST(EyePath, Errors) {
                ErrorId::kEyePathField, "'poses[0].eye'");
   expect_error(path_json("{" + pos + R"(, "forward": [0, 0, -1], "roll": 3})"),
                ErrorId::kEyePathField, "'poses[0].roll': unknown key");
-  expect_error(path_json("{" + pos + R"(, "forward": [0, 0, -1]})", R"("image_pattern": "gt.exr", )"),
-               ErrorId::kEyePathField, "image_pattern");
+  expect_error(
+      path_json("{" + pos + R"(, "forward": [0, 0, -1]})", R"("image_pattern": "gt.exr", )"),
+      ErrorId::kEyePathField, "image_pattern");
   expect_error(path_json("{" + pos + R"(, "forward": [0, "a", -1]})"), ErrorId::kEyePathField,
                "'poses[0].forward[1]'");
 }
@@ -170,7 +171,8 @@ TEST(EyePath, GroundTruthImageRoundTrip) {
   img.depth.resize(15);
   for (size_t i = 0; i < 15; ++i) {
     for (int c = 0; c < 3; ++c) img.color[3 * i + c] = static_cast<float>(i + c) * 0.5f;
-    img.depth[i] = i == 4 ? std::numeric_limits<float>::infinity() : 1.0f + static_cast<float>(i) / 7;
+    img.depth[i] =
+        i == 4 ? std::numeric_limits<float>::infinity() : 1.0f + static_cast<float>(i) / 7;
   }
   auto file = std::filesystem::temp_directory_path() / "calf_eye_path_test_gt.exr";
   ASSERT_TRUE(write_perspective_image(file, img).ok());

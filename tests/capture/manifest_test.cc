@@ -94,8 +94,8 @@ TEST(CaptureManifest, FieldErrorsNameTheField) {
                "'face_size'");
   expect_error(manifest_json("\"face_size\": 128", "\"face_size\": 0"), ErrorId::kManifestField,
                "'face_size': is 0");
-  expect_error(manifest_json("\"frame_count\": 24", "\"frame_count\": 0"),
-               ErrorId::kManifestField, "'frame_count'");
+  expect_error(manifest_json("\"frame_count\": 24", "\"frame_count\": 0"), ErrorId::kManifestField,
+               "'frame_count'");
   expect_error(manifest_json("\"fps\": 23.976", "\"fps\": 0"), ErrorId::kManifestField, "'fps'");
   expect_error(manifest_json("\"material\": true", "\"material\": 1"), ErrorId::kManifestField,
                "'material'");
@@ -115,7 +115,8 @@ TEST(CaptureManifest, Limits) {
   expect_error(manifest_json("\"frame_count\": 24", "\"frame_count\": 1000001"),
                ErrorId::kCaptureLimit, "frame_count");
   std::string many = "\"viewpoints\": [";
-  for (int i = 0; i < 4097; ++i) many += std::string(i ? "," : "") + "{\"position\": [" + std::to_string(i) + ", 0, 0]}";
+  for (int i = 0; i < 4097; ++i)
+    many += std::string(i ? "," : "") + "{\"position\": [" + std::to_string(i) + ", 0, 0]}";
   std::string json = manifest_json();
   size_t at = json.find("\"viewpoints\": [");
   json = json.substr(0, at) + many + "]}";

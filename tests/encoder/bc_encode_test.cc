@@ -39,7 +39,9 @@ std::vector<std::vector<uint8_t>> ldr_set() {
   return set;
 }
 
-double psnr_from_mse(double mse) { return mse <= 0 ? 99.0 : 10 * std::log10(255.0 * 255.0 / mse); }
+double psnr_from_mse(double mse) {
+  return mse <= 0 ? 99.0 : 10 * std::log10(255.0 * 255.0 / mse);
+}
 
 // PSNR over the channels [0, nc) of decoded `f` blocks against 4-channel source pixels.
 double psnr(Format f, const std::vector<uint8_t>& blocks, const std::vector<uint8_t>& src, int nc) {
@@ -54,15 +56,24 @@ double psnr(Format f, const std::vector<uint8_t>& blocks, const std::vector<uint
   return psnr_from_mse(se / (kSize * kSize * nc));
 }
 
-std::vector<uint8_t> encode8(Format f, const std::vector<uint8_t>& src, int quality, int threads = 1) {
+std::vector<uint8_t> encode8(Format f, const std::vector<uint8_t>& src, int quality,
+                             int threads = 1) {
   std::vector<uint8_t> blocks(encode_bound(f, kSize, kSize));
   const Image8 img{src.data(), kSize, kSize, kSize * 4, 4};
   Status st;
   switch (f) {
-    case Format::kBc1: st = encode_bc1(img, blocks.data(), blocks.size(), {quality, false, threads}); break;
-    case Format::kBc4: st = encode_bc4(img, blocks.data(), blocks.size(), {quality, threads}); break;
-    case Format::kBc5: st = encode_bc5(img, blocks.data(), blocks.size(), {quality, threads}); break;
-    default: st = encode_bc7(img, blocks.data(), blocks.size(), {quality, threads}); break;
+    case Format::kBc1:
+      st = encode_bc1(img, blocks.data(), blocks.size(), {quality, false, threads});
+      break;
+    case Format::kBc4:
+      st = encode_bc4(img, blocks.data(), blocks.size(), {quality, threads});
+      break;
+    case Format::kBc5:
+      st = encode_bc5(img, blocks.data(), blocks.size(), {quality, threads});
+      break;
+    default:
+      st = encode_bc7(img, blocks.data(), blocks.size(), {quality, threads});
+      break;
   }
   EXPECT_TRUE(st.ok()) << st.to_string();
   return blocks;
@@ -121,7 +132,8 @@ std::vector<std::vector<float>> hdr_set() {
 
 // PSNR on log2 values (floored at 2^-14), with the reference's log2 range as the peak: an
 // error of one stop over a 24-stop image is about 27.6 dB. Named "log2-PSNR" in reports.
-double log2_psnr(const std::vector<float>& ref, const std::vector<uint16_t>& halves, bool is_signed) {
+double log2_psnr(const std::vector<float>& ref, const std::vector<uint16_t>& halves,
+                 bool is_signed) {
   double lo = 1e9, hi = -1e9, se = 0;
   auto l2 = [](float v) { return std::log2(std::max(std::fabs(v), 0x1p-14f)); };
   for (float v : ref) lo = std::min(lo, double(l2(v))), hi = std::max(hi, double(l2(v)));
@@ -136,11 +148,12 @@ double log2_psnr(const std::vector<float>& ref, const std::vector<uint16_t>& hal
 std::vector<uint16_t> roundtrip_hdr(const std::vector<float>& img, const Bc6hOptions& o) {
   const Format f = o.is_signed ? Format::kBc6hSigned : Format::kBc6hUnsigned;
   std::vector<uint8_t> blocks(encode_bound(f, kSize, kSize));
-  const Status st = encode_bc6h({img.data(), kSize, kSize, kSize * 3, 3}, blocks.data(), blocks.size(), o);
+  const Status st =
+      encode_bc6h({img.data(), kSize, kSize, kSize * 3, 3}, blocks.data(), blocks.size(), o);
   EXPECT_TRUE(st.ok()) << st.to_string();
   std::vector<uint16_t> out(kSize * kSize * 3);
-  EXPECT_TRUE(decode_image(f, blocks.data(), blocks.size(), kSize, kSize, out.data(), out.size() * 2,
-                           kSize * 6)
+  EXPECT_TRUE(decode_image(f, blocks.data(), blocks.size(), kSize, kSize, out.data(),
+                           out.size() * 2, kSize * 6)
                   .ok());
   return out;
 }
@@ -215,7 +228,8 @@ TEST(BcHdr, RejectPolicyNamesThePixel) {
 TEST(BcHdr, SignedKeepsNegatives) {
   float px[48];
   for (int i = 0; i < 16; ++i)
-    for (int c = 0; c < 3; ++c) px[3 * i + c] = (i % 2 ? -1.0f : 1.0f) * std::exp2(float(i - 8 + c));
+    for (int c = 0; c < 3; ++c)
+      px[3 * i + c] = (i % 2 ? -1.0f : 1.0f) * std::exp2(float(i - 8 + c));
   Bc6hOptions o;
   o.is_signed = true;
   o.quality = 2;
@@ -256,10 +270,13 @@ TEST(BcLdr, ConstantBlocks) {
 TEST(BcLdr, TwoColourBlocksAreNearExactInBc7) {
   std::mt19937 rng(5);
   for (int k = 0; k < 100; ++k) {
-    uint8_t a[4] = {static_cast<uint8_t>(rng()), static_cast<uint8_t>(rng()), static_cast<uint8_t>(rng()), 255};
-    uint8_t b[4] = {static_cast<uint8_t>(rng()), static_cast<uint8_t>(rng()), static_cast<uint8_t>(rng()), 255};
+    uint8_t a[4] = {static_cast<uint8_t>(rng()), static_cast<uint8_t>(rng()),
+                    static_cast<uint8_t>(rng()), 255};
+    uint8_t b[4] = {static_cast<uint8_t>(rng()), static_cast<uint8_t>(rng()),
+                    static_cast<uint8_t>(rng()), 255};
     uint8_t px[64];
-    for (int i = 0; i < 16; ++i) std::copy((i % 4) < 2 ? a : b, ((i % 4) < 2 ? a : b) + 4, px + 4 * i);
+    for (int i = 0; i < 16; ++i)
+      std::copy((i % 4) < 2 ? a : b, ((i % 4) < 2 ? a : b) + 4, px + 4 * i);
     uint8_t blk[16], out[64];
     encode_bc7_block(px, blk, {});
     decode_bc7_block(blk, out);
@@ -330,7 +347,9 @@ TEST(BcApi, PartialBlocksClampToTheEdge) {
     }
   std::vector<uint8_t> blocks(encode_bound(Format::kBc7, 5, 5)), out(5 * 5 * 4);
   ASSERT_TRUE(encode_bc7({px.data(), 5, 5, 20, 4}, blocks.data(), blocks.size(), {}).ok());
-  ASSERT_TRUE(decode_image(Format::kBc7, blocks.data(), blocks.size(), 5, 5, out.data(), out.size(), 20).ok());
+  ASSERT_TRUE(
+      decode_image(Format::kBc7, blocks.data(), blocks.size(), 5, 5, out.data(), out.size(), 20)
+          .ok());
   for (size_t i = 0; i < px.size(); ++i) EXPECT_LE(std::abs(px[i] - out[i]), 2) << i;
 }
 

@@ -38,7 +38,7 @@ TEST(BcHalf, KnownValues) {
   EXPECT_EQ(float_to_half(0x1p-24f), 0x0001);  // smallest subnormal
   EXPECT_EQ(float_to_half(0x1p-25f), 0x0000);  // tie to even: 0
   EXPECT_EQ(float_to_half(0x1.8p-25f), 0x0001);
-  EXPECT_EQ(float_to_half(0x1p-14f), 0x0400);  // smallest normal
+  EXPECT_EQ(float_to_half(0x1p-14f), 0x0400);         // smallest normal
   EXPECT_EQ(float_to_half(1.0f + 0x1p-11f), 0x3c00);  // tie to even
   EXPECT_EQ(float_to_half(1.0f + 0x1.8p-11f), 0x3c01);
   EXPECT_TRUE(std::isnan(half_to_float(float_to_half(std::nanf("")))));
@@ -59,8 +59,8 @@ TEST(BcDecode, Bc1FourAndThreeColourModes) {
   const uint8_t four[8] = {0x00, 0xf8, 0x1f, 0x00, 0xe4, 0xe4, 0xe4, 0xe4};
   uint8_t rgba[64];
   decode_bc1_block(four, rgba);
-  const uint8_t want4[4][4] = {{255, 0, 0, 255}, {0, 0, 255, 255}, {170, 0, 85, 255},
-                               {85, 0, 170, 255}};
+  const uint8_t want4[4][4] = {
+      {255, 0, 0, 255}, {0, 0, 255, 255}, {170, 0, 85, 255}, {85, 0, 170, 255}};
   for (int i = 0; i < 16; ++i) {
     const int idx = (0xe4 >> (2 * (i % 4))) & 3;
     for (int c = 0; c < 4; ++c) EXPECT_EQ(rgba[4 * i + c], want4[idx][c]) << i << " " << c;
@@ -68,8 +68,8 @@ TEST(BcDecode, Bc1FourAndThreeColourModes) {
   // Swapped endpoints: 3 colours + transparent black.
   const uint8_t three[8] = {0x1f, 0x00, 0x00, 0xf8, 0xe4, 0xe4, 0xe4, 0xe4};
   decode_bc1_block(three, rgba);
-  const uint8_t want3[4][4] = {{0, 0, 255, 255}, {255, 0, 0, 255}, {127, 0, 127, 255},
-                               {0, 0, 0, 0}};
+  const uint8_t want3[4][4] = {
+      {0, 0, 255, 255}, {255, 0, 0, 255}, {127, 0, 127, 255}, {0, 0, 0, 0}};
   for (int i = 0; i < 16; ++i) {
     const int idx = (0xe4 >> (2 * (i % 4))) & 3;
     for (int c = 0; c < 4; ++c) EXPECT_EQ(rgba[4 * i + c], want3[idx][c]) << i << " " << c;
@@ -185,7 +185,7 @@ TEST(BcDecode, Bc6hMode11Extremes) {
   uint16_t rgb[48];
   decode_bc6h_block(w.b, false, rgb);
   for (uint16_t v : rgb) EXPECT_EQ(v, 0x7bff);  // 65504
-  decode_bc6h_block(w.b, true, rgb);  // signed: 1023 is -1 in 10 bits -> a tiny negative
+  decode_bc6h_block(w.b, true, rgb);            // signed: 1023 is -1 in 10 bits -> a tiny negative
   for (uint16_t v : rgb) EXPECT_EQ(v, ((((1 << 15) + 0x4000) >> 9) * 31 >> 5) | 0x8000);
 }
 
@@ -246,9 +246,9 @@ TEST(BcImage, PartialBlocksWriteOnlyInsideTexels) {
   for (auto& b : blocks) b = static_cast<uint8_t>(rng());
   const size_t stride = 32;
   std::vector<uint8_t> out(stride * 3, 0xee);
-  ASSERT_TRUE(decode_image(Format::kBc1, blocks.data(), blocks.size(), 5, 3, out.data(),
-                           out.size(), stride)
-                  .ok());
+  ASSERT_TRUE(
+      decode_image(Format::kBc1, blocks.data(), blocks.size(), 5, 3, out.data(), out.size(), stride)
+          .ok());
   uint8_t b0[64], b1[64];
   decode_bc1_block(blocks.data(), b0);
   decode_bc1_block(blocks.data() + 8, b1);
@@ -303,14 +303,14 @@ TEST(BcDecode, FrozenOutputs) {
     Format f;
     uint64_t hash;
   } kFrozen[] = {
-      {Format::kBc1, 0x4fdd27e4b1f47de0ull},       {Format::kBc4, 0xec0bd842aad6685aull},
-      {Format::kBc5, 0xd1c482bd7d4ea69eull},       {Format::kBc4Signed, 0xc393d7dca353420bull},
-      {Format::kBc5Signed, 0xa3e6abfd1bfc6dc6ull}, {Format::kBc6hUnsigned, 0x624058cb867d9826ull},
+      {Format::kBc1, 0x4fdd27e4b1f47de0ull},        {Format::kBc4, 0xec0bd842aad6685aull},
+      {Format::kBc5, 0xd1c482bd7d4ea69eull},        {Format::kBc4Signed, 0xc393d7dca353420bull},
+      {Format::kBc5Signed, 0xa3e6abfd1bfc6dc6ull},  {Format::kBc6hUnsigned, 0x624058cb867d9826ull},
       {Format::kBc6hSigned, 0xd6b3d9f85fbe94b3ull}, {Format::kBc7, 0xe6a702e1c22c97baull},
   };
   for (const auto& fr : kFrozen) {
-    EXPECT_EQ(decoded_hash(fr.f), fr.hash) << format_name(fr.f) << " 0x" << std::hex
-                                           << decoded_hash(fr.f);
+    EXPECT_EQ(decoded_hash(fr.f), fr.hash)
+        << format_name(fr.f) << " 0x" << std::hex << decoded_hash(fr.f);
   }
 }
 

@@ -1,9 +1,10 @@
-// Fuzz target: the reference lightfield decoder (decoder/include/calf/decoder/lightfield_reference.h)
-// on arbitrary bytes. Opens them as a .calf file from memory, opens every lightfield track and
-// decodes every view / face / frame it claims, plus every cell timeline and depth tile's rectangle
-// counts. Any crash, sanitizer report or hang is a bug; errors are expected. Seeded with tiny valid
-// encoded files (face 8, 2-3 frames) and files whose chunks were rewritten with corrupt contents
-// but valid hashes (so mutations reach the decoder's chunk parser, not just the container's checks).
+// Fuzz target: the reference lightfield decoder
+// (decoder/include/calf/decoder/lightfield_reference.h) on arbitrary bytes. Opens them as a .calf
+// file from memory, opens every lightfield track and decodes every view / face / frame it claims,
+// plus every cell timeline and depth tile's rectangle counts. Any crash, sanitizer report or hang
+// is a bug; errors are expected. Seeded with tiny valid encoded files (face 8, 2-3 frames) and
+// files whose chunks were rewritten with corrupt contents but valid hashes (so mutations reach the
+// decoder's chunk parser, not just the container's checks).
 #include <cstddef>
 #include <cstdint>
 #include <span>

@@ -10,9 +10,9 @@
 // The including test defines CALF_GALLIUM_DRIVER and kTolerance(Format) before including this.
 #pragma once
 #define GL_GLEXT_PROTOTYPES 1
-#include <GL/osmesa.h>
 #include <GL/gl.h>
 #include <GL/glext.h>
+#include <GL/osmesa.h>
 
 #include <gtest/gtest.h>
 
@@ -20,8 +20,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <string>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "calf/encoder/bc_encode.h"
@@ -37,8 +37,8 @@ class MesaContext {
   MesaContext() {
     // The Gallium driver is chosen when OSMesa creates its screen (the first context).
     setenv("GALLIUM_DRIVER", CALF_GALLIUM_DRIVER, 1);
-    const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 0,
-                           OSMESA_PROFILE, OSMESA_COMPAT_PROFILE, 0};
+    const int attribs[] = {
+        OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 0, OSMESA_PROFILE, OSMESA_COMPAT_PROFILE, 0};
     ctx_ = OSMesaCreateContextAttribs(attribs, nullptr);
     if (!ctx_) return;
     buffer_.resize(16 * 16 * 4);
@@ -65,14 +65,22 @@ MesaContext& context() {
 
 GLenum gl_format_of(Format f) {
   switch (f) {
-    case Format::kBc1: return GL_COMPRESSED_RGBA_S3TC_DXT1_EXT;
-    case Format::kBc4: return GL_COMPRESSED_RED_RGTC1;
-    case Format::kBc5: return GL_COMPRESSED_RG_RGTC2;
-    case Format::kBc4Signed: return GL_COMPRESSED_SIGNED_RED_RGTC1;
-    case Format::kBc5Signed: return GL_COMPRESSED_SIGNED_RG_RGTC2;
-    case Format::kBc6hUnsigned: return GL_COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT;
-    case Format::kBc6hSigned: return GL_COMPRESSED_RGB_BPTC_SIGNED_FLOAT;
-    case Format::kBc7: return GL_COMPRESSED_RGBA_BPTC_UNORM;
+    case Format::kBc1:
+      return GL_COMPRESSED_RGBA_S3TC_DXT1_EXT;
+    case Format::kBc4:
+      return GL_COMPRESSED_RED_RGTC1;
+    case Format::kBc5:
+      return GL_COMPRESSED_RG_RGTC2;
+    case Format::kBc4Signed:
+      return GL_COMPRESSED_SIGNED_RED_RGTC1;
+    case Format::kBc5Signed:
+      return GL_COMPRESSED_SIGNED_RG_RGTC2;
+    case Format::kBc6hUnsigned:
+      return GL_COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT;
+    case Format::kBc6hSigned:
+      return GL_COMPRESSED_RGB_BPTC_SIGNED_FLOAT;
+    case Format::kBc7:
+      return GL_COMPRESSED_RGBA_BPTC_UNORM;
   }
   return 0;
 }
@@ -81,8 +89,8 @@ GLenum gl_format_of(Format f) {
 // decoder's own output type: RGBA8 / R8 / RG8 / RGB half; signed RGTC as float.
 struct Readback {
   uint32_t width = 0, height = 0;
-  std::vector<uint8_t> bytes;   // unorm formats and BC6H halves
-  std::vector<float> floats;    // signed RGTC, and BC6H as float
+  std::vector<uint8_t> bytes;  // unorm formats and BC6H halves
+  std::vector<float> floats;   // signed RGTC, and BC6H as float
 };
 
 Readback mesa_decode(Format f, const std::vector<uint8_t>& blocks) {
@@ -161,7 +169,8 @@ int compare_with_mesa(Format f, const std::vector<uint8_t>& blocks, int* max_dif
       if (f == Format::kBc4Signed || f == Format::kBc5Signed) {
         for (int c = 0; c < nc; ++c) {
           const float want = std::max(static_cast<int8_t>(cpu[i * nc + c]) / 127.0f, -1.0f);
-          const int d = static_cast<int>(std::lround(std::fabs(rb.floats[t * nc + c] - want) * 127));
+          const int d =
+              static_cast<int>(std::lround(std::fabs(rb.floats[t * nc + c] - want) * 127));
           worst = std::max(worst, d);
           if (d > tol || (tol == 0 && rb.floats[t * nc + c] != want)) bad = true;
         }
@@ -208,8 +217,8 @@ std::vector<uint8_t> random_blocks(Format f, uint64_t seed) {
       const int mode = r % 9;  // 8 = the reserved all-zero mode byte
       b0 = mode == 8 ? 0 : static_cast<uint8_t>(((b0 << (mode + 1)) | (1u << mode)) & 0xff);
     } else if (f == Format::kBc6hUnsigned || f == Format::kBc6hSigned) {
-      static const uint8_t kModes[] = {0, 1, 2, 6, 10, 14, 18, 22, 26, 30, 3, 7, 11, 15,
-                                       19, 23, 27, 31};
+      static const uint8_t kModes[] = {0,  1, 2, 6,  10, 14, 18, 22, 26,
+                                       30, 3, 7, 11, 15, 19, 23, 27, 31};
       const uint8_t m = kModes[r % 18];
       b0 = static_cast<uint8_t>(m < 2 ? ((b0 & ~3u) | m) : ((b0 & ~31u) | m));
     } else if (f == Format::kBc1) {
@@ -236,7 +245,8 @@ class BcMesaTest : public ::testing::TestWithParam<Format> {
 TEST_P(BcMesaTest, RandomBlocksAgree) {
   const Format f = GetParam();
   int max_diff = 0;
-  EXPECT_EQ(compare_with_mesa(f, random_blocks(f, 0xca1f0000u + static_cast<int>(f)), &max_diff), 0);
+  EXPECT_EQ(compare_with_mesa(f, random_blocks(f, 0xca1f0000u + static_cast<int>(f)), &max_diff),
+            0);
   std::printf("%s vs Mesa %s: largest difference %d (allowed %d)\n", format_name(f),
               CALF_GALLIUM_DRIVER, max_diff, kTolerance(f));
 }
@@ -272,10 +282,18 @@ TEST_P(BcMesaTest, EncodedBlocksAgree) {
       for (int c = 0; c < 4; ++c) {
         int v;
         switch (region % 4) {
-          case 0: v = static_cast<int>((x * 4 + c * 40 + y) & 255); break;
-          case 1: v = static_cast<int>(rng() & 255); break;
-          case 2: v = ((x + y) % 8 < 4) ? 250 : 10; break;
-          default: v = 128; break;
+          case 0:
+            v = static_cast<int>((x * 4 + c * 40 + y) & 255);
+            break;
+          case 1:
+            v = static_cast<int>(rng() & 255);
+            break;
+          case 2:
+            v = ((x + y) % 8 < 4) ? 250 : 10;
+            break;
+          default:
+            v = 128;
+            break;
         }
         p[c] = static_cast<uint8_t>(c == 3 && region < 4 ? 255 : v);
       }
@@ -288,10 +306,18 @@ TEST_P(BcMesaTest, EncodedBlocksAgree) {
   std::vector<uint8_t> blocks(*compressed_size(f, w, h));
   Status st;
   switch (f) {
-    case Format::kBc1: st = encode_bc1({rgba.data(), w, h, w * 4, 4}, blocks.data(), blocks.size(), {}); break;
-    case Format::kBc4: st = encode_bc4({rgba.data(), w, h, w * 4, 4}, blocks.data(), blocks.size(), {}); break;
-    case Format::kBc5: st = encode_bc5({rgba.data(), w, h, w * 4, 4}, blocks.data(), blocks.size(), {}); break;
-    case Format::kBc7: st = encode_bc7({rgba.data(), w, h, w * 4, 4}, blocks.data(), blocks.size(), {}); break;
+    case Format::kBc1:
+      st = encode_bc1({rgba.data(), w, h, w * 4, 4}, blocks.data(), blocks.size(), {});
+      break;
+    case Format::kBc4:
+      st = encode_bc4({rgba.data(), w, h, w * 4, 4}, blocks.data(), blocks.size(), {});
+      break;
+    case Format::kBc5:
+      st = encode_bc5({rgba.data(), w, h, w * 4, 4}, blocks.data(), blocks.size(), {});
+      break;
+    case Format::kBc7:
+      st = encode_bc7({rgba.data(), w, h, w * 4, 4}, blocks.data(), blocks.size(), {});
+      break;
     default: {
       Bc6hOptions o;
       o.is_signed = f == Format::kBc6hSigned;
@@ -302,12 +328,11 @@ TEST_P(BcMesaTest, EncodedBlocksAgree) {
   EXPECT_EQ(compare_with_mesa(f, blocks), 0);
 }
 
-INSTANTIATE_TEST_SUITE_P(AllFormats, BcMesaTest,
-                         ::testing::Values(Format::kBc1, Format::kBc4, Format::kBc5,
-                                           Format::kBc4Signed, Format::kBc5Signed,
-                                           Format::kBc6hUnsigned, Format::kBc6hSigned,
-                                           Format::kBc7),
-                         [](const ::testing::TestParamInfo<Format>& p) { return std::string(format_name(p.param)); });
+INSTANTIATE_TEST_SUITE_P(
+    AllFormats, BcMesaTest,
+    ::testing::Values(Format::kBc1, Format::kBc4, Format::kBc5, Format::kBc4Signed,
+                      Format::kBc5Signed, Format::kBc6hUnsigned, Format::kBc6hSigned, Format::kBc7),
+    [](const ::testing::TestParamInfo<Format>& p) { return std::string(format_name(p.param)); });
 
 }  // namespace
 }  // namespace calf::bc

@@ -10,9 +10,12 @@ constexpr int kTolerance(Format f) {
   switch (f) {
     case Format::kBc6hUnsigned:
     case Format::kBc6hSigned:
-    case Format::kBc7: return 0;
-    case Format::kBc1: return 1;   // measured: 1 (on 100 000 random blocks)
-    default: return 2;             // BC4/BC5 unsigned and signed, measured: 2
+    case Format::kBc7:
+      return 0;
+    case Format::kBc1:
+      return 1;  // measured: 1 (on 100 000 random blocks)
+    default:
+      return 2;  // BC4/BC5 unsigned and signed, measured: 2
   }
 }
 }  // namespace calf::bc

@@ -3,6 +3,8 @@
 #define CALF_GALLIUM_DRIVER "softpipe"
 namespace calf::bc {
 enum class Format : unsigned char;
-constexpr int kTolerance(Format) { return 0; }
+constexpr int kTolerance(Format) {
+  return 0;
+}
 }  // namespace calf::bc
 #include "bc_mesa_common.h"

@@ -6,15 +6,15 @@
 // without the background thread.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
-#include <tuple>
-#include <unistd.h>
 #include <random>
 #include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "calf/capture/capture_set.h"
@@ -255,7 +255,8 @@ size_t expect_matches_reference(const Clip& clip, const CpuTextures& tex, const 
 }
 
 FrameUpdates advance_ok(ClipDecoder& d, CpuTextures& tex, uint32_t frame,
-                        const std::vector<EyeView>& eyes, const std::vector<uint32_t>& active = {}) {
+                        const std::vector<EyeView>& eyes,
+                        const std::vector<uint32_t>& active = {}) {
   FrameUpdates fu;
   const Status s = d.advance(frame, eyes, active, &fu);
   EXPECT_TRUE(s.ok()) << s.to_string();
@@ -321,7 +322,8 @@ TEST(ClipDecoder, SeekingEqualsPlayingEqualsReference) {
       expect_matches_reference(clip, ts, direct, target, ctx + " seek");
       expect_matches_reference(clip, tw, wandered, target, ctx + " wander");
       // A fresh seek uploads no more than playing did in total, and usually far less.
-      EXPECT_LE(direct.stats.update_bytes(), last.stats.update_bytes() + direct.stats.update_bytes());
+      EXPECT_LE(direct.stats.update_bytes(),
+                last.stats.update_bytes() + direct.stats.update_bytes());
     }
   }
   EXPECT_GT(visible_somewhere, 0u) << "no trial saw anything: the test would prove nothing";
@@ -340,8 +342,10 @@ TEST(ClipDecoder, SeveralViewersGiveTheUnionOfEachViewer) {
       ClipDecoder d = open_decoder(clip);
       CpuTextures tex = textures_for(d);
       const FrameUpdates fu = advance_ok(d, tex, frame, {e});
-      for (const CellParams& c : fu.cells) cells_union.insert({c.view, cube_face_index(c.face), c.cell});
-      for (const TileRef& t : fu.tiles) tiles_union.insert({t.view, cube_face_index(t.face), t.tile});
+      for (const CellParams& c : fu.cells)
+        cells_union.insert({c.view, cube_face_index(c.face), c.cell});
+      for (const TileRef& t : fu.tiles)
+        tiles_union.insert({t.view, cube_face_index(t.face), t.tile});
     }
     ClipDecoder all = open_decoder(clip);
     CpuTextures tex = textures_for(all);
@@ -374,8 +378,14 @@ TEST(ClipDecoder, UpdatesDoNotDependOnCullingPathThreadOrCache) {
       FrameUpdates fu;
       EXPECT_TRUE(d.advance(frames[i], eyes[i], {}, &fu).ok());
       for (const TextureUpdate& u : fu.updates) {
-        const uint32_t head[] = {static_cast<uint32_t>(u.target), u.view, uint32_t(cube_face_index(u.face)),
-                                 u.slot, u.rect.x, u.rect.y, u.rect.width, u.rect.height};
+        const uint32_t head[] = {static_cast<uint32_t>(u.target),
+                                 u.view,
+                                 uint32_t(cube_face_index(u.face)),
+                                 u.slot,
+                                 u.rect.x,
+                                 u.rect.y,
+                                 u.rect.width,
+                                 u.rect.height};
         log.insert(log.end(), reinterpret_cast<const uint8_t*>(head),
                    reinterpret_cast<const uint8_t*>(head) + sizeof(head));
         log.insert(log.end(), u.bytes.begin(), u.bytes.end());
@@ -427,7 +437,8 @@ TEST(ClipDecoder, DepthSeekStepsThroughTheWindow) {
     // Expected depth updates: per tile the keyframe rect, then the rects of frames W, 2W, ...,
     // target (the last step shorter), counted from the encoder's rectangle table.
     uint64_t expected = 0;
-    const uint32_t tiles_per_face = spec.options.depth_tiles_per_side * spec.options.depth_tiles_per_side;
+    const uint32_t tiles_per_face =
+        spec.options.depth_tiles_per_side * spec.options.depth_tiles_per_side;
     for (uint32_t face = 0; face < 6; ++face) {
       for (uint32_t tile = 0; tile < tiles_per_face; ++tile) {
         auto counts = ref->depth_rect_counts(0, face, tile);

@@ -24,8 +24,8 @@
 namespace calf::player {
 namespace {
 
-using testing::make_views;
 using testing::corner_views;
+using testing::make_views;
 using testing::room_with_spheres;
 using testing::Scene;
 
@@ -64,11 +64,11 @@ double psnr_vs(const std::vector<float>& ref, const std::vector<float>& test) {
 }
 
 struct Comparison {
-  double psnr = 0;         // GL against CPU
-  double depth_agree = 0;  // share of pixels with the same sky / hit and depth within 0.1 %
+  double psnr = 0;           // GL against CPU
+  double depth_agree = 0;    // share of pixels with the same sky / hit and depth within 0.1 %
   double psnr_same_hit = 0;  // GL against CPU over those pixels
   size_t flips = 0;          // the other pixels
-  size_t hits = 0;         // pixels the CPU renderer saw a surface at
+  size_t hits = 0;           // pixels the CPU renderer saw a surface at
   RenderedImage gl, cpu;
 };
 

@@ -65,16 +65,30 @@ class Context {
     if (!ctx_ || !OSMesaMakeCurrent(ctx_, pixels_, GL_UNSIGNED_BYTE, 1, 1)) return;
 #define CALF_GL(name)                                                              \
   gl.name = reinterpret_cast<decltype(gl.name)>(OSMesaGetProcAddress("gl" #name)); \
-  if (!gl.name) return;
-    CALF_GL(CreateShader)
-    CALF_GL(ShaderSource) CALF_GL(CompileShader) CALF_GL(GetShaderiv) CALF_GL(GetShaderInfoLog)
-        CALF_GL(CreateProgram) CALF_GL(AttachShader) CALF_GL(LinkProgram) CALF_GL(GetProgramiv)
-            CALF_GL(GetProgramInfoLog) CALF_GL(UseProgram) CALF_GL(GenBuffers)
-                CALF_GL(BindBufferBase) CALF_GL(BindBuffer) CALF_GL(BufferData)
-                    CALF_GL(GetBufferSubData) CALF_GL(DispatchCompute) CALF_GL(MemoryBarrier)
-                        CALF_GL(GetUniformLocation) CALF_GL(Uniform1ui) CALF_GL(Uniform1f)
+  if (!gl.name) return
+    CALF_GL(CreateShader);
+    CALF_GL(ShaderSource);
+    CALF_GL(CompileShader);
+    CALF_GL(GetShaderiv);
+    CALF_GL(GetShaderInfoLog);
+    CALF_GL(CreateProgram);
+    CALF_GL(AttachShader);
+    CALF_GL(LinkProgram);
+    CALF_GL(GetProgramiv);
+    CALF_GL(GetProgramInfoLog);
+    CALF_GL(UseProgram);
+    CALF_GL(GenBuffers);
+    CALF_GL(BindBufferBase);
+    CALF_GL(BindBuffer);
+    CALF_GL(BufferData);
+    CALF_GL(GetBufferSubData);
+    CALF_GL(DispatchCompute);
+    CALF_GL(MemoryBarrier);
+    CALF_GL(GetUniformLocation);
+    CALF_GL(Uniform1ui);
+    CALF_GL(Uniform1f);
 #undef CALF_GL
-                            ok_ = true;
+    ok_ = true;
   }
   ~Context() {
     if (ctx_) OSMesaDestroyContext(ctx_);

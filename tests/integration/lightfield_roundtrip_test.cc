@@ -61,8 +61,8 @@ class LightfieldRoundTrip : public ::testing::Test {
   // Decodes every view, face and frame of `file` and checks colour against Q (on the spatial
   // reference), depth against the quantised input (exactly, or within `max_rel` for BC5), and
   // material codes exactly (raw).
-  void check_file(const fs::path& capture_dir, const fs::path& file, ColourCoding coding,
-                  double q, bool exact_depth, double max_rel = 0, bool exact_material = true) {
+  void check_file(const fs::path& capture_dir, const fs::path& file, ColourCoding coding, double q,
+                  bool exact_depth, double max_rel = 0, bool exact_material = true) {
     auto reader = container::Reader::open(file.string());
     ASSERT_TRUE(reader.ok()) << reader.status().to_string();
     EXPECT_TRUE(reader->verify().empty());
@@ -105,8 +105,8 @@ class LightfieldRoundTrip : public ::testing::Test {
             ASSERT_TRUE(spatial_colour_reference(coding, orig, r.width, r.height, &reference).ok());
             const double quality = hdr ? psnr_log2(reference, got) : psnr_srgb(reference, got);
             worst = std::min(worst, quality);
-            EXPECT_GE(quality, q) << "view " << v << " face " << face << " frame " << f
-                                  << " cell " << c;
+            EXPECT_GE(quality, q) << "view " << v << " face " << face << " frame " << f << " cell "
+                                  << c;
           }
           for (uint32_t y = 0; y < h.face_size; ++y) {
             for (uint32_t x = 0; x < h.face_size; ++x) {
@@ -121,8 +121,8 @@ class LightfieldRoundTrip : public ::testing::Test {
                   ASSERT_EQ(got, kLog16Sky);
                 }
               } else if (want != kLog16Sky && got != kLog16Sky) {
-                const double rel =
-                    std::abs(std::expm1((static_cast<double>(got) - want) * range->relative_step()));
+                const double rel = std::abs(
+                    std::expm1((static_cast<double>(got) - want) * range->relative_step()));
                 ASSERT_LE(rel, max_rel * (1 + 1e-9) + 1e-12);
               }
               if (info.has_material && exact_material) {

@@ -14,8 +14,8 @@
 
 #include "calf/capture/capture_set.h"
 #include "calf/encoder/lightfield_encode.h"
-#include "calf/player/image_compare.h"
 #include "calf/format/container.h"
+#include "calf/player/image_compare.h"
 #include "calf/player/playback.h"
 
 namespace calf::player {
@@ -86,7 +86,8 @@ TEST(Playback, GlAndCpuRenderTheSameFrames) {
   const auto& [lo, hi] = (*gl)->view_volume();
   for (uint32_t frame = 0; frame < 3; ++frame) {
     Camera cam;
-    cam.position = {lo.x + 0.3 * (hi.x - lo.x), lo.y + 0.5 * (hi.y - lo.y), lo.z + 0.6 * (hi.z - lo.z)};
+    cam.position = {lo.x + 0.3 * (hi.x - lo.x), lo.y + 0.5 * (hi.y - lo.y),
+                    lo.z + 0.6 * (hi.z - lo.z)};
     cam.forward = {std::cos(frame * 2.0), -0.1, std::sin(frame * 2.0)};
     cam.width = 40;
     cam.height = 32;
@@ -115,8 +116,7 @@ TEST(LightfieldRepresentation, GlAndCpuBackendsAgreeThroughTheInterface) {
   LightfieldOptions o;
   o.render.steps = 48;
   o.selection.target_frame_ms = 0;
-  auto gl_lf = LightfieldRepresentation::open(*reader, 0, o, RenderBackend::kGl,
-                                              &(*context)->gl());
+  auto gl_lf = LightfieldRepresentation::open(*reader, 0, o, RenderBackend::kGl, &(*context)->gl());
   ASSERT_TRUE(gl_lf.ok()) << gl_lf.status().to_string();
   auto cpu_lf = LightfieldRepresentation::open(*reader, 0, o, RenderBackend::kCpu, nullptr);
   ASSERT_TRUE(cpu_lf.ok()) << cpu_lf.status().to_string();

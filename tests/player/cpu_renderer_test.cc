@@ -14,10 +14,10 @@
 namespace calf::player {
 namespace {
 
+using testing::corner_views;
 using testing::ground_truth;
 using testing::make_views;
 using testing::psnr;
-using testing::corner_views;
 using testing::room_with_spheres;
 using testing::Scene;
 

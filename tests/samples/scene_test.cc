@@ -20,7 +20,8 @@ namespace {
 namespace fs = std::filesystem;
 
 double distance(const Vec3& a, const Vec3& b) {
-  return std::sqrt((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) + (a.z - b.z) * (a.z - b.z));
+  return std::sqrt((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) +
+                   (a.z - b.z) * (a.z - b.z));
 }
 
 bool inside(const Box3& b, const Vec3& p) {
@@ -73,9 +74,9 @@ TEST(Rig, Forms) {
 
 // Finite numbers whose rig a capture manifest would refuse are --rig errors naming the problem.
 TEST(Rig, OverflowingOrRepeatedViewpointsAreSyntaxErrors) {
-  for (const char* bad : {"box:1e308,0,0,1e308,1,1", "grid:2,1,1,-1e308,0,0,1e308,0,0",
-                          "ring:4,1e308,1e308,0,0", "list:0,0,0/0,0,0", "list:1,2,3/4,5,6/1,2,3",
-                          "grid:3,1,1,0,0,0,5e-324,0,0"}) {
+  for (const char* bad :
+       {"box:1e308,0,0,1e308,1,1", "grid:2,1,1,-1e308,0,0,1e308,0,0", "ring:4,1e308,1e308,0,0",
+        "list:0,0,0/0,0,0", "list:1,2,3/4,5,6/1,2,3", "grid:3,1,1,0,0,0,5e-324,0,0"}) {
     auto r = parse_rig(bad);
     ASSERT_FALSE(r.ok()) << bad;
     EXPECT_EQ(r.status().id(), ErrorId::kRigSyntax) << bad;
@@ -88,10 +89,11 @@ TEST(Rig, OverflowingOrRepeatedViewpointsAreSyntaxErrors) {
 }
 
 TEST(Rig, SyntaxErrors) {
-  for (const char* bad : {"", "box", "box:1,2,3", "box:0,0,0,0,1,1", "ring:0,1,0,0,0",
-                          "ring:2.5,1,0,0,0", "ring:4,-1,0,0,0", "sphere:4,1,0,0", "grid:2,2,2,0,0,0,1,1",
-                          "grid:2,1,1,0,0,0,0,1,1", "list:", "list:1,2", "list:1,2,3/", "cone:1,2",
-                          "box:a,b,c,d,e,f", "ring:4,1,0,0,nan", "ring:5000,1,0,0,0"}) {
+  for (const char* bad :
+       {"", "box", "box:1,2,3", "box:0,0,0,0,1,1", "ring:0,1,0,0,0", "ring:2.5,1,0,0,0",
+        "ring:4,-1,0,0,0", "sphere:4,1,0,0", "grid:2,2,2,0,0,0,1,1", "grid:2,1,1,0,0,0,0,1,1",
+        "list:", "list:1,2", "list:1,2,3/", "cone:1,2", "box:a,b,c,d,e,f", "ring:4,1,0,0,nan",
+        "ring:5000,1,0,0,0"}) {
     auto r = parse_rig(bad);
     ASSERT_FALSE(r.ok()) << bad;
     EXPECT_EQ(r.status().id(), ErrorId::kRigSyntax) << bad;

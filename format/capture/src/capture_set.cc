@@ -70,7 +70,8 @@ Status validate_view_frame(const ViewFrame& f, std::string_view context) {
     }
     if (f.has_material) {
       float rfl = f.material[3 * i], rfr = f.material[3 * i + 1], ior = f.material[3 * i + 2];
-      bool weights_ok = rfl >= 0 && rfl <= 1 && rfr >= 0 && rfr <= 1 && rfl + rfr <= 1 + kWeightSlack;
+      bool weights_ok =
+          rfl >= 0 && rfl <= 1 && rfr >= 0 && rfr <= 1 && rfl + rfr <= 1 + kWeightSlack;
       if (!weights_ok || !(std::isfinite(ior) && ior > 0)) {
         return Status(ErrorId::kCaptureMaterialPixel,
                       ctx + ": " + texel_text(f, i) + ": material (" + value_text(rfl) + ", " +
@@ -91,8 +92,8 @@ Expected<std::string> read_small_file(const std::filesystem::path& path,
   std::ifstream in;
   if (regular) in.open(path, std::ios::binary);
   if (!regular || !in) {
-    const char* why = std::filesystem::is_directory(path, ec) ? ": cannot open (a directory)"
-                                                               : ": cannot open";
+    const char* why =
+        std::filesystem::is_directory(path, ec) ? ": cannot open (a directory)" : ": cannot open";
     return Status(ErrorId::kFileOpen, path.string() + why + std::string(what_if_missing));
   }
   std::string text;
@@ -123,8 +124,8 @@ Status write_file_atomically(const std::filesystem::path& path, std::string_view
   if (ec) {
     std::error_code ignored;
     std::filesystem::remove(temp, ignored);
-    return Status(ErrorId::kFileWrite, path.string() + ": cannot rename into place: " +
-                                           ec.message());
+    return Status(ErrorId::kFileWrite,
+                  path.string() + ": cannot rename into place: " + ec.message());
   }
   return Status::Ok();
 }
@@ -133,8 +134,9 @@ Status write_file_atomically(const std::filesystem::path& path, std::string_view
 
 Expected<CaptureSetReader> CaptureSetReader::open(const std::filesystem::path& directory) {
   std::filesystem::path manifest_path = directory / kManifestFileName;
-  CALF_ASSIGN_OR_RETURN(std::string text,
-                        read_small_file(manifest_path, " (not a capture set, or an incomplete one)"));
+  CALF_ASSIGN_OR_RETURN(
+      std::string text,
+      read_small_file(manifest_path, " (not a capture set, or an incomplete one)"));
   CALF_ASSIGN_OR_RETURN(CaptureManifest m, parse_manifest(text, manifest_path.string()));
   return CaptureSetReader(directory, std::move(m));
 }
@@ -149,9 +151,9 @@ Status CaptureSetReader::check_files() const {
       std::error_code ec;
       std::filesystem::path p = image_path(v, f);
       if (!std::filesystem::is_regular_file(p, ec)) {
-        return Status(ErrorId::kCaptureFileMissing,
-                      p.string() + ": missing (view " + std::to_string(v) + ", frame " +
-                          std::to_string(f) + ")");
+        return Status(ErrorId::kCaptureFileMissing, p.string() + ": missing (view " +
+                                                        std::to_string(v) + ", frame " +
+                                                        std::to_string(f) + ")");
       }
     }
   }
@@ -258,9 +260,8 @@ Status CaptureSetWriter::write(uint32_t view, uint32_t frame, const ViewFrame& d
   if (data.face_size != m.face_size || data.has_material != m.material) {
     return Status(ErrorId::kCaptureWriterMisuse,
                   path.string() + ": view-frame has face size " + std::to_string(data.face_size) +
-                      (data.has_material ? " with" : " without") +
-                      " material; the manifest says " + std::to_string(m.face_size) +
-                      (m.material ? " with" : " without"));
+                      (data.has_material ? " with" : " without") + " material; the manifest says " +
+                      std::to_string(m.face_size) + (m.material ? " with" : " without"));
   }
   const size_t slot = static_cast<size_t>(view) * m.frame_count + frame;
   if (written_[slot]) {

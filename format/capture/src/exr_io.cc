@@ -31,8 +31,8 @@ Status write_exr(const std::filesystem::path& path, uint32_t width, uint32_t hei
     if (!out) {
       return Status(ErrorId::kFileWrite, final_name + ": " + oiio_error("no OpenEXR writer"));
     }
-    OIIO::ImageSpec spec(static_cast<int>(width), static_cast<int>(height),
-                         static_cast<int>(nch), OIIO::TypeDesc::HALF);
+    OIIO::ImageSpec spec(static_cast<int>(width), static_cast<int>(height), static_cast<int>(nch),
+                         OIIO::TypeDesc::HALF);
     spec.channelnames.clear();
     spec.channelformats.clear();
     for (const ExrChannelOut& ch : channels) {
@@ -112,8 +112,7 @@ Status ExrReader::read_rows(uint32_t y0, uint32_t y1, std::vector<float>* out) {
   try {
     const OIIO::ImageSpec& spec = input_->spec();
     if (!input_->read_scanlines(0, 0, spec.y + static_cast<int>(y0), spec.y + static_cast<int>(y1),
-                                0, 0, static_cast<int>(nch), OIIO::TypeDesc::FLOAT,
-                                out->data())) {
+                                0, 0, static_cast<int>(nch), OIIO::TypeDesc::FLOAT, out->data())) {
       std::string e = input_->geterror();
       return Status(ErrorId::kCaptureImageFormat,
                     path_ + ": rows " + std::to_string(y0) + ".." + std::to_string(y1) +

@@ -76,8 +76,8 @@ Expected<EyePose> parse_pose(const Json& j, const std::string& path, std::string
     }
     double norm = std::sqrt(qv[0] * qv[0] + qv[1] * qv[1] + qv[2] * qv[2] + qv[3] * qv[3]);
     if (std::fabs(norm - 1) > 1e-3) {
-      return r.error(r.field("orientation"), "quaternion length " + std::to_string(norm) +
-                                                 " is not 1 (tolerance 1e-3)");
+      return r.error(r.field("orientation"),
+                     "quaternion length " + std::to_string(norm) + " is not 1 (tolerance 1e-3)");
     }
     for (double& c : qv) c /= norm;
     pose.forward = rotate(qv, {0, 0, -1});
@@ -156,15 +156,14 @@ Expected<EyePath> parse_eye_path(std::string_view json, std::string_view source)
     return r.error("poses", "expected a non-empty array of poses");
   }
   if (poses->size() > kMaxEyePoses) {
-    return Status(ErrorId::kCaptureLimit, std::string(source) + ": field 'poses': " +
-                                              std::to_string(poses->size()) +
-                                              " poses exceed the limit " +
-                                              std::to_string(kMaxEyePoses));
+    return Status(ErrorId::kCaptureLimit,
+                  std::string(source) + ": field 'poses': " + std::to_string(poses->size()) +
+                      " poses exceed the limit " + std::to_string(kMaxEyePoses));
   }
   path.poses.reserve(poses->size());
   for (size_t i = 0; i < poses->size(); ++i) {
-    CALF_ASSIGN_OR_RETURN(EyePose pose, parse_pose((*poses)[i], "poses[" + std::to_string(i) + "]",
-                                                   source, fov));
+    CALF_ASSIGN_OR_RETURN(EyePose pose,
+                          parse_pose((*poses)[i], "poses[" + std::to_string(i) + "]", source, fov));
     path.poses.push_back(pose);
   }
   return path;

@@ -32,9 +32,8 @@ Expected<Json> parse_json_object(std::string_view text, std::string_view source)
     return Status(ErrorId::kManifestSyntax, std::string(source) + ": not valid JSON: " + e.what());
   }
   if (!json.is_object()) {
-    return Status(ErrorId::kManifestSyntax,
-                  std::string(source) + ": the top level is " + json.type_name() +
-                      ", expected a JSON object");
+    return Status(ErrorId::kManifestSyntax, std::string(source) + ": the top level is " +
+                                                json.type_name() + ", expected a JSON object");
   }
   return json;
 }
@@ -51,8 +50,8 @@ Status FieldReader::check_keys(std::initializer_list<const char*> allowed) const
   for (const auto& item : object_.items()) {
     const std::string& key = item.key();
     if (key.rfind("x-", 0) == 0) continue;
-    bool known = std::any_of(allowed.begin(), allowed.end(),
-                             [&](const char* a) { return key == a; });
+    bool known =
+        std::any_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; });
     if (!known) return error(field(key.c_str()), "unknown key (extensions must start with \"x-\")");
   }
   return Status::Ok();
@@ -169,8 +168,7 @@ std::string scan_tokens(std::string_view pattern, std::vector<Token>* tokens) {
 
 }  // namespace
 
-std::string expand_pattern_token(std::string_view pattern, std::string_view token,
-                                 uint32_t value) {
+std::string expand_pattern_token(std::string_view pattern, std::string_view token, uint32_t value) {
   std::vector<Token> tokens;
   if (!scan_tokens(pattern, &tokens).empty()) return std::string(pattern);
   std::string out;
@@ -201,15 +199,16 @@ std::string pattern_problem(std::string_view pattern,
   std::vector<Token> tokens;
   if (std::string problem = scan_tokens(pattern, &tokens); !problem.empty()) return problem;
   for (std::string_view name : names) {
-    long count = std::count_if(tokens.begin(), tokens.end(),
-                               [&](const Token& t) { return t.name == name; });
+    long count =
+        std::count_if(tokens.begin(), tokens.end(), [&](const Token& t) { return t.name == name; });
     if (count != 1) return "must hold {" + std::string(name) + "} exactly once";
   }
   if (tokens.size() != names.size()) return "holds an unknown token";
   for (size_t i = 1; i < tokens.size(); ++i) {
-    std::string_view between = pattern.substr(tokens[i - 1].end, tokens[i].begin - tokens[i - 1].end);
-    bool separated = std::any_of(between.begin(), between.end(),
-                                 [](char c) { return c < '0' || c > '9'; });
+    std::string_view between =
+        pattern.substr(tokens[i - 1].end, tokens[i].begin - tokens[i - 1].end);
+    bool separated =
+        std::any_of(between.begin(), between.end(), [](char c) { return c < '0' || c > '9'; });
     if (!separated) return "needs a non-digit character between two tokens";
   }
   return "";

@@ -76,6 +76,7 @@ std::string expand_pattern_token(std::string_view pattern, std::string_view toke
 // well-formed "{name}" / "{name:0N}" form, with at least one non-digit character between two
 // tokens (so that no two index combinations give the same name). Returns a description of the
 // first problem, or "" when the pattern is valid.
-std::string pattern_problem(std::string_view pattern, std::initializer_list<std::string_view> tokens);
+std::string pattern_problem(std::string_view pattern,
+                            std::initializer_list<std::string_view> tokens);
 
 }  // namespace calf::capture::detail

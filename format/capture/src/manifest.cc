@@ -39,8 +39,8 @@ Status check_manifest(const CaptureManifest& m, std::string_view source) {
                                             " exceeds the limit " + std::to_string(kMaxFrames));
   }
   if (!(m.fps > 0 && m.fps <= 1000)) {
-    return fail(ErrorId::kManifestField, "field 'fps': " + std::to_string(m.fps) +
-                                             " is outside (0, 1000]");
+    return fail(ErrorId::kManifestField,
+                "field 'fps': " + std::to_string(m.fps) + " is outside (0, 1000]");
   }
   if (m.face_size == 0) return fail(ErrorId::kManifestField, "field 'face_size': is 0");
   if (m.face_size > kMaxCaptureFaceSize) {
@@ -50,19 +50,17 @@ Status check_manifest(const CaptureManifest& m, std::string_view source) {
   }
   if (m.viewpoints.empty()) return fail(ErrorId::kManifestField, "field 'viewpoints': is empty");
   if (m.viewpoints.size() > kMaxViewpoints) {
-    return fail(ErrorId::kCaptureLimit, "field 'viewpoints': " +
-                                            std::to_string(m.viewpoints.size()) +
-                                            " viewpoints exceed the limit " +
-                                            std::to_string(kMaxViewpoints));
+    return fail(ErrorId::kCaptureLimit,
+                "field 'viewpoints': " + std::to_string(m.viewpoints.size()) +
+                    " viewpoints exceed the limit " + std::to_string(kMaxViewpoints));
   }
   const Box3& vv = m.view_volume;
   for (double c : {vv.min.x, vv.min.y, vv.min.z, vv.max.x, vv.max.y, vv.max.z}) {
     if (!std::isfinite(c)) return fail(ErrorId::kManifestField, "field 'view_volume': not finite");
   }
   if (vv.min.x > vv.max.x || vv.min.y > vv.max.y || vv.min.z > vv.max.z) {
-    return fail(ErrorId::kManifestInconsistent, "field 'view_volume': min " +
-                                                    point_text(vv.min) + " exceeds max " +
-                                                    point_text(vv.max));
+    return fail(ErrorId::kManifestInconsistent, "field 'view_volume': min " + point_text(vv.min) +
+                                                    " exceeds max " + point_text(vv.max));
   }
   // Two viewpoints at one place would be redundant data and break view selection ties; two with
   // one name make error messages ambiguous. Sorting keeps this O(n log n) at the 4096 limit.
@@ -79,12 +77,11 @@ Status check_manifest(const CaptureManifest& m, std::string_view source) {
       return fail(ErrorId::kManifestField, field + ".name': must hold 1 to 200 characters");
     }
     if (!names.insert(v.name).second) {
-      return fail(ErrorId::kManifestInconsistent, field + ".name': \"" + v.name +
-                                                      "\" is used by an earlier viewpoint");
+      return fail(ErrorId::kManifestInconsistent,
+                  field + ".name': \"" + v.name + "\" is used by an earlier viewpoint");
     }
     if (!positions.insert({v.position.x, v.position.y, v.position.z}).second) {
-      return fail(ErrorId::kManifestInconsistent, field + ".position': " +
-                                                      point_text(v.position) +
+      return fail(ErrorId::kManifestInconsistent, field + ".position': " + point_text(v.position) +
                                                       " is used by an earlier viewpoint");
     }
   }
@@ -98,7 +95,8 @@ Status check_manifest(const CaptureManifest& m, std::string_view source) {
 
 Expected<Box3> parse_box(const FieldReader& parent, const char* key) {
   CALF_ASSIGN_OR_RETURN(const Json* v, parent.get(key));
-  if (!v->is_object()) return parent.error(parent.field(key), "expected {\"min\": .., \"max\": ..}");
+  if (!v->is_object())
+    return parent.error(parent.field(key), "expected {\"min\": .., \"max\": ..}");
   FieldReader r(*v, parent.field(key), parent.source(), parent.id());
   CALF_RETURN_IF_ERROR(r.check_keys({"min", "max"}));
   Box3 box;
@@ -115,15 +113,15 @@ Expected<CaptureManifest> parse_manifest(std::string_view json, std::string_view
   // Format and version first: a newer manifest may have fields this reader does not know.
   CALF_ASSIGN_OR_RETURN(std::string format, r.string("format"));
   if (format != kFormatName) {
-    return Status(ErrorId::kManifestVersion, std::string(source) + ": field 'format': \"" +
-                                                 format + "\" is not \"" + kFormatName + "\"");
+    return Status(ErrorId::kManifestVersion, std::string(source) + ": field 'format': \"" + format +
+                                                 "\" is not \"" + kFormatName + "\"");
   }
   CaptureManifest m;
   CALF_ASSIGN_OR_RETURN(m.version, r.uint("version", 0, UINT32_MAX));
   if (m.version != kCaptureFormatVersion) return check_manifest(m, source);
-  CALF_RETURN_IF_ERROR(r.check_keys({"format", "version", "scene", "generator", "frame_count",
-                                     "fps", "face_size", "file_pattern", "material",
-                                     "view_volume", "viewpoints"}));
+  CALF_RETURN_IF_ERROR(
+      r.check_keys({"format", "version", "scene", "generator", "frame_count", "fps", "face_size",
+                    "file_pattern", "material", "view_volume", "viewpoints"}));
   CALF_ASSIGN_OR_RETURN(m.scene, r.string_or("scene", ""));
   CALF_ASSIGN_OR_RETURN(m.generator, r.string_or("generator", ""));
   CALF_ASSIGN_OR_RETURN(m.frame_count, r.uint("frame_count", 0, UINT32_MAX));
@@ -136,10 +134,9 @@ Expected<CaptureManifest> parse_manifest(std::string_view json, std::string_view
   if (!views->is_array()) return r.error("viewpoints", "expected an array of viewpoints");
   // Checked before the loop so that a hostile count never drives an allocation.
   if (views->size() > kMaxViewpoints) {
-    return Status(ErrorId::kCaptureLimit, std::string(source) + ": field 'viewpoints': " +
-                                              std::to_string(views->size()) +
-                                              " viewpoints exceed the limit " +
-                                              std::to_string(kMaxViewpoints));
+    return Status(ErrorId::kCaptureLimit,
+                  std::string(source) + ": field 'viewpoints': " + std::to_string(views->size()) +
+                      " viewpoints exceed the limit " + std::to_string(kMaxViewpoints));
   }
   m.viewpoints.reserve(views->size());
   for (size_t i = 0; i < views->size(); ++i) {

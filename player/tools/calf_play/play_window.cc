@@ -53,8 +53,8 @@ struct CameraState {
 Status run_window(const std::string& clip_path, const PlaybackOptions& options,
                   const WindowOptions& wo) {
   if (!glfwInit()) {
-    return Status(ErrorId::kPlayerGl, "cannot open a window (no display? use --headless): " +
-                                          glfw_error());
+    return Status(ErrorId::kPlayerGl,
+                  "cannot open a window (no display? use --headless): " + glfw_error());
   }
   struct GlfwGuard {
     ~GlfwGuard() { glfwTerminate(); }

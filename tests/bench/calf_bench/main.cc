@@ -1,13 +1,14 @@
-// calf-bench: the speed <-> accuracy sweeps of calf on the built-in scenes (issue 9; docs/BENCH.md).
-// Per scene: capture once, ground truth once, then one knob at a time around a base configuration
-// (sweep.h), the peers in the same run (peers.h); writes sweep.md, sweep.csv and gnuplot PNGs into
+// calf-bench: the speed <-> accuracy sweeps of calf on the built-in scenes (issue 9;
+// docs/BENCH.md). Per scene: capture once, ground truth once, then one knob at a time around a base
+// configuration (sweep.h), the peers in the same run (peers.h); writes sweep.md, sweep.csv and
+// gnuplot PNGs into
 // --out (report.h). Progress goes to stderr; errors are one line and a non-zero exit (2 for a bad
 // command line, 1 for a failure while measuring).
 #include <stdlib.h>
 
 #include <chrono>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <fstream>
 #include <map>
@@ -16,8 +17,8 @@
 #include <thread>
 #include <vector>
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include "calf/format/container_types.h"
 #include "calf/player/gl_context.h"
@@ -64,7 +65,8 @@ bool parse_numbers(const std::string& option, const std::string& text, double lo
     }
     char* end = nullptr;
     const double v = std::strtod(item.c_str(), &end);
-    const bool whole = std::is_integral_v<T> ? v == static_cast<double>(static_cast<int64_t>(v)) : true;
+    const bool whole =
+        std::is_integral_v<T> ? v == static_cast<double>(static_cast<int64_t>(v)) : true;
     if (item.empty() || *end != 0 || !(v >= lo && v <= hi) || !whole ||
         (step > 0 && static_cast<int64_t>(v) % step != 0)) {
       *error = fmt::format("{}: '{}' is not {} in [{:g}, {:g}]{}{}", option, item,
@@ -147,7 +149,7 @@ std::string upper(std::string s) {
 // Progress on stderr: point i of N, elapsed and an ETA from the mean encode time, the mean
 // playback time and the mean per-scene rest (capture, ground truth, peers) seen so far.
 struct Progress {
-  size_t total = 0, done = 0;            // points (one playback each)
+  size_t total = 0, done = 0;             // points (one playback each)
   size_t encodes_total = 0, encodes = 0;  // distinct encodes
   size_t scenes_total = 0, scenes = 0;
   double encode_s = 0, play_s = 0, scene_rest_s = 0;
@@ -233,13 +235,14 @@ Status run_scene(const std::string& name, const Options& o, const ScenePlan& pla
   for (size_t i = 0; i < plan.points.size(); ++i) {
     out->points.push_back({plan.points[i], {}, i == 0});
   }
-  progress.note(fmt::format("{}: capture {:.1f} s, ground truth {:.1f} s", name,
-                            out->capture_s, out->ground_truth_s));
+  progress.note(fmt::format("{}: capture {:.1f} s, ground truth {:.1f} s", name, out->capture_s,
+                            out->ground_truth_s));
 
   // One encode per distinct encode configuration (the base first); its points are played from it.
   std::vector<EncodeConfig> encodes;
   for (const SweepPoint& p : plan.points) {
-    if (std::find(encodes.begin(), encodes.end(), p.encode) == encodes.end()) encodes.push_back(p.encode);
+    if (std::find(encodes.begin(), encodes.end(), p.encode) == encodes.end())
+      encodes.push_back(p.encode);
   }
   const fs::path base_clip = work / "clip_0.calf";
   for (size_t e = 0; e < encodes.size(); ++e) {
@@ -267,9 +270,9 @@ Status run_scene(const std::string& name, const Options& o, const ScenePlan& pla
     ref.base_clip = base_clip;
     ref.base = out->points[0].result;
     const EncodeConfig& b = out->points[0].point.encode;
-    ref.base_label = fmt::format("{} + {} + {}, cell {}, Q {:g} (base)",
-                                 upper(ref.base.colour_format), depth_coding_name(b.depth),
-                                 super_name(b.super), b.cell, b.q);
+    ref.base_label =
+        fmt::format("{} + {} + {}, cell {}, Q {:g} (base)", upper(ref.base.colour_format),
+                    depth_coding_name(b.depth), super_name(b.super), b.cell, b.q);
     for (const MeasuredPoint& p : out->points) {
       const PointResult& r = p.result;
       if (p.point.knob == Knob::kSuper && p.point.encode.super == container::Compression::kLzma2) {
@@ -280,7 +283,8 @@ Status run_scene(const std::string& name, const Options& o, const ScenePlan& pla
         ref.extra.push_back({"depth", "base with bc5 depth", r.depth_bytes, r.encode_s});
       }
     }
-    CALF_ASSIGN_OR_RETURN(out->peers, measure_peers(in->capture_dir(), ref, o.peers, &out->peer_notes));
+    CALF_ASSIGN_OR_RETURN(out->peers,
+                          measure_peers(in->capture_dir(), ref, o.peers, &out->peer_notes));
     progress.note(fmt::format("{}: peers {:.1f} s", name, now_seconds() - t0));
   }
   std::error_code ec;
@@ -309,41 +313,55 @@ int main(int argc, char** argv) {
   std::string views = "1,2,4,all", steps = "16,32,64,128", renderer = "gl";
   uint32_t face = 128, frames = 8, gt = 128, threads = 0, base_cell = 32;
   bool quick = false, no_peers = false, no_ffmpeg = false, keep = false;
-  app.add_option("--scenes", scenes, "built-in scenes, comma-separated (default "
+  app.add_option("--scenes", scenes,
+                 "built-in scenes, comma-separated (default "
                  "interior,turntable,mirror-box)");
-  app.add_option("--out", out, "output directory for sweep.md, sweep.csv, plots (default build/bench)");
-  app.add_option("--work", work, "scratch directory: each run makes its own run-XXXXXX folder "
+  app.add_option("--out", out,
+                 "output directory for sweep.md, sweep.csv, plots (default build/bench)");
+  app.add_option("--work", work,
+                 "scratch directory: each run makes its own run-XXXXXX folder "
                  "in it for captures and clips, removed afterwards unless --keep-work (default "
                  "OUT/work)");
   app.add_flag("--keep-work", keep, "keep the captures, ground truth and base clips");
-  app.add_option("--face", face, "cube face size of the captures, texels (default 128; --quick 64)");
+  app.add_option("--face", face,
+                 "cube face size of the captures, texels (default 128; --quick 64)");
   app.add_option("--frames", frames, "frames captured (default 8; --quick 4)");
-  app.add_option("--gt-size", gt, "ground-truth image side in pixels; one pose per frame "
+  app.add_option("--gt-size", gt,
+                 "ground-truth image side in pixels; one pose per frame "
                  "along the scene's eye path (default 128; --quick 64)");
-  app.add_option("--threads", threads, "capture, encode and CPU-render threads, 0 = all cores "
+  app.add_option("--threads", threads,
+                 "capture, encode and CPU-render threads, 0 = all cores "
                  "(default 0)");
-  app.add_option("--renderer", renderer, "gl (OpenGL 4.5 through OSMesa, as calf-play "
+  app.add_option("--renderer", renderer,
+                 "gl (OpenGL 4.5 through OSMesa, as calf-play "
                  "--headless) or cpu (the scalar reference renderer) (default gl)");
-  app.add_option("--knobs", knobs, "knobs to sweep, comma-separated: q, cell, window, aabbs, "
+  app.add_option("--knobs", knobs,
+                 "knobs to sweep, comma-separated: q, cell, window, aabbs, "
                  "depth, colour, super, views, steps, or all (default all)");
-  app.add_option("--base-cell", base_cell, "colour cell size of the base configuration "
-                 "(default 32; everything else in the base is calf-encode's / calf-play's default)");
+  app.add_option(
+      "--base-cell", base_cell,
+      "colour cell size of the base configuration "
+      "(default 32; everything else in the base is calf-encode's / calf-play's default)");
   app.add_option("--q", q, "PSNR thresholds Q in dB (default 35,40,45,50,55; --quick 40,50)");
   app.add_option("--cells", cells, "colour cell sizes (default 16,32,64; --quick 32,64)");
   app.add_option("--windows", windows, "depth windows W (default 1,2,4; --quick 1,2)");
   app.add_option("--aabbs", aabbs, "AABB limits A (default 1,2,4; --quick 1,2)");
   app.add_option("--depth-formats", depth, "depth formats: raw16, bc5 (default raw16,bc5)");
-  app.add_option("--colour-formats", colour, "colour formats: auto (BC6H for HDR captures, BC1 "
+  app.add_option("--colour-formats", colour,
+                 "colour formats: auto (BC6H for HDR captures, BC1 "
                  "for LDR), bc1, bc7, bc6h (default auto,bc1,bc7; --quick auto,bc7)");
   app.add_option("--super", super, "supercompression: zstd, lzma2, none (default zstd,lzma2)");
-  app.add_option("--views", views, "active view counts, 'all' = every viewpoint (default "
+  app.add_option("--views", views,
+                 "active view counts, 'all' = every viewpoint (default "
                  "1,2,4,all; --quick 1,all)");
   app.add_option("--steps", steps, "ray-march steps (default 16,32,64,128; --quick 32,64)");
-  app.add_flag("--quick", quick, "fewer points and a smaller capture, for trying things: the "
+  app.add_flag("--quick", quick,
+               "fewer points and a smaller capture, for trying things: the "
                "--quick values above unless given");
   app.add_flag("--no-peers", no_peers, "skip the peers (xz, zstd, ffmpeg)");
   app.add_flag("--no-ffmpeg", no_ffmpeg, "skip only the ffmpeg peers");
-  app.add_option("--x265-preset", o.peers.x265_preset, "x265 preset of the ffmpeg peers (default "
+  app.add_option("--x265-preset", o.peers.x265_preset,
+                 "x265 preset of the ffmpeg peers (default "
                  "medium)");
   try {
     app.parse(argc, argv);
@@ -399,7 +417,8 @@ int main(int argc, char** argv) {
     return fail("--renderer: '" + renderer + "' is neither gl nor cpu", 2);
   }
   if (face < 4 || face > 4096) return fail(fmt::format("--face {} is outside 4..4096", face), 2);
-  if (frames < 1 || frames > 100000) return fail(fmt::format("--frames {} is outside 1..100000", frames), 2);
+  if (frames < 1 || frames > 100000)
+    return fail(fmt::format("--frames {} is outside 1..100000", frames), 2);
   if (gt < 11 || gt > 4096) {
     return fail(fmt::format("--gt-size {} is outside 11..4096 (SSIM needs 11 pixels)", gt), 2);
   }
@@ -414,7 +433,8 @@ int main(int argc, char** argv) {
       known = known || s == i.name;
       names += std::string(names.empty() ? "" : ", ") + i.name;
     }
-    if (!known) return fail(fmt::format("--scenes: unknown scene '{}' (built-in: {})", s, names), 2);
+    if (!known)
+      return fail(fmt::format("--scenes: unknown scene '{}' (built-in: {})", s, names), 2);
     if (std::find(o.scenes.begin(), o.scenes.end(), s) == o.scenes.end()) o.scenes.push_back(s);
   }
   v.base_encode.cell = base_cell;
@@ -441,8 +461,8 @@ int main(int argc, char** argv) {
       "faces {}², {} frames, ground truth {}×{} (one pose per frame), threads {} ({}), base = "
       "calf-encode defaults with cell {} (Q {:g}, colour auto, depth raw16, W 2, A 2, zstd) and "
       "calf-play --headless defaults ({} views, {} steps, no performance culling)",
-      face, frames, gt, gt, threads, threads ? "as given" : "all cores", base_cell,
-      v.base_encode.q, v.base_play.views, v.base_play.steps);
+      face, frames, gt, gt, threads, threads ? "as given" : "all cores", base_cell, v.base_encode.q,
+      v.base_play.views, v.base_play.steps);
 
   std::error_code ec;
   fs::create_directories(o.out, ec);
@@ -516,9 +536,10 @@ int main(int argc, char** argv) {
   for (const SceneResult& r : results) rows += r.points.size();
   progress.note(fmt::format("done: {} points ({} encodes) in {}", rows, progress.encodes,
                             clock_text(run.total_s)));
-  std::printf("calf-bench: %zu scene%s, %zu points in %s; wrote %s (sweep.md, sweep.csv, %zu "
-              "plots); %s\n",
-              results.size(), results.size() == 1 ? "" : "s", rows, clock_text(run.total_s).c_str(), o.out.string().c_str(),
-              plots.size(), run.plot_notice.c_str());
+  std::printf(
+      "calf-bench: %zu scene%s, %zu points in %s; wrote %s (sweep.md, sweep.csv, %zu "
+      "plots); %s\n",
+      results.size(), results.size() == 1 ? "" : "s", rows, clock_text(run.total_s).c_str(),
+      o.out.string().c_str(), plots.size(), run.plot_notice.c_str());
   return 0;
 }

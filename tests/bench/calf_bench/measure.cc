@@ -20,8 +20,7 @@ namespace calf::bench {
 namespace fs = std::filesystem;
 
 double now_seconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 double cpu_seconds() {
@@ -71,9 +70,9 @@ Expected<std::unique_ptr<SceneInputs>> SceneInputs::make(const std::string& name
   // Read back what was written, as calf-play --compare does: the file is the reference.
   CALF_ASSIGN_OR_RETURN(in->path_, capture::read_eye_path(gt_dir / capture::kEyePathFileName));
   for (uint32_t k = 0; k < in->path_.poses.size(); ++k) {
-    CALF_ASSIGN_OR_RETURN(capture::PerspectiveImage image,
-                          capture::read_perspective_image(
-                              gt_dir / capture::eye_image_file_name(in->path_, k)));
+    CALF_ASSIGN_OR_RETURN(
+        capture::PerspectiveImage image,
+        capture::read_perspective_image(gt_dir / capture::eye_image_file_name(in->path_, k)));
     in->ground_truth_.push_back(std::move(image));
   }
   return in;
@@ -104,7 +103,8 @@ Status SceneInputs::play(const fs::path& clip, const PlayConfig& config, PointRe
   player::PlaybackOptions o;
   o.lightfield.render.steps = config.steps;
   o.lightfield.selection.max_active = config.views;
-  o.lightfield.selection.target_frame_ms = 0;  // calf-play --headless: quality first, no performance culling
+  o.lightfield.selection.target_frame_ms =
+      0;  // calf-play --headless: quality first, no performance culling
   o.use_gl = settings_.use_gl;
   const uint32_t cores = std::max(1u, std::thread::hardware_concurrency());
   o.lightfield.render.threads = std::min(256u, settings_.threads ? settings_.threads : cores);

@@ -27,8 +27,8 @@ struct MeasureSettings {
   uint32_t face_size = 128;
   uint32_t frames = 8;
   uint32_t gt_width = 128, gt_height = 128;
-  uint32_t threads = 0;   // capture, encode and CPU-render threads; 0 = all cores
-  bool use_gl = true;     // false: the CPU reference renderer
+  uint32_t threads = 0;                     // capture, encode and CPU-render threads; 0 = all cores
+  bool use_gl = true;                       // false: the CPU reference renderer
   const player::GlFunctions* gl = nullptr;  // the current OSMesa context's (use_gl)
 };
 
@@ -57,7 +57,8 @@ class SceneInputs {
   const capture::EyePath& eye_path() const { return path_; }
 
   // Encodes the capture set with `config` into `clip` (wall time measured around the call).
-  Expected<EncodeOutcome> encode(const EncodeConfig& config, const std::filesystem::path& clip) const;
+  Expected<EncodeOutcome> encode(const EncodeConfig& config,
+                                 const std::filesystem::path& clip) const;
 
   // Plays `clip` headless along the eye path with `config` and fills the playback fields of
   // `out` (frames, decode / render medians and first frame, PSNR, SSIM, ...).

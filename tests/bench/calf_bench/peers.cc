@@ -31,8 +31,8 @@ struct GridFrames {
   std::vector<uint16_t> depth;  // frames x height x width log-16 codes
   std::vector<uint8_t> rgb;     // frames x height x width x 3 sRGB bytes
   size_t at(uint32_t frame, uint32_t view, int face_index, uint32_t x, uint32_t y) const {
-    return (size_t{frame} * height + size_t{view} * face + y) * width +
-           size_t(face_index) * face + x;
+    return (size_t{frame} * height + size_t{view} * face + y) * width + size_t(face_index) * face +
+           x;
   }
 };
 
@@ -161,8 +161,8 @@ std::span<const uint8_t> bytes_of(const std::vector<uint16_t>& v) {
 }
 
 // A raw stream through one of calf's chunk coders at a peer's level, decoded back 3 times.
-PeerRow raw_peer(const std::string& stream, const std::string& method,
-                 std::span<const uint8_t> raw, container::Compression c, uint32_t frames) {
+PeerRow raw_peer(const std::string& stream, const std::string& method, std::span<const uint8_t> raw,
+                 container::Compression c, uint32_t frames) {
   PeerRow r;
   r.stream = stream;
   r.method = method;
@@ -207,7 +207,8 @@ RawPair raw_peers_in_parallel(const std::string& stream, std::span<const uint8_t
     r.xz = raw_peer(stream, "xz -9 (liblzma LZMA2 preset 9)", raw, container::Compression::kLzma2,
                     frames);
   });
-  r.zstd = raw_peer(stream, "zstd -19 (libzstd level 19)", raw, container::Compression::kZstd, frames);
+  r.zstd =
+      raw_peer(stream, "zstd -19 (libzstd level 19)", raw, container::Compression::kZstd, frames);
   xz.join();
   return r;
 }
@@ -224,9 +225,9 @@ PeerRow ffmpeg_row(const std::string& stream, const PeerResult& p, uint64_t raw_
   r.marginal_ms_per_frame = p.marginal_ms_per_frame;
   r.note = p.note;
   if (p.available) {
-    r.quality = p.crf >= 0 ? fmt::format("{:.2f} dB (CRF {:.2f}, {} encodes)", p.psnr_db, p.crf,
-                                         p.encodes)
-                           : (p.exact ? "exact" : "DIFFERS");
+    r.quality = p.crf >= 0
+                    ? fmt::format("{:.2f} dB (CRF {:.2f}, {} encodes)", p.psnr_db, p.crf, p.encodes)
+                    : (p.exact ? "exact" : "DIFFERS");
   }
   return r;
 }
@@ -263,14 +264,13 @@ Expected<std::vector<PeerRow>> measure_peers(const fs::path& capture_dir, const 
       "including ffmpeg's start-up, 'marginal' without it; the x265 colour peer's encode s is its "
       "final encode at the chosen CRF (the bisection's other encodes not counted).",
       g.frames, g.width, g.height, g.views, g.face, raw_depth,
-      decoded.depth_mismatches < 0
-          ? ""
-          : decoded.depth_mismatches == 0
-                ? ", identical code for code to the base clip's decoded depth"
-                : fmt::format(", differing from the base clip's decoded depth in {} codes",
-                              decoded.depth_mismatches),
-      raw_rgb, calf.base.colour_raw,
-      calf_psnr, full_decode.median_ms, g.frames, full_decode.first_ms);
+      decoded.depth_mismatches < 0 ? ""
+      : decoded.depth_mismatches == 0
+          ? ", identical code for code to the base clip's decoded depth"
+          : fmt::format(", differing from the base clip's decoded depth in {} codes",
+                        decoded.depth_mismatches),
+      raw_rgb, calf.base.colour_raw, calf_psnr, full_decode.median_ms, g.frames,
+      full_decode.first_ms);
 
   std::vector<PeerRow> rows;
   auto calf_row = [&](const std::string& stream, const std::string& method, uint64_t bytes,
@@ -286,12 +286,14 @@ Expected<std::vector<PeerRow>> measure_peers(const fs::path& capture_dir, const 
     r.quality = q;
     rows.push_back(r);
   };
-  const std::string depth_quality =
-      decoded.depth_mismatches == 0 ? "exact" : decoded.depth_mismatches < 0 ? "lossy" : "DIFFERS";
-  calf_row("depth", "calf " + calf.base_label, calf.base.depth_bytes, raw_depth,
-           calf.base.encode_s, full_decode.median_ms, depth_quality);
+  const std::string depth_quality = decoded.depth_mismatches == 0  ? "exact"
+                                    : decoded.depth_mismatches < 0 ? "lossy"
+                                                                   : "DIFFERS";
+  calf_row("depth", "calf " + calf.base_label, calf.base.depth_bytes, raw_depth, calf.base.encode_s,
+           full_decode.median_ms, depth_quality);
   for (const auto& e : calf.extra) {
-    if (e.stream == "depth") calf_row("depth", "calf " + e.method, e.bytes, raw_depth, e.encode_s, -1, "");
+    if (e.stream == "depth")
+      calf_row("depth", "calf " + e.method, e.bytes, raw_depth, e.encode_s, -1, "");
   }
   {
     const RawPair depth = raw_peers_in_parallel("depth", bytes_of(g.depth), g.frames);
@@ -299,7 +301,8 @@ Expected<std::vector<PeerRow>> measure_peers(const fs::path& capture_dir, const 
     rows.push_back(depth.zstd);
   }
   if (settings.ffmpeg) {
-    rows.push_back(ffmpeg_row("depth", ffv1_depth(g.depth, g.width, g.height, g.frames), raw_depth));
+    rows.push_back(
+        ffmpeg_row("depth", ffv1_depth(g.depth, g.width, g.height, g.frames), raw_depth));
     rows.push_back(ffmpeg_row(
         "depth", x265_lossless_depth(g.depth, g.width, g.height, g.frames, settings.x265_preset),
         raw_depth));
@@ -310,7 +313,8 @@ Expected<std::vector<PeerRow>> measure_peers(const fs::path& capture_dir, const 
   calf_row("colour", "calf " + calf.base_label, calf.base.colour_bytes, raw_rgb, calf.base.encode_s,
            full_decode.median_ms, fmt::format("{:.2f} dB", calf_psnr));
   for (const auto& e : calf.extra) {
-    if (e.stream == "colour") calf_row("colour", "calf " + e.method, e.bytes, raw_rgb, e.encode_s, -1, "");
+    if (e.stream == "colour")
+      calf_row("colour", "calf " + e.method, e.bytes, raw_rgb, e.encode_s, -1, "");
   }
   {
     const RawPair colour = raw_peers_in_parallel("colour", g.rgb, g.frames);
@@ -318,11 +322,11 @@ Expected<std::vector<PeerRow>> measure_peers(const fs::path& capture_dir, const 
     rows.push_back(colour.zstd);
   }
   if (settings.ffmpeg) {
-    rows.push_back(ffmpeg_row("colour",
-                              x265_colour_matched(g.rgb, g.width, g.height, g.frames, calf_psnr,
-                                                  settings.colour_tolerance_db, "auto",
-                                                  settings.x265_preset),
-                              raw_rgb));
+    rows.push_back(
+        ffmpeg_row("colour",
+                   x265_colour_matched(g.rgb, g.width, g.height, g.frames, calf_psnr,
+                                       settings.colour_tolerance_db, "auto", settings.x265_preset),
+                   raw_rgb));
   } else {
     rows.push_back(skipped("colour", "ffmpeg x265 at matched PSNR", "skipped (--no-ffmpeg)"));
   }

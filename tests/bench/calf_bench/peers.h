@@ -28,7 +28,7 @@
 namespace calf::bench {
 
 struct PeerSettings {
-  bool ffmpeg = true;              // false: the ffmpeg rows say "skipped (--no-ffmpeg)"
+  bool ffmpeg = true;  // false: the ffmpeg rows say "skipped (--no-ffmpeg)"
   std::string x265_preset = "medium";
   double colour_tolerance_db = 0.5;  // how close x265's PSNR must come to calf's (dB)
 };

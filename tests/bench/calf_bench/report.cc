@@ -30,7 +30,9 @@ std::vector<bool> pareto_front(const std::vector<std::pair<double, double>>& cq)
 // A value as sweep.csv prints it (3 decimals): the front is computed on the reported numbers,
 // so that anyone recomputing it from the CSV gets the same points.
 namespace {
-double as_reported(double v) { return std::stod(fmt::format("{:.3f}", v)); }
+double as_reported(double v) {
+  return std::stod(fmt::format("{:.3f}", v));
+}
 }  // namespace
 
 void mark_pareto(SceneResult* scene) {
@@ -115,7 +117,8 @@ std::string detail(Knob k, const MeasuredPoint& p) {
     case Knob::kWindow:
     case Knob::kAabbs:
       return fmt::format("{:.1f} Mbps@24 of updates", r.mean_mbps);
-    default: return "";
+    default:
+      return "";
   }
 }
 
@@ -123,16 +126,26 @@ std::string detail(Knob k, const MeasuredPoint& p) {
 std::string base_value(Knob k, const SweepPoint& p) {
   const EncodeConfig& e = p.encode;
   switch (k) {
-    case Knob::kQ: return fmt::format("{:g}", e.q);
-    case Knob::kCell: return fmt::format("{}", e.cell);
-    case Knob::kWindow: return fmt::format("{}", e.window);
-    case Knob::kAabbs: return fmt::format("{}", e.aabbs);
-    case Knob::kDepth: return depth_coding_name(e.depth);
-    case Knob::kColour: return colour_coding_name(e.colour);
-    case Knob::kSuper: return super_name(e.super);
-    case Knob::kViews: return fmt::format("{}", p.play.views);
-    case Knob::kSteps: return fmt::format("{}", p.play.steps);
-    case Knob::kBase: break;
+    case Knob::kQ:
+      return fmt::format("{:g}", e.q);
+    case Knob::kCell:
+      return fmt::format("{}", e.cell);
+    case Knob::kWindow:
+      return fmt::format("{}", e.window);
+    case Knob::kAabbs:
+      return fmt::format("{}", e.aabbs);
+    case Knob::kDepth:
+      return depth_coding_name(e.depth);
+    case Knob::kColour:
+      return colour_coding_name(e.colour);
+    case Knob::kSuper:
+      return super_name(e.super);
+    case Knob::kViews:
+      return fmt::format("{}", p.play.views);
+    case Knob::kSteps:
+      return fmt::format("{}", p.play.steps);
+    case Knob::kBase:
+      break;
   }
   return "base";
 }
@@ -145,9 +158,9 @@ std::string point_row(Knob k, const MeasuredPoint& p, bool base) {
       "| {} | {} | {} | {} | {} | {:.2f} ({:.1f}) | {:.2f} | {:.2f} | {:.1f} | {:.1f} | "
       "{:.1f} / {:.1f} / {:.1f} | {:.2f} | {:.4f} | {} | {} |\n",
       value, grouped(r.clip_bytes), grouped(r.colour_bytes), grouped(r.depth_bytes),
-      grouped(r.material_bytes), r.encode_s, r.encode_cpu_s, r.decode_ms, r.upload_ms,
-      r.render_ms, r.total_cpu_ms(), r.first_decode_ms, r.first_upload_ms, r.first_render_ms,
-      r.psnr_db, r.ssim, front_text(r), detail(k, p));
+      grouped(r.material_bytes), r.encode_s, r.encode_cpu_s, r.decode_ms, r.upload_ms, r.render_ms,
+      r.total_cpu_ms(), r.first_decode_ms, r.first_upload_ms, r.first_render_ms, r.psnr_db, r.ssim,
+      front_text(r), detail(k, p));
 }
 
 const char* kPointHeader =
@@ -218,10 +231,11 @@ Status write_markdown(const fs::path& file, const std::vector<SceneResult>& scen
       "{} min {:.0f} s total wall time.\n\n",
       run.command_line, run.date_utc, run.points, run.encodes, run.points, minutes,
       run.total_s - 60.0 * minutes);
-  out += fmt::format("- machine: {}\n- renderer: {}\n- load average (1 / 5 / 15 min): {} at the "
-                     "start, {} at the end (the machine is shared: timings move with it)\n"
-                     "- settings: {}\n",
-                     run.machine, run.renderer, run.load_start, run.load_end, run.settings);
+  out += fmt::format(
+      "- machine: {}\n- renderer: {}\n- load average (1 / 5 / 15 min): {} at the "
+      "start, {} at the end (the machine is shared: timings move with it)\n"
+      "- settings: {}\n",
+      run.machine, run.renderer, run.load_start, run.load_end, run.settings);
   out +=
       "- timings, one run per point (nothing cached between points): encode = "
       "`encode_lightfield_file`, wall seconds (CPU seconds of all threads in brackets); decode = "
@@ -240,10 +254,11 @@ Status write_markdown(const fs::path& file, const std::vector<SceneResult>& scen
       "with the other processes' load far more than between neighbouring points\n";
   out += fmt::format("- plots: {}\n\n", run.plot_notice);
 
-  out += "## Base configuration per scene\n\n"
-         "| scene | views | colour | clip bytes | colour | depth | material | encode s | decode ms "
-         "| upload ms | render ms | frame CPU ms | PSNR dB | SSIM |\n"
-         "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  out +=
+      "## Base configuration per scene\n\n"
+      "| scene | views | colour | clip bytes | colour | depth | material | encode s | decode ms "
+      "| upload ms | render ms | frame CPU ms | PSNR dB | SSIM |\n"
+      "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const SceneResult& s : scenes) {
     if (s.points.empty()) continue;
     const PointResult& r = s.points[0].result;
@@ -266,9 +281,10 @@ Status write_markdown(const fs::path& file, const std::vector<SceneResult>& scen
         b.colour_format, s.material ? "; it has a material stream" : "; no material stream",
         s.capture_s, s.ground_truth_s);
     if (b.hdr) {
-      out += "BC1 / BC7 on this HDR capture: the encoder clamps each linear value to [0, 1] and "
-             "codes it as 8-bit sRGB (highlights above 1 are lost), and Q is then judged by PSNR "
-             "on sRGB instead of log2-PSNR (docs/ENCODER.md).\n\n";
+      out +=
+          "BC1 / BC7 on this HDR capture: the encoder clamps each linear value to [0, 1] and "
+          "codes it as 8-bit sRGB (highlights above 1 are lost), and Q is then judged by PSNR "
+          "on sRGB instead of log2-PSNR (docs/ENCODER.md).\n\n";
     }
     for (const auto& [knob, rows] : s.tables) {
       out += fmt::format("### {}\n\n", knob_title(knob));
@@ -338,16 +354,26 @@ struct PointStyle {
 };
 PointStyle point_style(Knob k) {
   switch (k) {
-    case Knob::kBase: return {5, 1.6, "#000000"};
-    case Knob::kQ: return {2, 1.3, "#1f77b4"};
-    case Knob::kCell: return {3, 1.3, "#ff7f0e"};
-    case Knob::kWindow: return {4, 1.3, "#2ca02c"};
-    case Knob::kAabbs: return {6, 1.3, "#d62728"};
-    case Knob::kDepth: return {8, 1.3, "#9467bd"};
-    case Knob::kColour: return {7, 1.3, "#8c564b"};
-    case Knob::kSuper: return {10, 1.3, "#e377c2"};
-    case Knob::kViews: return {9, 1.3, "#17becf"};
-    case Knob::kSteps: return {11, 1.3, "#7f7f00"};
+    case Knob::kBase:
+      return {5, 1.6, "#000000"};
+    case Knob::kQ:
+      return {2, 1.3, "#1f77b4"};
+    case Knob::kCell:
+      return {3, 1.3, "#ff7f0e"};
+    case Knob::kWindow:
+      return {4, 1.3, "#2ca02c"};
+    case Knob::kAabbs:
+      return {6, 1.3, "#d62728"};
+    case Knob::kDepth:
+      return {8, 1.3, "#9467bd"};
+    case Knob::kColour:
+      return {7, 1.3, "#8c564b"};
+    case Knob::kSuper:
+      return {10, 1.3, "#e377c2"};
+    case Knob::kViews:
+      return {9, 1.3, "#17becf"};
+    case Knob::kSteps:
+      return {11, 1.3, "#7f7f00"};
   }
   return {1, 1.3, "#000000"};
 }
@@ -369,8 +395,7 @@ std::string plot_script(const SceneResult& s, const std::string& terminal, bool 
       "plot '{0}_front_{1}.dat' using 1:2 with linespoints lw 2 lc rgb '#999999' pt 6 ps 2.4 "
       "title 'Pareto front'",
       s.scene, axis, terminal, bytes ? "clip bytes" : "frame CPU time",
-      bytes ? "clip bytes (MB)"
-            : "CPU ms per frame: decode + upload + render (median)");
+      bytes ? "clip bytes (MB)" : "CPU ms per frame: decode + upload + render (median)");
   for (size_t i = 0; i < blocks.size(); ++i) {
     const PointStyle st = point_style(blocks[i]);
     g += fmt::format(
@@ -393,7 +418,8 @@ std::vector<std::string> write_plots(const fs::path& dir, const std::vector<Scen
   const fs::path err = tmp.ok() ? tmp / "gnuplot.err" : fs::path("/dev/null");
   // pngcairo draws smoother lines; the libgd png terminal is the fallback every gnuplot has.
   std::string terminal = "pngcairo";
-  internal::ProcessResult probe = internal::run({"gnuplot", "-e", "set terminal pngcairo"}, false, err);
+  internal::ProcessResult probe =
+      internal::run({"gnuplot", "-e", "set terminal pngcairo"}, false, err);
   if (!probe.started) {
     *notice = "gnuplot not found: plots skipped (tables and data written)";
   } else if (probe.exit_code != 0) {
@@ -406,13 +432,14 @@ std::vector<std::string> write_plots(const fs::path& dir, const std::vector<Scen
     for (bool bytes : {true, false}) {
       const std::string axis = bytes ? "bytes" : "ms";
       const std::string script = s.scene + "_psnr_" + axis + ".gp";
-      if (!write_file_whole(dir / (s.scene + "_front_" + axis + ".dat"), front_data(s, bytes)).ok() ||
+      if (!write_file_whole(dir / (s.scene + "_front_" + axis + ".dat"), front_data(s, bytes))
+               .ok() ||
           !write_file_whole(dir / script, plot_script(s, terminal, bytes, blocks)).ok() ||
           !probe.started) {
         continue;
       }
-      const internal::ProcessResult r = internal::run(
-          {"gnuplot", "-e", "cd '" + dir.string() + "'", script}, false, err);
+      const internal::ProcessResult r =
+          internal::run({"gnuplot", "-e", "cd '" + dir.string() + "'", script}, false, err);
       if (r.exit_code != 0) {
         *notice = "gnuplot failed on " + script + ": " + r.error + " (tables written)";
         continue;
@@ -421,8 +448,8 @@ std::vector<std::string> write_plots(const fs::path& dir, const std::vector<Scen
     }
   }
   if (probe.started && notice->empty()) {
-    *notice = fmt::format("gnuplot, terminal {} (800×500); scripts and data next to the PNGs",
-                          terminal);
+    *notice =
+        fmt::format("gnuplot, terminal {} (800×500); scripts and data next to the PNGs", terminal);
   }
   return made;
 }

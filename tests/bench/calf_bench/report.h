@@ -27,14 +27,14 @@ void mark_pareto(SceneResult* scene);
 // How the run went, for the head of sweep.md.
 struct RunInfo {
   std::string command_line;
-  std::string date_utc;        // ISO 8601
-  std::string machine;         // CPU, cores, memory, OS
-  std::string renderer;        // "GL: llvmpipe (...)" or "CPU reference renderer, N threads"
+  std::string date_utc;              // ISO 8601
+  std::string machine;               // CPU, cores, memory, OS
+  std::string renderer;              // "GL: llvmpipe (...)" or "CPU reference renderer, N threads"
   std::string load_start, load_end;  // /proc/loadavg at start and end
-  std::string settings;        // face, frames, ground truth size, threads, ...
+  std::string settings;              // face, frames, ground truth size, threads, ...
   double total_s = 0;
   size_t points = 0, encodes = 0;  // measured points (one playback each) and encodes
-  std::string plot_notice;     // filled by write_plots()
+  std::string plot_notice;         // filled by write_plots()
 };
 
 // One line per measured point; columns as the header row names them.

@@ -64,8 +64,8 @@ struct PlayConfig {
   friend bool operator==(const PlayConfig&, const PlayConfig&) = default;
 };
 
-const char* colour_coding_name(ColourCoding c);  // "auto", "bc1", ...
-const char* depth_coding_name(DepthCoding d);    // "raw16", "bc5"
+const char* colour_coding_name(ColourCoding c);    // "auto", "bc1", ...
+const char* depth_coding_name(DepthCoding d);      // "raw16", "bc5"
 const char* super_name(container::Compression c);  // "zstd", "lzma2", "none"
 
 // One point of a scene's sweep: the base configuration with `knob` set to `value`.
@@ -94,11 +94,11 @@ struct PointResult {
   // *_cpu_ms: the process's CPU time over the same call (every thread: llvmpipe's, the decoder's
   // prefetch thread), which other load on a shared machine hardly changes.
   uint32_t frames = 0;
-  double decode_ms = 0, upload_ms = 0, render_ms = 0;  // medians of frames 2..n
-  double prepare_cpu_ms = 0, render_cpu_ms = 0;        // medians of frames 2..n
+  double decode_ms = 0, upload_ms = 0, render_ms = 0;                    // medians of frames 2..n
+  double prepare_cpu_ms = 0, render_cpu_ms = 0;                          // medians of frames 2..n
   double first_decode_ms = 0, first_upload_ms = 0, first_render_ms = 0;  // frame 1
   double mean_active_views = 0;
-  double mean_mbps = 0;  // texture-update bitrate at 24 fps (decoder statistics)
+  double mean_mbps = 0;          // texture-update bitrate at 24 fps (decoder statistics)
   double psnr_db = 0, ssim = 0;  // means over the poses (a pose's PSNR capped at 100 dB)
   double worst_psnr_db = 0;
   // Pareto front membership within the scene (filled by the report).
@@ -122,12 +122,12 @@ struct PeerRow {
   std::string method;
   bool available = false;
   uint64_t bytes = 0;
-  uint64_t raw_bytes = 0;      // what this method codes
-  uint64_t calf_bytes = 0;     // calf's bytes of the same stream (base configuration)
+  uint64_t raw_bytes = 0;   // what this method codes
+  uint64_t calf_bytes = 0;  // calf's bytes of the same stream (base configuration)
   double encode_s = 0;
-  double decode_ms_per_frame = 0;  // the whole clip decoded, per frame
+  double decode_ms_per_frame = 0;     // the whole clip decoded, per frame
   double marginal_ms_per_frame = -1;  // ffmpeg: without its start-up (-1: not applicable)
-  std::string quality;  // "exact", "44.1 dB", ...
+  std::string quality;                // "exact", "44.1 dB", ...
   std::string note;
 };
 

@@ -8,70 +8,105 @@ namespace calf::bench {
 
 const char* knob_name(Knob knob) {
   switch (knob) {
-    case Knob::kBase: return "base";
-    case Knob::kQ: return "q";
-    case Knob::kCell: return "cell";
-    case Knob::kWindow: return "window";
-    case Knob::kAabbs: return "aabbs";
-    case Knob::kDepth: return "depth";
-    case Knob::kColour: return "colour";
-    case Knob::kSuper: return "super";
-    case Knob::kViews: return "views";
-    case Knob::kSteps: return "steps";
+    case Knob::kBase:
+      return "base";
+    case Knob::kQ:
+      return "q";
+    case Knob::kCell:
+      return "cell";
+    case Knob::kWindow:
+      return "window";
+    case Knob::kAabbs:
+      return "aabbs";
+    case Knob::kDepth:
+      return "depth";
+    case Knob::kColour:
+      return "colour";
+    case Knob::kSuper:
+      return "super";
+    case Knob::kViews:
+      return "views";
+    case Knob::kSteps:
+      return "steps";
   }
   return "?";
 }
 
 const char* knob_title(Knob knob) {
   switch (knob) {
-    case Knob::kBase: return "base configuration";
-    case Knob::kQ: return "PSNR threshold Q (dB, calf-encode --psnr)";
-    case Knob::kCell: return "colour cell size (px, calf-encode --cell)";
-    case Knob::kWindow: return "depth window W (calf-encode --depth-window)";
-    case Knob::kAabbs: return "AABB limit A (calf-encode --max-aabbs)";
-    case Knob::kDepth: return "depth format (calf-encode --depth-format)";
-    case Knob::kColour: return "colour format (calf-encode --color-format)";
-    case Knob::kSuper: return "supercompression (calf-encode --supercompression)";
-    case Knob::kViews: return "active views (calf-play --views)";
-    case Knob::kSteps: return "ray-march steps (calf-play --steps)";
+    case Knob::kBase:
+      return "base configuration";
+    case Knob::kQ:
+      return "PSNR threshold Q (dB, calf-encode --psnr)";
+    case Knob::kCell:
+      return "colour cell size (px, calf-encode --cell)";
+    case Knob::kWindow:
+      return "depth window W (calf-encode --depth-window)";
+    case Knob::kAabbs:
+      return "AABB limit A (calf-encode --max-aabbs)";
+    case Knob::kDepth:
+      return "depth format (calf-encode --depth-format)";
+    case Knob::kColour:
+      return "colour format (calf-encode --color-format)";
+    case Knob::kSuper:
+      return "supercompression (calf-encode --supercompression)";
+    case Knob::kViews:
+      return "active views (calf-play --views)";
+    case Knob::kSteps:
+      return "ray-march steps (calf-play --steps)";
   }
   return "?";
 }
 
-bool is_encode_knob(Knob knob) { return knob != Knob::kViews && knob != Knob::kSteps; }
+bool is_encode_knob(Knob knob) {
+  return knob != Knob::kViews && knob != Knob::kSteps;
+}
 
 const std::vector<Knob>& all_knobs() {
-  static const std::vector<Knob> knobs = {Knob::kQ,      Knob::kCell,   Knob::kWindow,
-                                          Knob::kAabbs,  Knob::kDepth,  Knob::kColour,
-                                          Knob::kSuper,  Knob::kViews,  Knob::kSteps};
+  static const std::vector<Knob> knobs = {Knob::kQ,     Knob::kCell,  Knob::kWindow,
+                                          Knob::kAabbs, Knob::kDepth, Knob::kColour,
+                                          Knob::kSuper, Knob::kViews, Knob::kSteps};
   return knobs;
 }
 
 const char* colour_coding_name(ColourCoding c) {
   switch (c) {
-    case ColourCoding::kAuto: return "auto";
-    case ColourCoding::kBc1: return "bc1";
-    case ColourCoding::kBc7: return "bc7";
-    case ColourCoding::kBc6h: return "bc6h";
-    case ColourCoding::kRgba8: return "rgba8";
-    case ColourCoding::kRgba16f: return "rgba16f";
+    case ColourCoding::kAuto:
+      return "auto";
+    case ColourCoding::kBc1:
+      return "bc1";
+    case ColourCoding::kBc7:
+      return "bc7";
+    case ColourCoding::kBc6h:
+      return "bc6h";
+    case ColourCoding::kRgba8:
+      return "rgba8";
+    case ColourCoding::kRgba16f:
+      return "rgba16f";
   }
   return "?";
 }
 
-const char* depth_coding_name(DepthCoding d) { return d == DepthCoding::kBc5 ? "bc5" : "raw16"; }
+const char* depth_coding_name(DepthCoding d) {
+  return d == DepthCoding::kBc5 ? "bc5" : "raw16";
+}
 
 const char* super_name(container::Compression c) {
   switch (c) {
-    case container::Compression::kZstd: return "zstd";
-    case container::Compression::kLzma2: return "lzma2";
-    default: return "none";
+    case container::Compression::kZstd:
+      return "zstd";
+    case container::Compression::kLzma2:
+      return "lzma2";
+    default:
+      return "none";
   }
 }
 
 namespace {
 
-std::string number(double v) { return fmt::format("{:g}", v); }
+std::string number(double v) {
+  return fmt::format("{:g}", v);
+}
 
 // The base with knob `k` set to its i-th value; `value` and `label` as the tables print them.
 SweepPoint varied(const SweepValues& s, Knob k, size_t i, uint32_t view_count) {
@@ -124,23 +159,34 @@ SweepPoint varied(const SweepValues& s, Knob k, size_t i, uint32_t view_count) {
       p.value = number(s.steps[i]);
       p.label = fmt::format("s{}", p.value);
       break;
-    case Knob::kBase: break;
+    case Knob::kBase:
+      break;
   }
   return p;
 }
 
 size_t value_count(const SweepValues& s, Knob k) {
   switch (k) {
-    case Knob::kQ: return s.q.size();
-    case Knob::kCell: return s.cells.size();
-    case Knob::kWindow: return s.windows.size();
-    case Knob::kAabbs: return s.aabbs.size();
-    case Knob::kDepth: return s.depth.size();
-    case Knob::kColour: return s.colour.size();
-    case Knob::kSuper: return s.super.size();
-    case Knob::kViews: return s.views.size();
-    case Knob::kSteps: return s.steps.size();
-    case Knob::kBase: break;
+    case Knob::kQ:
+      return s.q.size();
+    case Knob::kCell:
+      return s.cells.size();
+    case Knob::kWindow:
+      return s.windows.size();
+    case Knob::kAabbs:
+      return s.aabbs.size();
+    case Knob::kDepth:
+      return s.depth.size();
+    case Knob::kColour:
+      return s.colour.size();
+    case Knob::kSuper:
+      return s.super.size();
+    case Knob::kViews:
+      return s.views.size();
+    case Knob::kSteps:
+      return s.steps.size();
+    case Knob::kBase:
+      break;
   }
   return 0;
 }
@@ -163,7 +209,8 @@ ScenePlan plan_scene(const SweepValues& s, uint32_t view_count) {
     for (size_t i = 0; i < value_count(s, k); ++i) {
       SweepPoint p = varied(s, k, i, view_count);
       size_t at = plan.points.size();
-      // The same configuration as an earlier point (the base, or a repeated value) is measured once.
+      // The same configuration as an earlier point (the base, or a repeated value) is measured
+      // once.
       for (size_t j = 0; j < plan.points.size(); ++j) {
         if ((j == 0 || plan.points[j].knob == k) && plan.points[j].encode == p.encode &&
             plan.points[j].play == p.play) {
@@ -190,8 +237,8 @@ bool parse_knobs(const std::string& text, std::vector<Knob>* out, std::string* e
       *out = all_knobs();
     } else {
       const auto& known = all_knobs();
-      auto it = std::find_if(known.begin(), known.end(),
-                             [&](Knob k) { return item == knob_name(k); });
+      auto it =
+          std::find_if(known.begin(), known.end(), [&](Knob k) { return item == knob_name(k); });
       if (it == known.end()) {
         std::string names;
         for (Knob k : known) names += std::string(names.empty() ? "" : ", ") + knob_name(k);

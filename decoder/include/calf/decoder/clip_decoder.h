@@ -84,19 +84,19 @@ struct TileRef {
 
 struct FrameStats {
   uint32_t frame = 0;
-  uint64_t culling_tests = 0;      // frustum-frustum tests, cells and tiles
-  uint32_t visible_cells = 0;      // colour cells of active views seen by a viewer
-  uint32_t total_cells = 0;        // colour cells of active views
-  uint32_t visible_tiles = 0;      // depth tiles of active views seen by a viewer
+  uint64_t culling_tests = 0;  // frustum-frustum tests, cells and tiles
+  uint32_t visible_cells = 0;  // colour cells of active views seen by a viewer
+  uint32_t total_cells = 0;    // colour cells of active views
+  uint32_t visible_tiles = 0;  // depth tiles of active views seen by a viewer
   uint32_t total_tiles = 0;
-  uint32_t updates = 0;            // texture updates yielded
+  uint32_t updates = 0;                                            // texture updates yielded
   uint64_t colour_bytes = 0, depth_bytes = 0, material_bytes = 0;  // update payload bytes
-  uint32_t chunks_needed = 0;      // chunks this frame's updates were decoded from
+  uint32_t chunks_needed = 0;          // chunks this frame's updates were decoded from
   uint32_t chunks_read_on_demand = 0;  // of those, read by advance() itself (not prefetched)
-  size_t cached_bytes = 0;         // decompressed chunks held by the cache after the frame
-  double decode_ms = 0;            // wall time of advance()
-  uint32_t errors = 0;             // chunks that failed this frame
-  std::string first_error;         // the first of them, with its id, e.g. "CALF-E202 view 0 ..."
+  size_t cached_bytes = 0;             // decompressed chunks held by the cache after the frame
+  double decode_ms = 0;                // wall time of advance()
+  uint32_t errors = 0;                 // chunks that failed this frame
+  std::string first_error;  // the first of them, with its id, e.g. "CALF-E202 view 0 ..."
   uint64_t update_bytes() const { return colour_bytes + depth_bytes + material_bytes; }
   // The bitrate of the updates if every frame were like this one, at 24 frames per second
   // (paper 002 Table 3).

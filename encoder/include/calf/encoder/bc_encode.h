@@ -89,7 +89,7 @@ struct Bc7Options {
 enum class HdrPolicy : uint8_t { kClamp, kReject };
 
 struct Bc6hOptions {
-  int quality = 1;  // 0 fast, 1 default, 2 slow
+  int quality = 1;         // 0 fast, 1 default, 2 slow
   bool is_signed = false;  // BC6H_SF16 (keeps negatives) instead of BC6H_UF16
   HdrPolicy policy = HdrPolicy::kClamp;
   int threads = 1;

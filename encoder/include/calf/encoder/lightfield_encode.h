@@ -65,17 +65,17 @@ enum class ColourCoding : uint8_t { kAuto, kBc1, kBc7, kBc6h, kRgba8, kRgba16f }
 enum class DepthCoding : uint8_t { kRaw16, kBc5 };
 
 struct LightfieldEncodeOptions {
-  uint32_t cell_size = 64;            // colour cell side (px), 4..16384 and a multiple of 4
-  double min_psnr_db = 50;            // Q, (0, 200]
+  uint32_t cell_size = 64;  // colour cell side (px), 4..16384 and a multiple of 4
+  double min_psnr_db = 50;  // Q, (0, 200]
   ColourCoding colour = ColourCoding::kAuto;
   DepthCoding depth = DepthCoding::kRaw16;
-  uint32_t depth_tiles_per_side = 2;  // 1..64
-  uint32_t depth_window = 2;          // W, >= 1
-  uint32_t max_aabbs = 2;             // A, 1..64
+  uint32_t depth_tiles_per_side = 2;      // 1..64
+  uint32_t depth_window = 2;              // W, >= 1
+  uint32_t max_aabbs = 2;                 // A, 1..64
   uint32_t depth_keyframe_interval = 30;  // a depth keyframe every K frames, >= 1
   container::Compression supercompression = container::Compression::kZstd;
   container::CompressionOptions levels;  // zstd level / LZMA preset (fixed per clip)
-  uint32_t threads = 1;  // 0 = all cores; never changes the output
+  uint32_t threads = 1;                  // 0 = all cores; never changes the output
   // Called after each view-face is coded (done, total), by encode_lightfield_view() on the
   // calling thread only; the analysis pass does not report.
   std::function<void(uint64_t done, uint64_t total)> progress;
@@ -83,11 +83,11 @@ struct LightfieldEncodeOptions {
 
 // Bytes of one stream at each stage of paper 002 Table 1.
 struct StreamBytes {
-  uint64_t raw = 0;         // every frame uncompressed (colour: RGBA8 or RGBA16F; depth: 16-bit;
-                            // material: 3 bytes per texel)
-  uint64_t temporal = 0;    // after temporal coding, payload in the raw format (+ t, rect tables)
-  uint64_t spatial = 0;     // after spatial (BCn) coding too: the chunks' raw bytes
-  uint64_t stored = 0;      // after supercompression: the chunks' stored bytes
+  uint64_t raw = 0;       // every frame uncompressed (colour: RGBA8 or RGBA16F; depth: 16-bit;
+                          // material: 3 bytes per texel)
+  uint64_t temporal = 0;  // after temporal coding, payload in the raw format (+ t, rect tables)
+  uint64_t spatial = 0;   // after spatial (BCn) coding too: the chunks' raw bytes
+  uint64_t stored = 0;    // after supercompression: the chunks' stored bytes
   uint64_t chunks = 0;
 };
 

@@ -39,14 +39,14 @@ namespace calf::bc {
 
 // The block formats calf stores. The numeric values are stable (they may be written to files).
 enum class Format : uint8_t {
-  kBc1 = 1,          // RGB 5:6:5 endpoints + 2-bit indices, 1-bit alpha (8 bytes/block)
-  kBc4 = 2,          // one unsigned channel (8 bytes/block)
-  kBc5 = 3,          // two unsigned channels: a BC4 block for R, then one for G (16 bytes)
-  kBc4Signed = 4,    // one signed channel (8 bytes)
-  kBc5Signed = 5,    // two signed channels (16 bytes)
-  kBc6hUnsigned = 6, // HDR RGB, non-negative half floats (16 bytes)
-  kBc6hSigned = 7,   // HDR RGB, signed half floats (16 bytes)
-  kBc7 = 8,          // RGBA, 8 modes (16 bytes)
+  kBc1 = 1,           // RGB 5:6:5 endpoints + 2-bit indices, 1-bit alpha (8 bytes/block)
+  kBc4 = 2,           // one unsigned channel (8 bytes/block)
+  kBc5 = 3,           // two unsigned channels: a BC4 block for R, then one for G (16 bytes)
+  kBc4Signed = 4,     // one signed channel (8 bytes)
+  kBc5Signed = 5,     // two signed channels (16 bytes)
+  kBc6hUnsigned = 6,  // HDR RGB, non-negative half floats (16 bytes)
+  kBc6hSigned = 7,    // HDR RGB, signed half floats (16 bytes)
+  kBc7 = 8,           // RGBA, 8 modes (16 bytes)
 };
 
 // Largest image width or height accepted by the image-level functions (kBcDimensions above).
@@ -60,12 +60,16 @@ constexpr size_t block_bytes(Format f) {
 constexpr int channels(Format f) {
   switch (f) {
     case Format::kBc4:
-    case Format::kBc4Signed: return 1;
+    case Format::kBc4Signed:
+      return 1;
     case Format::kBc5:
-    case Format::kBc5Signed: return 2;
+    case Format::kBc5Signed:
+      return 2;
     case Format::kBc6hUnsigned:
-    case Format::kBc6hSigned: return 3;
-    default: return 4;
+    case Format::kBc6hSigned:
+      return 3;
+    default:
+      return 4;
   }
 }
 // Bytes per decoded value: 2 for BC6H (half floats), else 1.
@@ -73,9 +77,13 @@ constexpr int sample_bytes(Format f) {
   return (f == Format::kBc6hUnsigned || f == Format::kBc6hSigned) ? 2 : 1;
 }
 // Bytes per decoded texel.
-constexpr int texel_bytes(Format f) { return channels(f) * sample_bytes(f); }
+constexpr int texel_bytes(Format f) {
+  return channels(f) * sample_bytes(f);
+}
 // Blocks along a dimension of `pixels` texels: ceil(pixels / 4).
-constexpr uint32_t blocks_along(uint32_t pixels) { return (pixels + 3) / 4; }
+constexpr uint32_t blocks_along(uint32_t pixels) {
+  return (pixels + 3) / 4;
+}
 // Short name, e.g. "BC6H_UF16"; for messages and benchmark tables.
 const char* format_name(Format f);
 

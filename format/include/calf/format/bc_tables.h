@@ -23,6 +23,8 @@
 
 namespace calf::bc {
 
+// The tables keep the rows of the BC7 specification (16 entries a row):
+// clang-format off
 inline constexpr uint8_t kPartition2[64][16] = {
     {0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1},
     {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1},
@@ -177,10 +179,12 @@ inline constexpr uint8_t kAnchor3b[64] = {
     15, 3, 15, 10, 10, 8, 9, 10, 6, 15, 8, 15, 3, 6, 6, 8,
     15, 3, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 3, 15, 15, 8,
 };
+// clang-format on
 
 inline constexpr uint8_t kWeights2[4] = {0, 21, 43, 64};
 inline constexpr uint8_t kWeights3[8] = {0, 9, 18, 27, 37, 46, 55, 64};
-inline constexpr uint8_t kWeights4[16] = {0, 4, 9, 13, 17, 21, 26, 30, 34, 38, 43, 47, 51, 55, 60, 64};
+inline constexpr uint8_t kWeights4[16] = {0,  4,  9,  13, 17, 21, 26, 30,
+                                          34, 38, 43, 47, 51, 55, 60, 64};
 
 // The weight table for `bits`-bit indices (2, 3 or 4).
 constexpr const uint8_t* weights_for_bits(int bits) {
@@ -223,13 +227,13 @@ struct Bc6hMode {
 // In D3D's numbering: kBc6hModes[k] is "mode k+1"; e.g. kBc6hModes[10] (5-bit value 3) is D3D
 // mode 11, the one-region 10-bit untransformed mode.
 inline constexpr Bc6hMode kBc6hModes[14] = {
-    {0, 2, true, 5, 10, {5, 5, 5}},   {1, 2, true, 5, 7, {6, 6, 6}},
-    {2, 5, true, 5, 11, {5, 4, 4}},   {6, 5, true, 5, 11, {4, 5, 4}},
-    {10, 5, true, 5, 11, {4, 4, 5}},  {14, 5, true, 5, 9, {5, 5, 5}},
-    {18, 5, true, 5, 8, {6, 5, 5}},   {22, 5, true, 5, 8, {5, 6, 5}},
-    {26, 5, true, 5, 8, {5, 5, 6}},   {30, 5, false, 5, 6, {6, 6, 6}},
+    {0, 2, true, 5, 10, {5, 5, 5}},     {1, 2, true, 5, 7, {6, 6, 6}},
+    {2, 5, true, 5, 11, {5, 4, 4}},     {6, 5, true, 5, 11, {4, 5, 4}},
+    {10, 5, true, 5, 11, {4, 4, 5}},    {14, 5, true, 5, 9, {5, 5, 5}},
+    {18, 5, true, 5, 8, {6, 5, 5}},     {22, 5, true, 5, 8, {5, 6, 5}},
+    {26, 5, true, 5, 8, {5, 5, 6}},     {30, 5, false, 5, 6, {6, 6, 6}},
     {3, 5, false, 0, 10, {10, 10, 10}}, {7, 5, true, 0, 11, {9, 9, 9}},
-    {11, 5, true, 0, 12, {8, 8, 8}},  {15, 5, true, 0, 16, {4, 4, 4}},
+    {11, 5, true, 0, 12, {8, 8, 8}},    {15, 5, true, 0, 16, {4, 4, 4}},
 };
 
 // The index into kBc6hModes of the block whose first byte is `byte0`, or -1 for the reserved
@@ -328,7 +332,8 @@ constexpr Bc6hLayout bc6h_layout(const char* text, int partition_bits) {
     if (*p == ',') ++p;
   }
   // The partition number follows the endpoint fields; recorded as variable 13 ("d").
-  for (int bit = 0; bit < partition_bits; ++bit) layout.field[n++] = {13, static_cast<uint8_t>(bit)};
+  for (int bit = 0; bit < partition_bits; ++bit)
+    layout.field[n++] = {13, static_cast<uint8_t>(bit)};
   layout.count = n;
   return layout;
 }
@@ -336,7 +341,8 @@ constexpr Bc6hLayout bc6h_layout(const char* text, int partition_bits) {
 inline constexpr uint8_t kBc6hPartitionVar = 13;
 inline constexpr std::array<Bc6hLayout, 14> kBc6hLayouts = [] {
   std::array<Bc6hLayout, 14> all{};
-  for (int k = 0; k < 14; ++k) all[k] = bc6h_layout(kBc6hFieldText[k], kBc6hModes[k].partition_bits);
+  for (int k = 0; k < 14; ++k)
+    all[k] = bc6h_layout(kBc6hFieldText[k], kBc6hModes[k].partition_bits);
   return all;
 }();
 // The specification's block layout must fill exactly the bits before the indices.

@@ -29,6 +29,8 @@ enum class ErrorKind : uint8_t {
 
 // X(name, number, kind, one-line summary). The summary is the headline in docs/ERRORS.md; the
 // message of each Status says which file, field or value is at fault.
+// One error a line, the backslashes aligned by hand:
+// clang-format off
 #define CALF_ERROR_LIST(X)                                                                      \
   /* general */                                                                                 \
   X(kInvalidArgument, 1, kInvalidArgument, "an argument is outside what the API accepts")       \
@@ -139,6 +141,7 @@ enum class ErrorKind : uint8_t {
   X(kPlaybackClip, 460, kInvalidArgument, "the file has nothing calf-play can play")            \
   X(kPlaybackOption, 461, kInvalidArgument, "a calf-play option or eye path is unusable")        \
   /* end of the list: every line above ends with a backslash */
+// clang-format on
 
 enum class ErrorId : uint16_t {
   kOk = 0,

@@ -26,9 +26,9 @@
 namespace calf::container {
 
 // Stream tags (SPEC.md §11.1).
-#define CALF_LIGHTFIELD_STREAMS(X)                                                      \
-  X(kIndex, 0, "index") X(kColour, 1, "colour") X(kDepth, 2, "depth")                   \
-  X(kMaterial, 3, "material") X(kTParams, 4, "t")
+#define CALF_LIGHTFIELD_STREAMS(X) \
+  X(kIndex, 0, "index")            \
+  X(kColour, 1, "colour") X(kDepth, 2, "depth") X(kMaterial, 3, "material") X(kTParams, 4, "t")
 enum class LightfieldStream : uint16_t { CALF_LIGHTFIELD_STREAMS(CALF_STREAM_ENUM) };
 
 // Track header (36 bytes, SPEC.md §11.1); later fields are appended.
@@ -85,8 +85,12 @@ void append_planes(std::vector<uint8_t>& out, std::span<const uint8_t> texels,
 // index of refraction round(255 clamp((ior - 1) / 2, 0, 1)), so codes span ior 1 ... 3.
 uint8_t material_weight_code(float weight);
 uint8_t material_ior_code(float ior);
-inline float material_weight_from_code(uint8_t code) { return code / 255.0f; }
-inline float material_ior_from_code(uint8_t code) { return 1.0f + 2.0f * (code / 255.0f); }
+inline float material_weight_from_code(uint8_t code) {
+  return code / 255.0f;
+}
+inline float material_ior_from_code(uint8_t code) {
+  return 1.0f + 2.0f * (code / 255.0f);
+}
 
 // ---- Reading ----
 
@@ -197,7 +201,8 @@ struct RegionChunk {
   RegionCoding coding = RegionCoding::kR16;
   uint32_t tile_width = 0, tile_height = 0;
   uint32_t frame_count = 0;
-  std::vector<uint32_t> first_rect;  // frame_count + 1 entries: frame i owns rects [first_rect[i], first_rect[i + 1])
+  std::vector<uint32_t>
+      first_rect;  // frame_count + 1 entries: frame i owns rects [first_rect[i], first_rect[i + 1])
   std::vector<RegionRect> rects;
   uint64_t units = 0;  // texels or blocks of all rects
   std::span<const uint8_t> payload;

@@ -20,9 +20,9 @@ struct ContactSheetRow {
 };
 
 struct ContactSheetOptions {
-  uint32_t gap = 4;               // pixels between tiles and around the sheet, 0..64
-  uint8_t background = 48;        // grey level of the gaps
-  double heat_full_scale = 0.1;   // per-pixel error shown as red, as write_heat_map_png
+  uint32_t gap = 4;              // pixels between tiles and around the sheet, 0..64
+  uint8_t background = 48;       // grey level of the gaps
+  double heat_full_scale = 0.1;  // per-pixel error shown as red, as write_heat_map_png
 };
 
 // An 8-bit sRGB image, row-major from the top row, 3 bytes per pixel.

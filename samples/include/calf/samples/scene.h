@@ -29,11 +29,11 @@ namespace calf::samples {
 // channels record at a primary hit (paper 002, Sec. 6.1). No Fresnel term: the weights are the
 // same from every direction, so that a reconstruction from the material stream can match.
 struct Material {
-  glm::vec3 albedo{0.7f};     // diffuse reflectance, each channel in [0, 1]
-  glm::vec3 emission{0.0f};   // emitted radiance, may exceed 1 (HDR)
-  float reflect = 0;          // mirror weight in [0, 1]
-  float refract = 0;          // glass weight in [0, 1], reflect + refract <= 1
-  float ior = 1.5f;           // index of refraction of the inside (> 0)
+  glm::vec3 albedo{0.7f};    // diffuse reflectance, each channel in [0, 1]
+  glm::vec3 emission{0.0f};  // emitted radiance, may exceed 1 (HDR)
+  float reflect = 0;         // mirror weight in [0, 1]
+  float refract = 0;         // glass weight in [0, 1], reflect + refract <= 1
+  float ior = 1.5f;          // index of refraction of the inside (> 0)
 };
 
 // Object-space triangles. Front faces wind counter-clockwise seen from outside (the right-hand
@@ -58,8 +58,8 @@ struct Object {
   std::string name;
   TriangleMesh mesh;
   std::vector<Sphere> spheres;
-  uint32_t material = 0;   // index into Scene::materials
-  TransformAt transform;   // empty: identity at every time
+  uint32_t material = 0;  // index into Scene::materials
+  TransformAt transform;  // empty: identity at every time
 };
 
 // A point light; radiant intensity in scene radiance units times distance squared.
@@ -129,9 +129,9 @@ Expected<Scene> make_builtin_scene(std::string_view name);
 // Loads glTF / GLB / OBJ / PLY / FBX (anything assimp imports) with the node animations of its
 // first animation (sampled with linear / spherical interpolation, held at the ends). Materials: the
 // diffuse and emissive colours; reflectivity as mirror weight; 1 - opacity as glass weight with the
-// file's refraction index. Lights and cameras in the file are ignored: the scene gets a sun and sky,
-// a ring rig around the model's bounds and a validation path between its viewpoints. Frame count:
-// the animation's duration at 30 fps (at least 1 frame), capped at 300. Errors: E002 missing
+// file's refraction index. Lights and cameras in the file are ignored: the scene gets a sun and
+// sky, a ring rig around the model's bounds and a validation path between its viewpoints. Frame
+// count: the animation's duration at 30 fps (at least 1 frame), capped at 300. Errors: E002 missing
 // file, E172 unsupported extension, E171 import failure, E173 no triangles, E174 bad geometry.
 Expected<Scene> load_scene_file(const std::filesystem::path& path);
 
