@@ -31,17 +31,8 @@ std::string where(uint32_t view, uint32_t face, uint32_t region) {
 }
 
 Status check_eye(const EyeView& e, size_t i) {
-  const std::string name = "eye " + std::to_string(i) + ": ";
-  if (!is_finite(e.position) || !is_finite(e.forward) || !is_finite(e.up)) {
-    return bad_argument(name + "not finite");
-  }
-  if (length(e.forward) == 0 || length(e.up) == 0) return bad_argument(name + "zero forward or up");
-  if (!(e.fov_y > 0 && e.fov_y < std::numbers::pi) || !(e.aspect > 0) || !std::isfinite(e.aspect)) {
-    return bad_argument(name + "field of view or aspect out of range");
-  }
-  if (!(e.near > 0) || !(e.far > e.near) || !std::isfinite(e.far)) {
-    return bad_argument(name + "needs 0 < near < far < inf");
-  }
+  const char* problem = eye_view_problem(e);
+  if (problem) return bad_argument("eye " + std::to_string(i) + ": " + problem);
   return Status::Ok();
 }
 
@@ -57,6 +48,7 @@ struct ClipDecoder::Impl {
   uint16_t track = 0;
   container::LightfieldTrackHeader header;
   std::vector<LightfieldViewInfo> views;
+  std::vector<Status> view_problems;  // Ok, or why the view was dropped at open
   ClipDecoderOptions options;
   FaceGrid cells = *FaceGrid::with_cell_size(1, 1);
   FaceGrid tiles = *FaceGrid::with_cell_size(1, 1);
@@ -321,6 +313,10 @@ const container::LightfieldTrackHeader& ClipDecoder::header() const {
 const LightfieldViewInfo& ClipDecoder::view(uint32_t v) const {
   return impl_->views[v];
 }
+
+const Status& ClipDecoder::view_problem(uint32_t v) const {
+  return impl_->view_problems[v];
+}
 const ClipDecoderOptions& ClipDecoder::options() const {
   return impl_->options;
 }
@@ -335,7 +331,10 @@ Expected<ClipDecoder> ClipDecoder::open(const container::Reader& reader, uint16_
   impl->track = track;
   impl->header = ref.header();
   impl->options = options;
-  for (uint32_t v = 0; v < impl->header.view_count; ++v) impl->views.push_back(ref.view(v));
+  for (uint32_t v = 0; v < impl->header.view_count; ++v) {
+    impl->views.push_back(ref.view(v));
+    impl->view_problems.push_back(ref.view_problem(v));
+  }
   CALF_ASSIGN_OR_RETURN(impl->cells,
                         FaceGrid::with_cell_size(impl->header.face_size, impl->header.cell_size));
   CALF_ASSIGN_OR_RETURN(
@@ -376,12 +375,18 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
   }
   std::vector<uint32_t> active(active_views.begin(), active_views.end());
   if (active.empty()) {
-    for (uint32_t v = 0; v < d.header.view_count; ++v) active.push_back(v);
+    for (uint32_t v = 0; v < d.header.view_count; ++v) {
+      if (d.view_problems[v].ok()) active.push_back(v);
+    }
   }
   std::vector<bool> seen(d.header.view_count, false);
   for (uint32_t v : active) {
     if (v >= d.header.view_count || seen[v]) {
       return bad_argument("active view " + std::to_string(v) + " is out of range or repeated");
+    }
+    if (!d.view_problems[v].ok()) {
+      return bad_argument("active view " + std::to_string(v) +
+                          " was dropped at open: " + d.view_problems[v].to_string());
     }
     seen[v] = true;
   }
@@ -419,7 +424,7 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
   };
   for (uint32_t v : active) {
     const LightfieldViewInfo& info = d.views[v];
-    const Vec3 p{info.position[0], info.position[1], info.position[2]};
+    const Vec3 p = info.position;
     // Geometry: a cell frustum reaching past each viewer's far plane (seen from this viewpoint)
     // holds every point the viewer can see through it. The far cap depends on the viewer, so each
     // viewer is culled on its own and the visible sets are united: several viewers see exactly the

@@ -57,6 +57,25 @@ Expected<uint32_t> find_one(const container::Reader& r, uint16_t track, Lightfie
 
 }  // namespace
 
+Status LightfieldReference::read_view_index(uint32_t v) {
+  ChunkQuery q;
+  q.track = track_;
+  q.stream = static_cast<uint16_t>(LightfieldStream::kIndex);
+  q.view = v;
+  const auto ids = reader_->find_chunks(q);
+  const std::string what = "view " + std::to_string(v) + " index";
+  if (ids.size() != 1) {
+    return corrupt(what + ": " + std::to_string(ids.size()) + " index chunks, expected 1");
+  }
+  Expected<std::vector<uint8_t>> raw = reader_->read_chunk(ids[0]);
+  if (!raw.ok()) return raw.status().with_context(what);
+  CALF_ASSIGN_OR_RETURN(views_[v], lf::parse_view_index(*raw, what));
+  if (views_[v].has_material && header_.material_format == 0) {
+    return corrupt(what + ": material flagged but the track has none");
+  }
+  return Status::Ok();
+}
+
 Expected<LightfieldReference> LightfieldReference::open(const container::Reader& reader,
                                                         uint16_t track) {
   if (track >= reader.tracks().size() ||
@@ -77,22 +96,17 @@ Expected<LightfieldReference> LightfieldReference::open(const container::Reader&
                    std::to_string(reader.chunks().size()) + " chunks");
   }
   d.views_.resize(h.view_count);
+  d.view_problems_.resize(h.view_count);
+  uint32_t usable = 0;
   for (uint32_t v = 0; v < h.view_count; ++v) {
-    ChunkQuery q;
-    q.track = track;
-    q.stream = static_cast<uint16_t>(LightfieldStream::kIndex);
-    q.view = v;
-    const auto ids = reader.find_chunks(q);
-    const std::string what = "view " + std::to_string(v) + " index";
-    if (ids.size() != 1) {
-      return corrupt(what + ": " + std::to_string(ids.size()) + " index chunks, expected 1");
-    }
-    CALF_ASSIGN_OR_RETURN(std::vector<uint8_t> raw, reader.read_chunk(ids[0]));
-    CALF_ASSIGN_OR_RETURN(d.views_[v], lf::parse_view_index(raw, what));
-    if (d.views_[v].has_material && h.material_format == 0) {
-      return corrupt(what + ": material flagged but the track has none");
+    d.view_problems_[v] = d.read_view_index(v);
+    if (d.view_problems_[v].ok()) {
+      ++usable;
+    } else {
+      d.views_[v] = LightfieldViewInfo{};  // no half-read index
     }
   }
+  if (h.view_count > 0 && usable == 0) return d.view_problems_[0];
   return d;
 }
 
@@ -134,6 +148,7 @@ Status LightfieldReference::decode_face(uint32_t view, uint32_t face, uint32_t f
                                                  std::to_string(face) + " frame " +
                                                  std::to_string(frame) + " is outside the track");
   }
+  if (!view_problems_[view].ok()) return view_problems_[view];
   const uint32_t n = h.face_size;
   CALF_ASSIGN_OR_RETURN(FaceGrid cells, FaceGrid::with_cell_size(n, h.cell_size));
   CALF_ASSIGN_OR_RETURN(FaceGrid tiles, FaceGrid::with_cell_size(n, h.depth_tile_size));

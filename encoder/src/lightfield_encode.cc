@@ -641,9 +641,7 @@ Expected<LightfieldViewEncoding> encode_lightfield_view(const capture::CaptureSe
 
   // The view's index chunk (SPEC §11.1 "View index chunk").
   lf::ViewIndex vi;
-  vi.position[0] = m.viewpoints[v].position.x;
-  vi.position[1] = m.viewpoints[v].position.y;
-  vi.position[2] = m.viewpoints[v].position.z;
+  vi.position = m.viewpoints[v].position;
   vi.z_near = view.range ? view.range->z_near() : 1.0f;
   vi.z_far = view.range ? view.range->z_far() : 2.0f;
   vi.has_depth = view.range.has_value();

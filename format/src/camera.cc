@@ -13,15 +13,8 @@ Status camera_error(const std::string& what) {
 }  // namespace
 
 Status validate_camera(const Camera& c) {
-  // The frame's own degeneracy test: forward of length 0, or up (nearly) parallel to it; the
-  // threshold grows with a long up, whose cross product with a unit forward grows with it.
-  bool ok =
-      is_finite(c.position) && is_finite(c.forward) && is_finite(c.up) && length(c.forward) != 0;
-  if (ok) {
-    const double len = length(cross(normalize(c.forward), c.up));
-    ok = len > 1e-12 * std::max(1.0, length(c.up));
-  }
-  if (!ok) return camera_error("camera position, forward or up is not finite, zero or parallel");
+  if (!is_finite(c.position) || !view_axes_usable(c.forward, c.up))
+    return camera_error("camera position, forward or up is not finite, zero or parallel");
   if (!(c.fov_y > 0) || !(c.fov_y < 3.141592653589793)) {
     return camera_error("camera fov_y " + std::to_string(c.fov_y) + " is outside (0, pi)");
   }

@@ -1,6 +1,8 @@
 #include "calf/format/geometry.h"
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 
 namespace calf {
 namespace {
@@ -92,6 +94,23 @@ bool frusta_intersect(const Frustum& a, const Frustum& b) {
     }
   }
   return true;
+}
+
+bool view_axes_usable(const Vec3& forward, const Vec3& up) {
+  if (!is_finite(forward) || !is_finite(up) || length(forward) == 0) return false;
+  return length(cross(normalize(forward), up)) > 1e-12 * std::max(1.0, length(up));
+}
+
+const char* eye_view_problem(const EyeView& e) {
+  if (!is_finite(e.position) || !view_axes_usable(e.forward, e.up)) {
+    return "position or axes not finite, zero or parallel";
+  }
+  if (!(e.fov_y > 0 && e.fov_y < std::numbers::pi) || !(e.aspect > 0) || !std::isfinite(e.aspect)) {
+    return "field of view or aspect out of range";
+  }
+  if (!(e.near > 0) || !(e.far > e.near) || !std::isfinite(e.far))
+    return "needs 0 < near < far < inf";
+  return nullptr;
 }
 
 Frustum eye_frustum(const EyeView& eye) {

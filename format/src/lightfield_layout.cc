@@ -88,7 +88,9 @@ std::string depth_range_text(float z_near, float z_far) {
 
 Expected<std::vector<uint8_t>> serialize_view_index(const ViewIndex& index) {
   ViewIndexRecord r;
-  std::copy(std::begin(index.position), std::end(index.position), std::begin(r.position));
+  r.position[0] = index.position.x;
+  r.position[1] = index.position.y;
+  r.position[2] = index.position.z;
   r.z_near = index.z_near;
   r.z_far = index.z_far;
   r.flags = (index.has_depth ? 1u : 0u) | (index.has_material ? 2u : 0u);
@@ -115,7 +117,7 @@ Expected<ViewIndex> parse_view_index(std::span<const uint8_t> raw, const std::st
   if (!depth_range_ok(r.z_near, r.z_far))
     return corrupt(what + ": " + depth_range_text(r.z_near, r.z_far));
   ViewIndex v;
-  std::copy(std::begin(r.position), std::end(r.position), std::begin(v.position));
+  v.position = {r.position[0], r.position[1], r.position[2]};
   v.z_near = r.z_near;
   v.z_far = r.z_far;
   v.has_depth = (r.flags & 1) != 0;

@@ -13,7 +13,34 @@ constexpr uint32_t kMaxGrowthBackoff = 32;
 // The largest count the model's fit is allowed to propose (the selector's viewpoint limit).
 constexpr double kMaxFit = 65536;
 
+std::string out_of_range(const char* field, double value, const char* range) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.9g", value);
+  return std::string(field) + " = " + buf + " is outside " + range;
+}
+
 }  // namespace
+
+std::string frame_budget_problem(const FrameBudgetOptions& o) {
+  // `!(x >= lo && x <= hi)` so that NaN fails every range check.
+  if (!(o.target_frame_ms >= 0 && std::isfinite(o.target_frame_ms))) {
+    return out_of_range("target_frame_ms", o.target_frame_ms, "[0, inf)");
+  }
+  if (!(o.fixed_cost_ms >= 0 && std::isfinite(o.fixed_cost_ms))) {
+    return out_of_range("fixed_cost_ms", o.fixed_cost_ms, "[0, inf)");
+  }
+  if (!(o.over_budget_tolerance >= 0 && o.over_budget_tolerance <= 1)) {
+    return out_of_range("over_budget_tolerance", o.over_budget_tolerance, "[0, 1]");
+  }
+  if (!(o.grow_headroom >= 0 && o.grow_headroom < 1)) {
+    return out_of_range("grow_headroom", o.grow_headroom, "[0, 1)");
+  }
+  if (o.grow_after_frames < 1) return out_of_range("grow_after_frames", 0, "[1, 2^32)");
+  if (!(o.cost_smoothing > 0 && o.cost_smoothing <= 1)) {
+    return out_of_range("cost_smoothing", o.cost_smoothing, "(0, 1]");
+  }
+  return "";
+}
 
 FrameBudget::FrameBudget(const FrameBudgetOptions& options) : options_(options) {
   reset();

@@ -127,7 +127,7 @@ Expected<GlTextureLayout> layout_for_clip(const container::LightfieldTrackHeader
   layout.colour_two_slots = true;
   for (const decoder::LightfieldViewInfo& info : views) {
     GlViewInfo v;
-    v.position = {info.position[0], info.position[1], info.position[2]};
+    v.position = info.position;
     CALF_ASSIGN_OR_RETURN(v.range, LogDepthRange::make(info.z_near, info.z_far));
     v.face_size = header.face_size;
     v.cell_size = header.cell_size;

@@ -113,14 +113,18 @@ Expected<std::unique_ptr<LightfieldRepresentation>> LightfieldRepresentation::op
   for (uint32_t v = 0; v < h.view_count; ++v) {
     const auto& info = impl->decoder->view(v);
     views.push_back(info);
-    const Vec3 p{info.position[0], info.position[1], info.position[2]};
+    const Vec3 p = info.position;
     impl->viewpoints.push_back(p);
+    if (!impl->decoder->view_problem(v).ok()) continue;  // dropped: its position is unknown
     bounds = box_union(bounds, p);
     impl->has_material = impl->has_material || info.has_material;
   }
   impl->volume = parse_volume(reader.find_metadata("view_volume")).value_or(bounds);
   CALF_ASSIGN_OR_RETURN(ViewSelector sel, ViewSelector::make(impl->viewpoints, options.selection));
   impl->selector.emplace(std::move(sel));
+  for (uint32_t v = 0; v < h.view_count; ++v) {
+    if (!impl->decoder->view_problem(v).ok()) CALF_RETURN_IF_ERROR(impl->selector->exclude(v));
+  }
   impl->decoder->set_view_dependent(impl->view_dependent_for(options.render));
 
   if (backend == RenderBackend::kGl) {
@@ -182,6 +186,15 @@ const LightfieldOptions& LightfieldRepresentation::options() const {
 ViewSelector& LightfieldRepresentation::selector() {
   return *impl_->selector;
 }
+std::vector<std::pair<uint32_t, Status>> LightfieldRepresentation::dropped_views() const {
+  std::vector<std::pair<uint32_t, Status>> out;
+  for (uint32_t v = 0; v < impl_->viewpoints.size(); ++v) {
+    const Status& problem = impl_->decoder->view_problem(v);
+    if (!problem.ok()) out.emplace_back(v, problem);
+  }
+  return out;
+}
+
 const decoder::FrameStats& LightfieldRepresentation::last_stats() const {
   return impl_->updates.stats;
 }
@@ -353,9 +366,10 @@ RenderOptions LightfieldRepresentation::Impl::frame_options(const Vec3& eye) con
   // active set changes.
   std::vector<MarchView> m;
   for (uint32_t v = 0; v < viewpoints.size(); ++v) {
+    if (!decoder->view_problem(v).ok()) continue;
     m.push_back({viewpoints[v], decoder->view(v).z_near, decoder->view(v).z_far});
   }
-  return *march_range_for(m, eye, options.render);  // never empty: a clip has >= 1 view
+  return *march_range_for(m, eye, options.render);  // never empty: the decoder keeps >= 1 view
 }
 
 Status LightfieldRepresentation::render(const Camera& camera, RenderedImage* out) {

@@ -60,34 +60,16 @@ Status check_options(const ViewSelectionOptions& o) {
   if (!(o.incumbent_margin >= 0 && o.incumbent_margin < 1)) {
     return option_error("incumbent_margin", o.incumbent_margin, "[0, 1)");
   }
-  if (!(o.target_frame_ms >= 0 && std::isfinite(o.target_frame_ms))) {
-    return option_error("target_frame_ms", o.target_frame_ms, "[0, inf)");
-  }
-  if (!(o.fixed_cost_ms >= 0 && std::isfinite(o.fixed_cost_ms))) {
-    return option_error("fixed_cost_ms", o.fixed_cost_ms, "[0, inf)");
-  }
-  if (!(o.over_budget_tolerance >= 0 && o.over_budget_tolerance <= 1)) {
-    return option_error("over_budget_tolerance", o.over_budget_tolerance, "[0, 1]");
-  }
-  if (!(o.grow_headroom >= 0 && o.grow_headroom < 1)) {
-    return option_error("grow_headroom", o.grow_headroom, "[0, 1)");
-  }
-  if (o.grow_after_frames < 1) return option_error("grow_after_frames", 0, "[1, 2^32)");
-  if (!(o.cost_smoothing > 0 && o.cost_smoothing <= 1)) {
-    return option_error("cost_smoothing", o.cost_smoothing, "(0, 1]");
+  const std::string budget = frame_budget_problem(o.budget);
+  if (!budget.empty()) {
+    return Status(ErrorId::kViewSelectOptions, "view selection option budget." + budget);
   }
   return Status::Ok();
 }
 
-// The frame budget's options: the selector's knobs of the same names, its units active views.
+// The frame budget's options: the selector's, its units bounded by [min_active, max_active].
 FrameBudgetOptions budget_options(const ViewSelectionOptions& o) {
-  FrameBudgetOptions b;
-  b.target_frame_ms = o.target_frame_ms;
-  b.fixed_cost_ms = o.fixed_cost_ms;
-  b.over_budget_tolerance = o.over_budget_tolerance;
-  b.grow_headroom = o.grow_headroom;
-  b.grow_after_frames = o.grow_after_frames;
-  b.cost_smoothing = o.cost_smoothing;
+  FrameBudgetOptions b = o.budget;
   b.min_units = o.min_active;
   b.max_units = o.max_active;
   return b;
@@ -120,6 +102,7 @@ Expected<ViewSelector> ViewSelector::make(std::vector<Vec3> viewpoints,
   s.viewpoints_ = std::move(viewpoints);
   s.options_ = options;
   s.was_active_.assign(s.viewpoints_.size(), 0);
+  s.excluded_.assign(s.viewpoints_.size(), 0);
   s.reset();
   return s;
 }
@@ -129,6 +112,16 @@ void ViewSelector::reset() {
   std::fill(was_active_.begin(), was_active_.end(), 0);
   budget_.set_options(budget_options(options_));
   budget_.reset();
+}
+
+Status ViewSelector::exclude(uint32_t view) {
+  if (view >= viewpoints_.size()) {
+    return Status(ErrorId::kViewSelectOptions, "excluded view " + std::to_string(view) +
+                                                   " is not one of the " +
+                                                   std::to_string(viewpoints_.size()) + " views");
+  }
+  excluded_[view] = 1;
+  return Status::Ok();
 }
 
 Status ViewSelector::set_options(const ViewSelectionOptions& options) {
@@ -155,8 +148,10 @@ Expected<ViewSelection> ViewSelector::select(const Vec3& position, const Vec3& f
   const size_t n = viewpoints_.size();
   const Vec3 eye_from_ref = position - o.reference_point;
   const bool eye_at_ref = length(eye_from_ref) == 0;
-  std::vector<Ranked> ranked(n);
+  std::vector<Ranked> ranked;
+  ranked.reserve(n);
   for (uint32_t i = 0; i < n; ++i) {
+    if (excluded_[i]) continue;
     const double distance = length(viewpoints_[i] - position);
     double key = distance;
     if (o.priority == ViewPriority::kAngle) {
@@ -169,7 +164,7 @@ Expected<ViewSelection> ViewSelector::select(const Vec3& position, const Vec3& f
     if (was_active_[i]) key *= 1.0 - o.incumbent_margin;
     // Coordinates near the double range can overflow to inf - inf; a NaN key would break the
     // sort's ordering, so it ranks last (ties then break by index).
-    ranked[i] = {i, std::isnan(key) ? kInf : key, std::isnan(distance) ? kInf : distance};
+    ranked.push_back({i, std::isnan(key) ? kInf : key, std::isnan(distance) ? kInf : distance});
   }
   std::sort(ranked.begin(), ranked.end(), [](const Ranked& a, const Ranked& b) {
     if (a.key != b.key) return a.key < b.key;
@@ -189,7 +184,7 @@ Expected<ViewSelection> ViewSelector::select(const Vec3& position, const Vec3& f
   // O(n log n + n * max_active) whatever the number of viewpoints.
   std::vector<uint32_t> kept;
   kept.reserve(std::min<size_t>(n, o.max_active));
-  for (size_t r = 0; r < n; ++r) {
+  for (size_t r = 0; r < ranked.size(); ++r) {
     const uint32_t v = ranked[r].view;
     const Vec3 dir = viewpoints_[v] - position;
     const bool at_eye = ranked[r].distance == 0;

@@ -71,6 +71,7 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
   }
   // The light-field figures printed per pose are the first lightfield track's.
   const LightfieldRepresentation& lf = *play.lightfield();
+  warn_dropped_views(play);
   if (lf.options().render.rr && !lf.has_material()) {
     std::fprintf(stderr, "calf-play: notice: the clip has no material stream; --rr is ignored\n");
   }
@@ -251,7 +252,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 65536));
   app.add_option("--priority", priority, "view priority: distance or angle (default distance)")
       ->check(CLI::IsMember({"distance", "angle"}));
-  app.add_option("--frame-ms", o.selection.target_frame_ms,
+  app.add_option("--frame-ms", o.selection.budget.target_frame_ms,
                  "frame-time target of performance "
                  "culling in ms, 0 = off (default 11.1; headless default 0: quality first)");
   app.add_flag(
@@ -269,7 +270,7 @@ int main(int argc, char** argv) {
 
   play_options.use_gl = renderer == "gl";
   o.selection.priority = priority == "angle" ? ViewPriority::kAngle : ViewPriority::kDistance;
-  if (headless && app.count("--frame-ms") == 0) o.selection.target_frame_ms = 0;
+  if (headless && app.count("--frame-ms") == 0) o.selection.budget.target_frame_ms = 0;
   if (headless) {
     if (h.eye_path.empty() && h.compare.empty()) {
       return fail(Status(ErrorId::kPlaybackOption, "--headless needs --eye-path or --compare"));

@@ -59,9 +59,9 @@ Poses make_poses(const ClipDecoder& d, uint32_t directions) {
   const uint32_t n = d.header().view_count;
   double far = 1;
   for (uint32_t v = 0; v < n; ++v) {
-    p.centre.x += d.view(v).position[0] / n;
-    p.centre.y += d.view(v).position[1] / n;
-    p.centre.z += d.view(v).position[2] / n;
+    p.centre.x += d.view(v).position.x / n;
+    p.centre.y += d.view(v).position.y / n;
+    p.centre.z += d.view(v).position.z / n;
     far = std::max(far, 2.0 * d.view(v).z_far);
   }
   for (uint32_t i = 0; i < directions; ++i) {
@@ -82,8 +82,8 @@ std::vector<uint32_t> nearest_views(const ClipDecoder& d, const Vec3& eye, uint3
   std::vector<uint32_t> order(d.header().view_count);
   for (uint32_t v = 0; v < order.size(); ++v) order[v] = v;
   auto dist = [&](uint32_t v) {
-    const double* q = d.view(v).position;
-    return std::hypot(q[0] - eye.x, q[1] - eye.y, q[2] - eye.z);
+    const Vec3& q = d.view(v).position;
+    return std::hypot(q.x - eye.x, q.y - eye.y, q.z - eye.z);
   };
   std::stable_sort(order.begin(), order.end(),
                    [&](uint32_t a, uint32_t b) { return dist(a) < dist(b); });
@@ -176,7 +176,7 @@ Table4Row run_table4(const ClipDecoder& d, const Poses& poses, const std::vector
     CullStats regular, hierarchical;
     for (uint32_t v : active) {
       const LightfieldViewInfo& info = d.view(v);
-      const Vec3 p{info.position[0], info.position[1], info.position[2]};
+      const Vec3 p = info.position;
       // The decoder's far cap (clip_decoder.cc): past the viewer's far plane from this viewpoint.
       const double z_far = std::max<double>(
           info.z_far,

@@ -182,7 +182,7 @@ inline Expected<player::ViewSet> view_set_of(const DecodedClip& clip) {
   for (uint32_t v = 0; v < clip.view_count(); ++v) {
     const decoder::LightfieldViewInfo& info = clip.decoder->view(v);
     CALF_ASSIGN_OR_RETURN(LogDepthRange range, LogDepthRange::make(info.z_near, info.z_far));
-    const Vec3 p{info.position[0], info.position[1], info.position[2]};
+    const Vec3 p = info.position;
     CALF_ASSIGN_OR_RETURN(player::View view, player::View::make(p, range, n, false));
     const PixelRect whole{0, 0, n, n};
     for (int f = 0; f < kCubeFaceCount; ++f) {

@@ -208,7 +208,7 @@ TEST(DepthRange1e4To1e6, CaptureEncodeDecodeRenderRoundTrip) {
   const double default_near = std::max(1e-4f / 4.0, 1e6 / 1048576.0);
   PlaybackOptions po;
   po.use_gl = false;
-  po.lightfield.selection.target_frame_ms = 0;
+  po.lightfield.selection.budget.target_frame_ms = 0;
   auto cpu = Playback::open(clip, po, nullptr);
   ASSERT_TRUE(cpu.ok()) << cpu.status().to_string();
   for (int f = 0; f < 6; ++f) {
@@ -341,7 +341,7 @@ TEST(FlatDepth, EveryDepthEqualEncodesDecodesAndRendersExactly) {
       if (gl && ctx == nullptr) continue;
       PlaybackOptions po;
       po.use_gl = gl;
-      po.lightfield.selection.target_frame_ms = 0;
+      po.lightfield.selection.budget.target_frame_ms = 0;
       auto play = Playback::open(clip, po, gl ? &ctx->gl() : nullptr);
       ASSERT_TRUE(play.ok()) << play.status().to_string();
       for (int f = 0; f < 6; ++f) {

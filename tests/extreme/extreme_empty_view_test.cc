@@ -79,7 +79,7 @@ void play_and_check(
     const std::function<void(const RenderedImage&, size_t, const std::string&)>& check) {
   PlaybackOptions po;
   po.use_gl = gl;
-  po.lightfield.selection.target_frame_ms = 0;
+  po.lightfield.selection.budget.target_frame_ms = 0;
   player::OsMesaContext* ctx = gl ? gl_context() : nullptr;
   if (gl && ctx == nullptr) {
     std::printf("no OSMesa GL 4.5 context: GL half skipped\n");
@@ -261,7 +261,7 @@ TEST(NothingToSee, NothingDecodedRendersTheInitialBlackSky) {
   for (uint32_t v = 0; v < 2; ++v) {
     auto range = LogDepthRange::make(infos[v].z_near, infos[v].z_far);
     ASSERT_TRUE(range.ok());
-    const Vec3 p{infos[v].position[0], infos[v].position[1], infos[v].position[2]};
+    const Vec3 p = infos[v].position;
     auto view = player::View::make(p, *range, 16, false);
     ASSERT_TRUE(view.ok());
     for (int f = 0; f < 6; ++f) {

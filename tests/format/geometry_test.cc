@@ -166,6 +166,42 @@ TEST(GeometryTest, SeparatedOnlyByAnEdgePairAxis) {
   EXPECT_TRUE(frusta_intersect(a, b(1.0)));
 }
 
+// The axes test of geometry.h: finite, forward not zero, up not within 1e-12 * max(1, |up|) of
+// parallel to the unit forward.
+TEST(GeometryTest, ViewAxesUsable) {
+  EXPECT_TRUE(view_axes_usable(v(0, 0, -1), v(0, 1, 0)));
+  EXPECT_TRUE(view_axes_usable(v(0, 0, -1e-3), v(0, 5, 0)));  // lengths need not be 1
+  EXPECT_FALSE(view_axes_usable(v(0, 0, 0), v(0, 1, 0)));
+  EXPECT_FALSE(view_axes_usable(v(0, 0, -1), v(0, 0, 3)));       // parallel
+  EXPECT_FALSE(view_axes_usable(v(0, 0, -1), v(0, 1e-13, 1)));   // |cross| 1e-13 <= 1e-12
+  EXPECT_TRUE(view_axes_usable(v(0, 0, -1), v(0, 1e-11, 1)));    // 1e-11 > 1e-12
+  EXPECT_FALSE(view_axes_usable(v(0, 0, -1), v(0, 1e-9, 1e4)));  // threshold grows with |up|
+  EXPECT_FALSE(view_axes_usable(v(std::nan(""), 0, -1), v(0, 1, 0)));
+  EXPECT_FALSE(view_axes_usable(v(0, 0, -1), v(0, HUGE_VAL, 0)));
+}
+
+TEST(GeometryTest, EyeViewProblem) {
+  EXPECT_EQ(eye_view_problem(EyeView{}), nullptr);
+  EyeView e;
+  e.position.y = HUGE_VAL;
+  EXPECT_STREQ(eye_view_problem(e), "position or axes not finite, zero or parallel");
+  e = EyeView{};
+  e.up = e.forward;
+  EXPECT_STREQ(eye_view_problem(e), "position or axes not finite, zero or parallel");
+  e = EyeView{};
+  e.fov_y = kPi;
+  EXPECT_STREQ(eye_view_problem(e), "field of view or aspect out of range");
+  e = EyeView{};
+  e.aspect = 0;
+  EXPECT_STREQ(eye_view_problem(e), "field of view or aspect out of range");
+  e = EyeView{};
+  e.near = 0;
+  EXPECT_STREQ(eye_view_problem(e), "needs 0 < near < far < inf");
+  e = EyeView{};
+  e.far = HUGE_VAL;
+  EXPECT_STREQ(eye_view_problem(e), "needs 0 < near < far < inf");
+}
+
 // eye_frustum's corners from the formula in geometry.h: position at the origin, looking down -Z
 // with +Y up: f = (0, 0, -1), r = cross(f, up) = (1, 0, 0), u = cross(r, f) = (0, 1, 0). With a
 // 90 degree fov, tan(fov / 2) = 1 (0.9999999999999999 in doubles), aspect 2 gives tx = 2: near

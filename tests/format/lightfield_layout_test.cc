@@ -31,9 +31,9 @@ TEST(LightfieldLayout, ViewIndexBytesAreTheDocumentedOnes) {
   ASSERT_EQ(kViewIndex.size(), kViewIndexBytes);
   auto v = parse_view_index(kViewIndex, "view 0 index");
   ASSERT_TRUE(v.ok()) << v.status().to_string();
-  EXPECT_EQ(v->position[0], 1.5);
-  EXPECT_EQ(v->position[1], -2.0);
-  EXPECT_EQ(v->position[2], 0.25);
+  EXPECT_EQ(v->position.x, 1.5);
+  EXPECT_EQ(v->position.y, -2.0);
+  EXPECT_EQ(v->position.z, 0.25);
   EXPECT_EQ(v->z_near, 0.5f);
   EXPECT_EQ(v->z_far, 64.0f);
   EXPECT_TRUE(v->has_depth);
@@ -84,7 +84,7 @@ TEST(LightfieldLayout, ViewIndexRulesAreCorruptChunks) {
 
 TEST(LightfieldLayout, WritingAViewIndexTheReaderRefusesIsMisuse) {
   ViewIndex v;
-  v.position[2] = std::numeric_limits<double>::infinity();
+  v.position.z = std::numeric_limits<double>::infinity();
   EXPECT_EQ(serialize_view_index(v).status().id(), ErrorId::kContainerWriterMisuse);
   v = ViewIndex{};
   v.z_near = 3, v.z_far = 2;

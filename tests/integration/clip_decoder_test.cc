@@ -21,9 +21,11 @@
 #include "calf/decoder/clip_decoder.h"
 #include "calf/decoder/cpu_textures.h"
 #include "calf/decoder/lightfield_reference.h"
+#include "calf/decoder/lightfield_verify.h"
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/format/container.h"
 #include "calf/format/container_io.h"
+#include "synthetic_capture.h"
 
 namespace calf::decoder {
 namespace {
@@ -96,27 +98,18 @@ Clip make_clip(const ClipSpec& s) {
   name.append(std::to_string(::getpid())).append("_").append(std::to_string(s.seed));
   const fs::path dir = fs::temp_directory_path() / name;
   fs::remove_all(dir);
-  capture::CaptureManifest m;
-  m.frame_count = s.frames;
-  m.face_size = s.face;
-  m.fps = 24;
-  m.material = s.material;
-  m.view_volume = {{-1, -1, -1}, {1, 1, 1}};
-  for (uint32_t v = 0; v < s.views; ++v) {
-    std::string view_name = "v";
-    view_name.append(std::to_string(v));
-    m.viewpoints.push_back({view_name, {0.5 * v - 0.25, 0.1 * v, 0}});
-  }
+  testing_support::SceneSpec scene;
+  scene.face = s.face;
+  scene.frames = s.frames;
+  scene.views = s.views;
+  scene.material = s.material;
+  scene.first_viewpoint = {-0.25, 0, 0};
+  scene.viewpoint_step = {0.5, 0.1, 0};
   Clip clip;
   {
-    auto w = capture::CaptureSetWriter::create(dir, m);
-    EXPECT_TRUE(w.ok()) << w.status().to_string();
-    for (uint32_t v = 0; v < s.views; ++v) {
-      for (uint32_t f = 0; f < s.frames; ++f) {
-        EXPECT_TRUE(w->write(v, f, make_frame(s, v, f)).ok());
-      }
-    }
-    EXPECT_TRUE(w->finish().ok());
+    const Status written = testing_support::write_capture(
+        dir, scene, [&](uint32_t v, uint32_t f) { return make_frame(s, v, f); });
+    EXPECT_TRUE(written.ok()) << written.to_string();
     auto in = capture::CaptureSetReader::open(dir);
     EXPECT_TRUE(in.ok()) << in.status().to_string();
     auto writer = container::Writer::create(container::memory_sink(&clip.bytes));
@@ -541,6 +534,9 @@ TEST(ClipDecoder, BadArgumentsAreE300AndChangeNothing) {
   e = EyeView{};
   e.position.x = std::nan("");
   EXPECT_EQ(d.advance(0, std::vector<EyeView>{e}, {}, &fu).id(), ErrorId::kDecoderArgument);
+  e = EyeView{};
+  e.up = e.forward * -2.0;  // parallel axes: the frustum would be NaN
+  EXPECT_EQ(d.advance(0, std::vector<EyeView>{e}, {}, &fu).id(), ErrorId::kDecoderArgument);
   EXPECT_EQ(ClipDecoder::open(*clip.reader, 5).status().id(), ErrorId::kInvalidArgument);
 }
 
@@ -601,6 +597,79 @@ TEST(ClipDecoder, CorruptChunkIsReportedAndLastGoodStateKept) {
     before = tex.colour(0, face);
   }
   EXPECT_GT(reported, 0u) << "the damaged keyframe was never needed";
+}
+
+// A view whose index chunk is damaged (hash mismatch, CALF-E058) is dropped at open with its
+// reason; the other views decode exactly as before, and naming the dropped view is an error.
+// With every index chunk damaged, open fails.
+TEST(ClipDecoder, DamagedViewIndexDropsThatViewOnly) {
+  ClipSpec spec;
+  spec.seed = 72;
+  spec.views = 3;
+  Clip clip = make_clip(spec);
+  const auto& chunks = clip.reader->chunks();
+  std::vector<uint32_t> index_chunk(spec.views);
+  for (uint32_t id = 0; id < chunks.size(); ++id) {
+    if (chunks[id].keys.stream == static_cast<uint16_t>(container::LightfieldStream::kIndex)) {
+      index_chunk[chunks[id].keys.view] = id;
+    }
+  }
+  std::vector<uint8_t> damaged = clip.bytes;
+  damaged[chunks[index_chunk[1]].offset + 3] ^= 0x10;
+  auto reader = container::Reader::open(container::memory_source(damaged));
+  ASSERT_TRUE(reader.ok()) << reader.status().to_string();
+  ClipDecoderOptions o;
+  o.view_dependent = false;
+  auto d = ClipDecoder::open(*reader, 0, o);
+  ASSERT_TRUE(d.ok()) << d.status().to_string();
+  EXPECT_TRUE(d->view_problem(0).ok());
+  EXPECT_EQ(d->view_problem(1).id(), ErrorId::kContainerChunkHash)
+      << d->view_problem(1).to_string();
+  EXPECT_NE(d->view_problem(1).message().find("view 1 index"), std::string::npos);
+  EXPECT_TRUE(d->view_problem(2).ok());
+  ClipDecoder good = open_decoder(clip, o);
+  CpuTextures tex = textures_for(*d), want = textures_for(good);
+  for (uint32_t f = 0; f < spec.frames; ++f) {
+    FrameUpdates fu;
+    ASSERT_TRUE(d->advance(f, {}, {}, &fu).ok());
+    EXPECT_EQ(fu.stats.errors, 0u) << fu.stats.first_error;
+    for (const auto& c : fu.cells) EXPECT_NE(c.view, 1u);
+    ASSERT_TRUE(tex.apply(fu).ok());
+    advance_ok(good, want, f, {});
+    for (uint32_t v : {0u, 2u}) {
+      for (uint32_t face = 0; face < 6; ++face) {
+        const CubeFace cf = static_cast<CubeFace>(face);
+        ASSERT_EQ(tex.colour(v, cf), want.colour(v, cf)) << "view " << v << " frame " << f;
+        const auto a = tex.depth(v, cf), b = want.depth(v, cf);
+        ASSERT_TRUE(std::equal(a.begin(), a.end(), b.begin(), b.end()));
+      }
+    }
+  }
+  FrameUpdates fu;
+  const Status named = d->advance(0, {}, std::vector<uint32_t>{1}, &fu);
+  EXPECT_EQ(named.id(), ErrorId::kDecoderArgument);
+  EXPECT_NE(named.message().find("dropped"), std::string::npos) << named.to_string();
+  // The reference decoder and the verifier say the same.
+  auto ref = LightfieldReference::open(*reader, 0);
+  ASSERT_TRUE(ref.ok());
+  LightfieldFace face;
+  EXPECT_EQ(ref->decode_face(1, 0, 0, &face).id(), ErrorId::kContainerChunkHash);
+  EXPECT_TRUE(ref->decode_face(2, 0, 0, &face).ok());
+  const LightfieldVerifyResult verified = verify_lightfield_track(*reader, 0, true, 100);
+  ASSERT_EQ(verified.problems.size(), 1u);
+  EXPECT_EQ(verified.problems[0].id(), ErrorId::kContainerChunkHash);
+  EXPECT_TRUE(verified.hashes.empty());
+  EXPECT_EQ(verified.faces_decoded, uint64_t{2} * 6 * spec.frames);
+
+  // Flipping all three again: 0 and 2 damaged, 1 whole.
+  for (uint32_t v = 0; v < spec.views; ++v) damaged[chunks[index_chunk[v]].offset + 3] ^= 0x10;
+  auto one_left = container::Reader::open(container::memory_source(damaged));
+  ASSERT_TRUE(one_left.ok());
+  EXPECT_TRUE(ClipDecoder::open(*one_left, 0, o).ok());
+  damaged[chunks[index_chunk[1]].offset + 3] ^= 0x10;  // all three damaged
+  auto none_left = container::Reader::open(container::memory_source(damaged));
+  ASSERT_TRUE(none_left.ok());
+  EXPECT_EQ(ClipDecoder::open(*none_left, 0, o).status().id(), ErrorId::kContainerChunkHash);
 }
 
 }  // namespace

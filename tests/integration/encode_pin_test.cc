@@ -2,6 +2,9 @@
 // sets (tests/integration/synthetic_capture.h, made by code, so the same on every CPU) with every
 // colour and depth coding, material, both supercompressions and 1 or 2 threads.
 //
+// The pinned clips are also the lightfield conformance clips (tests/conformance/lightfield/),
+// which this test writes when asked (CALF_CONFORMANCE_OUT).
+//
 // The pins are today's bytes, recorded when the test was written (52eba46). A change that alters
 // them changes the bitstream: either a bug, or an intended format change that SPEC.md documents
 // and whose new pins are recorded here with the reason. The encoder's metadata names its version
@@ -9,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -83,6 +87,14 @@ TEST_P(EncodePin, OutputBytesAreUnchanged) {
     auto stats = encode_lightfield_file(capture, out.string(), o);
     ASSERT_TRUE(stats.ok()) << stats.status().to_string();
     EXPECT_EQ(file_hash(out), c.xxh3) << c.name << " with " << threads << " thread(s)";
+  }
+  // The generator of the lightfield conformance clips (tests/conformance/README.md): with
+  // CALF_CONFORMANCE_OUT set, the pinned clips are copied there as <name>.calf.
+  if (const char* dir = std::getenv("CALF_CONFORMANCE_OUT")) {
+    const fs::path to = fs::path(dir) / (std::string(c.name) + ".calf");
+    std::error_code ec;
+    fs::copy_file(root / "t1.calf", to, fs::copy_options::overwrite_existing, ec);
+    EXPECT_FALSE(ec) << to << ": " << ec.message();
   }
   fs::remove_all(root);
 }

@@ -128,9 +128,8 @@ ViewSet view_set_from(const decoder::ClipDecoder& d, const decoder::CpuTextures&
   for (uint32_t v = 0; v < d.header().view_count; ++v) {
     const decoder::LightfieldViewInfo& info = d.view(v);
     const bool material = info.has_material && d.header().material_format != 0;
-    View view =
-        *View::make({info.position[0], info.position[1], info.position[2]},
-                    *LogDepthRange::make(info.z_near, info.z_far), tex.face_size(), material);
+    View view = *View::make(info.position, *LogDepthRange::make(info.z_near, info.z_far),
+                            tex.face_size(), material);
     const uint32_t n = tex.face_size();
     for (int f = 0; f < kCubeFaceCount; ++f) {
       const CubeFace face = cube_face_from_index(f);

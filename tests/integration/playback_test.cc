@@ -77,7 +77,7 @@ TEST(Playback, GlAndCpuRenderTheSameFrames) {
   if (!context.ok()) GTEST_SKIP() << context.status().to_string();
   PlaybackOptions o;
   o.lightfield.render.steps = 48;
-  o.lightfield.selection.target_frame_ms = 0;
+  o.lightfield.selection.budget.target_frame_ms = 0;
   auto gl = Playback::open(clip_path(), o, &(*context)->gl());
   ASSERT_TRUE(gl.ok()) << gl.status().to_string();
   o.use_gl = false;
@@ -115,7 +115,7 @@ TEST(LightfieldRepresentation, GlAndCpuBackendsAgreeThroughTheInterface) {
   ASSERT_TRUE(reader.ok()) << reader.status().to_string();
   LightfieldOptions o;
   o.render.steps = 48;
-  o.selection.target_frame_ms = 0;
+  o.selection.budget.target_frame_ms = 0;
   auto gl_lf = LightfieldRepresentation::open(*reader, 0, o, RenderBackend::kGl, &(*context)->gl());
   ASSERT_TRUE(gl_lf.ok()) << gl_lf.status().to_string();
   auto cpu_lf = LightfieldRepresentation::open(*reader, 0, o, RenderBackend::kCpu, nullptr);

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "calf/capture/capture_set.h"
+#include "calf/format/geometry.h"
 #include "calf/format/status.h"
 
 namespace calf::testing_support {
@@ -20,6 +21,8 @@ struct SceneSpec {
   bool animated = true;
   bool hdr = false;
   bool material = false;
+  // Viewpoint v sits at first_viewpoint + v * viewpoint_step.
+  Vec3 first_viewpoint{0, 0, 0}, viewpoint_step{0.5, 0, 0};
 };
 
 // A small animated scene: smooth colour everywhere, a square that moves across face 0 (colour and
@@ -68,9 +71,9 @@ inline capture::ViewFrame make_frame(const SceneSpec& s, uint32_t view, uint32_t
   return vf;
 }
 
-// Writes a capture set of s.views viewpoints, s.frames frames of s.face texels (material channels
-// when s.material) whose view-frames come from `frame(view, frame)`, into `dir` (created; must not
-// exist yet).
+// Writes a capture set of s.views viewpoints (first_viewpoint + v * viewpoint_step), s.frames
+// frames of s.face texels (material channels when s.material) whose view-frames come from
+// `frame(view, frame)`, into `dir` (created; must not exist yet).
 template <class FrameFn>
 inline Status write_capture(const std::filesystem::path& dir, const SceneSpec& s, FrameFn frame) {
   capture::CaptureManifest m;
@@ -82,7 +85,7 @@ inline Status write_capture(const std::filesystem::path& dir, const SceneSpec& s
   for (uint32_t v = 0; v < s.views; ++v) {
     std::string id = "v";  // append, not operator+: GCC 12 -O3 misfires -Wrestrict on it
     id.append(std::to_string(v));
-    m.viewpoints.push_back({id, {0.5 * v, 0, 0}});
+    m.viewpoints.push_back({id, s.first_viewpoint + s.viewpoint_step * static_cast<double>(v)});
   }
   auto w = capture::CaptureSetWriter::create(dir, m);
   CALF_RETURN_IF_ERROR(w.status());

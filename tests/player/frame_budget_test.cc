@@ -64,5 +64,31 @@ TEST(FrameBudget, RefusesBadTimesAndIgnoresReportsBeforeUnits) {
   EXPECT_EQ(b.per_unit_cost_ms(), 0);
 }
 
+// frame_budget_problem names the first knob out of its documented range, with its value; the
+// units are the owner's to check.
+TEST(FrameBudgetTest, ProblemNamesTheKnob) {
+  FrameBudgetOptions o;
+  EXPECT_EQ(frame_budget_problem(o), "");
+  o.min_units = 0;  // not the budget's to check
+  EXPECT_EQ(frame_budget_problem(o), "");
+  o.target_frame_ms = -1;
+  EXPECT_EQ(frame_budget_problem(o), "target_frame_ms = -1 is outside [0, inf)");
+  o = FrameBudgetOptions{};
+  o.fixed_cost_ms = std::nan("");
+  EXPECT_EQ(frame_budget_problem(o), "fixed_cost_ms = nan is outside [0, inf)");
+  o = FrameBudgetOptions{};
+  o.over_budget_tolerance = 1.5;
+  EXPECT_EQ(frame_budget_problem(o), "over_budget_tolerance = 1.5 is outside [0, 1]");
+  o = FrameBudgetOptions{};
+  o.grow_headroom = 1;
+  EXPECT_EQ(frame_budget_problem(o), "grow_headroom = 1 is outside [0, 1)");
+  o = FrameBudgetOptions{};
+  o.grow_after_frames = 0;
+  EXPECT_EQ(frame_budget_problem(o), "grow_after_frames = 0 is outside [1, 2^32)");
+  o = FrameBudgetOptions{};
+  o.cost_smoothing = 0;
+  EXPECT_EQ(frame_budget_problem(o), "cost_smoothing = 0 is outside (0, 1]");
+}
+
 }  // namespace
 }  // namespace calf::player

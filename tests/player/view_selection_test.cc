@@ -27,7 +27,7 @@ ViewSelectionOptions no_culling(uint32_t max_active) {
   o.redundancy_angle_deg = 0;
   o.view_cone_deg = 180;
   o.max_active = max_active;
-  o.target_frame_ms = 0;
+  o.budget.target_frame_ms = 0;
   o.incumbent_margin = 0;
   return o;
 }
@@ -54,6 +54,20 @@ TEST(ViewSelection, DistancePriorityNearestFirst) {
   ViewSelector s =
       make({{3, 0, 0}, {0, 1, 0}, {0, 0, -2}, {-1, -1, 0}, {0, 0, 0.5}}, no_culling(5));
   EXPECT_EQ(select(s, kOrigin).active, (std::vector<uint32_t>{4, 1, 3, 2, 0}));
+}
+
+// An excluded view (one the decoder dropped) is never selected, even when it ranks first; a view
+// in a slot leaves it at the next selection and the others keep theirs.
+TEST(ViewSelection, ExcludedViewIsNeverSelected) {
+  ViewSelector s =
+      make({{3, 0, 0}, {0, 1, 0}, {0, 0, -2}, {-1, -1, 0}, {0, 0, 0.5}}, no_culling(3));
+  const ViewSelection first = select(s, kOrigin);
+  EXPECT_EQ(first.active, (std::vector<uint32_t>{4, 1, 3}));
+  ASSERT_TRUE(s.exclude(4).ok());
+  const ViewSelection second = select(s, kOrigin);
+  EXPECT_EQ(second.active, (std::vector<uint32_t>{1, 3, 2}));
+  EXPECT_EQ(second.left, (std::vector<uint32_t>{4}));
+  EXPECT_EQ(s.exclude(5).id(), ErrorId::kViewSelectOptions);
 }
 
 TEST(ViewSelection, DistanceTiesBreakByIndex) {
@@ -218,7 +232,7 @@ TEST(ViewSelection, SlotsStayPutAlongAMovingEye) {
   }
   ViewSelectionOptions o;
   o.max_active = 5;
-  o.target_frame_ms = 0;
+  o.budget.target_frame_ms = 0;
   ViewSelector s = make(grid, o);
   ViewSelection prev;
   size_t entered = 0, survivors = 0;
@@ -320,8 +334,8 @@ TEST(ViewSelection, ControllerFollowsALinearCostModel) {
   // frame_ms = 2 + c * n with the fixed 2 ms known; target 100/9 = 11.11 ms, tolerance 5 %,
   // headroom 10 % (growth only while 2 + 1.5 (n + 1) <= 10).
   ViewSelectionOptions o = no_culling(16);
-  o.target_frame_ms = 100.0 / 9.0;
-  o.fixed_cost_ms = 2;
+  o.budget.target_frame_ms = 100.0 / 9.0;
+  o.budget.fixed_cost_ms = 2;
   ViewSelector s = make(spread_views(16), o);
   // Light content, c = 1.5: shrink from 16 (26 ms) straight to floor(9.11 / 1.5) = 6 (11 ms).
   std::vector<uint32_t> a = run(s, 200, [](uint32_t n) { return 2 + 1.5 * n; });
@@ -342,7 +356,7 @@ TEST(ViewSelection, ControllerFollowsALinearCostModel) {
       s, 300, [](uint32_t n) { return 2 + 1.5 * n; }, &times);
   EXPECT_EQ(c.back(), 5u);
   EXPECT_EQ(changes(c), 2);
-  for (double t : times) ASSERT_LE(t, o.target_frame_ms);
+  for (double t : times) ASSERT_LE(t, o.budget.target_frame_ms);
 }
 
 TEST(ViewSelection, ControllerDoesNotOscillateOnAWrongModel) {
@@ -352,7 +366,7 @@ TEST(ViewSelection, ControllerDoesNotOscillateOnAWrongModel) {
   // keeps trying 5 and failing; each failure doubles its wait (up to 32 times). Without that
   // back-off it would flip 4 ↔ 5 every 31 frames: ~380 changes in 6000 frames.
   ViewSelectionOptions o = no_culling(16);
-  o.target_frame_ms = 100.0 / 9.0;
+  o.budget.target_frame_ms = 100.0 / 9.0;
   ViewSelector s = make(spread_views(16), o);
   uint64_t state = 12345;
   auto noise = [&state] {
@@ -365,7 +379,7 @@ TEST(ViewSelection, ControllerDoesNotOscillateOnAWrongModel) {
   int over = 0;
   for (size_t i = 200; i < c.size(); ++i) {
     ASSERT_TRUE(c[i] == 4 || c[i] == 5) << "frame " << i << ": " << c[i];
-    if (times[i] > o.target_frame_ms * 1.05) {
+    if (times[i] > o.budget.target_frame_ms * 1.05) {
       ++over;
       if (i + 1 < c.size()) {
         ASSERT_EQ(c[i + 1], 4u) << "an over-budget frame: shrink at once";
@@ -378,14 +392,14 @@ TEST(ViewSelection, ControllerDoesNotOscillateOnAWrongModel) {
 
 TEST(ViewSelection, ControllerRespectsMinActiveAndCanBeOff) {
   ViewSelectionOptions o = no_culling(8);
-  o.target_frame_ms = 10;
+  o.budget.target_frame_ms = 10;
   o.min_active = 2;
   ViewSelector s = make(spread_views(8), o);
   const std::vector<uint32_t> c = run(s, 50, [](uint32_t n) { return 100.0 * n; });
   EXPECT_EQ(c.back(), 2u);
   EXPECT_EQ(s.performance_limit(), 2u);
 
-  o.target_frame_ms = 0;  // off: the limit goes back to max_active, frame times are ignored
+  o.budget.target_frame_ms = 0;  // off: the limit goes back to max_active, frame times are ignored
   ASSERT_TRUE(s.set_options(o).ok());
   const std::vector<uint32_t> d = run(s, 10, [](uint32_t n) { return 100.0 * n; });
   EXPECT_EQ(d.front(), 8u);
@@ -396,7 +410,7 @@ TEST(ViewSelection, ControllerDoesNotGrowPastWhatCullingLeaves) {
   // Three views, the limit starts at max_active = 9 and the count is 3: under-budget frames must
   // not push the limit up (nothing to grow into), and an over-budget frame cuts below 3.
   ViewSelectionOptions o = no_culling(9);
-  o.target_frame_ms = 10;
+  o.budget.target_frame_ms = 10;
   ViewSelector s = make(spread_views(3), o);
   run(s, 100, [](uint32_t) { return 1.0; });
   EXPECT_EQ(s.performance_limit(), 9u);
@@ -442,13 +456,13 @@ TEST(ViewSelection, RejectsBadOptions) {
       [](auto& o) { o.min_active = 0; },
       [](auto& o) { o.min_active = o.max_active + 1; },
       [](auto& o) { o.incumbent_margin = 1; },
-      [](auto& o) { o.target_frame_ms = -1; },
-      [](auto& o) { o.target_frame_ms = std::numeric_limits<double>::infinity(); },
-      [](auto& o) { o.fixed_cost_ms = kNaN; },
-      [](auto& o) { o.over_budget_tolerance = 2; },
-      [](auto& o) { o.grow_headroom = 1; },
-      [](auto& o) { o.grow_after_frames = 0; },
-      [](auto& o) { o.cost_smoothing = 0; },
+      [](auto& o) { o.budget.target_frame_ms = -1; },
+      [](auto& o) { o.budget.target_frame_ms = std::numeric_limits<double>::infinity(); },
+      [](auto& o) { o.budget.fixed_cost_ms = kNaN; },
+      [](auto& o) { o.budget.over_budget_tolerance = 2; },
+      [](auto& o) { o.budget.grow_headroom = 1; },
+      [](auto& o) { o.budget.grow_after_frames = 0; },
+      [](auto& o) { o.budget.cost_smoothing = 0; },
   };
   ViewSelector s = make({{1, 0, 0}}, ViewSelectionOptions{});
   for (size_t i = 0; i < bad.size(); ++i) {

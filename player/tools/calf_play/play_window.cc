@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,14 @@ struct CameraState {
 
 }  // namespace
 
+void warn_dropped_views(const Playback& play) {
+  if (play.lightfield() == nullptr) return;
+  for (const auto& [view, problem] : play.lightfield()->dropped_views()) {
+    std::fprintf(stderr, "calf-play: warning: view %u dropped, the others play: %s\n", view,
+                 problem.to_string().c_str());
+  }
+}
+
 Status run_window(const std::string& clip_path, const PlaybackOptions& options,
                   const WindowOptions& wo) {
   if (!glfwInit()) {
@@ -79,6 +88,7 @@ Status run_window(const std::string& clip_path, const PlaybackOptions& options,
     return Status(ErrorId::kPlayerGl, "glTexImage2D / glClear missing from the context");
   }
   CALF_ASSIGN_OR_RETURN(std::unique_ptr<Playback> play, Playback::open(clip_path, options, &gl));
+  warn_dropped_views(*play);
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();

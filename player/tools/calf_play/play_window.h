@@ -26,6 +26,10 @@ struct WindowOptions {
   uint32_t max_frames = 0;  // quit after this many displayed frames (0 = never); for tests
 };
 
+// One stderr warning per light-field view the decoder dropped at open (its index chunk unusable):
+// the clip plays without it. Called by the window and the headless mode.
+void warn_dropped_views(const Playback& play);
+
 // Opens the window, plays until it is closed (or max_frames). Errors: CALF-E404 when no window or
 // GL 4.5 context can be had (e.g. no display: the message says so), the playback's errors.
 Status run_window(const std::string& clip_path, const PlaybackOptions& options,

@@ -103,7 +103,7 @@ Status SceneInputs::play(const fs::path& clip, const PlayConfig& config, PointRe
   player::PlaybackOptions o;
   o.lightfield.render.steps = config.steps;
   o.lightfield.selection.max_active = config.views;
-  o.lightfield.selection.target_frame_ms =
+  o.lightfield.selection.budget.target_frame_ms =
       0;  // calf-play --headless: quality first, no performance culling
   o.use_gl = settings_.use_gl;
   const uint32_t cores = std::max(1u, std::thread::hardware_concurrency());

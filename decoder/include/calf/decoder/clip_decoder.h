@@ -139,13 +139,17 @@ class ClipDecoder {
 
   const container::LightfieldTrackHeader& header() const;
   const LightfieldViewInfo& view(uint32_t v) const;
+  // Ok, or why view v was dropped at open (its index chunk unusable; LightfieldReference::open):
+  // a dropped view is never decoded, and naming it in advance()'s active views is an error.
+  const Status& view_problem(uint32_t v) const;
   const ClipDecoderOptions& options() const;
 
-  // Brings the state of `active_views` (indices, any order, no duplicates; empty = all views) to
+  // Brings the state of `active_views` (indices, any order, no duplicates, none dropped; empty =
+  // every view not dropped) to
   // `frame` for the viewers `eyes`, and fills `out` with the updates and the visible cells'
   // parameters. With no eyes and view_dependent on, nothing is visible. Errors (nothing changes):
-  // CALF-E300 for a frame, view or eye out of range (non-finite, far <= near). Corrupt chunks are
-  // not errors: see FrameStats::errors.
+  // CALF-E300 for a frame, view or eye out of range (an eye that fails eye_view_problem: not
+  // finite, degenerate axes, far <= near). Corrupt chunks are not errors: see FrameStats::errors.
   Status advance(uint32_t frame, std::span<const EyeView> eyes,
                  std::span<const uint32_t> active_views, FrameUpdates* out);
 

@@ -30,15 +30,21 @@ struct LightfieldFace {
 
 class LightfieldReference {
  public:
-  // `reader` must outlive the decoder. Errors: kInvalidArgument (no such track, not lightfield),
-  // kLightfieldFormat, kLightfieldChunk (a missing or bad index chunk).
+  // `reader` must outlive the decoder. A view whose index chunk is missing, repeated, damaged
+  // (its hash fails: CALF-E058) or out of range is dropped, not fatal: view_problem() says why,
+  // and the other views decode. Errors: kInvalidArgument (no such track, not lightfield),
+  // kLightfieldFormat, and the first view's problem when every view is dropped.
   static Expected<LightfieldReference> open(const container::Reader& reader, uint16_t track);
 
   const container::LightfieldTrackHeader& header() const { return header_; }
+  // A dropped view's info is the default ViewIndex (position 0, no depth, no material).
   const LightfieldViewInfo& view(uint32_t v) const { return views_[v]; }
+  // Ok for a usable view; for a dropped one, why its index chunk could not be used.
+  const Status& view_problem(uint32_t v) const { return view_problems_[v]; }
 
   // Decodes view `view`, face `face` (GL order), frame `frame` into `out` (resized).
-  // Errors: kInvalidArgument (index out of range), kLightfieldChunk, container errors.
+  // Errors: kInvalidArgument (index out of range), kLightfieldChunk, container errors, and a
+  // dropped view's problem.
   Status decode_face(uint32_t view, uint32_t face, uint32_t frame, LightfieldFace* out) const;
 
   // The interpolation weights and keyframes of one colour cell (its t chunk), for tests and tools.
@@ -50,10 +56,13 @@ class LightfieldReference {
 
  private:
   LightfieldReference() = default;
+  Status read_view_index(uint32_t v);
+
   const container::Reader* reader_ = nullptr;
   uint16_t track_ = 0;
   container::LightfieldTrackHeader header_;
   std::vector<LightfieldViewInfo> views_;
+  std::vector<Status> view_problems_;
 };
 
 }  // namespace calf::decoder

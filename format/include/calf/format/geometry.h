@@ -140,11 +140,22 @@ struct EyeView {
   Vec3 position, forward{0, 0, -1}, up{0, 1, 0};
   double fov_y = 1.5707963267948966, aspect = 1, near = 0.01, far = 1000;
 };
+// Whether `forward` and `up` span a viewing frame: both finite, forward not zero, up not (nearly)
+// parallel to it (|cross(normalize(forward), up)| > 1e-12 * max(1, |up|); the threshold grows with
+// a long up, whose cross product with a unit forward grows with it). The one test of a viewer's
+// axes, behind validate_camera (calf/format/camera.h) and eye_view_problem.
+bool view_axes_usable(const Vec3& forward, const Vec3& up);
+
+// Why `eye` cannot be culled against, or nullptr when it can: "position or axes not finite, zero
+// or parallel" (position not finite, or !view_axes_usable), "field of view or aspect out of range"
+// (fov_y outside (0, pi), aspect not finite and > 0), "needs 0 < near < far < inf".
+const char* eye_view_problem(const EyeView& eye);
+
 // The frustum of `eye`: f = forward / |forward|, r = normalize(cross(f, up)), u = cross(r, f);
 // corner i at position + d * near (near cap) and position + d * far (far cap) with
 // d = f + (r * (sx * tan(fov_y / 2) * aspect) + u * (sy * tan(fov_y / 2))) and
-// (sx, sy) = (-1, -1), (1, -1), (1, 1), (-1, 1). `eye` must have finite, non-parallel forward
-// and up (the decoder checks viewers before building their frusta).
+// (sx, sy) = (-1, -1), (1, -1), (1, 1), (-1, 1). `eye` must pass eye_view_problem (the decoder
+// checks viewers before building their frusta).
 Frustum eye_frustum(const EyeView& eye);
 
 }  // namespace calf

@@ -21,6 +21,7 @@
 
 #include "calf/format/container_fields.h"
 #include "calf/format/container_types.h"
+#include "calf/format/geometry.h"
 #include "calf/format/status.h"
 
 namespace calf::container {
@@ -99,7 +100,7 @@ inline constexpr size_t kViewIndexBytes = 52;
 
 // A view's index chunk (§11.1.3), as the decoder uses it.
 struct ViewIndex {
-  double position[3] = {0, 0, 0};
+  Vec3 position;  // the viewpoint, scene units
   float z_near = 1, z_far = 2;
   bool has_depth = false;     // the view saw a finite depth (else every code is sky)
   bool has_material = false;  // material chunks exist for this view

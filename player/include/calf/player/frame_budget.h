@@ -20,15 +20,17 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include "calf/format/status.h"
 
 namespace calf::player {
 
-// The controller's knobs. The owner validates them (ViewSelector::make / set_options check the
-// ranges given here, CALF-E450); FrameBudget assumes valid options.
+// The controller's knobs. The owner validates them with frame_budget_problem (ViewSelector::make /
+// set_options do, CALF-E450); FrameBudget assumes valid options.
 struct FrameBudgetOptions {
   // Frame-time target in ms (>= 0, finite); 0 turns the controller off (the limit is max_units).
+  // Default: 90 Hz, the rate of head-mounted displays paper 002 aims at (Sec. 7.2).
   double target_frame_ms = 1000.0 / 90.0;
   // The part of a frame's time that does not depend on the unit count, in ms (>= 0, finite).
   double fixed_cost_ms = 0.0;
@@ -37,7 +39,8 @@ struct FrameBudgetOptions {
   // Grow only when the predicted time with one more unit is at most target * (1 - headroom),
   // [0, 1).
   double grow_headroom = 0.10;
-  // Consecutive under-target frames before the limit grows by one, >= 1.
+  // Consecutive under-target frames before the limit grows by one, >= 1. Default: a third of a
+  // second at 90 Hz.
   uint32_t grow_after_frames = 30;
   // Weight of the newest sample in the running per-unit cost estimate, (0, 1].
   double cost_smoothing = 0.25;
@@ -45,6 +48,11 @@ struct FrameBudgetOptions {
   uint32_t min_units = 1;
   uint32_t max_units = 1;
 };
+
+// Why the knobs other than min_units / max_units are out of the ranges above, naming the first
+// ("target_frame_ms = -1 is outside [0, inf)"; NaN fails every range), or "" when all are in range.
+// The owner checks its own bounds on the units and wraps the text in its error.
+std::string frame_budget_problem(const FrameBudgetOptions& options);
 
 class FrameBudget {
  public:

@@ -82,6 +82,10 @@ class LightfieldRepresentation final : public Representation {
   const LightfieldOptions& options() const;
   ViewSelector& selector();
 
+  // The views the decoder dropped at open (an unusable index chunk; ClipDecoder::view_problem),
+  // increasing, each with why. They are never selected; the others play.
+  std::vector<std::pair<uint32_t, Status>> dropped_views() const;
+
   const decoder::FrameStats& last_stats() const;
   const ViewSelection& last_selection() const;
   double last_render_ms() const;

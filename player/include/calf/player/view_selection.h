@@ -25,9 +25,8 @@
 // Performance culling asks a frame budget (calf/player/frame_budget.h) how many views the frame
 // may use: the caller renders with the selection, then reports that frame's time
 // (report_frame_time), and the budget's controller (model frame_ms = fixed_cost_ms + n *
-// per_view_ms, n the active count) lowers or raises the limit. The budget's knobs are the
-// ViewSelectionOptions fields below of the same names; its units are active views, bounded by
-// [min_active, max_active].
+// per_view_ms, n the active count) lowers or raises the limit. Its knobs are
+// ViewSelectionOptions::budget; its units are active views, bounded by [min_active, max_active].
 //
 // Stereo: pass the midpoint of the two eyes and the mean forward direction.
 // Everything is deterministic: same inputs, same calls, same results.
@@ -70,22 +69,10 @@ struct ViewSelectionOptions {
   // Ranking stickiness for views active last frame, [0, 1): their priority key counts
   // (1 - margin) times its value. 0 turns it off.
   double incumbent_margin = 0.05;
-  // The frame budget's knobs (FrameBudgetOptions, frame_budget.h, documents them; the ranges are
-  // checked here). Frame-time target in ms (>= 0, finite); 0 turns performance culling off.
-  // Default: 90 Hz, the rate of head-mounted displays the paper aims at (Sec. 7.2).
-  double target_frame_ms = 1000.0 / 90.0;
-  // The part of a frame's time that does not depend on the active count, in ms (>= 0, finite).
-  double fixed_cost_ms = 0.0;
-  // Shrink only when a frame takes more than target * (1 + tolerance), [0, 1].
-  double over_budget_tolerance = 0.05;
-  // Grow only when the predicted time with one more view is at most target * (1 - headroom),
-  // [0, 1).
-  double grow_headroom = 0.10;
-  // Consecutive under-target frames before the limit grows by one, >= 1. Default: a third of a
-  // second at 90 Hz.
-  uint32_t grow_after_frames = 30;
-  // Weight of the newest sample in the running per-view cost estimate, (0, 1].
-  double cost_smoothing = 0.25;
+  // Performance culling's controller (frame_budget.h documents its knobs and defaults; make /
+  // set_options check their ranges). Its units are active views: min_units / max_units are not
+  // read, the selector bounds the count by [min_active, max_active].
+  FrameBudgetOptions budget;
 };
 
 // Views a selector accepts; slot and view indices fit 32 bits with kNoView to spare.
@@ -141,6 +128,9 @@ class ViewSelector {
   // Errors: CALF-E450; the old options stay.
   Status set_options(const ViewSelectionOptions& options);
 
+  // Never selects `view` again (a view the decoder dropped: its position is unknown); a view in a
+  // slot leaves it at the next selection. Errors: CALF-E450 for an index out of range.
+  Status exclude(uint32_t view);
   // Forgets the slot table and the controller's state (e.g. after a seek or a teleport).
   void reset();
 
@@ -160,6 +150,7 @@ class ViewSelector {
   ViewSelectionOptions options_;
   std::vector<uint32_t> slots_;      // last frame's slot table
   std::vector<uint8_t> was_active_;  // per view: in slots_
+  std::vector<uint8_t> excluded_;    // per view: never selected (exclude)
   bool selected_once_ = false;
   FrameBudget budget_;  // performance culling
 };
