@@ -6,6 +6,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -15,6 +16,7 @@
 #include "calf/capture/capture_set.h"
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/format/container.h"
+#include "calf/format/container_io.h"
 #include "calf/player/image_compare.h"
 #include "calf/player/playback.h"
 
@@ -205,6 +207,53 @@ TEST(Playback, FileWithoutLightfieldIsRefused) {
   empty.append("/tests/conformance/container/valid/empty.calf");
   auto play = Playback::open(empty, o, nullptr);
   EXPECT_EQ(play.status().id(), ErrorId::kPlaybackClip);
+}
+
+// A clip whose view 0 index chunk is damaged plays with the other views: the representation
+// reports the dropped view with its reason and never selects it.
+TEST(LightfieldRepresentation, DamagedViewIndexPlaysTheOtherViews) {
+  auto whole = container::Reader::open(clip_path());
+  ASSERT_TRUE(whole.ok()) << whole.status().to_string();
+  ASSERT_GE(std::get<container::LightfieldTrackHeader>(whole->tracks()[0].header).view_count, 2u);
+  std::vector<uint8_t> bytes;
+  {
+    std::FILE* f = std::fopen(clip_path().c_str(), "rb");
+    ASSERT_NE(f, nullptr);
+    uint8_t buf[65536];
+    size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) bytes.insert(bytes.end(), buf, buf + n);
+    std::fclose(f);
+  }
+  for (const auto& c : whole->chunks()) {
+    if (c.keys.stream == static_cast<uint16_t>(container::LightfieldStream::kIndex) &&
+        c.keys.view == 0) {
+      bytes[c.offset + 1] ^= 0x40;
+    }
+  }
+  auto reader = container::Reader::open(container::memory_source(bytes));
+  ASSERT_TRUE(reader.ok()) << reader.status().to_string();
+  LightfieldOptions o;
+  o.selection.budget.target_frame_ms = 0;
+  auto lf = LightfieldRepresentation::open(*reader, 0, o, RenderBackend::kCpu, nullptr);
+  ASSERT_TRUE(lf.ok()) << lf.status().to_string();
+  const auto dropped = (*lf)->dropped_views();
+  ASSERT_EQ(dropped.size(), 1u);
+  EXPECT_EQ(dropped[0].first, 0u);
+  EXPECT_EQ(dropped[0].second.id(), ErrorId::kContainerChunkHash);
+  Camera cam;
+  // At the dropped view's placeholder position (the origin): were it selectable it would rank
+  // first.
+  cam.position = (*lf)->viewpoints()[0];
+  cam.width = 24;
+  cam.height = 16;
+  for (uint32_t frame = 0; frame < 2; ++frame) {
+    ASSERT_TRUE((*lf)->prepare(frame, std::span<const Camera>(&cam, 1)).ok());
+    const auto& active = (*lf)->last_selection().active;
+    EXPECT_FALSE(active.empty());
+    EXPECT_EQ(std::count(active.begin(), active.end(), 0u), 0);
+    RenderedImage image;
+    ASSERT_TRUE((*lf)->render(cam, &image).ok());
+  }
 }
 
 }  // namespace
