@@ -5,11 +5,15 @@
 #   REGEX          a regular expression the stderr (fail), stdout (fail-list, ok) must match
 #   FORBID         paths that must not exist afterwards (';'-list): nothing half-written
 #   CLEAN          a directory removed before the run, so FORBID checks this run only
+#   STATUS         the exact exit status expected (e.g. 2 for a usage error), when set
 if(CLEAN)
   file(REMOVE_RECURSE "${CLEAN}")
 endif()
 execute_process(COMMAND ${CMD} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 string(REPLACE ";" " " shown "${CMD}")
+if(NOT "${STATUS}" STREQUAL "" AND NOT rc EQUAL "${STATUS}")
+  message(FATAL_ERROR "expected exit status ${STATUS} from: ${shown} (got ${rc})\nstdout: ${out}\nstderr: ${err}")
+endif()
 if(EXPECT STREQUAL "fail")
   if(rc EQUAL 0)
     message(FATAL_ERROR "expected a non-zero exit from: ${shown}\nstdout: ${out}\nstderr: ${err}")

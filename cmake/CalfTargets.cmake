@@ -46,7 +46,8 @@ function(calf_layer name)
     file(GLOB tool_extra CONFIGURE_DEPENDS ${dir}/tools/${tool}/*.cc)
     add_executable(${exe} ${tool_source} ${tool_extra})
     target_link_libraries(${exe} PRIVATE ${name} CLI11::CLI11 fmt::fmt calf_options)
-    target_include_directories(${exe} PRIVATE ${dir}/tools)
+    # format/tools/command_line.h: the exit statuses and usage errors every command shares.
+    target_include_directories(${exe} PRIVATE ${dir}/tools ${PROJECT_SOURCE_DIR}/format/tools)
   endforeach()
 endfunction()
 

@@ -43,8 +43,8 @@ Status validate_options(const LightfieldEncodeOptions& o) {
   if (o.depth_keyframe_interval < 1) {
     return bad("--depth-keyframe-interval 0: expected >= 1");
   }
-  if (o.threads > 1024)
-    return bad("--threads " + std::to_string(o.threads) + ": expected [0, 1024]");
+  // 256 as calf-capture's: beyond it oneTBB prints warnings of its own (a library never prints).
+  if (o.threads > 256) return bad("--threads " + std::to_string(o.threads) + ": expected [0, 256]");
   if (static_cast<uint16_t>(o.supercompression) >= container::kCompressionCount) {
     return bad("unknown supercompression");
   }

@@ -21,6 +21,7 @@
 #include "calf/encoder/color_keyframes.h"
 #include "calf/encoder/depth_aabb.h"
 #include "calf/format/bc.h"
+#include "calf/format/files.h"
 #include "calf/format/grid.h"
 #include "calf/format/lightfield_layout.h"
 #include "calf/format/log_depth.h"
@@ -749,6 +750,15 @@ Expected<LightfieldEncodeStats> encode_lightfield_file(const std::filesystem::pa
   CALF_RETURN_IF_ERROR(lightfield_internal::validate_options(options));
   CALF_ASSIGN_OR_RETURN(capture::CaptureSetReader input,
                         capture::CaptureSetReader::open(capture_dir));
+  // The output must not be one of the inputs: renaming over the manifest or an image would
+  // destroy the set the clip is made from (CALF-E007; the directory itself is E004's).
+  std::vector<std::string> inputs = {capture_dir.string(),
+                                     (capture_dir / capture::kManifestFileName).string()};
+  for (uint32_t v = 0; v < input.manifest().viewpoints.size(); ++v) {
+    for (uint32_t f = 0; f < input.manifest().frame_count; ++f)
+      inputs.push_back(input.image_path(v, f).string());
+  }
+  CALF_RETURN_IF_ERROR(files::check_output_not_input(out_path, inputs));
   CALF_ASSIGN_OR_RETURN(container::Writer writer,
                         container::Writer::create(out_path, options.levels));
   CALF_ASSIGN_OR_RETURN(LightfieldEncodeStats stats, encode_lightfield(input, writer, options));

@@ -1,6 +1,6 @@
 // calf-encode: a capture set in, a .calf with a lightfield track out (paper 002, Sec. 5;
 // format/SPEC.md §11.1). Errors are one line with a stable id and exit status 1 (no output file is
-// left behind); usage errors exit 2.
+// left behind, also when SIGINT / SIGTERM / SIGHUP end it); usage errors exit 2 (command_line.h).
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -13,15 +13,12 @@
 #include <CLI/CLI.hpp>
 
 #include "calf/encoder/lightfield_encode.h"
+#include "command_line.h"
 
 namespace {
 
 int fail(const calf::Status& status) {
-  std::string line = status.to_string();
-  const size_t newline = line.find('\n');
-  if (newline != std::string::npos) line = line.substr(0, newline);
-  std::fprintf(stderr, "calf-encode: %s\n", line.c_str());
-  return 1;
+  return calf::tools::print_error("calf-encode", status);
 }
 
 double peak_rss_mib() {
@@ -36,7 +33,12 @@ int main(int argc, char** argv) {
   CLI::App app{
       "calf-encode: encode a capture set (format/CAPTURE.md) into a .calf lightfield track "
       "(format/SPEC.md 11.1).\nColour: per-cell keyframes + 8-bit t (Alg. 2); depth: log-16 "
-      "keyframes + rectangle P-frames (Alg. 3); material coded like depth when present."};
+      "keyframes + rectangle P-frames (Alg. 3); material coded like depth when present.\n"
+      "The output is written whole or not at all (a temporary file beside it, renamed into "
+      "place; removed on an error or on SIGINT / SIGTERM / SIGHUP). It may not exist yet or be a "
+      "regular file; a directory, FIFO, device node or symbolic link there is refused "
+      "(CALF-E004), and so is an output that is one of the inputs (CALF-E007).\n" +
+      std::string(calf::tools::kExitStatusHelp)};
   calf::LightfieldEncodeOptions o;
   std::string manifest, out;
   std::string colour = "auto", depth = "raw16", super = "zstd";
@@ -45,7 +47,9 @@ int main(int argc, char** argv) {
       ->required();
   app.add_option("-o,--output", out, "output .calf (written whole or not at all)")->required();
   app.add_option("--threads", o.threads,
-                 "worker threads, 0 = all cores; output is identical for any count (default 0)")
+                 "worker threads 0..256, 0 = all cores; output is identical for any count "
+                 "(default 0)")
+      ->check(CLI::Range(0u, calf::tools::kMaxThreads))
       ->default_val(0);
   app.add_option("--cell", o.cell_size, "colour cell side in px, multiple of 4 (default 64)")
       ->default_val(64);
@@ -79,11 +83,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"zstd", "lzma2", "none"}))
       ->default_val("zstd");
   app.add_flag("-q,--quiet", quiet, "no progress line");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
-  }
+  if (int rc = calf::tools::parse_command_line(app, "calf-encode", argc, argv); rc >= 0) return rc;
 
   const std::map<std::string, calf::ColourCoding> colours = {
       {"auto", calf::ColourCoding::kAuto},   {"bc1", calf::ColourCoding::kBc1},

@@ -1,16 +1,16 @@
-// File and memory byte sources and sinks (POSIX: pread, pwrite, mkstemp, fsync, rename).
+// File and memory byte sources and sinks (POSIX: pread, pwrite; files.h: temporary file, rename).
 #include "calf/format/container_io.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 
 #include "calf/format/container_fields.h"
+#include "calf/format/files.h"
 
 namespace calf::container {
 namespace {
@@ -72,12 +72,7 @@ class MemorySource final : public ByteSource {
 
 class FileSink final : public ByteSink {
  public:
-  FileSink(int fd, std::string temp, std::string path)
-      : fd_(fd), temp_(std::move(temp)), path_(std::move(path)) {}
-  ~FileSink() override {
-    if (fd_ >= 0) ::close(fd_);
-    if (!committed_) ::unlink(temp_.c_str());
-  }
+  explicit FileSink(files::TempFile temp) : temp_(std::move(temp)) {}
   Status append(std::span<const uint8_t> bytes) override {
     CALF_RETURN_IF_ERROR(write_at(size_, bytes));
     size_ += bytes.size();
@@ -88,36 +83,24 @@ class FileSink final : public ByteSink {
       return Status(ErrorId::kInternal, cat("patch at ", offset, " past the end ", size_));
     return write_at(offset, bytes);
   }
-  Status commit() override {
-    if (::fsync(fd_) != 0 || ::close(fd_) != 0) {
-      fd_ = -1;
-      return Status(ErrorId::kFileWrite, cat(temp_, ": ", errno_text()));
-    }
-    fd_ = -1;
-    if (::rename(temp_.c_str(), path_.c_str()) != 0)
-      return Status(ErrorId::kFileWrite, cat("rename ", temp_, " to ", path_, ": ", errno_text()));
-    committed_ = true;
-    return Status::Ok();
-  }
+  Status commit() override { return temp_.commit(); }
 
  private:
   Status write_at(uint64_t offset, std::span<const uint8_t> bytes) {
     size_t done = 0;
     while (done < bytes.size()) {
-      const ssize_t n = ::pwrite(fd_, bytes.data() + done, bytes.size() - done,
+      const ssize_t n = ::pwrite(temp_.fd(), bytes.data() + done, bytes.size() - done,
                                  static_cast<off_t>(offset + done));
       if (n < 0) {
         if (errno == EINTR) continue;
-        return Status(ErrorId::kFileWrite, cat(temp_, ": write: ", errno_text()));
+        return Status(ErrorId::kFileWrite, cat(temp_.temp_path(), ": write: ", errno_text()));
       }
       done += static_cast<size_t>(n);
     }
     return Status::Ok();
   }
-  int fd_;
-  std::string temp_, path_;
+  files::TempFile temp_;  // removed on destruction unless committed
   uint64_t size_ = 0;
-  bool committed_ = false;
 };
 
 class MemorySink final : public ByteSink {
@@ -142,12 +125,12 @@ class MemorySink final : public ByteSink {
 }  // namespace
 
 Expected<std::unique_ptr<ByteSource>> open_file_source(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return Status(ErrorId::kFileOpen, cat(path, ": ", errno_text()));
+  // A regular file only, checked before the (non-blocking) open: a FIFO never blocks a reader.
+  CALF_ASSIGN_OR_RETURN(const int fd, files::open_regular_file(path));
   struct stat st;
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+  if (::fstat(fd, &st) != 0) {
     ::close(fd);
-    return Status(ErrorId::kFileOpen, cat(path, ": not a regular file"));
+    return Status(ErrorId::kFileOpen, cat(path, ": ", errno_text()));
   }
   return std::unique_ptr<ByteSource>(new FileSource(fd, static_cast<uint64_t>(st.st_size), path));
 }
@@ -160,18 +143,9 @@ std::unique_ptr<ByteSource> memory_source(std::vector<uint8_t> bytes) {
 }
 
 Expected<std::unique_ptr<ByteSink>> create_file_sink(const std::string& path) {
-  // O_EXCL with mode 0666 lets the kernel apply the process umask, as for any new file (mkstemp
-  // would create 0600, and reading the umask means changing it, which is process-global). The
-  // name is unique per process and call; a stale file of the same name is skipped, not reused.
-  static std::atomic<uint32_t> counter{0};
-  for (int attempt = 0; attempt < 100; ++attempt) {
-    std::string temp = cat(path, ".tmp-", static_cast<uint64_t>(::getpid()), "-",
-                           static_cast<uint64_t>(counter.fetch_add(1)));
-    const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd >= 0) return std::unique_ptr<ByteSink>(new FileSink(fd, std::move(temp), path));
-    if (errno != EEXIST) break;
-  }
-  return Status(ErrorId::kFileWrite, cat(path, ": cannot create a temporary file: ", errno_text()));
+  // The output rules (regular file or absent, temporary file naming, cleanup) are files.h's.
+  CALF_ASSIGN_OR_RETURN(files::TempFile temp, files::TempFile::create(path));
+  return std::unique_ptr<ByteSink>(new FileSink(std::move(temp)));
 }
 
 std::unique_ptr<ByteSink> memory_sink(std::vector<uint8_t>* out) {

@@ -34,8 +34,10 @@ Reader& Reader::operator=(Reader&&) noexcept = default;
 Reader::~Reader() = default;
 
 Expected<Reader> Reader::open(const std::string& path) {
-  CALF_ASSIGN_OR_RETURN(auto source, open_file_source(path));
-  return open(std::move(source));
+  CALF_ASSIGN_OR_RETURN(auto source, open_file_source(path));  // its errors name the path
+  Expected<Reader> r = open(std::move(source));
+  if (!r.ok()) return std::move(r).status().with_context(path);
+  return r;
 }
 
 Expected<Reader> Reader::open(std::unique_ptr<ByteSource> source) {

@@ -9,6 +9,7 @@
 
 #include "calf/format/container.h"
 #include "calf/format/version.h"
+#include "command_line.h"
 
 namespace {
 
@@ -28,6 +29,24 @@ std::string json_string(std::string_view s) {
     }
   }
   return out + "\"";
+}
+
+// Metadata for a terminal: control characters (C0, DEL, and C1 as UTF-8, which terminals act on
+// too) are shown as \xNN / \u00NN, so a clip cannot send escape sequences to the terminal.
+std::string printable(std::string_view s) {
+  std::string out;
+  for (size_t i = 0; i < s.size(); ++i) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c < 0x20 || c == 0x7f) {
+      out += fmt::format("\\x{:02x}", static_cast<unsigned>(c));
+    } else if (c == 0xc2 && i + 1 < s.size() && static_cast<unsigned char>(s[i + 1]) >= 0x80 &&
+               static_cast<unsigned char>(s[i + 1]) <= 0x9f) {
+      out += fmt::format("\\u{:04x}", static_cast<unsigned>(static_cast<unsigned char>(s[++i])));
+    } else {
+      out += s[i];
+    }
+  }
+  return out;
 }
 
 struct StreamStats {
@@ -72,7 +91,8 @@ void print_text(const std::string& path, const Reader& r, bool list_chunks) {
   fmt::print("  payload: {} stored bytes, {} raw bytes, ratio {}\n", total.stored, total.raw,
              ratio(total));
   if (!r.metadata().empty()) fmt::print("metadata:\n");
-  for (const auto& m : r.metadata()) fmt::print("  {} = {}\n", m.key, m.value);
+  for (const auto& m : r.metadata())
+    fmt::print("  {} = {}\n", printable(m.key), printable(m.value));
   for (const auto& t : r.tracks()) {
     fmt::print("track {}: {}{}{}\n", t.id, track_kind_name(t.record.kind),
                t.known ? "" : fmt::format(" (kind {}, skipped)", t.record.kind),
@@ -87,7 +107,7 @@ void print_text(const std::string& path, const Reader& r, bool list_chunks) {
     if (num && den)
       fmt::print("  {} frames at {:.3f} fps ({}/{}), {:.3f} s\n", frames,
                  static_cast<double>(num) / den, num, den, static_cast<double>(frames) * den / num);
-    for (const auto& e : fields) fmt::print("  {}: {}\n", e.name, field_text(e));
+    for (const auto& e : fields) fmt::print("  {}: {}\n", e.name, printable(field_text(e)));
     fmt::print("  {:<12} {:>8} {:>14} {:>14} {:>8}\n", "stream", "chunks", "stored bytes",
                "raw bytes", "ratio");
     for (const auto& [tag, s] : stream_stats(r, t.id)) {
@@ -171,26 +191,21 @@ void print_json(const std::string& path, const Reader& r, bool list_chunks) {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "calf-info: summarise a .calf clip (version, tracks, frames, views, face size, formats, "
-      "bytes per stream and ratio to raw). Reads only the header and directory; use "
-      "calf-verify to check every chunk.\nExit status: 0 ok, 1 the file is not a readable "
-      "calf clip, 2 bad command line."};
+      std::string("calf-info: summarise a .calf clip (version, tracks, frames, views, face size, "
+                  "formats, bytes per stream and ratio to raw). Reads only the header and "
+                  "directory; use calf-verify to check every chunk. Control characters in "
+                  "metadata are printed escaped (\\xNN) in text mode.\n") +
+      calf::tools::kExitStatusHelp};
   app.set_version_flag("--version", std::string("calf ") + calf::kVersionString);
   std::string path;
   bool json = false, chunks = false;
-  app.add_option("FILE", path, "the .calf clip")->required();
+  app.add_option("FILE", path, "the .calf clip (a regular file)")->required();
   app.add_flag("--json", json, "print one JSON object instead of text");
   app.add_flag("--chunks", chunks, "also list every chunk index entry");
-  CLI11_PARSE(app, argc, argv);
+  if (int rc = calf::tools::parse_command_line(app, "calf-info", argc, argv); rc >= 0) return rc;
+  // Reader::open's errors name the file once.
   auto reader = Reader::open(path);
-  if (!reader.ok()) {
-    // Errors opening the file already name it; later ones (header, directory) get it added.
-    const calf::Status& s = reader.status();
-    fmt::print(
-        stderr, "calf-info: {}\n",
-        (s.message().find(path) == std::string::npos ? s.with_context(path) : s).to_string());
-    return 1;
-  }
+  if (!reader.ok()) return calf::tools::print_error("calf-info", reader.status());
   if (json)
     print_json(path, *reader, chunks);
   else

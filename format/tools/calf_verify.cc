@@ -2,7 +2,7 @@
 // chunk's hash and decompression, every padding byte, then each lightfield track's layout by
 // decoding every face of every view at every frame (calf/decoder/lightfield_verify.h). Prints one
 // line per problem, each with its stable id, and exits 0 only when every file is good. With
-// --decode it prints the conformance hash of every decoded face (SPEC §13).
+// --decode it prints the conformance hash of every decoded face (SPEC §14).
 #include <fmt/core.h>
 #include <CLI/CLI.hpp>
 
@@ -10,38 +10,40 @@
 #include "calf/format/container.h"
 #include "calf/format/track_kinds.h"
 #include "calf/format/version.h"
+#include "command_line.h"
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "calf-verify: check .calf files completely: header, directory, every chunk hash and "
-      "decompression, padding, then every lightfield track's layout by decoding all of it.\n"
-      "Exit status: 0 all files good, 1 a problem was found, 2 bad command line."};
+      std::string("calf-verify: check .calf files completely: header, directory, every chunk "
+                  "hash and decompression, padding, then every lightfield track's layout by "
+                  "decoding all of it. Problems are listed on stdout, one line each with its CALF "
+                  "id.\nExit status: 0 all files good; 1 a problem was found (or a file could not "
+                  "be opened); 2 a usage error (bad option or argument), one line with CALF-E006 "
+                  "on stderr.")};
   app.set_version_flag("--version", std::string("calf ") + calf::kVersionString);
   std::vector<std::string> files;
   bool quiet = false, container_only = false, decode = false;
   size_t max_problems = 100;
-  app.add_option("FILE", files, "the .calf files to verify")->required();
+  app.add_option("FILE", files, "the .calf files to verify (regular files)")->required();
   app.add_flag("-q,--quiet", quiet, "print problems only, no 'ok' line");
   app.add_flag("--container-only", container_only,
                "check the container alone (SPEC §2-§10), not the tracks' layouts (§11)");
   app.add_flag("--decode", decode,
                "also print the conformance hash of every decoded face, one line each: "
-               "'track T frame F view V face X <XXH3-64 hex>' (SPEC §13); a file with problems "
+               "'track T frame F view V face X <XXH3-64 hex>' (SPEC §14); a file with problems "
                "prints none")
       ->excludes("--container-only");
-  app.add_option("--max-problems", max_problems, "stop listing a file's problems after N")
-      ->check(CLI::PositiveNumber);
-  CLI11_PARSE(app, argc, argv);
+  app.add_option("--max-problems", max_problems,
+                 "stop listing a file's problems after N, 1..1000000 (default 100)")
+      ->check(CLI::Range(size_t{1}, size_t{1000000}));
+  if (int rc = calf::tools::parse_command_line(app, "calf-verify", argc, argv); rc >= 0) return rc;
 
   int rc = 0;
   for (const auto& path : files) {
+    // Reader::open's errors name the file once.
     auto reader = calf::container::Reader::open(path);
     if (!reader.ok()) {
-      // Errors opening the file already name it; later ones (header, directory) get it added.
-      const calf::Status& s = reader.status();
-      fmt::print(
-          "{}\n",
-          (s.message().find(path) == std::string::npos ? s.with_context(path) : s).to_string());
+      fmt::print("{}\n", reader.status().to_string());
       rc = 1;
       continue;
     }

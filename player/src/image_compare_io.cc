@@ -2,12 +2,12 @@
 // OpenImageIO exceptions stop here; every file is written whole (temporary file, then rename).
 #include <cmath>
 #include <string>
-#include <system_error>
 #include <vector>
 
 #include <OpenImageIO/imageio.h>
 
 #include "calf/format/colour.h"
+#include "calf/format/files.h"
 #include "calf/player/contact_sheet.h"
 #include "calf/player/image_compare.h"
 
@@ -15,14 +15,15 @@ namespace calf::player {
 
 namespace {
 
-// Writes 8-bit RGB pixels (row-major from the top row) as a PNG to `path` via `path`.tmp.
+// Writes 8-bit RGB pixels (row-major from the top row) as a PNG to `path` through a temporary
+// file beside it (files::TempFile: the output rules and the cleanup on a signal).
 Status write_rgb8_png_file(const std::filesystem::path& path, uint32_t width, uint32_t height,
                            const std::vector<uint8_t>& pixels) {
   const std::string final_name = path.string();
-  const std::string temp_name = final_name + ".tmp";
-  std::error_code ignored;
+  CALF_ASSIGN_OR_RETURN(files::TempFile temp, files::TempFile::create(final_name));
+  temp.close_fd();  // OIIO opens the file by name
   try {
-    // By format name, not by file name: the temporary file's extension is ".tmp".
+    // By format name, not by file name: the temporary file's name ends in a counter.
     std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create("png");
     if (!out) {
       std::string e = OIIO::geterror();
@@ -32,7 +33,7 @@ Status write_rgb8_png_file(const std::filesystem::path& path, uint32_t width, ui
     OIIO::ImageSpec spec(static_cast<int>(width), static_cast<int>(height), 3,
                          OIIO::TypeDesc::UINT8);
     // No time stamp or software name: the bytes depend on the pixels only.
-    if (!out->open(temp_name, spec)) {
+    if (!out->open(temp.temp_path(), spec)) {
       std::string e = out->geterror();
       return Status(ErrorId::kFileWrite, final_name + ": " + (e.empty() ? "cannot open" : e));
     }
@@ -40,20 +41,12 @@ Status write_rgb8_png_file(const std::filesystem::path& path, uint32_t width, ui
     std::string e = ok ? "" : out->geterror();
     ok = out->close() && ok;
     if (!ok) {
-      std::filesystem::remove(temp_name, ignored);
       return Status(ErrorId::kFileWrite, final_name + ": " + (e.empty() ? "write failed" : e));
     }
   } catch (const std::exception& ex) {
-    std::filesystem::remove(temp_name, ignored);
     return Status(ErrorId::kFileWrite, final_name + ": " + ex.what());
   }
-  std::error_code ec;
-  std::filesystem::rename(temp_name, path, ec);
-  if (ec) {
-    std::filesystem::remove(temp_name, ignored);
-    return Status(ErrorId::kFileWrite, final_name + ": cannot rename into place: " + ec.message());
-  }
-  return Status::Ok();
+  return temp.commit(/*sync=*/false);
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 // calf-play: plays a .calf lightfield clip (paper 002 Sec. 6): in a GLFW window with fly / orbit
 // cameras and a Dear ImGui HUD, or headless through OSMesa along an eye path, writing frames and
 // comparing them with calf-capture's ground truth. Errors are one line with a stable id and exit
-// status 1; usage errors exit 2.
+// status 1; usage errors exit 2 (command_line.h).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -17,6 +17,7 @@
 #include "calf/player/image_compare.h"
 #include "calf/player/playback.h"
 #include "calf_play/play_window.h"
+#include "command_line.h"
 
 namespace {
 
@@ -25,10 +26,7 @@ using namespace calf;
 using namespace calf::player;
 
 int fail(const Status& status) {
-  std::string line = status.to_string();
-  line = line.substr(0, line.find('\n'));
-  std::fprintf(stderr, "calf-play: %s\n", line.c_str());
-  return 1;
+  return tools::print_error("calf-play", status);
 }
 
 struct HeadlessArgs {
@@ -195,7 +193,10 @@ int main(int argc, char** argv) {
       "+/- active views, Shift+S stereo, space pause, H HUD, Esc quit.\n"
       "Headless (--headless): renders an eye path (calf-capture writes one with --ground-truth) "
       "through OSMesa, writes frames to --out and, with --compare, prints PSNR / SSIM per pose "
-      "and a final 'mean PSNR <x> dB, mean SSIM <y>' line."};
+      "and a final 'mean PSNR <x> dB, mean SSIM <y>' line. Output files (frames, heat maps, "
+      "contact sheet) are written whole; an existing directory, FIFO, device or symbolic link "
+      "in their place is refused (CALF-E004).\n" +
+      std::string(tools::kExitStatusHelp)};
   std::string clip;
   HeadlessArgs h;
   bool headless = false;
@@ -266,7 +267,7 @@ int main(int argc, char** argv) {
   app.add_option("--ipd", w.ipd,
                  "window: distance between the eyes in scene units (default 0.064)");
   app.add_option("--frames", w.max_frames, "window: quit after this many frames (0 = never)");
-  CLI11_PARSE(app, argc, argv);
+  if (int rc = tools::parse_command_line(app, "calf-play", argc, argv); rc >= 0) return rc;
 
   play_options.use_gl = renderer == "gl";
   o.selection.priority = priority == "angle" ? ViewPriority::kAngle : ViewPriority::kDistance;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <system_error>
 
+#include "calf/format/files.h"
 #include "calf/samples/render.h"
 
 namespace calf::samples {
@@ -127,6 +128,8 @@ Expected<RenderStats> render_ground_truth(const Scene& scene, const capture::Eye
   if (ec || !std::filesystem::is_directory(directory, ec)) {
     return Status(ErrorId::kFileWrite, directory.string() + ": cannot create directory");
   }
+  // A FIFO or link under the eye path's name is refused, not removed (calf/format/files.h).
+  CALF_RETURN_IF_ERROR(files::check_output_file((directory / capture::kEyePathFileName).string()));
   std::filesystem::remove(directory / capture::kEyePathFileName, ec);
   const auto start = std::chrono::steady_clock::now();
   RenderStats stats;

@@ -1,6 +1,7 @@
 // calf-capture: renders capture sets (cube-map colour + depth [+ material] per viewpoint and
 // frame) and ground truth of the built-in sample scenes or of any file assimp imports.
-// Errors are one line with a stable id and exit status 1; usage errors exit 2.
+// Errors are one line with a stable id and exit status 1; usage errors exit 2 (command_line.h).
+// SIGINT / SIGTERM / SIGHUP remove the image being written (calf/format/files.h).
 #include <unistd.h>
 
 #include <chrono>
@@ -14,6 +15,7 @@
 #include "calf/samples/render.h"
 #include "calf/samples/scene.h"
 #include "calf/samples/scene_export.h"
+#include "command_line.h"
 
 namespace {
 
@@ -21,12 +23,7 @@ using calf::Status;
 namespace samples = calf::samples;
 
 int fail(const Status& status) {
-  std::string line = status.to_string();
-  // One line: the rig help (multi-line) is summarised.
-  size_t newline = line.find('\n');
-  if (newline != std::string::npos) line = line.substr(0, newline) + " (see --help)";
-  std::fprintf(stderr, "calf-capture: %s\n", line.c_str());
-  return 1;
+  return calf::tools::print_error("calf-capture", status);
 }
 
 // Progress on stderr: one updating line on a terminal, a line per ~10 % otherwise.
@@ -62,7 +59,9 @@ int main(int argc, char** argv) {
       "calf-capture: ray-trace capture sets (format/CAPTURE.md) and ground truth of sample "
       "scenes.\n"
       "Writes DIR/manifest.json last, so an interrupted run never leaves a set that looks "
-      "complete.",
+      "complete; every file is written whole (a temporary file renamed into place, removed on "
+      "an error or on SIGINT / SIGTERM / SIGHUP).\n" +
+          std::string(calf::tools::kExitStatusHelp),
       "calf-capture"};
   std::string scene_arg, out_dir, rig_arg = "default", eye_path_file, export_dir;
   uint32_t face_size = 256, frames = 0, threads = 0, ao_samples = 8, max_bounces = 6;
@@ -76,11 +75,14 @@ int main(int argc, char** argv) {
   app.add_option("--face-size", face_size, "cube face size in texels, 1..4096")
       ->capture_default_str();
   app.add_option("--frames", frames,
-                 "frames to render, 1..100000 (default: the scene's own, 30 for built-ins)");
+                 "frames to render, 1..100000 (default: the scene's own, 30 for built-ins)")
+      ->check(CLI::Range(1u, 100000u));
   app.add_option("--rig", rig_arg, std::string("viewpoints, one of:\n") + samples::kRigSyntaxHelp)
       ->capture_default_str();
   app.add_option("--threads", threads,
-                 "render threads, 0 = all hardware threads; output is identical for any count")
+                 "render threads 0..256, 0 = all hardware threads; output is identical for any "
+                 "count")
+      ->check(CLI::Range(0u, calf::tools::kMaxThreads))
       ->capture_default_str();
   app.add_option("--seed", seed, "seed of AO directions and noise")->capture_default_str();
   app.add_option("--ao-samples", ao_samples, "ambient-occlusion rays per diffuse hit, 0..256")
@@ -102,15 +104,7 @@ int main(int argc, char** argv) {
                  "scene.bin) with --frames frames; without --out, only export");
   app.add_flag("--list-scenes", list, "print the built-in scenes and exit");
   app.add_flag("--quiet", quiet, "no progress or summary lines on stderr");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp&) {
-    std::fputs(app.help().c_str(), stdout);
-    return 0;
-  } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "calf-capture: %s (see --help)\n", e.what());
-    return 2;
-  }
+  if (int rc = calf::tools::parse_command_line(app, "calf-capture", argc, argv); rc >= 0) return rc;
 
   if (list) {
     for (const samples::SceneInfo& s : samples::builtin_scenes()) {
@@ -121,9 +115,8 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (scene_arg.empty() || (out_dir.empty() && export_dir.empty())) {
-    std::fprintf(stderr,
-                 "calf-capture: --scene and --out (or --export-scene) are required (see --help)\n");
-    return 2;
+    return calf::tools::usage_error("calf-capture",
+                                    "--scene and --out (or --export-scene) are required");
   }
 
   samples::RenderOptions render;
@@ -136,10 +129,6 @@ int main(int argc, char** argv) {
   if (face_size < 1 || face_size > 4096) {
     return fail(Status(calf::ErrorId::kCaptureOption,
                        fmt::format("--face-size {} is outside 1..4096", face_size)));
-  }
-  if (frames > 100000) {
-    return fail(Status(calf::ErrorId::kCaptureOption,
-                       fmt::format("--frames {} is outside 1..100000", frames)));
   }
   auto scene = samples::load_scene(scene_arg);
   if (!scene.ok()) return fail(scene.status());

@@ -2,6 +2,7 @@
 // the writer's refusals, and one reader error per malformed-file case, each naming the file and,
 // for pixels, the face and texel.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <OpenImageIO/imageio.h>
 
@@ -206,6 +207,36 @@ TEST_F(CaptureSetTest, MissingImage) {
   EXPECT_EQ(s.id(), ErrorId::kCaptureFileMissing);
   EXPECT_NE(s.message().find("view 1, frame 0"), std::string::npos) << s.to_string();
   expect_read_error(ErrorId::kCaptureFileMissing, "no such file");
+}
+
+// A directory or a FIFO under an image's name is "not a regular file", not "missing"; the FIFO
+// is never opened (opening it would block).
+TEST_F(CaptureSetTest, ImageThatIsNotARegularFile) {
+  write_set(false);
+  fs::remove(image(1, 0));
+  fs::create_directories(image(1, 0));
+  auto r = CaptureSetReader::open(dir_);
+  ASSERT_TRUE(r.ok());
+  Status s = r->check_files();
+  EXPECT_EQ(s.id(), ErrorId::kFileOpen);
+  EXPECT_NE(s.message().find("not a regular file (a directory) (view 1, frame 0)"),
+            std::string::npos)
+      << s.to_string();
+  expect_read_error(ErrorId::kFileOpen, "not a regular file (a directory)");
+  fs::remove(image(1, 0));
+  ASSERT_EQ(::mkfifo(image(1, 0).c_str(), 0600), 0);
+  EXPECT_EQ(r->check_files().id(), ErrorId::kFileOpen);
+  expect_read_error(ErrorId::kFileOpen, "not a regular file (a FIFO)");
+}
+
+// Bytes of another format under an .exr name are refused before the image library sees them
+// (OIIO would try every format, and libpng prints its own errors on stderr).
+TEST_F(CaptureSetTest, OtherFormatUnderExrName) {
+  write_set(false);
+  const unsigned char png[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13};
+  std::ofstream(image(1, 0), std::ios::trunc | std::ios::binary)
+      .write(reinterpret_cast<const char*>(png), sizeof png);
+  expect_read_error(ErrorId::kCaptureImageFormat, "not an OpenEXR file");
 }
 
 TEST_F(CaptureSetTest, NotAnImage) {

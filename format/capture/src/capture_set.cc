@@ -6,6 +6,7 @@
 #include <fstream>
 #include <system_error>
 
+#include "calf/format/files.h"
 #include "calf/format/log_depth.h"
 #include "exr_io.h"
 
@@ -87,13 +88,21 @@ Expected<std::string> read_small_file(const std::filesystem::path& path,
                                       std::string_view what_if_missing) {
   // istreambuf_iterator would let libstdc++'s filebuf throw on a directory (EISDIR); a regular
   // file check first, then istream::read, which turns read errors into badbit.
+  // A directory or FIFO is refused by stat, before an open could block.
   std::error_code ec;
-  const bool regular = std::filesystem::is_regular_file(path, ec);
+  const std::filesystem::file_status st = std::filesystem::status(path, ec);
+  const bool regular = std::filesystem::is_regular_file(st);
   std::ifstream in;
   if (regular) in.open(path, std::ios::binary);
   if (!regular || !in) {
-    const char* why =
-        std::filesystem::is_directory(path, ec) ? ": cannot open (a directory)" : ": cannot open";
+    std::string why = ": cannot open";
+    if (std::filesystem::exists(st) && !regular) {
+      why += std::string(" (") +
+             (std::filesystem::is_directory(st) ? "a directory"
+              : std::filesystem::is_fifo(st)    ? "a FIFO"
+                                                : "not a regular file") +
+             ")";
+    }
     return Status(ErrorId::kFileOpen, path.string() + why + std::string(what_if_missing));
   }
   std::string text;
@@ -106,28 +115,11 @@ Expected<std::string> read_small_file(const std::filesystem::path& path,
 }
 
 Status write_file_atomically(const std::filesystem::path& path, std::string_view bytes) {
-  const std::string temp = path.string() + ".tmp";
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) return Status(ErrorId::kFileWrite, path.string() + ": cannot create " + temp);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    out.flush();
-    if (!out) {
-      out.close();
-      std::error_code ignored;
-      std::filesystem::remove(temp, ignored);
-      return Status(ErrorId::kFileWrite, path.string() + ": write failed");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(temp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    std::filesystem::remove(temp, ignored);
-    return Status(ErrorId::kFileWrite,
-                  path.string() + ": cannot rename into place: " + ec.message());
-  }
-  return Status::Ok();
+  // The output rules, temporary name and cleanup on a signal are files::TempFile's.
+  CALF_ASSIGN_OR_RETURN(files::TempFile temp, files::TempFile::create(path.string()));
+  CALF_RETURN_IF_ERROR(
+      temp.write(std::span(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size())));
+  return temp.commit(/*sync=*/false);
 }
 
 // ---- reader ------------------------------------------------------------------------------------
@@ -150,10 +142,13 @@ Status CaptureSetReader::check_files() const {
     for (uint32_t f = 0; f < manifest_.frame_count; ++f) {
       std::error_code ec;
       std::filesystem::path p = image_path(v, f);
-      if (!std::filesystem::is_regular_file(p, ec)) {
-        return Status(ErrorId::kCaptureFileMissing, p.string() + ": missing (view " +
-                                                        std::to_string(v) + ", frame " +
-                                                        std::to_string(f) + ")");
+      const std::string where =
+          " (view " + std::to_string(v) + ", frame " + std::to_string(f) + ")";
+      // Missing is E135; a directory or FIFO under an image's name is E002 "not a regular file".
+      if (Status s = files::check_regular_file(p.string()); !s.ok()) {
+        if (!std::filesystem::exists(p, ec))
+          return Status(ErrorId::kCaptureFileMissing, p.string() + ": missing" + where);
+        return Status(s.id(), s.message() + where);
       }
     }
   }
@@ -239,7 +234,9 @@ Expected<CaptureSetWriter> CaptureSetWriter::create(const std::filesystem::path&
     return Status(ErrorId::kFileWrite, directory.string() + ": cannot create directory" +
                                            (ec ? ": " + ec.message() : ""));
   }
-  // A stale manifest would make a half-rewritten set look complete.
+  // A stale manifest would make a half-rewritten set look complete. What is there must be a
+  // regular file (or nothing): a FIFO or link of that name is refused, not removed (files.h).
+  CALF_RETURN_IF_ERROR(files::check_output_file((directory / kManifestFileName).string()));
   std::filesystem::remove(directory / kManifestFileName, ec);
   if (ec) {
     return Status(ErrorId::kFileWrite, (directory / kManifestFileName).string() +

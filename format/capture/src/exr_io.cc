@@ -1,6 +1,10 @@
 #include "exr_io.h"
 
+#include <unistd.h>
+
 #include <system_error>
+
+#include "calf/format/files.h"
 
 namespace calf::capture::detail {
 
@@ -17,7 +21,10 @@ std::string oiio_error(const std::string& fallback) {
 Status write_exr(const std::filesystem::path& path, uint32_t width, uint32_t height,
                  const std::vector<ExrChannelOut>& channels) {
   const std::string final_name = path.string();
-  const std::string temp_name = final_name + ".tmp";
+  // The output rules, temporary name and cleanup on a signal are files::TempFile's.
+  CALF_ASSIGN_OR_RETURN(files::TempFile temp, files::TempFile::create(final_name));
+  temp.close_fd();  // OIIO opens the file by name
+  const std::string& temp_name = temp.temp_path();
   const size_t nch = channels.size();
   const size_t pixels = static_cast<size_t>(width) * height;
   // Interleave once: OIIO converts float to each channel's own format while writing.
@@ -53,29 +60,34 @@ Status write_exr(const std::filesystem::path& path, uint32_t width, uint32_t hei
     std::string e = ok ? "" : out->geterror();
     ok = out->close() && ok;
     if (!ok) {
-      std::error_code ignored;
-      std::filesystem::remove(temp_name, ignored);
       return Status(ErrorId::kFileWrite, final_name + ": " + (e.empty() ? "write failed" : e));
     }
   } catch (const std::exception& ex) {
-    std::error_code ignored;
-    std::filesystem::remove(temp_name, ignored);
     return Status(ErrorId::kFileWrite, final_name + ": " + ex.what());
   }
-  std::error_code ec;
-  std::filesystem::rename(temp_name, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    std::filesystem::remove(temp_name, ignored);
-    return Status(ErrorId::kFileWrite, final_name + ": cannot rename into place: " + ec.message());
-  }
-  return Status::Ok();
+  return temp.commit(/*sync=*/false);
 }
 
 Expected<ExrReader> ExrReader::open(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    return Status(ErrorId::kCaptureFileMissing, path.string() + ": no such file");
+  // Missing is E135; a directory or FIFO under an image's name is E002 "not a regular file".
+  if (Status s = files::check_regular_file(path.string()); !s.ok()) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) {
+      return Status(ErrorId::kCaptureFileMissing, path.string() + ": no such file");
+    }
+    return s;
+  }
+  // Only OpenEXR bytes reach OIIO: for anything else it would try every format it knows, and
+  // some of its libraries (libpng) print their own errors on stderr before failing.
+  {
+    CALF_ASSIGN_OR_RETURN(const int fd, files::open_regular_file(path.string()));
+    unsigned char magic[4] = {};
+    const ssize_t n = ::read(fd, magic, sizeof magic);
+    ::close(fd);
+    if (n != 4 || magic[0] != 0x76 || magic[1] != 0x2f || magic[2] != 0x31 || magic[3] != 0x01) {
+      return Status(ErrorId::kCaptureImageFormat,
+                    path.string() + ": not an OpenEXR file (no OpenEXR magic number)");
+    }
   }
   ExrReader r;
   r.path_ = path.string();

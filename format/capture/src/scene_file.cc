@@ -20,6 +20,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "calf/capture/capture_set.h"
+#include "calf/format/files.h"
 #include "json_fields.h"
 
 namespace calf::capture {
@@ -845,33 +846,23 @@ Status read_texture(const std::filesystem::path& path, SceneTexture* t) {
 
 Status write_png(const std::filesystem::path& path, const SceneTexture& t) {
   const std::string final_name = path.string();
-  const std::string temp = final_name + ".tmp";
+  // The output rules, temporary name and cleanup on a signal are files::TempFile's.
+  CALF_ASSIGN_OR_RETURN(files::TempFile temp, files::TempFile::create(final_name));
+  temp.close_fd();  // OIIO opens the file by name
   try {
     std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create("png");
     if (!out) return Status(ErrorId::kFileWrite, final_name + ": " + oiio_error("no PNG writer"));
     OIIO::ImageSpec spec(static_cast<int>(t.width), static_cast<int>(t.height), 4,
                          OIIO::TypeDesc::UINT8);
     spec.attribute("oiio:UnassociatedAlpha", 1);  // the pixels are not premultiplied
-    bool ok = out->open(temp, spec) && out->write_image(OIIO::TypeDesc::UINT8, t.rgba.data());
+    bool ok =
+        out->open(temp.temp_path(), spec) && out->write_image(OIIO::TypeDesc::UINT8, t.rgba.data());
     ok = out->close() && ok;
-    if (!ok) {
-      std::error_code ignored;
-      std::filesystem::remove(temp, ignored);
-      return Status(ErrorId::kFileWrite, final_name + ": " + oiio_error("write failed"));
-    }
+    if (!ok) return Status(ErrorId::kFileWrite, final_name + ": " + oiio_error("write failed"));
   } catch (const std::exception& e) {
-    std::error_code ignored;
-    std::filesystem::remove(temp, ignored);
     return Status(ErrorId::kFileWrite, final_name + ": " + e.what());
   }
-  std::error_code ec;
-  std::filesystem::rename(temp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    std::filesystem::remove(temp, ignored);
-    return Status(ErrorId::kFileWrite, final_name + ": cannot rename into place: " + ec.message());
-  }
-  return Status::Ok();
+  return temp.commit(/*sync=*/false);
 }
 
 }  // namespace
@@ -1110,6 +1101,8 @@ Status write_scene_file(const SceneFile& scene, const std::filesystem::path& dir
   std::filesystem::create_directories(directory, ec);
   if (ec) return Status(ErrorId::kFileWrite, directory.string() + ": " + ec.message());
   const std::filesystem::path manifest = directory / kSceneManifestFileName;
+  // A FIFO or link under the manifest's name is refused, not removed (calf/format/files.h).
+  CALF_RETURN_IF_ERROR(files::check_output_file(manifest.string()));
   std::filesystem::remove(manifest, ec);
   if (ec)
     return Status(ErrorId::kFileWrite, manifest.string() + ": cannot remove: " + ec.message());

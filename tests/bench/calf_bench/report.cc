@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "../ffmpeg_peers.h"
+#include "calf/format/files.h"
 #include "sweep_plan.h"
 
 namespace calf::bench {
@@ -60,24 +61,11 @@ std::string grouped(uint64_t n) {
 }
 
 Status write_file_whole(const fs::path& file, const std::string& text) {
-  const fs::path tmp = file.string() + fmt::format(".tmp{}", ::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    out.close();
-    if (!out) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      return Status(ErrorId::kFileWrite, file.string() + ": cannot write");
-    }
-  }
-  std::error_code ec;
-  fs::rename(tmp, file, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    return Status(ErrorId::kFileWrite, file.string() + ": " + ec.message());
-  }
-  return Status::Ok();
+  // calf's output rules (regular file or absent, temporary name, cleanup): files::TempFile.
+  CALF_ASSIGN_OR_RETURN(files::TempFile temp, files::TempFile::create(file.string()));
+  CALF_RETURN_IF_ERROR(
+      temp.write(std::span(reinterpret_cast<const uint8_t*>(text.data()), text.size())));
+  return temp.commit(/*sync=*/false);
 }
 
 namespace {

@@ -223,7 +223,8 @@ Expected<LightfieldEncodeStats> encode_lightfield(const capture::CaptureSetReade
                                                   const LightfieldEncodeOptions& options);
 
 // Opens the capture set at `capture_dir`, encodes it into `out_path` (written whole or not at
-// all), and sets metadata "encoder" and "source_scene".
+// all), and sets metadata "encoder" and "source_scene". An `out_path` that is the set's
+// directory, its manifest or one of its images is refused first (kOutputIsInput, naming both).
 Expected<LightfieldEncodeStats> encode_lightfield_file(const std::filesystem::path& capture_dir,
                                                        const std::string& out_path,
                                                        const LightfieldEncodeOptions& options);

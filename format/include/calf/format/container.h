@@ -63,7 +63,8 @@ class Reader {
   // kContainerDirectoryChecksum, then per directory entry kContainerDirectoryFormat,
   // kContainerMetadata, kContainerTrackKind, kContainerTrackHeader, kContainerLimit and per
   // chunk kContainerChunkTrack, kContainerCompression, kContainerRequiredFeature,
-  // kContainerChunkSize, kContainerChunkRange, kContainerChunkLayout.
+  // kContainerChunkSize, kContainerChunkRange, kContainerChunkLayout. Every error of the path
+  // overload names the path exactly once ("clip.calf: ..."), so a command prints it as it is.
   static Expected<Reader> open(const std::string& path);
   static Expected<Reader> open(std::unique_ptr<ByteSource> source);
 

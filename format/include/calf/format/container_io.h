@@ -31,7 +31,8 @@ class ByteSource {
   virtual Status read_at(uint64_t offset, std::span<uint8_t> out) const = 0;
 };
 
-// Opens `path` for reading (kFileOpen on failure). The size is taken once, by fstat.
+// Opens `path` for reading (kFileOpen on failure, also when it is not a regular file: checked
+// before the open, so a FIFO never blocks; files.h). The size is taken once, by fstat.
 Expected<std::unique_ptr<ByteSource>> open_file_source(const std::string& path);
 // A source over memory the caller keeps alive (no copy).
 std::unique_ptr<ByteSource> memory_source(std::span<const uint8_t> bytes);
@@ -51,7 +52,8 @@ class ByteSink {
   virtual Status commit() = 0;
 };
 
-// A sink writing `path` through a temporary file beside it (`path`.tmp-XXXXXX) + rename.
+// A sink writing `path` through a temporary file beside it + rename (files::TempFile: an
+// existing `path` that is not a regular file, or is a symbolic link, is refused with kFileWrite).
 Expected<std::unique_ptr<ByteSink>> create_file_sink(const std::string& path);
 // A sink writing into `*out` (which the caller keeps alive); commit() does nothing.
 std::unique_ptr<ByteSink> memory_sink(std::vector<uint8_t>* out);

@@ -38,6 +38,8 @@ enum class ErrorKind : uint8_t {
   X(kFileRead, 3, kIo, "a file could not be read")                                              \
   X(kFileWrite, 4, kIo, "a file could not be written or renamed into place")                    \
   X(kInternal, 5, kInternal, "an internal invariant failed")                                    \
+  X(kUsage, 6, kInvalidArgument, "a command-line option or argument is invalid")                \
+  X(kOutputIsInput, 7, kInvalidArgument, "an output path names one of the command's inputs")    \
   /* conventions */                                                                             \
   X(kDepthRange, 20, kInvalidArgument, "z_near / z_far do not form a valid log-depth range")    \
   X(kDepthValue, 21, kCorrupt, "a depth value is NaN, negative, zero or -inf")                  \

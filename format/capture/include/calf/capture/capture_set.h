@@ -114,7 +114,8 @@ class CaptureSetReader {
   const std::filesystem::path& directory() const { return directory_; }
   std::filesystem::path image_path(uint32_t view, uint32_t frame) const;
 
-  // Whether every image the manifest names exists (CALF-E135 names the first missing one).
+  // Whether every image the manifest names exists (CALF-E135 names the first missing one) and is
+  // a regular file (CALF-E002 for a directory or FIFO under an image's name).
   // Cheap (directory look-ups only); call it before a long encode to fail early.
   Status check_files() const;
 
@@ -162,7 +163,8 @@ class CaptureSetWriter {
   bool finished_ = false;
 };
 
-// Writes `bytes` to `path` whole: a temporary file beside it, flushed, then renamed over `path`.
+// Writes `bytes` to `path` whole: a temporary file beside it, flushed, then renamed over `path`
+// (calf/format/files.h: an existing `path` must be a regular file, not a link or a FIFO).
 // Errors: CALF-E004 naming the file and the system's reason. Shared by manifest, eye path and
 // image writers.
 Status write_file_atomically(const std::filesystem::path& path, std::string_view bytes);

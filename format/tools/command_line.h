@@ -1,0 +1,65 @@
+// What every calf command does with its command line and its errors (header-only; each command
+// includes it). One rule for all of them:
+//   exit 0  success, and after --help or --version (printed on stdout);
+//   exit 1  an error: one line on stderr, "<command>: CALF-Ennn <message>";
+//   exit 2  a usage error (unknown option, missing argument, a value of the wrong type or outside
+//           its range): one line on stderr, "<command>: CALF-E006 <message> (see --help)".
+// parse_command_line() also installs the signal handlers that remove the command's temporary
+// files on SIGINT / SIGTERM / SIGHUP (calf/format/files.h).
+#pragma once
+
+#include <cstdio>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "calf/format/files.h"
+#include "calf/format/status.h"
+
+namespace calf::tools {
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitError = 1;
+inline constexpr int kExitUsage = 2;
+
+// The sentence each command's --help ends with.
+inline constexpr const char* kExitStatusHelp =
+    "Exit status: 0 success; 1 an error, printed as one line '<command>: CALF-Ennn ...' "
+    "(docs/ERRORS.md); 2 a usage error (bad option or argument), one line with CALF-E006.";
+
+// The most threads a --threads option accepts (0 = all cores).
+inline constexpr unsigned kMaxThreads = 256;
+
+// Prints `status` as the command's one line on stderr (its first line only, newlines in the
+// message never make a second one) and returns `exit_status`.
+inline int print_error(const char* command, const Status& status, int exit_status = kExitError) {
+  std::string line = status.to_string();
+  const size_t newline = line.find('\n');
+  if (newline != std::string::npos) line = line.substr(0, newline) + " (see --help)";
+  std::fprintf(stderr, "%s: %s\n", command, line.c_str());
+  return exit_status;
+}
+
+// A usage error found after parsing (options that contradict each other): CALF-E006, exit 2.
+inline int usage_error(const char* command, const std::string& message) {
+  return print_error(command, Status(ErrorId::kUsage, message + " (see --help)"), kExitUsage);
+}
+
+// Parses the command line. Returns -1 when the command should go on, else the exit status to
+// return at once: 0 after --help / --version, 2 after a usage error (printed as one line).
+inline int parse_command_line(CLI::App& app, const char* command, int argc, char** argv) {
+  files::install_temp_file_cleanup();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version: stdout, exit 0
+    std::string message = e.what();
+    for (char& c : message)
+      if (c == '\n' || c == '\r') c = ' ';
+    while (!message.empty() && message.back() == ' ') message.pop_back();
+    return usage_error(command, message);
+  }
+  return -1;
+}
+
+}  // namespace calf::tools
