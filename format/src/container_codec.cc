@@ -12,6 +12,10 @@
 namespace calf::container {
 namespace {
 
+// The largest zstd Window_Size a reader accepts (SPEC.md 6.3, "Limits"): libzstd's default for
+// streaming decoders, and the largest window of any of its compression levels.
+constexpr uint64_t kMaxZstdWindow = uint64_t{1} << 27;
+
 struct ZstdCCtxDeleter {
   void operator()(ZSTD_CCtx* c) const { ZSTD_freeCCtx(c); }
 };

@@ -6,9 +6,8 @@
 // fixed level.
 //
 //   none   stored == raw.
-//   zstd   one regular zstd frame (RFC 8878) with Frame_Content_Size == raw_size, no dictionary,
-//          Window_Size <= kMaxZstdWindow (128 MiB), exactly stored_size bytes. The writer sets
-//          no zstd checksum (the chunk hash covers the stored bytes); one present is checked.
+//   zstd   one regular zstd frame (RFC 8878), Frame_Content_Size == raw_size, Window_Size <= 128
+//          MiB, no dictionary, exactly stored_size bytes; no zstd checksum written, one checked.
 //   LZMA2  one property byte (the LZMA2 dictionary size, encoded as in .xz filter flags), then a
 //          raw LZMA2 stream ending with its end marker, exactly stored_size bytes. The writer
 //          shrinks the dictionary to the chunk (>= 4 KiB); a reader refuses > kMaxLzmaDictionary.

@@ -51,7 +51,6 @@ inline constexpr uint32_t kMaxMetadataBytes = 1u << 20;    // all keys + values 
 inline constexpr uint32_t kMaxTrackHeaderSize = 1u << 16;  // bytes per track header blob
 inline constexpr uint64_t kMaxRawChunkSize = 1ull << 30;   // 1 GiB decompressed per chunk
 inline constexpr uint32_t kMaxLzmaDictionary = 64u << 20;  // LZMA2 dictionary a reader accepts
-inline constexpr uint64_t kMaxZstdWindow = 1ull << 27;     // zstd Window_Size a reader accepts
 inline constexpr uint32_t kMaxFrames = 1u << 24;
 inline constexpr uint32_t kMaxViews = 1u << 16;
 inline constexpr uint32_t kMaxDimension = 16384;  // face, cell, tile, atlas side (px)
