@@ -7,9 +7,14 @@
 
 #include <algorithm>
 #include <memory>
+#include <optional>
 
 namespace calf::container {
 namespace {
+
+// The largest zstd Window_Size a reader accepts (SPEC.md 6.3, "Limits"): libzstd's default for
+// streaming decoders, and the largest window of any of its compression levels.
+constexpr uint64_t kMaxZstdWindow = uint64_t{1} << 27;
 
 struct ZstdCCtxDeleter {
   void operator()(ZSTD_CCtx* c) const { ZSTD_freeCCtx(c); }
@@ -72,7 +77,33 @@ Expected<StoredChunk> compress_lzma2(std::span<const uint8_t> raw, uint32_t pres
   return out;
 }
 
+// The Window_Size of the zstd frame `stored` starts with (RFC 8878 3.1.1.1.2; a single-segment
+// frame's window is its Frame_Content_Size), or nullopt unless `stored` starts with the header of
+// a regular zstd frame (magic 0xFD2FB528: not a skippable or legacy frame).
+std::optional<uint64_t> zstd_window_size(std::span<const uint8_t> stored) {
+  if (stored.size() < 6 || load_le(stored.data(), 4) != 0xFD2FB528u) return std::nullopt;
+  const uint8_t descriptor = stored[4];
+  if ((descriptor & 0x20) == 0) {  // Single_Segment_flag clear: a Window_Descriptor follows
+    const uint8_t w = stored[5];
+    const uint64_t base = uint64_t{1} << (10 + (w >> 3));
+    return base + (base / 8) * (w & 7);
+  }
+  // Frame_Content_Size after the Dictionary_ID field (0, 1, 2 or 4 bytes): 1, 2 (+256), 4 or 8.
+  static constexpr size_t kDidBytes[4] = {0, 1, 2, 4}, kFcsBytes[4] = {1, 2, 4, 8};
+  const size_t at = 5 + kDidBytes[descriptor & 3], n = kFcsBytes[descriptor >> 6];
+  if (stored.size() < at + n) return std::nullopt;
+  return load_le(stored.data() + at, n) + (n == 2 ? 256 : 0);
+}
+
 Status decompress_zstd(std::span<const uint8_t> stored, std::span<uint8_t> out) {
+  // The window a decoder that decodes in pieces must keep, bounded (SPEC.md 6.3) so that every
+  // conforming reader can decode every chunk; libzstd's one-shot decoding would accept up to 2 GiB.
+  const std::optional<uint64_t> window = zstd_window_size(stored);
+  if (!window)
+    return Status(ErrorId::kContainerDecompress, "stored bytes do not start with a zstd frame");
+  if (*window > kMaxZstdWindow)
+    return Status(ErrorId::kContainerLimit,
+                  cat("zstd window of ", *window, " bytes exceeds its limit ", kMaxZstdWindow));
   // Check the frame's own size claims before decoding: exactly one frame, spanning all stored
   // bytes, declaring the raw length.
   const size_t frame = ZSTD_findFrameCompressedSize(stored.data(), stored.size());

@@ -3,6 +3,8 @@
 // corrupt; documented limits hold; codec edge cases; fields and UTF-8 helpers.
 #include <gtest/gtest.h>
 
+#include <xxhash.h>
+
 #include <random>
 
 #include "../conformance/container_corpus.h"
@@ -122,6 +124,59 @@ TEST(ContainerCodecTest, StoredBoundHoldsAndStreamsMustBeExact) {
   EXPECT_EQ(decompress_chunk({}, Compression::kLzma2, out).id(), ErrorId::kContainerDecompress);
   EXPECT_EQ(decompress_chunk(Bytes{1}, static_cast<Compression>(5), out).id(),
             ErrorId::kContainerCompression);
+}
+
+// A zstd frame (RFC 8878) written by hand: magic, Frame_Header_Descriptor `fhd`, the Window
+// Descriptor `wd` (when >= 0), a 4-byte Frame_Content_Size, one raw block holding `data`, and
+// the content checksum `checksum` when the descriptor's bit 2 asks for one.
+Bytes zstd_frame(uint8_t fhd, int wd, const Bytes& data, uint32_t checksum = 0) {
+  Bytes f = {0x28, 0xB5, 0x2F, 0xFD, fhd};
+  if (wd >= 0) f.push_back(static_cast<uint8_t>(wd));
+  f.resize(f.size() + 4);
+  store_le(f.data() + f.size() - 4, data.size(), 4);
+  f.resize(f.size() + 3);
+  store_le(f.data() + f.size() - 3, 1 | (data.size() << 3), 3);  // last block, raw
+  f.insert(f.end(), data.begin(), data.end());
+  if (fhd & 4) {
+    f.resize(f.size() + 4);
+    store_le(f.data() + f.size() - 4, checksum, 4);
+  }
+  return f;
+}
+
+// SPEC.md 6.3: Window_Size at most 128 MiB (kMaxZstdWindow, CALF-E049), a regular frame (not
+// skippable), a content checksum checked when present.
+TEST(ContainerCodecTest, ZstdWindowIsBoundedAndFramesAreRegular) {
+  const Bytes data(100, 7);
+  Bytes out(data.size());
+  constexpr uint8_t kFcs4 = 0x80;  // Frame_Content_Size_flag 2: 4 bytes, no single segment
+  // Window_Descriptor: exponent e, mantissa m: 2^(10 + e) * (1 + m / 8).
+  EXPECT_TRUE(decompress_chunk(zstd_frame(kFcs4, 17 << 3, data), Compression::kZstd, out).ok());
+  EXPECT_EQ(out, data);
+  for (int wd : {(17 << 3) | 1, 18 << 3, 21 << 3}) {  // 2^27 + 2^24, 2^28, 2^31
+    const Status s = decompress_chunk(zstd_frame(kFcs4, wd, data), Compression::kZstd, out);
+    EXPECT_EQ(s.id(), ErrorId::kContainerLimit) << wd << ": " << s.to_string();
+    EXPECT_NE(s.message().find("exceeds its limit 134217728"), std::string::npos) << s.message();
+  }
+  // A single-segment frame's window is its content size.
+  const Bytes single = zstd_frame(0xA0, -1, data);
+  EXPECT_TRUE(decompress_chunk(single, Compression::kZstd, out).ok());
+  // A skippable frame is not a zstd frame with a content size, even for an empty chunk.
+  const Bytes skippable = {0x50, 0x2A, 0x4D, 0x18, 4, 0, 0, 0, 1, 2, 3, 4};
+  Bytes none;
+  EXPECT_EQ(decompress_chunk(skippable, Compression::kZstd, none).id(),
+            ErrorId::kContainerDecompress);
+  // Content checksums: checked when present (low 32 bits of XXH64 of the content).
+  const uint32_t good = static_cast<uint32_t>(XXH64(data.data(), data.size(), 0));
+  EXPECT_TRUE(decompress_chunk(zstd_frame(kFcs4 | 4, 0, data, good), Compression::kZstd, out).ok());
+  EXPECT_EQ(
+      decompress_chunk(zstd_frame(kFcs4 | 4, 0, data, good ^ 1), Compression::kZstd, out).id(),
+      ErrorId::kContainerDecompress);
+  // Two frames are not one.
+  Bytes two = zstd_frame(kFcs4, 0, Bytes(50, 7));
+  const Bytes second = two;
+  two.insert(two.end(), second.begin(), second.end());
+  EXPECT_EQ(decompress_chunk(two, Compression::kZstd, out).id(), ErrorId::kContainerDecompress);
 }
 
 TEST(ContainerFieldsTest, DeclaredSizesAndMessages) {

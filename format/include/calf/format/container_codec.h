@@ -6,8 +6,8 @@
 // fixed level.
 //
 //   none   stored == raw.
-//   zstd   one zstd frame (RFC 8878) with Frame_Content_Size == raw_size, no dictionary, no
-//          zstd checksum (the chunk hash covers the stored bytes), exactly stored_size bytes.
+//   zstd   one regular zstd frame (RFC 8878), Frame_Content_Size == raw_size, Window_Size <= 128
+//          MiB, no dictionary, exactly stored_size bytes; no zstd checksum written, one checked.
 //   LZMA2  one property byte (the LZMA2 dictionary size, encoded as in .xz filter flags), then a
 //          raw LZMA2 stream ending with its end marker, exactly stored_size bytes. The writer
 //          shrinks the dictionary to the chunk (>= 4 KiB); a reader refuses > kMaxLzmaDictionary.
@@ -51,8 +51,8 @@ Expected<StoredChunk> compress_chunk(std::span<const uint8_t> raw, Compression c
 
 // Decompresses `stored` (scheme `c`) into `out`, whose size is the chunk's raw length; fails
 // with kContainerDecompress unless the stored bytes are exactly one well-formed stream that
-// decodes to exactly out.size() bytes, kContainerLimit for an LZMA2 dictionary above the limit,
-// kContainerCompression for an unknown scheme.
+// decodes to exactly out.size() bytes, kContainerLimit for a zstd window or an LZMA2 dictionary
+// above its limit, kContainerCompression for an unknown scheme.
 Status decompress_chunk(std::span<const uint8_t> stored, Compression c, std::span<uint8_t> out);
 
 }  // namespace calf::container
