@@ -232,6 +232,36 @@ TEST_F(CaptureSetTest, MissingDepthChannel) {
   expect_read_error(ErrorId::kCaptureImageFormat, "channel 'Z' is missing");
 }
 
+// CAPTURE.md allows HALF and FLOAT channels only: the image library would read a UINT channel
+// normalised to [0, 1] (depth 3 as ~7e-10), a silent misread.
+TEST_F(CaptureSetTest, UintChannelsAreRefused) {
+  for (const char* bad : {"Z", "G"}) {
+    write_set(false);
+    auto out = OIIO::ImageOutput::create("exr");
+    ASSERT_TRUE(out);
+    const std::vector<std::string> names = {"R", "G", "B", "Z"};
+    OIIO::ImageSpec spec(4, 24, 4, OIIO::TypeDesc::FLOAT);
+    spec.channelnames = names;
+    spec.channelformats.clear();
+    for (const std::string& n : names) {
+      spec.channelformats.push_back(n == bad ? OIIO::TypeDesc::UINT : OIIO::TypeDesc::FLOAT);
+    }
+    spec.alpha_channel = -1;
+    spec.z_channel = -1;
+    std::vector<uint32_t> px(4 * 24 * 4, 3);
+    ASSERT_TRUE(out->open(image(1, 0).string(), spec));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT, px.data()));
+    ASSERT_TRUE(out->close());
+    {
+      auto in = OIIO::ImageInput::open(image(1, 0).string());
+      ASSERT_TRUE(in);
+      EXPECT_EQ(in->spec().channelformat(bad[0] == 'Z' ? 3 : 1), OIIO::TypeDesc::UINT);
+    }
+    expect_read_error(ErrorId::kCaptureImageFormat,
+                      std::string("channel '") + bad + "' has pixel type uint");
+  }
+}
+
 TEST_F(CaptureSetTest, UnannouncedMaterial) {
   write_set(false);
   write_raw(image(1, 0), 4, 24,

@@ -1,5 +1,6 @@
 #include "exr_io.h"
 
+#include <algorithm>
 #include <system_error>
 
 namespace calf::capture::detail {
@@ -93,6 +94,8 @@ Expected<ExrReader> ExrReader::open(const std::filesystem::path& path) {
     r.width_ = static_cast<uint32_t>(spec.width);
     r.height_ = static_cast<uint32_t>(spec.height);
     r.names_ = spec.channelnames;
+    for (int c = 0; c < spec.nchannels; ++c) r.formats_.push_back(spec.channelformat(c));
+    r.names_.resize(static_cast<size_t>(std::max(0, spec.nchannels)));
   } catch (const std::exception& e) {
     return Status(ErrorId::kCaptureImageFormat, r.path_ + ": " + e.what());
   }
@@ -104,6 +107,14 @@ int ExrReader::channel(const std::string& name) const {
     if (names_[i] == name) return static_cast<int>(i);
   }
   return -1;
+}
+
+Status ExrReader::require_float(int index) const {
+  const OIIO::TypeDesc t = formats_[static_cast<size_t>(index)];
+  if (t == OIIO::TypeDesc::HALF || t == OIIO::TypeDesc::FLOAT) return Status::Ok();
+  return Status(ErrorId::kCaptureImageFormat,
+                path_ + ": channel '" + names_[static_cast<size_t>(index)] + "' has pixel type " +
+                    t.c_str() + ", expected half or float");
 }
 
 Status ExrReader::read_rows(uint32_t y0, uint32_t y1, std::vector<float>* out) {
