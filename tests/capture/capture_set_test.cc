@@ -211,7 +211,23 @@ TEST_F(CaptureSetTest, MissingImage) {
 TEST_F(CaptureSetTest, NotAnImage) {
   write_set(false);
   std::ofstream(image(1, 0), std::ios::trunc) << "this is not an EXR file";
-  expect_read_error(ErrorId::kCaptureImageFormat, "");
+  expect_read_error(ErrorId::kCaptureImageFormat, "not an OpenEXR file");
+}
+
+// A PNG (or any other image) named .exr never reaches another format's decoder: it is refused by
+// its magic bytes, so that no library prints its own line (issue 22 item 13).
+TEST_F(CaptureSetTest, ImageOfAnotherFormatNamedExr) {
+  write_set(false);
+  auto out = OIIO::ImageOutput::create("png");
+  ASSERT_TRUE(out);
+  const fs::path png = dir_ / "image.png";
+  OIIO::ImageSpec spec(4, 24, 3, OIIO::TypeDesc::UINT8);
+  std::vector<uint8_t> px(4 * 24 * 3, 128);
+  ASSERT_TRUE(out->open(png.string(), spec));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, px.data()));
+  ASSERT_TRUE(out->close());
+  fs::rename(png, image(1, 0));
+  expect_read_error(ErrorId::kCaptureImageFormat, "not an OpenEXR file");
 }
 
 TEST_F(CaptureSetTest, TruncatedImage) {

@@ -1,6 +1,7 @@
 #include "exr_io.h"
 
 #include <algorithm>
+#include <fstream>
 #include <system_error>
 
 namespace calf::capture::detail {
@@ -80,8 +81,25 @@ Expected<ExrReader> ExrReader::open(const std::filesystem::path& path) {
   }
   ExrReader r;
   r.path_ = path.string();
+  // Only the OpenEXR reader ever sees the bytes: OIIO's open() would hand a file that is not EXR
+  // to whichever of its format plugins claims it (a PNG named .exr reached libpng, which printed
+  // its own stderr line before the E136).
+  {
+    std::ifstream in(path, std::ios::binary);
+    char magic[4] = {0, 0, 0, 0};
+    in.read(magic, 4);
+    if (in.gcount() != 4 || magic[0] != 0x76 || magic[1] != 0x2f || magic[2] != 0x31 ||
+        magic[3] != 0x01) {
+      return Status(ErrorId::kCaptureImageFormat,
+                    r.path_ + ": not an OpenEXR file (its first bytes are not 76 2f 31 01)");
+    }
+  }
   try {
-    r.input_ = OIIO::ImageInput::open(r.path_);
+    r.input_ = OIIO::ImageInput::create("openexr");
+    if (r.input_) {
+      OIIO::ImageSpec spec;
+      if (!r.input_->open(r.path_, spec)) r.input_.reset();
+    }
     if (!r.input_) {
       return Status(ErrorId::kCaptureImageFormat,
                     r.path_ + ": not a readable image: " + oiio_error("unknown format"));
