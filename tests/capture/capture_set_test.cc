@@ -214,6 +214,33 @@ TEST_F(CaptureSetTest, NotAnImage) {
   expect_read_error(ErrorId::kCaptureImageFormat, "not an OpenEXR file");
 }
 
+// OpenEXR sizes its line-offset table by the declared data window: a 90-byte file declaring
+// 2^28 rows made it allocate 2 GB (found by capture_view_frame_fuzz). The header is checked first.
+TEST_F(CaptureSetTest, HeaderDeclaringMoreRowsThanTheFileHolds) {
+  write_set(false);
+  std::string exr("\x76\x2f\x31\x01\x02\x00\x00\x00", 8);
+  auto attribute = [&](const std::string& name, const std::string& type, const std::string& value) {
+    exr += name + '\0' + type + '\0';
+    const int32_t size = static_cast<int32_t>(value.size());
+    exr.append(reinterpret_cast<const char*>(&size), 4);
+    exr += value;
+  };
+  const int32_t window[4] = {0, 0, 3, (1 << 28) - 1};
+  attribute("dataWindow", "box2i", std::string(reinterpret_cast<const char*>(window), 16));
+  attribute("compression", "compression", std::string(1, '\0'));
+  exr += '\0';
+  std::ofstream(image(1, 0), std::ios::binary | std::ios::trunc) << exr;
+  expect_read_error(ErrorId::kCaptureImageFormat, "larger than any calf image");
+  const int32_t tall[4] = {0, 0, 3, 90000};
+  exr.replace(exr.find("box2i") + 10, 16, std::string(reinterpret_cast<const char*>(tall), 16));
+  std::ofstream(image(1, 0), std::ios::binary | std::ios::trunc) << exr;
+  expect_read_error(ErrorId::kCaptureImageFormat, "90001 rows need 90001 chunk offsets");
+  std::string tiled = exr;
+  tiled[5] = 0x02;  // version flags: tiled
+  std::ofstream(image(1, 0), std::ios::binary | std::ios::trunc) << tiled;
+  expect_read_error(ErrorId::kCaptureImageFormat, "single-part scanline");
+}
+
 // A PNG (or any other image) named .exr never reaches another format's decoder: it is refused by
 // its magic bytes, so that no library prints its own line (issue 22 item 13).
 TEST_F(CaptureSetTest, ImageOfAnotherFormatNamedExr) {
