@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <system_error>
 
 #include "calf/format/coordinates.h"
 #include "calf/samples/scene.h"
@@ -23,7 +24,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const char* const kExtensions[] = {".obj", ".ply", ".gltf", ".glb"};
   static const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("calf_assimp_fuzz_" + std::to_string(getpid()));
-  std::filesystem::create_directories(dir);
+  static const bool made = [] {
+    std::filesystem::create_directories(dir);
+    // The folder goes when the run ends, so that ctest leaves nothing in the temp directory.
+    std::atexit([] {
+      std::error_code ignored;
+      std::filesystem::remove_all(dir, ignored);
+    });
+    return true;
+  }();
+  (void)made;
   const std::filesystem::path file = dir / (std::string("model") + kExtensions[data[0] % 4]);
   {
     std::ofstream out(file, std::ios::binary | std::ios::trunc);

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <system_error>
 
 #include "calf/capture/capture_set.h"
 
@@ -19,7 +20,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size == 0) return 0;
   static const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("calf_view_frame_fuzz_" + std::to_string(getpid()));
-  std::filesystem::create_directories(dir);
+  static const bool made = [] {
+    std::filesystem::create_directories(dir);
+    // The folder goes when the run ends, so that ctest leaves nothing in the temp directory.
+    std::atexit([] {
+      std::error_code ignored;
+      std::filesystem::remove_all(dir, ignored);
+    });
+    return true;
+  }();
+  (void)made;
   calf::capture::CaptureManifest m;
   m.frame_count = 1;
   m.face_size = 1 + (data[0] & 3);
