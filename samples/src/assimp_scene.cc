@@ -4,10 +4,15 @@
 // away; transforms are then evaluated per frame by walking the node chain, so that any frame can
 // be rendered alone.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <memory>
+#include <string>
 #include <system_error>
 
+#include <assimp/BaseImporter.h>
+#include <assimp/importerdesc.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -15,7 +20,9 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "calf/format/coordinates.h"
 #include "calf/samples/scene.h"
+#include "model_prescan.h"
 
 namespace calf::samples {
 
@@ -122,6 +129,156 @@ Material convert_material(const aiMaterial* m) {
   return out;
 }
 
+bool finite_matrix(const aiMatrix4x4& m) {
+  const float* v = &m.a1;
+  for (int i = 0; i < 16; ++i) {
+    if (!std::isfinite(v[i])) return false;
+  }
+  return true;
+}
+
+std::string vertex_text(const aiVector3D& p) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "(%g, %g, %g)", static_cast<double>(p.x), static_cast<double>(p.y),
+                static_cast<double>(p.z));
+  return buf;
+}
+
+// Sets each mesh's primitive-type flags from its faces. The PLY importer can leave the polygon
+// flag on a mesh of triangles, and assimp's triangulation then aborts on its own assertion
+// (numOut != pMesh->mNumFaces); the flags are derived data, so recomputing them loses nothing.
+void set_primitive_types(const aiScene* ai) {
+  for (unsigned i = 0; i < ai->mNumMeshes; ++i) {
+    // The scene belongs to the importer and was created mutable; the post-processing steps
+    // that follow modify it the same way.
+    aiMesh* mesh = const_cast<aiMesh*>(ai->mMeshes[i]);
+    unsigned types = 0;
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const unsigned n = mesh->mFaces[f].mNumIndices;
+      types |= n == 1   ? aiPrimitiveType_POINT
+               : n == 2 ? aiPrimitiveType_LINE
+               : n == 3 ? aiPrimitiveType_TRIANGLE
+                        : aiPrimitiveType_POLYGON;
+    }
+    mesh->mPrimitiveTypes = types;
+  }
+}
+
+// assimp picks the importer by extension, but when several claim it (.gltf and .glb: glTF 1 and
+// glTF 2) and none recognises the content, it falls back to trying every importer it has on the
+// bytes: a truncated PLY header named .glb then reached the PLY importer, past the PLY pre-scan,
+// and looped forever. The content must be what the extension says: one of the importers for it
+// must recognise it, or the file is refused here.
+Status check_importer_for_extension(Assimp::Importer& importer, const std::string& file,
+                                    const std::string& lower_ext) {
+  std::vector<Assimp::BaseImporter*> claiming;
+  for (size_t i = 0; i < importer.GetImporterCount(); ++i) {
+    const aiImporterDesc* info = importer.GetImporterInfo(i);
+    if (!info || !info->mFileExtensions) continue;
+    std::string list = std::string(" ") + info->mFileExtensions + " ";
+    for (char& c : list) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (list.find(" " + lower_ext.substr(1) + " ") != std::string::npos) {
+      claiming.push_back(importer.GetImporter(i));
+    }
+  }
+  if (claiming.size() <= 1) return Status::Ok();  // assimp uses that one importer, no fallback
+  for (Assimp::BaseImporter* candidate : claiming) {
+    if (candidate && candidate->CanRead(file, importer.GetIOHandler(), true)) return Status::Ok();
+  }
+  return Status(ErrorId::kSceneLoad, file + ": its content is not a '" + lower_ext +
+                                         "' file that assimp's importers for it recognise");
+}
+
+// Every vertex, node transform and animation key of the imported file, before any
+// post-processing: assimp's vertex joining merges a NaN vertex into another one (NaN compares
+// equal to nothing and so sorts anywhere), which would hide it from any later check.
+// Face indices, node mesh references and array pointers are checked too: assimp's importers
+// pass a PLY face index 0xfe000000 through unchecked, and its post-processing then reads far
+// outside the vertex array.
+Status check_imported(const aiScene* ai, const std::string& file) {
+  if (ai->mNumMeshes > 0 && !ai->mMeshes) {
+    return Status(ErrorId::kSceneLoad, file + ": the importer returned no mesh array");
+  }
+  for (unsigned i = 0; i < ai->mNumMeshes; ++i) {
+    const aiMesh* mesh = ai->mMeshes[i];
+    const std::string where = file + ": mesh " + std::to_string(i);
+    if (!mesh || (mesh->mNumVertices > 0 && !mesh->mVertices) ||
+        (mesh->mNumFaces > 0 && !mesh->mFaces)) {
+      return Status(ErrorId::kSceneLoad, where + ": the importer returned an incomplete mesh");
+    }
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const aiFace& face = mesh->mFaces[f];
+      if (face.mNumIndices == 0) {
+        return Status(ErrorId::kSceneLoad,
+                      where + ": face " + std::to_string(f) + " has no vertex");
+      }
+      if (!face.mIndices) {
+        return Status(ErrorId::kSceneLoad,
+                      where + ": face " + std::to_string(f) + " has no indices");
+      }
+      for (unsigned k = 0; k < face.mNumIndices; ++k) {
+        if (face.mIndices[k] >= mesh->mNumVertices) {
+          return Status(ErrorId::kSceneGeometry, where + " '" + mesh->mName.C_Str() + "' face " +
+                                                     std::to_string(f) + " uses vertex " +
+                                                     std::to_string(face.mIndices[k]) + " of " +
+                                                     std::to_string(mesh->mNumVertices));
+        }
+      }
+    }
+    for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+      const aiVector3D& p = mesh->mVertices[v];
+      if (!coordinates_ok({p.x, p.y, p.z})) {
+        return Status(ErrorId::kSceneGeometry,
+                      file + ": mesh " + std::to_string(i) + " '" + mesh->mName.C_Str() +
+                          "' vertex " + std::to_string(v) + " " + vertex_text(p) +
+                          " is not finite or lies beyond the coordinate bound +-1e12");
+      }
+    }
+  }
+  std::vector<const aiNode*> stack = {ai->mRootNode};
+  while (!stack.empty()) {
+    const aiNode* node = stack.back();
+    stack.pop_back();
+    if (!finite_matrix(node->mTransformation)) {
+      return Status(ErrorId::kSceneGeometry,
+                    file + ": node '" + node->mName.C_Str() + "' has a non-finite transform");
+    }
+    for (unsigned k = 0; k < node->mNumMeshes; ++k) {
+      if (node->mMeshes[k] >= ai->mNumMeshes) {
+        return Status(ErrorId::kSceneLoad, file + ": node '" + node->mName.C_Str() +
+                                               "' names mesh " + std::to_string(node->mMeshes[k]) +
+                                               " of " + std::to_string(ai->mNumMeshes));
+      }
+    }
+    for (unsigned c = 0; c < node->mNumChildren; ++c) {
+      if (node->mChildren[c]) stack.push_back(node->mChildren[c]);
+    }
+  }
+  for (unsigned a = 0; a < ai->mNumAnimations; ++a) {
+    const aiAnimation* anim = ai->mAnimations[a];
+    bool ok = std::isfinite(anim->mDuration) && std::isfinite(anim->mTicksPerSecond);
+    for (unsigned c = 0; ok && c < anim->mNumChannels; ++c) {
+      const aiNodeAnim* ch = anim->mChannels[c];
+      auto vec_ok = [](const aiVectorKey& k) {
+        return std::isfinite(k.mTime) && std::isfinite(k.mValue.x) && std::isfinite(k.mValue.y) &&
+               std::isfinite(k.mValue.z);
+      };
+      for (unsigned k = 0; ok && k < ch->mNumPositionKeys; ++k) ok = vec_ok(ch->mPositionKeys[k]);
+      for (unsigned k = 0; ok && k < ch->mNumScalingKeys; ++k) ok = vec_ok(ch->mScalingKeys[k]);
+      for (unsigned k = 0; ok && k < ch->mNumRotationKeys; ++k) {
+        const aiQuatKey& q = ch->mRotationKeys[k];
+        ok = std::isfinite(q.mTime) && std::isfinite(q.mValue.w) && std::isfinite(q.mValue.x) &&
+             std::isfinite(q.mValue.y) && std::isfinite(q.mValue.z);
+      }
+    }
+    if (!ok) {
+      return Status(ErrorId::kSceneGeometry, file + ": animation " + std::to_string(a) +
+                                                 " has a non-finite key, time or duration");
+    }
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Expected<Scene> load_scene_file(const std::filesystem::path& path) {
@@ -136,10 +293,20 @@ Expected<Scene> load_scene_file(const std::filesystem::path& path) {
     return Status(ErrorId::kSceneFormat, file + ": assimp cannot import '" + ext +
                                              "' files (try glTF, GLB, OBJ, PLY or FBX)");
   }
+  std::string lower_ext = ext;
+  for (char& c : lower_ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  CALF_RETURN_IF_ERROR(detail::prescan_model_file(path, lower_ext));
   const aiScene* ai = nullptr;
   try {
-    ai = importer.ReadFile(
-        file, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+    CALF_RETURN_IF_ERROR(check_importer_for_extension(importer, file, lower_ext));
+    // Imported as it is first, checked, and only then post-processed (check_imported).
+    ai = importer.ReadFile(file, 0);
+    if (ai && ai->mRootNode && !(ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
+      CALF_RETURN_IF_ERROR(check_imported(ai, file));
+      set_primitive_types(ai);
+      ai = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                        aiProcess_SortByPType);
+    }
   } catch (const std::exception& e) {
     return Status(ErrorId::kSceneLoad, file + ": " + e.what());
   }
@@ -222,6 +389,13 @@ Expected<Scene> load_scene_file(const std::filesystem::path& path) {
     glm::mat4 m = o.transform(0);
     for (const glm::vec3& p : o.mesh.positions) {
       glm::vec3 w(m * glm::vec4(p, 1));
+      // Per vertex, not on the bounds: min and max drop NaN.
+      if (!coordinates_ok({w.x, w.y, w.z})) {
+        return Status(ErrorId::kSceneGeometry,
+                      file + ": object '" + o.name +
+                          "' has a vertex that its transform puts beyond the coordinate bound "
+                          "+-1e12 (or at a non-finite place)");
+      }
       lo = glm::min(lo, w);
       hi = glm::max(hi, w);
     }

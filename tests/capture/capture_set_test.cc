@@ -242,7 +242,50 @@ TEST_F(CaptureSetTest, OtherFormatUnderExrName) {
 TEST_F(CaptureSetTest, NotAnImage) {
   write_set(false);
   std::ofstream(image(1, 0), std::ios::trunc) << "this is not an EXR file";
-  expect_read_error(ErrorId::kCaptureImageFormat, "");
+  expect_read_error(ErrorId::kCaptureImageFormat, "not an OpenEXR file");
+}
+
+// OpenEXR sizes its line-offset table by the declared data window: a 90-byte file declaring
+// 2^28 rows made it allocate 2 GB (found by capture_view_frame_fuzz). The header is checked first.
+TEST_F(CaptureSetTest, HeaderDeclaringMoreRowsThanTheFileHolds) {
+  write_set(false);
+  std::string exr("\x76\x2f\x31\x01\x02\x00\x00\x00", 8);
+  auto attribute = [&](const std::string& name, const std::string& type, const std::string& value) {
+    exr += name + '\0' + type + '\0';
+    const int32_t size = static_cast<int32_t>(value.size());
+    exr.append(reinterpret_cast<const char*>(&size), 4);
+    exr += value;
+  };
+  const int32_t window[4] = {0, 0, 3, (1 << 28) - 1};
+  attribute("dataWindow", "box2i", std::string(reinterpret_cast<const char*>(window), 16));
+  attribute("compression", "compression", std::string(1, '\0'));
+  exr += '\0';
+  std::ofstream(image(1, 0), std::ios::binary | std::ios::trunc) << exr;
+  expect_read_error(ErrorId::kCaptureImageFormat, "larger than any calf image");
+  const int32_t tall[4] = {0, 0, 3, 90000};
+  exr.replace(exr.find("box2i") + 10, 16, std::string(reinterpret_cast<const char*>(tall), 16));
+  std::ofstream(image(1, 0), std::ios::binary | std::ios::trunc) << exr;
+  expect_read_error(ErrorId::kCaptureImageFormat, "90001 rows need 90001 chunk offsets");
+  std::string tiled = exr;
+  tiled[5] = 0x02;  // version flags: tiled
+  std::ofstream(image(1, 0), std::ios::binary | std::ios::trunc) << tiled;
+  expect_read_error(ErrorId::kCaptureImageFormat, "single-part scanline");
+}
+
+// A PNG (or any other image) named .exr never reaches another format's decoder: it is refused by
+// its magic bytes, so that no library prints its own line (issue 22 item 13).
+TEST_F(CaptureSetTest, ImageOfAnotherFormatNamedExr) {
+  write_set(false);
+  auto out = OIIO::ImageOutput::create("png");
+  ASSERT_TRUE(out);
+  const fs::path png = dir_ / "image.png";
+  OIIO::ImageSpec spec(4, 24, 3, OIIO::TypeDesc::UINT8);
+  std::vector<uint8_t> px(4 * 24 * 3, 128);
+  ASSERT_TRUE(out->open(png.string(), spec));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, px.data()));
+  ASSERT_TRUE(out->close());
+  fs::rename(png, image(1, 0));
+  expect_read_error(ErrorId::kCaptureImageFormat, "not an OpenEXR file");
 }
 
 TEST_F(CaptureSetTest, TruncatedImage) {
@@ -261,6 +304,36 @@ TEST_F(CaptureSetTest, MissingDepthChannel) {
   write_set(false);
   write_raw(image(1, 0), 4, 24, {"R", "G", "B"}, 1.0f);
   expect_read_error(ErrorId::kCaptureImageFormat, "channel 'Z' is missing");
+}
+
+// CAPTURE.md allows HALF and FLOAT channels only: the image library would read a UINT channel
+// normalised to [0, 1] (depth 3 as ~7e-10), a silent misread.
+TEST_F(CaptureSetTest, UintChannelsAreRefused) {
+  for (const char* bad : {"Z", "G"}) {
+    write_set(false);
+    auto out = OIIO::ImageOutput::create("exr");
+    ASSERT_TRUE(out);
+    const std::vector<std::string> names = {"R", "G", "B", "Z"};
+    OIIO::ImageSpec spec(4, 24, 4, OIIO::TypeDesc::FLOAT);
+    spec.channelnames = names;
+    spec.channelformats.clear();
+    for (const std::string& n : names) {
+      spec.channelformats.push_back(n == bad ? OIIO::TypeDesc::UINT : OIIO::TypeDesc::FLOAT);
+    }
+    spec.alpha_channel = -1;
+    spec.z_channel = -1;
+    std::vector<uint32_t> px(4 * 24 * 4, 3);
+    ASSERT_TRUE(out->open(image(1, 0).string(), spec));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT, px.data()));
+    ASSERT_TRUE(out->close());
+    {
+      auto in = OIIO::ImageInput::open(image(1, 0).string());
+      ASSERT_TRUE(in);
+      EXPECT_EQ(in->spec().channelformat(bad[0] == 'Z' ? 3 : 1), OIIO::TypeDesc::UINT);
+    }
+    expect_read_error(ErrorId::kCaptureImageFormat,
+                      std::string("channel '") + bad + "' has pixel type uint");
+  }
 }
 
 TEST_F(CaptureSetTest, UnannouncedMaterial) {

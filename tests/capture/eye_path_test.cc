@@ -137,6 +137,28 @@ TEST(EyePath, Errors) {
                "'poses[0].forward[1]'");
 }
 
+// One coordinate bound (calf/format/coordinates.h) for positions and look_at targets; a direction
+// is not a coordinate: [1e300, 1e300, 0] has a finite direction even though its length overflows.
+TEST(EyePath, CoordinatesAndHugeDirections) {
+  expect_error(path_json(R"({"time": 0, "position": [1e20, 1.6, 0], "forward": [0, 0, -1]})"),
+               ErrorId::kEyePathField,
+               "'poses[0].position': (1e+20, 1.6, 0) is not finite and within +-1e+12");
+  expect_error(path_json(R"({"time": 0, "position": [0, 1.6, 0], "look_at": [0, 1e300, -1]})"),
+               ErrorId::kEyePathField, "'poses[0].look_at'");
+  auto p = parse_eye_path(
+      path_json(R"({"time": 0, "position": [1e12, 1.6, -1e12], "forward": [1e300, 1e300, 0]},
+                   {"time": 0, "position": [0, 0, 0], "forward": [0, 0, -1e-300], "up": [0, 1e308, 0]})"),
+      "p");
+  ASSERT_TRUE(p.ok()) << p.status().to_string();
+  expect_near(p->poses[0].forward, {std::sqrt(0.5), std::sqrt(0.5), 0});
+  expect_near(p->poses[0].up, {-std::sqrt(0.5), std::sqrt(0.5), 0});
+  expect_near(p->poses[1].forward, {0, 0, -1});
+  expect_near(p->poses[1].up, {0, 1, 0});
+  // Zero stays zero, and a huge direction parallel to up is still parallel.
+  expect_error(path_json(R"({"time": 0, "position": [0, 0, 0], "forward": [0, 1e300, 0]})"),
+               ErrorId::kEyePathField, "parallel");
+}
+
 // A directory or a missing file given as an eye path (or as a capture set's manifest) is a clear
 // open error naming it (libstdc++'s filebuf throws on reading a directory; nothing may escape).
 TEST(EyePath, NonFilesAreOpenErrorsNamingThePath) {

@@ -109,6 +109,23 @@ TEST(CaptureManifest, FieldErrorsNameTheField) {
                "viewpoints[0]");
 }
 
+// One coordinate bound (calf/format/coordinates.h): a finite viewpoint at 1e300 is refused when
+// the manifest is read, naming the field, instead of reaching the encoder and player.
+TEST(CaptureManifest, CoordinatesBeyondTheBoundAreRefused) {
+  expect_error(manifest_json("-3.75", "1e300"), ErrorId::kManifestField,
+               "'viewpoints[1].position': (-1e-300, 2.5e+10, 1e+300) is not finite and within "
+               "+-1e+12");
+  expect_error(manifest_json("-3.75", "-1.0000001e12"), ErrorId::kManifestField,
+               "'viewpoints[1].position'");
+  auto at_bound = parse_manifest(manifest_json("-3.75", "-1e12"), "m");
+  EXPECT_TRUE(at_bound.ok()) << at_bound.status().to_string();
+  CaptureManifest m = sample_manifest();
+  m.view_volume.max.y = 2e12;
+  Status st = validate_manifest(m);
+  EXPECT_EQ(st.id(), ErrorId::kManifestField);
+  EXPECT_NE(st.message().find("'view_volume.max'"), std::string::npos) << st.to_string();
+}
+
 TEST(CaptureManifest, Limits) {
   expect_error(manifest_json("\"face_size\": 128", "\"face_size\": 16385"), ErrorId::kCaptureLimit,
                "16384");

@@ -88,6 +88,22 @@ TEST(Rig, OverflowingOrRepeatedViewpointsAreSyntaxErrors) {
       << twice.status().message();
 }
 
+// Large finite positions and extents used to reach Embree and abort on ray.valid(); the
+// coordinate bound (calf/format/coordinates.h) refuses them at the --rig text.
+TEST(Rig, PositionsBeyondTheCoordinateBoundAreSyntaxErrors) {
+  for (const char* bad :
+       {"list:2e18,1.6,0", "ring:3,1e300,0,1.6,0", "sphere:4,1e300,0,1.6,0",
+        "box:0,1.6,0,1e300,1,1", "grid:2,1,1,-2e12,0,0,0,0,0", "list:0,1e12,0/0,-1.5e12,0"}) {
+    auto r = parse_rig(bad);
+    ASSERT_FALSE(r.ok()) << bad;
+    EXPECT_EQ(r.status().id(), ErrorId::kRigSyntax) << bad;
+    EXPECT_NE(r.status().message().find("coordinate bound"), std::string::npos)
+        << r.status().message();
+  }
+  auto at_bound = parse_rig("list:1e12,1.6,-1e12");
+  EXPECT_TRUE(at_bound.ok()) << at_bound.status().to_string();
+}
+
 TEST(Rig, SyntaxErrors) {
   for (const char* bad :
        {"", "box", "box:1,2,3", "box:0,0,0,0,1,1", "ring:0,1,0,0,0", "ring:2.5,1,0,0,0",

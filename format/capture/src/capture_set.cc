@@ -195,6 +195,7 @@ Status CaptureSetReader::read(uint32_t view, uint32_t frame, ViewFrame* out) con
                         "' but the manifest says \"material\": false");
     }
   }
+  for (int c = 0; c < (m.material ? 7 : 4); ++c) CALF_RETURN_IF_ERROR(exr.require_float(idx[c]));
   if (out->face_size != n || out->has_material != m.material ||
       out->depth.size() != out->texel_count()) {
     out->resize(n, m.material);

@@ -39,6 +39,10 @@ class ExrReader {
   // The index of a channel by exact name, or -1.
   int channel(const std::string& name) const;
   int channel_count() const { return static_cast<int>(names_.size()); }
+  // Ok when channel `index` stores HALF or FLOAT samples, the only types format/CAPTURE.md
+  // allows; E136 otherwise (the image library would normalise a UINT channel, so that depth 3
+  // read back as ~7e-10: a misread, not an error, unless refused here).
+  Status require_float(int index) const;
   // Rows [y0, y1) of all channels as float, interleaved (channel_count() floats per pixel).
   Status read_rows(uint32_t y0, uint32_t y1, std::vector<float>* out);
 
@@ -48,6 +52,7 @@ class ExrReader {
   std::unique_ptr<OIIO::ImageInput> input_;
   uint32_t width_ = 0, height_ = 0;
   std::vector<std::string> names_;
+  std::vector<OIIO::TypeDesc> formats_;  // per channel
 };
 
 }  // namespace calf::capture::detail

@@ -1,8 +1,11 @@
 // Eye paths and ground-truth images (format/CAPTURE.md, "Eye paths").
 #include "calf/capture/eye_path.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+
+#include "calf/format/coordinates.h"
 
 #include "exr_io.h"
 #include "json_fields.h"
@@ -16,15 +19,24 @@ using detail::Json;
 
 constexpr const char* kFormatName = "calf-eye-path";
 
-// Unit forward and an up orthogonal to it; false when either is degenerate or they are parallel.
+// v scaled so that its largest component has magnitude 1 when its length would overflow or
+// lose precision ([1e300, 1e300, 0] has a finite direction but an infinite length); false for a
+// zero or non-finite v. Moderate vectors are returned unchanged, bit for bit.
+bool rescale(Vec3* v) {
+  double m = std::max({std::fabs(v->x), std::fabs(v->y), std::fabs(v->z)});
+  if (!(m > 0) || !std::isfinite(m)) return false;
+  if (m > 1e100 || m < 1e-100) *v = *v / m;
+  return true;
+}
+
+// Unit forward and an up orthogonal to it; false when either is zero or they are parallel.
 // Vectors that are already unit and orthogonal (to 1e-12) are kept bit for bit, so that parsing
 // a serialized path gives back the same numbers.
 bool orthonormalize(Vec3* forward, Vec3* up) {
+  if (!rescale(forward) || !rescale(up)) return false;
   double fl = length(*forward);
-  if (!(fl > 1e-12) || !std::isfinite(fl)) return false;
   if (std::fabs(fl - 1) > 1e-12) *forward = *forward * (1 / fl);
   double ul = length(*up);
-  if (!(ul > 1e-12) || !std::isfinite(ul)) return false;
   double along = dot(*up, *forward);
   if (std::fabs(along) > 1e-12 * ul) {
     Vec3 u = *up - *forward * along;
@@ -57,6 +69,9 @@ Expected<EyePose> parse_pose(const Json& j, const std::string& path, std::string
   EyePose pose;
   CALF_ASSIGN_OR_RETURN(pose.time, r.number("time"));
   CALF_ASSIGN_OR_RETURN(pose.position, r.point("position"));
+  CALF_RETURN_IF_ERROR(
+      check_coordinates(pose.position, ErrorId::kEyePathField,
+                        std::string(source) + ": field '" + r.field("position") + "'"));
   int forms = int{r.has("forward")} + int{r.has("look_at")} + int{r.has("orientation")};
   if (forms != 1) {
     return r.error(path, "give exactly one of \"forward\", \"look_at\", \"orientation\"");
@@ -87,6 +102,9 @@ Expected<EyePose> parse_pose(const Json& j, const std::string& path, std::string
       CALF_ASSIGN_OR_RETURN(pose.forward, r.point("forward"));
     } else {
       CALF_ASSIGN_OR_RETURN(Vec3 target, r.point("look_at"));
+      CALF_RETURN_IF_ERROR(
+          check_coordinates(target, ErrorId::kEyePathField,
+                            std::string(source) + ": field '" + r.field("look_at") + "'"));
       pose.forward = target - pose.position;
     }
     if (r.has("up")) {
@@ -240,6 +258,7 @@ Expected<PerspectiveImage> read_perspective_image(const std::filesystem::path& f
       return Status(ErrorId::kCaptureImageFormat,
                     file.string() + ": channel '" + names[c] + "' is missing");
     }
+    CALF_RETURN_IF_ERROR(exr.require_float(idx[c]));
   }
   PerspectiveImage image;
   image.width = exr.width();

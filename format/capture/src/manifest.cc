@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "calf/capture/capture_set.h"
+#include "calf/format/coordinates.h"
 #include "json_fields.h"
 
 namespace calf::capture {
@@ -55,9 +56,10 @@ Status check_manifest(const CaptureManifest& m, std::string_view source) {
                     " viewpoints exceed the limit " + std::to_string(kMaxViewpoints));
   }
   const Box3& vv = m.view_volume;
-  for (double c : {vv.min.x, vv.min.y, vv.min.z, vv.max.x, vv.max.y, vv.max.z}) {
-    if (!std::isfinite(c)) return fail(ErrorId::kManifestField, "field 'view_volume': not finite");
-  }
+  CALF_RETURN_IF_ERROR(
+      check_coordinates(vv.min, ErrorId::kManifestField, src + ": field 'view_volume.min'"));
+  CALF_RETURN_IF_ERROR(
+      check_coordinates(vv.max, ErrorId::kManifestField, src + ": field 'view_volume.max'"));
   if (vv.min.x > vv.max.x || vv.min.y > vv.max.y || vv.min.z > vv.max.z) {
     return fail(ErrorId::kManifestInconsistent, "field 'view_volume': min " + point_text(vv.min) +
                                                     " exceeds max " + point_text(vv.max));
@@ -69,10 +71,8 @@ Status check_manifest(const CaptureManifest& m, std::string_view source) {
   for (size_t i = 0; i < m.viewpoints.size(); ++i) {
     const Viewpoint& v = m.viewpoints[i];
     std::string field = "field 'viewpoints[" + std::to_string(i) + "]";
-    if (!std::isfinite(v.position.x) || !std::isfinite(v.position.y) ||
-        !std::isfinite(v.position.z)) {
-      return fail(ErrorId::kManifestField, field + ".position': not finite");
-    }
+    CALF_RETURN_IF_ERROR(
+        check_coordinates(v.position, ErrorId::kManifestField, src + ": " + field + ".position'"));
     if (v.name.empty() || v.name.size() > 200) {
       return fail(ErrorId::kManifestField, field + ".name': must hold 1 to 200 characters");
     }
