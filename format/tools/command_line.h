@@ -3,7 +3,9 @@
 //   exit 0  success, and after --help or --version (printed on stdout);
 //   exit 1  an error: one line on stderr, "<command>: CALF-Ennn <message>";
 //   exit 2  a usage error (unknown option, missing argument, a value of the wrong type or outside
-//           its range): one line on stderr, "<command>: CALF-E006 <message> (see --help)".
+//           its range): one line on stderr, "<command>: CALF-E006 <message> (see --help)"; a
+//           range or contradiction a command checks after parsing keeps its own id (calf-capture
+//           E177, calf-play E461) with exit 2.
 // parse_command_line() also installs the signal handlers that remove the command's temporary
 // files on SIGINT / SIGTERM / SIGHUP (calf/format/files.h).
 #pragma once
@@ -25,7 +27,8 @@ inline constexpr int kExitUsage = 2;
 // The sentence each command's --help ends with.
 inline constexpr const char* kExitStatusHelp =
     "Exit status: 0 success; 1 an error, printed as one line '<command>: CALF-Ennn ...' "
-    "(docs/ERRORS.md); 2 a usage error (bad option or argument), one line with CALF-E006.";
+    "(docs/ERRORS.md); 2 a usage error (bad option or argument, options that contradict each "
+    "other), one line with CALF-E006 or the option's own id.";
 
 // The most threads a --threads option accepts (0 = all cores).
 inline constexpr unsigned kMaxThreads = 256;

@@ -29,6 +29,12 @@ int fail(const Status& status) {
   return tools::print_error("calf-play", status);
 }
 
+// Options that contradict each other: E461, exit 2 like every usage error (command_line.h).
+int contradiction(const std::string& message) {
+  return tools::print_error("calf-play", Status(ErrorId::kPlaybackOption, message),
+                            tools::kExitUsage);
+}
+
 struct HeadlessArgs {
   std::string eye_path, out, compare, format = "png", contact_sheet;
   uint32_t sheet_rows = 8;
@@ -274,10 +280,10 @@ int main(int argc, char** argv) {
   if (headless && app.count("--frame-ms") == 0) o.selection.budget.target_frame_ms = 0;
   if (headless) {
     if (h.eye_path.empty() && h.compare.empty()) {
-      return fail(Status(ErrorId::kPlaybackOption, "--headless needs --eye-path or --compare"));
+      return contradiction("--headless needs --eye-path or --compare");
     }
     if (!h.contact_sheet.empty() && h.compare.empty()) {
-      return fail(Status(ErrorId::kPlaybackOption, "--contact-sheet needs --compare"));
+      return contradiction("--contact-sheet needs --compare");
     }
     std::unique_ptr<OsMesaContext> context;
     const GlFunctions* gl = nullptr;
@@ -292,10 +298,10 @@ int main(int argc, char** argv) {
     return run_headless(**play, h);
   }
   if (!play_options.use_gl) {
-    return fail(Status(ErrorId::kPlaybackOption, "--renderer cpu works only with --headless"));
+    return contradiction("--renderer cpu works only with --headless");
   }
   if (!h.contact_sheet.empty()) {
-    return fail(Status(ErrorId::kPlaybackOption, "--contact-sheet works only with --headless"));
+    return contradiction("--contact-sheet works only with --headless");
   }
   if (Status s = run_window(clip, play_options, w); !s.ok()) return fail(s);
   return 0;

@@ -26,6 +26,12 @@ int fail(const Status& status) {
   return calf::tools::print_error("calf-capture", status);
 }
 
+// An option value outside its range, found after parsing: its own id, exit 2 like every usage
+// error (command_line.h).
+int bad_option(const Status& status) {
+  return calf::tools::print_error("calf-capture", status, calf::tools::kExitUsage);
+}
+
 // Progress on stderr: one updating line on a terminal, a line per ~10 % otherwise.
 class Progress {
  public:
@@ -125,10 +131,10 @@ int main(int argc, char** argv) {
   render.ao_samples = ao_samples;
   render.max_bounces = max_bounces;
   render.noise = noise;
-  if (Status s = samples::validate_render_options(render); !s.ok()) return fail(s);
+  if (Status s = samples::validate_render_options(render); !s.ok()) return bad_option(s);
   if (face_size < 1 || face_size > 4096) {
-    return fail(Status(calf::ErrorId::kCaptureOption,
-                       fmt::format("--face-size {} is outside 1..4096", face_size)));
+    return bad_option(Status(calf::ErrorId::kCaptureOption,
+                             fmt::format("--face-size {} is outside 1..4096", face_size)));
   }
   auto scene = samples::load_scene(scene_arg);
   if (!scene.ok()) return fail(scene.status());
@@ -151,8 +157,8 @@ int main(int argc, char** argv) {
       char x = 0, extra = 0;
       if (std::sscanf(gt_size.c_str(), "%u%c%u%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 1 ||
           h < 1 || w > 16384 || h > 16384) {
-        return fail(Status(calf::ErrorId::kCaptureOption,
-                           "--gt-size '" + gt_size + "' is not WxH with sizes in 1..16384"));
+        return bad_option(Status(calf::ErrorId::kCaptureOption,
+                                 "--gt-size '" + gt_size + "' is not WxH with sizes in 1..16384"));
       }
       path = scene->validation_path(frame_count, scene->fps, w, h);
     }
