@@ -90,8 +90,8 @@ TEST_P(EncodePin, OutputBytesAreUnchanged) {
   }
   // The generator of the lightfield conformance clips (tests/conformance/README.md): with
   // CALF_CONFORMANCE_OUT set, the pinned clips are copied there as <name>.calf.
-  if (const char* dir = std::getenv("CALF_CONFORMANCE_OUT")) {
-    const fs::path to = fs::path(dir) / (std::string(c.name) + ".calf");
+  if (const char* out_dir = std::getenv("CALF_CONFORMANCE_OUT")) {
+    const fs::path to = fs::path(out_dir) / (std::string(c.name) + ".calf");
     std::error_code ec;
     fs::copy_file(root / "t1.calf", to, fs::copy_options::overwrite_existing, ec);
     EXPECT_FALSE(ec) << to << ": " << ec.message();
