@@ -177,7 +177,10 @@ Status check_importer_for_extension(Assimp::Importer& importer, const std::strin
     if (!info || !info->mFileExtensions) continue;
     std::string list = std::string(" ") + info->mFileExtensions + " ";
     for (char& c : list) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (list.find(" " + lower_ext.substr(1) + " ") != std::string::npos) {
+    // Appends, not operator+ on a temporary: GCC 12 -O3 misfires -Wrestrict on that.
+    std::string word = " ";
+    word.append(lower_ext, 1).append(" ");
+    if (list.find(word) != std::string::npos) {
       claiming.push_back(importer.GetImporter(i));
     }
   }
