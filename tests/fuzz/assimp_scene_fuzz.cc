@@ -6,8 +6,6 @@
 // hold only vertices within the bound.
 // Input: the first byte picks the extension (.obj, .ply, .gltf, .glb), the rest is the file,
 // written to a temporary folder of its own.
-#include <unistd.h>
-
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -18,22 +16,12 @@
 
 #include "calf/format/coordinates.h"
 #include "calf/samples/scene.h"
+#include "fuzz_scratch_dir.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size == 0) return 0;
   static const char* const kExtensions[] = {".obj", ".ply", ".gltf", ".glb"};
-  static const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("calf_assimp_fuzz_" + std::to_string(getpid()));
-  static const bool made = [] {
-    std::filesystem::create_directories(dir);
-    // The folder goes when the run ends, so that ctest leaves nothing in the temp directory.
-    std::atexit([] {
-      std::error_code ignored;
-      std::filesystem::remove_all(dir, ignored);
-    });
-    return true;
-  }();
-  (void)made;
+  const std::filesystem::path& dir = calf::fuzz::scratch_dir("calf_assimp_fuzz");
   const std::filesystem::path file = dir / (std::string("model") + kExtensions[data[0] % 4]);
   {
     std::ofstream out(file, std::ios::binary | std::ios::trunc);

@@ -4,8 +4,6 @@
 // exception or a stray allocation; an accepted view-frame passes validate_view_frame.
 // Input: the first byte picks the set (bits 0-1: face size 1 + value, bit 2: material), the rest
 // is the OpenEXR file.
-#include <unistd.h>
-
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -15,21 +13,11 @@
 #include <system_error>
 
 #include "calf/capture/capture_set.h"
+#include "fuzz_scratch_dir.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size == 0) return 0;
-  static const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("calf_view_frame_fuzz_" + std::to_string(getpid()));
-  static const bool made = [] {
-    std::filesystem::create_directories(dir);
-    // The folder goes when the run ends, so that ctest leaves nothing in the temp directory.
-    std::atexit([] {
-      std::error_code ignored;
-      std::filesystem::remove_all(dir, ignored);
-    });
-    return true;
-  }();
-  (void)made;
+  const std::filesystem::path& dir = calf::fuzz::scratch_dir("calf_view_frame_fuzz");
   calf::capture::CaptureManifest m;
   m.frame_count = 1;
   m.face_size = 1 + (data[0] & 3);
