@@ -8,7 +8,6 @@
 // it (re)writes the malformed corpus and manifest, and writes valid files only where missing
 // (a frozen file is never regenerated).
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -20,6 +19,7 @@
 #include <sstream>
 
 #include "../conformance/container_corpus.h"
+#include "run_command.h"
 
 namespace calf::container {
 namespace {
@@ -227,14 +227,8 @@ TEST(ContainerConformanceTest, CalfVerifyCommandAgrees) {
   ASSERT_TRUE(fs::exists(exe)) << exe << " is not built";
   const Manifest m = read_manifest();
   auto run = [&](const std::string& name, std::string* out) {
-    const std::string cmd =
-        "'" + exe.string() + "' --container-only '" + (suite_dir() / name).string() + "' 2>&1";
-    FILE* p = ::popen(cmd.c_str(), "r");
-    char buf[4096];
-    size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out->append(buf, n);
-    const int rc = ::pclose(p);
-    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+    return testing_support::run_command(
+        "'" + exe.string() + "' --container-only '" + (suite_dir() / name).string() + "'", out);
   };
   for (const auto& [name, v] : m.valid) {
     std::string out;

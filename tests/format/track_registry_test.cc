@@ -5,7 +5,6 @@
 #include "calf/format/track_registry.h"
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cctype>
@@ -18,6 +17,7 @@
 #include <sstream>
 
 #include "calf/format/container.h"
+#include "run_command.h"
 
 namespace calf::container {
 namespace {
@@ -214,13 +214,8 @@ TEST(TrackRegistry, CalfInfoPrintsEveryKind) {
     cmd += args;
     cmd += " '";
     cmd += p.string();
-    cmd += "' 2>&1";
-    FILE* pipe = ::popen(cmd.c_str(), "r");
-    char buf[4096];
-    size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) out->append(buf, n);
-    const int rc = ::pclose(pipe);
-    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+    cmd += "'";
+    return testing_support::run_command(cmd, out);
   };
   const Bytes file = file_of_every_kind(0, &fields);
   std::string text, json;
