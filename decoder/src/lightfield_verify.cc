@@ -55,13 +55,14 @@ LightfieldVerifyResult verify_lightfield_track(const container::Reader& reader, 
         if (!st.ok()) {
           failed[size_t{v} * 6 + f] = true;
           result.problems.push_back(st.with_context(name + " frame " + std::to_string(frame)));
-          if (result.problems.size() >= max_problems) return result;
+          if (result.problems.size() >= max_problems) {
+            result.hashes.clear();  // hashes only of a track without problems
+            return result;
+          }
           continue;
         }
         ++result.faces_decoded;
-        if (with_hashes && result.problems.empty()) {
-          result.hashes.push_back({frame, v, f, face_hash(face)});
-        }
+        if (with_hashes) result.hashes.push_back({frame, v, f, face_hash(face)});
       }
     }
   }
