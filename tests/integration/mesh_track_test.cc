@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iterator>
@@ -201,7 +202,9 @@ TEST(MeshTrack, FullSceneRoundTrip) {
 }
 
 // A visible set: per scene object a sorted list of mesh triangles.
-std::vector<std::vector<uint32_t>> test_subset() {
+// Without spheres the toys draw their one triangle and the tetrahedron three of its four.
+std::vector<std::vector<uint32_t>> test_subset(bool spheres = true) {
+  if (!spheres) return {{1}, {}, {0, 1}, {0, 2, 3, 5}, {0}, {0, 2, 3}};
   std::vector<uint32_t> toys = {0};
   for (uint32_t t = 1; t <= kSphereTriangles; ++t) toys.push_back(t);  // the first sphere whole
   toys.push_back(2000);
@@ -311,7 +314,9 @@ std::vector<uint8_t> rebuild(const std::vector<uint8_t>& file, const Edit& edit)
     last = *raw;
     last_keys = reader.chunks()[id].keys;
   }
-  if (edit.duplicate_last) EXPECT_TRUE(w->add_chunk(last_keys, last, Compression::kNone).ok());
+  if (edit.duplicate_last) {
+    EXPECT_TRUE(w->add_chunk(last_keys, last, Compression::kNone).ok());
+  }
   EXPECT_TRUE(w->finish().ok());
   return out;
 }
@@ -439,12 +444,15 @@ struct Clip {
   bool subset;
   Compression compression;
 };
+// The conformance clips are of the scene without spheres (a few KB): the decoder sees a sphere
+// as triangles like any other, and the round trips above cover the spheres.
 constexpr Clip kClips[] = {{"full_none", false, Compression::kNone},
-                           {"subset_zstd", true, Compression::kZstd}};
+                           {"subset_zstd", true, Compression::kZstd},
+                           {"full_lzma2", false, Compression::kLzma2}};
 
 std::vector<uint8_t> make_clip(const Clip& c) {
-  const capture::SceneFile scene = test::make_mesh_test_scene(3);
-  const auto visible = test_subset();
+  const capture::SceneFile scene = test::make_mesh_test_scene(3, false);
+  const auto visible = test_subset(false);
   encoder::MeshEncodeOptions o;
   o.supercompression = c.compression;
   o.segment_count = c.subset ? 8 : 0;
@@ -456,18 +464,39 @@ std::vector<uint8_t> make_clip(const Clip& c) {
 TEST(MeshConformance, Generator) {
   const char* out = std::getenv("CALF_CONFORMANCE_OUT");
   if (!out) GTEST_SKIP() << "set CALF_CONFORMANCE_OUT to write the clips";
-  for (const Clip& c : kClips) {
-    const auto bytes = make_clip(c);
-    std::ofstream f(std::string(out) + "/" + c.name + ".calf", std::ios::binary);
+  auto write = [](const std::string& path, const std::vector<uint8_t>& bytes) {
+    std::ofstream f(path, std::ios::binary);
     f.write(reinterpret_cast<const char*>(bytes.data()),
             static_cast<std::streamsize>(bytes.size()));
-  }
+    ASSERT_TRUE(f.good()) << path;
+  };
+  for (const Clip& c : kClips) write(std::string(out) + "/" + c.name + ".calf", make_clip(c));
+  // Fuzz seeds (tests/fuzz/corpus/mesh_track_fuzz/): the clips, and damaged copies whose chunks
+  // are stored uncompressed with valid hashes, so that mutations reach the track's parsers.
+  const std::string fuzz = std::string(out) + "/fuzz";
+  std::filesystem::create_directories(fuzz);
+  const auto subset = make_clip(kClips[1]);
+  write(fuzz + "/valid_full_none.calf", make_clip(kClips[0]));
+  write(fuzz + "/valid_subset_zstd.calf", subset);
+  write(fuzz + "/valid_subset_none.calf", rebuild(subset, {}));
+  const auto damaged = [&](const char* name, MeshStream stream, uint32_t region, size_t at,
+                           uint8_t value) {
+    Edit e;
+    e.chunk = [=](const container::ChunkKeys& k, std::vector<uint8_t>& raw, bool&) {
+      if (is(k, stream, region) && at < raw.size()) raw[at] = value;
+    };
+    write(fuzz + "/" + name + ".calf", rebuild(subset, e));
+  };
+  damaged("bad_index_version", MeshStream::kIndex, 0, 0, 2);
+  damaged("bad_position_nan", MeshStream::kVertices, 0, 36, 0x7f);
+  damaged("bad_vertex_index", MeshStream::kTriangles, 0, 0, 100);
+  damaged("bad_run_gap", MeshStream::kVisibility, 0, 52, 200);
 }
 
 // The runner: each committed clip decodes to the scene it was made from, and to its hashes.
 TEST(MeshConformance, CommittedClipsDecodeToTheSceneAndTheirHashes) {
-  const capture::SceneFile scene = test::make_mesh_test_scene(3);
-  const auto visible = test_subset();
+  const capture::SceneFile scene = test::make_mesh_test_scene(3, false);
+  const auto visible = test_subset(false);
   for (const Clip& c : kClips) {
     SCOPED_TRACE(c.name);
     const auto bytes =
