@@ -75,12 +75,15 @@ TEST(MeshLayout, VerticesRoundTripBitForBitAsDocumentedPlanes) {
   ASSERT_TRUE(bytes.ok()) << bytes.status().to_string();
   ASSERT_EQ(bytes->size(), vertices_chunk_size(p));
   EXPECT_EQ(bytes->size(), 4u * (3 * 3 * 3 + 2 + 2 * 9));
-  // Byte planes of component-planar deltas: word 0 is x of vertex 0 (-0.0f = 0x80000000), word 1
-  // x of vertex 1 minus x of vertex 0; 9 words, so plane 3 starts at byte 27.
+  // Byte planes of component planes: word 0 is x of vertex 0 (-0.0f = 0x80000000), word 1 x of
+  // vertex 1 (denorm_min = 0x00000001), word 3 y of vertex 0 (1e12f = 0x5368d4a5); 9 words, so
+  // plane 3 starts at byte 27.
   EXPECT_EQ((*bytes)[0], 0x00);
   EXPECT_EQ((*bytes)[27], 0x80);
-  EXPECT_EQ((*bytes)[1], 0x01);  // denorm_min (0x00000001) - 0x80000000 = 0x80000001
-  EXPECT_EQ((*bytes)[28], 0x80);
+  EXPECT_EQ((*bytes)[1], 0x01);
+  EXPECT_EQ((*bytes)[28], 0x00);
+  EXPECT_EQ((*bytes)[3], 0xa5);
+  EXPECT_EQ((*bytes)[30], 0x53);
   VertexArrays back;
   ASSERT_TRUE(decode_vertices(*bytes, p, &back, "v").ok());
   EXPECT_EQ(bits_of(back.positions), bits_of(a.positions));
