@@ -117,6 +117,19 @@ Status check_index(const IndexChunk& x, uint32_t frame_count, const std::string&
                      cat("materials[", i, "].emission ", e, " is negative"));
     }
   }
+  for (size_t i = 0; i < x.prototypes.size(); ++i) {
+    const PrototypeRecord& p = x.prototypes[i];
+    if (p.triangles_of == i) continue;
+    const uint32_t q = p.triangles_of;
+    if (q > i || x.prototypes[q].triangles_of != q ||
+        x.prototypes[q].triangle_count != p.triangle_count ||
+        ((x.prototypes[q].flags ^ p.flags) & kHasTriangleMaterials)) {
+      return error(ErrorId::kMeshIndex, what,
+                   cat("prototypes[", i, "].triangles_of ", q,
+                       " is not an earlier prototype with its own triangles, ", p.triangle_count,
+                       " triangles and the same triangle-material flag"));
+    }
+  }
   for (size_t i = 0; i < x.objects.size(); ++i) {
     const ObjectRecord& o = x.objects[i];
     const std::string name = cat("objects[", i, "]");

@@ -3,7 +3,7 @@
 // moving per frame), a strip with piecewise-linear vertex states, a mesh of one triangle and two
 // analytic spheres and a mesh that is one sphere alone. Without `spheres` (the small conformance
 // clips and fuzz seeds) the spheres are left out and the last mesh is a tetrahedron with
-// normals. Deterministic: the same floats on every machine.
+// normals; a panel reuses the quad's triangles. Deterministic: the same floats on every machine.
 #pragma once
 
 #include <cstdint>
@@ -74,6 +74,13 @@ inline capture::SceneFile make_mesh_test_scene(uint32_t frame_count = 3, bool sp
   }
   s.meshes.push_back(ball);
 
+  capture::SceneMesh panel;  // the quad's triangles on other vertices: shares its triangles chunk
+  panel.name = "panel";
+  panel.positions = {0, 0, 0, 2, 0, 0, 2, 1, 0, 0, 1, 0};
+  panel.indices = quad.indices;
+  panel.triangle_materials = quad.triangle_materials;
+  s.meshes.push_back(panel);
+
   capture::SceneObject floor{"floor", 0, 0, {}};  // identity
   capture::SceneObject tile{"tile", 0, 1, {{1, 0, 0, 2, 0, 1, 0, 0, 0, 0, 1, 0}}};
   capture::SceneObject mover{"mover", 0, 2, {}};
@@ -84,7 +91,8 @@ inline capture::SceneFile make_mesh_test_scene(uint32_t frame_count = 3, bool sp
   capture::SceneObject grass{"grass", 1, 0, {}};
   capture::SceneObject toys{"toys", 2, 2, {}};
   capture::SceneObject sun{"sun", 3, 1, {{2, 0, 0, 5, 0, 2, 0, 9, 0, 0, 2, 5}}};
-  s.objects = {floor, tile, mover, grass, toys, sun};
+  capture::SceneObject sign{"sign", 4, 1, {{1, 0, 0, 0, 0, 1, 0, 2, 0, 0, 1, -6}}};
+  s.objects = {floor, tile, mover, grass, toys, sun, sign};
   return s;
 }
 

@@ -145,12 +145,12 @@ TEST(MeshTrack, FullSceneRoundTrip) {
   const auto reader = open_reader(file);
   auto track = MeshTrack::open(reader, 0);
   ASSERT_TRUE(track.ok()) << track.status().to_string();
-  // Counts worked out by hand: quad 4 + strip 8 + balls 3 + 2 x 642 + ball 642 vertices; floor,
-  // tile, mover 2 triangles each, grass 6, toys 1 + 2 x 1280, sun 1280.
-  EXPECT_EQ(track->header().vertex_count, 1941u);
-  EXPECT_EQ(track->header().triangle_count, 3853u);
-  EXPECT_EQ(stats.triangles, 3853u);
-  EXPECT_EQ(stats.scene_triangles, 3853u);
+  // Counts worked out by hand: quad 4 + strip 8 + balls 3 + 2 x 642 + ball 642 + panel 4
+  // vertices; floor, tile, mover 2 triangles each, grass 6, toys 1 + 2 x 1280, sun 1280, sign 2.
+  EXPECT_EQ(track->header().vertex_count, 1945u);
+  EXPECT_EQ(track->header().triangle_count, 3855u);
+  EXPECT_EQ(stats.triangles, 3855u);
+  EXPECT_EQ(stats.scene_triangles, 3855u);
   EXPECT_EQ(track->header().flags, 0);
   EXPECT_EQ(track->frame_count(), 3u);
   EXPECT_DOUBLE_EQ(track->fps(), 24.0);
@@ -159,9 +159,13 @@ TEST(MeshTrack, FullSceneRoundTrip) {
   ASSERT_EQ(track->materials().size(), 3u);
   EXPECT_EQ(track->materials()[1].base_colour, (std::array<float, 3>{1, 0.75f, 0.25f}));
   EXPECT_EQ(track->materials()[1].emission, (std::array<float, 3>{4, 3, 2}));
-  ASSERT_EQ(track->prototype_count(), 4u);
-  ASSERT_EQ(track->object_count(), 6u);
-  for (uint32_t p = 0; p < 4; ++p) {
+  ASSERT_EQ(track->prototype_count(), 5u);
+  ASSERT_EQ(track->object_count(), 7u);
+  // The panel (prototype 4) draws the quad's triangles: one triangles chunk for both.
+  EXPECT_EQ(track->index().prototypes[4].triangles_of, 0u);
+  EXPECT_EQ(stats.triangles_stream.chunks, 4u);
+  EXPECT_EQ(stats.vertices_stream.chunks, 5u);
+  for (uint32_t p = 0; p < 5; ++p) {
     MeshPrototype got;
     ASSERT_TRUE(track->prototype(p, &got).ok());
     expect_prototype(got, expected_prototype(scene.meshes[p]), p);
@@ -172,7 +176,7 @@ TEST(MeshTrack, FullSceneRoundTrip) {
   ASSERT_TRUE(track->prototype(3, &ball).ok());
   EXPECT_TRUE(balls.normals.empty());
   EXPECT_EQ(ball.normals.size(), 3 * size_t{kSphereVertices});
-  for (uint32_t o = 0; o < 6; ++o) {
+  for (uint32_t o = 0; o < 7; ++o) {
     MeshObject got;
     ASSERT_TRUE(track->object(o, &got).ok());
     const auto& so = scene.objects[o];
@@ -196,19 +200,19 @@ TEST(MeshTrack, FullSceneRoundTrip) {
   // Out-of-range requests are errors.
   MeshObject o;
   MeshPrototype p;
-  EXPECT_EQ(track->object(6, &o).id(), ErrorId::kInvalidArgument);
-  EXPECT_EQ(track->prototype(4, &p).id(), ErrorId::kInvalidArgument);
+  EXPECT_EQ(track->object(7, &o).id(), ErrorId::kInvalidArgument);
+  EXPECT_EQ(track->prototype(5, &p).id(), ErrorId::kInvalidArgument);
   EXPECT_EQ(MeshTrack::open(reader, 1).status().id(), ErrorId::kInvalidArgument);
 }
 
 // A visible set: per scene object a sorted list of mesh triangles.
 // Without spheres the toys draw their one triangle and the tetrahedron three of its four.
 std::vector<std::vector<uint32_t>> test_subset(bool spheres = true) {
-  if (!spheres) return {{1}, {}, {0, 1}, {0, 2, 3, 5}, {0}, {0, 2, 3}};
+  if (!spheres) return {{1}, {}, {0, 1}, {0, 2, 3, 5}, {0}, {0, 2, 3}, {1}};
   std::vector<uint32_t> toys = {0};
   for (uint32_t t = 1; t <= kSphereTriangles; ++t) toys.push_back(t);  // the first sphere whole
   toys.push_back(2000);
-  return {{1}, {}, {0, 1}, {0, 2, 3, 5}, toys, {5, 6, 7, 900}};
+  return {{1}, {}, {0, 1}, {0, 2, 3, 5}, toys, {5, 6, 7, 900}, {1}};
 }
 
 TEST(MeshTrack, SubsetRoundTrip) {
@@ -222,12 +226,12 @@ TEST(MeshTrack, SubsetRoundTrip) {
   ASSERT_TRUE(track.ok()) << track.status().to_string();
   EXPECT_EQ(track->header().flags, mesh::kHeaderVisibleSet);
   EXPECT_EQ(track->header().segment_count, 8u);
-  EXPECT_EQ(track->header().triangle_count, 1u + 2 + 4 + 1282 + 4);
+  EXPECT_EQ(track->header().triangle_count, 1u + 2 + 4 + 1282 + 4 + 1);
   // The tile (object 1) draws nothing and is left out; every mesh is still used.
-  ASSERT_EQ(track->object_count(), 5u);
-  ASSERT_EQ(track->prototype_count(), 4u);
-  const uint32_t sources[5] = {0, 2, 3, 4, 5};
-  for (uint32_t o = 0; o < 5; ++o) {
+  ASSERT_EQ(track->object_count(), 6u);
+  ASSERT_EQ(track->prototype_count(), 5u);
+  const uint32_t sources[6] = {0, 2, 3, 4, 5, 6};
+  for (uint32_t o = 0; o < 6; ++o) {
     MeshObject got;
     ASSERT_TRUE(track->object(o, &got).ok());
     const uint32_t s = sources[o];
@@ -328,6 +332,11 @@ ErrorId damage_id(const std::vector<uint8_t>& file) {
   return r.problems.empty() ? ErrorId::kOk : r.problems[0].id();
 }
 
+// Drops the last n bytes (std::min: GCC's -Wstringop-overflow cannot tell n <= size otherwise).
+void shrink(std::vector<uint8_t>& r, size_t n) {
+  r.resize(r.size() - std::min(n, r.size()));
+}
+
 bool is(const container::ChunkKeys& k, MeshStream s, uint32_t region) {
   return k.stream == static_cast<uint16_t>(s) && k.region == region;
 }
@@ -337,8 +346,9 @@ TEST(MeshTrack, DamagedChunksGiveTheTrackIds) {
   const auto visible = test_subset();
   const auto good = encode(scene, &visible);
   ASSERT_EQ(damage_id(rebuild(good, {})), ErrorId::kOk) << "rebuilding alone changes nothing";
-  // Offsets in the index chunk (§11.4.2): 3 materials, 4 prototypes.
-  constexpr size_t kObjects = 4 + 4 + 48 + 4 + 3 * 24 + 4 + 4 * 16 + 4;
+  // Offsets in the index chunk (§11.4.2): 3 materials, 5 prototypes.
+  constexpr size_t kObjects = 4 + 4 + 48 + 4 + 3 * 24 + 4 + 5 * 20 + 4;
+  constexpr size_t kPrototypes = 4 + 4 + 48 + 4 + 3 * 24 + 4;
   auto on = [](MeshStream s, uint32_t region, std::function<void(std::vector<uint8_t>&)> f) {
     Edit e;
     e.chunk = [=](const container::ChunkKeys& k, std::vector<uint8_t>& raw, bool&) {
@@ -356,7 +366,7 @@ TEST(MeshTrack, DamagedChunksGiveTheTrackIds) {
        ErrorId::kMeshUnsupported},
       {"index flags", on(MeshStream::kIndex, 0, [](auto& r) { r[4] = 1; }),
        ErrorId::kMeshUnsupported},
-      {"index truncated", on(MeshStream::kIndex, 0, [](auto& r) { r.resize(r.size() - 1); }),
+      {"index truncated", on(MeshStream::kIndex, 0, [](auto& r) { shrink(r, 1); }),
        ErrorId::kMeshChunk},
       {"index trailing byte", on(MeshStream::kIndex, 0, [](auto& r) { r.push_back(0); }),
        ErrorId::kMeshChunk},
@@ -374,8 +384,12 @@ TEST(MeshTrack, DamagedChunksGiveTheTrackIds) {
        on(MeshStream::kIndex, 0, [](auto& r) { r[kObjects + 8] = 3; }), ErrorId::kMeshIndex},
       {"transform count 2", on(MeshStream::kIndex, 0, [](auto& r) { r[kObjects + 12] = 2; }),
        ErrorId::kMeshIndex},
-      {"prototype vertex count",
-       on(MeshStream::kIndex, 0, [](auto& r) { r[4 + 4 + 48 + 4 + 72 + 4] = 5; }),
+      {"prototype vertex count", on(MeshStream::kIndex, 0, [](auto& r) { r[kPrototypes] = 5; }),
+       ErrorId::kMeshChunk},
+      {"triangles of a later prototype",
+       on(MeshStream::kIndex, 0, [](auto& r) { r[kPrototypes + 16] = 4; }), ErrorId::kMeshIndex},
+      {"shared triangles claimed as own",
+       on(MeshStream::kIndex, 0, [](auto& r) { r[kPrototypes + 4 * 20 + 16] = 4; }),
        ErrorId::kMeshChunk},
       {"position NaN",
        on(MeshStream::kVertices, 0,
@@ -386,8 +400,8 @@ TEST(MeshTrack, DamagedChunksGiveTheTrackIds) {
       {"state times not increasing",
        on(MeshStream::kVertices, 1, [](auto& r) { r[96 + 3 * 3 + 1] = 0xbf; }),
        ErrorId::kMeshValue},
-      {"vertices chunk short",
-       on(MeshStream::kVertices, 1, [](auto& r) { r.resize(r.size() - 4); }), ErrorId::kMeshChunk},
+      {"vertices chunk short", on(MeshStream::kVertices, 1, [](auto& r) { shrink(r, 4); }),
+       ErrorId::kMeshChunk},
       {"vertex index out of range", on(MeshStream::kTriangles, 0, [](auto& r) { r[0] = 100; }),
        ErrorId::kMeshIndex},
       {"triangle material out of range", on(MeshStream::kTriangles, 0, [](auto& r) { r[24] = 7; }),
