@@ -172,6 +172,11 @@ Status GlMeshRenderer::build_program() {
     gl.GetProgramInfoLog(program_, static_cast<GLsizei>(log.size()), nullptr, log.data());
     return Status(kGlMissing, std::string("the mesh program does not link: ") + log.data());
   }
+  const auto loc = [&](const char* name) { return gl.GetUniformLocation(program_, name); };
+  uniforms_ = {loc("model_x"),    loc("model_y"),        loc("model_z"),
+               loc("model_t"),    loc("normal_x"),       loc("normal_y"),
+               loc("normal_z"),   loc("has_normals"),    loc("has_triangle_materials"),
+               loc("has_subset"), loc("object_material")};
   return check_gl_error(gl, "building the mesh program");
 }
 
@@ -382,8 +387,10 @@ Status GlMeshRenderer::render(const MeshDrawList& list, const Camera& camera,
   gl.Uniform3f(loc("light"), kMeshKeyLight[0], kMeshKeyLight[1], kMeshKeyLight[2]);
   gl.Uniform1f(loc("ambient"), kMeshAmbient);
   gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, materials_);
-  const GLint has_normals = loc("has_normals"), has_tm = loc("has_triangle_materials"),
-              has_subset = loc("has_subset"), object_material = loc("object_material");
+  const ObjectUniforms& u = uniforms_;
+  const auto at = [&](GLint location, const Vec3& v) {
+    gl.Uniform3f(location, f(v.x), f(v.y), f(v.z));
+  };
 
   for (size_t o = 0; o < objects_.size(); ++o) {
     const ObjectBuffers& ob = objects_[o];
@@ -395,10 +402,10 @@ Status GlMeshRenderer::render(const MeshDrawList& list, const Camera& camera,
     for (int row = 0; row < 3; ++row) {
       for (int col = 0; col < 4; ++col) r[row][col] = m[4 * row + col];
     }
-    vec3("model_x", {r[0][0], r[1][0], r[2][0]});
-    vec3("model_y", {r[0][1], r[1][1], r[2][1]});
-    vec3("model_z", {r[0][2], r[1][2], r[2][2]});
-    vec3("model_t", Vec3{r[0][3], r[1][3], r[2][3]} - camera.position);
+    at(u.model_x, {r[0][0], r[1][0], r[2][0]});
+    at(u.model_y, {r[0][1], r[1][1], r[2][1]});
+    at(u.model_z, {r[0][2], r[1][2], r[2][2]});
+    at(u.model_t, Vec3{r[0][3], r[1][3], r[2][3]} - camera.position);
     // Inverse transpose up to a positive factor: the cofactor matrix (normals are normalised).
     double cof[3][3];
     for (int a = 0; a < 3; ++a) {
@@ -407,13 +414,13 @@ Status GlMeshRenderer::render(const MeshDrawList& list, const Camera& camera,
         cof[a][b] = r[a1][b1] * r[a2][b2] - r[a1][b2] * r[a2][b1];
       }
     }
-    vec3("normal_x", {cof[0][0], cof[1][0], cof[2][0]});
-    vec3("normal_y", {cof[0][1], cof[1][1], cof[2][1]});
-    vec3("normal_z", {cof[0][2], cof[1][2], cof[2][2]});
-    gl.Uniform1i(has_normals, pb.has_normals ? 1 : 0);
-    gl.Uniform1i(has_tm, pb.has_triangle_materials ? 1 : 0);
-    gl.Uniform1i(has_subset, ob.all_triangles ? 0 : 1);
-    gl.Uniform1ui(object_material, lo.material);
+    at(u.normal_x, {cof[0][0], cof[1][0], cof[2][0]});
+    at(u.normal_y, {cof[0][1], cof[1][1], cof[2][1]});
+    at(u.normal_z, {cof[0][2], cof[1][2], cof[2][2]});
+    gl.Uniform1i(u.has_normals, pb.has_normals ? 1 : 0);
+    gl.Uniform1i(u.has_triangle_materials, pb.has_triangle_materials ? 1 : 0);
+    gl.Uniform1i(u.has_subset, ob.all_triangles ? 0 : 1);
+    gl.Uniform1ui(u.object_material, lo.material);
     gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1,
                       pb.has_triangle_materials ? pb.triangle_materials : materials_);
     gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, ob.all_triangles ? materials_ : ob.triangles);

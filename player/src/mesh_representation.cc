@@ -103,11 +103,17 @@ Expected<std::unique_ptr<MeshRepresentation>> MeshRepresentation::open(
     CALF_RETURN_IF_ERROR(m.prototype(p, &proto));
     MeshDrawPrototype d;
     decoder::positions_at(proto, 0.0, &d.positions);
-    d.normals = proto.normals;
-    d.colours = proto.colours;
-    d.indices = proto.indices;
-    d.triangle_materials = proto.triangle_materials;
-    if (!proto.state_times.empty()) impl->dynamic.push_back(p);
+    // The decoded prototype is kept only when it has states (prepare() reads them); the draw
+    // list takes the rest, so a static scene is held once.
+    d.normals = std::move(proto.normals);
+    d.colours = std::move(proto.colours);
+    d.indices = std::move(proto.indices);
+    d.triangle_materials = std::move(proto.triangle_materials);
+    if (!proto.state_times.empty()) {
+      impl->dynamic.push_back(p);
+    } else {
+      proto = decoder::MeshPrototype{};
+    }
     list.prototypes.push_back(std::move(d));
   }
   impl->objects.resize(m.object_count());

@@ -87,8 +87,15 @@ class GlMeshRenderer {
     uint32_t prototype = 0, drawn = 0;
     bool all_triangles = true;
   };
+  // The per-object uniforms' locations, looked up once after linking.
+  struct ObjectUniforms {
+    GLint model_x = -1, model_y = -1, model_z = -1, model_t = -1;
+    GLint normal_x = -1, normal_y = -1, normal_z = -1;
+    GLint has_normals = -1, has_triangle_materials = -1, has_subset = -1, object_material = -1;
+  };
   const GlFunctions* gl_;
   GLuint program_ = 0, materials_ = 0;
+  ObjectUniforms uniforms_;
   std::vector<PrototypeBuffers> prototypes_;
   std::vector<ObjectBuffers> objects_;
   size_t material_count_ = 0;
