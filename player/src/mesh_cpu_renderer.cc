@@ -220,9 +220,9 @@ Status render_mesh_cpu(const MeshDrawList& list, const Camera& camera,
       s.face = cross(s.p[1] - s.p[0], s.p[2] - s.p[0]);
       if (!(length(s.face) > 0)) continue;  // degenerate: covers nothing
       s.side = dot(s.face, s.p[0]) > 0 ? -1 : 1;
-      s.material =
-          &list.materials[proto.triangle_materials.empty() ? object.material
-                                                           : proto.triangle_materials[tri]];
+      const uint32_t own =
+          proto.triangle_materials.empty() ? kMeshObjectMaterial : proto.triangle_materials[tri];
+      s.material = &list.materials[own == kMeshObjectMaterial ? object.material : own];
       std::array<ViewVertex, 4> poly;
       const int n = clip_near(view, options.near, &poly);
       if (n < 3) continue;

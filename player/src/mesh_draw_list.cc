@@ -53,7 +53,8 @@ Status check_prototype(const MeshDrawPrototype& p, size_t index, size_t material
                         " triangles");
     }
     for (size_t t = 0; t < p.triangle_materials.size(); ++t) {
-      if (p.triangle_materials[t] >= material_count) {
+      if (p.triangle_materials[t] >= material_count &&
+          p.triangle_materials[t] != kMeshObjectMaterial) {
         return list_error(name + ", triangle " + std::to_string(t) + ": material " +
                           std::to_string(p.triangle_materials[t]) + " >= material count " +
                           std::to_string(material_count));

@@ -65,6 +65,7 @@ void main() {
   vec3 face_normal = normalize(face) * side;
   uint triangle = has_subset ? subset[gl_PrimitiveIDIn] : uint(gl_PrimitiveIDIn);
   uint m = has_triangle_materials ? triangle_materials[triangle] : object_material;
+  if (m == 0xffffffffu) m = object_material;  // kMeshObjectMaterial
   for (int i = 0; i < 3; ++i) {
     gl_Position = gl_in[i].gl_Position;
     g_rel = v_rel[i];

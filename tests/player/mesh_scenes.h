@@ -89,7 +89,8 @@ inline std::array<float, 12> placement(double angle, double scale, double tx, do
 }
 
 // A scene exercising every feature: a ground plane, cubes (shared prototype, rotated, one with a
-// triangle subset, one with per-triangle materials), a coloured sphere with normals, an emitter.
+// triangle subset, one with per-triangle materials, some of them
+// the object's), a coloured sphere with normals, an emitter.
 inline MeshDrawList feature_scene() {
   MeshDrawList list;
   list.materials = {{{0.6f, 0.6f, 0.55f}, {0, 0, 0}},
@@ -100,7 +101,9 @@ inline MeshDrawList feature_scene() {
   list.prototypes.push_back(rectangle(-6, 6, -6, 6, 0));  // ground, turned to y = 0 below
   list.prototypes.push_back(cube());
   MeshDrawPrototype striped = cube();
-  for (uint32_t t = 0; t < 12; ++t) striped.triangle_materials.push_back(t % 2 ? 2 : 4);
+  for (uint32_t t = 0; t < 12; ++t) {
+    striped.triangle_materials.push_back(t % 3 == 2 ? kMeshObjectMaterial : (t % 2 ? 2 : 4));
+  }
   list.prototypes.push_back(striped);
   list.prototypes.push_back(sphere(10, 16));
 

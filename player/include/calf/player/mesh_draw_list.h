@@ -23,11 +23,12 @@
 //   colour = base * vertex_colour * (kMeshAmbient + (1 - kMeshAmbient) * max(0, n . L)) + emission
 // with L = kMeshKeyLight (a unit vector towards a fixed key light, world space), base and emission
 // the triangle's material (the object's, or the prototype's per-triangle material when it has
-// them), vertex_colour the prototype's colours interpolated perspective-correctly (1 when it has
-// none), and n the unit normal facing the eye's side of the triangle: the prototype's vertex
-// normals transformed by the transform's inverse transpose and interpolated perspective-correctly,
-// or the face normal normalize((p1 - p0) x (p2 - p0)) when the prototype has none; flipped when the
-// triangle's front (the side (p1 - p0) x (p2 - p0) points to) faces away from the eye.
+// them and it is not kMeshObjectMaterial), vertex_colour the prototype's colours interpolated
+// perspective-correctly (1 when it has none), and n the unit normal facing the eye's side of the
+// triangle: the prototype's vertex normals transformed by the transform's inverse transpose and
+// interpolated perspective-correctly, or the face normal normalize((p1 - p0) x (p2 - p0)) when the
+// prototype has none; flipped when the triangle's front (the side (p1 - p0) x (p2 - p0) points to)
+// faces away from the eye.
 #pragma once
 
 #include <array>
@@ -43,6 +44,10 @@ inline constexpr std::array<float, 3> kMeshKeyLight = {0.30304576f, 0.80812204f,
 // The ambient share of the shading (the rest is Lambert under the key light).
 inline constexpr float kMeshAmbient = 0.3f;
 
+// A per-triangle material of this value takes the object's material (as the mesh track's
+// mesh::kObjectMaterial: an analytic sphere's triangles in a mesh with per-triangle materials).
+inline constexpr uint32_t kMeshObjectMaterial = 0xffffffffu;
+
 // A surface: linear diffuse reflectance and emitted radiance.
 struct MeshDrawMaterial {
   std::array<float, 3> base_colour{0.7f, 0.7f, 0.7f};
@@ -57,7 +62,7 @@ struct MeshDrawPrototype {
   std::vector<float> colours;     // empty (white) or 3 per vertex, linear
   std::vector<uint32_t> indices;  // 3 per triangle, each < vertex count
   // Empty (every triangle takes its object's material) or 1 per triangle: an index into
-  // MeshDrawList::materials.
+  // MeshDrawList::materials, or kMeshObjectMaterial for the object's.
   std::vector<uint32_t> triangle_materials;
 
   size_t vertex_count() const { return positions.size() / 3; }
