@@ -1,6 +1,7 @@
 // calf-encode: a capture set in, a .calf with a lightfield track out (paper 002, Sec. 5;
-// format/SPEC.md §11.1). Errors are one line with a stable id and exit status 1 (no output file is
-// left behind, also when SIGINT / SIGTERM / SIGHUP end it); usage errors exit 2 (command_line.h).
+// format/SPEC.md §11.1); with --mode mesh a scene file in, a mesh track out (§11.4). Errors are one
+// line with a stable id and exit status 1 (no output file is left behind, also when SIGINT /
+// SIGTERM / SIGHUP end it); usage errors exit 2 (command_line.h).
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -13,6 +14,7 @@
 #include <CLI/CLI.hpp>
 
 #include "calf/encoder/lightfield_encode.h"
+#include "calf/encoder/mesh_encode.h"
 #include "command_line.h"
 
 namespace {
@@ -29,6 +31,51 @@ double peak_rss_mib() {
 
 }  // namespace
 
+// --mode mesh: the scene file at `input` (its folder or scene.json) into a full-scene mesh track.
+int encode_mesh(const std::string& input, const std::string& out, const std::string& super,
+                uint32_t threads) {
+  calf::encoder::MeshEncodeOptions o;
+  o.threads = threads;
+  o.supercompression = super == "lzma2"  ? calf::container::Compression::kLzma2
+                       : super == "none" ? calf::container::Compression::kNone
+                                         : calf::container::Compression::kZstd;
+  std::filesystem::path dir = input;
+  if (dir.filename() == calf::capture::kSceneManifestFileName) dir = dir.parent_path();
+  if (dir.empty()) dir = ".";
+  const auto start = std::chrono::steady_clock::now();
+  // (The lead's --visible-set flags go here: compute_visible_set on the scene's perimeter
+  // segments, then encode_mesh_track with the lists and options.segment_count.)
+  auto stats = calf::encoder::encode_mesh_file(dir, out, o);
+  if (!stats.ok()) return fail(stats.status());
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const uint64_t stored = stats->index.stored + stats->vertices_stream.stored +
+                          stats->triangles_stream.stored + stats->visibility.stored;
+  std::fprintf(stderr,
+               "calf-encode: wrote %s in %.2f s (mesh: %u objects, %u prototypes, %u materials, "
+               "%llu triangles of %llu, %llu vertices)\n",
+               out.c_str(), seconds, stats->objects, stats->prototypes, stats->materials,
+               static_cast<unsigned long long>(stats->triangles),
+               static_cast<unsigned long long>(stats->scene_triangles),
+               static_cast<unsigned long long>(stats->vertices));
+  auto line = [](const char* name, const calf::encoder::MeshStreamBytes& b) {
+    std::fprintf(stderr, "  %-10s raw %llu  stored %llu  (%.2fx)  %llu chunks\n", name,
+                 static_cast<unsigned long long>(b.raw), static_cast<unsigned long long>(b.stored),
+                 b.stored ? static_cast<double>(b.raw) / static_cast<double>(b.stored) : 0.0,
+                 static_cast<unsigned long long>(b.chunks));
+  };
+  line("index", stats->index);
+  line("vertices", stats->vertices_stream);
+  line("triangles", stats->triangles_stream);
+  line("visibility", stats->visibility);
+  std::fprintf(
+      stderr, "  plain f32/u32 arrays %llu bytes, stored %llu (%.2fx)\n",
+      static_cast<unsigned long long>(stats->plain_bytes), static_cast<unsigned long long>(stored),
+      stored ? static_cast<double>(stats->plain_bytes) / static_cast<double>(stored) : 0.0);
+  std::fprintf(stderr, "calf-encode: peak RSS %.1f MiB\n", peak_rss_mib());
+  return 0;
+}
+
 int main(int argc, char** argv) {
   CLI::App app{
       "calf-encode: encode a capture set (format/CAPTURE.md) into a .calf lightfield track "
@@ -37,14 +84,25 @@ int main(int argc, char** argv) {
       "The output is written whole or not at all (a temporary file beside it, renamed into "
       "place; removed on an error or on SIGINT / SIGTERM / SIGHUP). It may not exist yet or be a "
       "regular file; a directory, FIFO, device node or symbolic link there is refused "
-      "(CALF-E004), and so is an output that is one of the inputs (CALF-E007).\n" +
+      "(CALF-E004), and so is an output that is one of the inputs (CALF-E007).\n"
+      "--mode mesh: INPUT is a scene file (format/SCENE.md: its folder or scene.json) and the "
+      "output holds a mesh track of the whole scene (format/SPEC.md 11.4: materials, prototypes "
+      "with spheres tessellated, objects with their transforms); only --supercompression, "
+      "--threads and --quiet apply, the lightfield options are ignored.\n" +
       std::string(calf::tools::kExitStatusHelp)};
   calf::LightfieldEncodeOptions o;
   std::string manifest, out;
-  std::string colour = "auto", depth = "raw16", super = "zstd";
+  std::string colour = "auto", depth = "raw16", super = "zstd", mode = "lightfield";
   bool quiet = false;
-  app.add_option("MANIFEST", manifest, "capture set: its manifest.json or the directory holding it")
+  app.add_option("MANIFEST", manifest,
+                 "lightfield: the capture set (its manifest.json or the directory holding it); "
+                 "mesh: the scene file (its scene.json or folder)")
       ->required();
+  app.add_option("--mode", mode,
+                 "lightfield (a capture set into a lightfield track) or mesh (a scene file into "
+                 "a mesh track) (default lightfield)")
+      ->check(CLI::IsMember({"lightfield", "mesh"}))
+      ->default_val("lightfield");
   app.add_option("-o,--output", out, "output .calf (written whole or not at all)")->required();
   app.add_option("--threads", o.threads,
                  "worker threads 0..256, 0 = all cores; output is identical for any count "
@@ -84,6 +142,7 @@ int main(int argc, char** argv) {
       ->default_val("zstd");
   app.add_flag("-q,--quiet", quiet, "no progress line");
   if (int rc = calf::tools::parse_command_line(app, "calf-encode", argc, argv); rc >= 0) return rc;
+  if (mode == "mesh") return encode_mesh(manifest, out, super, o.threads);
 
   const std::map<std::string, calf::ColourCoding> colours = {
       {"auto", calf::ColourCoding::kAuto},   {"bc1", calf::ColourCoding::kBc1},

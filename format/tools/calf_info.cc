@@ -1,11 +1,14 @@
 // calf-info: an ffprobe-like summary of a .calf clip: version, tracks (kind, frames, fps, views,
-// face size, formats), metadata, and bytes per stream with the ratio to raw. --json prints the
+// face size, formats; a mesh track's objects, prototypes and triangles), metadata, and bytes per
+// stream with the ratio to raw. --json prints the
 // same as one JSON object; --chunks adds the chunk index. Reads only the header and directory.
 #include <fmt/core.h>
 #include <CLI/CLI.hpp>
 
 #include <map>
+#include <optional>
 #include <string>
+#include <variant>
 
 #include "calf/format/container.h"
 #include "calf/format/version.h"
@@ -82,6 +85,27 @@ std::map<uint16_t, StreamStats> stream_stats(const Reader& r, uint16_t track) {
   return out;
 }
 
+// A mesh track's figures from its header and directory alone (SPEC §11.4: one vertices chunk per
+// prototype, one visibility chunk per object), or nothing for another kind.
+struct MeshFigures {
+  uint64_t objects = 0, prototypes = 0, triangles = 0, vertices = 0;
+};
+std::optional<MeshFigures> mesh_figures(const Reader& r, const Track& t) {
+  const auto* h = std::get_if<MeshTrackHeader>(&t.header);
+  if (!h) return std::nullopt;
+  MeshFigures f;
+  const auto streams = stream_stats(r, t.id);
+  auto count = [&](MeshStream s) {
+    const auto it = streams.find(static_cast<uint16_t>(s));
+    return it == streams.end() ? uint64_t{0} : it->second.chunks;
+  };
+  f.objects = count(MeshStream::kVisibility);
+  f.prototypes = count(MeshStream::kVertices);
+  f.triangles = h->triangle_count;
+  f.vertices = h->vertex_count;
+  return f;
+}
+
 void print_text(const std::string& path, const Reader& r, bool list_chunks) {
   const auto& h = r.header();
   StreamStats total;
@@ -108,6 +132,10 @@ void print_text(const std::string& path, const Reader& r, bool list_chunks) {
       fmt::print("  {} frames at {:.3f} fps ({}/{}), {:.3f} s\n", frames,
                  static_cast<double>(num) / den, num, den, static_cast<double>(frames) * den / num);
     for (const auto& e : fields) fmt::print("  {}: {}\n", e.name, printable(field_text(e)));
+    if (const auto m = mesh_figures(r, t)) {
+      fmt::print("  mesh: {} objects, {} prototypes, {} triangles drawn, {} vertices stored\n",
+                 m->objects, m->prototypes, m->triangles, m->vertices);
+    }
     fmt::print("  {:<12} {:>8} {:>14} {:>14} {:>8}\n", "stream", "chunks", "stored bytes",
                "raw bytes", "ratio");
     for (const auto& [tag, s] : stream_stats(r, t.id)) {
@@ -156,7 +184,13 @@ void print_json(const std::string& path, const Reader& r, bool list_chunks) {
     for (size_t i = 0; i < fields.size(); ++i)
       o += fmt::format("{}{}:{}", i ? "," : "", json_string(fields[i].name),
                        fields[i].numeric ? fields[i].value : json_string(fields[i].value));
-    o += "},\"streams\":[";
+    o += "}";
+    if (const auto m = mesh_figures(r, t)) {
+      o += fmt::format(
+          ",\"mesh\":{{\"objects\":{},\"prototypes\":{},\"triangles\":{},\"vertices\":{}}}",
+          m->objects, m->prototypes, m->triangles, m->vertices);
+    }
+    o += ",\"streams\":[";
     bool first = true;
     for (const auto& [tag, s] : stream_stats(r, t.id)) {
       o += fmt::format(

@@ -72,6 +72,10 @@ class MeshTrack {
   uint32_t object_count() const;
   uint32_t prototype_count() const;
   const std::vector<MeshMaterial>& materials() const { return materials_; }
+  // The index chunk as read (format/mesh_layout.h): the prototype and object records with their
+  // counts and flags, e.g. for figures without decoding (calf-verify, tests).
+  const mesh::IndexChunk& index() const;
+  uint16_t track() const { return track_; }
 
   // Decodes object `index` (its transforms and triangle subset); errors name the chunk.
   Status object(uint32_t index, MeshObject* out) const;

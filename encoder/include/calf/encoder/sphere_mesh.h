@@ -18,7 +18,8 @@ inline constexpr uint32_t kSphereVertices = 10u * (1u << (2 * kSphereSubdivision
 
 // Appends one sphere's vertices (3 floats each: positions and unit normals) and triangles
 // (counter-clockwise seen from outside, indices offset by the vertices already in `positions`)
-// to the arrays. Deterministic: the same sphere gives the same floats on every machine.
+// to the arrays (`normals` may be null: no normals). Deterministic: the same sphere gives the
+// same floats on every machine.
 void append_sphere_mesh(const float centre[3], float radius, std::vector<float>* positions,
                         std::vector<float>* normals, std::vector<uint32_t>* indices);
 

@@ -121,6 +121,11 @@ enum class ErrorKind : uint8_t {
   X(kEncoderInput, 201, kCorrupt, "the capture set contradicts itself or the chosen options")  \
   X(kLightfieldChunk, 202, kCorrupt, "a lightfield chunk is missing or contradicts its layout") \
   X(kLightfieldFormat, 203, kUnsupported, "a lightfield track uses a format the decoder lacks") \
+  X(kMeshChunk, 220, kCorrupt, "a mesh chunk is missing, repeated or contradicts its layout")  \
+  X(kMeshUnsupported, 221, kUnsupported, "a mesh track's layout version or flag is unknown")    \
+  X(kMeshIndex, 222, kCorrupt, "a mesh vertex, triangle, prototype or material index is invalid") \
+  X(kMeshValue, 223, kCorrupt, "a mesh value is NaN, infinite or outside its range")            \
+  X(kMeshLimit, 224, kLimit, "a mesh track count or chunk size exceeds its limit")              \
   /* decoder: 300-399 */                                                                        \
   X(kDecoderArgument, 300, kInvalidArgument, "a decoder option, frame, view or eye is invalid") \
   /* player: 400-499 */                                                                         \

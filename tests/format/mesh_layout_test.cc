@@ -1,0 +1,184 @@
+// The mesh track's chunk layouts (format/mesh_layout.h, SPEC §11.4) on their own: every array
+// round-trips bit for bit (odd floats included), the bytes are the documented planes, and each
+// broken rule gives its id.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <limits>
+
+#include "calf/format/mesh_layout.h"
+
+namespace calf::mesh {
+namespace {
+
+std::vector<uint32_t> bits_of(const std::vector<float>& a) {
+  std::vector<uint32_t> out;
+  for (float f : a) out.push_back(std::bit_cast<uint32_t>(f));
+  return out;
+}
+
+IndexChunk small_index() {
+  IndexChunk x;
+  x.view_min[0] = -1;
+  x.view_max[0] = 2;
+  x.materials.resize(2);
+  x.materials[1].emission[2] = 5;
+  x.prototypes.push_back({3, 1, kHasNormals | kHasColours | kHasTriangleMaterials, 2});
+  x.prototypes.push_back({4, 2, 0, 0});
+  x.objects.push_back({7, 0, 1, 1, kAllTriangles, 1});
+  x.objects.push_back({9, 1, 0, 3, 0, 1});
+  return x;
+}
+
+TEST(MeshLayout, IndexRoundTripAndSize) {
+  const IndexChunk x = small_index();
+  auto bytes = serialize_index(x, 3);
+  ASSERT_TRUE(bytes.ok()) << bytes.status().to_string();
+  // 8 + 48 + (4 + 2 x 24) + (4 + 2 x 16) + (4 + 2 x 24), by hand.
+  EXPECT_EQ(bytes->size(), 8u + 48 + 52 + 36 + 52);
+  auto back = parse_index(*bytes, 3, "index");
+  ASSERT_TRUE(back.ok()) << back.status().to_string();
+  EXPECT_EQ(back->objects[1].source_object, 9u);
+  EXPECT_EQ(back->prototypes[0].state_count, 2u);
+  EXPECT_EQ(back->materials[1].emission[2], 5.0f);
+  EXPECT_EQ(back->view_max[0], 2.0);
+  // transform_count 3 is only valid for a 3-frame track.
+  EXPECT_EQ(parse_index(*bytes, 4, "index").status().id(), ErrorId::kMeshIndex);
+  EXPECT_EQ(serialize_index(x, 4).status().id(), ErrorId::kContainerWriterMisuse);
+}
+
+TEST(MeshLayout, IndexVersionIsCheckedFirst) {
+  auto bytes = serialize_index(small_index(), 3);
+  ASSERT_TRUE(bytes.ok());
+  std::vector<uint8_t> v2 = *bytes;
+  v2[0] = 2;
+  v2.resize(6);  // a later layout may be anything after its version
+  EXPECT_EQ(parse_index(v2, 3, "index").status().id(), ErrorId::kMeshUnsupported);
+  EXPECT_EQ(parse_index(std::span<const uint8_t>(bytes->data(), 3), 3, "index").status().id(),
+            ErrorId::kMeshChunk);
+  std::vector<uint8_t> cut(bytes->begin(), bytes->end() - 1);
+  EXPECT_EQ(parse_index(cut, 3, "index").status().id(), ErrorId::kMeshChunk);
+}
+
+TEST(MeshLayout, VerticesRoundTripBitForBitAsDocumentedPlanes) {
+  const PrototypeRecord p{3, 1, kHasNormals | kHasColours, 2};
+  VertexArrays a;
+  const float denormal = std::numeric_limits<float>::denorm_min();
+  a.positions = {-0.0f, 1e12f, -1e12f, denormal, 3.5f, -2, 1, 1, 1};
+  a.normals = {0, 1, 0, 0, 0, -1, 1e-30f, 0, 0};
+  a.colours = {0, 0.5f, 1, 1, 1, 1, 0.25f, 0, 0};
+  a.state_times = {0, 0.5f};
+  a.state_positions = {-0.0f, 1e12f, -1e12f, denormal, 3.5f, -2, 1, 1, 1,
+                       0,     1,     2,      3,        4,    5,  6, 7, 8};
+  auto bytes = encode_vertices(p, a);
+  ASSERT_TRUE(bytes.ok()) << bytes.status().to_string();
+  ASSERT_EQ(bytes->size(), vertices_chunk_size(p));
+  EXPECT_EQ(bytes->size(), 4u * (3 * 3 * 3 + 2 + 2 * 9));
+  // Byte planes of component-planar deltas: word 0 is x of vertex 0 (-0.0f = 0x80000000), word 1
+  // x of vertex 1 minus x of vertex 0; 9 words, so plane 3 starts at byte 27.
+  EXPECT_EQ((*bytes)[0], 0x00);
+  EXPECT_EQ((*bytes)[27], 0x80);
+  EXPECT_EQ((*bytes)[1], 0x01);  // denorm_min (0x00000001) - 0x80000000 = 0x80000001
+  EXPECT_EQ((*bytes)[28], 0x80);
+  VertexArrays back;
+  ASSERT_TRUE(decode_vertices(*bytes, p, &back, "v").ok());
+  EXPECT_EQ(bits_of(back.positions), bits_of(a.positions));
+  EXPECT_EQ(bits_of(back.normals), bits_of(a.normals));
+  EXPECT_EQ(bits_of(back.colours), bits_of(a.colours));
+  EXPECT_EQ(bits_of(back.state_times), bits_of(a.state_times));
+  EXPECT_EQ(bits_of(back.state_positions), bits_of(a.state_positions));
+  // State 0 equal to the rest pose codes as zero words.
+  for (size_t i = 4 * (27 + 2); i < 4 * (27 + 2 + 9); ++i) EXPECT_EQ((*bytes)[i], 0) << i;
+}
+
+TEST(MeshLayout, VertexValuesAreChecked) {
+  const PrototypeRecord p{1, 0, kHasNormals, 2};
+  VertexArrays a;
+  a.positions = {0, 0, 0};
+  a.normals = {0, 0, 1};
+  a.state_times = {0, 1};
+  a.state_positions = {0, 0, 0, 0, 0, 0};
+  ASSERT_TRUE(encode_vertices(p, a).ok());
+  VertexArrays bad = a;
+  bad.positions[1] = 2e12f;
+  EXPECT_EQ(encode_vertices(p, bad).status().id(), ErrorId::kContainerWriterMisuse);
+  bad = a;
+  bad.normals = {0, 0, 0};
+  auto zero = encode_vertices(p, bad);
+  EXPECT_EQ(zero.status().id(), ErrorId::kContainerWriterMisuse);
+  bad = a;
+  bad.state_times = {1, 1};
+  EXPECT_EQ(encode_vertices(p, bad).status().id(), ErrorId::kContainerWriterMisuse);
+  bad = a;
+  bad.state_times = {0};
+  EXPECT_EQ(encode_vertices(p, bad).status().id(), ErrorId::kContainerWriterMisuse);
+  // A decoded NaN is E223, a short chunk E220.
+  auto bytes = encode_vertices(p, a);
+  std::vector<uint8_t> nan = *bytes;
+  nan[2 * 3] = 0xc0;  // word 0 (x of vertex 0), plane 2 at 2 x 3 words
+  nan[3 * 3] = 0x7f;
+  VertexArrays out;
+  EXPECT_EQ(decode_vertices(nan, p, &out, "v").id(), ErrorId::kMeshValue);
+  std::vector<uint8_t> cut(bytes->begin(), bytes->end() - 1);
+  EXPECT_EQ(decode_vertices(cut, p, &out, "v").id(), ErrorId::kMeshChunk);
+}
+
+TEST(MeshLayout, TrianglesRoundTripAndIndicesAreChecked) {
+  const PrototypeRecord p{5, 3, kHasTriangleMaterials, 0};
+  TriangleArrays a;
+  a.indices = {0, 1, 2, 4, 3, 2, 0, 4, 1};
+  a.triangle_materials = {1, kObjectMaterial, 0};
+  auto bytes = encode_triangles(p, a);
+  ASSERT_TRUE(bytes.ok());
+  ASSERT_EQ(bytes->size(), triangles_chunk_size(p));
+  EXPECT_EQ(bytes->size(), 4u * (9 + 3));
+  TriangleArrays back;
+  ASSERT_TRUE(decode_triangles(*bytes, p, 2, &back, "t").ok());
+  EXPECT_EQ(back.indices, a.indices);
+  EXPECT_EQ(back.triangle_materials, a.triangle_materials);
+  EXPECT_EQ(decode_triangles(*bytes, p, 1, &back, "t").id(), ErrorId::kMeshIndex);
+  PrototypeRecord fewer = p;
+  fewer.vertex_count = 4;
+  EXPECT_EQ(decode_triangles(*bytes, fewer, 2, &back, "t").id(), ErrorId::kMeshIndex);
+}
+
+TEST(MeshLayout, VisibilityRunsRoundTrip) {
+  const PrototypeRecord p{3, 100, 0, 0};
+  ObjectRecord o{0, 0, 0, 2, 0, 0};
+  Visibility v;
+  v.transforms = {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0},
+                  {1, 0, 0, 0.5f, 0, 1, 0, 0, 0, 0, 1, -0.0f}};
+  v.triangles = {0, 1, 2, 7, 9, 10, 99};
+  o.triangle_count = static_cast<uint32_t>(v.triangles.size());
+  auto bytes = encode_visibility(o, p, v);
+  ASSERT_TRUE(bytes.ok()) << bytes.status().to_string();
+  // Runs [0, 3), [7, 8), [9, 11), [99, 100): 4 runs, 96 + 4 + 32 bytes.
+  ASSERT_EQ(bytes->size(), 96u + 4 + 4 * 8);
+  EXPECT_EQ((*bytes)[96], 4);
+  Visibility back;
+  ASSERT_TRUE(decode_visibility(*bytes, o, p, &back, "vis").ok());
+  EXPECT_EQ(back.triangles, v.triangles);
+  ASSERT_EQ(back.transforms.size(), 2u);
+  EXPECT_EQ(std::bit_cast<uint32_t>(back.transforms[1][11]), 0x80000000u);
+  EXPECT_EQ(back.transforms[1][3], 0.5f);
+  // Unsorted subsets are refused by the writer; a wrong object count by the reader.
+  Visibility unsorted = v;
+  std::swap(unsorted.triangles[0], unsorted.triangles[1]);
+  EXPECT_EQ(encode_visibility(o, p, unsorted).status().id(), ErrorId::kContainerWriterMisuse);
+  ObjectRecord more = o;
+  more.triangle_count += 1;
+  EXPECT_EQ(decode_visibility(*bytes, more, p, &back, "vis").id(), ErrorId::kMeshIndex);
+  // All triangles: transforms only.
+  ObjectRecord all{0, 0, 0, 1, kAllTriangles, 100};
+  Visibility t1;
+  t1.transforms = {v.transforms[0]};
+  auto b1 = encode_visibility(all, p, t1);
+  ASSERT_TRUE(b1.ok());
+  EXPECT_EQ(b1->size(), 48u);
+  b1->push_back(0);
+  EXPECT_EQ(decode_visibility(*b1, all, p, &back, "vis").id(), ErrorId::kMeshChunk);
+}
+
+}  // namespace
+}  // namespace calf::mesh

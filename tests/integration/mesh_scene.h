@@ -1,0 +1,83 @@
+// A small scene file made by code for the mesh track's tests, conformance clip and fuzz seeds:
+// a quad with normals, colours and per-triangle materials placed twice (one static instance, one
+// moving per frame), a strip with piecewise-linear vertex states, and a mesh of two analytic
+// spheres (one with its own triangle). Deterministic: the same floats on every machine.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "calf/capture/scene_file.h"
+
+namespace calf::test {
+
+inline capture::SceneFile make_mesh_test_scene(uint32_t frame_count = 3) {
+  capture::SceneFile s;
+  s.name = "mesh-test";
+  s.fps = 24;
+  s.frame_count = frame_count;
+  s.view_region_min = {-1, 1.5, -1};
+  s.view_region_max = {1, 1.7, 1};
+  s.materials.push_back({"grey", {0.5f, 0.5f, 0.5f}, capture::kNoTexture, {0, 0, 0}, 0, 0, 1.5f});
+  s.materials.push_back({"lamp", {1, 0.75f, 0.25f}, capture::kNoTexture, {4, 3, 2}, 0, 0, 1.5f});
+  s.materials.push_back(
+      {"blue", {0.1f, 0.2f, 0.9f}, capture::kNoTexture, {0, 0, 0}, 0.5f, 0, 1.5f});
+
+  capture::SceneMesh quad;
+  quad.name = "quad";
+  quad.positions = {-1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1};
+  quad.normals = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
+  quad.colors = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0.5f, 0.25f, 0.125f};
+  quad.indices = {0, 2, 1, 0, 3, 2};
+  quad.triangle_materials = {0, 2};
+  s.meshes.push_back(quad);
+
+  capture::SceneMesh strip;  // a 6-triangle strip that sways: 3 states
+  strip.name = "strip";
+  for (int i = 0; i < 4; ++i) {
+    const float x = static_cast<float>(i) * 0.3f - 0.45f;
+    strip.positions.insert(strip.positions.end(), {x, 0.0f, 3.0f, x, 1.0f, 3.0f});
+  }
+  for (uint32_t i = 0; i < 3; ++i) {
+    const uint32_t a = 2 * i, b = a + 1, c = a + 2, d = a + 3;
+    strip.indices.insert(strip.indices.end(), {a, c, b, b, c, d});
+  }
+  strip.state_times = {0.0f, 0.05f, 0.1f};
+  for (int k = 0; k < 3; ++k) {
+    for (size_t v = 0; v < strip.positions.size(); v += 3) {
+      const bool top = strip.positions[v + 1] > 0.5f;
+      strip.state_positions.push_back(strip.positions[v] +
+                                      (top ? 0.1f * static_cast<float>(k) : 0));
+      strip.state_positions.push_back(strip.positions[v + 1]);
+      strip.state_positions.push_back(strip.positions[v + 2]);
+    }
+  }
+  s.meshes.push_back(strip);
+
+  capture::SceneMesh balls;  // one triangle of its own, then two spheres
+  balls.name = "balls";
+  balls.positions = {0, 0, -4, 0.5f, 0, -4, 0, 0.5f, -4};
+  balls.indices = {0, 1, 2};
+  balls.spheres = {{{0, 1, -5}, 0.5f}, {{1.5f, 0.75f, -5}, 0.25f}};
+  s.meshes.push_back(balls);
+
+  capture::SceneMesh ball;  // a sphere alone: stored with its normals
+  ball.name = "ball";
+  ball.spheres = {{{0, 0, 0}, 1}};
+  s.meshes.push_back(ball);
+
+  capture::SceneObject floor{"floor", 0, 0, {}};  // identity
+  capture::SceneObject tile{"tile", 0, 1, {{1, 0, 0, 2, 0, 1, 0, 0, 0, 0, 1, 0}}};
+  capture::SceneObject mover{"mover", 0, 2, {}};
+  for (uint32_t f = 0; f < frame_count; ++f) {
+    mover.transforms.push_back(
+        {1, 0, 0, 0.25f * static_cast<float>(f), 0, 1, 0, 0.5f, 0, 0, 1, -2});
+  }
+  capture::SceneObject grass{"grass", 1, 0, {}};
+  capture::SceneObject toys{"toys", 2, 2, {}};
+  capture::SceneObject sun{"sun", 3, 1, {{2, 0, 0, 5, 0, 2, 0, 9, 0, 0, 2, 5}}};
+  s.objects = {floor, tile, mover, grass, toys, sun};
+  return s;
+}
+
+}  // namespace calf::test

@@ -1,0 +1,505 @@
+// The mesh track end to end (format/SPEC.md §11.4): a scene made by code (mesh_scene.h) encoded
+// by encode_mesh_track, decoded by MeshTrack, compared with the scene itself (positions bitwise,
+// subsets exactly); determinism; damaged chunks give the track's ids, never a crash; and the
+// frozen conformance clips of tests/conformance/mesh/ still decode to the scene and their hashes.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "calf/decoder/mesh_track.h"
+#include "calf/decoder/mesh_verify.h"
+#include "calf/encoder/mesh_encode.h"
+#include "calf/encoder/sphere_mesh.h"
+#include "calf/format/container.h"
+#include "mesh_scene.h"
+
+namespace calf {
+namespace {
+
+using container::Compression;
+using container::MeshStream;
+using decoder::MeshObject;
+using decoder::MeshPrototype;
+using decoder::MeshTrack;
+using encoder::kSphereTriangles;
+using encoder::kSphereVertices;
+
+std::vector<uint8_t> encode(const capture::SceneFile& scene,
+                            const std::vector<std::vector<uint32_t>>* visible,
+                            encoder::MeshEncodeOptions options = {},
+                            encoder::MeshEncodeStats* stats = nullptr) {
+  std::vector<uint8_t> file;
+  auto w = container::Writer::create(container::memory_sink(&file));
+  EXPECT_TRUE(w.ok());
+  const Status st = encoder::encode_mesh_track(scene, visible, options, &*w, stats);
+  EXPECT_TRUE(st.ok()) << st.to_string();
+  EXPECT_TRUE(w->finish().ok());
+  return file;
+}
+
+container::Reader open_reader(const std::vector<uint8_t>& file) {
+  auto r = container::Reader::open(container::memory_source(std::span<const uint8_t>(file)));
+  EXPECT_TRUE(r.ok()) << r.status().to_string();
+  return std::move(*r);
+}
+
+template <class T>
+bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (std::bit_cast<uint32_t>(a[i]) != std::bit_cast<uint32_t>(b[i])) return false;
+  }
+  return true;
+}
+
+// What the track must hold for a scene mesh, built here from the scene and the sphere contract
+// (not from the encoder's prototype_arrays).
+MeshPrototype expected_prototype(const capture::SceneMesh& m) {
+  MeshPrototype p;
+  p.positions = m.positions;
+  p.normals = m.normals;
+  p.colours = m.colors;
+  p.indices = m.indices;
+  p.triangle_materials = m.triangle_materials;
+  p.state_times = m.state_times;
+  const bool normals = !m.normals.empty() || m.indices.empty();
+  std::vector<float> sphere_pos, sphere_nrm, ignored;
+  for (const auto& s : m.spheres) {
+    std::vector<uint32_t> idx;
+    const size_t before = sphere_pos.size() / 3;
+    encoder::append_sphere_mesh(s.center.data(), s.radius, &sphere_pos, &sphere_nrm, &idx);
+    for (uint32_t i : idx) p.indices.push_back(i + static_cast<uint32_t>(m.vertex_count()));
+    EXPECT_EQ(idx.front(), before);
+  }
+  p.positions.insert(p.positions.end(), sphere_pos.begin(), sphere_pos.end());
+  if (normals) p.normals.insert(p.normals.end(), sphere_nrm.begin(), sphere_nrm.end());
+  if (!m.spheres.empty() && !m.triangle_materials.empty())
+    p.triangle_materials.resize(p.indices.size() / 3, mesh::kObjectMaterial);
+  for (size_t k = 0; k < m.state_times.size(); ++k) {
+    const size_t n = m.positions.size();
+    p.state_positions.insert(p.state_positions.end(), m.state_positions.begin() + k * n,
+                             m.state_positions.begin() + (k + 1) * n);
+    p.state_positions.insert(p.state_positions.end(), sphere_pos.begin(), sphere_pos.end());
+  }
+  return p;
+}
+
+void expect_prototype(const MeshPrototype& got, const MeshPrototype& want, size_t index) {
+  SCOPED_TRACE("prototype " + std::to_string(index));
+  EXPECT_TRUE(same_bits(got.positions, want.positions));
+  EXPECT_TRUE(same_bits(got.normals, want.normals));
+  EXPECT_TRUE(same_bits(got.colours, want.colours));
+  EXPECT_EQ(got.indices, want.indices);
+  EXPECT_EQ(got.triangle_materials, want.triangle_materials);
+  EXPECT_TRUE(same_bits(got.state_times, want.state_times));
+  EXPECT_TRUE(same_bits(got.state_positions, want.state_positions));
+}
+
+TEST(SphereMesh, IcosphereCountsAndUnitNormals) {
+  std::vector<float> pos, nrm;
+  std::vector<uint32_t> idx = {7};  // appended after what is there
+  const float c[3] = {1, 2, 3};
+  pos.assign(6, 0.0f);  // two vertices already present
+  encoder::append_sphere_mesh(c, 2.0f, &pos, &nrm, &idx);
+  ASSERT_EQ(pos.size(), 6 + 3 * size_t{kSphereVertices});
+  ASSERT_EQ(nrm.size(), 3 * size_t{kSphereVertices});
+  ASSERT_EQ(idx.size(), 1 + 3 * size_t{kSphereTriangles});
+  EXPECT_EQ(kSphereVertices, 642u);
+  EXPECT_EQ(kSphereTriangles, 1280u);
+  for (size_t i = 1; i < idx.size(); ++i) {
+    EXPECT_GE(idx[i], 2u);
+    EXPECT_LT(idx[i], 2u + kSphereVertices);
+  }
+  for (size_t v = 0; v < kSphereVertices; ++v) {
+    const float* n = &nrm[3 * v];
+    EXPECT_NEAR(n[0] * n[0] + n[1] * n[1] + n[2] * n[2], 1.0, 1e-6);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(pos[6 + 3 * v + k], c[k] + 2.0f * n[k], 1e-5);
+  }
+  // Counter-clockwise from outside: every face normal points away from the centre.
+  for (size_t t = 1; t < idx.size(); t += 3) {
+    const float* a = &pos[3 * idx[t]];
+    const float* b = &pos[3 * idx[t + 1]];
+    const float* d = &pos[3 * idx[t + 2]];
+    const double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double e2[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+    const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                         e1[0] * e2[1] - e1[1] * e2[0]};
+    const double out = n[0] * (a[0] - c[0]) + n[1] * (a[1] - c[1]) + n[2] * (a[2] - c[2]);
+    EXPECT_GT(out, 0) << "triangle " << t / 3;
+  }
+}
+
+TEST(MeshTrack, FullSceneRoundTrip) {
+  const capture::SceneFile scene = test::make_mesh_test_scene(3);
+  encoder::MeshEncodeStats stats;
+  const auto file = encode(scene, nullptr, {}, &stats);
+  const auto reader = open_reader(file);
+  auto track = MeshTrack::open(reader, 0);
+  ASSERT_TRUE(track.ok()) << track.status().to_string();
+  // Counts worked out by hand: quad 4 + strip 8 + balls 3 + 2 x 642 + ball 642 vertices; floor,
+  // tile, mover 2 triangles each, grass 6, toys 1 + 2 x 1280, sun 1280.
+  EXPECT_EQ(track->header().vertex_count, 1941u);
+  EXPECT_EQ(track->header().triangle_count, 3853u);
+  EXPECT_EQ(stats.triangles, 3853u);
+  EXPECT_EQ(stats.scene_triangles, 3853u);
+  EXPECT_EQ(track->header().flags, 0);
+  EXPECT_EQ(track->frame_count(), 3u);
+  EXPECT_DOUBLE_EQ(track->fps(), 24.0);
+  EXPECT_EQ(track->view_volume().min, (Vec3{-1, 1.5, -1}));
+  EXPECT_EQ(track->view_volume().max, (Vec3{1, 1.7, 1}));
+  ASSERT_EQ(track->materials().size(), 3u);
+  EXPECT_EQ(track->materials()[1].base_colour, (std::array<float, 3>{1, 0.75f, 0.25f}));
+  EXPECT_EQ(track->materials()[1].emission, (std::array<float, 3>{4, 3, 2}));
+  ASSERT_EQ(track->prototype_count(), 4u);
+  ASSERT_EQ(track->object_count(), 6u);
+  for (uint32_t p = 0; p < 4; ++p) {
+    MeshPrototype got;
+    ASSERT_TRUE(track->prototype(p, &got).ok());
+    expect_prototype(got, expected_prototype(scene.meshes[p]), p);
+  }
+  // The mixed mesh (own triangle without normals + spheres) has no normals; the sphere alone has.
+  MeshPrototype balls, ball;
+  ASSERT_TRUE(track->prototype(2, &balls).ok());
+  ASSERT_TRUE(track->prototype(3, &ball).ok());
+  EXPECT_TRUE(balls.normals.empty());
+  EXPECT_EQ(ball.normals.size(), 3 * size_t{kSphereVertices});
+  for (uint32_t o = 0; o < 6; ++o) {
+    MeshObject got;
+    ASSERT_TRUE(track->object(o, &got).ok());
+    const auto& so = scene.objects[o];
+    EXPECT_EQ(got.prototype, so.mesh);
+    EXPECT_EQ(got.material, so.material);
+    EXPECT_TRUE(got.all_triangles);
+    EXPECT_TRUE(got.triangles.empty());
+    for (uint32_t f = 0; f < 4; ++f)
+      EXPECT_EQ(decoder::transform_at(got, f), capture::transform_at(so, f)) << o << " " << f;
+    EXPECT_EQ(got.transforms.size(), o == 2 ? 3u : 1u) << "static objects keep one transform";
+  }
+  // States: the decoder's positions_at gives the scene reader's floats.
+  MeshPrototype strip;
+  ASSERT_TRUE(track->prototype(1, &strip).ok());
+  for (double t : {-1.0, 0.0, 0.01, 0.05, 0.075, 0.1, 5.0}) {
+    std::vector<float> got, want;
+    decoder::positions_at(strip, t, &got);
+    capture::positions_at(scene.meshes[1], t, &want);
+    EXPECT_TRUE(same_bits(got, want)) << "time " << t;
+  }
+  // Out-of-range requests are errors.
+  MeshObject o;
+  MeshPrototype p;
+  EXPECT_EQ(track->object(6, &o).id(), ErrorId::kInvalidArgument);
+  EXPECT_EQ(track->prototype(4, &p).id(), ErrorId::kInvalidArgument);
+  EXPECT_EQ(MeshTrack::open(reader, 1).status().id(), ErrorId::kInvalidArgument);
+}
+
+// A visible set: per scene object a sorted list of mesh triangles.
+std::vector<std::vector<uint32_t>> test_subset() {
+  std::vector<uint32_t> toys = {0};
+  for (uint32_t t = 1; t <= kSphereTriangles; ++t) toys.push_back(t);  // the first sphere whole
+  toys.push_back(2000);
+  return {{1}, {}, {0, 1}, {0, 2, 3, 5}, toys, {5, 6, 7, 900}};
+}
+
+TEST(MeshTrack, SubsetRoundTrip) {
+  const capture::SceneFile scene = test::make_mesh_test_scene(3);
+  const auto visible = test_subset();
+  encoder::MeshEncodeOptions options;
+  options.segment_count = 8;
+  const auto file = encode(scene, &visible, options);
+  const auto reader = open_reader(file);
+  auto track = MeshTrack::open(reader, 0);
+  ASSERT_TRUE(track.ok()) << track.status().to_string();
+  EXPECT_EQ(track->header().flags, mesh::kHeaderVisibleSet);
+  EXPECT_EQ(track->header().segment_count, 8u);
+  EXPECT_EQ(track->header().triangle_count, 1u + 2 + 4 + 1282 + 4);
+  // The tile (object 1) draws nothing and is left out; every mesh is still used.
+  ASSERT_EQ(track->object_count(), 5u);
+  ASSERT_EQ(track->prototype_count(), 4u);
+  const uint32_t sources[5] = {0, 2, 3, 4, 5};
+  for (uint32_t o = 0; o < 5; ++o) {
+    MeshObject got;
+    ASSERT_TRUE(track->object(o, &got).ok());
+    const uint32_t s = sources[o];
+    EXPECT_EQ(track->index().objects[o].source_object, s);
+    EXPECT_EQ(got.prototype, scene.objects[s].mesh);
+    if (s == 2) {
+      EXPECT_TRUE(got.all_triangles) << "a list of every triangle is stored as all";
+      EXPECT_TRUE(got.triangles.empty());
+    } else {
+      EXPECT_FALSE(got.all_triangles);
+      EXPECT_EQ(got.triangles, visible[s]) << "object " << s;
+    }
+  }
+}
+
+TEST(MeshTrack, DeterministicForThreadsAndDecodesTheSameForEveryScheme) {
+  const capture::SceneFile scene = test::make_mesh_test_scene(4);
+  const auto visible = test_subset();
+  encoder::MeshEncodeOptions one, many;
+  many.threads = 4;
+  EXPECT_EQ(encode(scene, &visible, one), encode(scene, &visible, many));
+  EXPECT_EQ(encode(scene, nullptr, one), encode(scene, nullptr, one));
+  std::vector<uint64_t> first;
+  for (Compression c : {Compression::kZstd, Compression::kLzma2, Compression::kNone}) {
+    encoder::MeshEncodeOptions o;
+    o.supercompression = c;
+    const auto file = encode(scene, &visible, o);
+    const auto reader = open_reader(file);
+    const auto r = decoder::verify_mesh_track(reader, 0, true, 10);
+    ASSERT_TRUE(r.problems.empty()) << r.problems[0].to_string();
+    std::vector<uint64_t> hashes;
+    for (const auto& line : r.hash_lines) hashes.push_back(std::hash<std::string>{}(line));
+    if (first.empty()) {
+      first = hashes;
+    } else {
+      EXPECT_EQ(hashes, first);
+    }
+  }
+}
+
+TEST(MeshTrack, BadVisibleSetsAreRefused) {
+  const capture::SceneFile scene = test::make_mesh_test_scene(2);
+  std::vector<uint8_t> file;
+  auto w = container::Writer::create(container::memory_sink(&file));
+  ASSERT_TRUE(w.ok());
+  std::vector<std::vector<uint32_t>> short_list = {{0}};
+  EXPECT_EQ(encoder::encode_mesh_track(scene, &short_list, {}, &*w).id(), ErrorId::kEncoderInput);
+  auto unsorted = test_subset();
+  unsorted[3] = {2, 1};
+  EXPECT_EQ(encoder::encode_mesh_track(scene, &unsorted, {}, &*w).id(), ErrorId::kEncoderInput);
+  auto beyond = test_subset();
+  beyond[0] = {2};  // the quad has 2 triangles
+  EXPECT_EQ(encoder::encode_mesh_track(scene, &beyond, {}, &*w).id(), ErrorId::kEncoderInput);
+  capture::SceneFile far = scene;
+  far.meshes[0].positions[0] = 2e12f;  // beyond the coordinate bound
+  EXPECT_EQ(encoder::encode_mesh_track(far, nullptr, {}, &*w).id(), ErrorId::kEncoderInput);
+}
+
+// ---- Damaged chunks: the file is rebuilt with valid hashes, so the track's parser sees them ----
+
+struct Edit {
+  std::function<void(const container::ChunkKeys&, std::vector<uint8_t>&, bool& drop)> chunk;
+  std::function<void(container::MeshTrackHeader&)> header;
+  bool duplicate_last = false;
+};
+
+std::vector<uint8_t> rebuild(const std::vector<uint8_t>& file, const Edit& edit) {
+  const auto reader = open_reader(file);
+  std::vector<uint8_t> out;
+  auto w = container::Writer::create(container::memory_sink(&out));
+  EXPECT_TRUE(w.ok());
+  auto h = std::get<container::MeshTrackHeader>(reader.tracks()[0].header);
+  if (edit.header) edit.header(h);
+  EXPECT_TRUE(w->add_track(h).ok());
+  std::vector<uint8_t> last;
+  container::ChunkKeys last_keys;
+  for (uint32_t id = 0; id < reader.chunks().size(); ++id) {
+    auto raw = reader.read_chunk(id);
+    EXPECT_TRUE(raw.ok());
+    bool drop = false;
+    if (edit.chunk) edit.chunk(reader.chunks()[id].keys, *raw, drop);
+    if (drop) continue;
+    EXPECT_TRUE(w->add_chunk(reader.chunks()[id].keys, *raw, Compression::kNone).ok());
+    last = *raw;
+    last_keys = reader.chunks()[id].keys;
+  }
+  if (edit.duplicate_last) EXPECT_TRUE(w->add_chunk(last_keys, last, Compression::kNone).ok());
+  EXPECT_TRUE(w->finish().ok());
+  return out;
+}
+
+// The first problem of verifying the damaged file (open's error, else decoding's).
+ErrorId damage_id(const std::vector<uint8_t>& file) {
+  const auto reader = open_reader(file);
+  const auto r = decoder::verify_mesh_track(reader, 0, false, 10);
+  return r.problems.empty() ? ErrorId::kOk : r.problems[0].id();
+}
+
+bool is(const container::ChunkKeys& k, MeshStream s, uint32_t region) {
+  return k.stream == static_cast<uint16_t>(s) && k.region == region;
+}
+
+TEST(MeshTrack, DamagedChunksGiveTheTrackIds) {
+  const capture::SceneFile scene = test::make_mesh_test_scene(3);
+  const auto visible = test_subset();
+  const auto good = encode(scene, &visible);
+  ASSERT_EQ(damage_id(rebuild(good, {})), ErrorId::kOk) << "rebuilding alone changes nothing";
+  // Offsets in the index chunk (§11.4.2): 3 materials, 4 prototypes.
+  constexpr size_t kObjects = 4 + 4 + 48 + 4 + 3 * 24 + 4 + 4 * 16 + 4;
+  auto on = [](MeshStream s, uint32_t region, std::function<void(std::vector<uint8_t>&)> f) {
+    Edit e;
+    e.chunk = [=](const container::ChunkKeys& k, std::vector<uint8_t>& raw, bool&) {
+      if (is(k, s, region)) f(raw);
+    };
+    return e;
+  };
+  struct Case {
+    const char* name;
+    Edit edit;
+    ErrorId id;
+  };
+  std::vector<Case> cases = {
+      {"layout version 2", on(MeshStream::kIndex, 0, [](auto& r) { r[0] = 2; }),
+       ErrorId::kMeshUnsupported},
+      {"index flags", on(MeshStream::kIndex, 0, [](auto& r) { r[4] = 1; }),
+       ErrorId::kMeshUnsupported},
+      {"index truncated", on(MeshStream::kIndex, 0, [](auto& r) { r.resize(r.size() - 1); }),
+       ErrorId::kMeshChunk},
+      {"index trailing byte", on(MeshStream::kIndex, 0, [](auto& r) { r.push_back(0); }),
+       ErrorId::kMeshChunk},
+      {"view region inverted", on(MeshStream::kIndex, 0, [](auto& r) { r[8 + 7] = 0x40; }),
+       ErrorId::kMeshValue},
+      {"material NaN",
+       on(MeshStream::kIndex, 0, [](auto& r) { r[60 + 2] = 0xc0, r[60 + 3] = 0x7f; }),
+       ErrorId::kMeshValue},
+      {"materials count huge",
+       on(MeshStream::kIndex, 0, [](auto& r) { r[56] = 0xff, r[57] = 0xff, r[58] = 0x0f; }),
+       ErrorId::kMeshLimit},
+      {"object prototype out of range",
+       on(MeshStream::kIndex, 0, [](auto& r) { r[kObjects + 4] = 9; }), ErrorId::kMeshIndex},
+      {"object material out of range",
+       on(MeshStream::kIndex, 0, [](auto& r) { r[kObjects + 8] = 3; }), ErrorId::kMeshIndex},
+      {"transform count 2", on(MeshStream::kIndex, 0, [](auto& r) { r[kObjects + 12] = 2; }),
+       ErrorId::kMeshIndex},
+      {"prototype vertex count",
+       on(MeshStream::kIndex, 0, [](auto& r) { r[4 + 4 + 48 + 4 + 72 + 4] = 5; }),
+       ErrorId::kMeshChunk},
+      {"position NaN",
+       on(MeshStream::kVertices, 0,
+          [](auto& r) { r[0] = 0, r[12] = 0, r[24] = 0xc0, r[36] = 0x7f; }),
+       ErrorId::kMeshValue},
+      {"colour above 1", on(MeshStream::kVertices, 0, [](auto& r) { r[2 * 48 + 36] = 0x40; }),
+       ErrorId::kMeshValue},
+      {"state times not increasing",
+       on(MeshStream::kVertices, 1, [](auto& r) { r[96 + 3 * 3 + 1] = 0xbf; }),
+       ErrorId::kMeshValue},
+      {"vertices chunk short",
+       on(MeshStream::kVertices, 1, [](auto& r) { r.resize(r.size() - 4); }), ErrorId::kMeshChunk},
+      {"vertex index out of range", on(MeshStream::kTriangles, 0, [](auto& r) { r[0] = 100; }),
+       ErrorId::kMeshIndex},
+      {"triangle material out of range", on(MeshStream::kTriangles, 0, [](auto& r) { r[24] = 7; }),
+       ErrorId::kMeshIndex},
+      {"transform NaN", on(MeshStream::kVisibility, 0, [](auto& r) { r[24] = 0xc0, r[36] = 0x7f; }),
+       ErrorId::kMeshValue},
+      {"visibility short", on(MeshStream::kVisibility, 0, [](auto& r) { r.resize(20); }),
+       ErrorId::kMeshChunk},
+      {"run count wrong", on(MeshStream::kVisibility, 0, [](auto& r) { r[48] = 3; }),
+       ErrorId::kMeshChunk},
+      {"run beyond the prototype", on(MeshStream::kVisibility, 0, [](auto& r) { r[52] = 200; }),
+       ErrorId::kMeshIndex},
+      {"empty run", on(MeshStream::kVisibility, 0, [](auto& r) { r[56] = 0; }),
+       ErrorId::kMeshIndex},
+  };
+  Edit drop;
+  drop.chunk = [](const container::ChunkKeys& k, std::vector<uint8_t>&, bool& d) {
+    d = is(k, MeshStream::kVisibility, 4);
+  };
+  cases.push_back({"visibility chunk missing", drop, ErrorId::kMeshChunk});
+  Edit drop_index;
+  drop_index.chunk = [](const container::ChunkKeys& k, std::vector<uint8_t>&, bool& d) {
+    d = is(k, MeshStream::kTriangles, 2);
+  };
+  cases.push_back({"triangles chunk missing", drop_index, ErrorId::kMeshChunk});
+  Edit twice;
+  twice.duplicate_last = true;
+  cases.push_back({"visibility chunk twice", twice, ErrorId::kMeshChunk});
+  Edit count;
+  count.header = [](container::MeshTrackHeader& h) { h.triangle_count += 1; };
+  cases.push_back({"header triangle count", count, ErrorId::kMeshChunk});
+  Edit flags;
+  flags.header = [](container::MeshTrackHeader& h) { h.flags = 2; };
+  cases.push_back({"header reserved flag", flags, ErrorId::kMeshUnsupported});
+  for (const Case& c : cases) {
+    EXPECT_EQ(damage_id(rebuild(good, c.edit)), c.id) << c.name;
+  }
+}
+
+// ---- The frozen conformance clips (tests/conformance/mesh/) ----
+
+std::string source_path(const std::string& rel) {
+  const char* root = std::getenv("CALF_SOURCE_DIR");
+  return std::string(root ? root : ".") + "/" + rel;
+}
+
+std::vector<uint8_t> read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+struct Clip {
+  const char* name;
+  bool subset;
+  Compression compression;
+};
+constexpr Clip kClips[] = {{"full_none", false, Compression::kNone},
+                           {"subset_zstd", true, Compression::kZstd}};
+
+std::vector<uint8_t> make_clip(const Clip& c) {
+  const capture::SceneFile scene = test::make_mesh_test_scene(3);
+  const auto visible = test_subset();
+  encoder::MeshEncodeOptions o;
+  o.supercompression = c.compression;
+  o.segment_count = c.subset ? 8 : 0;
+  return encode(scene, c.subset ? &visible : nullptr, o);
+}
+
+// The generator (tests/conformance/README.md): with CALF_CONFORMANCE_OUT=DIR it writes the clips
+// there; the committed copies are never regenerated for a new version.
+TEST(MeshConformance, Generator) {
+  const char* out = std::getenv("CALF_CONFORMANCE_OUT");
+  if (!out) GTEST_SKIP() << "set CALF_CONFORMANCE_OUT to write the clips";
+  for (const Clip& c : kClips) {
+    const auto bytes = make_clip(c);
+    std::ofstream f(std::string(out) + "/" + c.name + ".calf", std::ios::binary);
+    f.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
+  }
+}
+
+// The runner: each committed clip decodes to the scene it was made from, and to its hashes.
+TEST(MeshConformance, CommittedClipsDecodeToTheSceneAndTheirHashes) {
+  const capture::SceneFile scene = test::make_mesh_test_scene(3);
+  const auto visible = test_subset();
+  for (const Clip& c : kClips) {
+    SCOPED_TRACE(c.name);
+    const auto bytes =
+        read_bytes(source_path(std::string("tests/conformance/mesh/") + c.name + ".calf"));
+    ASSERT_FALSE(bytes.empty());
+    const auto reader = open_reader(bytes);
+    auto track = MeshTrack::open(reader, 0);
+    ASSERT_TRUE(track.ok()) << track.status().to_string();
+    for (uint32_t p = 0; p < track->prototype_count(); ++p) {
+      MeshPrototype got;
+      ASSERT_TRUE(track->prototype(p, &got).ok());
+      expect_prototype(got, expected_prototype(scene.meshes[p]), p);
+    }
+    for (uint32_t o = 0; o < track->object_count(); ++o) {
+      MeshObject got;
+      ASSERT_TRUE(track->object(o, &got).ok());
+      const uint32_t s = track->index().objects[o].source_object;
+      if (!got.all_triangles) {
+        EXPECT_EQ(got.triangles, visible[s]);
+      }
+      EXPECT_EQ(decoder::transform_at(got, 2), capture::transform_at(scene.objects[s], 2));
+    }
+    const auto result = decoder::verify_mesh_track(reader, 0, true, 10);
+    std::ostringstream lines;
+    for (const auto& l : result.hash_lines) lines << l << "\n";
+    const auto want =
+        read_bytes(source_path(std::string("tests/conformance/mesh/") + c.name + ".hashes"));
+    EXPECT_EQ(lines.str(), std::string(want.begin(), want.end()));
+    // Today's encoder still writes the frozen bytes (a change means a new clip, not an edit).
+    EXPECT_EQ(make_clip(c), bytes);
+  }
+}
+
+}  // namespace
+}  // namespace calf
