@@ -9,8 +9,13 @@
 #include <vector>
 
 #include "calf/decoder/mesh_track.h"
+#include "calf/format/mesh_layout.h"
 
 namespace calf::player {
+
+// The track's "the object's material" passes into the draw list unchanged.
+static_assert(mesh::kObjectMaterial == kMeshObjectMaterial);
+
 namespace {
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
