@@ -122,8 +122,10 @@ TEST(MeshPlayback, GlAndCpuAgreeThroughPlayback) {
       for (int ch = 0; ch < 3; ++ch) same.color[3 * k + ch] = c.color[3 * k + ch];
     }
     const double p = *psnr(rgb_ref(same), rgb_ref(c));
-    std::printf("frame %u: %zu of %zu depths differ, PSNR %.2f dB where both show one surface\n",
-                frame, differing, c.depth.size(), p);
+    // Measured: 0 depths differ; 48.5 dB, all but one pixel: a centre on the floor quad's
+    // diagonal, where its two triangles (grey and blue, one plane) meet, goes to the other one.
+    std::printf("frame %u: %zu of %zu depths differ, PSNR %.2f dB where the depths agree\n", frame,
+                differing, c.depth.size(), p);
     EXPECT_LE(differing, c.depth.size() / 100);
     EXPECT_GE(p, 45.0);
   }
