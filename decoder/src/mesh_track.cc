@@ -121,6 +121,14 @@ Expected<MeshTrack> MeshTrack::open(const container::Reader& reader, uint16_t tr
     const uint32_t ids[2] = {index->vertices[p], index->triangles[p]};
     for (int s = 0; s < 2; ++s) {
       const char* name = s ? "triangles" : "vertices";
+      if (s == 1 && r.triangles_of != p) {
+        // It draws an earlier prototype's triangles and has no chunk of its own.
+        if (ids[s] != kNone) {
+          return corrupt(cat("prototype ", p, " has triangles chunk ", ids[s],
+                             " but uses prototype ", r.triangles_of, "'s"));
+        }
+        continue;
+      }
       if (ids[s] == kNone) return corrupt(cat("prototype ", p, " has no ", name, " chunk"));
       if (chunks[ids[s]].raw_size != want[s]) {
         return corrupt(cat("prototype ", p, " ", name, " chunk ", ids[s], " holds ",
@@ -188,8 +196,11 @@ Status MeshTrack::prototype(uint32_t i, MeshPrototype* out) const {
   CALF_RETURN_IF_ERROR(mesh::decode_vertices(*vraw, r, &v, vwhat));
   vraw->clear();
   vraw->shrink_to_fit();
-  const std::string twhat = cat("prototype ", i, " triangles chunk ", index_->triangles[i]);
-  Expected<std::vector<uint8_t>> traw = reader_->read_chunk(index_->triangles[i]);
+  // A prototype sharing an earlier one's triangles reads that chunk; its indices are checked
+  // against its own vertex count.
+  const uint32_t tid = index_->triangles[r.triangles_of];
+  const std::string twhat = cat("prototype ", i, " triangles chunk ", tid);
+  Expected<std::vector<uint8_t>> traw = reader_->read_chunk(tid);
   if (!traw.ok()) return std::move(traw).status().with_context(twhat);
   mesh::TriangleArrays tri;
   CALF_RETURN_IF_ERROR(mesh::decode_triangles(

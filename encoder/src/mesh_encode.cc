@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <numeric>
 #include <string>
 #include <utility>
@@ -109,6 +110,7 @@ Expected<Plan> make_plan(const capture::SceneFile& scene,
     plan.prototype_mesh.push_back(static_cast<uint32_t>(m));
   }
   plan.prototypes.resize(plan.prototype_mesh.size());
+  std::map<uint64_t, std::vector<uint32_t>> by_triangles;  // hash of the indices -> prototypes
   // The prototypes' arrays are built here already (in parallel by the caller's arena would gain
   // little: building is a copy; coding and compression are the parallel part).
   for (size_t p = 0; p < plan.prototype_mesh.size(); ++p) {
@@ -116,7 +118,22 @@ Expected<Plan> make_plan(const capture::SceneFile& scene,
     Expected<MeshPrototypeArrays> a = prototype_arrays(scene.meshes[m]);
     if (!a.ok()) return std::move(a).status().with_context(cat("scene mesh ", m));
     plan.prototypes[p] = std::move(*a);
-    x.prototypes.push_back(plan.prototypes[p].record);
+    // Identical triangles (indices and triangle materials) are stored once: the first prototype
+    // holding them keeps the chunk (SPEC §11.4.2 triangles_of).
+    auto& record = plan.prototypes[p].record;
+    record.triangles_of = static_cast<uint32_t>(p);
+    const auto& tri = plan.prototypes[p].triangles;
+    const uint64_t key = container::hash64(std::span<const uint8_t>(
+        reinterpret_cast<const uint8_t*>(tri.indices.data()), 4 * tri.indices.size()));
+    for (uint32_t q : by_triangles[key]) {
+      const auto& other = plan.prototypes[q].triangles;
+      if (other.indices == tri.indices && other.triangle_materials == tri.triangle_materials) {
+        record.triangles_of = q;
+        break;
+      }
+    }
+    if (record.triangles_of == p) by_triangles[key].push_back(static_cast<uint32_t>(p));
+    x.prototypes.push_back(record);
     h.vertex_count += plan.prototypes[p].record.vertex_count;
   }
   for (size_t o = 0; o < scene.objects.size(); ++o) {
@@ -303,7 +320,7 @@ Status encode_mesh_track(const capture::SceneFile& scene,
               part.status =
                   compress_into(part, MeshStream::kVertices, region,
                                 mesh::encode_vertices(p.record, p.vertices), options, what);
-              if (part.status.ok()) {
+              if (part.status.ok() && p.record.triangles_of == i) {
                 part.status =
                     compress_into(part, MeshStream::kTriangles, region,
                                   mesh::encode_triangles(p.record, p.triangles), options, what);

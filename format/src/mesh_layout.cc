@@ -44,16 +44,15 @@ float from_bits(uint32_t w) {
   return std::bit_cast<float>(w);
 }
 
-// A vec3 array of `v` vertices as component-planar deltas: word c*v + i is the bit pattern of
-// component c of vertex i minus that of the reference (component c of vertex i of `ref` when
-// given, else of vertex i - 1, 0 for vertex 0), modulo 2^32.
+// A vec3 array of `v` vertices as component planes: word c*v + i is component c of vertex i,
+// minus (modulo 2^32) the same component of the same vertex of `ref` when one is given. Not
+// predicted from the previous vertex: measured on the built-in scenes' meshes (whose vertex order
+// is not spatial) zstd -19 stored 10-40 % more bytes with that prediction than without.
 void put_vec3(std::vector<uint8_t>& out, const float* a, const float* ref, size_t v) {
   std::vector<uint32_t> words(3 * v);
   for (size_t c = 0; c < 3; ++c) {
-    for (size_t i = 0; i < v; ++i) {
-      const uint32_t prev = ref ? bits(ref[3 * i + c]) : i ? bits(a[3 * (i - 1) + c]) : 0;
-      words[c * v + i] = bits(a[3 * i + c]) - prev;
-    }
+    for (size_t i = 0; i < v; ++i)
+      words[c * v + i] = bits(a[3 * i + c]) - (ref ? bits(ref[3 * i + c]) : 0u);
   }
   put_planes(out, words);
 }
@@ -63,10 +62,8 @@ void get_vec3(const uint8_t* in, float* a, const float* ref, size_t v) {
   std::vector<uint32_t> words(3 * v);
   get_planes(in, 3 * v, words.data());
   for (size_t c = 0; c < 3; ++c) {
-    for (size_t i = 0; i < v; ++i) {
-      const uint32_t prev = ref ? bits(ref[3 * i + c]) : i ? bits(a[3 * (i - 1) + c]) : 0;
-      a[3 * i + c] = from_bits(words[c * v + i] + prev);
-    }
+    for (size_t i = 0; i < v; ++i)
+      a[3 * i + c] = from_bits(words[c * v + i] + (ref ? bits(ref[3 * i + c]) : 0u));
   }
 }
 
@@ -118,6 +115,19 @@ Status check_index(const IndexChunk& x, uint32_t frame_count, const std::string&
       if (!(e >= 0.0f))
         return error(ErrorId::kMeshValue, what,
                      cat("materials[", i, "].emission ", e, " is negative"));
+    }
+  }
+  for (size_t i = 0; i < x.prototypes.size(); ++i) {
+    const PrototypeRecord& p = x.prototypes[i];
+    if (p.triangles_of == i) continue;
+    const uint32_t q = p.triangles_of;
+    if (q > i || x.prototypes[q].triangles_of != q ||
+        x.prototypes[q].triangle_count != p.triangle_count ||
+        ((x.prototypes[q].flags ^ p.flags) & kHasTriangleMaterials)) {
+      return error(ErrorId::kMeshIndex, what,
+                   cat("prototypes[", i, "].triangles_of ", q,
+                       " is not an earlier prototype with its own triangles, ", p.triangle_count,
+                       " triangles and the same triangle-material flag"));
     }
   }
   for (size_t i = 0; i < x.objects.size(); ++i) {

@@ -25,7 +25,7 @@ IndexChunk small_index() {
   x.materials.resize(2);
   x.materials[1].emission[2] = 5;
   x.prototypes.push_back({3, 1, kHasNormals | kHasColours | kHasTriangleMaterials, 2});
-  x.prototypes.push_back({4, 2, 0, 0});
+  x.prototypes.push_back({4, 2, 0, 0, 1});
   x.objects.push_back({7, 0, 1, 1, kAllTriangles, 1});
   x.objects.push_back({9, 1, 0, 3, 0, 1});
   return x;
@@ -35,14 +35,25 @@ TEST(MeshLayout, IndexRoundTripAndSize) {
   const IndexChunk x = small_index();
   auto bytes = serialize_index(x, 3);
   ASSERT_TRUE(bytes.ok()) << bytes.status().to_string();
-  // 8 + 48 + (4 + 2 x 24) + (4 + 2 x 16) + (4 + 2 x 24), by hand.
-  EXPECT_EQ(bytes->size(), 8u + 48 + 52 + 36 + 52);
+  // 8 + 48 + (4 + 2 x 24) + (4 + 2 x 20) + (4 + 2 x 24), by hand.
+  EXPECT_EQ(bytes->size(), 8u + 48 + 52 + 44 + 52);
   auto back = parse_index(*bytes, 3, "index");
   ASSERT_TRUE(back.ok()) << back.status().to_string();
   EXPECT_EQ(back->objects[1].source_object, 9u);
   EXPECT_EQ(back->prototypes[0].state_count, 2u);
   EXPECT_EQ(back->materials[1].emission[2], 5.0f);
   EXPECT_EQ(back->view_max[0], 2.0);
+  // A prototype may draw an earlier one's triangles, of the same count and flag bit 2 only.
+  IndexChunk shared = x;
+  shared.prototypes.push_back({5, 2, 0, 0, 1});
+  EXPECT_TRUE(serialize_index(shared, 3).ok());
+  shared.prototypes.back().triangles_of = 0;  // 1 triangle and triangle materials
+  EXPECT_EQ(serialize_index(shared, 3).status().id(), ErrorId::kContainerWriterMisuse);
+  shared.prototypes.back().triangles_of = 3;  // not earlier
+  EXPECT_EQ(serialize_index(shared, 3).status().id(), ErrorId::kContainerWriterMisuse);
+  auto forward = serialize_index(x, 3);
+  (*forward)[8 + 48 + 4 + 48 + 4 + 16] = 1;  // prototype 0 draws prototype 1's triangles
+  EXPECT_EQ(parse_index(*forward, 3, "index").status().id(), ErrorId::kMeshIndex);
   // transform_count 3 is only valid for a 3-frame track.
   EXPECT_EQ(parse_index(*bytes, 4, "index").status().id(), ErrorId::kMeshIndex);
   EXPECT_EQ(serialize_index(x, 4).status().id(), ErrorId::kContainerWriterMisuse);
@@ -75,12 +86,15 @@ TEST(MeshLayout, VerticesRoundTripBitForBitAsDocumentedPlanes) {
   ASSERT_TRUE(bytes.ok()) << bytes.status().to_string();
   ASSERT_EQ(bytes->size(), vertices_chunk_size(p));
   EXPECT_EQ(bytes->size(), 4u * (3 * 3 * 3 + 2 + 2 * 9));
-  // Byte planes of component-planar deltas: word 0 is x of vertex 0 (-0.0f = 0x80000000), word 1
-  // x of vertex 1 minus x of vertex 0; 9 words, so plane 3 starts at byte 27.
+  // Byte planes of component planes: word 0 is x of vertex 0 (-0.0f = 0x80000000), word 1 x of
+  // vertex 1 (denorm_min = 0x00000001), word 3 y of vertex 0 (1e12f = 0x5368d4a5); 9 words, so
+  // plane 3 starts at byte 27.
   EXPECT_EQ((*bytes)[0], 0x00);
   EXPECT_EQ((*bytes)[27], 0x80);
-  EXPECT_EQ((*bytes)[1], 0x01);  // denorm_min (0x00000001) - 0x80000000 = 0x80000001
-  EXPECT_EQ((*bytes)[28], 0x80);
+  EXPECT_EQ((*bytes)[1], 0x01);
+  EXPECT_EQ((*bytes)[28], 0x00);
+  EXPECT_EQ((*bytes)[3], 0xa5);
+  EXPECT_EQ((*bytes)[30], 0x53);
   VertexArrays back;
   ASSERT_TRUE(decode_vertices(*bytes, p, &back, "v").ok());
   EXPECT_EQ(bits_of(back.positions), bits_of(a.positions));

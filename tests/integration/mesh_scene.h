@@ -1,7 +1,9 @@
 // A small scene file made by code for the mesh track's tests, conformance clip and fuzz seeds:
 // a quad with normals, colours and per-triangle materials placed twice (one static instance, one
-// moving per frame), a strip with piecewise-linear vertex states, and a mesh of two analytic
-// spheres (one with its own triangle). Deterministic: the same floats on every machine.
+// moving per frame), a strip with piecewise-linear vertex states, a mesh of one triangle and two
+// analytic spheres and a mesh that is one sphere alone. Without `spheres` (the small conformance
+// clips and fuzz seeds) the spheres are left out and the last mesh is a tetrahedron with
+// normals; a panel reuses the quad's triangles. Deterministic: the same floats on every machine.
 #pragma once
 
 #include <cstdint>
@@ -11,7 +13,7 @@
 
 namespace calf::test {
 
-inline capture::SceneFile make_mesh_test_scene(uint32_t frame_count = 3) {
+inline capture::SceneFile make_mesh_test_scene(uint32_t frame_count = 3, bool spheres = true) {
   capture::SceneFile s;
   s.name = "mesh-test";
   s.fps = 24;
@@ -58,13 +60,26 @@ inline capture::SceneFile make_mesh_test_scene(uint32_t frame_count = 3) {
   balls.name = "balls";
   balls.positions = {0, 0, -4, 0.5f, 0, -4, 0, 0.5f, -4};
   balls.indices = {0, 1, 2};
-  balls.spheres = {{{0, 1, -5}, 0.5f}, {{1.5f, 0.75f, -5}, 0.25f}};
+  if (spheres) balls.spheres = {{{0, 1, -5}, 0.5f}, {{1.5f, 0.75f, -5}, 0.25f}};
   s.meshes.push_back(balls);
 
   capture::SceneMesh ball;  // a sphere alone: stored with its normals
   ball.name = "ball";
-  ball.spheres = {{{0, 0, 0}, 1}};
+  if (spheres) {
+    ball.spheres = {{{0, 0, 0}, 1}};
+  } else {
+    ball.positions = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    ball.normals = {1, 0, 0, 0, 1, 0, 0, 0, 1, -1, -1, -1};
+    ball.indices = {0, 1, 2, 0, 3, 1, 1, 3, 2, 2, 3, 0};
+  }
   s.meshes.push_back(ball);
+
+  capture::SceneMesh panel;  // the quad's triangles on other vertices: shares its triangles chunk
+  panel.name = "panel";
+  panel.positions = {0, 0, 0, 2, 0, 0, 2, 1, 0, 0, 1, 0};
+  panel.indices = quad.indices;
+  panel.triangle_materials = quad.triangle_materials;
+  s.meshes.push_back(panel);
 
   capture::SceneObject floor{"floor", 0, 0, {}};  // identity
   capture::SceneObject tile{"tile", 0, 1, {{1, 0, 0, 2, 0, 1, 0, 0, 0, 0, 1, 0}}};
@@ -76,7 +91,8 @@ inline capture::SceneFile make_mesh_test_scene(uint32_t frame_count = 3) {
   capture::SceneObject grass{"grass", 1, 0, {}};
   capture::SceneObject toys{"toys", 2, 2, {}};
   capture::SceneObject sun{"sun", 3, 1, {{2, 0, 0, 5, 0, 2, 0, 9, 0, 0, 2, 5}}};
-  s.objects = {floor, tile, mover, grass, toys, sun};
+  capture::SceneObject sign{"sign", 4, 1, {{1, 0, 0, 0, 0, 1, 0, 2, 0, 0, 1, -6}}};
+  s.objects = {floor, tile, mover, grass, toys, sun, sign};
   return s;
 }
 

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iterator>
@@ -144,12 +145,12 @@ TEST(MeshTrack, FullSceneRoundTrip) {
   const auto reader = open_reader(file);
   auto track = MeshTrack::open(reader, 0);
   ASSERT_TRUE(track.ok()) << track.status().to_string();
-  // Counts worked out by hand: quad 4 + strip 8 + balls 3 + 2 x 642 + ball 642 vertices; floor,
-  // tile, mover 2 triangles each, grass 6, toys 1 + 2 x 1280, sun 1280.
-  EXPECT_EQ(track->header().vertex_count, 1941u);
-  EXPECT_EQ(track->header().triangle_count, 3853u);
-  EXPECT_EQ(stats.triangles, 3853u);
-  EXPECT_EQ(stats.scene_triangles, 3853u);
+  // Counts worked out by hand: quad 4 + strip 8 + balls 3 + 2 x 642 + ball 642 + panel 4
+  // vertices; floor, tile, mover 2 triangles each, grass 6, toys 1 + 2 x 1280, sun 1280, sign 2.
+  EXPECT_EQ(track->header().vertex_count, 1945u);
+  EXPECT_EQ(track->header().triangle_count, 3855u);
+  EXPECT_EQ(stats.triangles, 3855u);
+  EXPECT_EQ(stats.scene_triangles, 3855u);
   EXPECT_EQ(track->header().flags, 0);
   EXPECT_EQ(track->frame_count(), 3u);
   EXPECT_DOUBLE_EQ(track->fps(), 24.0);
@@ -158,9 +159,13 @@ TEST(MeshTrack, FullSceneRoundTrip) {
   ASSERT_EQ(track->materials().size(), 3u);
   EXPECT_EQ(track->materials()[1].base_colour, (std::array<float, 3>{1, 0.75f, 0.25f}));
   EXPECT_EQ(track->materials()[1].emission, (std::array<float, 3>{4, 3, 2}));
-  ASSERT_EQ(track->prototype_count(), 4u);
-  ASSERT_EQ(track->object_count(), 6u);
-  for (uint32_t p = 0; p < 4; ++p) {
+  ASSERT_EQ(track->prototype_count(), 5u);
+  ASSERT_EQ(track->object_count(), 7u);
+  // The panel (prototype 4) draws the quad's triangles: one triangles chunk for both.
+  EXPECT_EQ(track->index().prototypes[4].triangles_of, 0u);
+  EXPECT_EQ(stats.triangles_stream.chunks, 4u);
+  EXPECT_EQ(stats.vertices_stream.chunks, 5u);
+  for (uint32_t p = 0; p < 5; ++p) {
     MeshPrototype got;
     ASSERT_TRUE(track->prototype(p, &got).ok());
     expect_prototype(got, expected_prototype(scene.meshes[p]), p);
@@ -171,7 +176,7 @@ TEST(MeshTrack, FullSceneRoundTrip) {
   ASSERT_TRUE(track->prototype(3, &ball).ok());
   EXPECT_TRUE(balls.normals.empty());
   EXPECT_EQ(ball.normals.size(), 3 * size_t{kSphereVertices});
-  for (uint32_t o = 0; o < 6; ++o) {
+  for (uint32_t o = 0; o < 7; ++o) {
     MeshObject got;
     ASSERT_TRUE(track->object(o, &got).ok());
     const auto& so = scene.objects[o];
@@ -195,17 +200,19 @@ TEST(MeshTrack, FullSceneRoundTrip) {
   // Out-of-range requests are errors.
   MeshObject o;
   MeshPrototype p;
-  EXPECT_EQ(track->object(6, &o).id(), ErrorId::kInvalidArgument);
-  EXPECT_EQ(track->prototype(4, &p).id(), ErrorId::kInvalidArgument);
+  EXPECT_EQ(track->object(7, &o).id(), ErrorId::kInvalidArgument);
+  EXPECT_EQ(track->prototype(5, &p).id(), ErrorId::kInvalidArgument);
   EXPECT_EQ(MeshTrack::open(reader, 1).status().id(), ErrorId::kInvalidArgument);
 }
 
 // A visible set: per scene object a sorted list of mesh triangles.
-std::vector<std::vector<uint32_t>> test_subset() {
+// Without spheres the toys draw their one triangle and the tetrahedron three of its four.
+std::vector<std::vector<uint32_t>> test_subset(bool spheres = true) {
+  if (!spheres) return {{1}, {}, {0, 1}, {0, 2, 3, 5}, {0}, {0, 2, 3}, {1}};
   std::vector<uint32_t> toys = {0};
   for (uint32_t t = 1; t <= kSphereTriangles; ++t) toys.push_back(t);  // the first sphere whole
   toys.push_back(2000);
-  return {{1}, {}, {0, 1}, {0, 2, 3, 5}, toys, {5, 6, 7, 900}};
+  return {{1}, {}, {0, 1}, {0, 2, 3, 5}, toys, {5, 6, 7, 900}, {1}};
 }
 
 TEST(MeshTrack, SubsetRoundTrip) {
@@ -219,12 +226,12 @@ TEST(MeshTrack, SubsetRoundTrip) {
   ASSERT_TRUE(track.ok()) << track.status().to_string();
   EXPECT_EQ(track->header().flags, mesh::kHeaderVisibleSet);
   EXPECT_EQ(track->header().segment_count, 8u);
-  EXPECT_EQ(track->header().triangle_count, 1u + 2 + 4 + 1282 + 4);
+  EXPECT_EQ(track->header().triangle_count, 1u + 2 + 4 + 1282 + 4 + 1);
   // The tile (object 1) draws nothing and is left out; every mesh is still used.
-  ASSERT_EQ(track->object_count(), 5u);
-  ASSERT_EQ(track->prototype_count(), 4u);
-  const uint32_t sources[5] = {0, 2, 3, 4, 5};
-  for (uint32_t o = 0; o < 5; ++o) {
+  ASSERT_EQ(track->object_count(), 6u);
+  ASSERT_EQ(track->prototype_count(), 5u);
+  const uint32_t sources[6] = {0, 2, 3, 4, 5, 6};
+  for (uint32_t o = 0; o < 6; ++o) {
     MeshObject got;
     ASSERT_TRUE(track->object(o, &got).ok());
     const uint32_t s = sources[o];
@@ -311,7 +318,9 @@ std::vector<uint8_t> rebuild(const std::vector<uint8_t>& file, const Edit& edit)
     last = *raw;
     last_keys = reader.chunks()[id].keys;
   }
-  if (edit.duplicate_last) EXPECT_TRUE(w->add_chunk(last_keys, last, Compression::kNone).ok());
+  if (edit.duplicate_last) {
+    EXPECT_TRUE(w->add_chunk(last_keys, last, Compression::kNone).ok());
+  }
   EXPECT_TRUE(w->finish().ok());
   return out;
 }
@@ -323,6 +332,11 @@ ErrorId damage_id(const std::vector<uint8_t>& file) {
   return r.problems.empty() ? ErrorId::kOk : r.problems[0].id();
 }
 
+// Drops the last n bytes (std::min: GCC's -Wstringop-overflow cannot tell n <= size otherwise).
+void shrink(std::vector<uint8_t>& r, size_t n) {
+  r.resize(r.size() - std::min(n, r.size()));
+}
+
 bool is(const container::ChunkKeys& k, MeshStream s, uint32_t region) {
   return k.stream == static_cast<uint16_t>(s) && k.region == region;
 }
@@ -332,8 +346,9 @@ TEST(MeshTrack, DamagedChunksGiveTheTrackIds) {
   const auto visible = test_subset();
   const auto good = encode(scene, &visible);
   ASSERT_EQ(damage_id(rebuild(good, {})), ErrorId::kOk) << "rebuilding alone changes nothing";
-  // Offsets in the index chunk (§11.4.2): 3 materials, 4 prototypes.
-  constexpr size_t kObjects = 4 + 4 + 48 + 4 + 3 * 24 + 4 + 4 * 16 + 4;
+  // Offsets in the index chunk (§11.4.2): 3 materials, 5 prototypes.
+  constexpr size_t kObjects = 4 + 4 + 48 + 4 + 3 * 24 + 4 + 5 * 20 + 4;
+  constexpr size_t kPrototypes = 4 + 4 + 48 + 4 + 3 * 24 + 4;
   auto on = [](MeshStream s, uint32_t region, std::function<void(std::vector<uint8_t>&)> f) {
     Edit e;
     e.chunk = [=](const container::ChunkKeys& k, std::vector<uint8_t>& raw, bool&) {
@@ -351,7 +366,7 @@ TEST(MeshTrack, DamagedChunksGiveTheTrackIds) {
        ErrorId::kMeshUnsupported},
       {"index flags", on(MeshStream::kIndex, 0, [](auto& r) { r[4] = 1; }),
        ErrorId::kMeshUnsupported},
-      {"index truncated", on(MeshStream::kIndex, 0, [](auto& r) { r.resize(r.size() - 1); }),
+      {"index truncated", on(MeshStream::kIndex, 0, [](auto& r) { shrink(r, 1); }),
        ErrorId::kMeshChunk},
       {"index trailing byte", on(MeshStream::kIndex, 0, [](auto& r) { r.push_back(0); }),
        ErrorId::kMeshChunk},
@@ -369,8 +384,12 @@ TEST(MeshTrack, DamagedChunksGiveTheTrackIds) {
        on(MeshStream::kIndex, 0, [](auto& r) { r[kObjects + 8] = 3; }), ErrorId::kMeshIndex},
       {"transform count 2", on(MeshStream::kIndex, 0, [](auto& r) { r[kObjects + 12] = 2; }),
        ErrorId::kMeshIndex},
-      {"prototype vertex count",
-       on(MeshStream::kIndex, 0, [](auto& r) { r[4 + 4 + 48 + 4 + 72 + 4] = 5; }),
+      {"prototype vertex count", on(MeshStream::kIndex, 0, [](auto& r) { r[kPrototypes] = 5; }),
+       ErrorId::kMeshChunk},
+      {"triangles of a later prototype",
+       on(MeshStream::kIndex, 0, [](auto& r) { r[kPrototypes + 16] = 4; }), ErrorId::kMeshIndex},
+      {"shared triangles claimed as own",
+       on(MeshStream::kIndex, 0, [](auto& r) { r[kPrototypes + 4 * 20 + 16] = 4; }),
        ErrorId::kMeshChunk},
       {"position NaN",
        on(MeshStream::kVertices, 0,
@@ -381,8 +400,8 @@ TEST(MeshTrack, DamagedChunksGiveTheTrackIds) {
       {"state times not increasing",
        on(MeshStream::kVertices, 1, [](auto& r) { r[96 + 3 * 3 + 1] = 0xbf; }),
        ErrorId::kMeshValue},
-      {"vertices chunk short",
-       on(MeshStream::kVertices, 1, [](auto& r) { r.resize(r.size() - 4); }), ErrorId::kMeshChunk},
+      {"vertices chunk short", on(MeshStream::kVertices, 1, [](auto& r) { shrink(r, 4); }),
+       ErrorId::kMeshChunk},
       {"vertex index out of range", on(MeshStream::kTriangles, 0, [](auto& r) { r[0] = 100; }),
        ErrorId::kMeshIndex},
       {"triangle material out of range", on(MeshStream::kTriangles, 0, [](auto& r) { r[24] = 7; }),
@@ -439,12 +458,15 @@ struct Clip {
   bool subset;
   Compression compression;
 };
+// The conformance clips are of the scene without spheres (a few KB): the decoder sees a sphere
+// as triangles like any other, and the round trips above cover the spheres.
 constexpr Clip kClips[] = {{"full_none", false, Compression::kNone},
-                           {"subset_zstd", true, Compression::kZstd}};
+                           {"subset_zstd", true, Compression::kZstd},
+                           {"full_lzma2", false, Compression::kLzma2}};
 
 std::vector<uint8_t> make_clip(const Clip& c) {
-  const capture::SceneFile scene = test::make_mesh_test_scene(3);
-  const auto visible = test_subset();
+  const capture::SceneFile scene = test::make_mesh_test_scene(3, false);
+  const auto visible = test_subset(false);
   encoder::MeshEncodeOptions o;
   o.supercompression = c.compression;
   o.segment_count = c.subset ? 8 : 0;
@@ -456,18 +478,39 @@ std::vector<uint8_t> make_clip(const Clip& c) {
 TEST(MeshConformance, Generator) {
   const char* out = std::getenv("CALF_CONFORMANCE_OUT");
   if (!out) GTEST_SKIP() << "set CALF_CONFORMANCE_OUT to write the clips";
-  for (const Clip& c : kClips) {
-    const auto bytes = make_clip(c);
-    std::ofstream f(std::string(out) + "/" + c.name + ".calf", std::ios::binary);
+  auto write = [](const std::string& path, const std::vector<uint8_t>& bytes) {
+    std::ofstream f(path, std::ios::binary);
     f.write(reinterpret_cast<const char*>(bytes.data()),
             static_cast<std::streamsize>(bytes.size()));
-  }
+    ASSERT_TRUE(f.good()) << path;
+  };
+  for (const Clip& c : kClips) write(std::string(out) + "/" + c.name + ".calf", make_clip(c));
+  // Fuzz seeds (tests/fuzz/corpus/mesh_track_fuzz/): the clips, and damaged copies whose chunks
+  // are stored uncompressed with valid hashes, so that mutations reach the track's parsers.
+  const std::string fuzz = std::string(out) + "/fuzz";
+  std::filesystem::create_directories(fuzz);
+  const auto subset = make_clip(kClips[1]);
+  write(fuzz + "/valid_full_none.calf", make_clip(kClips[0]));
+  write(fuzz + "/valid_subset_zstd.calf", subset);
+  write(fuzz + "/valid_subset_none.calf", rebuild(subset, {}));
+  const auto damaged = [&](const char* name, MeshStream stream, uint32_t region, size_t at,
+                           uint8_t value) {
+    Edit e;
+    e.chunk = [=](const container::ChunkKeys& k, std::vector<uint8_t>& raw, bool&) {
+      if (is(k, stream, region) && at < raw.size()) raw[at] = value;
+    };
+    write(fuzz + "/" + name + ".calf", rebuild(subset, e));
+  };
+  damaged("bad_index_version", MeshStream::kIndex, 0, 0, 2);
+  damaged("bad_position_nan", MeshStream::kVertices, 0, 36, 0x7f);
+  damaged("bad_vertex_index", MeshStream::kTriangles, 0, 0, 100);
+  damaged("bad_run_gap", MeshStream::kVisibility, 0, 52, 200);
 }
 
 // The runner: each committed clip decodes to the scene it was made from, and to its hashes.
 TEST(MeshConformance, CommittedClipsDecodeToTheSceneAndTheirHashes) {
-  const capture::SceneFile scene = test::make_mesh_test_scene(3);
-  const auto visible = test_subset();
+  const capture::SceneFile scene = test::make_mesh_test_scene(3, false);
+  const auto visible = test_subset(false);
   for (const Clip& c : kClips) {
     SCOPED_TRACE(c.name);
     const auto bytes =

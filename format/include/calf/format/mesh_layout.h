@@ -101,21 +101,27 @@ struct MaterialRecord {
 };
 static_assert(container::fixed_size<MaterialRecord>() == 24);
 
-// A prototype mesh: its counts and which optional arrays exist. 16 bytes.
+// A prototype mesh: its counts, which optional arrays exist, and whose triangles chunk it uses.
+// 20 bytes.
 struct PrototypeRecord {
   uint32_t vertex_count = 0;
   uint32_t triangle_count = 0;
   uint32_t flags = 0;        // kHasNormals | kHasColours | kHasTriangleMaterials
   uint32_t state_count = 0;  // piecewise-linear vertex states, 0 (static) .. kMaxStates
+  // Its own index p: the prototype has its triangles chunk. An earlier prototype q < p: it has
+  // none and draws q's triangles (identical indices and triangle materials, e.g. two meshes that
+  // are each one analytic sphere); q has its own chunk, the same triangle count and flag bit 2.
+  uint32_t triangles_of = 0;
   template <class Self, class V>
   static constexpr void fields(Self& s, V& v) {
     v(s.vertex_count, "vertex_count");
     v(s.triangle_count, "triangle_count");
     v(s.flags, "flags");
     v(s.state_count, "state_count", container::Range{0, kMaxStates});
+    v(s.triangles_of, "triangles_of");
   }
 };
-static_assert(container::fixed_size<PrototypeRecord>() == 16);
+static_assert(container::fixed_size<PrototypeRecord>() == 20);
 
 // An object: a prototype placed with a material and one transform (static) or one per frame,
 // drawing all of the prototype's triangles or a subset of triangle_count of them. 24 bytes.
