@@ -150,8 +150,8 @@ TEST(MeshPlayback, StatesAndTransformsFollowTheFrame) {
   const Camera cam = eye();
   ASSERT_TRUE((*rep)->prepare(2, std::span<const Camera>(&cam, 1)).ok());
   const MeshDrawList& list = (*rep)->draw_list();
-  // Scene objects in order: floor, tile, mover (x += 0.25 per frame), grass, toys, sun.
-  ASSERT_EQ(list.objects.size(), 6u);
+  // Scene objects in order: floor, tile, mover (x += 0.25 per frame), grass, toys, sun, ...
+  ASSERT_EQ(list.objects.size(), test::make_mesh_test_scene(3).objects.size());
   EXPECT_FLOAT_EQ(list.objects[2].transform[3], 0.5f);
   // The strip (prototype 1) at t = 2 / 24 s, between its states at 0.05 s and 0.1 s, whose top
   // vertices sit 0.1 and 0.2 to the right of the rest pose: 0.1 + 0.1 (t - 0.05) / 0.05.
