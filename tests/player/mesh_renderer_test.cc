@@ -303,6 +303,33 @@ TEST(MeshGlRenderer, EmptyListAndSubsetsAndStructureChecks) {
   EXPECT_EQ((*gl)->render(list, front_camera(8, 8), {}, &im).id(), ErrorId::kMeshGlStructure);
 }
 
+// Near clipping on both: a floor running from behind the eye, clipped at 0.5, shows the same
+// pixels and depths (GL clips in homogeneous coordinates, the CPU in view space).
+TEST(MeshGlRenderer, NearClippingAgreesWithCpu) {
+  REQUIRE_GL();
+  MeshDrawList list = one_object(rectangle(-3, 3, -3, 3, 0));
+  list.objects[0].transform = {1, 0, 0, 0, 0, 0, 1, -0.2f, 0, -1, 0, 0};  // the floor y = -0.2
+  MeshRenderOptions o;
+  o.near = 0.5;
+  auto gl = GlMeshRenderer::make(context()->gl());
+  ASSERT_TRUE(gl.ok());
+  ASSERT_TRUE((*gl)->upload(list).ok());
+  const Camera cam = front_camera(48, 48);
+  RenderedImage g;
+  ASSERT_TRUE((*gl)->render(list, cam, o, &g).ok());
+  const RenderedImage c = cpu(list, cam, o);
+  size_t differing = 0;
+  for (size_t k = 0; k < c.depth.size(); ++k) {
+    const bool same = (std::isinf(g.depth[k]) && std::isinf(c.depth[k])) ||
+                      std::abs(g.depth[k] - c.depth[k]) <= 1e-4f * c.depth[k];
+    differing += same ? 0 : 1;
+  }
+  std::printf("near clipping: %zu of %zu pixels covered (CPU), %zu differ\n", covered(c),
+              c.depth.size(), differing);
+  EXPECT_GT(covered(c), 200u);
+  EXPECT_LE(differing, 48u);  // at most one row: the clip line
+}
+
 // The representation over a draw list: render is the renderer's, and stats count triangles.
 TEST(MeshRepresentation, FromDrawListRendersAndReports) {
   const MeshDrawList list = test::feature_scene();
