@@ -134,6 +134,36 @@ Expected<std::vector<float>> error_map(const RgbImageRef& a, const RgbImageRef& 
   return e;
 }
 
+Expected<MissingGeometry> missing_geometry(const RenderedImage& test,
+                                           const RenderedImage& reference,
+                                           const DepthTolerance& tolerance) {
+  if (!(std::isfinite(tolerance.relative) && tolerance.relative >= 0 &&
+        std::isfinite(tolerance.absolute) && tolerance.absolute >= 0)) {
+    return Status(ErrorId::kImageCompareOption,
+                  "depth tolerance " + std::to_string(tolerance.relative) + " relative, " +
+                      std::to_string(tolerance.absolute) + " absolute is not finite and >= 0");
+  }
+  const size_t n = size_t{test.width} * test.height;
+  if (n == 0 || test.width != reference.width || test.height != reference.height ||
+      test.depth.size() < n || reference.depth.size() < n) {
+    return Status(ErrorId::kImageCompare, "depth images of " + std::to_string(test.width) + " x " +
+                                              std::to_string(test.height) + " and " +
+                                              std::to_string(reference.width) + " x " +
+                                              std::to_string(reference.height) +
+                                              " are empty, differ in size or lack depth values");
+  }
+  MissingGeometry m;
+  m.pixels = n;
+  for (size_t i = 0; i < n; ++i) {
+    const double r = reference.depth[i];
+    if (!std::isfinite(r)) continue;
+    const double t = test.depth[i];
+    if (!(t <= r * (1 + tolerance.relative) + tolerance.absolute)) ++m.missing;
+  }
+  m.epsilon = static_cast<double>(m.missing) / static_cast<double>(n);
+  return m;
+}
+
 std::array<uint8_t, 3> heat_color(double t) {
   // Stops at t = 0, 1/4, 1/2, 3/4, 1: black, blue, cyan, yellow, red.
   static constexpr double kStops[5][3] = {{0, 0, 0}, {0, 0, 1}, {0, 1, 1}, {1, 1, 0}, {1, 0, 0}};

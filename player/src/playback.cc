@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "calf/format/container.h"
+#include "calf/player/mesh_representation.h"
 
 namespace calf::player {
 
@@ -40,10 +41,15 @@ Expected<std::unique_ptr<Playback>> Playback::open(const std::string& clip_path,
                                                            options.lightfield, backend, gl));
       if (impl->lightfield == nullptr) impl->lightfield = lf.get();
       impl->owned.push_back(std::move(lf));
+    } else if (std::holds_alternative<container::MeshTrackHeader>(header)) {
+      CALF_ASSIGN_OR_RETURN(std::unique_ptr<MeshRepresentation> mesh,
+                            MeshRepresentation::open(*impl->reader, static_cast<uint16_t>(t),
+                                                     options.mesh, backend, gl));
+      impl->owned.push_back(std::move(mesh));
     }
   }
   if (impl->owned.empty()) {
-    return Status(ErrorId::kPlaybackClip, clip_path + ": no lightfield track to play");
+    return Status(ErrorId::kPlaybackClip, clip_path + ": no lightfield or mesh track to play");
   }
   impl->volume = impl->owned.front()->view_volume();
   for (const auto& r : impl->owned) {

@@ -1,4 +1,5 @@
-// calf-play: plays a .calf lightfield clip (paper 002 Sec. 6): in a GLFW window with fly / orbit
+// calf-play: plays a .calf clip — its lightfield tracks (paper 002 Sec. 6) and mesh tracks (paper
+// 004's full scene or visible set), composited by depth: in a GLFW window with fly / orbit
 // cameras and a Dear ImGui HUD, or headless through OSMesa along an eye path, writing frames and
 // comparing them with calf-capture's ground truth. Errors are one line with a stable id and exit
 // status 1; usage errors exit 2 (command_line.h).
@@ -15,6 +16,7 @@
 #include "calf/player/contact_sheet.h"
 #include "calf/player/gl_context.h"
 #include "calf/player/image_compare.h"
+#include "calf/player/mesh_representation.h"
 #include "calf/player/playback.h"
 #include "calf_play/play_window.h"
 #include "command_line.h"
@@ -37,6 +39,8 @@ int contradiction(const std::string& message) {
 
 struct HeadlessArgs {
   std::string eye_path, out, compare, format = "png", contact_sheet;
+  // --compare-clip: the full-scene clip played beside CLIP for epsilon (paper 004).
+  std::string compare_clip;
   uint32_t sheet_rows = 8;
   bool heat_maps = true;
 };
@@ -54,8 +58,27 @@ struct SheetTile {
   capture::PerspectiveImage ground_truth;
 };
 
-// Plays `path` pose by pose; poses sharing a time (a stereo pair) are prepared together.
-int run_headless(Playback& play, const HeadlessArgs& a) {
+// Per-pose figures of CLIP against the full-scene clip (--compare-clip).
+struct ClipComparison {
+  double sum_eps = 0, max_eps = 0, sum_psnr = 0, sum_ssim = 0;
+  double min_psnr = INFINITY, min_ssim = INFINITY;
+  size_t max_eps_pose = 0;
+  uint32_t count = 0;
+  std::vector<double> render_ms;  // the full-scene clip's
+};
+
+// Triangles drawn by the mesh representations of `play`, for the per-pose line.
+uint64_t mesh_triangles(const Playback& play) {
+  uint64_t n = 0;
+  for (const Representation* r : play.representations()) {
+    if (const auto* m = dynamic_cast<const MeshRepresentation*>(r)) n += m->triangles_drawn();
+  }
+  return n;
+}
+
+// Plays `path` pose by pose; poses sharing a time (a stereo pair) are prepared together. With
+// `full`, the same poses are rendered from the full-scene clip too and compared (epsilon).
+int run_headless(Playback& play, Playback* full, const HeadlessArgs& a) {
   fs::path gt_dir;
   capture::EyePath path;
   if (!a.compare.empty()) gt_dir = a.compare;
@@ -73,10 +96,10 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
     fs::create_directories(a.out, ec);
     if (ec) return fail(Status(ErrorId::kFileWrite, a.out + ": " + ec.message()));
   }
-  // The light-field figures printed per pose are the first lightfield track's.
-  const LightfieldRepresentation& lf = *play.lightfield();
+  // The light-field figures printed per pose are the first lightfield track's (if any).
+  const LightfieldRepresentation* lf = play.lightfield();
   warn_dropped_views(play);
-  if (lf.options().render.rr && !lf.has_material()) {
+  if (lf != nullptr && lf->options().render.rr && !lf->has_material()) {
     std::fprintf(stderr, "calf-play: notice: the clip has no material stream; --rr is ignored\n");
   }
   double sum_psnr = 0, sum_ssim = 0, sum_decode = 0, sum_mbps = 0;
@@ -88,7 +111,8 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
       a.contact_sheet.empty() ? std::vector<size_t>{}
                               : contact_sheet_poses(path.poses.size(), a.sheet_rows);
   std::vector<SheetTile> sheet;
-  RenderedImage image;
+  RenderedImage image, full_image;
+  ClipComparison cc;
   for (size_t i = 0; i < path.poses.size();) {
     size_t j = i + 1;
     while (j < path.poses.size() && path.poses[j].time == path.poses[i].time) ++j;
@@ -96,7 +120,11 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
     for (size_t k = i; k < j; ++k) eyes.push_back(capture::camera_from_pose(path, k));
     const uint32_t frame = play.frame_at_time(path.poses[i].time);
     if (Status s = play.prepare(frame, eyes); !s.ok()) return fail(s);
-    const auto& st = lf.last_stats();
+    if (full != nullptr) {
+      if (Status s = full->prepare(full->frame_at_time(path.poses[i].time), eyes); !s.ok())
+        return fail(s);
+    }
+    const decoder::FrameStats st = lf != nullptr ? lf->last_stats() : decoder::FrameStats{};
     if (st.errors > 0) {
       std::fprintf(stderr,
                    "calf-play: warning: frame %u: %u damaged chunk(s), last good state "
@@ -125,11 +153,36 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
             return fail(s);
         }
       }
-      std::printf(
-          "pose %zu frame %u: %zu views, %u/%u cells, %.2f Mbps@24, decode %.2f ms, "
-          "render %.1f ms",
-          k, frame, lf.last_selection().active.size(), st.visible_cells, st.total_cells,
-          st.mbps_at_24fps(), st.decode_ms, play.last_render_ms());
+      if (lf != nullptr) {
+        std::printf(
+            "pose %zu frame %u: %zu views, %u/%u cells, %.2f Mbps@24, decode %.2f ms, "
+            "render %.1f ms",
+            k, frame, lf->last_selection().active.size(), st.visible_cells, st.total_cells,
+            st.mbps_at_24fps(), st.decode_ms, play.last_render_ms());
+      } else {
+        std::printf("pose %zu frame %u: %llu triangles, render %.1f ms", k, frame,
+                    static_cast<unsigned long long>(mesh_triangles(play)), play.last_render_ms());
+      }
+      if (full != nullptr) {
+        if (Status s = full->render(cam, &full_image); !s.ok()) return fail(s);
+        auto eps = missing_geometry(image, full_image);
+        if (!eps.ok()) return fail(eps.status());
+        auto p = psnr(rgb_ref(image), rgb_ref(full_image));
+        if (!p.ok()) return fail(p.status());
+        auto s = ssim(rgb_ref(image), rgb_ref(full_image));
+        if (!s.ok()) return fail(s.status());
+        std::printf(", vs full (%.1f ms): epsilon %.4f %%, PSNR %.2f dB, SSIM %.4f",
+                    full->last_render_ms(), 100 * eps->epsilon, *p, *s);
+        cc.sum_eps += eps->epsilon;
+        if (eps->epsilon > cc.max_eps || cc.count == 0)
+          cc.max_eps = eps->epsilon, cc.max_eps_pose = k;
+        cc.sum_psnr += std::min(*p, 100.0);
+        cc.sum_ssim += *s;
+        cc.min_psnr = std::min(cc.min_psnr, *p);
+        cc.min_ssim = std::min(cc.min_ssim, *s);
+        cc.render_ms.push_back(full->last_render_ms());
+        ++cc.count;
+      }
       sum_decode += st.decode_ms;
       sum_mbps += st.mbps_at_24fps();
       decode_ms.push_back(st.decode_ms);
@@ -170,6 +223,20 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
       "%.1f ms, mean %.2f Mbps@24\n",
       path.poses.size(), sum_decode / n, median(decode_ms), first_render, later_render,
       sum_mbps / n);
+  if (cc.count > 0) {
+    const double full_first = cc.render_ms.front();
+    const double full_later = cc.render_ms.size() > 1
+                                  ? median({cc.render_ms.begin() + 1, cc.render_ms.end()})
+                                  : full_first;
+    std::printf(
+        "against the full scene (%u poses): epsilon mean %.4f %% max %.4f %% (pose %zu); PSNR mean "
+        "%.2f dB min %.2f dB; SSIM mean %.4f min %.4f\n",
+        cc.count, 100 * cc.sum_eps / cc.count, 100 * cc.max_eps, cc.max_eps_pose,
+        cc.sum_psnr / cc.count, cc.min_psnr, cc.sum_ssim / cc.count, cc.min_ssim);
+    std::printf(
+        "frame time (median render after the first): %.1f ms this clip, %.1f ms full scene\n",
+        later_render, full_later);
+  }
   if (compared > 0) {
     std::printf("mean PSNR %.2f dB, mean SSIM %.4f\n", sum_psnr / compared, sum_ssim / compared);
     std::printf("worst pose: PSNR %.2f dB (pose %zu), SSIM %.4f (pose %zu)\n", min_psnr,
@@ -193,13 +260,17 @@ int run_headless(Playback& play, const HeadlessArgs& a) {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "calf-play: play a .calf lightfield clip (paper 002 Sec. 6): ray-march reconstruction from "
-      "the nearest viewpoints' colour + depth cube maps, decoded view-dependently.\n"
+      "calf-play: play a .calf clip: lightfield tracks (paper 002 Sec. 6) by ray-march "
+      "reconstruction from the nearest viewpoints' colour + depth cube maps, decoded "
+      "view-dependently; mesh tracks (paper 004: a full scene or its visible set) by "
+      "rasterising their triangles; composited by depth.\n"
       "Window: drag to look, WASD/QE to fly, O orbit, R reflections/refractions (RR), V priority, "
       "+/- active views, Shift+S stereo, space pause, H HUD, Esc quit.\n"
       "Headless (--headless): renders an eye path (calf-capture writes one with --ground-truth) "
       "through OSMesa, writes frames to --out and, with --compare, prints PSNR / SSIM per pose "
-      "and a final 'mean PSNR <x> dB, mean SSIM <y>' line. Output files (frames, heat maps, "
+      "and a final 'mean PSNR <x> dB, mean SSIM <y>' line; with --compare-clip FULL.calf it "
+      "compares with the full scene instead (epsilon, PSNR, SSIM, frame times). Output files "
+      "(frames, heat maps, "
       "contact sheet) are written whole; an existing directory, FIFO, device or symbolic link "
       "in their place is refused (CALF-E004).\n" +
       std::string(tools::kExitStatusHelp)};
@@ -210,7 +281,9 @@ int main(int argc, char** argv) {
   PlaybackOptions play_options;
   LightfieldOptions& o = play_options.lightfield;  // the knobs below are the light field's
   WindowOptions w;
-  app.add_option("CLIP", clip, "the .calf file (its first lightfield track is played)")->required();
+  app.add_option("CLIP", clip,
+                 "the .calf file: every lightfield and mesh track is played, composited by depth")
+      ->required();
   app.add_flag("--headless", headless,
                "render --eye-path (or the --compare directory's path) "
                "without a window, through OSMesa");
@@ -228,6 +301,12 @@ int main(int argc, char** argv) {
                  "ground-truth directory written by calf-capture "
                  "--ground-truth: per-pose PSNR / SSIM and heat maps");
   app.add_flag("!--no-heat-maps", h.heat_maps, "with --compare and --out: do not write heat maps");
+  app.add_option("--compare-clip", h.compare_clip,
+                 "headless: also play FULL.calf (the full scene of a visible-set clip) along the "
+                 "same eye path with the same renderer and print per pose and overall epsilon "
+                 "(paper 004: the share of pixels whose depth lies farther than the full scene's "
+                 "by more than 0.1 %, i.e. where a triangle is missing), PSNR and SSIM against it, "
+                 "and the frame time of both");
   app.add_option("--contact-sheet", h.contact_sheet,
                  "with --compare: write a PNG with one row per "
                  "pose: ground truth | calf | error heat map");
@@ -285,6 +364,9 @@ int main(int argc, char** argv) {
     if (!h.contact_sheet.empty() && h.compare.empty()) {
       return contradiction("--contact-sheet needs --compare");
     }
+    if (!h.compare_clip.empty() && fs::path(h.compare_clip) == fs::path(clip)) {
+      return contradiction("--compare-clip names CLIP itself");
+    }
     std::unique_ptr<OsMesaContext> context;
     const GlFunctions* gl = nullptr;
     if (play_options.use_gl) {
@@ -295,7 +377,16 @@ int main(int argc, char** argv) {
     }
     auto play = Playback::open(clip, play_options, gl);
     if (!play.ok()) return fail(play.status());
-    return run_headless(**play, h);
+    std::unique_ptr<Playback> full;
+    if (!h.compare_clip.empty()) {
+      auto f = Playback::open(h.compare_clip, play_options, gl);
+      if (!f.ok()) return fail(f.status());
+      full = std::move(*f);
+    }
+    return run_headless(**play, full.get(), h);
+  }
+  if (!h.compare_clip.empty()) {
+    return contradiction("--compare-clip works only with --headless");
   }
   if (!play_options.use_gl) {
     return contradiction("--renderer cpu works only with --headless");

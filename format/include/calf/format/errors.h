@@ -147,6 +147,10 @@ enum class ErrorKind : uint8_t {
   X(kViewSelectLimit, 454, kLimit, "more viewpoints than view selection accepts")              \
   X(kPlaybackClip, 460, kInvalidArgument, "the file has nothing calf-play can play")            \
   X(kPlaybackOption, 461, kInvalidArgument, "a calf-play option or eye path is unusable")        \
+  X(kMeshDrawList, 470, kInvalidArgument, "a mesh draw list is inconsistent or not finite")    \
+  X(kMeshRenderOptions, 471, kInvalidArgument, "a mesh render option is outside its range")    \
+  X(kMeshGlStructure, 472, kInvalidArgument, "a mesh draw list differs from its GL upload")    \
+  X(kMeshPlayback, 473, kInvalidArgument, "a mesh track cannot be played as asked")           \
   /* end of the list: every line above ends with a backslash */
 // clang-format on
 

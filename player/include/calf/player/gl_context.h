@@ -94,7 +94,17 @@ using GlGetProc = GlProc (*)(const char* name);
   X(PFNGLCHECKFRAMEBUFFERSTATUSPROC, CheckFramebufferStatus)        \
   X(PFNGLDRAWBUFFERSPROC, DrawBuffers)                              \
   X(PFNGLREADBUFFERPROC, ReadBuffer)                                \
-  X(PFNGLREADPIXELSPROC, ReadPixels)
+  X(PFNGLREADPIXELSPROC, ReadPixels)                                \
+  X(PFNGLENABLEPROC, Enable)                                        \
+  X(PFNGLDEPTHFUNCPROC, DepthFunc)                                  \
+  X(PFNGLCLIPCONTROLPROC, ClipControl)                              \
+  X(PFNGLCLEARBUFFERFVPROC, ClearBufferfv)                          \
+  X(PFNGLDRAWELEMENTSPROC, DrawElements)                            \
+  X(PFNGLVERTEXATTRIBPOINTERPROC, VertexAttribPointer)              \
+  X(PFNGLENABLEVERTEXATTRIBARRAYPROC, EnableVertexAttribArray)      \
+  X(PFNGLDISABLEVERTEXATTRIBARRAYPROC, DisableVertexAttribArray)    \
+  X(PFNGLVERTEXATTRIB3FPROC, VertexAttrib3f)                        \
+  X(PFNGLBUFFERSUBDATAPROC, BufferSubData)
 // clang-format on
 
 // The loaded table plus what the context offers. Valid only while the context it was loaded in

@@ -35,6 +35,7 @@
 #include "calf/capture/eye_path.h"
 #include "calf/format/status.h"
 #include "calf/player/cpu_renderer.h"
+#include "calf/player/rendered_image.h"
 
 namespace calf::player {
 
@@ -60,6 +61,32 @@ Expected<double> psnr(const RgbImageRef& a, const RgbImageRef& b);
 
 // Mean SSIM of the sRGB luma (definition above), in [-1, 1]; 1 for identical images.
 Expected<double> ssim(const RgbImageRef& a, const RgbImageRef& b);
+
+// The pixel error epsilon of paper 004 (Popescu et al., Sec. 5): the share of pixels where a
+// triangle is missing. A pixel counts when the reference (the full scene, rendered by the same
+// renderer at the same pose) shows a surface there, and the image under test shows nothing or a
+// surface farther than it by more than the tolerance:
+//   reference depth r finite  and  not (test depth <= r * (1 + relative) + absolute)
+// (a NaN test depth counts; a NaN or +inf reference depth never does). A test surface nearer
+// than the reference is not counted: a subset of the scene's triangles cannot occlude more. The
+// tolerance absorbs float noise between two renders of the same triangle, which the same renderer
+// makes bit-identical anyway; its default (0.1 % + 1e-6 scene units) lies far below the depth gap
+// a missing triangle leaves on the walk traces of issue 19.
+struct DepthTolerance {
+  double relative = 1e-3;  // >= 0, finite
+  double absolute = 1e-6;  // >= 0, finite
+};
+struct MissingGeometry {
+  uint64_t missing = 0;  // pixels counted
+  uint64_t pixels = 0;   // all pixels of the image
+  double epsilon = 0;    // missing / pixels, in [0, 1]
+};
+// Epsilon of `test` against `reference` (depth buffers of two RenderedImages). Errors: CALF-E431
+// for images of different or zero size or incomplete depth buffers, CALF-E432 for a negative or
+// non-finite tolerance.
+Expected<MissingGeometry> missing_geometry(const RenderedImage& test,
+                                           const RenderedImage& reference,
+                                           const DepthTolerance& tolerance = {});
 
 // Per-pixel error for heat maps: the root mean square over R, G, B of the differences of the
 // sRGB-encoded, clamped values, in [0, 1]; width * height values, row-major from the top row.

@@ -1,6 +1,7 @@
 // Playback of a .calf clip: the loop calf-play runs for each displayed frame, shared by the
 // window, the headless mode and the tests. It holds one representation (representation.h) per
-// playable track — today every lightfield track, played by LightfieldRepresentation — on one
+// playable track — every lightfield track, played by LightfieldRepresentation, and every mesh
+// track (paper 004's full scene or visible set), played by MeshRepresentation — on one
 // backend (GL or the CPU reference), and composites their renders by radial depth: per pixel the
 // nearest surface wins (ties: the earlier track). With one playable track the render is that
 // track's, bit for bit.
@@ -19,6 +20,7 @@
 #include "calf/format/status.h"
 #include "calf/player/gl_context.h"
 #include "calf/player/lightfield_representation.h"
+#include "calf/player/mesh_representation.h"
 #include "calf/player/representation.h"
 
 namespace calf::player {
@@ -29,14 +31,16 @@ struct PlaybackOptions {
   bool use_gl = true;
   // Options of every lightfield track's representation.
   LightfieldOptions lightfield;
+  // Options of every mesh track's representation.
+  MeshOptions mesh;
 };
 
 class Playback {
  public:
   // Opens `clip_path` and a representation for each playable track. `gl` is needed when
   // options.use_gl; the GL context it was loaded from must stay current on this thread. Errors:
-  // the container's and the representations' (LightfieldRepresentation::open); CALF-E460 for a
-  // file without a playable track.
+  // the container's and the representations' (LightfieldRepresentation::open,
+  // MeshRepresentation::open); CALF-E460 for a file without a playable track.
   static Expected<std::unique_ptr<Playback>> open(const std::string& clip_path,
                                                   const PlaybackOptions& options,
                                                   const GlFunctions* gl);

@@ -1,0 +1,236 @@
+// The scalar CPU rasteriser of a mesh draw list: the reference the GL rasteriser is tested against
+// (what it does is in mesh_renderer.h and mesh_draw_list.h).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include "calf/player/mesh_renderer.h"
+
+namespace calf::player {
+namespace {
+
+// A vertex in the camera's frame: x along right, y along up, z along forward (eye at 0).
+struct ViewVertex {
+  double x, y, z;
+};
+
+// A point in image coordinates: x to the right, y down, pixel centres at half-integers.
+struct ImagePoint {
+  double x, y;
+};
+
+// Lexicographic order, so that an edge's computations run in one order whichever triangle asks.
+bool before(const ViewVertex& a, const ViewVertex& b) {
+  if (a.x != b.x) return a.x < b.x;
+  if (a.y != b.y) return a.y < b.y;
+  return a.z < b.z;
+}
+bool before(const ImagePoint& a, const ImagePoint& b) {
+  return a.x != b.x ? a.x < b.x : a.y < b.y;
+}
+
+// The point of edge a-b at z = near (a and b on either side), computed from the edge's endpoints
+// in canonical order so that two triangles sharing the edge clip it to the same point.
+ViewVertex clip_point(ViewVertex a, ViewVertex b, double near) {
+  if (before(b, a)) std::swap(a, b);
+  const double s = (near - a.z) / (b.z - a.z);
+  return {a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), near};
+}
+
+// Sutherland-Hodgman against z >= near: 0, 3 or 4 vertices.
+int clip_near(const std::array<ViewVertex, 3>& in, double near, std::array<ViewVertex, 4>* out) {
+  int n = 0;
+  for (int i = 0; i < 3; ++i) {
+    const ViewVertex& a = in[i];
+    const ViewVertex& b = in[(i + 1) % 3];
+    const bool a_in = a.z >= near, b_in = b.z >= near;
+    if (a_in) (*out)[n++] = a;
+    if (a_in != b_in) (*out)[n++] = clip_point(a, b, near);
+  }
+  return n;
+}
+
+// The edge function of a -> b at p: > 0 on the side the triangle's interior is on once the
+// triangle is oriented (see cover()). Evaluated from the endpoints in canonical order and negated
+// when they were swapped, so the two triangles sharing an edge get exactly opposite values.
+double edge(ImagePoint a, ImagePoint b, double px, double py) {
+  double sign = 1;
+  if (before(b, a)) {
+    std::swap(a, b);
+    sign = -1;
+  }
+  return sign * ((b.x - a.x) * (py - a.y) - (b.y - a.y) * (px - a.x));
+}
+
+// The top-left rule for edge a -> b of a triangle whose interior is on the edge function's
+// positive side: a left edge (interior to its right: the function grows with x) or a top edge
+// (horizontal, interior below it in the y-down image: the function grows with y).
+bool top_left(const ImagePoint& a, const ImagePoint& b) {
+  const double ddx = -(b.y - a.y), ddy = b.x - a.x;
+  return ddx > 0 || (ddx == 0 && ddy > 0);
+}
+
+bool inside(double e, bool tl) {
+  return e > 0 || (e == 0 && tl);
+}
+
+// Everything one triangle's pixels need.
+struct TriangleShade {
+  Vec3 p[3];        // eye-relative world positions
+  Vec3 n[3];        // world normals (vertex normals through the normal matrix), or unused
+  Vec3 colour[3];   // vertex colours (1 when none)
+  Vec3 face;        // unnormalised face normal (p1 - p0) x (p2 - p0)
+  double side = 1;  // -1 when the front faces away from the eye
+  bool vertex_normals = false;
+  const MeshDrawMaterial* material = nullptr;
+};
+
+struct Target {
+  const Camera* camera;
+  const std::vector<Vec3>* rays;
+  RenderedImage* out;
+};
+
+void shade_pixel(const TriangleShade& s, const Target& t, uint32_t i, uint32_t j) {
+  const size_t k = size_t{j} * t.camera->width + i;
+  const Vec3& d = (*t.rays)[k];
+  const double den = dot(s.face, d);
+  if (den == 0) return;
+  const double dist = dot(s.face, s.p[0]) / den;
+  if (!(dist > 0)) return;
+  const float depth = static_cast<float>(dist);
+  if (!(depth < t.out->depth[k])) return;  // ties keep the first drawn
+  const Vec3 x = d * dist;
+  const double nn = dot(s.face, s.face);
+  const double l1 = dot(s.face, cross(x - s.p[0], s.p[2] - s.p[0])) / nn;
+  const double l2 = dot(s.face, cross(s.p[1] - s.p[0], x - s.p[0])) / nn;
+  const double l0 = 1 - l1 - l2;
+  const Vec3 normal = s.vertex_normals ? normalize(s.n[0] * l0 + s.n[1] * l1 + s.n[2] * l2) * s.side
+                                       : normalize(s.face) * s.side;
+  const Vec3 vc = s.colour[0] * l0 + s.colour[1] * l1 + s.colour[2] * l2;
+  const Vec3 light{kMeshKeyLight[0], kMeshKeyLight[1], kMeshKeyLight[2]};
+  const double lit = kMeshAmbient + (1 - double{kMeshAmbient}) * std::max(0.0, dot(normal, light));
+  const MeshDrawMaterial& m = *s.material;
+  const double c[3] = {vc.x, vc.y, vc.z};
+  t.out->depth[k] = depth;
+  for (int ch = 0; ch < 3; ++ch) {
+    t.out->color[3 * k + ch] = static_cast<float>(m.base_colour[ch] * c[ch] * lit + m.emission[ch]);
+  }
+}
+
+// Rasterises the image-space triangle a, b, c (one piece of the clipped triangle) with the
+// top-left rule, shading the covered pixels from the whole triangle `s`.
+void cover(ImagePoint a, ImagePoint b, ImagePoint c, const TriangleShade& s, const Target& t) {
+  const double area = edge(a, b, c.x, c.y);
+  if (area == 0 || !std::isfinite(area)) return;
+  if (area < 0) std::swap(b, c);
+  const bool tl0 = top_left(a, b), tl1 = top_left(b, c), tl2 = top_left(c, a);
+  const double w = t.camera->width, h = t.camera->height;
+  // Pixel centres i + 0.5 within the bounds: i from ceil(min - 0.5) to floor(max - 0.5).
+  const double x0 = std::max(0.0, std::ceil(std::min({a.x, b.x, c.x}) - 0.5));
+  const double x1 = std::min(w - 1, std::floor(std::max({a.x, b.x, c.x}) - 0.5));
+  const double y0 = std::max(0.0, std::ceil(std::min({a.y, b.y, c.y}) - 0.5));
+  const double y1 = std::min(h - 1, std::floor(std::max({a.y, b.y, c.y}) - 0.5));
+  if (!(x0 <= x1 && y0 <= y1)) return;
+  for (double y = y0; y <= y1; ++y) {
+    const double py = y + 0.5;
+    for (double x = x0; x <= x1; ++x) {
+      const double px = x + 0.5;
+      if (inside(edge(a, b, px, py), tl0) && inside(edge(b, c, px, py), tl1) &&
+          inside(edge(c, a, px, py), tl2)) {
+        shade_pixel(s, t, static_cast<uint32_t>(x), static_cast<uint32_t>(y));
+      }
+    }
+  }
+}
+
+}  // namespace
+
+Status render_mesh_cpu(const MeshDrawList& list, const Camera& camera,
+                       const MeshRenderOptions& options, RenderedImage* out) {
+  CALF_RETURN_IF_ERROR(validate_camera(camera));
+  CALF_RETURN_IF_ERROR(validate_mesh_render_options(options));
+  CALF_RETURN_IF_ERROR(validate_mesh_draw_list(list));
+  const uint32_t width = camera.width, height = camera.height;
+  out->width = width;
+  out->height = height;
+  out->color.assign(size_t{3} * width * height, 0.0f);
+  out->depth.assign(size_t{width} * height, std::numeric_limits<float>::infinity());
+  const CameraFrame frame = camera_frame(camera);
+  std::vector<Vec3> rays(size_t{width} * height);
+  for (uint32_t j = 0; j < height; ++j) {
+    for (uint32_t i = 0; i < width; ++i)
+      rays[size_t{j} * width + i] = camera_ray(camera, frame, i, j);
+  }
+  const Target target{&camera, &rays, out};
+  const double h = std::tan(camera.fov_y / 2);
+  const double aspect = static_cast<double>(width) / height;
+  // View coordinates -> image coordinates (the inverse of camera_ray's pixel -> direction).
+  const auto project = [&](const ViewVertex& v) {
+    const double a = v.x / (v.z * h * aspect), b = v.y / (v.z * h);
+    return ImagePoint{(a + 1) * 0.5 * width, (1 - b) * 0.5 * height};
+  };
+
+  for (const MeshDrawObject& object : list.objects) {
+    const MeshDrawPrototype& proto = list.prototypes[object.prototype];
+    const auto& m = object.transform;
+    double r[3][4];
+    for (int row = 0; row < 3; ++row) {
+      for (int col = 0; col < 4; ++col) r[row][col] = m[4 * row + col];
+    }
+    // The eye-relative translation, and the normal matrix (inverse transpose = cofactors / det).
+    const Vec3 offset = Vec3{r[0][3], r[1][3], r[2][3]} - camera.position;
+    double cof[3][3];
+    for (int a = 0; a < 3; ++a) {
+      for (int b = 0; b < 3; ++b) {
+        const int a1 = (a + 1) % 3, a2 = (a + 2) % 3, b1 = (b + 1) % 3, b2 = (b + 2) % 3;
+        cof[a][b] = r[a1][b1] * r[a2][b2] - r[a1][b2] * r[a2][b1];
+      }
+    }
+    const auto world = [&](uint32_t v) {
+      const float* p = &proto.positions[3 * size_t{v}];
+      return Vec3{r[0][0] * p[0] + r[0][1] * p[1] + r[0][2] * p[2],
+                  r[1][0] * p[0] + r[1][1] * p[1] + r[1][2] * p[2],
+                  r[2][0] * p[0] + r[2][1] * p[1] + r[2][2] * p[2]} +
+             offset;
+    };
+    const auto normal = [&](uint32_t v) {
+      const float* n = &proto.normals[3 * size_t{v}];
+      return Vec3{cof[0][0] * n[0] + cof[0][1] * n[1] + cof[0][2] * n[2],
+                  cof[1][0] * n[0] + cof[1][1] * n[1] + cof[1][2] * n[2],
+                  cof[2][0] * n[0] + cof[2][1] * n[1] + cof[2][2] * n[2]};
+    };
+    const size_t count = object.drawn_triangles(proto);
+    for (size_t q = 0; q < count; ++q) {
+      const uint32_t tri = object.all_triangles ? static_cast<uint32_t>(q) : object.triangles[q];
+      TriangleShade s;
+      s.vertex_normals = !proto.normals.empty();
+      std::array<ViewVertex, 3> view;
+      for (int c = 0; c < 3; ++c) {
+        const uint32_t v = proto.indices[3 * size_t{tri} + c];
+        s.p[c] = world(v);
+        if (s.vertex_normals) s.n[c] = normal(v);
+        s.colour[c] = proto.colours.empty()
+                          ? Vec3{1, 1, 1}
+                          : Vec3{proto.colours[3 * size_t{v}], proto.colours[3 * size_t{v} + 1],
+                                 proto.colours[3 * size_t{v} + 2]};
+        view[c] = {dot(s.p[c], frame.right), dot(s.p[c], frame.up), dot(s.p[c], frame.forward)};
+      }
+      s.face = cross(s.p[1] - s.p[0], s.p[2] - s.p[0]);
+      if (!(length(s.face) > 0)) continue;  // degenerate: covers nothing
+      s.side = dot(s.face, s.p[0]) > 0 ? -1 : 1;
+      const uint32_t own =
+          proto.triangle_materials.empty() ? kMeshObjectMaterial : proto.triangle_materials[tri];
+      s.material = &list.materials[own == kMeshObjectMaterial ? object.material : own];
+      std::array<ViewVertex, 4> poly;
+      const int n = clip_near(view, options.near, &poly);
+      if (n < 3) continue;
+      const ImagePoint p0 = project(poly[0]);
+      for (int k = 1; k + 1 < n; ++k) cover(p0, project(poly[k]), project(poly[k + 1]), s, target);
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace calf::player

@@ -1,0 +1,471 @@
+// The OpenGL 4.5 rasteriser of a mesh draw list (mesh_renderer.h). Eye-relative coordinates
+// throughout: the CPU folds the eye into each object's translation in double, so the GPU's floats
+// keep their precision however far the scene lies from the origin.
+#include <array>
+#include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "calf/player/mesh_renderer.h"
+#include "gl_errors.h"
+
+namespace calf::player {
+
+using internal::kGlMissing;
+
+namespace {
+
+constexpr const char* kVertexShader = R"(
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 normal;
+layout(location = 2) in vec3 colour;
+// Object -> eye-relative world: columns of the 3 x 3 part and the translation minus the eye.
+uniform vec3 model_x, model_y, model_z, model_t;
+// The normal matrix (inverse transpose of the 3 x 3 part), by columns.
+uniform vec3 normal_x, normal_y, normal_z;
+// Camera: unit right, up, forward; tan(fov_y / 2) * aspect and tan(fov_y / 2); near distance.
+uniform vec3 cam_right, cam_up, cam_forward;
+uniform float scale_x, scale_y, near_distance;
+out vec3 v_rel;
+out vec3 v_normal;
+out vec3 v_colour;
+void main() {
+  v_rel = model_x * position.x + model_y * position.y + model_z * position.z + model_t;
+  v_normal = normal_x * normal.x + normal_y * normal.y + normal_z * normal.z;
+  v_colour = colour;
+  float z = dot(v_rel, cam_forward);
+  // Reversed Z, infinite far, zero-to-one clip range: depth = near / z, clipped where z < near.
+  gl_Position =
+      vec4(dot(v_rel, cam_right) / scale_x, dot(v_rel, cam_up) / scale_y, near_distance, z);
+}
+)";
+
+constexpr const char* kGeometryShader = R"(
+layout(triangles) in;
+layout(triangle_strip, max_vertices = 3) out;
+in vec3 v_rel[];
+in vec3 v_normal[];
+in vec3 v_colour[];
+out vec3 g_rel;
+out vec3 g_normal;
+out vec3 g_colour;
+flat out vec3 g_base;
+flat out vec3 g_emission;
+struct Material { vec4 base; vec4 emission; };
+layout(std430, binding = 0) readonly buffer Materials { Material materials[]; };
+layout(std430, binding = 1) readonly buffer TriangleMaterials { uint triangle_materials[]; };
+layout(std430, binding = 2) readonly buffer Subset { uint subset[]; };
+uniform bool has_normals, has_triangle_materials, has_subset;
+uniform uint object_material;
+void main() {
+  vec3 face = cross(v_rel[1] - v_rel[0], v_rel[2] - v_rel[0]);
+  // The side the eye sees: flip the normals when the front faces away.
+  float side = dot(face, v_rel[0]) > 0.0 ? -1.0 : 1.0;
+  vec3 face_normal = normalize(face) * side;
+  uint triangle = has_subset ? subset[gl_PrimitiveIDIn] : uint(gl_PrimitiveIDIn);
+  uint m = has_triangle_materials ? triangle_materials[triangle] : object_material;
+  if (m == 0xffffffffu) m = object_material;  // kMeshObjectMaterial
+  for (int i = 0; i < 3; ++i) {
+    gl_Position = gl_in[i].gl_Position;
+    g_rel = v_rel[i];
+    g_normal = has_normals ? v_normal[i] * side : face_normal;
+    g_colour = v_colour[i];
+    g_base = materials[m].base.rgb;
+    g_emission = materials[m].emission.rgb;
+    EmitVertex();
+  }
+  EndPrimitive();
+}
+)";
+
+constexpr const char* kFragmentShader = R"(
+in vec3 g_rel;
+in vec3 g_normal;
+in vec3 g_colour;
+flat in vec3 g_base;
+flat in vec3 g_emission;
+uniform vec3 light;
+uniform float ambient;
+layout(location = 0) out vec4 out_colour;
+void main() {
+  vec3 n = normalize(g_normal);
+  float lit = ambient + (1.0 - ambient) * max(0.0, dot(n, light));
+  out_colour = vec4(g_base * g_colour * lit + g_emission, length(g_rel));
+}
+)";
+
+Expected<GLuint> compile(const GlFunctions& gl, GLenum type, const char* body, const char* what) {
+  const std::string source = std::string("#version 450 core\n") + body;
+  const GLuint shader = gl.CreateShader(type);
+  const char* text = source.c_str();
+  gl.ShaderSource(shader, 1, &text, nullptr);
+  gl.CompileShader(shader);
+  GLint ok = 0;
+  gl.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    std::vector<char> log(8192, '\0');
+    gl.GetShaderInfoLog(shader, static_cast<GLsizei>(log.size()), nullptr, log.data());
+    gl.DeleteShader(shader);
+    return Status(kGlMissing,
+                  std::string("the mesh ") + what + " shader does not compile: " + log.data());
+  }
+  return shader;
+}
+
+Status structure_error(const std::string& what) {
+  return Status(ErrorId::kMeshGlStructure, what + " (upload the draw list again)");
+}
+
+template <class T>
+GLuint make_buffer(const GlFunctions& gl, GLenum target, const std::vector<T>& data) {
+  GLuint b = 0;
+  gl.GenBuffers(1, &b);
+  gl.BindBuffer(target, b);
+  // A zero-sized store is legal but cannot be bound as a storage range: keep one element.
+  const std::vector<T> one(1);
+  const std::vector<T>& d = data.empty() ? one : data;
+  gl.BufferData(target, static_cast<GLsizeiptr>(d.size() * sizeof(T)), d.data(), GL_STATIC_DRAW);
+  return b;
+}
+
+}  // namespace
+
+Expected<std::unique_ptr<GlMeshRenderer>> GlMeshRenderer::make(const GlFunctions& gl) {
+  std::unique_ptr<GlMeshRenderer> r(new GlMeshRenderer(gl));
+  CALF_RETURN_IF_ERROR(r->build_program());
+  return r;
+}
+
+GlMeshRenderer::~GlMeshRenderer() {
+  release_buffers();
+  const GlFunctions& gl = *gl_;
+  if (program_ != 0) gl.DeleteProgram(program_);
+  if (fbo_ != 0) gl.DeleteFramebuffers(1, &fbo_);
+  if (colour_target_ != 0) gl.DeleteTextures(1, &colour_target_);
+  if (depth_target_ != 0) gl.DeleteTextures(1, &depth_target_);
+}
+
+Status GlMeshRenderer::build_program() {
+  const GlFunctions& gl = *gl_;
+  const std::array<std::pair<GLenum, const char*>, 3> stages = {
+      {{GL_VERTEX_SHADER, kVertexShader},
+       {GL_GEOMETRY_SHADER, kGeometryShader},
+       {GL_FRAGMENT_SHADER, kFragmentShader}}};
+  const char* names[3] = {"vertex", "geometry", "fragment"};
+  std::vector<GLuint> shaders;
+  for (size_t i = 0; i < stages.size(); ++i) {
+    Expected<GLuint> s = compile(gl, stages[i].first, stages[i].second, names[i]);
+    if (!s.ok()) {
+      for (GLuint done : shaders) gl.DeleteShader(done);
+      return s.status();
+    }
+    shaders.push_back(*s);
+  }
+  program_ = gl.CreateProgram();
+  for (GLuint s : shaders) gl.AttachShader(program_, s);
+  gl.LinkProgram(program_);
+  for (GLuint s : shaders) gl.DeleteShader(s);
+  GLint ok = 0;
+  gl.GetProgramiv(program_, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    std::vector<char> log(8192, '\0');
+    gl.GetProgramInfoLog(program_, static_cast<GLsizei>(log.size()), nullptr, log.data());
+    return Status(kGlMissing, std::string("the mesh program does not link: ") + log.data());
+  }
+  const auto loc = [&](const char* name) { return gl.GetUniformLocation(program_, name); };
+  uniforms_ = {loc("model_x"),    loc("model_y"),        loc("model_z"),
+               loc("model_t"),    loc("normal_x"),       loc("normal_y"),
+               loc("normal_z"),   loc("has_normals"),    loc("has_triangle_materials"),
+               loc("has_subset"), loc("object_material")};
+  return check_gl_error(gl, "building the mesh program");
+}
+
+void GlMeshRenderer::release_buffers() {
+  const GlFunctions& gl = *gl_;
+  for (PrototypeBuffers& p : prototypes_) {
+    const GLuint buffers[] = {p.positions, p.normals, p.colours, p.indices, p.triangle_materials};
+    for (GLuint b : buffers) {
+      if (b != 0) gl.DeleteBuffers(1, &b);
+    }
+    if (p.vao != 0) gl.DeleteVertexArrays(1, &p.vao);
+  }
+  for (ObjectBuffers& o : objects_) {
+    if (o.indices != 0) gl.DeleteBuffers(1, &o.indices);
+    if (o.triangles != 0) gl.DeleteBuffers(1, &o.triangles);
+  }
+  if (materials_ != 0) gl.DeleteBuffers(1, &materials_);
+  materials_ = 0;
+  prototypes_.clear();
+  objects_.clear();
+}
+
+Status GlMeshRenderer::upload(const MeshDrawList& list) {
+  CALF_RETURN_IF_ERROR(validate_mesh_draw_list(list));
+  const GlFunctions& gl = *gl_;
+  release_buffers();
+  for (const MeshDrawPrototype& p : list.prototypes) {
+    PrototypeBuffers b;
+    b.vertex_count = static_cast<uint32_t>(p.vertex_count());
+    b.triangle_count = static_cast<uint32_t>(p.triangle_count());
+    b.has_normals = !p.normals.empty();
+    b.has_colours = !p.colours.empty();
+    b.has_triangle_materials = !p.triangle_materials.empty();
+    gl.GenVertexArrays(1, &b.vao);
+    gl.BindVertexArray(b.vao);
+    b.positions = make_buffer(gl, GL_ARRAY_BUFFER, p.positions);
+    gl.VertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+    gl.EnableVertexAttribArray(0);
+    // Absent normals / colours: the attribute reads the constant set at draw time.
+    if (b.has_normals) {
+      b.normals = make_buffer(gl, GL_ARRAY_BUFFER, p.normals);
+      gl.VertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+      gl.EnableVertexAttribArray(1);
+    }
+    if (b.has_colours) {
+      b.colours = make_buffer(gl, GL_ARRAY_BUFFER, p.colours);
+      gl.VertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+      gl.EnableVertexAttribArray(2);
+    }
+    b.indices = make_buffer(gl, GL_ELEMENT_ARRAY_BUFFER, p.indices);
+    gl.BindVertexArray(0);
+    if (b.has_triangle_materials) {
+      b.triangle_materials = make_buffer(gl, GL_SHADER_STORAGE_BUFFER, p.triangle_materials);
+    }
+    prototypes_.push_back(b);
+  }
+  for (const MeshDrawObject& o : list.objects) {
+    ObjectBuffers b;
+    b.prototype = o.prototype;
+    b.all_triangles = o.all_triangles;
+    b.drawn = static_cast<uint32_t>(o.drawn_triangles(list.prototypes[o.prototype]));
+    if (!o.all_triangles) {
+      // The subset's own index buffer (subsets do not change between frames) and its triangle
+      // numbers, which the geometry shader maps primitives through.
+      const std::vector<uint32_t>& all = list.prototypes[o.prototype].indices;
+      std::vector<uint32_t> indices;
+      indices.reserve(3 * o.triangles.size());
+      for (uint32_t t : o.triangles) {
+        for (int c = 0; c < 3; ++c) indices.push_back(all[3 * size_t{t} + c]);
+      }
+      // Created through GL_ARRAY_BUFFER (buffers are typeless): no vertex array is bound here.
+      b.indices = make_buffer(gl, GL_ARRAY_BUFFER, indices);
+      b.triangles = make_buffer(gl, GL_SHADER_STORAGE_BUFFER, o.triangles);
+    }
+    objects_.push_back(b);
+  }
+  gl.BindBuffer(GL_ARRAY_BUFFER, 0);
+  CALF_RETURN_IF_ERROR(update_materials(list));
+  return check_gl_error(gl, "uploading the mesh buffers");
+}
+
+Status GlMeshRenderer::update_materials(const MeshDrawList& list) {
+  const GlFunctions& gl = *gl_;
+  std::vector<float> packed;  // std430: vec4 base, vec4 emission
+  for (const MeshDrawMaterial& m : list.materials) {
+    for (float v : m.base_colour) packed.push_back(v);
+    packed.push_back(0);
+    for (float v : m.emission) packed.push_back(v);
+    packed.push_back(0);
+  }
+  if (materials_ != 0) gl.DeleteBuffers(1, &materials_);
+  materials_ = make_buffer(gl, GL_SHADER_STORAGE_BUFFER, packed);
+  material_count_ = list.materials.size();
+  return check_gl_error(gl, "uploading the mesh materials");
+}
+
+Status GlMeshRenderer::check_structure(const MeshDrawList& list) const {
+  if (list.prototypes.size() != prototypes_.size() || list.objects.size() != objects_.size() ||
+      list.materials.size() != material_count_) {
+    return structure_error("the draw list has " + std::to_string(list.prototypes.size()) +
+                           " prototypes, " + std::to_string(list.objects.size()) + " objects and " +
+                           std::to_string(list.materials.size()) + " materials, the upload " +
+                           std::to_string(prototypes_.size()) + ", " +
+                           std::to_string(objects_.size()) + " and " +
+                           std::to_string(material_count_));
+  }
+  for (size_t p = 0; p < prototypes_.size(); ++p) {
+    const MeshDrawPrototype& lp = list.prototypes[p];
+    if (lp.vertex_count() != prototypes_[p].vertex_count ||
+        lp.triangle_count() != prototypes_[p].triangle_count) {
+      return structure_error("prototype " + std::to_string(p) +
+                             " changed its vertex or triangle count");
+    }
+  }
+  for (size_t o = 0; o < objects_.size(); ++o) {
+    const MeshDrawObject& lo = list.objects[o];
+    if (lo.prototype != objects_[o].prototype || lo.all_triangles != objects_[o].all_triangles ||
+        lo.drawn_triangles(list.prototypes[lo.prototype]) != objects_[o].drawn) {
+      return structure_error("object " + std::to_string(o) + " changed its prototype or subset");
+    }
+  }
+  return Status::Ok();
+}
+
+Status GlMeshRenderer::update_positions(const MeshDrawList& list, uint32_t prototype) {
+  CALF_RETURN_IF_ERROR(check_structure(list));
+  if (prototype >= prototypes_.size()) {
+    return structure_error("prototype " + std::to_string(prototype) + " was not uploaded");
+  }
+  const std::vector<float>& p = list.prototypes[prototype].positions;
+  for (float x : p) {
+    if (!std::isfinite(x)) {
+      return Status(ErrorId::kMeshDrawList,
+                    "prototype " + std::to_string(prototype) + ": a position is not finite");
+    }
+  }
+  if (p.empty()) return Status::Ok();
+  const GlFunctions& gl = *gl_;
+  gl.BindBuffer(GL_ARRAY_BUFFER, prototypes_[prototype].positions);
+  gl.BufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(p.size() * sizeof(float)), p.data());
+  gl.BindBuffer(GL_ARRAY_BUFFER, 0);
+  return check_gl_error(gl, "updating mesh positions");
+}
+
+Status GlMeshRenderer::ensure_target(uint32_t width, uint32_t height) {
+  if (colour_target_ != 0 && width == target_width_ && height == target_height_) {
+    return Status::Ok();
+  }
+  const GlFunctions& gl = *gl_;
+  if (colour_target_ != 0) gl.DeleteTextures(1, &colour_target_);
+  if (depth_target_ != 0) gl.DeleteTextures(1, &depth_target_);
+  if (fbo_ == 0) gl.GenFramebuffers(1, &fbo_);
+  const auto w = static_cast<GLsizei>(width), h = static_cast<GLsizei>(height);
+  gl.GenTextures(1, &colour_target_);
+  gl.BindTexture(GL_TEXTURE_2D, colour_target_);
+  gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, w, h);
+  gl.GenTextures(1, &depth_target_);
+  gl.BindTexture(GL_TEXTURE_2D, depth_target_);
+  gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_DEPTH_COMPONENT32F, w, h);
+  gl.BindTexture(GL_TEXTURE_2D, 0);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, colour_target_, 0);
+  gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, depth_target_, 0);
+  const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
+  CALF_RETURN_IF_ERROR(check_gl_error(gl, "creating the mesh render target"));
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    return Status(kGlMissing, "an RGBA32F + DEPTH32F framebuffer of " + std::to_string(width) +
+                                  " x " + std::to_string(height) + " is not complete");
+  }
+  target_width_ = width;
+  target_height_ = height;
+  return Status::Ok();
+}
+
+Status GlMeshRenderer::render(const MeshDrawList& list, const Camera& camera,
+                              const MeshRenderOptions& options, RenderedImage* out) {
+  CALF_RETURN_IF_ERROR(validate_camera(camera));
+  CALF_RETURN_IF_ERROR(validate_mesh_render_options(options));
+  CALF_RETURN_IF_ERROR(check_structure(list));
+  const GlFunctions& gl = *gl_;
+  CALF_RETURN_IF_ERROR(ensure_target(camera.width, camera.height));
+  gl.BindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  const GLenum buffer = GL_COLOR_ATTACHMENT0;
+  gl.DrawBuffers(1, &buffer);
+  gl.Viewport(0, 0, static_cast<GLsizei>(camera.width), static_cast<GLsizei>(camera.height));
+  const float clear_colour[4] = {0, 0, 0, INFINITY};
+  const float clear_depth = 0;  // reversed Z: 0 is infinitely far
+  gl.ClearBufferfv(GL_COLOR, 0, clear_colour);
+  gl.ClearBufferfv(GL_DEPTH, 0, &clear_depth);
+  for (GLenum cap : {GL_BLEND, GL_SCISSOR_TEST, GL_CULL_FACE, GL_STENCIL_TEST}) gl.Disable(cap);
+  gl.Enable(GL_DEPTH_TEST);
+  gl.DepthFunc(GL_GREATER);
+  gl.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  gl.UseProgram(program_);
+  const auto loc = [&](const char* name) { return gl.GetUniformLocation(program_, name); };
+  const auto f = [](double x) { return static_cast<float>(x); };
+  const auto vec3 = [&](const char* name, const Vec3& v) {
+    gl.Uniform3f(loc(name), f(v.x), f(v.y), f(v.z));
+  };
+  const CameraFrame frame = camera_frame(camera);
+  const double h = std::tan(camera.fov_y / 2);
+  vec3("cam_right", frame.right);
+  vec3("cam_up", frame.up);
+  vec3("cam_forward", frame.forward);
+  gl.Uniform1f(loc("scale_x"), f(h * camera.width / camera.height));
+  gl.Uniform1f(loc("scale_y"), f(h));
+  gl.Uniform1f(loc("near_distance"), f(options.near));
+  gl.Uniform3f(loc("light"), kMeshKeyLight[0], kMeshKeyLight[1], kMeshKeyLight[2]);
+  gl.Uniform1f(loc("ambient"), kMeshAmbient);
+  gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, materials_);
+  const ObjectUniforms& u = uniforms_;
+  const auto at = [&](GLint location, const Vec3& v) {
+    gl.Uniform3f(location, f(v.x), f(v.y), f(v.z));
+  };
+
+  for (size_t o = 0; o < objects_.size(); ++o) {
+    const ObjectBuffers& ob = objects_[o];
+    if (ob.drawn == 0) continue;
+    const PrototypeBuffers& pb = prototypes_[ob.prototype];
+    const MeshDrawObject& lo = list.objects[o];
+    const auto& m = lo.transform;
+    double r[3][4];
+    for (int row = 0; row < 3; ++row) {
+      for (int col = 0; col < 4; ++col) r[row][col] = m[4 * row + col];
+    }
+    at(u.model_x, {r[0][0], r[1][0], r[2][0]});
+    at(u.model_y, {r[0][1], r[1][1], r[2][1]});
+    at(u.model_z, {r[0][2], r[1][2], r[2][2]});
+    at(u.model_t, Vec3{r[0][3], r[1][3], r[2][3]} - camera.position);
+    // Inverse transpose up to a positive factor: the cofactor matrix (normals are normalised).
+    double cof[3][3];
+    for (int a = 0; a < 3; ++a) {
+      for (int b = 0; b < 3; ++b) {
+        const int a1 = (a + 1) % 3, a2 = (a + 2) % 3, b1 = (b + 1) % 3, b2 = (b + 2) % 3;
+        cof[a][b] = r[a1][b1] * r[a2][b2] - r[a1][b2] * r[a2][b1];
+      }
+    }
+    at(u.normal_x, {cof[0][0], cof[1][0], cof[2][0]});
+    at(u.normal_y, {cof[0][1], cof[1][1], cof[2][1]});
+    at(u.normal_z, {cof[0][2], cof[1][2], cof[2][2]});
+    gl.Uniform1i(u.has_normals, pb.has_normals ? 1 : 0);
+    gl.Uniform1i(u.has_triangle_materials, pb.has_triangle_materials ? 1 : 0);
+    gl.Uniform1i(u.has_subset, ob.all_triangles ? 0 : 1);
+    gl.Uniform1ui(u.object_material, lo.material);
+    gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1,
+                      pb.has_triangle_materials ? pb.triangle_materials : materials_);
+    gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, ob.all_triangles ? materials_ : ob.triangles);
+    gl.BindVertexArray(pb.vao);
+    if (!pb.has_normals) gl.VertexAttrib3f(1, 0, 0, 1);
+    if (!pb.has_colours) gl.VertexAttrib3f(2, 1, 1, 1);
+    if (!ob.all_triangles) gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, ob.indices);
+    gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * ob.drawn), GL_UNSIGNED_INT, nullptr);
+    // Give the vertex array its own index buffer back for the next object of this prototype.
+    if (!ob.all_triangles) gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, pb.indices);
+    gl.BindVertexArray(0);
+  }
+
+  // Leave the state other renderers (the light field's full-screen pass, the HUD) expect.
+  gl.Disable(GL_DEPTH_TEST);
+  gl.ClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+  CALF_RETURN_IF_ERROR(check_gl_error(gl, "drawing the mesh"));
+
+  const size_t w = camera.width, hh = camera.height;
+  std::vector<float> rgba(4 * w * hh);
+  gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+  gl.PixelStorei(GL_PACK_ROW_LENGTH, 0);
+  gl.PixelStorei(GL_PACK_SKIP_PIXELS, 0);
+  gl.PixelStorei(GL_PACK_SKIP_ROWS, 0);
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
+  gl.ReadPixels(0, 0, static_cast<GLsizei>(w), static_cast<GLsizei>(hh), GL_RGBA, GL_FLOAT,
+                rgba.data());
+  gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+  CALF_RETURN_IF_ERROR(check_gl_error(gl, "reading back the mesh frame"));
+  out->width = camera.width;
+  out->height = camera.height;
+  out->color.resize(3 * w * hh);
+  out->depth.resize(w * hh);
+  // GL rows run bottom-up; the image's row 0 is the top.
+  for (size_t j = 0; j < hh; ++j) {
+    const float* row = &rgba[4 * w * (hh - 1 - j)];
+    for (size_t i = 0; i < w; ++i) {
+      const size_t k = j * w + i;
+      for (int ch = 0; ch < 3; ++ch) out->color[3 * k + ch] = row[4 * i + ch];
+      out->depth[k] = row[4 * i + 3];
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace calf::player
