@@ -147,6 +147,8 @@ enum class ErrorKind : uint8_t {
   X(kViewSelectLimit, 454, kLimit, "more viewpoints than view selection accepts")              \
   X(kPlaybackClip, 460, kInvalidArgument, "the file has nothing calf-play can play")            \
   X(kPlaybackOption, 461, kInvalidArgument, "a calf-play option or eye path is unusable")        \
+  X(kExportInput, 480, kInvalidArgument, "a track cannot be exported as asked")                \
+  X(kExportWrite, 481, kInternal, "the glTF / OBJ exporter failed")                             \
   /* end of the list: every line above ends with a backslash */
 // clang-format on
 
