@@ -28,6 +28,9 @@ PACKAGES=(
   ffmpeg zstd xz-utils gnuplot-nox
 )
 
+# node and npm for the glTF-Validator below, from Debian when the machine has none.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then PACKAGES+=(nodejs npm); fi
+
 missing=()
 for p in "${PACKAGES[@]}"; do
   if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
@@ -35,8 +38,25 @@ for p in "${PACKAGES[@]}"; do
   fi
 done
 
+# Khronos' glTF-Validator (npm), the second glTF reader of the export tests
+# (tests/export/gltf_validate.js), pinned, into build/npm; node and npm from Debian when the
+# machine has none.
+GLTF_VALIDATOR_VERSION=2.0.0-dev.3.10
+install_gltf_validator() {
+  local dir
+  dir="$(cd "$(dirname "$0")/.." && pwd)/build/npm"
+  if [ -f "$dir/node_modules/gltf-validator/package.json" ] &&
+     grep -q "\"version\": \"$GLTF_VALIDATOR_VERSION\"" "$dir/node_modules/gltf-validator/package.json"; then
+    return
+  fi
+  mkdir -p "$dir"
+  npm install --no-save --no-audit --no-fund --loglevel=error --prefix "$dir" \
+    "gltf-validator@$GLTF_VALIDATOR_VERSION" >/dev/null
+  echo "calf setup: glTF-Validator $GLTF_VALIDATOR_VERSION installed in $dir"
+}
 if [ ${#missing[@]} -eq 0 ]; then
   echo "calf setup: all ${#PACKAGES[@]} packages already installed"
+  install_gltf_validator
   exit 0
 fi
 
@@ -47,3 +67,4 @@ export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 echo "calf setup: done"
+install_gltf_validator

@@ -151,6 +151,8 @@ enum class ErrorKind : uint8_t {
   X(kMeshRenderOptions, 471, kInvalidArgument, "a mesh render option is outside its range")    \
   X(kMeshGlStructure, 472, kInvalidArgument, "a mesh draw list differs from its GL upload")    \
   X(kMeshPlayback, 473, kInvalidArgument, "a mesh track cannot be played as asked")           \
+  X(kExportInput, 480, kInvalidArgument, "a track cannot be exported as asked")                \
+  X(kExportWrite, 481, kInternal, "the glTF / OBJ exporter failed")                             \
   /* end of the list: every line above ends with a backslash */
 // clang-format on
 

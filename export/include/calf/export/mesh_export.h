@@ -1,0 +1,64 @@
+// Exporting a mesh track (format/SPEC.md §11.4) to the formats engines import: glTF 2.0 binary
+// (.glb), glTF 2.0 with its buffer embedded (.gltf) and Wavefront OBJ (+ .mtl). The scene is
+// built as an assimp scene and written by assimp's own exporters (DESIGN.md: no hand-written
+// glTF), so a visible set computed by calf drops into Unity, Unreal, Blender or three.js.
+//
+// What is exported, at one frame of the track:
+//   - one node per object, named "object <i>" (or "object <i>: <prototype i>"), carrying the
+//     object's transform at that frame as its node matrix;
+//   - one mesh per prototype that an object draws whole (objects sharing it share the mesh: glTF
+//     instancing), and one mesh per object drawing a subset, holding only the vertices its
+//     triangles use; positions at the frame's time when the prototype has vertex states;
+//   - normals (the prototype's, or none: the importer computes flat ones), vertex colours
+//     (linear, as COLOR_0) and materials (base colour and emission); triangles with a
+//     per-triangle material are split into one mesh per material, as glTF primitives carry one
+//     material each.
+// Triangle counts are preserved exactly: the export of a track whose objects draw T triangles in
+// all holds T triangles.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "calf/decoder/mesh_track.h"
+#include "calf/format/status.h"
+
+namespace calf::exporter {
+
+enum class MeshExportFormat : uint8_t {
+  kGlb,   // glTF 2.0 binary, one file (assimp "glb2")
+  kGltf,  // glTF 2.0 JSON plus its binary buffer <stem>.bin (assimp "gltf2"): two files
+  kObj,   // Wavefront OBJ plus its .mtl (assimp "obj"): two files
+};
+
+// The format named by a file extension (".glb", ".gltf", ".obj", any case), or an error
+// (CALF-E480) naming the extension.
+Expected<MeshExportFormat> mesh_export_format_from_path(const std::string& path);
+
+// One file of an export: its name suffix ("" for the main file, ".bin" for a .gltf's buffer,
+// ".mtl" for OBJ's material library) and its bytes.
+struct ExportedFile {
+  std::string suffix;
+  std::vector<uint8_t> bytes;
+};
+
+struct MeshExportStats {
+  uint64_t objects = 0;    // nodes written
+  uint64_t meshes = 0;     // meshes written (after splitting by material)
+  uint64_t vertices = 0;   // over meshes
+  uint64_t triangles = 0;  // over objects (instances counted each time)
+};
+
+// Exports `track` at `frame` (< frame_count, else CALF-E480) in `format`. The side files are
+// meant to be written as `<stem><suffix>` beside the main file (stem: the main file's name
+// without its extension), and the main file refers to them by those names. Errors: the track's
+// decoding errors (naming the object or prototype), CALF-E480 for a frame out of range, an empty
+// track or a stem of other characters than A-Z a-z 0-9 _ - . (for .gltf / .obj), CALF-E481 when
+// assimp's exporter fails (its message quoted).
+Expected<std::vector<ExportedFile>> export_mesh_track(const decoder::MeshTrack& track,
+                                                      uint32_t frame, MeshExportFormat format,
+                                                      const std::string& stem,
+                                                      MeshExportStats* stats = nullptr);
+
+}  // namespace calf::exporter

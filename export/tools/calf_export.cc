@@ -1,0 +1,114 @@
+// calf-export: a mesh track of a .calf clip (a full scene or its visible set) to glTF 2.0 (.glb /
+// .gltf) or OBJ (+ .mtl) through assimp's exporters (calf/export/mesh_export.h, docs/EXPORT.md).
+// Errors are one line with a stable id and exit status 1; usage errors exit 2; every file is
+// written whole or not at all.
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include "calf/decoder/mesh_track.h"
+#include "calf/export/mesh_export.h"
+#include "calf/format/container.h"
+#include "calf/format/files.h"
+#include "command_line.h"
+
+namespace {
+
+constexpr const char* kCommand = "calf-export";
+
+int fail(const calf::Status& status) {
+  return calf::tools::print_error(kCommand, status);
+}
+
+std::string file_name(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "calf-export: write a mesh track of a .calf clip (the full scene or its visible set, "
+      "calf-encode --mode mesh) as glTF 2.0 or OBJ for engines (docs/EXPORT.md).\n"
+      "The format follows the output's extension: .glb (binary glTF, one file), .gltf (glTF JSON "
+      "with its buffer OUT.bin beside it) or .obj (with its material library OUT.mtl beside it). "
+      "Objects become nodes with their transform at --frame; objects drawing a whole prototype "
+      "share its mesh (glTF instancing); a visible-set object gets a mesh of its visible "
+      "triangles only. Vertex colours, normals and material base colour / emission (clamped to "
+      "1) are kept. Each file is written whole or not at all (a temporary file renamed into "
+      "place).\n" +
+      std::string(calf::tools::kExitStatusHelp)};
+  std::string clip, out;
+  uint32_t frame = 0;
+  int track_option = -1;
+  bool quiet = false;
+  app.add_option("CLIP", clip, "input .calf holding a mesh track")->required();
+  app.add_option("-o,--output", out, "output .glb, .gltf or .obj")->required();
+  app.add_option("--frame", frame,
+                 "the frame whose transforms and vertex states are exported (default 0)")
+      ->default_val(0);
+  app.add_option("--track", track_option,
+                 "index of the mesh track in the clip (default: the first mesh track)");
+  app.add_flag("-q,--quiet", quiet, "print nothing on success");
+  if (const int exit = calf::tools::parse_command_line(app, kCommand, argc, argv); exit >= 0) {
+    return exit;
+  }
+
+  auto format = calf::exporter::mesh_export_format_from_path(out);
+  if (!format.ok()) return calf::tools::print_error(kCommand, format.status(), 2);
+  auto reader = calf::container::Reader::open(clip);
+  if (!reader.ok()) return fail(reader.status());
+  const auto& tracks = reader.value().tracks();
+  int track = track_option;
+  if (track < 0) {
+    for (size_t i = 0; i < tracks.size(); ++i) {
+      if (tracks[i].record.kind == static_cast<uint16_t>(calf::container::TrackKind::kMesh)) {
+        track = static_cast<int>(i);
+        break;
+      }
+    }
+    if (track < 0) {
+      return fail(calf::Status(calf::ErrorId::kExportInput, clip + ": the clip has no mesh track"));
+    }
+  }
+  if (static_cast<size_t>(track) >= tracks.size() ||
+      tracks[track].record.kind != static_cast<uint16_t>(calf::container::TrackKind::kMesh)) {
+    return fail(calf::Status(calf::ErrorId::kExportInput,
+                             fmt::format("{}: track {} is not a mesh track", clip, track)));
+  }
+  auto mesh = calf::decoder::MeshTrack::open(reader.value(), static_cast<uint16_t>(track));
+  if (!mesh.ok()) return fail(mesh.status().with_context(clip));
+
+  // The side files (.bin of a .gltf, .mtl of an .obj) go beside the output, named after it.
+  const std::string base = out.substr(0, out.find_last_of('.'));
+  calf::exporter::MeshExportStats stats;
+  auto files = calf::exporter::export_mesh_track(mesh.value(), frame, format.value(),
+                                                 file_name(base), &stats);
+  if (!files.ok()) return fail(files.status().with_context(clip));
+
+  // Every file is written to its temporary name first and renamed only when all were written.
+  std::vector<calf::files::TempFile> temps;
+  for (const auto& file : files.value()) {
+    std::string path = out;
+    if (!file.suffix.empty()) path = base + file.suffix;
+    auto temp = calf::files::TempFile::create(path);
+    if (!temp.ok()) return fail(temp.status());
+    if (calf::Status s = temp.value().write(file.bytes); !s.ok()) return fail(s);
+    temps.push_back(std::move(temp.value()));
+  }
+  for (auto& temp : temps) {
+    if (calf::Status s = temp.commit(); !s.ok()) return fail(s);
+  }
+  if (!quiet) {
+    std::printf("%s: frame %u: %llu objects, %llu meshes, %llu vertices, %llu triangles\n",
+                out.c_str(), frame, static_cast<unsigned long long>(stats.objects),
+                static_cast<unsigned long long>(stats.meshes),
+                static_cast<unsigned long long>(stats.vertices),
+                static_cast<unsigned long long>(stats.triangles));
+  }
+  return calf::tools::kExitOk;
+}
