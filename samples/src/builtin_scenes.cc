@@ -363,10 +363,9 @@ const std::vector<SceneInfo>& builtin_scenes() {
        "a hall with animation in one corner, thin geometry, changing light (Sponza/Robot)"},
       {"mirror-box", "a box with a moving mirror sphere and glass sphere, material output"},
       {"city",
-       "streets of instanced buildings with windows, seen from a crossing: TRIS_CITY triangles"},
-      {"blades", "a field of thin grass blades swaying in vertex states: TRIS_BLADES triangles"},
-      {"spheres",
-       "bouncing analytic spheres among walls and pillars: TRIS_SPHERES triangles, 14 spheres"},
+       "streets of instanced buildings with windows, seen from a crossing: 1,417,070 triangles"},
+      {"blades", "a field of thin grass blades swaying in vertex states: 5,376,050 triangles"},
+      {"spheres", "bouncing analytic spheres among walls and pillars: 1,616 triangles, 14 spheres"},
   };
   return list;
 }
