@@ -70,9 +70,9 @@ struct Geometry {
 };
 
 // A shared mesh built once per frame into its own Embree scene, instanced by every object that
-// places it.
+// places it. Holding the mesh keeps the tracer valid after the scene is gone, as for own meshes.
 struct Prototype {
-  const TriangleMesh* mesh = nullptr;
+  std::shared_ptr<const TriangleMesh> mesh;
   std::vector<glm::vec3> positions;  // object space at the frame's time (vertex states applied)
   RTCScene scene = nullptr;
 };
@@ -398,7 +398,7 @@ Expected<std::unique_ptr<FrameTracer>> FrameTracer::create(const Scene& scene, d
     const int32_t index = static_cast<int32_t>(impl->prototypes.size());
     prototype_of.emplace(o.shared_mesh.get(), index);
     Prototype& pr = impl->prototypes.emplace_back();
-    pr.mesh = o.shared_mesh.get();
+    pr.mesh = o.shared_mesh;
     positions_at(*pr.mesh, time, &pr.positions);
     if (!std::all_of(pr.positions.begin(), pr.positions.end(), finite3)) {
       return Status(ErrorId::kSceneGeometry, at_time(o));
