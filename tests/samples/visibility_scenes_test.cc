@@ -8,6 +8,7 @@
 
 #include <unistd.h>
 
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -63,88 +64,90 @@ const SceneInfo* info_of(const char* name) {
   return nullptr;
 }
 
-TEST(VisibilityScenes, HoldTheTrianglesTheirListingPromises) {
-  for (const Promise& p : kPromises) {
-    SCOPED_TRACE(p.name);
-    const SceneInfo* info = info_of(p.name);
-    ASSERT_NE(info, nullptr);
-    auto scene = make_builtin_scene(p.name);
-    ASSERT_TRUE(scene.ok()) << scene.status().to_string();
-    Status st = validate_scene(*scene);
-    EXPECT_TRUE(st.ok()) << st.to_string();
-    EXPECT_EQ(triangles_in(info->description), scene->triangle_count()) << info->description;
-    EXPECT_EQ(triangles_in(scene->description), scene->triangle_count()) << scene->description;
-    EXPECT_GE(scene->triangle_count(), p.min_triangles);
-    EXPECT_GE(scene->sphere_count(), p.min_spheres);
-    // Short clips for tests and demos.
-    EXPECT_GE(scene->frame_count, 8u);
-    EXPECT_LE(scene->frame_count, 30u);
-    EXPECT_GT(scene->fps, 0);
-    // The view region is a thin slab at eye height (1.6 .. 1.8 m) with the default rig in it.
-    const Box3& region = scene->default_rig.view_volume;
-    EXPECT_LE(region.min.y, 1.7);
-    EXPECT_GE(region.max.y, 1.7);
-    EXPECT_LE(region.max.y - region.min.y, 0.25);
-    EXPECT_GT(region.max.x - region.min.x, 1.0);
-    EXPECT_GT(region.max.z - region.min.z, 1.0);
-    for (const auto& v : scene->default_rig.viewpoints) {
-      EXPECT_GE(v.position.y, region.min.y);
-      EXPECT_LE(v.position.y, region.max.y);
-    }
+// One test per scene (each a ctest of its own, so that the heavy blades stay apart).
+class VisibilityScene : public ::testing::TestWithParam<Promise> {};
+
+INSTANTIATE_TEST_SUITE_P(Builtin, VisibilityScene, ::testing::ValuesIn(kPromises),
+                         [](const ::testing::TestParamInfo<Promise>& test) {
+                           return std::string(test.param.name);
+                         });
+
+TEST_P(VisibilityScene, HoldTheTrianglesTheirListingPromises) {
+  const Promise& p = GetParam();
+  const SceneInfo* info = info_of(p.name);
+  ASSERT_NE(info, nullptr);
+  auto scene = make_builtin_scene(p.name);
+  ASSERT_TRUE(scene.ok()) << scene.status().to_string();
+  Status st = validate_scene(*scene);
+  EXPECT_TRUE(st.ok()) << st.to_string();
+  EXPECT_EQ(triangles_in(info->description), scene->triangle_count()) << info->description;
+  EXPECT_EQ(triangles_in(scene->description), scene->triangle_count()) << scene->description;
+  EXPECT_GE(scene->triangle_count(), p.min_triangles);
+  EXPECT_GE(scene->sphere_count(), p.min_spheres);
+  // Short clips for tests and demos.
+  EXPECT_GE(scene->frame_count, 8u);
+  EXPECT_LE(scene->frame_count, 30u);
+  EXPECT_GT(scene->fps, 0);
+  // The view region is a thin slab at eye height (1.6 .. 1.8 m) with the default rig in it.
+  const Box3& region = scene->default_rig.view_volume;
+  EXPECT_LE(region.min.y, 1.7);
+  EXPECT_GE(region.max.y, 1.7);
+  EXPECT_LE(region.max.y - region.min.y, 0.25);
+  EXPECT_GT(region.max.x - region.min.x, 1.0);
+  EXPECT_GT(region.max.z - region.min.z, 1.0);
+  for (const auto& v : scene->default_rig.viewpoints) {
+    EXPECT_GE(v.position.y, region.min.y);
+    EXPECT_LE(v.position.y, region.max.y);
   }
 }
 
-TEST(VisibilityScenes, AreGeneratedTheSameEveryTime) {
-  for (const Promise& p : kPromises) {
-    SCOPED_TRACE(p.name);
-    capture::EncodedScene first, second;
-    for (capture::EncodedScene* out : {&first, &second}) {
-      auto scene = make_builtin_scene(p.name);
-      ASSERT_TRUE(scene.ok());
-      auto file = export_scene(*scene, scene->frame_count);
-      ASSERT_TRUE(file.ok()) << file.status().to_string();
-      auto encoded = capture::encode_scene_file(*file);
-      ASSERT_TRUE(encoded.ok()) << encoded.status().to_string();
-      *out = std::move(*encoded);
-    }
-    EXPECT_GT(first.buffer.size(), 1000u);
-    EXPECT_EQ(fnv1a(first.buffer), fnv1a(second.buffer));
-    EXPECT_TRUE(first.buffer == second.buffer);
-    EXPECT_TRUE(first.manifest == second.manifest);
-  }
-}
-
-TEST(VisibilityScenes, ExportAndReadBackWithSharedMeshesStoredOnce) {
-  for (const Promise& p : kPromises) {
-    SCOPED_TRACE(p.name);
+TEST_P(VisibilityScene, AreGeneratedTheSameEveryTime) {
+  const Promise& p = GetParam();
+  capture::EncodedScene first, second;
+  for (capture::EncodedScene* out : {&first, &second}) {
     auto scene = make_builtin_scene(p.name);
     ASSERT_TRUE(scene.ok());
-    const fs::path dir =
-        fs::temp_directory_path() /
-        ("calf_visibility_scenes_" + std::string(p.name) + "_" + std::to_string(getpid()));
-    fs::remove_all(dir);
-    ASSERT_TRUE(write_scene(*scene, scene->frame_count, dir).ok());
-    auto back = capture::read_scene_file(dir);
-    ASSERT_TRUE(back.ok()) << back.status().to_string();
-    auto direct = export_scene(*scene, scene->frame_count);
-    ASSERT_TRUE(direct.ok());
-    EXPECT_TRUE(*back == *direct);
-    EXPECT_EQ(back->triangle_count(), scene->triangle_count());
-    EXPECT_EQ(back->objects.size(), scene->objects.size());
-    size_t spheres = 0;
-    for (const capture::SceneObject& o : back->objects)
-      spheres += back->meshes[o.mesh].spheres.size();
-    EXPECT_EQ(spheres, scene->sphere_count());
-    if (p.min_triangles >= 1000000) {
-      // Instancing: the file holds each prototype once, a small share of the placed triangles.
-      EXPECT_LT(back->mesh_triangle_count() * 10, back->triangle_count());
-      EXPECT_LT(back->meshes.size() * 5, back->objects.size());
-    }
-    const capture::SceneEnvironment& e = back->environment;
-    EXPECT_GT(e.sun_irradiance[0], 0) << "a sun";
-    EXPECT_EQ(back->view_region_min[1], scene->default_rig.view_volume.min.y);
-    fs::remove_all(dir);
+    auto file = export_scene(*scene, scene->frame_count);
+    ASSERT_TRUE(file.ok()) << file.status().to_string();
+    auto encoded = capture::encode_scene_file(*file);
+    ASSERT_TRUE(encoded.ok()) << encoded.status().to_string();
+    *out = std::move(*encoded);
   }
+  EXPECT_GT(first.buffer.size(), 1000u);
+  EXPECT_EQ(fnv1a(first.buffer), fnv1a(second.buffer));
+  EXPECT_TRUE(first.buffer == second.buffer);
+  EXPECT_TRUE(first.manifest == second.manifest);
+}
+
+TEST_P(VisibilityScene, ExportAndReadBackWithSharedMeshesStoredOnce) {
+  const Promise& p = GetParam();
+  auto scene = make_builtin_scene(p.name);
+  ASSERT_TRUE(scene.ok());
+  const fs::path dir =
+      fs::temp_directory_path() /
+      ("calf_visibility_scenes_" + std::string(p.name) + "_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  ASSERT_TRUE(write_scene(*scene, scene->frame_count, dir).ok());
+  auto back = capture::read_scene_file(dir);
+  ASSERT_TRUE(back.ok()) << back.status().to_string();
+  auto direct = export_scene(*scene, scene->frame_count);
+  ASSERT_TRUE(direct.ok());
+  EXPECT_TRUE(*back == *direct);
+  EXPECT_EQ(back->triangle_count(), scene->triangle_count());
+  EXPECT_EQ(back->objects.size(), scene->objects.size());
+  size_t spheres = 0;
+  for (const capture::SceneObject& o : back->objects)
+    spheres += back->meshes[o.mesh].spheres.size();
+  EXPECT_EQ(spheres, scene->sphere_count());
+  if (p.min_triangles >= 1000000) {
+    // Instancing: the file holds each prototype once, a small share of the placed triangles.
+    EXPECT_LT(back->mesh_triangle_count() * 10, back->triangle_count());
+    EXPECT_LT(back->meshes.size() * 5, back->objects.size());
+  }
+  const capture::SceneEnvironment& e = back->environment;
+  EXPECT_GT(e.sun_irradiance[0], 0) << "a sun";
+  EXPECT_EQ(back->view_region_min[1], scene->default_rig.view_volume.min.y);
+  fs::remove_all(dir);
 }
 
 TEST(VisibilityScenes, BladesSwayInVertexStates) {
