@@ -243,5 +243,25 @@ TEST(VisibilityScenes, CityIsMostlyHiddenFromTheCrossing) {
   std::printf("city: BVH build + one 6 x 32^2 cube map in %.3f s\n", seconds);
 }
 
+// Instanced geometry (Embree instances of per-prototype BVHs) keeps the tracer's promise: the
+// same bytes whatever the thread count.
+TEST(VisibilityScenes, InstancedSceneRendersTheSameForAnyThreadCount) {
+  auto scene = make_builtin_scene("city");
+  ASSERT_TRUE(scene.ok());
+  capture::ViewFrame first;
+  for (uint32_t threads : {1u, 3u}) {
+    auto tracer = FrameTracer::create(*scene, 0.2, RenderOptions{threads, 5, 2, 6, 0});
+    ASSERT_TRUE(tracer.ok()) << tracer.status().to_string();
+    capture::ViewFrame frame;
+    (*tracer)->render_cube({1.0, 1.65, -2.0}, 3, 1, 16, false, &frame);
+    if (threads == 1) {
+      first = frame;
+      continue;
+    }
+    EXPECT_TRUE(frame.color == first.color);
+    EXPECT_TRUE(frame.depth == first.depth);
+  }
+}
+
 }  // namespace
 }  // namespace calf::samples
