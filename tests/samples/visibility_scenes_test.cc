@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <ostream>
 #include <set>
 #include <string>
 
@@ -32,6 +33,11 @@ struct Promise {
   uint64_t min_triangles;  // issue 19: city >= 1 M, blades >= 5 M
   size_t min_spheres;
 };
+// gtest prints a parameter in test names and messages: the scene's name.
+void PrintTo(const Promise& p, std::ostream* os) {
+  *os << p.name;
+}
+
 constexpr Promise kPromises[] = {
     {"city", 1000000, 0}, {"blades", 5000000, 0}, {"spheres", 1000, 10}};
 
