@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <string>
 #include <utility>
+#include "calf/format/vertex_states.h"
 
 namespace calf::decoder {
 
@@ -224,26 +225,9 @@ const MeshTransform& transform_at(const MeshObject& object, uint32_t frame) {
 // The same arithmetic as capture::positions_at (SCENE.md "Vertex states"), so that the track
 // and the scene it came from give the same floats at every time.
 void positions_at(const MeshPrototype& prototype, double time, std::vector<float>* out) {
-  const std::vector<float>& times = prototype.state_times;
-  const size_t n = prototype.positions.size();
-  if (times.empty() || prototype.state_positions.size() != times.size() * n) {
-    *out = prototype.positions;
-    return;
-  }
-  const size_t next =
-      static_cast<size_t>(std::upper_bound(times.begin(), times.end(), time) - times.begin());
-  const float* states = prototype.state_positions.data();
-  if (next == 0 || next == times.size()) {
-    const float* held = states + (next == 0 ? 0 : times.size() - 1) * n;
-    out->assign(held, held + n);
-    return;
-  }
-  const double t0 = times[next - 1], t1 = times[next];
-  const float w = static_cast<float>((time - t0) / (t1 - t0));
-  const float* a = states + (next - 1) * n;
-  const float* b = states + next * n;
-  out->resize(n);
-  for (size_t i = 0; i < n; ++i) (*out)[i] = a[i] + w * (b[i] - a[i]);
+  out->resize(prototype.positions.size());
+  vertex_states_at(prototype.positions, prototype.state_times, prototype.state_positions, time,
+                   *out);
 }
 
 }  // namespace calf::decoder

@@ -5,8 +5,10 @@
 #include <unordered_set>
 
 #include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
 
 #include "calf/capture/scene_file.h"
+#include "calf/format/vertex_states.h"
 #include "calf/samples/scene.h"
 #include "glm_vec.h"
 
@@ -43,28 +45,14 @@ size_t Scene::sphere_count() const {
 }
 
 void positions_at(const TriangleMesh& mesh, double time, std::vector<glm::vec3>* out) {
-  const std::vector<float>& times = mesh.state_times;
-  const size_t n = mesh.positions.size();
-  if (times.empty()) {
-    *out = mesh.positions;
-    return;
-  }
-  // The first state after `time`, compared in double as capture::positions_at does.
-  const size_t next =
-      static_cast<size_t>(std::upper_bound(times.begin(), times.end(), time) - times.begin());
-  if (next == 0 || next == times.size()) {
-    const auto held = mesh.state_positions.begin() +
-                      static_cast<std::ptrdiff_t>((next == 0 ? 0 : times.size() - 1) * n);
-    out->assign(held, held + static_cast<std::ptrdiff_t>(n));
-    return;
-  }
-  const double t0 = times[next - 1], t1 = times[next];
-  const float w = static_cast<float>((time - t0) / (t1 - t0));
-  const glm::vec3* a = mesh.state_positions.data() + (next - 1) * n;
-  const glm::vec3* b = mesh.state_positions.data() + next * n;
-  out->resize(n);
-  // Per component a + w * (b - a) in float, the scene-file reader's formula.
-  for (size_t i = 0; i < n; ++i) (*out)[i] = a[i] + w * (b[i] - a[i]);
+  static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
+  out->resize(mesh.positions.size());
+  if (out->empty()) return;
+  const size_t n = mesh.positions.size() * 3;
+  const size_t s = mesh.state_positions.size() * 3;
+  vertex_states_at({glm::value_ptr(mesh.positions.front()), n}, mesh.state_times,
+                   {s == 0 ? nullptr : glm::value_ptr(mesh.state_positions.front()), s}, time,
+                   {glm::value_ptr(out->front()), n});
 }
 
 namespace {

@@ -21,6 +21,7 @@
 
 #include "calf/capture/capture_set.h"
 #include "calf/format/files.h"
+#include "calf/format/vertex_states.h"
 #include "json_fields.h"
 
 namespace calf::capture {
@@ -887,27 +888,8 @@ const SceneTransform& transform_at(const SceneObject& object, uint32_t frame) {
 }
 
 void positions_at(const SceneMesh& mesh, double time, std::vector<float>* out) {
-  const std::vector<float>& times = mesh.state_times;
-  const size_t n = mesh.positions.size();
-  if (times.empty()) {
-    *out = mesh.positions;
-    return;
-  }
-  // The first state after `time`; before the first and after the last the state is held.
-  size_t next =
-      static_cast<size_t>(std::upper_bound(times.begin(), times.end(), time) - times.begin());
-  const float* states = mesh.state_positions.data();
-  if (next == 0 || next == times.size()) {
-    const float* held = states + (next == 0 ? 0 : times.size() - 1) * n;
-    out->assign(held, held + n);
-    return;
-  }
-  const double t0 = times[next - 1], t1 = times[next];
-  const float w = static_cast<float>((time - t0) / (t1 - t0));
-  const float* a = states + (next - 1) * n;
-  const float* b = states + next * n;
-  out->resize(n);
-  for (size_t i = 0; i < n; ++i) (*out)[i] = a[i] + w * (b[i] - a[i]);
+  out->resize(mesh.positions.size());
+  vertex_states_at(mesh.positions, mesh.state_times, mesh.state_positions, time, *out);
 }
 
 Status validate_scene_file(const SceneFile& scene) {
