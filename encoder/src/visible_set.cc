@@ -9,7 +9,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <mutex>
+#include <numeric>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,6 +19,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 #include <tbb/task_arena.h>
 
 #include "calf/encoder/visible_set.h"
@@ -64,7 +67,29 @@ struct TileScratch {
   std::vector<std::vector<Interval>> lists = std::vector<std::vector<Interval>>(kTile * kTile);
   std::vector<Interval> tmp;
   std::vector<SphereDepth> spheres;
+  // Per pixel: the farthest distance of its list when the list covers all of [0, 1], else inf.
+  std::vector<double> far = std::vector<double>(kTile * kTile);
 };
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double pixel_far(const std::vector<Interval>& list, std::span<const SphereDepth> spheres,
+                 double length) {
+  if (list.empty() || list.front().s0 > 0 || list.back().s1 < 1) return kInf;
+  double far = 0;
+  for (size_t i = 0; i < list.size(); ++i) {
+    if (i > 0 && list[i].s0 != list[i - 1].s1) return kInf;
+    // Depths are lines or convex (spheres): largest at an end.
+    far = std::max(
+        {far, depth_at(list[i], spheres, list[i].s0), depth_at(list[i], spheres, list[i].s1)});
+  }
+  return far * length;
+}
+
+double segment_distance(const Vec3& p, const Vec3& v0, const Vec3& w, double ww) {
+  const double t = std::clamp(dot(p - v0, w) / ww, 0.0, 1.0);
+  return length(p - (v0 + w * t));
+}
 
 class SegmentRunner {
  public:
@@ -132,8 +157,37 @@ void SegmentRunner::run(const FrameGeometry& geo, const ViewSegment& segment,
       mark(s.primitive, {0, 0, true, segment_index, frame, kCubeFaceCount, 0, 0, t, t});
   }
 
-  // Binning: (tile, item) pairs per chunk of items, then a counting sort in chunk order, so each
-  // tile lists its items in scene order whatever thread binned them.
+  // Front to back: items sorted by a lower bound of their distance to the segment (ties: scene
+  // order), so that most later items are hidden and rejected early (composite's fast path, and
+  // whole tiles once every pixel's list covers [0, 1] nearer than the item can be).
+  std::vector<double> near(items);
+  std::vector<uint32_t> sorted(items);
+  const double ww = dot(w, w);
+  tbb::parallel_for(tbb::blocked_range<uint32_t>(0, items, kChunk),
+                    [&](const tbb::blocked_range<uint32_t>& range) {
+                      Vec3 pts[8];
+                      for (uint32_t item = range.begin(); item < range.end(); ++item) {
+                        Vec3 centre;
+                        double radius = 0;
+                        if (item < nt) {
+                          item_points(geo, item, pts);
+                          centre = (pts[0] + pts[1] + pts[2]) / 3.0;
+                          for (int k = 0; k < 3; ++k)
+                            radius = std::max(radius, length(pts[k] - centre));
+                        } else {
+                          centre = geo.spheres[item - nt].centre;
+                          radius = geo.spheres[item - nt].radius;
+                        }
+                        near[item] = std::max(0.0, segment_distance(centre, v0, w, ww) - radius);
+                      }
+                    });
+  std::iota(sorted.begin(), sorted.end(), 0u);
+  tbb::parallel_sort(sorted.begin(), sorted.end(), [&](uint32_t a, uint32_t b) {
+    return near[a] != near[b] ? near[a] < near[b] : a < b;
+  });
+
+  // Binning: (tile, position in `sorted`) pairs per chunk, then a counting sort in chunk order,
+  // so each tile lists its items front to back whatever thread binned them.
   const uint32_t chunks = (items + kChunk - 1) / kChunk;
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> binned(chunks);
   tbb::parallel_for(tbb::blocked_range<uint32_t>(0, chunks, 1), [&](const tbb::blocked_range<
@@ -143,14 +197,14 @@ void SegmentRunner::run(const FrameGeometry& geo, const ViewSegment& segment,
     for (uint32_t c = range.begin(); c < range.end(); ++c) {
       auto& out = binned[c];
       const uint32_t end = std::min(items, (c + 1) * kChunk);
-      for (uint32_t item = c * kChunk; item < end; ++item) {
-        const int np = item_points(geo, item, pts);
+      for (uint32_t pos = c * kChunk; pos < end; ++pos) {
+        const int np = item_points(geo, sorted[pos], pts);
         for (int f = 0; f < kCubeFaceCount; ++f) {
           if (!bound.compute({pts, static_cast<size_t>(np)}, v0, v1, bases_[f], n, prepared_.delta))
             continue;
           for (int ty = bound.y0() / kTile; ty <= bound.y1() / int{kTile}; ++ty)
             for (int tx = bound.x0() / kTile; tx <= bound.x1() / int{kTile}; ++tx)
-              out.emplace_back(f * tiles_per_face + ty * tiles_per_side + tx, item);
+              out.emplace_back(f * tiles_per_face + ty * tiles_per_side + tx, pos);
         }
       }
     }
@@ -183,9 +237,21 @@ void SegmentRunner::run(const FrameGeometry& geo, const ViewSegment& segment,
           const int px1 = std::min<int>(static_cast<int>(n), px0 + kTile) - 1;
           const int py1 = std::min<int>(static_cast<int>(n), py0 + kTile) - 1;
           scratch.spheres.clear();
+          std::fill(scratch.far.begin(), scratch.far.end(), kInf);
+          double tile_far = kInf;
+          bool changed = false;
           uint64_t pairs = 0;
           for (uint64_t k = start[tile]; k < start[tile + 1]; ++k) {
-            const uint32_t item = order[k];
+            const uint32_t item = sorted[order[k]];
+            if (changed && (k - start[tile]) % 16 == 0) {
+              tile_far = 0;
+              for (int y = py0; y <= py1; ++y)
+                for (int x = px0; x <= px1; ++x)
+                  tile_far = std::max(tile_far, scratch.far[(y - py0) * kTile + (x - px0)]);
+              changed = false;
+            }
+            // Occluded in the whole tile: nearer surfaces cover every pixel over all of [0, 1].
+            if (near[item] >= tile_far) continue;
             const int np = item_points(geo, item, pts);
             if (!bound.compute({pts, static_cast<size_t>(np)}, v0, v1, basis, n, prepared_.delta))
               continue;
@@ -206,7 +272,7 @@ void SegmentRunner::run(const FrameGeometry& geo, const ViewSegment& segment,
                 if (triangle) {
                   if (!triangle_coverage(setup, sc, tc, &iv[0])) continue;
                   iv[0].primitive = primitive;
-                  composite(&row[x - px0], iv[0], scratch.spheres, &scratch.tmp);
+                  if (!composite(&row[x - px0], iv[0], scratch.spheres, &scratch.tmp)) continue;
                 } else {
                   const Vec3 d = basis.m + basis.s * sc + basis.t * tc;
                   SphereDepth depth;
@@ -218,6 +284,9 @@ void SegmentRunner::run(const FrameGeometry& geo, const ViewSegment& segment,
                     composite(&row[x - px0], iv[i], scratch.spheres, &scratch.tmp);
                   }
                 }
+                scratch.far[(y - py0) * kTile + (x - px0)] =
+                    pixel_far(row[x - px0], scratch.spheres, std::sqrt(1 + sc * sc + tc * tc));
+                changed = true;
               }
             }
           }

@@ -125,7 +125,8 @@ int sphere_coverage(const WorldSphere& sphere, const Vec3& v0, const Vec3& w, co
 double depth_at(const Interval& i, std::span<const SphereDepth> spheres, double s);
 // Depth-composites `in` into the sorted, disjoint list `list` (scratch: a reused buffer): where
 // `in` is nearer it replaces what was there, where nothing was it is added, ties keep the list.
-void composite(std::vector<Interval>* list, const Interval& in,
+// Returns false when the list did not change (`in` hidden wherever it covers).
+bool composite(std::vector<Interval>* list, const Interval& in,
                std::span<const SphereDepth> spheres, std::vector<Interval>* scratch);
 
 // ---- the driver's shared checks ----
