@@ -18,6 +18,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <ctime>
 #include <string>
 #include <thread>
@@ -165,6 +166,7 @@ int main(int argc, char** argv) {
                  "from-point stops doubling its points past this x the from-segment time");
   app.add_option("--eye", eye, "eye height of the perimeter (default 1.7)");
   CLI11_PARSE(app, argc, argv);
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // rows appear as they are measured
 
   const City city = make_city(blocks, subdiv, 1);
   const std::vector<ViewSegment> segs =

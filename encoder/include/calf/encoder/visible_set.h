@@ -46,12 +46,13 @@
 // T-junction do differ by rounding, hence `min_interval` below. Pixel bounds are grown
 // by 1e-3 pixel and clipped at a depth of 1e-9 times the scene's extent along the face axis, so
 // only geometry closer than that to the eye can be missed by the bound. Ties (equal depth over an
-// interval, e.g. coplanar duplicates) go to the primitive inserted first (object order, then
-// triangle order). Spheres' depths are not linear in s: crossings between two depth curves of
-// which one is a sphere's are found by 32 samples and bisection, so two depth curves crossing
-// twice within 1/32 of an interval may miss a sliver. tests/encoder/visible_set_test.cc checks
-// the set against from-point ID buffers at >= 1000 random points per segment and checks every
-// member at the middle of its longest interval with an independent ray caster.
+// interval, e.g. coplanar duplicates) go to the primitive inserted first (front to back by a
+// lower bound of the distance to the segment, then scene order: triangles, then spheres). Spheres'
+// depths are not linear in s: crossings between two depth curves of which one is a sphere's are
+// found by 32 samples and bisection, so two depth curves crossing twice within 1/32 of an interval
+// may miss a sliver. tests/encoder/visible_set_test.cc checks the set against from-point ID buffers
+// at >= 1000 random points per segment and checks every member at the middle of its longest
+// interval with an independent ray caster.
 //
 // Spheres (Sec. 3.3). An analytic sphere is one primitive: its coverage interval per pixel is
 // where the ray's distance to the centre is at most the radius (a quadratic in s) and the eye is
@@ -61,8 +62,11 @@
 // for the times the eye is inside it (conservative).
 //
 // Costs. O(sum over triangles of the pixels of their bound x the intervals per pixel) per
-// segment, face and frame; the work is split into 32 x 32 pixel tiles run in parallel, each
-// tile inserting its triangles in scene order, so the result does not depend on the thread count.
+// segment, face and frame (paper: O(n m k log k)). The work is split into 32 x 32 pixel tiles run
+// in parallel, each inserting its primitives front to back (so most insertions are hidden and
+// change nothing) and skipping a primitive once every pixel of the tile is covered over all of
+// [0, 1] by nearer surfaces. A tile's result depends only on its own primitives in a fixed
+// order, so the set does not depend on the thread count. docs/VISIBILITY.md has the figures.
 #pragma once
 
 #include <cstdint>
