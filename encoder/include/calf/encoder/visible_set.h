@@ -126,8 +126,10 @@ struct VisibleSetStats {
   uint64_t scene_triangles = 0;       // over objects (instances counted each time; a sphere
                                       // counts kSphereTriangles)
   uint64_t visible_triangles = 0;     // in the set (same counting)
-  uint64_t triangle_pixel_pairs = 0;  // (primitive, pixel) pairs processed, over segments, faces
-                                      // and frames (from-point: over points, faces, frames)
+  uint64_t triangle_pixel_pairs = 0;  // (primitive, pixel) pairs whose coverage was computed
+                                      // (pixels inside bounds; primitives a tile culled as hidden
+                                      // not counted), over segments, faces and frames
+                                      // (from-point: over points, faces, frames)
   uint64_t frames_solved = 0;         // distinct frames solved (repeated geometry skipped)
   double seconds = 0;                 // wall time of compute_visible_set
 };
