@@ -6,7 +6,7 @@
 // tests/format/errors_test.cc fails when an id here is missing from that document.
 //
 // Ranges:   1- 19 general (arguments, files)      20- 39 conventions (cube, log depth, grids)
-//          40- 99 container (format/SPEC.md)     100-129 BCn block codecs (110-119: visible sets)
+//          40- 99 container (format/SPEC.md)     100-129 BCn block codecs
 //         130-149 capture sets (format/CAPTURE.md) 150-169 scene files (format/SCENE.md)
 //         170-199 calf-capture and sample scenes
 //         200-299 encoder    300-399 decoder    400-499 player
