@@ -6,7 +6,7 @@
 // tests/format/errors_test.cc fails when an id here is missing from that document.
 //
 // Ranges:   1- 19 general (arguments, files)      20- 39 conventions (cube, log depth, grids)
-//          40- 99 container (format/SPEC.md)     100-129 BCn block codecs
+//          40- 99 container (format/SPEC.md)     100-129 BCn block codecs (110-119: visible sets)
 //         130-149 capture sets (format/CAPTURE.md) 150-169 scene files (format/SCENE.md)
 //         170-199 calf-capture and sample scenes
 //         200-299 encoder    300-399 decoder    400-499 player
@@ -79,6 +79,13 @@ enum class ErrorKind : uint8_t {
   X(kBcOptions, 103, kInvalidArgument, "an encoder option or channel count is invalid")        \
   X(kBcNonFinite, 104, kInvalidArgument, "HDR input holds NaN or infinity (rejected)")         \
   X(kBcOutOfRange, 105, kInvalidArgument, "HDR input is out of the format's range (rejected)") \
+  /* visible sets: 110-119 (encoder/include/calf/encoder/visible_set.h) */                        \
+  X(kVisibleSetNoSegment, 110, kInvalidArgument, "no view segment or eye point was given")      \
+  X(kVisibleSetSegment, 111, kInvalidArgument, "a view segment is degenerate or not finite")    \
+  X(kVisibleSetOutside, 112, kInvalidArgument, "a segment or eye lies outside the scene bounds") \
+  X(kVisibleSetScene, 113, kInvalidArgument, "the scene has no triangle or cannot be read")     \
+  X(kVisibleSetOption, 114, kInvalidArgument, "a visible-set option is outside its range")      \
+  X(kVisibleSetLimit, 115, kLimit, "the scene has more primitives than the builder accepts")     \
   /* capture sets: 130-169 */                                                                   \
   X(kManifestSyntax, 130, kCorrupt, "a manifest or eye path is not valid JSON")                 \
   X(kManifestField, 131, kCorrupt, "a manifest field is missing, mistyped or out of range")     \
