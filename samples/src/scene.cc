@@ -1,9 +1,12 @@
 // Scene validation, procedural geometry helpers and loading by name.
+#include <algorithm>
 #include <cmath>
 #include <system_error>
+#include <unordered_set>
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "calf/capture/scene_file.h"
 #include "calf/samples/scene.h"
 #include "glm_vec.h"
 
@@ -27,9 +30,90 @@ bool Scene::has_mirror_or_glass() const {
   return false;
 }
 
+size_t Scene::triangle_count() const {
+  size_t n = 0;
+  for (const Object& o : objects) n += o.triangle_mesh().triangles.size();
+  return n;
+}
+
+size_t Scene::sphere_count() const {
+  size_t n = 0;
+  for (const Object& o : objects) n += o.spheres.size();
+  return n;
+}
+
+void positions_at(const TriangleMesh& mesh, double time, std::vector<glm::vec3>* out) {
+  const std::vector<float>& times = mesh.state_times;
+  const size_t n = mesh.positions.size();
+  if (times.empty()) {
+    *out = mesh.positions;
+    return;
+  }
+  // The first state after `time`, compared in double as capture::positions_at does.
+  const size_t next =
+      static_cast<size_t>(std::upper_bound(times.begin(), times.end(), time) - times.begin());
+  if (next == 0 || next == times.size()) {
+    const auto held = mesh.state_positions.begin() +
+                      static_cast<std::ptrdiff_t>((next == 0 ? 0 : times.size() - 1) * n);
+    out->assign(held, held + static_cast<std::ptrdiff_t>(n));
+    return;
+  }
+  const double t0 = times[next - 1], t1 = times[next];
+  const float w = static_cast<float>((time - t0) / (t1 - t0));
+  const glm::vec3* a = mesh.state_positions.data() + (next - 1) * n;
+  const glm::vec3* b = mesh.state_positions.data() + next * n;
+  out->resize(n);
+  // Per component a + w * (b - a) in float, the scene-file reader's formula.
+  for (size_t i = 0; i < n; ++i) (*out)[i] = a[i] + w * (b[i] - a[i]);
+}
+
+namespace {
+
+// The checks of one mesh (own or shared), naming `what` (the object) in messages.
+Status validate_mesh(const TriangleMesh& mesh, const std::string& what) {
+  auto bad = [&](const std::string& why) {
+    return Status(ErrorId::kSceneGeometry, what + " " + why);
+  };
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    if (!finite(mesh.positions[i])) return bad("has a non-finite vertex " + std::to_string(i));
+  }
+  const size_t v = mesh.positions.size();
+  for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+    const glm::uvec3& t = mesh.triangles[i];
+    if (t.x >= v || t.y >= v || t.z >= v) {
+      return bad("has triangle " + std::to_string(i) + " with a vertex index out of range");
+    }
+  }
+  const size_t states = mesh.state_times.size();
+  if (states > capture::kSceneMaxStates) {
+    return bad("has " + std::to_string(states) + " vertex states, more than 4096");
+  }
+  for (size_t k = 0; k < states; ++k) {
+    const float t = mesh.state_times[k];
+    if (!std::isfinite(t) || t < 0 || (k > 0 && !(t > mesh.state_times[k - 1]))) {
+      return bad("has vertex state " + std::to_string(k) + " at time " + std::to_string(t) +
+                 ": times must be finite, >= 0 and strictly increasing");
+    }
+  }
+  if (mesh.state_positions.size() != states * v) {
+    return bad("has " + std::to_string(mesh.state_positions.size()) + " state positions for " +
+               std::to_string(states) + " states of " + std::to_string(v) + " vertices");
+  }
+  for (size_t i = 0; i < mesh.state_positions.size(); ++i) {
+    if (!finite(mesh.state_positions[i])) {
+      return bad("has a non-finite position of vertex " + std::to_string(v ? i % v : 0) +
+                 " in state " + std::to_string(v ? i / v : 0));
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 Status validate_scene(const Scene& scene) {
   const std::string where = "scene '" + scene.name + "'";
   size_t primitives = 0;
+  std::unordered_set<const TriangleMesh*> checked;
   for (size_t m = 0; m < scene.materials.size(); ++m) {
     const Material& mat = scene.materials[m];
     bool ok = finite(mat.albedo) && finite(mat.emission) && mat.reflect >= 0 && mat.refract >= 0 &&
@@ -46,18 +130,18 @@ Status validate_scene(const Scene& scene) {
                                                  std::to_string(o.material) + " of " +
                                                  std::to_string(scene.materials.size()));
     }
-    for (const glm::vec3& p : o.mesh.positions) {
-      if (!finite(p)) {
+    const std::string what = where + ": object '" + o.name + "'";
+    if (o.shared_mesh) {
+      if (!o.mesh.positions.empty() || !o.mesh.triangles.empty() || !o.spheres.empty()) {
         return Status(ErrorId::kSceneGeometry,
-                      where + ": object '" + o.name + "' has a non-finite vertex");
+                      what + " has a shared mesh and also triangles or spheres of its own");
       }
-    }
-    for (const glm::uvec3& t : o.mesh.triangles) {
-      if (t.x >= o.mesh.positions.size() || t.y >= o.mesh.positions.size() ||
-          t.z >= o.mesh.positions.size()) {
-        return Status(ErrorId::kSceneGeometry,
-                      where + ": object '" + o.name + "' has a triangle index out of range");
+      // A shared mesh is checked once, however many objects place it.
+      if (checked.insert(o.shared_mesh.get()).second) {
+        CALF_RETURN_IF_ERROR(validate_mesh(*o.shared_mesh, what + " (shared mesh)"));
       }
+    } else {
+      CALF_RETURN_IF_ERROR(validate_mesh(o.mesh, what));
     }
     for (const Sphere& s : o.spheres) {
       if (!finite(s.center) || !(s.radius > 0) || !std::isfinite(s.radius)) {
@@ -65,7 +149,7 @@ Status validate_scene(const Scene& scene) {
                       where + ": object '" + o.name + "' has a sphere with a bad centre or radius");
       }
     }
-    primitives += o.mesh.triangles.size() + o.spheres.size();
+    primitives += o.triangle_mesh().triangles.size() + o.spheres.size();
   }
   if (primitives == 0) {
     return Status(ErrorId::kSceneEmpty, where + ": no triangles and no spheres to render");

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <string>
+#include <unordered_map>
+#include <vector>
 
 namespace calf::samples {
 
@@ -11,6 +13,13 @@ namespace {
 
 capture::SceneFloat3 float3(const glm::vec3& v) {
   return {v.x, v.y, v.z};
+}
+
+std::vector<float> flatten(const std::vector<glm::vec3>& v) {
+  std::vector<float> out;
+  out.reserve(v.size() * 3);
+  for (const glm::vec3& p : v) out.insert(out.end(), {p.x, p.y, p.z});
+  return out;
 }
 
 // glm matrices are column-major (m[column][row]); a scene transform is row-major 3 x 4.
@@ -67,20 +76,30 @@ Expected<capture::SceneFile> export_scene(const Scene& scene, uint32_t frames) {
     out.materials.push_back(sm);
   }
   auto time_of = [&](uint32_t f) { return static_cast<double>(f) / scene.fps; };
+  // A shared mesh becomes one scene-file mesh at its first use; later objects point at it.
+  std::unordered_map<const TriangleMesh*, uint32_t> mesh_of;
   for (const Object& o : scene.objects) {
-    capture::SceneMesh mesh;
-    mesh.name = o.name;
-    mesh.positions.reserve(o.mesh.positions.size() * 3);
-    for (const glm::vec3& p : o.mesh.positions)
-      mesh.positions.insert(mesh.positions.end(), {p.x, p.y, p.z});
-    mesh.indices.reserve(o.mesh.triangles.size() * 3);
-    for (const glm::uvec3& t : o.mesh.triangles)
-      mesh.indices.insert(mesh.indices.end(), {t.x, t.y, t.z});
-    for (const Sphere& s : o.spheres) mesh.spheres.push_back({float3(s.center), s.radius});
     capture::SceneObject object;
     object.name = o.name;
-    object.mesh = static_cast<uint32_t>(out.meshes.size());
     object.material = o.material;
+    auto found = o.shared_mesh ? mesh_of.find(o.shared_mesh.get()) : mesh_of.end();
+    if (found != mesh_of.end()) {
+      object.mesh = found->second;
+    } else {
+      object.mesh = static_cast<uint32_t>(out.meshes.size());
+      if (o.shared_mesh) mesh_of.emplace(o.shared_mesh.get(), object.mesh);
+      const TriangleMesh& source = o.triangle_mesh();
+      capture::SceneMesh mesh;
+      mesh.name = o.shared_mesh && !source.name.empty() ? source.name : o.name;
+      mesh.positions = flatten(source.positions);
+      mesh.indices.reserve(source.triangles.size() * 3);
+      for (const glm::uvec3& t : source.triangles)
+        mesh.indices.insert(mesh.indices.end(), {t.x, t.y, t.z});
+      for (const Sphere& s : o.spheres) mesh.spheres.push_back({float3(s.center), s.radius});
+      mesh.state_times = source.state_times;
+      mesh.state_positions = flatten(source.state_positions);
+      out.meshes.push_back(std::move(mesh));
+    }
     if (o.transform) {
       std::vector<capture::SceneTransform> samples(frames);
       for (uint32_t f = 0; f < frames; ++f) samples[f] = row_major(o.transform(time_of(f)));
@@ -89,7 +108,6 @@ Expected<capture::SceneFile> export_scene(const Scene& scene, uint32_t frames) {
         object.transforms = std::move(samples);
       }
     }
-    out.meshes.push_back(std::move(mesh));
     out.objects.push_back(std::move(object));
   }
   for (size_t i = 0; i < scene.lights.size(); ++i) {

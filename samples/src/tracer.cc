@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include <embree3/rtcore.h>
@@ -53,13 +54,66 @@ void basis(const glm::vec3& n, glm::vec3* t, glm::vec3* b) {
   *b = glm::vec3(c, s + n.y * n.y * a, -n.y);
 }
 
+// One geometry of the top-level Embree scene: an object's triangles or spheres in world space, or
+// an instance of a shared mesh (a prototype).
 struct Geometry {
   uint32_t material = 0;
   bool spheres = false;
   std::vector<glm::vec3> positions;  // world space at the frame's time
   std::vector<glm::uvec3> triangles;
   std::vector<glm::vec4> balls;  // world centre + radius
+  // An instance: its prototype (index into Impl::prototypes) and the matrix taking the
+  // prototype's face normals to world normals (the transform's 3 x 3 part, negated when it
+  // mirrors, which flips the winding).
+  int32_t prototype = -1;
+  glm::mat3 normal_matrix{1.0f};
 };
+
+// A shared mesh built once per frame into its own Embree scene, instanced by every object that
+// places it. Holding the mesh keeps the tracer valid after the scene is gone, as for own meshes.
+struct Prototype {
+  std::shared_ptr<const TriangleMesh> mesh;
+  std::vector<glm::vec3> positions;  // object space at the frame's time (vertex states applied)
+  RTCScene scene = nullptr;
+};
+
+bool finite3(const glm::vec3& p) {
+  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+}
+
+// Attaches `positions` / `triangles` to `scene` as one triangle geometry with id `id`.
+Status attach_triangles(RTCDevice device, RTCScene scene, unsigned id,
+                        const std::vector<glm::vec3>& positions,
+                        const std::vector<glm::uvec3>& triangles) {
+  RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+      geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), positions.size()));
+  auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+      geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), triangles.size()));
+  if (!v || !idx) {
+    rtcReleaseGeometry(geom);
+    return Status(ErrorId::kRayTracer, "Embree: cannot allocate buffers");
+  }
+  for (size_t i = 0; i < positions.size(); ++i) {
+    v[3 * i] = positions[i].x, v[3 * i + 1] = positions[i].y, v[3 * i + 2] = positions[i].z;
+  }
+  for (size_t i = 0; i < triangles.size(); ++i) {
+    idx[3 * i] = triangles[i].x, idx[3 * i + 1] = triangles[i].y, idx[3 * i + 2] = triangles[i].z;
+  }
+  rtcCommitGeometry(geom);
+  rtcAttachGeometryByID(scene, geom, id);
+  rtcReleaseGeometry(geom);
+  return Status::Ok();
+}
+
+RTCScene new_scene(RTCDevice device) {
+  RTCScene scene = rtcNewScene(device);
+  // Robust mode: no cracks between triangles sharing an edge (stray sky pixels would be depth +inf
+  // holes in the middle of a wall).
+  rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+  return scene;
+}
 
 struct LightAt {
   glm::vec3 position, intensity;
@@ -76,6 +130,7 @@ struct FrameTracer::Impl {
   RTCDevice device = nullptr;
   RTCScene rtc = nullptr;
   std::vector<Geometry> geometries;
+  std::vector<Prototype> prototypes;
   std::vector<Material> materials;
   std::vector<LightAt> lights;
   Sky sky;
@@ -86,6 +141,9 @@ struct FrameTracer::Impl {
 
   ~Impl() {
     if (rtc) rtcReleaseScene(rtc);
+    for (Prototype& p : prototypes) {
+      if (p.scene) rtcReleaseScene(p.scene);
+    }
     if (device) rtcReleaseDevice(device);
   }
 
@@ -108,7 +166,9 @@ struct FrameTracer::Impl {
     ++*rays;
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
     hit->t = rh.ray.tfar;
-    hit->geom = rh.hit.geomID;
+    // An instance hit names the instance (a top-level geometry) in instID and the prototype's
+    // own geometry (always 0) in geomID.
+    hit->geom = rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? rh.hit.instID[0] : rh.hit.geomID;
     hit->prim = rh.hit.primID;
     return true;
   }
@@ -134,9 +194,16 @@ struct FrameTracer::Impl {
   glm::vec3 normal(const Hit& h, const glm::vec3& p) const {
     const Geometry& g = geometries[h.geom];
     if (g.spheres) return glm::normalize(p - glm::vec3(g.balls[h.prim]));
-    const glm::uvec3& t = g.triangles[h.prim];
-    glm::vec3 n =
-        glm::cross(g.positions[t.y] - g.positions[t.x], g.positions[t.z] - g.positions[t.x]);
+    glm::vec3 n;
+    if (g.prototype >= 0) {
+      const Prototype& pr = prototypes[static_cast<size_t>(g.prototype)];
+      const glm::uvec3& t = pr.mesh->triangles[h.prim];
+      n = g.normal_matrix *
+          glm::cross(pr.positions[t.y] - pr.positions[t.x], pr.positions[t.z] - pr.positions[t.x]);
+    } else {
+      const glm::uvec3& t = g.triangles[h.prim];
+      n = glm::cross(g.positions[t.y] - g.positions[t.x], g.positions[t.z] - g.positions[t.x]);
+    }
     float len = glm::length(n);
     return len > 0 ? n / len : glm::vec3(0, 1, 0);
   }
@@ -317,15 +384,54 @@ Expected<std::unique_ptr<FrameTracer>> FrameTracer::create(const Scene& scene, d
   const std::string config = options.threads ? "threads=" + std::to_string(options.threads) : "";
   impl->device = rtcNewDevice(config.c_str());
   if (!impl->device) return Status(ErrorId::kRayTracer, "Embree: cannot create a device");
-  impl->rtc = rtcNewScene(impl->device);
-  // Robust mode: no cracks between triangles sharing an edge (stray sky pixels would be depth +inf
-  // holes in the middle of a wall).
-  rtcSetSceneFlags(impl->rtc, RTC_SCENE_FLAG_ROBUST);
-  rtcSetSceneBuildQuality(impl->rtc, RTC_BUILD_QUALITY_HIGH);
+  impl->rtc = new_scene(impl->device);
+  tbb::task_arena arena(options.threads == 0 ? tbb::task_arena::automatic
+                                             : static_cast<int>(options.threads));
+  auto at_time = [&](const Object& o) {
+    return "object '" + o.name + "' is not finite at time " + std::to_string(time);
+  };
+  // Shared meshes, in order of first use (so geometry ids do not depend on pointer values).
+  std::unordered_map<const TriangleMesh*, int32_t> prototype_of;
+  std::vector<glm::vec3> positions;
+  for (const Object& o : scene.objects) {
+    if (!o.shared_mesh || prototype_of.count(o.shared_mesh.get())) continue;
+    const int32_t index = static_cast<int32_t>(impl->prototypes.size());
+    prototype_of.emplace(o.shared_mesh.get(), index);
+    Prototype& pr = impl->prototypes.emplace_back();
+    pr.mesh = o.shared_mesh;
+    positions_at(*pr.mesh, time, &pr.positions);
+    if (!std::all_of(pr.positions.begin(), pr.positions.end(), finite3)) {
+      return Status(ErrorId::kSceneGeometry, at_time(o));
+    }
+    pr.scene = new_scene(impl->device);
+    if (!pr.mesh->triangles.empty()) {
+      CALF_RETURN_IF_ERROR(
+          attach_triangles(impl->device, pr.scene, 0, pr.positions, pr.mesh->triangles));
+    }
+    arena.execute([&] { rtcCommitScene(pr.scene); });
+  }
 
   for (const Object& o : scene.objects) {
     const glm::mat4 m = o.transform ? o.transform(time) : glm::mat4(1);
-    const float scale = std::cbrt(std::fabs(glm::determinant(glm::mat3(m))));
+    const float det = glm::determinant(glm::mat3(m));
+    const float scale = std::cbrt(std::fabs(det));
+    if (o.shared_mesh) {
+      Geometry g;
+      g.material = o.material;
+      g.prototype = prototype_of.at(o.shared_mesh.get());
+      g.normal_matrix = glm::mat3(m) * (det < 0 ? -1.0f : 1.0f);
+      for (int c = 0; c < 4; ++c) {
+        if (!finite3(glm::vec3(m[c]))) return Status(ErrorId::kSceneGeometry, at_time(o));
+      }
+      RTCGeometry geom = rtcNewGeometry(impl->device, RTC_GEOMETRY_TYPE_INSTANCE);
+      rtcSetGeometryInstancedScene(geom, impl->prototypes[static_cast<size_t>(g.prototype)].scene);
+      rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &m[0][0]);
+      rtcCommitGeometry(geom);
+      rtcAttachGeometryByID(impl->rtc, geom, static_cast<unsigned>(impl->geometries.size()));
+      rtcReleaseGeometry(geom);
+      impl->geometries.push_back(std::move(g));
+      continue;
+    }
     for (int pass = 0; pass < 2; ++pass) {
       Geometry g;
       g.material = o.material;
@@ -333,51 +439,31 @@ Expected<std::unique_ptr<FrameTracer>> FrameTracer::create(const Scene& scene, d
       if (!g.spheres) {
         if (o.mesh.triangles.empty()) continue;
         g.triangles = o.mesh.triangles;
-        g.positions.reserve(o.mesh.positions.size());
-        for (const glm::vec3& p : o.mesh.positions) g.positions.emplace_back(m * glm::vec4(p, 1));
+        positions_at(o.mesh, time, &positions);
+        g.positions.reserve(positions.size());
+        for (const glm::vec3& p : positions) g.positions.emplace_back(m * glm::vec4(p, 1));
       } else {
         if (o.spheres.empty()) continue;
-        for (const Sphere& s : o.spheres) {
-          g.balls.emplace_back(glm::vec3(m * glm::vec4(s.center, 1)), s.radius * scale);
+        for (const Sphere& sp : o.spheres) {
+          g.balls.emplace_back(glm::vec3(m * glm::vec4(sp.center, 1)), sp.radius * scale);
         }
       }
-      for (const glm::vec3& p : g.positions) {
-        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-          return Status(ErrorId::kSceneGeometry,
-                        "object '" + o.name + "' is not finite at time " + std::to_string(time));
-        }
+      if (!std::all_of(g.positions.begin(), g.positions.end(), finite3)) {
+        return Status(ErrorId::kSceneGeometry, at_time(o));
       }
       for (const glm::vec4& b : g.balls) {
-        if (!std::isfinite(b.x) || !std::isfinite(b.y) || !std::isfinite(b.z) || !(b.w > 0) ||
-            !std::isfinite(b.w)) {
+        if (!finite3(glm::vec3(b)) || !(b.w > 0) || !std::isfinite(b.w)) {
           return Status(
               ErrorId::kSceneGeometry,
               "object '" + o.name + "' has a degenerate sphere at time " + std::to_string(time));
         }
       }
-      RTCGeometry geom;
+      const unsigned id = static_cast<unsigned>(impl->geometries.size());
       if (!g.spheres) {
-        geom = rtcNewGeometry(impl->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
-                                                              RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                                              g.positions.size()));
-        auto* idx = static_cast<uint32_t*>(
-            rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                    3 * sizeof(uint32_t), g.triangles.size()));
-        if (!v || !idx) {
-          rtcReleaseGeometry(geom);
-          return Status(ErrorId::kRayTracer, "Embree: cannot allocate buffers");
-        }
-        for (size_t i = 0; i < g.positions.size(); ++i) {
-          v[3 * i] = g.positions[i].x, v[3 * i + 1] = g.positions[i].y,
-                v[3 * i + 2] = g.positions[i].z;
-        }
-        for (size_t i = 0; i < g.triangles.size(); ++i) {
-          idx[3 * i] = g.triangles[i].x, idx[3 * i + 1] = g.triangles[i].y,
-                  idx[3 * i + 2] = g.triangles[i].z;
-        }
+        CALF_RETURN_IF_ERROR(
+            attach_triangles(impl->device, impl->rtc, id, g.positions, g.triangles));
       } else {
-        geom = rtcNewGeometry(impl->device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+        RTCGeometry geom = rtcNewGeometry(impl->device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
         auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
             geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), g.balls.size()));
         if (!v) {
@@ -387,15 +473,13 @@ Expected<std::unique_ptr<FrameTracer>> FrameTracer::create(const Scene& scene, d
         for (size_t i = 0; i < g.balls.size(); ++i) {
           for (int c = 0; c < 4; ++c) v[4 * i + c] = g.balls[i][c];
         }
+        rtcCommitGeometry(geom);
+        rtcAttachGeometryByID(impl->rtc, geom, id);
+        rtcReleaseGeometry(geom);
       }
-      rtcCommitGeometry(geom);
-      rtcAttachGeometryByID(impl->rtc, geom, static_cast<unsigned>(impl->geometries.size()));
-      rtcReleaseGeometry(geom);
       impl->geometries.push_back(std::move(g));
     }
   }
-  tbb::task_arena arena(options.threads == 0 ? tbb::task_arena::automatic
-                                             : static_cast<int>(options.threads));
   arena.execute([&] { rtcCommitScene(impl->rtc); });
   if (RTCError e = rtcGetDeviceError(impl->device); e != RTC_ERROR_NONE) {
     return Status(ErrorId::kRayTracer,

@@ -1,6 +1,7 @@
 // Scene export (calf/samples/scene_export.h): every built-in scene becomes a scene file whose
-// counts, materials, transforms and lights are the scene's own, sampled per frame; and the built
-// calf-capture --export-scene writes a folder the scene-file reader accepts.
+// counts, materials, transforms, vertex states and lights are the scene's own, sampled per frame,
+// with each shared mesh stored once; and the built calf-capture --export-scene writes a folder the
+// scene-file reader accepts.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -8,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -32,20 +34,33 @@ void expect_same_counts(const Scene& scene, const capture::SceneFile& file, uint
   EXPECT_EQ(file.frame_count, frames);
   EXPECT_EQ(file.fps, scene.fps);
   ASSERT_EQ(file.objects.size(), scene.objects.size());
-  ASSERT_EQ(file.meshes.size(), scene.objects.size());
+  // One mesh per object, except that a shared mesh is stored once.
+  std::set<const TriangleMesh*> shared;
+  size_t own = 0;
+  for (const Object& object : scene.objects) {
+    if (object.shared_mesh) {
+      shared.insert(object.shared_mesh.get());
+    } else {
+      ++own;
+    }
+  }
+  ASSERT_EQ(file.meshes.size(), own + shared.size());
   ASSERT_EQ(file.materials.size(), scene.materials.size());
   ASSERT_EQ(file.lights.size(), scene.lights.size());
   size_t triangles = 0;
   for (size_t o = 0; o < scene.objects.size(); ++o) {
     const Object& object = scene.objects[o];
+    const TriangleMesh& source = object.triangle_mesh();
     const capture::SceneMesh& mesh = file.meshes[file.objects[o].mesh];
-    EXPECT_EQ(mesh.vertex_count(), object.mesh.positions.size()) << object.name;
-    EXPECT_EQ(mesh.triangle_count(), object.mesh.triangles.size()) << object.name;
+    EXPECT_EQ(mesh.vertex_count(), source.positions.size()) << object.name;
+    EXPECT_EQ(mesh.triangle_count(), source.triangles.size()) << object.name;
     EXPECT_EQ(mesh.spheres.size(), object.spheres.size()) << object.name;
+    EXPECT_EQ(mesh.state_times, source.state_times) << object.name;
     EXPECT_EQ(file.objects[o].material, object.material);
-    triangles += object.mesh.triangles.size();
+    triangles += source.triangles.size();
   }
   EXPECT_EQ(file.triangle_count(), triangles);
+  EXPECT_EQ(file.triangle_count(), scene.triangle_count());
   EXPECT_EQ(file.view_region_min[0], scene.default_rig.view_volume.min.x);
   EXPECT_EQ(file.view_region_max[1], scene.default_rig.view_volume.max.y);
 }
@@ -74,7 +89,9 @@ TEST(SceneExport, BuiltinScenesKeepTheirContent) {
         EXPECT_EQ(t[4], m[0][1]);
         EXPECT_EQ(t[10], m[2][2]);
       }
-      some_animated = some_animated || object.transforms.size() == frames;
+      // Moving transforms, or vertex states (the swaying blades).
+      some_animated = some_animated || object.transforms.size() == frames ||
+                      !file->meshes[object.mesh].state_times.empty();
     }
     EXPECT_TRUE(some_animated) << "every built-in scene moves something";
     for (size_t m = 0; m < scene->materials.size(); ++m) {

@@ -54,8 +54,9 @@ struct RenderStats {
 // A scene frozen at one time and built into an Embree BVH, ready to trace from any thread.
 class FrameTracer {
  public:
-  // Builds the scene at `time` seconds. E174 for non-finite transformed geometry, E178 when
-  // Embree fails.
+  // Builds the scene at `time` seconds: vertex states at that time, every shared mesh once as an
+  // Embree scene of its own, instanced by the objects that place it. E174 for non-finite
+  // transformed geometry, E178 when Embree fails.
   static Expected<std::unique_ptr<FrameTracer>> create(const Scene& scene, double time,
                                                        const RenderOptions& options);
   ~FrameTracer();

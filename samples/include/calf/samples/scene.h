@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -39,10 +40,25 @@ struct Material {
 // Object-space triangles. Front faces wind counter-clockwise seen from outside (the right-hand
 // normal cross(v1 - v0, v2 - v0) points out); closed objects must be consistently wound because
 // the inside-geometry check counts back-face hits.
+//
+// Optional piecewise-linear vertex states (format/SCENE.md "Vertex states", paper 004 Eqs. 3-4):
+// state k gives every vertex's object-space position at state_times[k] seconds; between two
+// states a vertex moves linearly in time, before the first and after the last it is held. The
+// times are floats, as a scene file stores them, so that an exported scene moves exactly as the
+// ray tracer rendered it. Without states `positions` is the position at every time; with them it
+// is the rest pose (what a reader without animation uses), and the tracer ignores it.
 struct TriangleMesh {
   std::vector<glm::vec3> positions;
   std::vector<glm::uvec3> triangles;
+  std::vector<float> state_times;          // empty, or 1..4096 finite, >= 0, increasing
+  std::vector<glm::vec3> state_positions;  // state_times.size() * positions.size(), state-major
+  std::string name;                        // informative: the scene-file name of a shared mesh
 };
+
+// The positions of `mesh` at `time` seconds into `out`: `positions` without states, else linear
+// between the two states around `time` (held outside them). The arithmetic is that of
+// capture::positions_at (scene_file.h), so both give the same floats.
+void positions_at(const TriangleMesh& mesh, double time, std::vector<glm::vec3>* out);
 
 // An analytic sphere (exact radial depth; Embree's sphere primitive).
 struct Sphere {
@@ -54,12 +70,22 @@ struct Sphere {
 // scaled by the cube root of the determinant.
 using TransformAt = std::function<glm::mat4(double time)>;
 
+// An object: its own triangles and spheres, or an instance of a shared mesh (a prototype that
+// many objects place, each with its own transform and material). The ray tracer builds a shared
+// mesh once per frame and instances it; the scene-file export stores it once (format/SCENE.md
+// "Instancing and large scenes"). So a field of 5 M triangles made of a few patches costs the
+// patches' memory, not the field's.
 struct Object {
   std::string name;
   TriangleMesh mesh;
   std::vector<Sphere> spheres;
   uint32_t material = 0;  // index into Scene::materials
   TransformAt transform;  // empty: identity at every time
+  // Set: the object's triangles are this mesh's, and `mesh` and `spheres` must be empty (E174).
+  std::shared_ptr<const TriangleMesh> shared_mesh;
+
+  // The triangles the object places: *shared_mesh when set, else mesh.
+  const TriangleMesh& triangle_mesh() const { return shared_mesh ? *shared_mesh : mesh; }
 };
 
 // A point light; radiant intensity in scene radiance units times distance squared.
@@ -110,9 +136,15 @@ struct Scene {
 
   // Whether any material reflects or refracts: only then does a capture carry material channels.
   bool has_mirror_or_glass() const;
+  // Triangles over objects, an instanced mesh counted once per object that places it.
+  size_t triangle_count() const;
+  // Analytic spheres over objects.
+  size_t sphere_count() const;
 };
 
-// Checks indices, finiteness, radii and material ranges at time 0. Errors: E173 empty, E174.
+// Checks indices, finiteness, radii, material ranges and vertex states (times finite, >= 0,
+// strictly increasing, at most 4096; one finite position per vertex per state) at time 0, each
+// shared mesh once. Errors: E173 empty, E174 (naming the object and what is wrong).
 Status validate_scene(const Scene& scene);
 
 // ---- built-in scenes ---------------------------------------------------------------------------
@@ -121,7 +153,11 @@ struct SceneInfo {
   const char* name;
   const char* description;
 };
-// The built-in scenes, in --list-scenes order: "turntable", "interior", "mirror-box".
+// The built-in scenes, in --list-scenes order: "turntable", "interior", "mirror-box" (paper 002's
+// cases), then the heavy scenes of the visible-set mode (paper 004): "city" (streets of
+// instanced buildings, most of it hidden from a street crossing), "blades" (a field of swaying
+// grass blades in vertex states) and "spheres" (bouncing analytic spheres among occluders).
+// Each description gives the scene's triangle count.
 const std::vector<SceneInfo>& builtin_scenes();
 // Builds a built-in scene (E170 for an unknown name).
 Expected<Scene> make_builtin_scene(std::string_view name);
