@@ -40,7 +40,7 @@ double peak_rss_mib() {
 // The --visible-set options of --mode mesh (docs/VISIBILITY.md).
 struct VisibleSetFlags {
   bool enabled = false;
-  double eye_height = std::numeric_limits<double>::quiet_NaN();  // NaN: the region's middle y
+  std::optional<double> eye_height;  // none: the middle of the view region's y range
   uint32_t segments_per_edge = 1;
   calf::encoder::VisibleSetOptions options;
   bool quiet = false;
@@ -55,9 +55,8 @@ calf::Expected<calf::encoder::VisibleSet> visible_set_of(const calf::capture::Sc
   const calf::Box3 region{
       {scene.view_region_min[0], scene.view_region_min[1], scene.view_region_min[2]},
       {scene.view_region_max[0], scene.view_region_max[1], scene.view_region_max[2]}};
-  const double eye_height = std::isnan(flags.eye_height)
-                                ? 0.5 * (scene.view_region_min[1] + scene.view_region_max[1])
-                                : flags.eye_height;
+  const double eye_height =
+      flags.eye_height.value_or(0.5 * (scene.view_region_min[1] + scene.view_region_max[1]));
   const auto segments =
       calf::encoder::perimeter_segments(region, eye_height, flags.segments_per_edge);
   double perimeter = 0;
@@ -66,28 +65,35 @@ calf::Expected<calf::encoder::VisibleSet> visible_set_of(const calf::capture::Sc
     perimeter += std::sqrt(dx * dx + dy * dy + dz * dz);
   }
   *segment_count = static_cast<uint32_t>(segments.size());
-  if (!flags.quiet) {
-    std::fprintf(stderr,
-                 "calf-encode: visible set: %zu segments (%.3f m of perimeter at eye height %.3f), "
-                 "6 faces of %u px, %u frames, %s granularity ...\n",
-                 segments.size(), perimeter, eye_height, flags.options.face_size, scene.frame_count,
-                 flags.options.object_granularity ? "object" : "triangle");
+  // The builder reports no progress: on a terminal, say what is being solved until it returns
+  // (erased then, so an error stays the one line calf-encode prints).
+  const bool tty = !flags.quiet && isatty(2) != 0;
+  if (tty) {
+    std::fprintf(
+        stderr, "calf-encode: visible set: solving %zu segments x 6 faces of %u px x %u frames ...",
+        segments.size(), flags.options.face_size, scene.frame_count);
+    std::fflush(stderr);
   }
   auto set = calf::encoder::compute_visible_set(scene, segments, flags.options);
+  if (tty) std::fprintf(stderr, "\r\033[K");
   if (!set.ok()) return set;
   if (!flags.quiet) {
     const auto& st = set->stats;
-    std::fprintf(stderr,
-                 "calf-encode: visible set: %llu of %llu triangles (%.3f %%) in %.2f s; %llu "
-                 "frames solved, %llu (triangle, pixel) pairs, %.3g pairs/s\n",
-                 static_cast<unsigned long long>(st.visible_triangles),
-                 static_cast<unsigned long long>(st.scene_triangles),
-                 st.scene_triangles ? 100.0 * static_cast<double>(st.visible_triangles) /
-                                          static_cast<double>(st.scene_triangles)
-                                    : 0.0,
-                 st.seconds, static_cast<unsigned long long>(st.frames_solved),
-                 static_cast<unsigned long long>(st.triangle_pixel_pairs),
-                 st.seconds > 0 ? static_cast<double>(st.triangle_pixel_pairs) / st.seconds : 0.0);
+    std::fprintf(
+        stderr,
+        "calf-encode: visible set: %zu segments (%.3f of perimeter at eye height %.3f), 6 faces "
+        "of %u px, %s granularity: %llu of %llu triangles (%.3f %%) in %.2f s; %llu of %u frames "
+        "solved, %llu (triangle, pixel) pairs, %.3g pairs/s\n",
+        segments.size(), perimeter, eye_height, flags.options.face_size,
+        flags.options.object_granularity ? "object" : "triangle",
+        static_cast<unsigned long long>(st.visible_triangles),
+        static_cast<unsigned long long>(st.scene_triangles),
+        st.scene_triangles ? 100.0 * static_cast<double>(st.visible_triangles) /
+                                 static_cast<double>(st.scene_triangles)
+                           : 0.0,
+        st.seconds, static_cast<unsigned long long>(st.frames_solved), scene.frame_count,
+        static_cast<unsigned long long>(st.triangle_pixel_pairs),
+        st.seconds > 0 ? static_cast<double>(st.triangle_pixel_pairs) / st.seconds : 0.0);
   }
   return set;
 }
@@ -113,12 +119,12 @@ int encode_mesh(const std::string& input, const std::string& out, const std::str
     auto computed = visible_set_of(*scene, vs, &o.segment_count);
     if (!computed.ok()) return fail(computed.status());
     set = std::move(*computed);
+    // How the set was made (no time: the bytes depend on the scene and the options only).
     metadata.emplace_back(
         "visible_set",
-        fmt::format("segments {} face_size {} granularity {} triangles {} of {} seconds {:.3f}",
-                    o.segment_count, vs.options.face_size,
-                    vs.options.object_granularity ? "object" : "triangle",
-                    set->stats.visible_triangles, set->stats.scene_triangles, set->stats.seconds));
+        fmt::format("segments {} face_size {} granularity {} triangles {} of {}", o.segment_count,
+                    vs.options.face_size, vs.options.object_granularity ? "object" : "triangle",
+                    set->stats.visible_triangles, set->stats.scene_triangles));
   }
   auto stats = calf::encoder::encode_mesh_file(*scene, dir, out, set ? &set->triangles : nullptr, o,
                                                metadata);
