@@ -13,8 +13,8 @@
 # tests/bench-visible_set_bench (cmake --build BUILD_DIR --target calf-capture calf-encode
 # calf-play calf-info bench-visible_set_bench). Environment:
 #   SCENES   "name:frames:face ..." (default "spheres:24:800 city:12:800 blades:12:800 MODEL:0:800"):
-#            a built-in scene or a model file, the frames exported (0: the scene's own) and the
-#            cube face size of the visible-set builder (paper 004: 800);
+#            a built-in scene or a model file, the frames exported and walked (0: the scene's
+#            own, walked with 12 poses) and the cube face size of the builder (paper 004: 800);
 #   MODEL    the model file from outside the project (default: assimp-testmodels' 2CylinderEngine
 #            glTF, apt-get install assimp-testmodels);
 #   GT_SIZE  pose image size (default 320x240); THREADS (default 0: all cores);
@@ -47,7 +47,8 @@ for spec in $SCENES; do
   rm -rf "$d"
   mkdir -p "$d"
   frame_args=()
-  ((frames > 0)) && frame_args=(--frames "$frames")
+  walk_args=(--frames 12) # a static model has 1 frame: still walk 12 poses
+  ((frames > 0)) && frame_args=(--frames "$frames") && walk_args=(--frames "$frames")
   echo "== $name (frames ${frames/#0/scene\'s}, face $face)"
   "$B/calf-capture" --scene "$scene" --export-scene "$d/scene" "${frame_args[@]}" --quiet
   "$B/calf-encode" --mode mesh "$d/scene" -o "$d/full.calf" --threads "$THREADS" -q \
@@ -57,7 +58,7 @@ for spec in $SCENES; do
     --visibility-face-size "$face" --threads "$THREADS" 2>&1 | tee "$d/visible.log"
   t1=$(now)
   "$B/calf-capture" --scene "$scene" --out "$d/walk" --ground-truth --gt-size "$GT_SIZE" \
-    --ao-samples 0 --max-bounces 0 "${frame_args[@]}" --quiet
+    --ao-samples 0 --max-bounces 0 "${walk_args[@]}" --quiet
   for r in gl cpu; do
     "$B/calf-play" "$d/visible.calf" --headless --eye-path "$d/walk/eye_path.json" \
       --compare-clip "$d/full.calf" --renderer "$r" >"$d/play-$r.log" 2>&1
