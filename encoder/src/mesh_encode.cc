@@ -359,6 +359,14 @@ Expected<MeshEncodeStats> encode_mesh_file(const std::filesystem::path& scene_di
                                            const std::string& out_path,
                                            const MeshEncodeOptions& options) {
   CALF_ASSIGN_OR_RETURN(const capture::SceneFile scene, capture::read_scene_file(scene_dir));
+  return encode_mesh_file(scene, scene_dir, out_path, nullptr, options);
+}
+
+Expected<MeshEncodeStats> encode_mesh_file(
+    const capture::SceneFile& scene, const std::filesystem::path& scene_dir,
+    const std::string& out_path, const std::vector<std::vector<uint32_t>>* visible,
+    const MeshEncodeOptions& options,
+    const std::vector<std::pair<std::string, std::string>>& extra_metadata) {
   // The output must not be one of the inputs (CALF-E007).
   std::vector<std::string> inputs = {scene_dir.string(),
                                      (scene_dir / capture::kSceneManifestFileName).string(),
@@ -368,7 +376,7 @@ Expected<MeshEncodeStats> encode_mesh_file(const std::filesystem::path& scene_di
   CALF_ASSIGN_OR_RETURN(container::Writer writer,
                         container::Writer::create(out_path, options.levels));
   MeshEncodeStats stats;
-  CALF_RETURN_IF_ERROR(encode_mesh_track(scene, nullptr, options, &writer, &stats));
+  CALF_RETURN_IF_ERROR(encode_mesh_track(scene, visible, options, &writer, &stats));
   CALF_RETURN_IF_ERROR(
       writer.set_metadata("encoder", std::string("calf-encode ") + kVersionString));
   if (!scene.name.empty()) CALF_RETURN_IF_ERROR(writer.set_metadata("source_scene", scene.name));
@@ -377,6 +385,8 @@ Expected<MeshEncodeStats> encode_mesh_file(const std::filesystem::path& scene_di
                 scene.view_region_min[0], scene.view_region_min[1], scene.view_region_min[2],
                 scene.view_region_max[0], scene.view_region_max[1], scene.view_region_max[2]);
   CALF_RETURN_IF_ERROR(writer.set_metadata("view_volume", volume));
+  for (const auto& [key, value] : extra_metadata)
+    CALF_RETURN_IF_ERROR(writer.set_metadata(key, value));
   CALF_RETURN_IF_ERROR(writer.finish());
   return stats;
 }

@@ -6,15 +6,21 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
+#include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/encoder/mesh_encode.h"
+#include "calf/encoder/visible_set.h"
 #include "command_line.h"
 
 namespace {
@@ -31,9 +37,71 @@ double peak_rss_mib() {
 
 }  // namespace
 
-// --mode mesh: the scene file at `input` (its folder or scene.json) into a full-scene mesh track.
+// The --visible-set options of --mode mesh (docs/VISIBILITY.md).
+struct VisibleSetFlags {
+  bool enabled = false;
+  std::optional<double> eye_height;  // none: the middle of the view region's y range
+  uint32_t segments_per_edge = 1;
+  calf::encoder::VisibleSetOptions options;
+  bool quiet = false;
+};
+
+// Computes the visible set of `scene` from its view region's perimeter (calf/encoder/
+// visible_set.h), printing what it solves and a summary; the set's errors (E110-E115) pass
+// through.
+calf::Expected<calf::encoder::VisibleSet> visible_set_of(const calf::capture::SceneFile& scene,
+                                                         const VisibleSetFlags& flags,
+                                                         uint32_t* segment_count) {
+  const calf::Box3 region{
+      {scene.view_region_min[0], scene.view_region_min[1], scene.view_region_min[2]},
+      {scene.view_region_max[0], scene.view_region_max[1], scene.view_region_max[2]}};
+  const double eye_height =
+      flags.eye_height.value_or(0.5 * (scene.view_region_min[1] + scene.view_region_max[1]));
+  const auto segments =
+      calf::encoder::perimeter_segments(region, eye_height, flags.segments_per_edge);
+  double perimeter = 0;
+  for (const auto& g : segments) {
+    const double dx = g.b.x - g.a.x, dy = g.b.y - g.a.y, dz = g.b.z - g.a.z;
+    perimeter += std::sqrt(dx * dx + dy * dy + dz * dz);
+  }
+  *segment_count = static_cast<uint32_t>(segments.size());
+  // The builder reports no progress: on a terminal, say what is being solved until it returns
+  // (erased then, so an error stays the one line calf-encode prints).
+  const bool tty = !flags.quiet && isatty(2) != 0;
+  if (tty) {
+    std::fprintf(
+        stderr, "calf-encode: visible set: solving %zu segments x 6 faces of %u px x %u frames ...",
+        segments.size(), flags.options.face_size, scene.frame_count);
+    std::fflush(stderr);
+  }
+  auto set = calf::encoder::compute_visible_set(scene, segments, flags.options);
+  if (tty) std::fprintf(stderr, "\r\033[K");
+  if (!set.ok()) return set;
+  if (!flags.quiet) {
+    const auto& st = set->stats;
+    std::fprintf(
+        stderr,
+        "calf-encode: visible set: %zu segments (%.3f of perimeter at eye height %.3f), 6 faces "
+        "of %u px, %s granularity: %llu of %llu triangles (%.3f %%) in %.2f s; %llu of %u frames "
+        "solved, %llu (triangle, pixel) pairs, %.3g pairs/s\n",
+        segments.size(), perimeter, eye_height, flags.options.face_size,
+        flags.options.object_granularity ? "object" : "triangle",
+        static_cast<unsigned long long>(st.visible_triangles),
+        static_cast<unsigned long long>(st.scene_triangles),
+        st.scene_triangles ? 100.0 * static_cast<double>(st.visible_triangles) /
+                                 static_cast<double>(st.scene_triangles)
+                           : 0.0,
+        st.seconds, static_cast<unsigned long long>(st.frames_solved), scene.frame_count,
+        static_cast<unsigned long long>(st.triangle_pixel_pairs),
+        st.seconds > 0 ? static_cast<double>(st.triangle_pixel_pairs) / st.seconds : 0.0);
+  }
+  return set;
+}
+
+// --mode mesh: the scene file at `input` (its folder or scene.json) into a mesh track of the
+// whole scene or, with --visible-set, of the triangles visible from its view region.
 int encode_mesh(const std::string& input, const std::string& out, const std::string& super,
-                uint32_t threads) {
+                uint32_t threads, const VisibleSetFlags& vs) {
   calf::encoder::MeshEncodeOptions o;
   o.threads = threads;
   o.supercompression = super == "lzma2"  ? calf::container::Compression::kLzma2
@@ -43,9 +111,23 @@ int encode_mesh(const std::string& input, const std::string& out, const std::str
   if (dir.filename() == calf::capture::kSceneManifestFileName) dir = dir.parent_path();
   if (dir.empty()) dir = ".";
   const auto start = std::chrono::steady_clock::now();
-  // (The lead's --visible-set flags go here: compute_visible_set on the scene's perimeter
-  // segments, then encode_mesh_track with the lists and options.segment_count.)
-  auto stats = calf::encoder::encode_mesh_file(dir, out, o);
+  auto scene = calf::capture::read_scene_file(dir);
+  if (!scene.ok()) return fail(scene.status());
+  std::optional<calf::encoder::VisibleSet> set;
+  std::vector<std::pair<std::string, std::string>> metadata;
+  if (vs.enabled) {
+    auto computed = visible_set_of(*scene, vs, &o.segment_count);
+    if (!computed.ok()) return fail(computed.status());
+    set = std::move(*computed);
+    // How the set was made (no time: the bytes depend on the scene and the options only).
+    metadata.emplace_back(
+        "visible_set",
+        fmt::format("segments {} face_size {} granularity {} triangles {} of {}", o.segment_count,
+                    vs.options.face_size, vs.options.object_granularity ? "object" : "triangle",
+                    set->stats.visible_triangles, set->stats.scene_triangles));
+  }
+  auto stats = calf::encoder::encode_mesh_file(*scene, dir, out, set ? &set->triangles : nullptr, o,
+                                               metadata);
   if (!stats.ok()) return fail(stats.status());
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -87,8 +169,10 @@ int main(int argc, char** argv) {
       "(CALF-E004), and so is an output that is one of the inputs (CALF-E007).\n"
       "--mode mesh: INPUT is a scene file (format/SCENE.md: its folder or scene.json) and the "
       "output holds a mesh track of the whole scene (format/SPEC.md 11.4: materials, prototypes "
-      "with spheres tessellated, objects with their transforms); only --supercompression, "
-      "--threads and --quiet apply, the lightfield options are ignored.\n" +
+      "with spheres tessellated, objects with their transforms), or with --visible-set only the "
+      "triangles visible from the scene's view region (paper 004); only --supercompression, "
+      "--threads, --quiet and the visible-set options apply, the lightfield options are "
+      "ignored.\n" +
       std::string(calf::tools::kExitStatusHelp)};
   calf::LightfieldEncodeOptions o;
   std::string manifest, out;
@@ -141,8 +225,35 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"zstd", "lzma2", "none"}))
       ->default_val("zstd");
   app.add_flag("-q,--quiet", quiet, "no progress line");
+  VisibleSetFlags vs;
+  auto* vs_flag = app.add_flag(
+      "--visible-set", vs.enabled,
+      "mesh: keep only the triangles visible from some point of the scene's view region "
+      "(paper 004 from-segment visibility on the perimeter of its rectangle at --eye-height, "
+      "every frame of the scene; docs/VISIBILITY.md) (default off: the whole scene)");
+  auto needs_vs = [&](CLI::Option* opt) { return opt->needs(vs_flag); };
+  needs_vs(app.add_option("--eye-height", vs.eye_height,
+                          "with --visible-set: height (y) of the perimeter rectangle; must lie in "
+                          "the scene's bounds (default: the middle of the view region's y range)"));
+  needs_vs(app.add_option("--segments-per-edge", vs.segments_per_edge,
+                          "with --visible-set: segments each of the rectangle's 4 edges is cut "
+                          "into, 1..1024 (default 1)")
+               ->check(CLI::Range(1u, 1024u))
+               ->default_val(1));
+  needs_vs(app.add_option("--visibility-face-size", vs.options.face_size,
+                          "with --visible-set: side in px of the 6 cube faces rasterised per "
+                          "segment, 1..8192 (default 800, as paper 004)")
+               ->check(CLI::Range(1u, calf::encoder::kVisibleSetMaxFaceSize))
+               ->default_val(800));
+  needs_vs(app.add_flag("--object-granularity", vs.options.object_granularity,
+                        "with --visible-set: keep an object whole as soon as one of its triangles "
+                        "is visible (default off: single triangles)"));
   if (int rc = calf::tools::parse_command_line(app, "calf-encode", argc, argv); rc >= 0) return rc;
-  if (mode == "mesh") return encode_mesh(manifest, out, super, o.threads);
+  if (mode != "mesh" && vs.enabled)
+    return calf::tools::usage_error("calf-encode", "--visible-set needs --mode mesh");
+  vs.options.threads = o.threads;
+  vs.quiet = quiet;
+  if (mode == "mesh") return encode_mesh(manifest, out, super, o.threads, vs);
 
   const std::map<std::string, calf::ColourCoding> colours = {
       {"auto", calf::ColourCoding::kAuto},   {"bc1", calf::ColourCoding::kBc1},

@@ -27,6 +27,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "calf/capture/scene_file.h"
@@ -97,6 +98,15 @@ Status encode_mesh_track(const capture::SceneFile& scene,
 Expected<MeshEncodeStats> encode_mesh_file(const std::filesystem::path& scene_dir,
                                            const std::string& out_path,
                                            const MeshEncodeOptions& options);
+
+// As above for a scene already read from `scene_dir` (calf-encode --visible-set reads it once to
+// compute the set): `visible` as for encode_mesh_track (nullptr: every triangle), and
+// `extra_metadata` (key, value) pairs written after the ones above (e.g. how the set was made).
+Expected<MeshEncodeStats> encode_mesh_file(
+    const capture::SceneFile& scene, const std::filesystem::path& scene_dir,
+    const std::string& out_path, const std::vector<std::vector<uint32_t>>* visible,
+    const MeshEncodeOptions& options,
+    const std::vector<std::pair<std::string, std::string>>& extra_metadata = {});
 
 // The scene's fps as the header's fraction: n/1 for a whole number, n/1001 for the NTSC rates
 // (23.976 = 24000/1001), else round(fps * 10^6) / 10^6 reduced. Exposed for the decoder tests.
