@@ -170,7 +170,8 @@ int main(int argc, char** argv) {
       "--mode mesh: INPUT is a scene file (format/SCENE.md: its folder or scene.json) and the "
       "output holds a mesh track of the whole scene (format/SPEC.md 11.4: materials, prototypes "
       "with spheres tessellated, objects with their transforms), or with --visible-set only the "
-      "triangles visible from the scene's view region (paper 004); only --supercompression, "
+      "triangles visible from the scene's view region (paper 004; its errors: CALF-E110..E115, "
+      "docs/ERRORS.md); only --supercompression, "
       "--threads, --quiet and the visible-set options apply, the lightfield options are "
       "ignored.\n" +
       std::string(calf::tools::kExitStatusHelp)};
