@@ -178,7 +178,7 @@ int run_headless(Playback& play, Playback* full, const HeadlessArgs& a) {
           cc.max_eps = eps->epsilon, cc.max_eps_pose = k;
         cc.sum_psnr += std::min(*p, 100.0);
         cc.sum_ssim += *s;
-        cc.min_psnr = std::min(cc.min_psnr, *p);
+        cc.min_psnr = std::min(cc.min_psnr, std::min(*p, 100.0));
         cc.min_ssim = std::min(cc.min_ssim, *s);
         cc.render_ms.push_back(full->last_render_ms());
         ++cc.count;
@@ -198,7 +198,7 @@ int run_headless(Playback& play, Playback* full, const HeadlessArgs& a) {
         sum_psnr += std::min(*p, 100.0);  // an exact frame counts as 100 dB, not infinity
         sum_ssim += *s;
         ++compared;
-        if (*p < min_psnr) min_psnr = *p, min_psnr_pose = k;
+        if (std::min(*p, 100.0) < min_psnr) min_psnr = std::min(*p, 100.0), min_psnr_pose = k;
         if (*s < min_ssim) min_ssim = *s, min_ssim_pose = k;
         if (!a.out.empty() && a.heat_maps) {
           const fs::path heat = fs::path(a.out) / (std::string("heat_") + (name + 6) + ".png");
@@ -230,7 +230,7 @@ int run_headless(Playback& play, Playback* full, const HeadlessArgs& a) {
                                   : full_first;
     std::printf(
         "against the full scene (%u poses): epsilon mean %.4f %% max %.4f %% (pose %zu); PSNR mean "
-        "%.2f dB min %.2f dB; SSIM mean %.4f min %.4f\n",
+        "%.2f dB min %.2f dB (an identical pose counts as 100 dB); SSIM mean %.4f min %.4f\n",
         cc.count, 100 * cc.sum_eps / cc.count, 100 * cc.max_eps, cc.max_eps_pose,
         cc.sum_psnr / cc.count, cc.min_psnr, cc.sum_ssim / cc.count, cc.min_ssim);
     std::printf(
