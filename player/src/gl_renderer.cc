@@ -8,6 +8,7 @@
 
 #include "calf/player/glsl_conventions.h"
 #include "gl_errors.h"
+#include "gl_frame_readback.h"
 #include "gl_raymarch_shader.h"
 #include "sampling.h"
 
@@ -266,32 +267,8 @@ Status GlRenderer::render(const Camera& camera, RenderedImage* out) {
   gl.DrawBuffers(1, &buffer);
   CALF_RETURN_IF_ERROR(draw(camera));
 
-  const size_t w = camera.width, h = camera.height;
-  std::vector<float> rgba(4 * w * h);
-  gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
-  gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
-  gl.PixelStorei(GL_PACK_ROW_LENGTH, 0);
-  gl.PixelStorei(GL_PACK_SKIP_PIXELS, 0);
-  gl.PixelStorei(GL_PACK_SKIP_ROWS, 0);
-  gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
-  gl.ReadPixels(0, 0, static_cast<GLsizei>(w), static_cast<GLsizei>(h), GL_RGBA, GL_FLOAT,
-                rgba.data());
-  gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-  CALF_RETURN_IF_ERROR(check_gl_error(gl, "reading back the frame"));
-  out->width = camera.width;
-  out->height = camera.height;
-  out->color.resize(3 * w * h);
-  out->depth.resize(w * h);
-  // GL rows run bottom-up; the image's row 0 is the top.
-  for (size_t j = 0; j < h; ++j) {
-    const float* row = &rgba[4 * w * (h - 1 - j)];
-    for (size_t i = 0; i < w; ++i) {
-      const size_t k = j * w + i;
-      for (int ch = 0; ch < 3; ++ch) out->color[3 * k + ch] = row[4 * i + ch];
-      out->depth[k] = row[4 * i + 3];
-    }
-  }
-  return Status::Ok();
+  return internal::read_back_colour_and_depth(gl, camera.width, camera.height,
+                                              "reading back the frame", out);
 }
 
 }  // namespace calf::player

@@ -9,6 +9,7 @@
 
 #include "calf/player/mesh_renderer.h"
 #include "gl_errors.h"
+#include "gl_frame_readback.h"
 
 namespace calf::player {
 
@@ -440,32 +441,8 @@ Status GlMeshRenderer::render(const MeshDrawList& list, const Camera& camera,
   gl.ClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
   CALF_RETURN_IF_ERROR(check_gl_error(gl, "drawing the mesh"));
 
-  const size_t w = camera.width, hh = camera.height;
-  std::vector<float> rgba(4 * w * hh);
-  gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
-  gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
-  gl.PixelStorei(GL_PACK_ROW_LENGTH, 0);
-  gl.PixelStorei(GL_PACK_SKIP_PIXELS, 0);
-  gl.PixelStorei(GL_PACK_SKIP_ROWS, 0);
-  gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
-  gl.ReadPixels(0, 0, static_cast<GLsizei>(w), static_cast<GLsizei>(hh), GL_RGBA, GL_FLOAT,
-                rgba.data());
-  gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-  CALF_RETURN_IF_ERROR(check_gl_error(gl, "reading back the mesh frame"));
-  out->width = camera.width;
-  out->height = camera.height;
-  out->color.resize(3 * w * hh);
-  out->depth.resize(w * hh);
-  // GL rows run bottom-up; the image's row 0 is the top.
-  for (size_t j = 0; j < hh; ++j) {
-    const float* row = &rgba[4 * w * (hh - 1 - j)];
-    for (size_t i = 0; i < w; ++i) {
-      const size_t k = j * w + i;
-      for (int ch = 0; ch < 3; ++ch) out->color[3 * k + ch] = row[4 * i + ch];
-      out->depth[k] = row[4 * i + 3];
-    }
-  }
-  return Status::Ok();
+  return internal::read_back_colour_and_depth(gl, camera.width, camera.height,
+                                              "reading back the mesh frame", out);
 }
 
 }  // namespace calf::player
