@@ -14,14 +14,14 @@
 #include <string>
 #include <system_error>
 
+#include "../scratch_dir.h"
 #include "calf/format/coordinates.h"
 #include "calf/samples/scene.h"
-#include "fuzz_scratch_dir.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size == 0) return 0;
   static const char* const kExtensions[] = {".obj", ".ply", ".gltf", ".glb"};
-  const std::filesystem::path& dir = calf::fuzz::scratch_dir("calf_assimp_fuzz");
+  const std::filesystem::path& dir = calf::test::scratch_dir("calf_assimp_fuzz");
   const std::filesystem::path file = dir / (std::string("model") + kExtensions[data[0] % 4]);
   {
     std::ofstream out(file, std::ios::binary | std::ios::trunc);

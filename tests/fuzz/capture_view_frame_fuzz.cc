@@ -12,12 +12,12 @@
 #include <string>
 #include <system_error>
 
+#include "../scratch_dir.h"
 #include "calf/capture/capture_set.h"
-#include "fuzz_scratch_dir.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size == 0) return 0;
-  const std::filesystem::path& dir = calf::fuzz::scratch_dir("calf_view_frame_fuzz");
+  const std::filesystem::path& dir = calf::test::scratch_dir("calf_view_frame_fuzz");
   calf::capture::CaptureManifest m;
   m.frame_count = 1;
   m.face_size = 1 + (data[0] & 3);

@@ -4,8 +4,6 @@
 // a visible set that lost an object against the full scene.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -14,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "../scratch_dir.h"
 #include "calf/encoder/mesh_encode.h"
 #include "calf/encoder/sphere_mesh.h"
 #include "calf/format/container.h"
@@ -27,16 +26,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path scratch_dir() {
-  static const fs::path dir = [] {
-    std::string name = "calf_mesh_playback_";
-    name.append(std::to_string(::getpid()));
-    const fs::path d = fs::temp_directory_path() / name;
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-  }();
-  return dir;
+const fs::path& scratch_dir() {
+  return test::scratch_dir("calf_mesh_playback");
 }
 
 // Encodes the test scene (3 frames) with `visible` (nullptr: every triangle) into a file.

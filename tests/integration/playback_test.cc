@@ -4,8 +4,6 @@
 // volume comes from the clip's metadata.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +11,7 @@
 #include <filesystem>
 #include <string>
 
+#include "../scratch_dir.h"
 #include "calf/capture/capture_set.h"
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/format/container.h"
@@ -28,11 +27,7 @@ namespace fs = std::filesystem;
 // A clip made once for the whole file: calf-capture's interior scene, 16-texel faces, 3 frames.
 const std::string& clip_path() {
   static const std::string path = [] {
-    std::string name = "calf_playback_";  // append: GCC 12 -O3 misfires -Wrestrict on operator+
-    name.append(std::to_string(::getpid()));
-    const fs::path dir = fs::temp_directory_path() / name;
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const fs::path& dir = test::scratch_dir("calf_playback");
     const std::string capture = (dir / "cap").string(), clip = (dir / "clip.calf").string();
     std::string cmd = CALF_CAPTURE_EXE;
     cmd.append(" --scene interior --face-size 16 --frames 3 --quiet --out ").append(capture);

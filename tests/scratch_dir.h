@@ -1,6 +1,6 @@
-// The scratch folder of a fuzz target that must hand its input to a reader as files: one folder
-// per process under the temp directory, made on first use and removed when the run ends (so
-// ctest leaves nothing behind).
+// The scratch folder of a test or fuzz target that writes files (clips, scene files, inputs a
+// reader must open by path): one folder per process under the temp directory, made on first use
+// and removed when the process exits (so ctest leaves nothing behind).
 #pragma once
 
 #include <unistd.h>
@@ -10,7 +10,7 @@
 #include <string>
 #include <system_error>
 
-namespace calf::fuzz {
+namespace calf::test {
 
 // temp_directory_path() / "<name>_<pid>", created on the first call. Every call of one process
 // must pass the same `name`.
@@ -30,4 +30,4 @@ inline const std::filesystem::path& scratch_dir(const char* name) {
   return *dir;
 }
 
-}  // namespace calf::fuzz
+}  // namespace calf::test
