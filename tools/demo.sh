@@ -4,16 +4,23 @@
 # it into a .calf clip, summarise and fully verify the clip, render ground truth along the scene's
 # eye path and play the clip headless along it (GL through OSMesa), comparing every frame with the
 # ground truth. Ends with a one-screen report and a contact sheet PNG (ground truth | calf | error
-# heat map). Every step's full output is kept in build/demo/logs/. A second run skips installed
-# packages and rebuilds incrementally.
+# heat map). Then the visible-set mesh mode (paper 004, docs/VISIBILITY.md) on the built-in
+# `city` (1.4 M triangles): export the scene file, encode the full scene and the triangles visible
+# from the view region's perimeter as mesh clips, and play the visible set against the full scene
+# along a walk inside the region (epsilon = share of pixels where a triangle is missing, PSNR,
+# SSIM, frame times). Every step's full output is kept in build/demo/logs/. A second run skips
+# installed packages and rebuilds incrementally.
 #
 # Environment: CALF_DEMO_SCENE (default interior; see calf-capture --list-scenes),
 # CALF_DEMO_FACE (capture face size, default 64), CALF_DEMO_FRAMES (default 8),
-# CALF_DEMO_GT (ground-truth size WxH, default 128x128).
+# CALF_DEMO_GT (ground-truth size WxH, default 128x128); visible-set part: CALF_DEMO_VS_SCENE
+# (default city; empty skips the part), CALF_DEMO_VS_FACE (the builder's cube face, default 200;
+# the paper's 800 takes minutes), CALF_DEMO_VS_FRAMES (frames solved and walk poses, default 6);
+# CALF_DEMO_BUILD (build directory, default build/release).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./tools/setup.sh
-BUILD=build/release
+BUILD=${CALF_DEMO_BUILD:-build/release}
 cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$BUILD" --target calf-capture calf-encode calf-info calf-verify calf-play
 
@@ -21,10 +28,14 @@ SCENE=${CALF_DEMO_SCENE:-interior}
 FACE=${CALF_DEMO_FACE:-64}
 FRAMES=${CALF_DEMO_FRAMES:-8}
 GT=${CALF_DEMO_GT:-128x128}
+VS_SCENE=${CALF_DEMO_VS_SCENE-city}
+VS_FACE=${CALF_DEMO_VS_FACE:-200}
+VS_FRAMES=${CALF_DEMO_VS_FRAMES:-6}
 OUT=build/demo
 LOGS=$OUT/logs
 CLIP=$OUT/$SCENE.calf
 SHEET=$OUT/contact_sheet.png
+VS=$OUT/visible-set
 rm -rf "$OUT"
 mkdir -p "$LOGS"
 
@@ -63,6 +74,22 @@ run ground-truth "$BUILD"/calf-capture --scene "$SCENE" --ground-truth --out "$O
 run calf-play "$BUILD"/calf-play "$CLIP" --headless --compare "$OUT/ground-truth" \
   --out "$OUT/play" --contact-sheet "$SHEET"
 
+if [ -n "$VS_SCENE" ]; then
+  echo "calf demo: visible-set mesh mode on $VS_SCENE, face $VS_FACE, $VS_FRAMES frames"
+  run vs-export-scene "$BUILD"/calf-capture --scene "$VS_SCENE" --export-scene "$VS/scene" \
+    --frames "$VS_FRAMES" --quiet
+  run vs-encode-full "$BUILD"/calf-encode --mode mesh "$VS/scene" -o "$VS/full.calf"
+  run vs-encode-visible "$BUILD"/calf-encode --mode mesh "$VS/scene" -o "$VS/visible.calf" \
+    --visible-set --visibility-face-size "$VS_FACE"
+  VS_BUILD_S=$LAST_SECONDS
+  # The walk: the scene's validation eye path inside the region. calf-capture writes it with
+  # --ground-truth; the mesh comparison uses its poses only, so the images are the cheapest kind.
+  run vs-walk "$BUILD"/calf-capture --scene "$VS_SCENE" --out "$VS/walk" --ground-truth \
+    --gt-size 320x240 --ao-samples 0 --max-bounces 0 --frames "$VS_FRAMES" --quiet
+  run vs-play "$BUILD"/calf-play "$VS/visible.calf" --headless --eye-path "$VS/walk/eye_path.json" \
+    --compare-clip "$VS/full.calf"
+fi
+
 PLAY=$LOGS/calf-play.log
 ENC=$LOGS/calf-encode.log
 CAPTURE_BYTES=$(du -sb "$OUT/capture" | cut -f1)
@@ -85,5 +112,19 @@ echo "          (GL 4.5 through OSMesa / llvmpipe on the CPU; the first render c
 echo "quality   $(line_of "$PLAY" '^mean PSNR') against ground truth at $GT"
 echo "          $(line_of "$PLAY" '^worst pose')"
 echo "sheet     $SHEET (rows: poses along the path; ground truth | calf | error heat map)"
+if [ -n "$VS_SCENE" ]; then
+  VSLOG=$LOGS/vs-encode-visible.log
+  VSPLAY=$LOGS/vs-play.log
+  echo "visible   $VS_SCENE (paper 004): $(line_of "$VSLOG" 'visible set:' |
+    grep -oE '[0-9]+ of [0-9]+ triangles \([0-9.]+ %\)') kept, from"\
+    "$(line_of "$VSLOG" 'visible set:' | grep -oE '[0-9]+ segments')" \
+    "at face $VS_FACE, $VS_FRAMES frames; build $VS_BUILD_S s wall"
+  awk -v v="$(stat -c %s "$VS/visible.calf")" -v f="$(stat -c %s "$VS/full.calf")" 'BEGIN {
+    printf "          mesh clip %.1f KB (the full scene: %.1f KB)\n", v / 1e3, f / 1e3 }'
+  echo "          render $(line_of "$VSPLAY" '^frame time' | sed 's/^frame time ([^)]*): //')"\
+    "(GL on llvmpipe, median after the first pose)"
+  echo "          $(line_of "$VSPLAY" '^against the full scene' | sed -E 's/ \(an identical[^)]*\)//')"
+  echo "          (epsilon: share of pixels where a triangle is missing; paper 004: <= 0.19 % mean)"
+fi
 echo "files     capture set $OUT/capture, frames and heat maps $OUT/play, logs $LOGS"
 echo "=================================================================================="
