@@ -8,7 +8,8 @@
 
 #include "calf/player/glsl_conventions.h"
 #include "gl_errors.h"
-#include "gl_frame_readback.h"
+#include "gl_program.h"
+#include "gl_raster_target.h"
 #include "gl_raymarch_shader.h"
 #include "sampling.h"
 
@@ -47,24 +48,6 @@ Status camera_axes(const Camera& c, Vec3* forward, Vec3* right, Vec3* up) {
   return Status::Ok();
 }
 
-Expected<GLuint> compile(const GlFunctions& gl, GLenum type, const std::string& source,
-                         const char* what) {
-  const GLuint shader = gl.CreateShader(type);
-  const char* text = source.c_str();
-  gl.ShaderSource(shader, 1, &text, nullptr);
-  gl.CompileShader(shader);
-  GLint ok = 0;
-  gl.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    std::vector<char> log(8192, '\0');
-    gl.GetShaderInfoLog(shader, static_cast<GLsizei>(log.size()), nullptr, log.data());
-    gl.DeleteShader(shader);
-    return Status(kGlMissing,
-                  std::string("the ") + what + " shader does not compile: " + log.data());
-  }
-  return shader;
-}
-
 }  // namespace
 
 Expected<RenderOptions> march_range_for(const GlTextureLayout& layout, const Vec3& eye,
@@ -82,8 +65,6 @@ GlRenderer::~GlRenderer() {
   if (program_ != 0) gl_->DeleteProgram(program_);
   if (vao_ != 0) gl_->DeleteVertexArrays(1, &vao_);
   if (view_buffer_ != 0) gl_->DeleteBuffers(1, &view_buffer_);
-  if (fbo_ != 0) gl_->DeleteFramebuffers(1, &fbo_);
-  if (target_ != 0) gl_->DeleteTextures(1, &target_);
 }
 
 Expected<std::unique_ptr<GlRenderer>> GlRenderer::make(const GlViews& views,
@@ -117,59 +98,21 @@ Status GlRenderer::set_options(const RenderOptions& options) {
 
 Status GlRenderer::build_program() {
   const GlFunctions& gl = *gl_;
-  const std::string version = "#version 450 core\n";
-  CALF_ASSIGN_OR_RETURN(
-      const GLuint vs,
-      compile(gl, GL_VERTEX_SHADER, version + internal::kGlFullscreenVertex, "vertex"));
   std::string defines =
       "#define CALF_MAX_VIEWS " + std::to_string(internal::kGlMaxActiveViews) + "\n";
   if (views_->depth_is_bc5()) defines += "#define CALF_DEPTH_BC5\n";
   defines += "#define CALF_HINTS " + std::to_string(options_.surface_hints) + "\n";
-  const Expected<GLuint> fs =
-      compile(gl, GL_FRAGMENT_SHADER,
-              version + defines + kGlslConventions + internal::kGlRaymarchFragment, "ray-march");
-  if (!fs.ok()) {
-    gl.DeleteShader(vs);
-    return fs.status();
-  }
-  program_ = gl.CreateProgram();
-  gl.AttachShader(program_, vs);
-  gl.AttachShader(program_, *fs);
-  gl.LinkProgram(program_);
-  gl.DeleteShader(vs);
-  gl.DeleteShader(*fs);
-  GLint ok = 0;
-  gl.GetProgramiv(program_, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    std::vector<char> log(8192, '\0');
-    gl.GetProgramInfoLog(program_, static_cast<GLsizei>(log.size()), nullptr, log.data());
-    return Status(kGlMissing, std::string("the ray-march program does not link: ") + log.data());
-  }
+  const Expected<GLuint> program = internal::build_gl_program(
+      gl,
+      {{GL_VERTEX_SHADER, internal::kGlFullscreenVertex, "vertex"},
+       {GL_FRAGMENT_SHADER, defines + kGlslConventions + internal::kGlRaymarchFragment,
+        "ray-march"}},
+      "the ray-march program");
+  if (!program.ok()) return program.status();
+  program_ = *program;
   if (vao_ == 0) gl.GenVertexArrays(1, &vao_);
   if (view_buffer_ == 0) gl.GenBuffers(1, &view_buffer_);
   return check_gl_error(gl, "building the ray-march program");
-}
-
-Status GlRenderer::ensure_target(uint32_t width, uint32_t height) {
-  if (target_ != 0 && width == target_width_ && height == target_height_) return Status::Ok();
-  const GlFunctions& gl = *gl_;
-  if (target_ != 0) gl.DeleteTextures(1, &target_);
-  if (fbo_ == 0) gl.GenFramebuffers(1, &fbo_);
-  gl.GenTextures(1, &target_);
-  gl.BindTexture(GL_TEXTURE_2D, target_);
-  gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, static_cast<GLsizei>(width),
-                  static_cast<GLsizei>(height));
-  gl.BindFramebuffer(GL_FRAMEBUFFER, fbo_);
-  gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, target_, 0);
-  const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
-  CALF_RETURN_IF_ERROR(check_gl_error(gl, "creating the RGBA32F render target"));
-  if (status != GL_FRAMEBUFFER_COMPLETE) {
-    return Status(kGlMissing, "an RGBA32F framebuffer of " + std::to_string(width) + " x " +
-                                  std::to_string(height) + " is not complete");
-  }
-  target_width_ = width;
-  target_height_ = height;
-  return Status::Ok();
 }
 
 Status GlRenderer::draw(const Camera& camera) {
@@ -260,15 +203,13 @@ Status GlRenderer::draw(const Camera& camera) {
 Status GlRenderer::render(const Camera& camera, RenderedImage* out) {
   Vec3 forward, right, up;
   CALF_RETURN_IF_ERROR(camera_axes(camera, &forward, &right, &up));
-  const GlFunctions& gl = *gl_;
-  CALF_RETURN_IF_ERROR(ensure_target(camera.width, camera.height));
-  gl.BindFramebuffer(GL_FRAMEBUFFER, fbo_);
-  const GLenum buffer = GL_COLOR_ATTACHMENT0;
-  gl.DrawBuffers(1, &buffer);
+  if (target_ == nullptr) {
+    target_ = std::make_unique<internal::GlRasterTarget>(*gl_, /*with_depth=*/false);
+  }
+  CALF_RETURN_IF_ERROR(
+      target_->bind_and_clear(camera.width, camera.height, "the ray-march render target"));
   CALF_RETURN_IF_ERROR(draw(camera));
-
-  return internal::read_back_colour_and_depth(gl, camera.width, camera.height,
-                                              "reading back the frame", out);
+  return target_->read_back("reading back the frame", out);
 }
 
 }  // namespace calf::player

@@ -9,11 +9,10 @@
 
 #include "calf/player/mesh_renderer.h"
 #include "gl_errors.h"
-#include "gl_frame_readback.h"
+#include "gl_program.h"
+#include "gl_raster_target.h"
 
 namespace calf::player {
-
-using internal::kGlMissing;
 
 namespace {
 
@@ -96,24 +95,6 @@ void main() {
 }
 )";
 
-Expected<GLuint> compile(const GlFunctions& gl, GLenum type, const char* body, const char* what) {
-  const std::string source = std::string("#version 450 core\n") + body;
-  const GLuint shader = gl.CreateShader(type);
-  const char* text = source.c_str();
-  gl.ShaderSource(shader, 1, &text, nullptr);
-  gl.CompileShader(shader);
-  GLint ok = 0;
-  gl.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    std::vector<char> log(8192, '\0');
-    gl.GetShaderInfoLog(shader, static_cast<GLsizei>(log.size()), nullptr, log.data());
-    gl.DeleteShader(shader);
-    return Status(kGlMissing,
-                  std::string("the mesh ") + what + " shader does not compile: " + log.data());
-  }
-  return shader;
-}
-
 Status structure_error(const std::string& what) {
   return Status(ErrorId::kMeshGlStructure, what + " (upload the draw list again)");
 }
@@ -134,46 +115,29 @@ GLuint make_buffer(const GlFunctions& gl, GLenum target, const std::vector<T>& d
 
 Expected<std::unique_ptr<GlMeshRenderer>> GlMeshRenderer::make(const GlFunctions& gl) {
   std::unique_ptr<GlMeshRenderer> r(new GlMeshRenderer(gl));
+  r->target_ = std::make_unique<internal::GlRasterTarget>(gl, /*with_depth=*/true);
   CALF_RETURN_IF_ERROR(r->build_program());
   return r;
 }
+
+GlMeshRenderer::GlMeshRenderer(const GlFunctions& gl) : gl_(&gl) {}
 
 GlMeshRenderer::~GlMeshRenderer() {
   release_buffers();
   const GlFunctions& gl = *gl_;
   if (program_ != 0) gl.DeleteProgram(program_);
-  if (fbo_ != 0) gl.DeleteFramebuffers(1, &fbo_);
-  if (colour_target_ != 0) gl.DeleteTextures(1, &colour_target_);
-  if (depth_target_ != 0) gl.DeleteTextures(1, &depth_target_);
 }
 
 Status GlMeshRenderer::build_program() {
   const GlFunctions& gl = *gl_;
-  const std::array<std::pair<GLenum, const char*>, 3> stages = {
-      {{GL_VERTEX_SHADER, kVertexShader},
-       {GL_GEOMETRY_SHADER, kGeometryShader},
-       {GL_FRAGMENT_SHADER, kFragmentShader}}};
-  const char* names[3] = {"vertex", "geometry", "fragment"};
-  std::vector<GLuint> shaders;
-  for (size_t i = 0; i < stages.size(); ++i) {
-    Expected<GLuint> s = compile(gl, stages[i].first, stages[i].second, names[i]);
-    if (!s.ok()) {
-      for (GLuint done : shaders) gl.DeleteShader(done);
-      return s.status();
-    }
-    shaders.push_back(*s);
-  }
-  program_ = gl.CreateProgram();
-  for (GLuint s : shaders) gl.AttachShader(program_, s);
-  gl.LinkProgram(program_);
-  for (GLuint s : shaders) gl.DeleteShader(s);
-  GLint ok = 0;
-  gl.GetProgramiv(program_, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    std::vector<char> log(8192, '\0');
-    gl.GetProgramInfoLog(program_, static_cast<GLsizei>(log.size()), nullptr, log.data());
-    return Status(kGlMissing, std::string("the mesh program does not link: ") + log.data());
-  }
+  const Expected<GLuint> program =
+      internal::build_gl_program(gl,
+                                 {{GL_VERTEX_SHADER, kVertexShader, "vertex"},
+                                  {GL_GEOMETRY_SHADER, kGeometryShader, "geometry"},
+                                  {GL_FRAGMENT_SHADER, kFragmentShader, "fragment"}},
+                                 "the mesh program");
+  if (!program.ok()) return program.status();
+  program_ = *program;
   const auto loc = [&](const char* name) { return gl.GetUniformLocation(program_, name); };
   uniforms_ = {loc("model_x"),    loc("model_y"),        loc("model_z"),
                loc("model_t"),    loc("normal_x"),       loc("normal_y"),
@@ -323,51 +287,14 @@ Status GlMeshRenderer::update_positions(const MeshDrawList& list, uint32_t proto
   return check_gl_error(gl, "updating mesh positions");
 }
 
-Status GlMeshRenderer::ensure_target(uint32_t width, uint32_t height) {
-  if (colour_target_ != 0 && width == target_width_ && height == target_height_) {
-    return Status::Ok();
-  }
-  const GlFunctions& gl = *gl_;
-  if (colour_target_ != 0) gl.DeleteTextures(1, &colour_target_);
-  if (depth_target_ != 0) gl.DeleteTextures(1, &depth_target_);
-  if (fbo_ == 0) gl.GenFramebuffers(1, &fbo_);
-  const auto w = static_cast<GLsizei>(width), h = static_cast<GLsizei>(height);
-  gl.GenTextures(1, &colour_target_);
-  gl.BindTexture(GL_TEXTURE_2D, colour_target_);
-  gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, w, h);
-  gl.GenTextures(1, &depth_target_);
-  gl.BindTexture(GL_TEXTURE_2D, depth_target_);
-  gl.TexStorage2D(GL_TEXTURE_2D, 1, GL_DEPTH_COMPONENT32F, w, h);
-  gl.BindTexture(GL_TEXTURE_2D, 0);
-  gl.BindFramebuffer(GL_FRAMEBUFFER, fbo_);
-  gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, colour_target_, 0);
-  gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, depth_target_, 0);
-  const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
-  CALF_RETURN_IF_ERROR(check_gl_error(gl, "creating the mesh render target"));
-  if (status != GL_FRAMEBUFFER_COMPLETE) {
-    return Status(kGlMissing, "an RGBA32F + DEPTH32F framebuffer of " + std::to_string(width) +
-                                  " x " + std::to_string(height) + " is not complete");
-  }
-  target_width_ = width;
-  target_height_ = height;
-  return Status::Ok();
-}
-
 Status GlMeshRenderer::render(const MeshDrawList& list, const Camera& camera,
                               const MeshRenderOptions& options, RenderedImage* out) {
   CALF_RETURN_IF_ERROR(validate_camera(camera));
   CALF_RETURN_IF_ERROR(validate_mesh_render_options(options));
   CALF_RETURN_IF_ERROR(check_structure(list));
   const GlFunctions& gl = *gl_;
-  CALF_RETURN_IF_ERROR(ensure_target(camera.width, camera.height));
-  gl.BindFramebuffer(GL_FRAMEBUFFER, fbo_);
-  const GLenum buffer = GL_COLOR_ATTACHMENT0;
-  gl.DrawBuffers(1, &buffer);
-  gl.Viewport(0, 0, static_cast<GLsizei>(camera.width), static_cast<GLsizei>(camera.height));
-  const float clear_colour[4] = {0, 0, 0, INFINITY};
-  const float clear_depth = 0;  // reversed Z: 0 is infinitely far
-  gl.ClearBufferfv(GL_COLOR, 0, clear_colour);
-  gl.ClearBufferfv(GL_DEPTH, 0, &clear_depth);
+  CALF_RETURN_IF_ERROR(
+      target_->bind_and_clear(camera.width, camera.height, "the mesh render target"));
   for (GLenum cap : {GL_BLEND, GL_SCISSOR_TEST, GL_CULL_FACE, GL_STENCIL_TEST}) gl.Disable(cap);
   gl.Enable(GL_DEPTH_TEST);
   gl.DepthFunc(GL_GREATER);
@@ -441,8 +368,7 @@ Status GlMeshRenderer::render(const MeshDrawList& list, const Camera& camera,
   gl.ClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
   CALF_RETURN_IF_ERROR(check_gl_error(gl, "drawing the mesh"));
 
-  return internal::read_back_colour_and_depth(gl, camera.width, camera.height,
-                                              "reading back the mesh frame", out);
+  return target_->read_back("reading back the mesh frame", out);
 }
 
 }  // namespace calf::player

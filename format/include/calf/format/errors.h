@@ -158,6 +158,9 @@ enum class ErrorKind : uint8_t {
   X(kMeshRenderOptions, 471, kInvalidArgument, "a mesh render option is outside its range")    \
   X(kMeshGlStructure, 472, kInvalidArgument, "a mesh draw list differs from its GL upload")    \
   X(kMeshPlayback, 473, kInvalidArgument, "a mesh track cannot be played as asked")           \
+  X(kSurfelDrawList, 474, kInvalidArgument, "a surfel draw list is inconsistent or not finite") \
+  X(kSurfelRenderOptions, 475, kInvalidArgument, "a surfel render option is outside its range") \
+  X(kSurfelGlStructure, 476, kInvalidArgument, "a surfel draw list differs from its GL upload") \
   X(kExportInput, 480, kInvalidArgument, "a track cannot be exported as asked")                \
   X(kExportWrite, 481, kInternal, "the glTF / OBJ exporter failed")                             \
   /* end of the list: every line above ends with a backslash */

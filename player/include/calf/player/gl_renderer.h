@@ -32,6 +32,10 @@
 
 namespace calf::player {
 
+namespace internal {
+class GlRasterTarget;
+}
+
 // march_range_for() of cpu_renderer.h for a GL texture layout: far = max_j(|eye - P_j| +
 // z_far_j), near = min_j z_near_j / 4 but no nearer
 // than far / 2^20 (a tiny z_near must not stretch the log steps). Errors: CALF-E403 for no views.
@@ -69,14 +73,12 @@ class GlRenderer {
  private:
   GlRenderer(const GlViews& views, const RenderOptions& options);
   Status build_program();
-  Status ensure_target(uint32_t width, uint32_t height);
 
   const GlViews* views_;
   const GlFunctions* gl_;
   RenderOptions options_;
   GLuint program_ = 0, vao_ = 0, view_buffer_ = 0;
-  GLuint fbo_ = 0, target_ = 0;
-  uint32_t target_width_ = 0, target_height_ = 0;
+  std::unique_ptr<internal::GlRasterTarget> target_;  // made on the first render()
 };
 
 }  // namespace calf::player

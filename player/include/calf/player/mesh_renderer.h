@@ -40,6 +40,10 @@
 
 namespace calf::player {
 
+namespace internal {
+class GlRasterTarget;
+}
+
 // Renders `list` for `camera` into `out` (resized to the camera's image). Errors: CALF-E470 for an
 // invalid list, CALF-E471 for invalid options, CALF-E403 for an invalid camera. Deterministic.
 Status render_mesh_cpu(const MeshDrawList& list, const Camera& camera,
@@ -71,9 +75,8 @@ class GlMeshRenderer {
                 RenderedImage* out);
 
  private:
-  explicit GlMeshRenderer(const GlFunctions& gl) : gl_(&gl) {}
+  explicit GlMeshRenderer(const GlFunctions& gl);
   Status build_program();
-  Status ensure_target(uint32_t width, uint32_t height);
   Status check_structure(const MeshDrawList& list) const;
   void release_buffers();
 
@@ -99,8 +102,7 @@ class GlMeshRenderer {
   std::vector<PrototypeBuffers> prototypes_;
   std::vector<ObjectBuffers> objects_;
   size_t material_count_ = 0;
-  GLuint fbo_ = 0, colour_target_ = 0, depth_target_ = 0;
-  uint32_t target_width_ = 0, target_height_ = 0;
+  std::unique_ptr<internal::GlRasterTarget> target_;
 };
 
 }  // namespace calf::player

@@ -1,0 +1,67 @@
+// Private to the player: compiling and linking a GLSL 4.50 program from its stages, shared by the
+// light-field ray-marcher (gl_renderer.cc), the mesh rasteriser (mesh_gl_renderer.cc) and the
+// surfel splatter (surfel_gl_renderer.cc).
+#pragma once
+
+#include <initializer_list>
+#include <string>
+#include <vector>
+
+#include "calf/format/status.h"
+#include "calf/player/gl_context.h"
+#include "gl_errors.h"
+
+namespace calf::player::internal {
+
+// One shader stage: its type (GL_VERTEX_SHADER ...), its source after the `#version` line, and a
+// name for errors ("vertex", "ray-march").
+struct GlStage {
+  GLenum type;
+  std::string source;
+  const char* name;
+};
+
+// Compiles every stage with `#version 450 core` prepended and links them into a program.
+// `program` names it in errors ("the mesh program"). Errors: CALF-E404 naming the stage that
+// does not compile or the program that does not link, with the driver's log. Shaders are deleted
+// either way; the caller owns the returned program.
+inline Expected<GLuint> build_gl_program(const GlFunctions& gl,
+                                         std::initializer_list<GlStage> stages,
+                                         const std::string& program) {
+  std::vector<GLuint> shaders;
+  const auto release = [&] {
+    for (GLuint s : shaders) gl.DeleteShader(s);
+  };
+  for (const GlStage& stage : stages) {
+    const std::string text = "#version 450 core\n" + stage.source;
+    const GLuint shader = gl.CreateShader(stage.type);
+    shaders.push_back(shader);
+    const char* source = text.c_str();
+    gl.ShaderSource(shader, 1, &source, nullptr);
+    gl.CompileShader(shader);
+    GLint ok = 0;
+    gl.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+      std::vector<char> log(8192, '\0');
+      gl.GetShaderInfoLog(shader, static_cast<GLsizei>(log.size()), nullptr, log.data());
+      release();
+      return Status(kGlMissing,
+                    program + ": the " + stage.name + " shader does not compile: " + log.data());
+    }
+  }
+  const GLuint id = gl.CreateProgram();
+  for (GLuint s : shaders) gl.AttachShader(id, s);
+  gl.LinkProgram(id);
+  release();
+  GLint ok = 0;
+  gl.GetProgramiv(id, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    std::vector<char> log(8192, '\0');
+    gl.GetProgramInfoLog(id, static_cast<GLsizei>(log.size()), nullptr, log.data());
+    gl.DeleteProgram(id);
+    return Status(kGlMissing, program + " does not link: " + log.data());
+  }
+  return id;
+}
+
+}  // namespace calf::player::internal
