@@ -103,12 +103,14 @@ uint32_t level_count(uint64_t n) {
   return k;
 }
 
+// Levels past 2^64 surfels do not exist; their bounds saturate instead of overflowing the shift.
 uint64_t level_begin(uint32_t k) {
-  return k == 0 ? 0 : uint64_t{kFirstLevelSurfels} << (k - 1);
+  if (k == 0) return 0;
+  return k - 1 < 54 ? uint64_t{kFirstLevelSurfels} << (k - 1) : UINT64_MAX;
 }
 
 uint64_t level_end(uint32_t k, uint64_t n) {
-  return std::min(n, uint64_t{kFirstLevelSurfels} << k);
+  return std::min(n, k < 54 ? uint64_t{kFirstLevelSurfels} << k : UINT64_MAX);
 }
 
 uint64_t level_chunk_size(uint32_t k, uint64_t n) {

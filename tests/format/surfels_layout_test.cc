@@ -22,6 +22,7 @@ TEST(SurfelsLayout, LevelsCutAtPowersOfTwoTimes1024) {
   EXPECT_EQ(level_count(2049), 3u);
   EXPECT_EQ(level_count(100000), 8u);  // 1024 * 2^6 = 65536 < 100000 <= 131072
   EXPECT_EQ(level_count(kMaxSurfels), 17u);
+  EXPECT_EQ(level_count(UINT64_MAX), 55u) << "the bounds saturate, no shift overflows";
   EXPECT_EQ(level_begin(0), 0u);
   EXPECT_EQ(level_begin(1), 1024u);
   EXPECT_EQ(level_begin(2), 2048u);
