@@ -1,5 +1,6 @@
 // calf-info: an ffprobe-like summary of a .calf clip: version, tracks (kind, frames, fps, views,
-// face size, formats; a mesh track's objects, prototypes and triangles), metadata, and bytes per
+// face size, formats; a mesh track's objects, prototypes and triangles; a surfels track's
+// prototypes, surfels and bytes per surfel), metadata, and bytes per
 // stream with the ratio to raw. --json prints the
 // same as one JSON object; --chunks adds the chunk index. Reads only the header and directory.
 #include <fmt/core.h>
@@ -106,6 +107,30 @@ std::optional<MeshFigures> mesh_figures(const Reader& r, const Track& t) {
   return f;
 }
 
+// A surfels track's figures from its header and directory alone (SPEC §11.3: the header's
+// prototype and surfel counts; level chunks are stream 1, region = prototype), or nothing for
+// another kind.
+struct SurfelsFigures {
+  uint64_t prototypes = 0, with_surfels = 0, surfels = 0, stored = 0;
+  double bytes_per_surfel() const {
+    return surfels ? static_cast<double>(stored) / static_cast<double>(surfels) : 0.0;
+  }
+};
+std::optional<SurfelsFigures> surfels_figures(const Reader& r, const Track& t) {
+  const auto* h = std::get_if<SurfelsTrackHeader>(&t.header);
+  if (!h) return std::nullopt;
+  SurfelsFigures f;
+  f.prototypes = h->object_count;
+  f.surfels = h->surfel_count;
+  for (const auto& c : r.chunks()) {
+    if (c.keys.track != t.id || c.keys.stream != static_cast<uint16_t>(SurfelsStream::kSurfels))
+      continue;
+    f.stored += c.stored_size;
+    if (c.keys.layer == 0) ++f.with_surfels;
+  }
+  return f;
+}
+
 void print_text(const std::string& path, const Reader& r, bool list_chunks) {
   const auto& h = r.header();
   StreamStats total;
@@ -135,6 +160,12 @@ void print_text(const std::string& path, const Reader& r, bool list_chunks) {
     if (const auto m = mesh_figures(r, t)) {
       fmt::print("  mesh: {} objects, {} prototypes, {} triangles drawn, {} vertices stored\n",
                  m->objects, m->prototypes, m->triangles, m->vertices);
+    }
+    if (const auto m = surfels_figures(r, t)) {
+      fmt::print(
+          "  surfels: {} prototypes ({} with surfels), {} surfels, {} stored bytes, {:.3f} "
+          "bytes per surfel\n",
+          m->prototypes, m->with_surfels, m->surfels, m->stored, m->bytes_per_surfel());
     }
     fmt::print("  {:<12} {:>8} {:>14} {:>14} {:>8}\n", "stream", "chunks", "stored bytes",
                "raw bytes", "ratio");
@@ -189,6 +220,12 @@ void print_json(const std::string& path, const Reader& r, bool list_chunks) {
       o += fmt::format(
           ",\"mesh\":{{\"objects\":{},\"prototypes\":{},\"triangles\":{},\"vertices\":{}}}",
           m->objects, m->prototypes, m->triangles, m->vertices);
+    }
+    if (const auto m = surfels_figures(r, t)) {
+      o += fmt::format(
+          ",\"surfels\":{{\"prototypes\":{},\"with_surfels\":{},\"surfels\":{},"
+          "\"stored_bytes\":{},\"bytes_per_surfel\":{:.3f}}}",
+          m->prototypes, m->with_surfels, m->surfels, m->stored, m->bytes_per_surfel());
     }
     o += ",\"streams\":[";
     bool first = true;

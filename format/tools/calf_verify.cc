@@ -1,7 +1,8 @@
 // calf-verify: full validation of .calf files (format/SPEC.md): header, directory, limits, every
 // chunk's hash and decompression, every padding byte, then each lightfield track's layout by
 // decoding every face of every view at every frame (calf/decoder/lightfield_verify.h) and each
-// mesh track's by decoding every prototype and object (calf/decoder/mesh_verify.h). Prints one
+// mesh track's by decoding every prototype and object (calf/decoder/mesh_verify.h), and each
+// surfels track's by decoding every prototype's buffer (calf/decoder/surfels_verify.h). Prints one
 // line per problem, each with its stable id, and exits 0 only when every file is good. With
 // --decode it prints the conformance hash of every decoded face (SPEC §14).
 #include <fmt/core.h>
@@ -9,6 +10,7 @@
 
 #include "calf/decoder/lightfield_verify.h"
 #include "calf/decoder/mesh_verify.h"
+#include "calf/decoder/surfels_verify.h"
 #include "calf/format/container.h"
 #include "calf/format/track_kinds.h"
 #include "calf/format/version.h"
@@ -17,7 +19,7 @@
 int main(int argc, char** argv) {
   CLI::App app{std::string(
       "calf-verify: check .calf files completely: header, directory, every chunk "
-      "hash and decompression, padding, then every lightfield and mesh track's layout "
+      "hash and decompression, padding, then every lightfield, mesh and surfels track's layout "
       "by decoding all of it. Problems are listed on stdout, one line each with its CALF "
       "id.\nExit status: 0 all files good; 1 a problem was found (or a file could not "
       "be opened); 2 a usage error (bad option or argument), one line with CALF-E006 "
@@ -34,7 +36,8 @@ int main(int argc, char** argv) {
                "also print the conformance hash of every decoded face, one line each: "
                "'track T frame F view V face X <XXH3-64 hex>' (SPEC §14), and of every mesh "
                "prototype and object: 'track T prototype P <hex>', 'track T object O <hex>' "
-               "(SPEC §11.4.6); a file with problems prints none")
+               "(SPEC §11.4.6), and of every surfels prototype: 'track T surfels P <hex>' "
+               "(SPEC §11.3.6); a file with problems prints none")
       ->excludes("--container-only");
   app.add_option("--max-problems", max_problems,
                  "stop listing a file's problems after N, 1..1000000 (default 100)")
@@ -52,7 +55,7 @@ int main(int argc, char** argv) {
     }
     auto problems = reader->verify(max_problems);
     // Layouts only of a sound container: damaged chunks would only repeat the problems above.
-    uint64_t faces = 0, mesh_parts = 0;
+    uint64_t faces = 0, mesh_parts = 0, surfel_prototypes = 0, surfels = 0;
     std::vector<std::string> hash_lines;
     for (const auto& track : reader->tracks()) {
       if (container_only || !problems.empty()) break;
@@ -61,6 +64,15 @@ int main(int argc, char** argv) {
             calf::decoder::verify_mesh_track(*reader, track.id, decode, max_problems);
         problems.insert(problems.end(), result.problems.begin(), result.problems.end());
         mesh_parts += result.prototypes_decoded + result.objects_decoded;
+        hash_lines.insert(hash_lines.end(), result.hash_lines.begin(), result.hash_lines.end());
+        continue;
+      }
+      if (track.record.kind == static_cast<uint16_t>(calf::container::TrackKind::kSurfels)) {
+        const auto result =
+            calf::decoder::verify_surfels_track(*reader, track.id, decode, max_problems);
+        problems.insert(problems.end(), result.problems.begin(), result.problems.end());
+        surfel_prototypes += result.prototypes_decoded;
+        surfels += result.surfels_decoded;
         hash_lines.insert(hash_lines.end(), result.hash_lines.begin(), result.hash_lines.end());
         continue;
       }
@@ -84,12 +96,17 @@ int main(int argc, char** argv) {
     if (!quiet) {
       fmt::print("{}: ok ({} tracks, {} chunks, {} bytes verified{})\n", path,
                  reader->tracks().size(), reader->chunks().size(), reader->header().file_size,
-                 container_only ? ", layouts not checked"
-                                : fmt::format(", {} faces decoded{}", faces,
-                                              mesh_parts ? fmt::format(", {} mesh prototypes and "
-                                                                       "objects decoded",
-                                                                       mesh_parts)
-                                                         : ""));
+                 container_only
+                     ? ", layouts not checked"
+                     : fmt::format(", {} faces decoded{}", faces,
+                                   mesh_parts ? fmt::format(", {} mesh prototypes and "
+                                                            "objects decoded",
+                                                            mesh_parts)
+                                              : "") +
+                           (surfel_prototypes ? fmt::format(", {} surfel prototypes ({} surfels) "
+                                                            "decoded",
+                                                            surfel_prototypes, surfels)
+                                              : ""));
     }
   }
   return rc;

@@ -133,6 +133,12 @@ enum class ErrorKind : uint8_t {
   X(kMeshIndex, 222, kCorrupt, "a mesh vertex, triangle, prototype or material index is invalid") \
   X(kMeshValue, 223, kCorrupt, "a mesh value is NaN, infinite or outside its range")            \
   X(kMeshLimit, 224, kLimit, "a mesh track count or chunk size exceeds its limit")              \
+  X(kSurfelsChunk, 230, kCorrupt, "a surfels chunk is missing, repeated or contradicts its layout") \
+  X(kSurfelsUnsupported, 231, kUnsupported, "a surfels track's layout version or flag is unknown") \
+  X(kSurfelsPairing, 232, kCorrupt, "a surfels track and its mesh track do not pair")        \
+  X(kSurfelsValue, 233, kCorrupt, "a surfels value is NaN, infinite or outside its range")    \
+  X(kSurfelsLimit, 234, kLimit, "a surfels track count or chunk size exceeds its limit")      \
+  X(kSurfelsInput, 235, kInvalidArgument, "surfels given to the encoder are inconsistent")    \
   /* decoder: 300-399 */                                                                        \
   X(kDecoderArgument, 300, kInvalidArgument, "a decoder option, frame, view or eye is invalid") \
   /* player: 400-499 */                                                                         \
