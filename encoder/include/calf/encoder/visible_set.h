@@ -24,6 +24,8 @@
 // considered; so the paper's coupled motion (Eqs. 3-4: eye and vertices moving with one
 // parameter, quadratic edge events) is not needed for an exact answer at every frame, and the
 // cost grows linearly with the number of distinct frames (of vertex states sampled by frames).
+// The coupled motion answers another question and is offered beside it:
+// VisibleSetOptions::motion = VisibilityMotion::kCoupled (below).
 //
 // Algorithm (per segment, frame and face; Alg. 1). Per triangle ABC, the directions from points of
 // the segment to points of the triangle are those of the convex hull of the six points
