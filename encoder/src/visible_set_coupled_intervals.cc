@@ -63,6 +63,33 @@ bool lex_less(const Vec3& a, const Vec3& b) {
   return a.z < b.z;
 }
 
+// True when c[0] + ... + c[deg] t^deg (deg <= 5) keeps one strict sign on [lo, hi], shown by its
+// Bernstein coefficients there all having that sign (the polynomial is their convex combination).
+// A cheap exclusion before root isolation; false when in doubt.
+bool one_sign_on(const double* c, int deg, double lo, double hi) {
+  // Taylor shift to lo, scale to u in [0, 1]: q(u) = p(lo + (hi - lo) u).
+  double q[6];
+  std::copy_n(c, deg + 1, q);
+  for (int i = 0; i < deg; ++i)
+    for (int j = deg - 1; j >= i; --j) q[j] += lo * q[j + 1];
+  const double h = hi - lo;
+  double scale = 1;
+  for (int i = 0; i <= deg; ++i) q[i] *= scale, scale *= h;
+  // b_k = sum_{i <= k} C(k, i) / C(deg, i) q_i.
+  static constexpr double kBinomial[6][6] = {{1, 0, 0, 0, 0, 0}, {1, 1, 0, 0, 0, 0},
+                                             {1, 2, 1, 0, 0, 0}, {1, 3, 3, 1, 0, 0},
+                                             {1, 4, 6, 4, 1, 0}, {1, 5, 10, 10, 5, 1}};
+  int first = 0;
+  for (int k = 0; k <= deg; ++k) {
+    double b = 0;
+    for (int i = 0; i <= k; ++i) b += kBinomial[k][i] / kBinomial[deg][i] * q[i];
+    const int s = sign(b);
+    if (s == 0 || (k > 0 && s != first)) return false;
+    first = s;
+  }
+  return true;
+}
+
 }  // namespace
 
 int polynomial_roots(const double* c, int deg, double lo, double hi, double* out) {
@@ -151,6 +178,16 @@ int coupled_triangle_coverage(const CoupledTriangleSetup& t, double sc, double t
     for (int j = 0; j < 3; ++j)
       fk[k][j] = t.edge[k][j][0] + sc * t.edge[k][j][1] + tc * t.edge[k][j][2];
   for (int j = 0; j < 3; ++j) n[j] = t.normal[j][0] + sc * t.normal[j][1] + tc * t.normal[j][2];
+  // Most pixels of a bound are never covered: two edges of fixed, opposite signs over [0, 1]
+  // (all three Bernstein coefficients of each of one sign) reject the pixel without roots.
+  int fixed = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double b0 = fk[k][0], b1 = fk[k][0] + 0.5 * fk[k][1], b2 = fk[k][0] + fk[k][1] + fk[k][2];
+    const int s = b0 > 0 && b1 > 0 && b2 > 0 ? 1 : b0 < 0 && b1 < 0 && b2 < 0 ? -1 : 0;
+    if (s == 0) continue;
+    if (fixed == -s) return 0;
+    fixed = s;
+  }
   // Cut [0, 1] at every event (edges: Eq. 4; the normal: the ray grazes the plane; g: the plane
   // passes through the eye) and test each piece at its middle: a root computed a little off
   // only moves a boundary, never inverts a piece.
@@ -253,7 +290,10 @@ int crossings(const CoupledInterval& a, const CoupledInterval& b, double lo, dou
     for (int i = 0; i < 4; ++i)
       for (int j = 0; j < 3; ++j)
         p[i + j] += a.depth.num[i] * b.depth.den[j] - b.depth.num[i] * a.depth.den[j];
-    return polynomial_roots(p, 5, lo, hi, out);
+    int deg = 5;
+    while (deg > 0 && p[deg] == 0) --deg;
+    if (deg >= 2 && one_sign_on(p, deg, lo, hi)) return 0;
+    return polynomial_roots(p, deg, lo, hi, out);
   }
   auto diff = [&](double t) { return coupled_depth_at(a.depth, t) - coupled_depth_at(b.depth, t); };
   int n = 0;
