@@ -86,7 +86,8 @@ double coupled_depth_at(const CoupledDepth& d, double t);
 
 // Depth-composites `in` into the sorted, disjoint list (as visibility::composite: where `in` is
 // strictly nearer it replaces the list, gaps are filled, ties keep the list). Crossings of two
-// triangle depths: polynomial_roots of the cross-multiplied numerators (exact up to rounding);
+// triangle depths: none when the cross-multiplied numerators' Bernstein coefficients over the
+// overlap share a sign, else their polynomial_roots (exact up to rounding);
 // with a sphere: 64 samples and bisection (two crossings within 1/64 of an overlap can be
 // missed). Returns false when nothing changed.
 bool coupled_composite(std::vector<CoupledInterval>* list, const CoupledInterval& in,

@@ -348,6 +348,43 @@ TEST(VisibleSetCoupled, SameResultForOneAndFourThreads) {
   EXPECT_EQ(a.stats.frames_solved, 1u);
 }
 
+// Steps are pairs of consecutive frames; a step repeating the previous one's geometry is skipped.
+TEST(VisibleSetCoupled, StepsAreConsecutiveFrames) {
+  // Three frames: the wall holds still from frame 0 to 1, then moves from 1 to 2.
+  SceneFile s = slit_scene();
+  s.frame_count = 3;
+  capture::SceneMesh& wall = s.meshes[0];
+  const size_t n = wall.positions.size();
+  std::vector<float> moved(wall.state_positions.begin() + static_cast<std::ptrdiff_t>(n),
+                           wall.state_positions.end());
+  wall.state_times = {0.0f, 0.1f, 0.2f};
+  wall.state_positions.resize(n);
+  wall.state_positions.insert(wall.state_positions.end(), wall.positions.begin(),
+                              wall.positions.end());
+  wall.state_positions.insert(wall.state_positions.end(), moved.begin(), moved.end());
+  const VisibleSet c = coupled(s, kSlitSegment, 64);
+  EXPECT_EQ(c.stats.frames_solved, 2u);
+  bool target = false;
+  for (const VisibilityWitness& w : c.witnesses)
+    if (w.object == 1) {
+      target = true;
+      EXPECT_EQ(w.frame, 1u) << "the target lines up only while the wall moves (frames 1 -> 2)";
+    }
+  EXPECT_TRUE(target);
+
+  // Four identical frames: one step without motion, the per-frame set.
+  SceneFile still = random_moving_scene(6, 40, 0);
+  still.frame_count = 4;
+  const VisibleSet c4 = coupled(still, kSegment, 16);
+  EXPECT_EQ(c4.stats.frames_solved, 1u);
+  VisibleSetOptions o;
+  o.face_size = 16;
+  const ViewSegment segs[1] = {kSegment};
+  Expected<VisibleSet> per_frame = compute_visible_set(still, segs, o);
+  ASSERT_TRUE(per_frame.ok()) << per_frame.status().to_string();
+  EXPECT_EQ(c4.triangles, per_frame->triangles);
+}
+
 TEST(VisibleSetCoupled, MotionOutOfRangeIsAnError) {
   const SceneFile s = slit_scene();
   VisibleSetOptions o;
