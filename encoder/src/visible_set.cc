@@ -23,6 +23,7 @@
 #include <tbb/task_arena.h>
 
 #include "calf/encoder/visible_set.h"
+#include "visible_set_coupled.h"
 #include "visible_set_internal.h"
 
 namespace calf::encoder {
@@ -346,6 +347,13 @@ Expected<VisibleSet> compute_visible_set(const capture::SceneFile& scene,
     CALF_RETURN_IF_ERROR(
         check_point(prepared, segments[i].b, "segment " + std::to_string(i) + " end"));
   }
+  // Paper 004 Sec. 3.2's coupled eye and vertex motion: visible_set_coupled.cc.
+  if (options.motion == VisibilityMotion::kCoupled)
+    return solve_coupled(scene, segments, options, prepared, t0);
+  if (options.motion != VisibilityMotion::kPerFrame)
+    return Status(ErrorId::kVisibleSetOption, "motion " +
+                                                  std::to_string(static_cast<int>(options.motion)) +
+                                                  " is neither per-frame (0) nor coupled (1)");
   SegmentRunner runner(options, prepared);
   tbb::task_arena arena(options.threads == 0 ? tbb::task_arena::automatic
                                              : static_cast<int>(options.threads));

@@ -78,20 +78,22 @@ calf::Expected<calf::encoder::VisibleSet> visible_set_of(const calf::capture::Sc
   if (tty) std::fprintf(stderr, "\r\033[K");
   if (!set.ok()) return set;
   if (!flags.quiet) {
+    const bool coupled = flags.options.motion == calf::encoder::VisibilityMotion::kCoupled;
     const auto& st = set->stats;
     std::fprintf(
         stderr,
         "calf-encode: visible set: %zu segments (%.3f of perimeter at eye height %.3f), 6 faces "
-        "of %u px, %s granularity: %llu of %llu triangles (%.3f %%) in %.2f s; %llu of %u frames "
+        "of %u px, %s granularity%s: %llu of %llu triangles (%.3f %%) in %.2f s; %llu of %u %s "
         "solved, %llu (triangle, pixel) pairs, %.3g pairs/s\n",
         segments.size(), perimeter, eye_height, flags.options.face_size,
-        flags.options.object_granularity ? "object" : "triangle",
+        flags.options.object_granularity ? "object" : "triangle", coupled ? ", coupled motion" : "",
         static_cast<unsigned long long>(st.visible_triangles),
         static_cast<unsigned long long>(st.scene_triangles),
         st.scene_triangles ? 100.0 * static_cast<double>(st.visible_triangles) /
                                  static_cast<double>(st.scene_triangles)
                            : 0.0,
         st.seconds, static_cast<unsigned long long>(st.frames_solved), scene.frame_count,
+        coupled ? "frames: motion steps" : "frames",
         static_cast<unsigned long long>(st.triangle_pixel_pairs),
         st.seconds > 0 ? static_cast<double>(st.triangle_pixel_pairs) / st.seconds : 0.0);
   }
@@ -125,6 +127,8 @@ int encode_mesh(const std::string& input, const std::string& out, const std::str
         fmt::format("segments {} face_size {} granularity {} triangles {} of {}", o.segment_count,
                     vs.options.face_size, vs.options.object_granularity ? "object" : "triangle",
                     set->stats.visible_triangles, set->stats.scene_triangles));
+    if (vs.options.motion == calf::encoder::VisibilityMotion::kCoupled)
+      metadata.back().second += " motion coupled";
   }
   auto stats = calf::encoder::encode_mesh_file(*scene, dir, out, set ? &set->triangles : nullptr, o,
                                                metadata);
@@ -249,7 +253,18 @@ int main(int argc, char** argv) {
   needs_vs(app.add_flag("--object-granularity", vs.options.object_granularity,
                         "with --visible-set: keep an object whole as soon as one of its triangles "
                         "is visible (default off: single triangles)"));
+  std::string vs_motion = "per-frame";
+  needs_vs(app.add_option("--visibility-motion", vs_motion,
+                          "with --visible-set: per-frame (default): every frame is a static scene "
+                          "and the eye sweeps each segment at every frame (what can be seen from "
+                          "some point at some frame); coupled: paper 004 Sec. 3.2, the eye walks "
+                          "each segment while the scene moves from frame f to f + 1, vertices on "
+                          "straight lines (what an eye moving with the scene sees); "
+                          "docs/VISIBILITY.md")
+               ->check(CLI::IsMember({"per-frame", "coupled"}))
+               ->default_val("per-frame"));
   if (int rc = calf::tools::parse_command_line(app, "calf-encode", argc, argv); rc >= 0) return rc;
+  if (vs_motion == "coupled") vs.options.motion = calf::encoder::VisibilityMotion::kCoupled;
   if (mode != "mesh" && vs.enabled)
     return calf::tools::usage_error("calf-encode", "--visible-set needs --mode mesh");
   vs.options.threads = o.threads;

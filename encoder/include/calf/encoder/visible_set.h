@@ -24,6 +24,8 @@
 // considered; so the paper's coupled motion (Eqs. 3-4: eye and vertices moving with one
 // parameter, quadratic edge events) is not needed for an exact answer at every frame, and the
 // cost grows linearly with the number of distinct frames (of vertex states sampled by frames).
+// The coupled motion answers another question and is offered beside it:
+// VisibleSetOptions::motion = VisibilityMotion::kCoupled (below).
 //
 // Algorithm (per segment, frame and face; Alg. 1). Per triangle ABC, the directions from points of
 // the segment to points of the triangle are those of the convex hull of the six points
@@ -98,6 +100,26 @@ std::vector<ViewSegment> perimeter_segments(const Box3& region, double eye_heigh
 // Largest face_size accepted.
 inline constexpr uint32_t kVisibleSetMaxFaceSize = 8192;
 
+// How time and the eye's motion are combined (VisibleSetOptions::motion).
+//   kPerFrame: each displayed frame is a static scene and the eye sweeps the whole segment at
+//     every frame: "what can be seen from some point of the segment at some frame?" (the
+//     default; exact for every pose the player draws).
+//   kCoupled: paper 004 Sec. 3.2 (Eqs. 3-4). For each motion step, a pair of consecutive frames
+//     (f, f + 1) of the range whose world geometry differs from the previous step's, the eye and
+//     every vertex move with one parameter t in [0, 1]: the eye at v(t) = a + t (b - a), each
+//     world-space vertex at (1 - t) X_f + t X_{f+1} (a chord between the two frames: exact for
+//     vertex states no finer than frames, an approximation for rigid rotations and for states
+//     finer than frames). "What can be seen by an eye that walks the segment while the scene
+//     moves from frame f to f + 1?": the diagonal of (eye position x time), not a superset of
+//     the per-frame sets (a triangle seen only from the end of the segment at frame f is not
+//     seen by it). A range of one frame (or a scene that never moves) is solved as one step with
+//     no motion, which answers the per-frame question. Edge events are quadratic in t, the
+//     "ahead" test cubic, depth rational (cubic over quadratic): see visible_set_coupled.h in
+//     encoder/src. VisibleSetStats::frames_solved then counts motion steps; witnesses carry the
+//     step's first frame and an interval of t. Only compute_visible_set honours it (the
+//     from-point functions sample frames).
+enum class VisibilityMotion : uint8_t { kPerFrame = 0, kCoupled = 1 };
+
 struct VisibleSetOptions {
   // Side of each of the six cube faces rasterised around a segment (paper 004: 800), 1 ..
   // kVisibleSetMaxFaceSize.
@@ -119,6 +141,8 @@ struct VisibleSetOptions {
   double min_interval = 1e-9;
   // Fill VisibleSet::witnesses (tests and debugging; costs a little time and memory).
   bool witnesses = false;
+  // Per-frame (default) or the paper's coupled eye and vertex motion (see VisibilityMotion).
+  VisibilityMotion motion = VisibilityMotion::kPerFrame;
 };
 
 // What was computed, for reports and benchmarks.
