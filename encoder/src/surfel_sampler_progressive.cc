@@ -1,0 +1,133 @@
+// The progressive sampler of paper 001 Sec. 3.2 (calf/encoder/surfel_sampler.h, kProgressive):
+// rounds of a random sample of the input set, the samples farthest from the chosen surfels
+// accepted, the ones close to them set aside.
+#include <algorithm>
+#include <cmath>
+
+#include "surfel_sampler_internal.h"
+
+namespace calf::surfel_internal {
+
+std::vector<uint32_t> order_progressive(std::span<const P3> points, uint32_t n,
+                                        const SurfelSamplerOptions& options) {
+  const auto count = static_cast<uint32_t>(points.size());
+  const uint32_t max_accept =
+      options.max_accept != 0 ? options.max_accept : std::max(1u, options.round_samples / 4);
+  Rng rng(options.seed);
+
+  // The input set: candidates neither chosen nor set aside, each with its position, so that a
+  // draw costs one cache miss, not two (the draws are what the sampler's time goes to on a
+  // million candidates). Draws swap the drawn entry with the last one, so the set's order (and
+  // hence the draws) depends only on the seed and the input.
+  struct Entry {
+    P3 p;
+    uint32_t id;
+  };
+  std::vector<Entry> pool(count);
+  for (uint32_t i = 0; i < count; ++i) pool[i] = {points[i], i};
+  std::vector<Entry> reserve;  // set aside by the vicinity rule, in the order set aside
+  auto draw = [&]() {
+    const uint32_t j = rng.below(static_cast<uint32_t>(pool.size()));
+    const Entry e = pool[j];
+    pool[j] = pool.back();
+    pool.pop_back();
+    return e;
+  };
+
+  std::vector<uint32_t> order;
+  order.reserve(n);
+  // The first surfel is the same draw as the exact greedy permutation's first (rng.below(count)
+  // on the identity list), so both orders start from one point.
+  order.push_back(draw().id);
+
+  // Grid over the chosen surfels. It starts with one cell per object and is rebuilt with the
+  // current spacing (the best distance of a round, about the covering radius of the chosen set)
+  // whenever that falls below half the cell: queries then stay within one ring of cells, and the
+  // O(chosen) rebuilds add up to O(n) over the halvings.
+  P3 origin;
+  float extent;
+  bounding_box(points, &origin, &extent);
+  PointGrid grid;
+  grid.reset(origin, extent, extent, n);
+  grid.insert(order.front(), points[order.front()]);
+  auto rebuild = [&](float cell) {
+    grid.reset(origin, extent, cell, n);
+    for (uint32_t id : order) grid.insert(id, points[id]);
+  };
+
+  std::vector<Entry> sample;
+  std::vector<float> d2;
+  std::vector<uint8_t> exact;
+  uint32_t accept = 1;
+  uint64_t round = 0;
+  const float vicinity2 = static_cast<float>(options.vicinity * options.vicinity);
+  float previous_best2 = 0.0f;  // the first accepted distance of the last round, squared
+  while (order.size() < n) {
+    if (pool.empty()) pool.swap(reserve);  // n <= count: the reserve is not empty then
+    const size_t s = std::min<size_t>(options.round_samples, pool.size());
+    sample.resize(s);
+    d2.resize(s);
+    exact.resize(s);
+    // Draw first, query after: the draws' cache misses are independent and overlap.
+    for (size_t k = 0; k < s; ++k) sample[k] = draw();
+    // Most samples lie well inside the covered part: a query stops at the first chosen surfel
+    // within half the last round's best distance and keeps that upper bound. Only a sample whose
+    // bound comes out on top is queried in full below (lazy evaluation: the surfels accepted
+    // are those an exact query of every sample would accept).
+    const float stop2 = 0.25f * previous_best2;
+    for (size_t k = 0; k < s; ++k) {
+      bool is_exact = true;
+      d2[k] = grid.nearest2(sample[k].p, UINT32_MAX, stop2, &is_exact);
+      exact[k] = is_exact ? 1 : 0;
+    }
+    // Within the round: the exact greedy step over the sample, `accept` times.
+    const size_t take = std::min<size_t>({accept, n - order.size(), s});
+    float round_best2 = -1.0f, last2 = 0.0f;
+    for (size_t a = 0; a < take; ++a) {
+      size_t best = s;
+      while (true) {
+        best = s;
+        for (size_t k = 0; k < s; ++k) {
+          if (d2[k] < 0.0f) continue;  // accepted this round
+          if (best == s || d2[k] > d2[best] ||
+              (d2[k] == d2[best] && sample[k].id < sample[best].id))
+            best = k;
+        }
+        if (exact[best] != 0) break;
+        // An upper bound on top: replace it by the exact distance (to every surfel chosen so
+        // far, this round's included) and choose again.
+        d2[best] = grid.nearest2(sample[best].p);
+        exact[best] = 1;
+      }
+      const uint32_t id = sample[best].id;
+      last2 = d2[best];
+      if (a == 0) round_best2 = last2;
+      d2[best] = -1.0f;
+      order.push_back(id);
+      grid.insert(id, points[id]);
+      // Exact values stay exact and bounds stay bounds under this minimum.
+      if (a + 1 < take)
+        for (size_t k = 0; k < s; ++k)
+          if (d2[k] >= 0.0f) d2[k] = std::min(d2[k], dist2(sample[k].p, points[id]));
+    }
+    // The rest go back to the input set, or aside when they are close to the chosen set (a
+    // bound below the threshold is enough to know; a bound above it puts the sample back).
+    const float aside2 = vicinity2 * last2;
+    for (size_t k = 0; k < s; ++k) {
+      if (d2[k] < 0.0f) continue;
+      if (d2[k] < aside2) {
+        reserve.push_back(sample[k]);
+      } else {
+        pool.push_back(sample[k]);
+      }
+    }
+    if (round_best2 > 0.0f && round_best2 < 0.25f * grid.cell() * grid.cell())
+      rebuild(std::sqrt(round_best2));
+    if (round_best2 >= 0.0f) previous_best2 = round_best2;
+    ++round;
+    if (round % options.growth_period == 0 && accept < max_accept) ++accept;
+  }
+  return order;
+}
+
+}  // namespace calf::surfel_internal
