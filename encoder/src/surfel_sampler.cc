@@ -12,18 +12,6 @@
 #include "surfel_sampler_internal.h"
 
 namespace calf {
-namespace surfel_internal {
-
-std::vector<P3> to_float_points(std::span<const Vec3> candidates) {
-  std::vector<P3> points(candidates.size());
-  for (size_t i = 0; i < candidates.size(); ++i)
-    points[i] = {static_cast<float>(candidates[i].x), static_cast<float>(candidates[i].y),
-                 static_cast<float>(candidates[i].z)};
-  return points;
-}
-
-}  // namespace surfel_internal
-
 namespace {
 
 using surfel_internal::P3;
@@ -46,6 +34,8 @@ Status check_options(const SurfelSamplerOptions& o) {
                         std::to_string(o.round_samples));
   if (!(o.vicinity >= 0.0 && o.vicinity < 1.0))
     return option_error("vicinity " + std::to_string(o.vicinity) + " is not in [0, 1)");
+  if (!(o.extend_below >= 0.0 && o.extend_below < 1.0))
+    return option_error("extend_below " + std::to_string(o.extend_below) + " is not in [0, 1)");
   if (o.p_m < 1) return option_error("p_m is 0 (must be >= 1)");
   if (o.threads > kSurfelMaxThreads)
     return option_error("threads " + std::to_string(o.threads) + " is above " +
@@ -105,17 +95,16 @@ Expected<SurfelOrder> order_surfels(std::span<const Vec3> candidates, uint32_t n
   }
   CALF_RETURN_IF_ERROR(check_options(options));
 
-  const std::vector<P3> points = surfel_internal::to_float_points(candidates);
   SurfelOrder result;
   switch (options.method) {
     case SurfelOrderMethod::kProgressive:
-      result.order = surfel_internal::order_progressive(points, n, options);
+      result.order = surfel_internal::order_progressive(candidates, n, options);
       break;
     case SurfelOrderMethod::kExactGreedy:
-      result.order = surfel_internal::order_exact_greedy(points, n, options);
+      result.order = surfel_internal::order_exact_greedy(candidates, n, options);
       break;
     case SurfelOrderMethod::kRandom:
-      result.order = order_random(points.size(), n, options.seed);
+      result.order = order_random(candidates.size(), n, options.seed);
       break;
   }
   if (result.order.size() != n)
@@ -124,7 +113,8 @@ Expected<SurfelOrder> order_surfels(std::span<const Vec3> candidates, uint32_t n
 
   result.p_m = std::min(options.p_m, n);
   std::vector<P3> head(result.p_m);
-  for (uint32_t i = 0; i < result.p_m; ++i) head[i] = points[result.order[i]];
+  for (uint32_t i = 0; i < result.p_m; ++i)
+    head[i] = surfel_internal::to_float(candidates[result.order[i]]);
   std::vector<float> nn = surfel_internal::nearest_neighbour_distances(head, options.threads);
   const auto mid = nn.begin() + static_cast<std::ptrdiff_t>((nn.size() - 1) / 2);
   std::nth_element(nn.begin(), mid, nn.end());

@@ -22,15 +22,15 @@ constexpr size_t kChunk = 1 << 14;
 
 }  // namespace
 
-std::vector<uint32_t> order_exact_greedy(std::span<const P3> points, uint32_t n,
+std::vector<uint32_t> order_exact_greedy(std::span<const Vec3> candidates, uint32_t n,
                                          const SurfelSamplerOptions& options) {
-  const size_t count = points.size();
+  const size_t count = candidates.size();
   // Structure of arrays so the update loop vectorises.
   std::vector<float> xs(count), ys(count), zs(count);
   for (size_t i = 0; i < count; ++i) {
-    xs[i] = points[i].x;
-    ys[i] = points[i].y;
-    zs[i] = points[i].z;
+    xs[i] = static_cast<float>(candidates[i].x);
+    ys[i] = static_cast<float>(candidates[i].y);
+    zs[i] = static_cast<float>(candidates[i].z);
   }
   // Squared distance to the chosen set; chosen candidates hold -1 so that neither the update
   // (a minimum) nor the choice (a maximum) ever touches them again.

@@ -20,8 +20,9 @@ inline float dist2(const P3& a, const P3& b) {
   return dx * dx + dy * dy + dz * dz;
 }
 
-// The candidates rounded to float once (the header's "Positions are rounded to float").
-std::vector<P3> to_float_points(std::span<const Vec3> candidates);
+inline P3 to_float(const Vec3& v) {
+  return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
+}
 
 // SplitMix64 (Steele et al. 2014): 64 bits of state, the same stream on every platform.
 class Rng {
@@ -102,10 +103,12 @@ void bounding_box(std::span<const P3> points, P3* origin, float* extent);
 // Nearest-neighbour distance (not squared) of each of `points` among the others, on `threads`.
 std::vector<float> nearest_neighbour_distances(std::span<const P3> points, uint32_t threads);
 
-// The ordering algorithms; inputs already validated (n in [1, points.size()], options in range).
-std::vector<uint32_t> order_progressive(std::span<const P3> points, uint32_t n,
+// The ordering algorithms; inputs already validated (n in [1, candidates.size()], positions
+// within the coordinate bound, options in range). Each rounds positions to float as it reads
+// them.
+std::vector<uint32_t> order_progressive(std::span<const Vec3> candidates, uint32_t n,
                                         const SurfelSamplerOptions& options);
-std::vector<uint32_t> order_exact_greedy(std::span<const P3> points, uint32_t n,
+std::vector<uint32_t> order_exact_greedy(std::span<const Vec3> candidates, uint32_t n,
                                          const SurfelSamplerOptions& options);
 
 }  // namespace calf::surfel_internal

@@ -89,6 +89,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--vicinity", base.vicinity, "progressive: set-aside factor")
       ->capture_default_str();
+  app.add_option("--extend-below", base.extend_below, "progressive: extend a poor round")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   base.threads = threads;
 

@@ -90,6 +90,7 @@ const char* surfel_order_method_name(SurfelOrderMethod method);
 // Limits of the options (checked by order_surfels: CALF-E243).
 inline constexpr uint32_t kSurfelMaxRoundSamples = 65536;
 inline constexpr uint32_t kSurfelMaxThreads = 256;
+inline constexpr uint32_t kSurfelMaxExtensions = 4;
 
 struct SurfelSamplerOptions {
   SurfelOrderMethod method = SurfelOrderMethod::kProgressive;
@@ -107,6 +108,12 @@ struct SurfelSamplerOptions {
   // Progressive: samples of a round nearer to the chosen set than vicinity x (the distance of the
   // round's last accepted surfel) are set aside (see above), in [0, 1); 0 sets none aside.
   double vicinity = 0.5;
+  // Progressive: a round whose farthest sample is nearer to the chosen set than extend_below x
+  // the previous round's first accepted distance draws another round_samples samples into the
+  // same round, up to kSurfelMaxExtensions times, in [0, 1); 0 never extends (the paper's plain
+  // rounds). This cuts the low tail of accepted distances (r_min) at the cost of more draws in
+  // the rounds that need them (docs/SURFELS.md has the measured trade).
+  double extend_below = 0.9;
   // The prefix length whose median nearest-neighbour distance is r_m (paper: p_m = 1000), >= 1.
   uint32_t p_m = 1000;
   // Worker threads for the exact greedy permutation and for r_m (0: hardware concurrency), at
