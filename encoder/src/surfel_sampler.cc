@@ -79,8 +79,7 @@ Expected<SurfelOrder> order_surfels(std::span<const Vec3> candidates, uint32_t n
                                              " candidates, above 2^32 - 1");
   if (n == 0 || n > candidates.size())
     return Status(ErrorId::kSurfelCount, "surfel sampler: surfel count " + std::to_string(n) +
-                                             " is not in 1.." +
-                                             std::to_string(candidates.size()) +
+                                             " is not in 1.." + std::to_string(candidates.size()) +
                                              " (the candidate count)");
   for (size_t i = 0; i < candidates.size(); ++i) {
     const Vec3& p = candidates[i];
@@ -88,8 +87,8 @@ Expected<SurfelOrder> order_surfels(std::span<const Vec3> candidates, uint32_t n
     for (int a = 0; a < 3; ++a) {
       if (!coordinate_ok(c[a]))
         return Status(ErrorId::kSurfelPosition,
-                      "surfel sampler: candidate " + std::to_string(i) + " coordinate " +
-                          "xyz"[a] + " = " + std::to_string(c[a]) +
+                      "surfel sampler: candidate " + std::to_string(i) + " coordinate " + "xyz"[a] +
+                          " = " + std::to_string(c[a]) +
                           " is not finite or beyond the coordinate bound 1e12");
     }
   }

@@ -132,8 +132,7 @@ float PointGrid::nearest2(const P3& q, uint32_t skip, float stop2, bool* exact) 
   // Visits one cell; true when the search may stop early (a point within sqrt(stop2) found).
   auto visit = [&](int32_t dx, int32_t dy, int32_t dz) {
     const int32_t x = c.x + dx, y = c.y + dy, z = c.z + dz;
-    if (x < 0 || y < 0 || z < 0 || x > max_index_ || y > max_index_ || z > max_index_)
-      return false;
+    if (x < 0 || y < 0 || z < 0 || x > max_index_ || y > max_index_ || z > max_index_) return false;
     // Skip a cell that cannot hold a nearer point (cheaper than its hash lookup). The 0.9999
     // leaves room for rounding of the cell coordinates.
     const double gx = gap(dx, qx), gy = gap(dy, qy), gz = gap(dz, qz);
@@ -147,8 +146,8 @@ float PointGrid::nearest2(const P3& q, uint32_t skip, float stop2, bool* exact) 
   // The ring R holds the cells whose largest coordinate difference from q's cell is R. A point in
   // ring R + 1 or beyond is at least R cells away from q along some axis; the factor below leaves
   // room for rounding of the cell coordinates.
-  const int32_t last_ring = std::max({c.x, c.y, c.z, max_index_ - c.x, max_index_ - c.y,
-                                      max_index_ - c.z});
+  const int32_t last_ring =
+      std::max({c.x, c.y, c.z, max_index_ - c.x, max_index_ - c.y, max_index_ - c.z});
   for (int32_t r = 0; r <= last_ring; ++r) {
     for (int32_t dz = -r; dz <= r; ++dz) {
       for (int32_t dy = -r; dy <= r; ++dy) {

@@ -25,8 +25,7 @@ std::vector<float> nearest_neighbour_distances(std::span<const P3> points, uint3
   // them and a query finishes within a ring or two. (Points filling a volume would only make the
   // cells fuller: slower, never wrong.)
   PointGrid grid;
-  grid.reset(origin, extent, extent / std::sqrt(static_cast<float>(points.size())),
-             points.size());
+  grid.reset(origin, extent, extent / std::sqrt(static_cast<float>(points.size())), points.size());
   for (size_t i = 0; i < points.size(); ++i) grid.insert(static_cast<uint32_t>(i), points[i]);
   tbb::task_arena arena(threads == 0 ? tbb::task_arena::automatic : static_cast<int>(threads));
   arena.execute([&] {

@@ -114,8 +114,7 @@ std::vector<uint32_t> order_progressive(std::span<const Vec3> candidates, uint32
       size_t best = s;
       for (size_t k = 0; k < s; ++k) {
         if (d2[k] < 0.0f) continue;
-        if (best == s || d2[k] > d2[best] ||
-            (d2[k] == d2[best] && sample[k].id < sample[best].id))
+        if (best == s || d2[k] > d2[best] || (d2[k] == d2[best] && sample[k].id < sample[best].id))
           best = k;
       }
       if (best == s || exact[best] != 0) return best;
@@ -125,7 +124,13 @@ std::vector<uint32_t> order_progressive(std::span<const Vec3> candidates, uint32
   };
   const float extend2 = static_cast<float>(options.extend_below * options.extend_below);
   while (order.size() < n) {
-    if (pool.empty()) pool.swap(reserve);  // n <= count: the reserve is not empty then
+    // An input set that cannot fill a round takes the samples set aside back (in the order set
+    // aside): a round of a few leftovers would accept whatever they are. n <= count, so the two
+    // together are never empty here.
+    if (pool.size() < options.round_samples && !reserve.empty()) {
+      pool.insert(pool.end(), reserve.begin(), reserve.end());
+      reserve.clear();
+    }
     sample.clear();
     d2.clear();
     exact.clear();

@@ -38,8 +38,8 @@ std::vector<Vec3> bumpy_sphere(uint32_t count) {
   for (uint32_t i = 0; i < count; ++i) {
     const double z = 1.0 - 2.0 * (i + 0.5) / count;
     const double theta = std::acos(z), phi = golden * i;
-    const double r = 1.0 + 0.15 * std::sin(5 * theta) * std::sin(4 * phi) +
-                     0.05 * std::sin(17 * theta);
+    const double r =
+        1.0 + 0.15 * std::sin(5 * theta) * std::sin(4 * phi) + 0.05 * std::sin(17 * theta);
     const double s = std::sin(theta);
     p[i] = {r * s * std::cos(phi), r * s * std::sin(phi), r * z};
   }
@@ -94,17 +94,19 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   base.threads = threads;
 
-  const std::vector<Vec3> points = surface == "plane" ? plane_grid(candidates)
-                                                      : bumpy_sphere(candidates);
-  fmt::print("surface {}: {} candidates; threads {}; progressive: {} samples/round, k = {} rounds, "
-             "max accept {}, vicinity {}\n\n",
-             surface, points.size(), threads, base.round_samples, base.growth_period,
-             base.max_accept, base.vicinity);
+  const std::vector<Vec3> points =
+      surface == "plane" ? plane_grid(candidates) : bumpy_sphere(candidates);
+  fmt::print(
+      "surface {}: {} candidates; threads {}; progressive: {} samples/round, k = {} rounds, "
+      "max accept {}, vicinity {}\n\n",
+      surface, points.size(), threads, base.round_samples, base.growth_period, base.max_accept,
+      base.vicinity);
 
   const calf::SurfelOrderMethod methods[] = {calf::SurfelOrderMethod::kProgressive,
                                              calf::SurfelOrderMethod::kExactGreedy,
                                              calf::SurfelOrderMethod::kRandom};
-  fmt::print("milliseconds, wall / CPU (median of runs); limit: exact / progressive >= 50 at 10k\n");
+  fmt::print(
+      "milliseconds, wall / CPU (median of runs); limit: exact / progressive >= 50 at 10k\n");
   fmt::print("{:>8} {:>20} {:>20} {:>20} {:>16}\n", "surfels", "progressive", "exact", "random",
              "exact/progr. cpu");
   std::vector<std::vector<uint32_t>> longest(3);
@@ -122,8 +124,8 @@ int main(int argc, char** argv) {
         const double c0 = cpu_seconds();
         auto order = calf::order_surfels(points, n, o);
         cpus.push_back((cpu_seconds() - c0) * 1e3);
-        runs.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() *
-                       1e3);
+        runs.push_back(
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() * 1e3);
         if (!order.ok()) {
           fmt::print(stderr, "{}\n", order.status().to_string());
           return 1;
@@ -141,8 +143,9 @@ int main(int argc, char** argv) {
   }
   std::fflush(stdout);
 
-  fmt::print("\nspacing of prefixes (nearest-neighbour distance within the prefix; limit: "
-             "progressive r_min/r_max within 10 % of exact's)\n");
+  fmt::print(
+      "\nspacing of prefixes (nearest-neighbour distance within the prefix; limit: "
+      "progressive r_min/r_max within 10 % of exact's)\n");
   fmt::print("{:>8} {:>12} {:>10} {:>10} {:>10} {:>10} {:>12}\n", "prefix", "method", "r_min",
              "r_median", "r_max", "min/max", "vs exact");
   std::vector<uint32_t> prefixes = {1000, 5000};
@@ -161,8 +164,8 @@ int main(int argc, char** argv) {
       const double rho = s->r_min / s->r_max;
       if (m == 1) exact_rho = rho;
       fmt::print("{:>8} {:>12} {:>10.5f} {:>10.5f} {:>10.5f} {:>10.3f} {:>11.1f}%\n", p,
-                 calf::surfel_order_method_name(methods[m]), s->r_min, s->r_median, s->r_max,
-                 rho, 100.0 * (rho / exact_rho - 1.0));
+                 calf::surfel_order_method_name(methods[m]), s->r_min, s->r_median, s->r_max, rho,
+                 100.0 * (rho / exact_rho - 1.0));
     }
   }
   return 0;

@@ -15,9 +15,8 @@
 namespace calf {
 namespace {
 
-constexpr SurfelOrderMethod kMethods[] = {SurfelOrderMethod::kProgressive,
-                                          SurfelOrderMethod::kExactGreedy,
-                                          SurfelOrderMethod::kRandom};
+constexpr SurfelOrderMethod kMethods[] = {
+    SurfelOrderMethod::kProgressive, SurfelOrderMethod::kExactGreedy, SurfelOrderMethod::kRandom};
 
 // side x side grid on the unit square (z = 0): a flat surface whose ideal spacing is known.
 std::vector<Vec3> plane_grid(int side) {
@@ -65,14 +64,14 @@ double dist(const Vec3& a, const Vec3& b) {
 // how many surfels were built). n = the candidate count exercises the progressive sampler's
 // reserve (samples set aside come back when the input set runs dry).
 TEST(SurfelSamplerTest, OrdersArePermutationsAndPrefixesNest) {
-  const std::vector<Vec3> c = sphere(2000);
+  const std::vector<Vec3> c = sphere(1500);
   for (SurfelOrderMethod m : kMethods) {
     SCOPED_TRACE(surfel_order_method_name(m));
-    const SurfelOrder all = order(c, 2000, with(m));
-    ASSERT_EQ(all.order.size(), 2000u);
+    const SurfelOrder all = order(c, 1500, with(m));
+    ASSERT_EQ(all.order.size(), 1500u);
     std::set<uint32_t> seen(all.order.begin(), all.order.end());
-    EXPECT_EQ(seen.size(), 2000u);
-    EXPECT_LT(*seen.rbegin(), 2000u);
+    EXPECT_EQ(seen.size(), 1500u);
+    EXPECT_LT(*seen.rbegin(), 1500u);
     for (uint32_t n : {1u, 2u, 300u, 1200u}) {
       const SurfelOrder part = order(c, n, with(m));
       ASSERT_EQ(part.order.size(), n);
@@ -87,7 +86,7 @@ TEST(SurfelSamplerTest, ExactGreedySatisfiesItsDefinition) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::vector<Vec3> c;
-  for (int i = 0; i < 250; ++i) c.push_back({u(rng), u(rng), u(rng)});  // a volume
+  for (int i = 0; i < 250; ++i) c.push_back({u(rng), u(rng), u(rng)});      // a volume
   for (int i = 0; i < 150; ++i) c.push_back({u(rng), 0.25 * u(rng), 2.0});  // a far slab
   const SurfelOrder o = order(c, 400, with(SurfelOrderMethod::kExactGreedy));
   ASSERT_EQ(o.order.size(), 400u);
@@ -116,7 +115,7 @@ TEST(SurfelSamplerTest, ExactGreedySatisfiesItsDefinition) {
   for (size_t i = 1; i < radius.size(); ++i) EXPECT_LE(radius[i], radius[i - 1] * (1 + 1e-6));
 }
 
-// Spreading on a known surface: 60,000 candidates drawn uniformly on the unit square (not a grid,
+// Spreading on a known surface: 40,000 candidates drawn uniformly on the unit square (not a grid,
 // whose spacing would put a floor under random's r_min). rho = r_min / r_max of a prefix.
 // Thresholds, not taken from the code's output:
 // - an r-net on a dense connected surface has r_min >= r and r_max <= ~2r (a point's nearest
@@ -129,7 +128,7 @@ TEST(SurfelSamplerTest, ExactGreedySatisfiesItsDefinition) {
 TEST(SurfelSamplerTest, ProgressiveSpreadsFarBetterThanRandom) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<Vec3> c(60000);
+  std::vector<Vec3> c(40000);
   for (Vec3& p : c) p = {u(rng), u(rng), 0.0};
   const SurfelOrder prog = order(c, 2000, with(SurfelOrderMethod::kProgressive));
   const SurfelOrder exact = order(c, 2000, with(SurfelOrderMethod::kExactGreedy));
@@ -160,19 +159,19 @@ TEST(SurfelSamplerTest, ProgressiveSpreadsFarBetterThanRandom) {
 // The same input, options and seed give the same order and r_m for any thread count; another
 // seed gives another order.
 TEST(SurfelSamplerTest, DeterministicOverThreadsAndSeeds) {
-  const std::vector<Vec3> c = sphere(4000);
+  const std::vector<Vec3> c = sphere(3000);
   for (SurfelOrderMethod m : kMethods) {
     SCOPED_TRACE(surfel_order_method_name(m));
-    const SurfelOrder one = order(c, 400, with(m, 1));
+    const SurfelOrder one = order(c, 300, with(m, 1));
     for (uint32_t threads : {2u, 4u, 0u}) {
-      const SurfelOrder other = order(c, 400, with(m, threads));
+      const SurfelOrder other = order(c, 300, with(m, threads));
       EXPECT_EQ(one.order, other.order) << threads;
       EXPECT_EQ(one.r_m, other.r_m) << threads;
       EXPECT_EQ(one.p_m, other.p_m);
     }
-    const SurfelOrder again = order(c, 400, with(m, 1));
+    const SurfelOrder again = order(c, 300, with(m, 1));
     EXPECT_EQ(one.order, again.order);
-    const SurfelOrder seeded = order(c, 400, with(m, 1, 8));
+    const SurfelOrder seeded = order(c, 300, with(m, 1, 8));
     EXPECT_NE(one.order, seeded.order);
   }
 }
@@ -213,6 +212,32 @@ TEST(SurfelSamplerTest, RmAndPrefixSpacingOnHandComputedValues) {
   EXPECT_EQ(*prefix_for_radius(dup.r_m, dup.p_m, 0.01, 50), 1u);
 }
 
+// prefix_spacing (a hashed grid) against brute force, on points clustered at three scales (a
+// dense blob, a sparse slab, two far outliers) so that queries cross many empty cells.
+TEST(SurfelSamplerTest, PrefixSpacingMatchesBruteForce) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Vec3> c;
+  for (int i = 0; i < 400; ++i) c.push_back({0.01 * u(rng), 0.01 * u(rng), 0.01 * u(rng)});
+  for (int i = 0; i < 300; ++i) c.push_back({5 * u(rng), 2.0, 5 * u(rng)});
+  c.push_back({-30, 7, 2});
+  c.push_back({40, -3, 9});
+  std::vector<uint32_t> ord(c.size());
+  for (uint32_t i = 0; i < ord.size(); ++i) ord[i] = (i * 389u) % static_cast<uint32_t>(c.size());
+  for (uint32_t prefix : {2u, 3u, 250u, 702u}) {
+    std::vector<double> nn(prefix, std::numeric_limits<double>::infinity());
+    for (uint32_t i = 0; i < prefix; ++i)
+      for (uint32_t j = 0; j < prefix; ++j)
+        if (i != j) nn[i] = std::min(nn[i], dist(c[ord[i]], c[ord[j]]));
+    std::sort(nn.begin(), nn.end());
+    auto s = prefix_spacing(c, ord, prefix, 2);
+    ASSERT_TRUE(s.ok()) << s.status().to_string();
+    EXPECT_NEAR(s->r_min, nn.front(), 1e-6 * nn.front()) << prefix;
+    EXPECT_NEAR(s->r_median, nn[(prefix - 1) / 2], 1e-6 * nn[(prefix - 1) / 2]) << prefix;
+    EXPECT_NEAR(s->r_max, nn.back(), 1e-6 * nn.back()) << prefix;
+  }
+}
+
 // p(r) = p_m (r_m / r)^2, rounded up, clamped to [1, n].
 TEST(SurfelSamplerTest, PrefixForRadius) {
   auto p = [](float r_m, uint32_t p_m, double r, uint32_t n) {
@@ -220,14 +245,14 @@ TEST(SurfelSamplerTest, PrefixForRadius) {
     EXPECT_TRUE(v.ok()) << v.status().to_string();
     return v.ok() ? *v : 0u;
   };
-  EXPECT_EQ(p(0.5f, 1000, 0.25, 100000), 4000u);   // half the radius: 4x the surfels
-  EXPECT_EQ(p(0.5f, 1000, 1.0, 100000), 250u);     // twice: a quarter
-  EXPECT_EQ(p(0.5f, 1000, 0.5, 100000), 1000u);    // r = r_m: p_m
-  EXPECT_EQ(p(0.5f, 1000, 1.5, 100000), 112u);     // 1000 / 9 = 111.1 -> 112
-  EXPECT_EQ(p(0.5f, 1000, 0.25, 3000), 3000u);     // clamped to n
-  EXPECT_EQ(p(0.5f, 1000, 1e-30, 3000), 3000u);    // far beyond uint32: still n
-  EXPECT_EQ(p(0.5f, 1000, 1000.0, 3000), 1u);      // 0.00025 -> at least one surfel
-  EXPECT_EQ(p(0.0f, 1000, 0.1, 3000), 1u);         // r_m = 0: one surfel
+  EXPECT_EQ(p(0.5f, 1000, 0.25, 100000), 4000u);  // half the radius: 4x the surfels
+  EXPECT_EQ(p(0.5f, 1000, 1.0, 100000), 250u);    // twice: a quarter
+  EXPECT_EQ(p(0.5f, 1000, 0.5, 100000), 1000u);   // r = r_m: p_m
+  EXPECT_EQ(p(0.5f, 1000, 1.5, 100000), 112u);    // 1000 / 9 = 111.1 -> 112
+  EXPECT_EQ(p(0.5f, 1000, 0.25, 3000), 3000u);    // clamped to n
+  EXPECT_EQ(p(0.5f, 1000, 1e-30, 3000), 3000u);   // far beyond uint32: still n
+  EXPECT_EQ(p(0.5f, 1000, 1000.0, 3000), 1u);     // 0.00025 -> at least one surfel
+  EXPECT_EQ(p(0.0f, 1000, 0.1, 3000), 1u);        // r_m = 0: one surfel
   EXPECT_EQ(p(0.5f, 1, 0.5, 10), 1u);
   for (double bad : {0.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
     auto v = prefix_for_radius(0.5f, 1000, bad, 10);
@@ -292,8 +317,7 @@ TEST(SurfelSamplerTest, Errors) {
   EXPECT_EQ(prefix_spacing(c, ord, 4).status().id(), ErrorId::kSurfelCount);
   const std::vector<uint32_t> outside = {0, 100};
   EXPECT_EQ(prefix_spacing(c, outside, 2).status().id(), ErrorId::kSurfelCount);
-  EXPECT_EQ(prefix_spacing(c, ord, 2, kSurfelMaxThreads + 1).status().id(),
-            ErrorId::kSurfelOption);
+  EXPECT_EQ(prefix_spacing(c, ord, 2, kSurfelMaxThreads + 1).status().id(), ErrorId::kSurfelOption);
 }
 
 }  // namespace

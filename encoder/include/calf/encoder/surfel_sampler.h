@@ -26,28 +26,42 @@
 //   how the candidates are split). Meant as the quality reference and for small objects.
 //
 // - kProgressive (default), the paper's sampler (Sec. 3.2). The first surfel is drawn with `seed`
-//   from the input set (all candidates). Then rounds: draw `round_samples` candidates uniformly
-//   without replacement from the input set (fewer when fewer remain); each sample's distance to
-//   the chosen set is found with a hashed uniform grid over the chosen surfels (cell size
-//   following the current spacing, rebuilt when the spacing halves); then accept the `accept`
-//   samples farthest from the chosen set one by one, each time updating the other samples'
-//   distances by the surfel just accepted (so two surfels accepted in the same round are not
-//   placed side by side: within a round this is the exact greedy step over the sample). The
-//   samples not accepted go back to the input set, except those nearer to the chosen set than
-//   `vicinity` times the distance of the last surfel accepted this round: the paper's "samples
-//   that are at close vicinity to the chosen samples can also be removed from the input set".
-//   Such a sample could only be chosen once the spacing has shrunk below `vicinity` times its
-//   current value; setting it aside keeps later rounds from wasting draws on the dense parts. The
-//   samples set aside are not lost: when the input set runs out before n surfels, they become
-//   the input set again (in the order they were set aside), so any n <= N is reached.
+//   from the input set (all candidates; the same draw as kExactGreedy's first). Then rounds:
+//   1. Draw `round_samples` candidates uniformly without replacement from the input set (fewer
+//      when fewer remain) and find each one's distance to the chosen set with a hashed uniform
+//      grid over the chosen surfels (cell size following the current spacing, rebuilt whenever
+//      a round's best distance falls below half a cell).
+//   2. Extension (calf's addition, `extend_below`; 0 turns it off): while the farthest sample is
+//      nearer than extend_below x the previous round's first accepted distance, draw another
+//      round_samples into the same round, at most kSurfelMaxExtensions times. Rounds whose
+//      sample happened to miss the uncovered parts pay for more draws; the others cost nothing.
+//   3. Accept the `accept` samples farthest from the chosen set one by one, each time updating
+//      the other samples' distances by the surfel just accepted (so two surfels accepted in the
+//      same round are not placed side by side: within a round this is the exact greedy step
+//      over the sample; ties go to the smaller candidate index).
+//   4. The samples not accepted go back to the input set, except those nearer to the chosen set
+//      than `vicinity` times the distance of the last surfel accepted this round: the paper's
+//      "samples that are at close vicinity to the chosen samples can also be removed from the
+//      input set". Such a sample could only be chosen once the spacing has shrunk below
+//      `vicinity` times its current value; setting it aside keeps later rounds from wasting
+//      draws on covered parts. Set-aside samples are not lost: when the input set holds fewer
+//      than round_samples, they join it again (appended in the order set aside), so rounds stay
+//      full and any n <= N is reached.
 //   Growth heuristic (paper: "after each k iterations, the number of candidates chosen from the
 //   random sample set is increased by one (e.g., k = 500)"): an iteration is read as one round
 //   (draw a sample, accept from it), as in the authors' MinSG code, which counts rounds;
 //   `accept` starts at 1 and grows by one after every `growth_period` rounds, up to
 //   `max_accept`. Reading "iterations" as accepted surfels instead would make `accept` reach the
 //   whole sample (200) at 100k surfels, i.e. a random order. Rounds to reach n surfels: about
-//   k sqrt(2 n / k) (n = 10k: ~3,200 rounds, accept 6; 100k: ~10,000 rounds, accept 20), so the
-//   cost is O(rounds x round_samples) grid queries, independent of N after the O(N) set-up.
+//   sqrt(2 n k) (n = 10k: ~3,200 rounds, accept 6; 100k: ~10,000 rounds, accept 20), so the
+//   cost is O(rounds x round_samples) grid queries plus an O(N) set-up, nearly independent of N.
+//   Speed without changing the result: the input set stores each candidate's position (a draw
+//   is one cache miss), the slots of a round's draws are chosen and prefetched before any is
+//   read, and a query stops at the first chosen surfel within half the previous round's best
+//   distance, keeping that upper bound; a bound is replaced by the exact distance only when it
+//   comes out on top (lazy evaluation), so the surfels accepted are those exact queries would
+//   give. (A bound also decides the vicinity rule: a bound below the threshold proves the
+//   sample close; a bound above it sends the sample back to the input set.)
 //   Single-threaded (each round depends on the last); `threads` does not change it.
 //
 // - kRandom: a uniformly random permutation of the candidates (Fisher-Yates with `seed`), cut at
