@@ -303,6 +303,8 @@ TEST(SurfelSamplerTest, Errors) {
   EXPECT_EQ(option([](auto& o) { o.vicinity = 1.0; }), ErrorId::kSurfelOption);
   EXPECT_EQ(option([](auto& o) { o.vicinity = -0.1; }), ErrorId::kSurfelOption);
   EXPECT_EQ(option([](auto& o) { o.vicinity = std::nan(""); }), ErrorId::kSurfelOption);
+  EXPECT_EQ(option([](auto& o) { o.extend_below = 1.0; }), ErrorId::kSurfelOption);
+  EXPECT_EQ(option([](auto& o) { o.extend_below = -0.5; }), ErrorId::kSurfelOption);
   EXPECT_EQ(option([](auto& o) { o.p_m = 0; }), ErrorId::kSurfelOption);
   EXPECT_EQ(option([](auto& o) { o.threads = kSurfelMaxThreads + 1; }), ErrorId::kSurfelOption);
   EXPECT_EQ(option([](auto& o) { o.method = static_cast<SurfelOrderMethod>(7); }),
