@@ -173,6 +173,7 @@ Status render_mesh_cpu(const MeshDrawList& list, const Camera& camera,
   };
 
   for (const MeshDrawObject& object : list.objects) {
+    if (!object.visible) continue;
     const MeshDrawPrototype& proto = list.prototypes[object.prototype];
     const auto& m = object.transform;
     double r[3][4];

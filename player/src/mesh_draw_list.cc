@@ -129,7 +129,9 @@ Status validate_mesh_render_options(const MeshRenderOptions& options) {
 
 uint64_t mesh_draw_triangle_count(const MeshDrawList& list) {
   uint64_t n = 0;
-  for (const MeshDrawObject& o : list.objects) n += o.drawn_triangles(list.prototypes[o.prototype]);
+  for (const MeshDrawObject& o : list.objects) {
+    if (o.visible) n += o.drawn_triangles(list.prototypes[o.prototype]);
+  }
   return n;
 }
 

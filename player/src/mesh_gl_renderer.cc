@@ -323,7 +323,7 @@ Status GlMeshRenderer::render(const MeshDrawList& list, const Camera& camera,
 
   for (size_t o = 0; o < objects_.size(); ++o) {
     const ObjectBuffers& ob = objects_[o];
-    if (ob.drawn == 0) continue;
+    if (ob.drawn == 0 || !list.objects[o].visible) continue;
     const PrototypeBuffers& pb = prototypes_[ob.prototype];
     const MeshDrawObject& lo = list.objects[o];
     const auto& m = lo.transform;

@@ -177,6 +177,13 @@ const Box3& MeshRepresentation::view_volume() const {
 const MeshDrawList& MeshRepresentation::draw_list() const {
   return impl_->list;
 }
+void MeshRepresentation::set_object_visible(size_t o, bool visible) {
+  MeshDrawObject& object = impl_->list.objects[o];
+  if (object.visible == visible) return;
+  const uint64_t n = object.drawn_triangles(impl_->list.prototypes[object.prototype]);
+  object.visible = visible;
+  impl_->drawn = visible ? impl_->drawn + n : impl_->drawn - n;
+}
 uint64_t MeshRepresentation::triangles_drawn() const {
   return impl_->drawn;
 }

@@ -6,6 +6,7 @@
 
 #include "calf/format/container.h"
 #include "calf/player/mesh_representation.h"
+#include "calf/player/surfel_representation.h"
 
 namespace calf::player {
 
@@ -32,9 +33,23 @@ Expected<std::unique_ptr<Playback>> Playback::open(const std::string& clip_path,
   CALF_ASSIGN_OR_RETURN(container::Reader reader, container::Reader::open(clip_path));
   impl->reader = std::make_unique<container::Reader>(std::move(reader));
   const RenderBackend backend = options.use_gl ? RenderBackend::kGl : RenderBackend::kCpu;
+  // A surfels track plays its paired mesh track itself (near objects as meshes): that mesh track
+  // is not opened again.
+  std::vector<bool> played_by_surfels(impl->reader->tracks().size(), false);
+  for (size_t t = 0; t < impl->reader->tracks().size(); ++t) {
+    if (!std::holds_alternative<container::SurfelsTrackHeader>(impl->reader->tracks()[t].header)) {
+      continue;
+    }
+    CALF_ASSIGN_OR_RETURN(std::unique_ptr<SurfelRepresentation> surfels,
+                          SurfelRepresentation::open(*impl->reader, static_cast<uint16_t>(t),
+                                                     options.surfels, backend, gl));
+    played_by_surfels[surfels->mesh_track()] = true;
+    impl->owned.push_back(std::move(surfels));
+  }
   // The track kinds calf can play, one case each (representation.h: "Adding a representation").
   for (size_t t = 0; t < impl->reader->tracks().size(); ++t) {
     const auto& header = impl->reader->tracks()[t].header;
+    if (played_by_surfels[t]) continue;
     if (std::holds_alternative<container::LightfieldTrackHeader>(header)) {
       CALF_ASSIGN_OR_RETURN(std::unique_ptr<LightfieldRepresentation> lf,
                             LightfieldRepresentation::open(*impl->reader, static_cast<uint16_t>(t),
@@ -49,7 +64,7 @@ Expected<std::unique_ptr<Playback>> Playback::open(const std::string& clip_path,
     }
   }
   if (impl->owned.empty()) {
-    return Status(ErrorId::kPlaybackClip, clip_path + ": no lightfield or mesh track to play");
+    return Status(ErrorId::kPlaybackClip, clip_path + ": no lightfield, mesh or surfels track to play");
   }
   impl->volume = impl->owned.front()->view_volume();
   for (const auto& r : impl->owned) {

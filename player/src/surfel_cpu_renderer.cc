@@ -120,7 +120,9 @@ Status render_surfels_cpu(const SurfelDrawList& list, const Camera& camera,
           const double lit =
               kMeshAmbient + (1 - double{kMeshAmbient}) * std::max(0.0, dot(normal, light));
           out->depth[k] = depth;
-          for (int ch = 0; ch < 3; ++ch) out->color[3 * k + ch] = static_cast<float>(pc[ch] * lit);
+          for (int ch = 0; ch < 3; ++ch) {
+            out->color[3 * k + ch] = static_cast<float>(object.tint[ch] * pc[ch] * lit);
+          }
         }
       }
     }

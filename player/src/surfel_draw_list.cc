@@ -59,6 +59,10 @@ Status check_object(const SurfelDrawObject& o, size_t index, const SurfelDrawLis
   for (float x : o.transform) {
     if (!std::isfinite(x)) return list_error(name + ": the transform is not finite");
   }
+  for (float x : o.tint) {
+    if (!(std::isfinite(x) && x >= 0))
+      return list_error(name + ": a tint is negative or not finite");
+  }
   if (!(std::abs(internal::ObjectTransform(o.transform).det) > 1e-30)) {
     return list_error(name + ": the transform is singular");
   }

@@ -39,6 +39,7 @@ in vec3 v_colour[];
 // Object -> eye-relative world: columns of the 3 x 3 part and the translation minus the eye.
 uniform vec3 model_x, model_y, model_z, model_t;
 uniform float radius;
+uniform vec3 tint;
 uniform vec3 cam_right, cam_up, cam_forward;
 uniform float scale_x, scale_y, near_distance;
 uniform vec3 light;
@@ -66,7 +67,7 @@ void main() {
   vec3 du = linear(u * radius), dv = linear(v * radius);
   vec3 n = normalize(cross(du, dv));
   if (dot(n, c) > 0.0) n = -n;  // the side the eye sees
-  vec3 shaded = v_colour[0] * (ambient + (1.0 - ambient) * max(0.0, dot(n, light)));
+  vec3 shaded = tint * v_colour[0] * (ambient + (1.0 - ambient) * max(0.0, dot(n, light)));
   const vec2 corners[4] = vec2[4](vec2(-1.0, -1.0), vec2(1.0, -1.0), vec2(-1.0, 1.0),
                                   vec2(1.0, 1.0));
   for (int i = 0; i < 4; ++i) {
@@ -206,7 +207,7 @@ Status GlSurfelRenderer::render(const SurfelDrawList& list, const Camera& camera
   gl.Uniform3f(loc("light"), kMeshKeyLight[0], kMeshKeyLight[1], kMeshKeyLight[2]);
   gl.Uniform1f(loc("ambient"), kMeshAmbient);
   const GLint model_x = loc("model_x"), model_y = loc("model_y"), model_z = loc("model_z"),
-              model_t = loc("model_t"), radius = loc("radius");
+              model_t = loc("model_t"), radius = loc("radius"), tint = loc("tint");
   for (const SurfelDrawObject& o : list.objects) {
     if (o.count == 0) continue;
     const internal::ObjectTransform t(o.transform);
@@ -215,6 +216,7 @@ Status GlSurfelRenderer::render(const SurfelDrawList& list, const Camera& camera
     vec3(model_z, {t.r[0][2], t.r[1][2], t.r[2][2]});
     vec3(model_t, t.translation() - camera.position);
     gl.Uniform1f(radius, o.radius);
+    gl.Uniform3f(tint, o.tint[0], o.tint[1], o.tint[2]);
     gl.BindVertexArray(prototypes_[o.prototype].vao);
     gl.DrawArrays(GL_POINTS, 0, static_cast<GLsizei>(o.count));
   }

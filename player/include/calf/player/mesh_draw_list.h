@@ -79,8 +79,11 @@ struct MeshDrawObject {
   // strictly increasing; empty draws nothing).
   bool all_triangles = true;
   std::vector<uint32_t> triangles;
+  // false: the object is skipped (the surfel representation draws it as surfels this frame). Not
+  // part of the structure a GL upload fixes: it may change between renders.
+  bool visible = true;
 
-  // How many triangles this object draws.
+  // How many triangles this object draws when visible.
   size_t drawn_triangles(const MeshDrawPrototype& p) const {
     return all_triangles ? p.triangle_count() : triangles.size();
   }
@@ -108,7 +111,8 @@ struct MeshRenderOptions {
 // CALF-E471 unless `options` are valid (near > 0 and finite).
 [[nodiscard]] Status validate_mesh_render_options(const MeshRenderOptions& options);
 
-// The number of triangles `list` draws (every object's subset) — the "triangles drawn" figure.
+// The number of triangles `list` draws (every visible object's subset) — the "triangles drawn"
+// figure.
 // `list` must be valid.
 uint64_t mesh_draw_triangle_count(const MeshDrawList& list);
 

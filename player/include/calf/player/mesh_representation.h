@@ -70,6 +70,9 @@ class MeshRepresentation final : public Representation {
 
   // The draw list at the prepared frame.
   const MeshDrawList& draw_list() const;
+  // Shows or hides object `o` (< the draw list's object count) from the next render on; the
+  // surfel representation hides the objects it draws as surfels. Triangles drawn follow.
+  void set_object_visible(size_t o, bool visible);
   // Triangles drawn per render (the objects' subsets) and the prototypes' total over the objects.
   uint64_t triangles_drawn() const;
   uint64_t triangles_total() const;

@@ -21,6 +21,7 @@
 #include "calf/player/gl_context.h"
 #include "calf/player/lightfield_representation.h"
 #include "calf/player/mesh_representation.h"
+#include "calf/player/surfel_representation.h"
 #include "calf/player/representation.h"
 
 namespace calf::player {
@@ -33,6 +34,8 @@ struct PlaybackOptions {
   LightfieldOptions lightfield;
   // Options of every mesh track's representation.
   MeshOptions mesh;
+  // Options of every surfels track's representation (which also plays its paired mesh track).
+  SurfelOptions surfels;
 };
 
 class Playback {

@@ -22,7 +22,7 @@
 //
 // Shading, as the mesh's (mesh_draw_list.h) with the surfel's colour as base colour and its normal
 // (M's inverse transpose times n_i, normalised, flipped to face the eye):
-//   colour = c_i * (kMeshAmbient + (1 - kMeshAmbient) * max(0, n . kMeshKeyLight)).
+//   colour = tint * c_i * (kMeshAmbient + (1 - kMeshAmbient) * max(0, n . kMeshKeyLight)).
 #pragma once
 
 #include <array>
@@ -50,6 +50,9 @@ struct SurfelDrawObject {
   std::array<float, 12> transform{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
   uint32_t count = 0;   // the prefix drawn: 0 .. the prototype's surfel count
   float radius = 0.0f;  // disc radius in object-space units: > 0 and finite when count > 0
+  // Multiplies every surfel colour of this object (linear, finite, >= 0): the object's material
+  // base colour when the prototype's colours are relative to it (SPEC §11.3.2), else 1.
+  std::array<float, 3> tint{1, 1, 1};
 };
 
 struct SurfelDrawList {
@@ -69,7 +72,8 @@ void surfel_tangents(const Vec3& n, Vec3* u, Vec3* v);
 
 // CALF-E474 unless `list` is drawable, naming the first fault: buffers of different lengths or
 // not multiples of 3, a prototype index or prefix count out of range, a non-finite position,
-// normal, colour or transform, a normal not of unit length, a negative colour, a transform whose
+// normal, colour, tint or transform, a normal not of unit length, a negative colour or tint, a
+// transform whose
 // 3 x 3 part is singular, a radius not > 0 and finite on an object drawing surfels.
 [[nodiscard]] Status validate_surfel_draw_list(const SurfelDrawList& list);
 

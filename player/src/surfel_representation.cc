@@ -1,0 +1,284 @@
+// The surfel representation; what it does is in the public header.
+#include "calf/player/surfel_representation.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "calf/decoder/mesh_track.h"
+#include "calf/decoder/surfels_track.h"
+#include "calf/format/surfels_layout.h"
+#include "calf/player/rendered_image.h"
+#include "calf/player/surfel_renderer.h"
+#include "object_transform.h"
+
+namespace calf::player {
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string format(const char* fmt, auto... args) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, fmt, args...);
+  return buf;
+}
+
+Status option_error(const std::string& what) {
+  return Status(ErrorId::kPlaybackOption, "surfel option " + what);
+}
+
+// How an object is drawn at the prepared frame.
+enum class Drawn : uint8_t { kSurfels, kBoth, kMesh };
+
+}  // namespace
+
+Status validate_surfel_options(const SurfelOptions& o) {
+  CALF_RETURN_IF_ERROR(validate_surfel_render_options(o.render));
+  CALF_RETURN_IF_ERROR(validate_mesh_render_options(o.mesh.render));
+  if (!(o.min_point_size > 0 && o.min_point_size <= o.max_point_size && o.max_point_size <= 64)) {
+    return option_error(format("point size range [%g, %g] is not within (0, 64]", o.min_point_size,
+                               o.max_point_size));
+  }
+  if (!(o.point_size >= o.min_point_size && o.point_size <= o.max_point_size)) {
+    return option_error(format("point size %g is outside [%g, %g]", o.point_size, o.min_point_size,
+                               o.max_point_size));
+  }
+  if (!(std::isfinite(o.target_frame_ms) && o.target_frame_ms >= 0)) {
+    return option_error(
+        format("target frame time %g ms is not finite and >= 0", o.target_frame_ms));
+  }
+  if (!(o.controller_gain > 0 && o.controller_gain <= 1)) {
+    return option_error(format("controller gain %g is outside (0, 1]", o.controller_gain));
+  }
+  if (!(o.blend_share >= 0 && o.blend_share <= 1)) {
+    return option_error(format("blend share %g is outside [0, 1]", o.blend_share));
+  }
+  return Status::Ok();
+}
+
+struct SurfelRepresentation::Impl {
+  uint16_t track = 0;
+  RenderBackend backend = RenderBackend::kGl;
+  SurfelOptions options;
+  double point_size = 2;
+  std::unique_ptr<MeshRepresentation> mesh;
+  std::vector<surfels::PrototypeRecord> records;
+  // Per prototype: the centre and radius of its box's bounding sphere, object space.
+  std::vector<Vec3> centres;
+  std::vector<double> radii;
+  SurfelDrawList list;
+  std::vector<Drawn> drawn;
+  std::unique_ptr<GlSurfelRenderer> gl;
+  RenderedImage layer;  // the surfels' image before compositing
+  std::vector<Camera> eyes;
+  uint64_t surfels = 0;
+  uint32_t counts[3] = {0, 0, 0};  // objects per Drawn
+  double render_ms = 0, prepare_ms = 0;
+
+  void choose(const Camera& first);
+};
+
+SurfelRepresentation::SurfelRepresentation(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+SurfelRepresentation::~SurfelRepresentation() = default;
+
+Expected<std::unique_ptr<SurfelRepresentation>> SurfelRepresentation::open(
+    const container::Reader& reader, uint16_t track, const SurfelOptions& options,
+    RenderBackend backend, const GlFunctions* gl) {
+  if (track >= reader.tracks().size() ||
+      !std::holds_alternative<container::SurfelsTrackHeader>(reader.tracks()[track].header)) {
+    return Status(ErrorId::kMeshPlayback,
+                  "track " + std::to_string(track) + " is not a surfels track");
+  }
+  CALF_RETURN_IF_ERROR(validate_surfel_options(options));
+  auto impl = std::make_unique<Impl>();
+  impl->track = track;
+  impl->backend = backend;
+  impl->options = options;
+  impl->point_size = options.point_size;
+  CALF_ASSIGN_OR_RETURN(const decoder::SurfelsTrack surfels,
+                        decoder::SurfelsTrack::open(reader, track));
+  {
+    CALF_ASSIGN_OR_RETURN(const decoder::MeshTrack mesh_track,
+                          decoder::MeshTrack::open(reader, surfels.mesh_track()));
+    CALF_RETURN_IF_ERROR(surfels.check_pairing(mesh_track));
+  }
+  CALF_ASSIGN_OR_RETURN(impl->mesh, MeshRepresentation::open(reader, surfels.mesh_track(),
+                                                             options.mesh, backend, gl));
+  for (uint32_t p = 0; p < surfels.prototype_count(); ++p) {
+    const surfels::PrototypeRecord& r = surfels.record(p);
+    impl->records.push_back(r);
+    const Vec3 lo{r.box_min[0], r.box_min[1], r.box_min[2]};
+    const Vec3 hi{r.box_max[0], r.box_max[1], r.box_max[2]};
+    impl->centres.push_back((lo + hi) * 0.5);
+    impl->radii.push_back(length(hi - lo) * 0.5);
+    decoder::SurfelBuffer buffer;
+    CALF_RETURN_IF_ERROR(surfels.prototype(p, &buffer));
+    SurfelDrawPrototype d;
+    d.positions = std::move(buffer.positions);
+    d.normals = std::move(buffer.normals);
+    d.colours = std::move(buffer.colours);
+    impl->list.prototypes.push_back(std::move(d));
+  }
+  // A surfel's colour multiplies its object's material base colour unless its prototype's
+  // colours are the base colour itself (SPEC §11.3.2): the object's tint. Emission is not drawn.
+  const MeshDrawList& mesh_list = impl->mesh->draw_list();
+  for (const MeshDrawObject& o : mesh_list.objects) {
+    SurfelDrawObject s;
+    s.prototype = o.prototype;
+    s.transform = o.transform;
+    if (s.prototype < impl->records.size() &&
+        (impl->records[s.prototype].flags & surfels::kColourIsBase) == 0) {
+      s.tint = mesh_list.materials[o.material].base_colour;
+    }
+    impl->list.objects.push_back(s);
+  }
+  impl->drawn.assign(impl->list.objects.size(), Drawn::kMesh);
+  CALF_RETURN_IF_ERROR(validate_surfel_draw_list(impl->list));
+  if (backend == RenderBackend::kGl) {
+    if (gl == nullptr) {
+      return Status(ErrorId::kPlayerGl,
+                    "the GL surfel renderer needs a current OpenGL 4.5 context");
+    }
+    CALF_ASSIGN_OR_RETURN(impl->gl, GlSurfelRenderer::make(*gl));
+    CALF_RETURN_IF_ERROR(impl->gl->upload(impl->list));
+  }
+  return std::unique_ptr<SurfelRepresentation>(new SurfelRepresentation(std::move(impl)));
+}
+
+void SurfelRepresentation::Impl::choose(const Camera& first) {
+  const MeshDrawList& mesh_list = mesh->draw_list();
+  const double pixel =
+      2 * std::tan(first.fov_y / 2) / first.height;  // world size per unit distance
+  surfels = 0;
+  counts[0] = counts[1] = counts[2] = 0;
+  for (size_t o = 0; o < list.objects.size(); ++o) {
+    SurfelDrawObject& s = list.objects[o];
+    s.transform = mesh_list.objects[o].transform;
+    const surfels::PrototypeRecord& rec = records[s.prototype];
+    Drawn how = Drawn::kMesh;
+    s.count = 0;
+    if (rec.surfel_count > 0) {
+      const internal::ObjectTransform t(s.transform);
+      const double scale = std::cbrt(std::abs(t.det));
+      const Vec3 centre = t.linear(centres[s.prototype]) + t.translation();
+      double d = std::numeric_limits<double>::infinity();
+      for (const Camera& eye : eyes) d = std::min(d, length(centre - eye.position));
+      d = std::max(d - scale * radii[s.prototype], options.render.near);
+      const double radius = point_size / 2 * pixel * d / scale;  // object units
+      // Eq. 1 unclamped, to tell "needs more than the buffer holds" from "needs all of it".
+      const double need = rec.prefix_count * std::pow(rec.prefix_radius / radius, 2);
+      if (need <= rec.surfel_count) {
+        s.count = surfels::prefix_for_radius(rec, radius);
+        s.radius = static_cast<float>(radius);
+        how = need > options.blend_share * rec.surfel_count ? Drawn::kBoth : Drawn::kSurfels;
+      }
+    }
+    drawn[o] = how;
+    ++counts[static_cast<int>(how)];
+    surfels += s.count;
+    mesh->set_object_visible(o, how != Drawn::kSurfels);
+  }
+}
+
+std::string_view SurfelRepresentation::kind() const {
+  return "surfels";
+}
+uint16_t SurfelRepresentation::track() const {
+  return impl_->track;
+}
+RenderBackend SurfelRepresentation::backend() const {
+  return impl_->backend;
+}
+uint32_t SurfelRepresentation::frame_count() const {
+  return impl_->mesh->frame_count();
+}
+double SurfelRepresentation::fps() const {
+  return impl_->mesh->fps();
+}
+const Box3& SurfelRepresentation::view_volume() const {
+  return impl_->mesh->view_volume();
+}
+uint16_t SurfelRepresentation::mesh_track() const {
+  return impl_->mesh->track();
+}
+double SurfelRepresentation::point_size() const {
+  return impl_->point_size;
+}
+uint64_t SurfelRepresentation::surfels_drawn() const {
+  return impl_->surfels;
+}
+uint64_t SurfelRepresentation::triangles_drawn() const {
+  return impl_->mesh->triangles_drawn();
+}
+const SurfelDrawList& SurfelRepresentation::draw_list() const {
+  return impl_->list;
+}
+
+Status SurfelRepresentation::prepare(uint32_t frame, std::span<const Camera> eyes) {
+  Impl& d = *impl_;
+  const auto t0 = std::chrono::steady_clock::now();
+  CALF_RETURN_IF_ERROR(d.mesh->prepare(frame, eyes));
+  d.eyes.assign(eyes.begin(), eyes.end());
+  d.choose(eyes.front());
+  d.prepare_ms = ms_since(t0);
+  return Status::Ok();
+}
+
+Status SurfelRepresentation::render(const Camera& camera, RenderedImage* out) {
+  Impl& d = *impl_;
+  const auto t0 = std::chrono::steady_clock::now();
+  CALF_RETURN_IF_ERROR(d.mesh->render(camera, out));
+  if (d.surfels > 0) {
+    if (d.gl) {
+      CALF_RETURN_IF_ERROR(d.gl->render(d.list, camera, d.options.render, &d.layer));
+    } else {
+      CALF_RETURN_IF_ERROR(render_surfels_cpu(d.list, camera, d.options.render, &d.layer));
+    }
+    CALF_RETURN_IF_ERROR(composite_nearest(d.layer, out));
+  }
+  d.render_ms = ms_since(t0);
+  return Status::Ok();
+}
+
+Status SurfelRepresentation::report_frame_time(double frame_ms) {
+  Impl& d = *impl_;
+  if (!(std::isfinite(frame_ms) && frame_ms >= 0)) {
+    return Status(ErrorId::kViewSelectFrameTime,
+                  "frame time " + std::to_string(frame_ms) + " ms is negative or not finite");
+  }
+  const SurfelOptions& o = d.options;
+  if (o.target_frame_ms > 0 && frame_ms > 0) {
+    const double factor = std::pow(frame_ms / o.target_frame_ms, o.controller_gain / 2);
+    d.point_size = std::clamp(d.point_size * factor, o.min_point_size, o.max_point_size);
+  }
+  return Status::Ok();
+}
+
+RepresentationStats SurfelRepresentation::stats() const {
+  const Impl& d = *impl_;
+  RepresentationStats out;
+  out.title =
+      format("surfels track %u (%s)", d.track, d.backend == RenderBackend::kGl ? "gl" : "cpu");
+  out.entries.push_back({"objects surfels / both / mesh",
+                         format("%u / %u / %u", d.counts[0], d.counts[1], d.counts[2])});
+  out.entries.push_back(
+      {"surfels drawn", format("%llu", static_cast<unsigned long long>(d.surfels))});
+  out.entries.push_back({"triangles drawn", format("%llu", static_cast<unsigned long long>(
+                                                               d.mesh->triangles_drawn()))});
+  out.entries.push_back(
+      {"point size", format("%.2f px%s", d.point_size,
+                            d.options.target_frame_ms > 0
+                                ? format(" (target %.1f ms)", d.options.target_frame_ms).c_str()
+                                : "")});
+  out.entries.push_back({"prepare", format("%.2f ms", d.prepare_ms)});
+  out.entries.push_back({"draw", format("%.1f ms", d.render_ms)});
+  return out;
+}
+
+}  // namespace calf::player
