@@ -104,7 +104,7 @@ TEST(FactoryScene, IsGeneratedTheSameEveryTime) {
   EXPECT_EQ(fa->meshes.size(), 18u);  // 15 shared parts and floor, walls, lines
 }
 
-// Rays from 40 directions around each part towards points near its middle: the nearest
+// Rays from 24 directions around each part towards points near its middle: the nearest
 // triangle each meets is a front face (counter-clockwise seen from outside).
 TEST(FactoryScene, PartsAreWoundOutward) {
   auto scene = make_builtin_scene("factory");
@@ -115,9 +115,9 @@ TEST(FactoryScene, PartsAreWoundOutward) {
     const glm::vec3 centre = (lo + hi) * 0.5f;
     const float radius = glm::length(hi - lo);
     size_t hits = 0, front = 0;
-    for (int k = 0; k < 40; ++k) {
+    for (int k = 0; k < 24; ++k) {
       // A Fibonacci sphere of directions; targets spread over the middle half of the box.
-      const float z = 1 - (2 * k + 1) / 40.0f, phi = 2.39996323f * static_cast<float>(k);
+      const float z = 1 - (2 * k + 1) / 24.0f, phi = 2.39996323f * static_cast<float>(k);
       const float s = std::sqrt(1 - z * z);
       const glm::vec3 d(s * std::cos(phi), z, s * std::sin(phi));
       const glm::vec3 target = centre + (hi - lo) * 0.25f *
@@ -149,7 +149,7 @@ TEST(FactoryScene, PartsAreWoundOutward) {
         front += facing < 0;
       }
     }
-    EXPECT_GE(hits, 8u) << name;
+    EXPECT_GE(hits, 5u) << name;
     EXPECT_EQ(front, hits) << name << ": rays from outside meet back faces first";
   }
 }
