@@ -237,15 +237,16 @@ Scene factory_scene() {
   s.ao_distance = 1.0f;
   s.fps = 24;
   s.frame_count = 24;
-  // The middle of the central aisle at eye height: 4 m x 2 m, 1.6 .. 1.8 m high.
-  s.default_rig = box_rig({0, 1.7, 0}, {2, 0.1, 1});
+  // The middle of the central aisle at eye height: 12 m x 2 m, 1.6 .. 1.8 m high.
+  s.default_rig = box_rig({0, 1.7, 0}, {6, 0.1, 1});
   // A walk along the central aisle, the gaze sweeping from one row of machines to the other.
   s.validation_path = [](uint32_t frames, double fps, uint32_t w, uint32_t h) {
     capture::EyePath path;
     path.width = w, path.height = h;
     for (uint32_t f = 0; f < frames; ++f) {
       const double u = frames > 1 ? static_cast<double>(f) / (frames - 1) : 0.5;
-      const glm::dvec3 p(-6 + 12 * u, 1.7, 0.6 * std::sin(kTau * u));
+      // Inside the region and away from its viewpoints (the centre is passed 0.36 m aside).
+      const glm::dvec3 p(-5 + 10 * u, 1.7, 0.5 * std::sin(kTau * u + 0.8));
       const double yaw = 0.7 * std::sin(kTau * u + 0.5);
       path.poses.push_back(
           look_at_pose(f / fps, p, p + glm::dvec3(std::cos(yaw), -0.12, std::sin(yaw)), 70));
