@@ -366,6 +366,7 @@ const std::vector<SceneInfo>& builtin_scenes() {
        "streets of instanced buildings with windows, seen from a crossing: 1,417,070 triangles"},
       {"blades", "a field of thin grass blades swaying in vertex states: 5,376,050 triangles"},
       {"spheres", "bouncing analytic spheres among walls and pillars: 1,616 triangles, 14 spheres"},
+      {"factory", "a machine hall of instanced CAD parts seen from an aisle: 28,075,486 triangles"},
   };
   return list;
 }
@@ -377,6 +378,7 @@ Expected<Scene> make_builtin_scene(std::string_view name) {
   if (name == "city") return city_scene();
   if (name == "blades") return blades_scene();
   if (name == "spheres") return spheres_scene();
+  if (name == "factory") return factory_scene();
   return Status(ErrorId::kSceneUnknown, "no built-in scene '" + std::string(name) + "'");
 }
 

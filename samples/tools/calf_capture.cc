@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <thread>
 
@@ -15,6 +16,7 @@
 #include "calf/samples/render.h"
 #include "calf/samples/scene.h"
 #include "calf/samples/scene_export.h"
+#include "calf/samples/surfel_candidates.h"
 #include "command_line.h"
 
 namespace {
@@ -58,6 +60,26 @@ class Progress {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
+// --surfel-candidates: ray casts and writes, with progress and a summary line.
+int write_candidates(const calf::capture::SceneFile& scene,
+                     const samples::SurfelCandidateOptions& options, const std::string& path,
+                     bool quiet) {
+  Progress progress("surfel view", quiet);
+  auto stats = samples::write_surfel_candidates(scene, options, path,
+                                                [&](uint64_t d, uint64_t t) { progress(d, t); });
+  if (!stats.ok()) return fail(stats.status());
+  if (!quiet) {
+    std::fprintf(stderr,
+                 "calf-capture: %s: %llu candidates of %llu meshes (%u^2 x %u views), %.1f MB in "
+                 "%.2f s, %.1f Mrays/s\n",
+                 path.c_str(), static_cast<unsigned long long>(stats->candidates),
+                 static_cast<unsigned long long>(stats->meshes), options.resolution,
+                 options.directions, static_cast<double>(stats->bytes) * 1e-6, stats->seconds,
+                 stats->seconds > 0 ? static_cast<double>(stats->rays) / stats->seconds * 1e-6 : 0);
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -75,6 +97,8 @@ int main(int argc, char** argv) {
   float noise = 0;
   std::string gt_size = "256x256";
   bool list = false, ground_truth = false, quiet = false;
+  std::string surfel_path, surfel_corners = "cube";
+  samples::SurfelCandidateOptions surfel;
   app.add_option("--scene", scene_arg,
                  "built-in scene name (see --list-scenes) or a glTF/GLB/OBJ/PLY/FBX file");
   app.add_option("--out", out_dir, "output directory (created if missing)");
@@ -108,6 +132,25 @@ int main(int argc, char** argv) {
   app.add_option("--export-scene", export_dir,
                  "also write the scene as a scene file (format/SCENE.md: DIR/scene.json last, "
                  "scene.bin) with --frames frames; without --out, only export");
+  app.add_option("--surfel-candidates", surfel_path,
+                 "also ray-cast the initial surfel candidates (paper 001 Sec. 3.1) of every mesh "
+                 "prototype of the scene, as --export-scene numbers them, into this file "
+                 "(format/SURFEL_CANDIDATES.md): an orthographic G-buffer per direction, one "
+                 "candidate (position, normal, unshaded base colour per material) per hit pixel; "
+                 "without --out, only this. --scene may then also name a scene-file folder "
+                 "(DIR/scene.json)");
+  app.add_option("--surfel-resolution", surfel.resolution,
+                 "G-buffer side R in pixels of --surfel-candidates, 1..4096 (the paper: 1024)")
+      ->capture_default_str();
+  app.add_option("--surfel-directions", surfel.directions,
+                 "G-buffers per prototype: 8 (from the corners towards the centre) or 16 (those "
+                 "8 and the same turned 45 degrees about +Y)")
+      ->capture_default_str();
+  app.add_option("--surfel-corners", surfel_corners,
+                 "which corners the 8 directions come from: cube (the bounding box made cubical: "
+                 "the diagonals, a flat or long part is never seen edge-on) or box (the bounding "
+                 "box's own corners, the paper's rule)")
+      ->capture_default_str();
   app.add_flag("--list-scenes", list, "print the built-in scenes and exit");
   app.add_flag("--quiet", quiet, "no progress or summary lines on stderr");
   if (int rc = calf::tools::parse_command_line(app, "calf-capture", argc, argv); rc >= 0) return rc;
@@ -120,9 +163,9 @@ int main(int argc, char** argv) {
     }
     return 0;
   }
-  if (scene_arg.empty() || (out_dir.empty() && export_dir.empty())) {
-    return calf::tools::usage_error("calf-capture",
-                                    "--scene and --out (or --export-scene) are required");
+  if (scene_arg.empty() || (out_dir.empty() && export_dir.empty() && surfel_path.empty())) {
+    return calf::tools::usage_error(
+        "calf-capture", "--scene and --out (or --export-scene, --surfel-candidates) are required");
   }
 
   samples::RenderOptions render;
@@ -136,9 +179,43 @@ int main(int argc, char** argv) {
     return bad_option(Status(calf::ErrorId::kCaptureOption,
                              fmt::format("--face-size {} is outside 1..4096", face_size)));
   }
+  if (!surfel_path.empty()) {
+    surfel.threads = threads;
+    if (surfel_corners == "cube") {
+      surfel.corners = calf::capture::SurfelCorners::kCube;
+    } else if (surfel_corners == "box") {
+      surfel.corners = calf::capture::SurfelCorners::kBox;
+    } else {
+      return bad_option(Status(calf::ErrorId::kSurfelOption, "--surfel-corners '" + surfel_corners +
+                                                                 "' is neither cube nor box"));
+    }
+    if (Status s = samples::validate_surfel_candidate_options(surfel); !s.ok()) {
+      return bad_option(s);
+    }
+  }
+  // A scene-file folder feeds --surfel-candidates alone: its meshes are what an encoder reads.
+  std::error_code ec;
+  const std::filesystem::path scene_json =
+      std::filesystem::path(scene_arg) / calf::capture::kSceneManifestFileName;
+  if (!surfel_path.empty() && std::filesystem::is_directory(scene_arg, ec) &&
+      std::filesystem::exists(scene_json, ec)) {
+    if (!out_dir.empty() || !export_dir.empty()) {
+      return calf::tools::usage_error(
+          "calf-capture", "a scene-file folder as --scene goes with --surfel-candidates alone");
+    }
+    auto file = calf::capture::read_scene_file(scene_arg);
+    if (!file.ok()) return fail(file.status());
+    return write_candidates(*file, surfel, surfel_path, quiet);
+  }
   auto scene = samples::load_scene(scene_arg);
   if (!scene.ok()) return fail(scene.status());
   const uint32_t frame_count = frames ? frames : scene->frame_count;
+  if (!surfel_path.empty()) {
+    auto file = samples::export_scene(*scene, frame_count);
+    if (!file.ok()) return fail(file.status());
+    if (int rc = write_candidates(*file, surfel, surfel_path, quiet); rc != 0) return rc;
+    if (out_dir.empty() && export_dir.empty()) return 0;
+  }
   if (!export_dir.empty()) {
     if (Status s = samples::write_scene(*scene, frame_count, export_dir); !s.ok()) return fail(s);
     if (!quiet) std::fprintf(stderr, "calf-capture: scene file %s written\n", export_dir.c_str());

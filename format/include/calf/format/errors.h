@@ -123,6 +123,17 @@ enum class ErrorKind : uint8_t {
   X(kViewpointInsideGeometry, 176, kInvalidArgument, "a viewpoint or eye lies inside geometry") \
   X(kCaptureOption, 177, kInvalidArgument, "a render option is outside its range")              \
   X(kRayTracer, 178, kInternal, "Embree failed to create a device or scene")                    \
+  /* surfel candidates: 180-189 (format/SURFEL_CANDIDATES.md, calf-capture --surfel-candidates) */ \
+  X(kSurfelFileIdentifier, 180, kCorrupt, "a file is not a surfel-candidate file")              \
+  X(kSurfelFileVersion, 181, kUnsupported, "a surfel-candidate file's version or flag is unknown") \
+  X(kSurfelFileTruncated, 182, kNeedMoreData, "a surfel-candidate file ends inside a record")   \
+  X(kSurfelFileField, 183, kCorrupt, "a surfel-candidate field contradicts the file or record") \
+  X(kSurfelFileValue, 184, kCorrupt, "a surfel candidate value is NaN, infinite or out of range") \
+  X(kSurfelFileLimit, 185, kLimit, "a surfel-candidate count exceeds its documented limit")     \
+  X(kSurfelFileHash, 186, kCorrupt, "a surfel-candidate record's hash does not match")          \
+  X(kSurfelWriterMisuse, 187, kInvalidArgument, "the candidate writer got inconsistent arrays") \
+  X(kSurfelOption, 188, kInvalidArgument, "a surfel-candidate option is outside its range")     \
+  X(kSurfelSceneMismatch, 189, kInvalidArgument, "surfel candidates do not belong to the scene") \
   /* encoder: 200-299 */                                                                        \
   X(kEncoderOption, 200, kInvalidArgument, "an encoder option is outside its range")          \
   X(kEncoderInput, 201, kCorrupt, "the capture set contradicts itself or the chosen options")  \

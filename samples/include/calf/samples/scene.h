@@ -156,7 +156,8 @@ struct SceneInfo {
 // The built-in scenes, in --list-scenes order: "turntable", "interior", "mirror-box" (paper 002's
 // cases), then the heavy scenes of the visible-set mode (paper 004): "city" (streets of
 // instanced buildings, most of it hidden from a street crossing), "blades" (a field of swaying
-// grass blades in vertex states) and "spheres" (bouncing analytic spheres among occluders).
+// grass blades in vertex states) and "spheres" (bouncing analytic spheres among occluders); then
+// the surfel mode's "factory" (a machine hall of ~28 M instanced triangles of CAD-like parts).
 // Each description gives the scene's triangle count.
 const std::vector<SceneInfo>& builtin_scenes();
 // Builds a built-in scene (E170 for an unknown name).
