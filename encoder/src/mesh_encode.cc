@@ -366,17 +366,21 @@ Expected<MeshEncodeStats> encode_mesh_file(
     const capture::SceneFile& scene, const std::filesystem::path& scene_dir,
     const std::string& out_path, const std::vector<std::vector<uint32_t>>* visible,
     const MeshEncodeOptions& options,
-    const std::vector<std::pair<std::string, std::string>>& extra_metadata) {
+    const std::vector<std::pair<std::string, std::string>>& extra_metadata,
+    const std::vector<std::string>& more_inputs,
+    const std::function<Status(container::Writer*)>& more_tracks) {
   // The output must not be one of the inputs (CALF-E007).
   std::vector<std::string> inputs = {scene_dir.string(),
                                      (scene_dir / capture::kSceneManifestFileName).string(),
                                      (scene_dir / capture::kSceneBufferFileName).string()};
   for (const auto& t : scene.textures) inputs.push_back((scene_dir / t.path).string());
+  inputs.insert(inputs.end(), more_inputs.begin(), more_inputs.end());
   CALF_RETURN_IF_ERROR(files::check_output_not_input(out_path, inputs));
   CALF_ASSIGN_OR_RETURN(container::Writer writer,
                         container::Writer::create(out_path, options.levels));
   MeshEncodeStats stats;
   CALF_RETURN_IF_ERROR(encode_mesh_track(scene, visible, options, &writer, &stats));
+  if (more_tracks) CALF_RETURN_IF_ERROR(more_tracks(&writer));
   CALF_RETURN_IF_ERROR(
       writer.set_metadata("encoder", std::string("calf-encode ") + kVersionString));
   if (!scene.name.empty()) CALF_RETURN_IF_ERROR(writer.set_metadata("source_scene", scene.name));

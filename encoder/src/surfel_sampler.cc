@@ -17,7 +17,7 @@ namespace {
 using surfel_internal::P3;
 
 Status option_error(const std::string& what) {
-  return Status(ErrorId::kSurfelOption, "surfel sampler: " + what);
+  return Status(ErrorId::kSurfelSamplerOption, "surfel sampler: " + what);
 }
 
 Status check_options(const SurfelSamplerOptions& o) {

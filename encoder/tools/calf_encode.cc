@@ -20,6 +20,7 @@
 
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/encoder/mesh_encode.h"
+#include "calf/encoder/surfels_build.h"
 #include "calf/encoder/visible_set.h"
 #include "command_line.h"
 
@@ -162,6 +163,42 @@ int encode_mesh(const std::string& input, const std::string& out, const std::str
   return 0;
 }
 
+// --mode surfels: the scene file at `input` and its surfel candidates into a mesh track (track 0)
+// and the surfels track paired with it (track 1; paper 001, encoder/surfels_build.h).
+int encode_surfels(const std::string& input, const std::string& candidates, const std::string& out,
+                   const std::string& super, uint32_t threads,
+                   const calf::encoder::SurfelBuildOptions& build) {
+  calf::encoder::MeshEncodeOptions mesh;
+  calf::encoder::SurfelsEncodeOptions surfels;
+  mesh.threads = surfels.threads = threads;
+  mesh.supercompression = surfels.supercompression =
+      super == "lzma2"  ? calf::container::Compression::kLzma2
+      : super == "none" ? calf::container::Compression::kNone
+                        : calf::container::Compression::kZstd;
+  std::filesystem::path dir = input;
+  if (dir.filename() == calf::capture::kSceneManifestFileName) dir = dir.parent_path();
+  if (dir.empty()) dir = ".";
+  const auto start = std::chrono::steady_clock::now();
+  calf::encoder::SurfelsEncodeStats encoded;
+  auto stats =
+      calf::encoder::encode_surfel_file(dir, candidates, out, build, mesh, surfels, &encoded);
+  if (!stats.ok()) return fail(stats.status());
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::fprintf(stderr,
+               "calf-encode: wrote %s in %.2f s (surfels: %u of %u prototypes, %llu surfels of "
+               "%llu candidates, %s sampler %.2f s; %.2f bytes per surfel stored)\n",
+               out.c_str(), seconds, stats->prototypes_with_surfels, stats->prototypes,
+               static_cast<unsigned long long>(stats->surfels),
+               static_cast<unsigned long long>(stats->candidates),
+               calf::surfel_order_method_name(build.sampler.method), stats->sample_seconds,
+               stats->surfels ? static_cast<double>(encoded.surfels_stored) /
+                                    static_cast<double>(stats->surfels)
+                              : 0.0);
+  std::fprintf(stderr, "calf-encode: peak RSS %.1f MiB\n", peak_rss_mib());
+  return 0;
+}
+
 int main(int argc, char** argv) {
   CLI::App app{
       "calf-encode: encode a capture set (format/CAPTURE.md) into a .calf lightfield track "
@@ -177,7 +214,12 @@ int main(int argc, char** argv) {
       "triangles visible from the scene's view region (paper 004; its errors: CALF-E110..E115, "
       "docs/ERRORS.md); only --supercompression, "
       "--threads, --quiet and the visible-set options apply, the lightfield options are "
-      "ignored.\n" +
+      "ignored.\n"
+      "--mode surfels: INPUT is a scene file and --surfel-candidates its candidate file "
+      "(format/SURFEL_CANDIDATES.md, from calf-capture --surfel-candidates); the output holds the "
+      "mesh track of the whole scene and a surfels track (format/SPEC.md 11.3): per prototype up "
+      "to --surfels surfels ordered so every prefix is a level of detail (paper 001; "
+      "docs/SURFELS.md).\n" +
       std::string(calf::tools::kExitStatusHelp)};
   calf::LightfieldEncodeOptions o;
   std::string manifest, out;
@@ -188,9 +230,10 @@ int main(int argc, char** argv) {
                  "mesh: the scene file (its scene.json or folder)")
       ->required();
   app.add_option("--mode", mode,
-                 "lightfield (a capture set into a lightfield track) or mesh (a scene file into "
-                 "a mesh track) (default lightfield)")
-      ->check(CLI::IsMember({"lightfield", "mesh"}))
+                 "lightfield (a capture set into a lightfield track), mesh (a scene file into "
+                 "a mesh track) or surfels (a scene file and its surfel candidates into a mesh "
+                 "track and a surfels track) (default lightfield)")
+      ->check(CLI::IsMember({"lightfield", "mesh", "surfels"}))
       ->default_val("lightfield");
   app.add_option("-o,--output", out, "output .calf (written whole or not at all)")->required();
   app.add_option("--threads", o.threads,
@@ -263,7 +306,34 @@ int main(int argc, char** argv) {
                           "docs/VISIBILITY.md")
                ->check(CLI::IsMember({"per-frame", "coupled"}))
                ->default_val("per-frame"));
+  std::string candidates, sampler = "progressive";
+  calf::encoder::SurfelBuildOptions surfel_build;
+  app.add_option("--surfel-candidates", candidates,
+                 "surfels: the candidate file of the scene (calf-capture --surfel-candidates)");
+  app.add_option("--surfels", surfel_build.max_surfels,
+                 "surfels: most surfels per prototype, 1..2^26 (fewer when it has fewer "
+                 "candidates) (default 65536)")
+      ->check(CLI::Range(1u, 1u << 26))
+      ->default_val(65536);
+  app.add_option("--surfel-sampler", sampler,
+                 "surfels: progressive (paper 001's approximate greedy permutation), exact (the "
+                 "greedy permutation, O(n N): slow) or random (default progressive)")
+      ->check(CLI::IsMember({"progressive", "exact", "random"}))
+      ->default_val("progressive");
   if (int rc = calf::tools::parse_command_line(app, "calf-encode", argc, argv); rc >= 0) return rc;
+  if (mode == "surfels") {
+    if (candidates.empty() || vs.enabled) {
+      return calf::tools::usage_error(
+          "calf-encode", "--mode surfels needs --surfel-candidates and takes no --visible-set");
+    }
+    surfel_build.sampler.method = sampler == "exact"    ? calf::SurfelOrderMethod::kExactGreedy
+                                  : sampler == "random" ? calf::SurfelOrderMethod::kRandom
+                                                        : calf::SurfelOrderMethod::kProgressive;
+    surfel_build.sampler.threads = o.threads;
+    return encode_surfels(manifest, candidates, out, super, o.threads, surfel_build);
+  }
+  if (!candidates.empty())
+    return calf::tools::usage_error("calf-encode", "--surfel-candidates needs --mode surfels");
   if (vs_motion == "coupled") vs.options.motion = calf::encoder::VisibilityMotion::kCoupled;
   if (mode != "mesh" && vs.enabled)
     return calf::tools::usage_error("calf-encode", "--visible-set needs --mode mesh");

@@ -295,20 +295,20 @@ TEST(SurfelSamplerTest, Errors) {
     change(o);
     return error_of(c, 10, o);
   };
-  EXPECT_EQ(option([](auto& o) { o.round_samples = 0; }), ErrorId::kSurfelOption);
+  EXPECT_EQ(option([](auto& o) { o.round_samples = 0; }), ErrorId::kSurfelSamplerOption);
   EXPECT_EQ(option([](auto& o) { o.round_samples = kSurfelMaxRoundSamples + 1; }),
-            ErrorId::kSurfelOption);
-  EXPECT_EQ(option([](auto& o) { o.growth_period = 0; }), ErrorId::kSurfelOption);
-  EXPECT_EQ(option([](auto& o) { o.max_accept = 201; }), ErrorId::kSurfelOption);
-  EXPECT_EQ(option([](auto& o) { o.vicinity = 1.0; }), ErrorId::kSurfelOption);
-  EXPECT_EQ(option([](auto& o) { o.vicinity = -0.1; }), ErrorId::kSurfelOption);
-  EXPECT_EQ(option([](auto& o) { o.vicinity = std::nan(""); }), ErrorId::kSurfelOption);
-  EXPECT_EQ(option([](auto& o) { o.extend_below = 1.0; }), ErrorId::kSurfelOption);
-  EXPECT_EQ(option([](auto& o) { o.extend_below = -0.5; }), ErrorId::kSurfelOption);
-  EXPECT_EQ(option([](auto& o) { o.p_m = 0; }), ErrorId::kSurfelOption);
-  EXPECT_EQ(option([](auto& o) { o.threads = kSurfelMaxThreads + 1; }), ErrorId::kSurfelOption);
+            ErrorId::kSurfelSamplerOption);
+  EXPECT_EQ(option([](auto& o) { o.growth_period = 0; }), ErrorId::kSurfelSamplerOption);
+  EXPECT_EQ(option([](auto& o) { o.max_accept = 201; }), ErrorId::kSurfelSamplerOption);
+  EXPECT_EQ(option([](auto& o) { o.vicinity = 1.0; }), ErrorId::kSurfelSamplerOption);
+  EXPECT_EQ(option([](auto& o) { o.vicinity = -0.1; }), ErrorId::kSurfelSamplerOption);
+  EXPECT_EQ(option([](auto& o) { o.vicinity = std::nan(""); }), ErrorId::kSurfelSamplerOption);
+  EXPECT_EQ(option([](auto& o) { o.extend_below = 1.0; }), ErrorId::kSurfelSamplerOption);
+  EXPECT_EQ(option([](auto& o) { o.extend_below = -0.5; }), ErrorId::kSurfelSamplerOption);
+  EXPECT_EQ(option([](auto& o) { o.p_m = 0; }), ErrorId::kSurfelSamplerOption);
+  EXPECT_EQ(option([](auto& o) { o.threads = kSurfelMaxThreads + 1; }), ErrorId::kSurfelSamplerOption);
   EXPECT_EQ(option([](auto& o) { o.method = static_cast<SurfelOrderMethod>(7); }),
-            ErrorId::kSurfelOption);
+            ErrorId::kSurfelSamplerOption);
   // Edges of the ranges are accepted.
   EXPECT_EQ(option([](auto& o) { o.round_samples = 1; }), ErrorId::kOk);
   EXPECT_EQ(option([](auto& o) { o.max_accept = 200; }), ErrorId::kOk);
@@ -319,7 +319,7 @@ TEST(SurfelSamplerTest, Errors) {
   EXPECT_EQ(prefix_spacing(c, ord, 4).status().id(), ErrorId::kSurfelCount);
   const std::vector<uint32_t> outside = {0, 100};
   EXPECT_EQ(prefix_spacing(c, outside, 2).status().id(), ErrorId::kSurfelCount);
-  EXPECT_EQ(prefix_spacing(c, ord, 2, kSurfelMaxThreads + 1).status().id(), ErrorId::kSurfelOption);
+  EXPECT_EQ(prefix_spacing(c, ord, 2, kSurfelMaxThreads + 1).status().id(), ErrorId::kSurfelSamplerOption);
 }
 
 }  // namespace

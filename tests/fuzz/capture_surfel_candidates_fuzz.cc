@@ -11,7 +11,7 @@
 #include <span>
 
 #include "calf/capture/surfel_candidates.h"
-#include "fuzz_scratch_dir.h"
+#include "../scratch_dir.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::span<const uint8_t> bytes(data, size);
@@ -27,7 +27,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     return 0;
   }
-  const std::string path = (calf::fuzz::scratch_dir("surfel_candidates_fuzz") / "in.cand").string();
+  const std::string path = (calf::test::scratch_dir("surfel_candidates_fuzz") / "in.cand").string();
   {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));

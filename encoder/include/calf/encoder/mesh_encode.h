@@ -26,6 +26,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -102,11 +103,15 @@ Expected<MeshEncodeStats> encode_mesh_file(const std::filesystem::path& scene_di
 // As above for a scene already read from `scene_dir` (calf-encode --visible-set reads it once to
 // compute the set): `visible` as for encode_mesh_track (nullptr: every triangle), and
 // `extra_metadata` (key, value) pairs written after the ones above (e.g. how the set was made).
+// `more_inputs` are other files the output must not be; `more_tracks` (optional) adds tracks after
+// the mesh track (track 0), e.g. the surfels track paired with it.
 Expected<MeshEncodeStats> encode_mesh_file(
     const capture::SceneFile& scene, const std::filesystem::path& scene_dir,
     const std::string& out_path, const std::vector<std::vector<uint32_t>>* visible,
     const MeshEncodeOptions& options,
-    const std::vector<std::pair<std::string, std::string>>& extra_metadata = {});
+    const std::vector<std::pair<std::string, std::string>>& extra_metadata = {},
+    const std::vector<std::string>& more_inputs = {},
+    const std::function<Status(container::Writer*)>& more_tracks = nullptr);
 
 // The scene's fps as the header's fraction: n/1 for a whole number, n/1001 for the NTSC rates
 // (23.976 = 24000/1001), else round(fps * 10^6) / 10^6 reduced. Exposed for the decoder tests.

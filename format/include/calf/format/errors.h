@@ -153,7 +153,7 @@ enum class ErrorKind : uint8_t {
   X(kSurfelNoCandidates, 240, kInvalidArgument, "no candidate surfel position was given")   \
   X(kSurfelCount, 241, kInvalidArgument, "a surfel count is zero or above the candidates")  \
   X(kSurfelPosition, 242, kInvalidArgument, "a candidate surfel position is not finite")    \
-  X(kSurfelOption, 243, kInvalidArgument, "a surfel sampler option is outside its range")   \
+  X(kSurfelSamplerOption, 243, kInvalidArgument, "a surfel sampler option is outside its range")   \
   X(kSurfelRadius, 244, kInvalidArgument, "a surfel radius, r_m or p_m is invalid")         \
   /* decoder: 300-399 */                                                                        \
   X(kDecoderArgument, 300, kInvalidArgument, "a decoder option, frame, view or eye is invalid") \
