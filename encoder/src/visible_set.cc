@@ -65,26 +65,58 @@ std::string point_string(const Vec3& v) {
 }
 
 struct TileScratch {
-  std::vector<std::vector<Interval>> lists = std::vector<std::vector<Interval>>(kTile * kTile);
-  std::vector<Interval> tmp;
+  std::vector<IntervalList> lists = std::vector<IntervalList>(kTile * kTile);
+  IntervalPool pool;
+  CompositeScratch composite;
   std::vector<SphereDepth> spheres;
-  // Per pixel: the farthest distance of its list when the list covers all of [0, 1], else inf.
+  // Per pixel: an upper bound of the farthest depth of its list when the list covers all of
+  // [0, 1], else inf (pixel_far); whether the list changed since; a time in the gap pixel_far
+  // found last (negative: none).
   std::vector<double> far = std::vector<double>(kTile * kTile);
+  std::vector<uint8_t> dirty = std::vector<uint8_t>(kTile * kTile);
+  std::vector<double> gap = std::vector<double>(kTile * kTile);
 };
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-double pixel_far(const std::vector<Interval>& list, std::span<const SphereDepth> spheres,
-                 double length) {
-  if (list.empty() || list.front().s0 > 0 || list.back().s1 < 1) return kInf;
-  double far = 0;
-  for (size_t i = 0; i < list.size(); ++i) {
-    if (i > 0 && list[i].s0 != list[i - 1].s1) return kInf;
-    // Depths are lines or convex (spheres): largest at an end.
-    far = std::max(
-        {far, depth_at(list[i], spheres, list[i].s0), depth_at(list[i], spheres, list[i].s1)});
-  }
+// Whether no interval of `list` covers time s.
+bool uncovered(const IntervalList& list, const IntervalPool& pool, double s) {
+  const IntervalList::Pos p = list.first_ending_after(pool, s);
+  return p == list.end() || list.at(pool, p).s0 > s;
+}
+
+// The farthest distance (along the unit ray) of a list that covers all of [0, 1], else inf.
+// `gap` remembers a time in a gap: lists only fill up, so while that time stays uncovered (a
+// binary search) the list is still incomplete and its blocks are not read again. On grass the
+// lists near the horizon keep a gap to the end (sky beyond the field) and are long (~1,000
+// intervals).
+double pixel_far(const IntervalList& list, const IntervalPool& pool, double length, double* gap) {
+  if (*gap >= 0 && uncovered(list, pool, *gap)) return kInf;
+  const double far = list.far_bound(pool, gap);
+  if (far == kInf) return kInf;
+  *gap = -1;
   return far * length;
+}
+
+// The occlusion bound of a tile: the largest pixel_far over its pixels (inf while one pixel's
+// list has a gap). Lists only ever get nearer and fill up, so a bound computed earlier stays
+// an upper bound: only pixels whose list changed since (dirty) are recomputed, and the scan stops
+// at the first pixel with a gap (rechecked in O(log k) by pixel_far's memo).
+double tile_far(TileScratch* s, int w, int h, int px0, int py0, uint32_t n) {
+  double out = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const int i = y * int{kTile} + x;
+      if (s->dirty[i]) {
+        const double sc = pixel_sc(static_cast<uint32_t>(px0 + x), n);
+        const double tc = pixel_sc(static_cast<uint32_t>(py0 + y), n);
+        s->far[i] = pixel_far(s->lists[i], s->pool, std::sqrt(1 + sc * sc + tc * tc), &s->gap[i]);
+        s->dirty[i] = 0;
+      }
+      if (s->far[i] == kInf) return kInf;
+      out = std::max(out, s->far[i]);
+    }
+  return out;
 }
 
 double segment_distance(const Vec3& p, const Vec3& v0, const Vec3& w, double ww) {
@@ -239,20 +271,20 @@ void SegmentRunner::run(const FrameGeometry& geo, const ViewSegment& segment,
           const int py1 = std::min<int>(static_cast<int>(n), py0 + kTile) - 1;
           scratch.spheres.clear();
           std::fill(scratch.far.begin(), scratch.far.end(), kInf);
-          double tile_far = kInf;
-          bool changed = false;
+          std::fill(scratch.dirty.begin(), scratch.dirty.end(), 0);
+          std::fill(scratch.gap.begin(), scratch.gap.end(), -1.0);
+          double far = kInf;
+          uint32_t changed = 0;
           uint64_t pairs = 0;
           for (uint64_t k = start[tile]; k < start[tile + 1]; ++k) {
             const uint32_t item = sorted[order[k]];
-            if (changed && (k - start[tile]) % 16 == 0) {
-              tile_far = 0;
-              for (int y = py0; y <= py1; ++y)
-                for (int x = px0; x <= px1; ++x)
-                  tile_far = std::max(tile_far, scratch.far[(y - py0) * kTile + (x - px0)]);
-              changed = false;
+            if (changed >= 16) {
+              far = tile_far(&scratch, px1 - px0 + 1, py1 - py0 + 1, px0, py0, n);
+              changed = 0;
             }
-            // Occluded in the whole tile: nearer surfaces cover every pixel over all of [0, 1].
-            if (near[item] >= tile_far) continue;
+            // Occluded in the whole tile: nearer surfaces cover every pixel over all of [0, 1]
+            // (the item is at least near[item] from every point of the segment).
+            if (near[item] >= far) continue;
             const int np = item_points(geo, item, pts);
             if (!bound.compute({pts, static_cast<size_t>(np)}, v0, v1, basis, n, prepared_.delta))
               continue;
@@ -260,49 +292,58 @@ void SegmentRunner::run(const FrameGeometry& geo, const ViewSegment& segment,
             if (triangle) setup_triangle(pts, v0, w, basis, &setup);
             const uint32_t primitive =
                 triangle ? geo.triangles[item] : geo.spheres[item - nt].primitive;
+            bool any = false;
             for (int y = std::max(py0, bound.y0()); y <= std::min(py1, bound.y1()); ++y) {
               int xa, xb;
               if (!bound.row_span(y, &xa, &xb)) continue;
               xa = std::max(xa, px0), xb = std::min(xb, px1);
               const double tc = pixel_sc(static_cast<uint32_t>(y), n);
-              std::vector<Interval>* row = &scratch.lists[(y - py0) * kTile];
+              const int row = (y - py0) * int{kTile} - px0;
               for (int x = xa; x <= xb; ++x) {
+                const int i = row + x;
+                // Occluded at this pixel (the same bound, one pixel; possibly stale, so larger).
+                if (near[item] >= scratch.far[i]) continue;
                 ++pairs;
                 const double sc = pixel_sc(static_cast<uint32_t>(x), n);
+                IntervalList& list = scratch.lists[i];
                 Interval iv[2];
+                bool hit = false;
                 if (triangle) {
                   if (!triangle_coverage(setup, sc, tc, &iv[0])) continue;
                   iv[0].primitive = primitive;
-                  if (!composite(&row[x - px0], iv[0], scratch.spheres, &scratch.tmp)) continue;
+                  hit = composite(&list, &scratch.pool, iv[0], scratch.spheres, &scratch.composite);
                 } else {
                   const Vec3 d = basis.m + basis.s * sc + basis.t * tc;
                   SphereDepth depth;
                   const int c = sphere_coverage(geo.spheres[item - nt], v0, w, d, iv, &depth);
                   if (c == 0) continue;
                   scratch.spheres.push_back(depth);
-                  for (int i = 0; i < c; ++i) {
-                    iv[i].sphere = static_cast<int32_t>(scratch.spheres.size() - 1);
-                    composite(&row[x - px0], iv[i], scratch.spheres, &scratch.tmp);
+                  for (int j = 0; j < c; ++j) {
+                    iv[j].sphere = static_cast<int32_t>(scratch.spheres.size() - 1);
+                    hit |=
+                        composite(&list, &scratch.pool, iv[j], scratch.spheres, &scratch.composite);
                   }
                 }
-                scratch.far[(y - py0) * kTile + (x - px0)] =
-                    pixel_far(row[x - px0], scratch.spheres, std::sqrt(1 + sc * sc + tc * tc));
-                changed = true;
+                if (hit) scratch.dirty[i] = 1, any = true;
               }
             }
+            changed += any;
           }
           pairs_.fetch_add(pairs, std::memory_order_relaxed);
           // Alg. 1 lines 10-13: the primitives left in the lists.
           for (int y = py0; y <= py1; ++y)
             for (int x = px0; x <= px1; ++x) {
-              std::vector<Interval>& list = scratch.lists[(y - py0) * kTile + (x - px0)];
-              for (const Interval& iv : list)
+              IntervalList& list = scratch.lists[(y - py0) * kTile + (x - px0)];
+              list.for_each(scratch.pool, [&](const Interval& iv) {
                 if (iv.s1 - iv.s0 > options_.min_interval)
                   mark(iv.primitive,
                        {0, 0, iv.sphere >= 0, segment_index, frame, static_cast<uint32_t>(face),
                         static_cast<uint32_t>(x), static_cast<uint32_t>(y), iv.s0, iv.s1});
+                return true;
+              });
               list.clear();
             }
+          scratch.pool.reset();
         }
       });
 }

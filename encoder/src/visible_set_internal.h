@@ -2,6 +2,7 @@
 //   visible_set_scene.cc      the scene flattened to world-space primitives per frame, numbering
 //   visible_set_raster.cc     cube-face bases, conservative pixel bounds, the per-pixel coverage
 //                             intervals of Eq. 2 (triangles) and Sec. 3.3 (spheres)
+//   visible_set_list.cc       a pixel's interval list, stored in blocks
 //   visible_set_intervals.cc  depth compositing of coverage intervals into a pixel's list
 //   visible_set.cc            the driver: checks, frames, segments, tiles, threads, the union
 //   visible_set_from_points.cc  the from-point z-buffer baseline
@@ -120,14 +121,102 @@ bool triangle_coverage(const TriangleSetup& t, double sc, double tc, Interval* o
 int sphere_coverage(const WorldSphere& sphere, const Vec3& v0, const Vec3& w, const Vec3& d,
                     Interval out[2], SphereDepth* depth);
 
+// ---- a pixel's interval list ----
+
+// Intervals per block of an IntervalList.
+inline constexpr uint32_t kListBlock = 32;
+
+// The blocks of the interval lists of one tile, handed out one at a time and taken back all at
+// once (reset) when the tile is done. Block ids stay valid across allocations; pointers from
+// block() do not.
+class IntervalPool {
+ public:
+  uint32_t allocate();
+  void release(uint32_t block);
+  // Every block free again (the lists using them must be cleared).
+  void reset();
+  Interval* block(uint32_t b) { return &storage_[size_t{b} * kListBlock]; }
+  const Interval* block(uint32_t b) const { return &storage_[size_t{b} * kListBlock]; }
+
+ private:
+  std::vector<Interval> storage_;
+  std::vector<uint32_t> free_;
+  uint32_t used_ = 0;
+};
+
+// A pixel's sorted, disjoint intervals, in blocks of at most kListBlock held in an IntervalPool
+// (visible_set_list.cc says why). A position is (block, index); end() is (blocks, 0). Each block
+// also keeps the largest depth at its intervals' ends and whether they leave a gap between them,
+// so that far_bound() costs one step per block, not per interval.
+class IntervalList {
+ public:
+  struct Pos {
+    uint32_t block = 0, index = 0;
+    friend bool operator==(const Pos&, const Pos&) = default;
+  };
+  bool empty() const { return size_ == 0; }
+  size_t size() const { return size_; }
+  // Forgets the intervals (the pool's blocks are taken back by IntervalPool::reset).
+  void clear();
+  Pos begin() const { return {}; }
+  Pos end() const { return {static_cast<uint32_t>(blocks_.size()), 0}; }
+  void next(Pos* p) const {
+    if (++p->index == blocks_[p->block].count) ++p->block, p->index = 0;
+  }
+  const Interval& at(const IntervalPool& pool, Pos p) const {
+    return pool.block(blocks_[p.block].id)[p.index];
+  }
+  // The first interval whose s1 is above s (end() when none).
+  Pos first_ending_after(const IntervalPool& pool, double s) const;
+  // Replaces the intervals [first, last) by `with` (sorted, disjoint, fitting between the
+  // neighbours; `spheres` their sphere depths); `tmp` is a reused buffer. Positions are invalid
+  // afterwards.
+  void replace(IntervalPool* pool, Pos first, Pos last, std::span<const Interval> with,
+               std::span<const SphereDepth> spheres, std::vector<Interval>* tmp);
+  // The largest depth of the list (largest of its intervals' depths at their ends: depths are
+  // lines or convex) when its intervals cover all of [0, 1] without a gap; else +inf, with a time
+  // inside a gap in *gap.
+  double far_bound(const IntervalPool& pool, double* gap) const;
+  // Calls f(interval) in order while it returns true; false when one returned false.
+  template <typename F>
+  bool for_each(const IntervalPool& pool, F&& f) const {
+    for (const Block& b : blocks_) {
+      const Interval* e = pool.block(b.id);
+      for (uint32_t i = 0; i < b.count; ++i)
+        if (!f(e[i])) return false;
+    }
+    return true;
+  }
+
+ private:
+  struct Block {
+    double end = 0;   // s1 of its last interval
+    double far = 0;   // largest depth at its intervals' ends
+    uint32_t id = 0;  // in the pool
+    uint16_t count = 0;
+    bool gap = false;  // some interval does not start where the previous one ends
+  };
+  std::vector<Block> blocks_;
+  size_t size_ = 0;
+};
+
 // ---- depth compositing ----
 
-double depth_at(const Interval& i, std::span<const SphereDepth> spheres, double s);
-// Depth-composites `in` into the sorted, disjoint list `list` (scratch: a reused buffer): where
-// `in` is nearer it replaces what was there, where nothing was it is added, ties keep the list.
+// Reused buffers of composite().
+struct CompositeScratch {
+  std::vector<Interval> out, tmp;
+};
+
+double sphere_depth_at(const Interval& i, std::span<const SphereDepth> spheres, double s);
+// The depth of interval `i` at s (a line inline: it is in every inner loop).
+inline double depth_at(const Interval& i, std::span<const SphereDepth> spheres, double s) {
+  return i.sphere < 0 ? i.p + i.q * s : sphere_depth_at(i, spheres, s);
+}
+// Depth-composites `in` into the sorted, disjoint list `list` (its blocks in `pool`): where `in`
+// is nearer it replaces what was there, where nothing was it is added, ties keep the list.
 // Returns false when the list did not change (`in` hidden wherever it covers).
-bool composite(std::vector<Interval>* list, const Interval& in,
-               std::span<const SphereDepth> spheres, std::vector<Interval>* scratch);
+bool composite(IntervalList* list, IntervalPool* pool, const Interval& in,
+               std::span<const SphereDepth> spheres, CompositeScratch* scratch);
 
 // ---- the driver's shared checks ----
 

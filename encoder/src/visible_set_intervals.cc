@@ -63,41 +63,42 @@ Interval piece(const Interval& i, double s0, double s1) {
 
 }  // namespace
 
-double depth_at(const Interval& i, std::span<const SphereDepth> spheres, double s) {
-  if (i.sphere < 0) return i.p + i.q * s;
+double sphere_depth_at(const Interval& i, std::span<const SphereDepth> spheres, double s) {
   const SphereDepth& d = spheres[static_cast<size_t>(i.sphere)];
   return d.k0 + d.k1 * s - std::sqrt(std::max(0.0, d.c0 + s * (d.c1 + s * d.c2)));
 }
 
-bool composite(std::vector<Interval>* list, const Interval& in,
-               std::span<const SphereDepth> spheres, std::vector<Interval>* scratch) {
+bool composite(IntervalList* list, IntervalPool* pool, const Interval& in,
+               std::span<const SphereDepth> spheres, CompositeScratch* scratch) {
   if (list->empty()) {
-    list->push_back(in);
+    list->replace(pool, list->begin(), list->end(), {&in, 1}, spheres, &scratch->tmp);
     return true;
   }
   // The first interval ending after in.s0 (the list is sorted and disjoint).
-  const auto first = std::upper_bound(list->begin(), list->end(), in.s0,
-                                      [](double s, const Interval& e) { return s < e.s1; });
+  const IntervalList::Pos first = list->first_ending_after(*pool, in.s0);
+  const IntervalList::Pos end = list->end();
   if (in.sphere < 0) {
     // Most insertions in a dense scene are hidden: `in` is no nearer than the list at both ends
     // of every overlap (lines: then nowhere in between) and finds no gap. Nothing changes.
     double cursor = in.s0;
     bool hidden = true;
-    for (auto it = first; it != list->end() && it->s0 < in.s1 && hidden; ++it) {
-      if (it->s0 > cursor || it->sphere >= 0) {
+    for (IntervalList::Pos p = first; p != end; list->next(&p)) {
+      const Interval& e = list->at(*pool, p);
+      if (!(e.s0 < in.s1)) break;
+      if (e.s0 > cursor || e.sphere >= 0) {
         hidden = false;
         break;
       }
-      const double c = std::max(it->s0, in.s0), f = std::min(it->s1, in.s1);
-      hidden = in.p + in.q * c >= it->p + it->q * c && in.p + in.q * f >= it->p + it->q * f;
+      const double c = std::max(e.s0, in.s0), f = std::min(e.s1, in.s1);
+      hidden = in.p + in.q * c >= e.p + e.q * c && in.p + in.q * f >= e.p + e.q * f;
       cursor = f;
+      if (!hidden) break;
     }
     if (hidden && cursor >= in.s1) return false;
   }
-  // The overlapped range [first, last) is rebuilt in `scratch` and spliced back in place.
-  const auto last = std::lower_bound(first, list->end(), in.s1,
-                                     [](const Interval& e, double s) { return e.s0 < s; });
-  std::vector<Interval>& out = *scratch;
+  // The overlapped range [first, last) (intervals starting before in.s1) is rebuilt in `out` and
+  // replaces it.
+  std::vector<Interval>& out = scratch->out;
   out.clear();
   auto push = [&](const Interval& p) {
     if (!(p.s1 > p.s0)) return;
@@ -112,8 +113,10 @@ bool composite(std::vector<Interval>* list, const Interval& in,
     out.push_back(p);
   };
   double cursor = in.s0;  // the part of `in` before it has been placed
-  for (auto it = first; it != last; ++it) {
-    const Interval& e = *it;
+  IntervalList::Pos last = first;
+  for (; last != end; list->next(&last)) {
+    const Interval& e = list->at(*pool, last);
+    if (!(e.s0 < in.s1)) break;
     const double c = std::max(e.s0, in.s0), f = std::min(e.s1, in.s1);
     if (e.s0 < c) push(piece(e, e.s0, c));
     if (cursor < c) push(piece(in, cursor, c));
@@ -131,16 +134,7 @@ bool composite(std::vector<Interval>* list, const Interval& in,
     if (e.s1 > f) push(piece(e, f, e.s1));
   }
   if (cursor < in.s1) push(piece(in, cursor, in.s1));
-  const size_t at = static_cast<size_t>(first - list->begin());
-  const size_t old_count = static_cast<size_t>(last - first);
-  if (out.size() > old_count) {
-    list->insert(list->begin() + static_cast<std::ptrdiff_t>(at + old_count),
-                 out.size() - old_count, Interval{});
-  } else if (out.size() < old_count) {
-    list->erase(list->begin() + static_cast<std::ptrdiff_t>(at + out.size()),
-                list->begin() + static_cast<std::ptrdiff_t>(at + old_count));
-  }
-  std::copy(out.begin(), out.end(), list->begin() + static_cast<std::ptrdiff_t>(at));
+  list->replace(pool, first, last, out, spheres, &scratch->tmp);
   return true;
 }
 

@@ -40,10 +40,15 @@ void build_frame(const capture::SceneFile& scene, const PrimitiveTable& table, u
   out->vertices.clear();
   out->triangles.clear();
   out->spheres.clear();
+  // Sized once: a 5 M triangle field grown by push_back spent as long in reallocation and page
+  // faults as in the transforms, every frame.
+  out->vertices.reserve(3 * (table.count()));
+  out->triangles.reserve(table.count());
   const double time = frame / scene.fps;
   // Vertex positions per mesh at this time, computed once for all its instances.
   std::vector<std::vector<float>> positions(scene.meshes.size());
   std::vector<uint8_t> done(scene.meshes.size(), 0);
+  std::vector<Vec3> world;
   bool any = false;
   for (size_t o = 0; o < scene.objects.size(); ++o) {
     const capture::SceneObject& object = scene.objects[o];
@@ -55,7 +60,7 @@ void build_frame(const capture::SceneFile& scene, const PrimitiveTable& table, u
     const std::vector<float>& p = positions[object.mesh];
     const capture::SceneTransform& m = capture::transform_at(object, frame);
     // Each vertex transformed once, so corners shared by triangles get the same bits.
-    std::vector<Vec3> world(mesh.vertex_count());
+    world.resize(mesh.vertex_count());
     for (size_t v = 0; v < world.size(); ++v)
       world[v] = apply(m, p[3 * v], p[3 * v + 1], p[3 * v + 2]);
     const uint64_t base = table.base[o];
@@ -63,8 +68,11 @@ void build_frame(const capture::SceneFile& scene, const PrimitiveTable& table, u
       for (int k = 0; k < 3; ++k) {
         const Vec3& c = world[mesh.indices[3 * tri + k]];
         out->vertices.push_back(c);
-        out->bounds = any ? box_union(out->bounds, c) : Box3{c, c};
+        if (!any) out->bounds = Box3{c, c};
         any = true;
+        Box3& b = out->bounds;
+        b.min = {std::min(b.min.x, c.x), std::min(b.min.y, c.y), std::min(b.min.z, c.z)};
+        b.max = {std::max(b.max.x, c.x), std::max(b.max.y, c.y), std::max(b.max.z, c.z)};
       }
       out->triangles.push_back(static_cast<uint32_t>(base + tri));
     }

@@ -13,6 +13,11 @@
 //      100 % of the from-segment set, doubling the points until --max-ratio x the from-segment
 //      time).
 // Each timing is the median of --repeats runs. docs/VISIBILITY.md keeps a committed run.
+//
+// With --scene-file DIR it instead runs from-segment only on an exported scene file
+// (calf-capture --export-scene), from the perimeter of the scene's view region at the middle of its
+// height, for each count of --frames (time against the number of distinct frames, i.e. of vertex
+// states sampled), optionally on one --segment only: the blades scene's figures.
 #include <fmt/core.h>
 #include <CLI/CLI.hpp>
 
@@ -148,6 +153,57 @@ double perimeter(const std::vector<ViewSegment>& segs) {
   return p;
 }
 
+// --scene-file: one row per frame count.
+int run_scene_file(const std::string& dir, const std::vector<int>& frame_counts, int segment,
+                   int segments_per_edge, int repeats, const VisibleSetOptions& base) {
+  auto scene = calf::capture::read_scene_file(dir);
+  if (!scene.ok()) {
+    fmt::print("error: {}\n", scene.status().to_string());
+    return 1;
+  }
+  const Box3 region{
+      {scene->view_region_min[0], scene->view_region_min[1], scene->view_region_min[2]},
+      {scene->view_region_max[0], scene->view_region_max[1], scene->view_region_max[2]}};
+  std::vector<ViewSegment> segs = perimeter_segments(region, 0.5 * (region.min.y + region.max.y),
+                                                     static_cast<uint32_t>(segments_per_edge));
+  if (segment >= 0) {
+    if (static_cast<size_t>(segment) >= segs.size()) {
+      fmt::print("error: --segment {} of {}\n", segment, segs.size());
+      return 1;
+    }
+    segs = {segs[static_cast<size_t>(segment)]};
+  }
+  const double mtri = scene->triangle_count() / 1e6, metres = perimeter(segs);
+  fmt::print(
+      "# visible-set bench: scene '{}' ({}), {:.3f} Mtri, {} frames, {} segment(s), {:.2f} m, face "
+      "{}\n\n",
+      scene->name, dir, mtri, scene->frame_count, segs.size(), metres, base.face_size);
+  fmt::print(
+      "| frames | solved | wall s | CPU s | CPU s / frame | CPU s / Mtri / m | (tri, pixel) pairs "
+      "| "
+      "Mpairs / CPU s | visible tri | visible % |\n|---|---|---|---|---|---|---|---|---|---|\n");
+  for (int frames : frame_counts) {
+    VisibleSetOptions o = base;
+    o.frames = static_cast<uint32_t>(std::max(1, frames));
+    VisibleSet v;
+    const Timing t = median_seconds(repeats, [&] {
+      auto r = compute_visible_set(*scene, segs, o);
+      if (!r.ok()) {
+        fmt::print("error: {}\n", r.status().to_string());
+        std::exit(1);
+      }
+      v = std::move(*r);
+    });
+    const uint64_t solved = std::max<uint64_t>(1, v.stats.frames_solved);
+    fmt::print("| {} | {} | {:.2f} | {:.2f} | {:.2f} | {:.4f} | {} | {:.2f} | {} | {:.3f} |\n",
+               frames, v.stats.frames_solved, t.wall, t.cpu, t.cpu / solved,
+               t.cpu / solved / mtri / metres, v.stats.triangle_pixel_pairs,
+               v.stats.triangle_pixel_pairs / t.cpu / 1e6, v.stats.visible_triangles,
+               100.0 * v.stats.visible_triangles / std::max<uint64_t>(1, v.stats.scene_triangles));
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -171,8 +227,21 @@ int main(int argc, char** argv) {
   app.add_option("--motion", motions,
                  "table 2's motion models: per-frame and/or coupled (default per-frame)")
       ->check(CLI::IsMember({"per-frame", "coupled"}));
+  std::string scene_dir;
+  std::vector<int> frame_counts = {1};
+  int segment = -1;
+  app.add_option("--scene-file", scene_dir,
+                 "run from-segment only on this exported scene file (its view region)");
+  app.add_option("--frames", frame_counts, "with --scene-file: frame counts to time (default 1)");
+  app.add_option("--segment", segment, "with --scene-file: only this perimeter segment");
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // rows appear as they are measured
+  if (!scene_dir.empty()) {
+    VisibleSetOptions o;
+    o.face_size = face;
+    o.threads = threads;
+    return run_scene_file(scene_dir, frame_counts, segment, segments_per_edge, repeats, o);
+  }
 
   const City city = make_city(blocks, subdiv, 1);
   const std::vector<ViewSegment> segs =

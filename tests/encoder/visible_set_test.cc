@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <set>
 #include <utility>
@@ -23,6 +24,7 @@
 
 #include "calf/encoder/sphere_mesh.h"
 #include "calf/format/cube.h"
+#include "visible_set_internal.h"  // encoder/src: the block interval list, tested directly below
 
 namespace calf::encoder {
 namespace {
@@ -548,6 +550,76 @@ TEST(VisibleSetTest, BadInputIsOneLineWithItsId) {
   EXPECT_EQ(id(compute_visible_set_at_points(scene, {}, o)), ErrorId::kVisibleSetNoSegment);
   // Every message is one line.
   EXPECT_EQ(r.status().to_string().find('\n'), std::string::npos);
+}
+
+// The per-pixel interval list (blocks of kListBlock intervals, split and rewritten in place) and
+// the compositor on it, against a brute-force lower envelope: thousands of random depth lines
+// make lists far longer than a block, as on grass. At random times the list must hold the
+// nearest line covering that time (none where no line covers it), in sorted disjoint order, and
+// its depth bound must be +inf with an uncovered time while it has a gap, then the largest depth
+// at its intervals' ends once a far background line covers [0, 1].
+TEST(VisibleSetTest, IntervalListMatchesBruteForceLowerEnvelope) {
+  using visibility::Interval;
+  std::mt19937_64 rng(19);
+  std::uniform_real_distribution<double> u(0, 1);
+  visibility::IntervalPool pool;
+  visibility::IntervalList list;
+  visibility::CompositeScratch scratch;
+  std::vector<Interval> inserted;
+  auto check = [&](bool complete) {
+    std::vector<Interval> flat;
+    list.for_each(pool, [&](const Interval& i) {
+      flat.push_back(i);
+      return true;
+    });
+    ASSERT_EQ(flat.size(), list.size());
+    for (size_t i = 0; i < flat.size(); ++i) {
+      ASSERT_LT(flat[i].s0, flat[i].s1);
+      if (i > 0) {
+        ASSERT_LE(flat[i - 1].s1, flat[i].s0);
+      }
+    }
+    for (int k = 0; k < 400; ++k) {
+      const double s = u(rng);
+      double best = std::numeric_limits<double>::infinity();
+      int64_t want = -1;
+      for (const Interval& i : inserted)
+        if (i.s0 < s && s < i.s1 && i.p + i.q * s < best) best = i.p + i.q * s, want = i.primitive;
+      int64_t got = -1;
+      for (const Interval& i : flat)
+        if (i.s0 <= s && s < i.s1) got = i.primitive;
+      ASSERT_EQ(got, want) << "at s = " << s << " after " << inserted.size() << " intervals";
+    }
+    double gap = -1;
+    const double far = list.far_bound(pool, &gap);
+    if (!complete) {
+      ASSERT_EQ(far, std::numeric_limits<double>::infinity());
+      ASSERT_GE(gap, 0);
+      ASSERT_LE(gap, 1);
+      for (const Interval& i : flat) ASSERT_FALSE(i.s0 <= gap && gap < i.s1) << "gap " << gap;
+    } else {
+      double want_far = 0;
+      for (const Interval& i : flat)
+        want_far = std::max({want_far, i.p + i.q * i.s0, i.p + i.q * i.s1});
+      ASSERT_EQ(far, want_far);
+    }
+  };
+  auto insert = [&](double s0, double s1, double p, double q) {
+    Interval in{s0, s1, p, q, static_cast<uint32_t>(inserted.size()), -1};
+    inserted.push_back(in);
+    visibility::composite(&list, &pool, in, {}, &scratch);
+  };
+  for (int n = 0; n < 3000; ++n) {
+    const double s0 = u(rng), len = 0.002 + 0.03 * u(rng) * u(rng);
+    insert(s0, std::min(1.0, s0 + len), 1 + 50 * u(rng), 4 * u(rng) - 2);
+    if (n % 500 == 499) check(false);
+  }
+  EXPECT_GT(list.size(), 4 * visibility::kListBlock);  // many blocks, split many times
+  insert(0, 1, 200, 0);                                // a far background: no gap left
+  check(true);
+  // A near line over the middle replaces hundreds of intervals at once (blocks merged away).
+  insert(0.25, 0.75, 0.5, 0);
+  check(true);
 }
 
 }  // namespace
