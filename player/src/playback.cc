@@ -64,7 +64,8 @@ Expected<std::unique_ptr<Playback>> Playback::open(const std::string& clip_path,
     }
   }
   if (impl->owned.empty()) {
-    return Status(ErrorId::kPlaybackClip, clip_path + ": no lightfield, mesh or surfels track to play");
+    return Status(ErrorId::kPlaybackClip,
+                  clip_path + ": no lightfield, mesh or surfels track to play");
   }
   impl->volume = impl->owned.front()->view_volume();
   for (const auto& r : impl->owned) {

@@ -306,7 +306,8 @@ TEST(SurfelSamplerTest, Errors) {
   EXPECT_EQ(option([](auto& o) { o.extend_below = 1.0; }), ErrorId::kSurfelSamplerOption);
   EXPECT_EQ(option([](auto& o) { o.extend_below = -0.5; }), ErrorId::kSurfelSamplerOption);
   EXPECT_EQ(option([](auto& o) { o.p_m = 0; }), ErrorId::kSurfelSamplerOption);
-  EXPECT_EQ(option([](auto& o) { o.threads = kSurfelMaxThreads + 1; }), ErrorId::kSurfelSamplerOption);
+  EXPECT_EQ(option([](auto& o) { o.threads = kSurfelMaxThreads + 1; }),
+            ErrorId::kSurfelSamplerOption);
   EXPECT_EQ(option([](auto& o) { o.method = static_cast<SurfelOrderMethod>(7); }),
             ErrorId::kSurfelSamplerOption);
   // Edges of the ranges are accepted.
@@ -319,7 +320,8 @@ TEST(SurfelSamplerTest, Errors) {
   EXPECT_EQ(prefix_spacing(c, ord, 4).status().id(), ErrorId::kSurfelCount);
   const std::vector<uint32_t> outside = {0, 100};
   EXPECT_EQ(prefix_spacing(c, outside, 2).status().id(), ErrorId::kSurfelCount);
-  EXPECT_EQ(prefix_spacing(c, ord, 2, kSurfelMaxThreads + 1).status().id(), ErrorId::kSurfelSamplerOption);
+  EXPECT_EQ(prefix_spacing(c, ord, 2, kSurfelMaxThreads + 1).status().id(),
+            ErrorId::kSurfelSamplerOption);
 }
 
 }  // namespace

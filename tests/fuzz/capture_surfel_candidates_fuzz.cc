@@ -10,8 +10,8 @@
 #include <fstream>
 #include <span>
 
-#include "calf/capture/surfel_candidates.h"
 #include "../scratch_dir.h"
+#include "calf/capture/surfel_candidates.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::span<const uint8_t> bytes(data, size);
