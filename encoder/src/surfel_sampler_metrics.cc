@@ -48,8 +48,9 @@ Expected<PrefixSpacing> prefix_spacing(std::span<const Vec3> candidates,
                                              " is not in 1.." + std::to_string(order.size()) +
                                              " (the order's length)");
   if (threads > kSurfelMaxThreads)
-    return Status(ErrorId::kSurfelSamplerOption, "prefix_spacing: threads " + std::to_string(threads) +
-                                              " is above " + std::to_string(kSurfelMaxThreads));
+    return Status(ErrorId::kSurfelSamplerOption, "prefix_spacing: threads " +
+                                                     std::to_string(threads) + " is above " +
+                                                     std::to_string(kSurfelMaxThreads));
   std::vector<surfel_internal::P3> points(prefix);
   for (uint32_t i = 0; i < prefix; ++i) {
     if (order[i] >= candidates.size())

@@ -21,8 +21,8 @@
 #include "calf/player/gl_context.h"
 #include "calf/player/lightfield_representation.h"
 #include "calf/player/mesh_representation.h"
-#include "calf/player/surfel_representation.h"
 #include "calf/player/representation.h"
+#include "calf/player/surfel_representation.h"
 
 namespace calf::player {
 
