@@ -18,6 +18,7 @@
 #include "calf/player/image_compare.h"
 #include "calf/player/mesh_representation.h"
 #include "calf/player/playback.h"
+#include "calf/player/surfel_representation.h"
 #include "calf_play/play_window.h"
 #include "command_line.h"
 
@@ -43,6 +44,7 @@ struct HeadlessArgs {
   std::string compare_clip;
   uint32_t sheet_rows = 8;
   bool heat_maps = true;
+  double surfel_target_ms = 0;  // --surfel-target-ms: report render times to the controller
 };
 
 double median(std::vector<double> v) {
@@ -72,8 +74,17 @@ uint64_t mesh_triangles(const Playback& play) {
   uint64_t n = 0;
   for (const Representation* r : play.representations()) {
     if (const auto* m = dynamic_cast<const MeshRepresentation*>(r)) n += m->triangles_drawn();
+    if (const auto* s = dynamic_cast<const SurfelRepresentation*>(r)) n += s->triangles_drawn();
   }
   return n;
+}
+
+// The first surfels track's representation, or nullptr.
+SurfelRepresentation* surfels_of(const Playback& play) {
+  for (Representation* r : play.representations()) {
+    if (auto* s = dynamic_cast<SurfelRepresentation*>(r)) return s;
+  }
+  return nullptr;
 }
 
 // Plays `path` pose by pose; poses sharing a time (a stereo pair) are prepared together. With
@@ -162,6 +173,15 @@ int run_headless(Playback& play, Playback* full, const HeadlessArgs& a) {
       } else {
         std::printf("pose %zu frame %u: %llu triangles, render %.1f ms", k, frame,
                     static_cast<unsigned long long>(mesh_triangles(play)), play.last_render_ms());
+      }
+      if (SurfelRepresentation* sr = surfels_of(play)) {
+        std::printf(", %llu surfels at %.2f px",
+                    static_cast<unsigned long long>(sr->surfels_drawn()), sr->point_size());
+        // Headless has no display: the render time stands for the frame time the point-size
+        // controller follows (only when it has a target; not the first, which compiles shaders).
+        if (a.surfel_target_ms > 0 && k > 0) {
+          if (Status s = play.report_frame_time(play.last_render_ms()); !s.ok()) return fail(s);
+        }
       }
       if (full != nullptr) {
         if (Status s = full->render(cam, &full_image); !s.ok()) return fail(s);
@@ -314,6 +334,20 @@ int main(int argc, char** argv) {
                  "poses on the contact sheet, spread evenly along "
                  "the path, first and last included (default 8)")
       ->check(CLI::Range(1, 256));
+  SurfelOptions& so = play_options.surfels;
+  app.add_option("--surfel-point-size", so.point_size,
+                 "surfels: disc diameter in pixels the prefixes are chosen for (the start value "
+                 "with --surfel-target-ms), 1..64 (default 2)")
+      ->check(CLI::Range(1.0, 64.0));
+  app.add_option("--surfel-target-ms", so.target_frame_ms,
+                 "surfels: frame-time target in ms; the point size follows it between 1 and 16 "
+                 "px (headless: each pose's render time counts as its frame time) (default 0: "
+                 "fixed point size)")
+      ->check(CLI::Range(0.0, 10000.0));
+  app.add_option("--surfel-blend", so.blend_share,
+                 "surfels: an object whose prefix needs more than this share of its surfels is "
+                 "drawn from the mesh as well (0..1; 1: no blend zone) (default 0.5)")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--renderer", renderer,
                  "gl (OpenGL 4.5 ray-march, the product) or cpu (the scalar "
                  "reference; headless only) (default gl)")
@@ -383,6 +417,7 @@ int main(int argc, char** argv) {
       if (!f.ok()) return fail(f.status());
       full = std::move(*f);
     }
+    h.surfel_target_ms = so.target_frame_ms;
     return run_headless(**play, full.get(), h);
   }
   if (!h.compare_clip.empty()) {
