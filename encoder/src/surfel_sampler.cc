@@ -121,21 +121,4 @@ Expected<SurfelOrder> order_surfels(std::span<const Vec3> candidates, uint32_t n
   return result;
 }
 
-Expected<uint32_t> prefix_for_radius(float r_m, uint32_t p_m, double r, uint32_t n) {
-  if (!(r > 0.0) || !std::isfinite(r))
-    return Status(ErrorId::kSurfelRadius,
-                  "surfel prefix: radius " + std::to_string(r) + " is not a finite value > 0");
-  if (!(r_m >= 0.0f) || !std::isfinite(r_m))
-    return Status(ErrorId::kSurfelRadius,
-                  "surfel prefix: r_m " + std::to_string(r_m) + " is not a finite value >= 0");
-  if (p_m == 0) return Status(ErrorId::kSurfelRadius, "surfel prefix: p_m is 0");
-  if (n == 0) return Status(ErrorId::kSurfelRadius, "surfel prefix: the surfel count n is 0");
-  const double ratio = static_cast<double>(r_m) / r;
-  const double p = std::ceil(static_cast<double>(p_m) * ratio * ratio);
-  // Compared in double before converting: p may be far beyond uint32 (or +inf for a tiny r).
-  if (!(p >= 1.0)) return 1u;
-  if (p >= static_cast<double>(n)) return n;
-  return static_cast<uint32_t>(p);
-}
-
 }  // namespace calf

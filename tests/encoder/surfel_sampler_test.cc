@@ -204,12 +204,11 @@ TEST(SurfelSamplerTest, RmAndPrefixSpacingOnHandComputedValues) {
   const SurfelOrder single = order(c, 1, with(SurfelOrderMethod::kProgressive));
   EXPECT_EQ(single.p_m, 1u);
   EXPECT_EQ(single.r_m, 0.0f);
-  // Coincident candidates: any order, r_m = 0, and then every radius gives one surfel.
+  // Coincident candidates: any order, r_m = 0.
   const std::vector<Vec3> same(50, Vec3{1, 2, 3});
   const SurfelOrder dup = order(same, 50, with(SurfelOrderMethod::kProgressive));
   EXPECT_EQ(dup.order.size(), 50u);
   EXPECT_EQ(dup.r_m, 0.0f);
-  EXPECT_EQ(*prefix_for_radius(dup.r_m, dup.p_m, 0.01, 50), 1u);
 }
 
 // prefix_spacing (a hashed grid) against brute force, on points clustered at three scales (a
@@ -236,33 +235,6 @@ TEST(SurfelSamplerTest, PrefixSpacingMatchesBruteForce) {
     EXPECT_NEAR(s->r_median, nn[(prefix - 1) / 2], 1e-6 * nn[(prefix - 1) / 2]) << prefix;
     EXPECT_NEAR(s->r_max, nn.back(), 1e-6 * nn.back()) << prefix;
   }
-}
-
-// p(r) = p_m (r_m / r)^2, rounded up, clamped to [1, n].
-TEST(SurfelSamplerTest, PrefixForRadius) {
-  auto p = [](float r_m, uint32_t p_m, double r, uint32_t n) {
-    auto v = prefix_for_radius(r_m, p_m, r, n);
-    EXPECT_TRUE(v.ok()) << v.status().to_string();
-    return v.ok() ? *v : 0u;
-  };
-  EXPECT_EQ(p(0.5f, 1000, 0.25, 100000), 4000u);  // half the radius: 4x the surfels
-  EXPECT_EQ(p(0.5f, 1000, 1.0, 100000), 250u);    // twice: a quarter
-  EXPECT_EQ(p(0.5f, 1000, 0.5, 100000), 1000u);   // r = r_m: p_m
-  EXPECT_EQ(p(0.5f, 1000, 1.5, 100000), 112u);    // 1000 / 9 = 111.1 -> 112
-  EXPECT_EQ(p(0.5f, 1000, 0.25, 3000), 3000u);    // clamped to n
-  EXPECT_EQ(p(0.5f, 1000, 1e-30, 3000), 3000u);   // far beyond uint32: still n
-  EXPECT_EQ(p(0.5f, 1000, 1000.0, 3000), 1u);     // 0.00025 -> at least one surfel
-  EXPECT_EQ(p(0.0f, 1000, 0.1, 3000), 1u);        // r_m = 0: one surfel
-  EXPECT_EQ(p(0.5f, 1, 0.5, 10), 1u);
-  for (double bad : {0.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
-    auto v = prefix_for_radius(0.5f, 1000, bad, 10);
-    ASSERT_FALSE(v.ok()) << bad;
-    EXPECT_EQ(v.status().id(), ErrorId::kSurfelRadius);
-  }
-  EXPECT_EQ(prefix_for_radius(-1.0f, 1000, 1.0, 10).status().id(), ErrorId::kSurfelRadius);
-  EXPECT_EQ(prefix_for_radius(std::nanf(""), 1000, 1.0, 10).status().id(), ErrorId::kSurfelRadius);
-  EXPECT_EQ(prefix_for_radius(0.5f, 0, 1.0, 10).status().id(), ErrorId::kSurfelRadius);
-  EXPECT_EQ(prefix_for_radius(0.5f, 1000, 1.0, 0).status().id(), ErrorId::kSurfelRadius);
 }
 
 ErrorId error_of(std::span<const Vec3> c, uint32_t n, const SurfelSamplerOptions& o) {

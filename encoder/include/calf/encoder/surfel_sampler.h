@@ -80,7 +80,8 @@
 //
 // Prefix from a radius (paper Sec. 4.1). r_m is r_median of the first p_m surfels (p_m =
 // min(options.p_m, n)); a surfel disc of radius r covers about 4 surfels of half that radius on
-// a surface, which gives the prefix p(r) = p_m (r_m / r)^2 (prefix_for_radius).
+// a surface, which gives the prefix p(r) = p_m (r_m / r)^2 (surfels::prefix_for_radius,
+// calf/format/surfels_layout.h).
 #pragma once
 
 #include <cstdint>
@@ -170,11 +171,5 @@ struct PrefixSpacing {
 Expected<PrefixSpacing> prefix_spacing(std::span<const Vec3> candidates,
                                        std::span<const uint32_t> order, uint32_t prefix,
                                        uint32_t threads = 0);
-
-// The prefix length for surfel radius r (paper Sec. 4.1): ceil(p_m (r_m / r)^2), computed in
-// double and clamped to [1, n] (so a radius larger than the object's gives 1 surfel, a tiny one
-// all n; r_m = 0 gives 1). Errors (CALF-E244): r <= 0 or not finite, r_m < 0 or not finite,
-// p_m = 0, n = 0. Commands turn a target radius <= 0 into this one-line error.
-Expected<uint32_t> prefix_for_radius(float r_m, uint32_t p_m, double r, uint32_t n);
 
 }  // namespace calf

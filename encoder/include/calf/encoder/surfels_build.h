@@ -38,7 +38,7 @@ struct SurfelBuildStats {
 
 // The surfels track input for `scene` from `candidates` (which must match it: CALF-E189 from
 // check_surfel_candidates_match otherwise). Errors: the reader's (E180 - E189), the sampler's
-// (E240 - E244), kEncoderOption for max_surfels = 0.
+// (E240 - E243), kEncoderOption for max_surfels = 0.
 Expected<SurfelsTrackInput> build_surfels(const capture::SceneFile& scene,
                                           const capture::SurfelCandidateReader& candidates,
                                           const SurfelBuildOptions& options,
