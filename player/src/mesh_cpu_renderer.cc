@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "calf/player/mesh_renderer.h"
+#include "object_transform.h"
 
 namespace calf::player {
 namespace {
@@ -175,20 +176,11 @@ Status render_mesh_cpu(const MeshDrawList& list, const Camera& camera,
   for (const MeshDrawObject& object : list.objects) {
     if (!object.visible) continue;
     const MeshDrawPrototype& proto = list.prototypes[object.prototype];
-    const auto& m = object.transform;
-    double r[3][4];
-    for (int row = 0; row < 3; ++row) {
-      for (int col = 0; col < 4; ++col) r[row][col] = m[4 * row + col];
-    }
+    const internal::ObjectTransform t(object.transform);
+    const auto& r = t.r;
     // The eye-relative translation, and the normal matrix (inverse transpose = cofactors / det).
-    const Vec3 offset = Vec3{r[0][3], r[1][3], r[2][3]} - camera.position;
-    double cof[3][3];
-    for (int a = 0; a < 3; ++a) {
-      for (int b = 0; b < 3; ++b) {
-        const int a1 = (a + 1) % 3, a2 = (a + 2) % 3, b1 = (b + 1) % 3, b2 = (b + 2) % 3;
-        cof[a][b] = r[a1][b1] * r[a2][b2] - r[a1][b2] * r[a2][b1];
-      }
-    }
+    const Vec3 offset = t.translation() - camera.position;
+    const auto& cof = t.cof;
     const auto world = [&](uint32_t v) {
       const float* p = &proto.positions[3 * size_t{v}];
       return Vec3{r[0][0] * p[0] + r[0][1] * p[1] + r[0][2] * p[2],

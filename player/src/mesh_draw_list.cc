@@ -4,6 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include "object_transform.h"
+
 namespace calf::player {
 namespace {
 
@@ -77,11 +79,8 @@ Status check_object(const MeshDrawObject& o, size_t index, const MeshDrawList& l
   for (float x : o.transform) {
     if (!std::isfinite(x)) return list_error(name + ": the transform is not finite");
   }
-  const auto& m = o.transform;
   // The 3 x 3 part's determinant, in double: a singular transform has no normal matrix.
-  const double det = double{m[0]} * (double{m[5]} * m[10] - double{m[6]} * m[9]) -
-                     double{m[1]} * (double{m[4]} * m[10] - double{m[6]} * m[8]) +
-                     double{m[2]} * (double{m[4]} * m[9] - double{m[5]} * m[8]);
+  const double det = internal::ObjectTransform(o.transform).det;
   if (!(std::abs(det) > 1e-30)) return list_error(name + ": the transform is singular");
   if (!o.all_triangles) {
     const size_t count = list.prototypes[o.prototype].triangle_count();

@@ -11,6 +11,7 @@
 #include "gl_errors.h"
 #include "gl_program.h"
 #include "gl_raster_target.h"
+#include "object_transform.h"
 
 namespace calf::player {
 
@@ -326,23 +327,14 @@ Status GlMeshRenderer::render(const MeshDrawList& list, const Camera& camera,
     if (ob.drawn == 0 || !list.objects[o].visible) continue;
     const PrototypeBuffers& pb = prototypes_[ob.prototype];
     const MeshDrawObject& lo = list.objects[o];
-    const auto& m = lo.transform;
-    double r[3][4];
-    for (int row = 0; row < 3; ++row) {
-      for (int col = 0; col < 4; ++col) r[row][col] = m[4 * row + col];
-    }
+    const internal::ObjectTransform t(lo.transform);
+    const auto& r = t.r;
     at(u.model_x, {r[0][0], r[1][0], r[2][0]});
     at(u.model_y, {r[0][1], r[1][1], r[2][1]});
     at(u.model_z, {r[0][2], r[1][2], r[2][2]});
-    at(u.model_t, Vec3{r[0][3], r[1][3], r[2][3]} - camera.position);
+    at(u.model_t, t.translation() - camera.position);
     // Inverse transpose up to a positive factor: the cofactor matrix (normals are normalised).
-    double cof[3][3];
-    for (int a = 0; a < 3; ++a) {
-      for (int b = 0; b < 3; ++b) {
-        const int a1 = (a + 1) % 3, a2 = (a + 2) % 3, b1 = (b + 1) % 3, b2 = (b + 2) % 3;
-        cof[a][b] = r[a1][b1] * r[a2][b2] - r[a1][b2] * r[a2][b1];
-      }
-    }
+    const auto& cof = t.cof;
     at(u.normal_x, {cof[0][0], cof[1][0], cof[2][0]});
     at(u.normal_y, {cof[0][1], cof[1][1], cof[2][1]});
     at(u.normal_z, {cof[0][2], cof[1][2], cof[2][2]});

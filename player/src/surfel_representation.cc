@@ -233,14 +233,18 @@ Status SurfelRepresentation::prepare(uint32_t frame, std::span<const Camera> eye
 Status SurfelRepresentation::render(const Camera& camera, RenderedImage* out) {
   Impl& d = *impl_;
   const auto t0 = std::chrono::steady_clock::now();
-  CALF_RETURN_IF_ERROR(d.mesh->render(camera, out));
+  // A pass is skipped when it draws nothing: with no mesh object the surfels render straight into
+  // `out`; with no surfel the mesh does.
+  const bool meshes = d.mesh->triangles_drawn() > 0;
+  if (meshes || d.surfels == 0) CALF_RETURN_IF_ERROR(d.mesh->render(camera, out));
   if (d.surfels > 0) {
+    RenderedImage* target = meshes ? &d.layer : out;
     if (d.gl) {
-      CALF_RETURN_IF_ERROR(d.gl->render(d.list, camera, d.options.render, &d.layer));
+      CALF_RETURN_IF_ERROR(d.gl->render(d.list, camera, d.options.render, target));
     } else {
-      CALF_RETURN_IF_ERROR(render_surfels_cpu(d.list, camera, d.options.render, &d.layer));
+      CALF_RETURN_IF_ERROR(render_surfels_cpu(d.list, camera, d.options.render, target));
     }
-    CALF_RETURN_IF_ERROR(composite_nearest(d.layer, out));
+    if (meshes) CALF_RETURN_IF_ERROR(composite_nearest(d.layer, out));
   }
   d.render_ms = ms_since(t0);
   return Status::Ok();
