@@ -36,6 +36,25 @@ Status option_error(const std::string& what) {
 // How an object is drawn at the prepared frame.
 enum class Drawn : uint8_t { kSurfels, kBoth, kMesh };
 
+// e of SurfelFoveation for a point seen by `eye`: its image-plane position in units of the
+// half-diagonal; infinity behind the eye.
+double eccentricity(const Camera& eye, const CameraFrame& frame, const Vec3& point) {
+  const Vec3 v = point - eye.position;
+  const double z = dot(v, frame.forward);
+  if (!(z > 0)) return std::numeric_limits<double>::infinity();
+  const double ty = std::tan(eye.fov_y / 2);
+  const double tx = ty * eye.width / eye.height;
+  const double x = dot(v, frame.right) / z, y = dot(v, frame.up) / z;
+  return std::sqrt((x * x + y * y) / (tx * tx + ty * ty));
+}
+
+// The point-size factor of SurfelFoveation at eccentricity e.
+double foveation_factor(const SurfelFoveation& f, double e) {
+  if (!f.enabled || e <= f.inner) return 1;
+  if (e >= f.outer) return f.periphery_scale;
+  return 1 + (f.periphery_scale - 1) * (e - f.inner) / (f.outer - f.inner);
+}
+
 }  // namespace
 
 Status validate_surfel_options(const SurfelOptions& o) {
@@ -59,6 +78,16 @@ Status validate_surfel_options(const SurfelOptions& o) {
   if (!(o.blend_share >= 0 && o.blend_share <= 1)) {
     return option_error(format("blend share %g is outside [0, 1]", o.blend_share));
   }
+  const SurfelFoveation& f = o.foveation;
+  if (!(f.inner >= 0 && f.inner <= f.outer && f.outer <= 4)) {
+    return option_error(
+        format("foveation zones inner %g, outer %g are not 0 <= inner <= outer <= 4", f.inner,
+               f.outer));
+  }
+  if (!(f.periphery_scale >= 1 && f.periphery_scale <= 16)) {
+    return option_error(format("foveation periphery scale %g is outside [1, 16]",
+                               f.periphery_scale));
+  }
   return Status::Ok();
 }
 
@@ -79,6 +108,7 @@ struct SurfelRepresentation::Impl {
   std::vector<Camera> eyes;
   uint64_t surfels = 0;
   uint32_t counts[3] = {0, 0, 0};  // objects per Drawn
+  uint32_t peripheral = 0;          // objects drawn with a foveation factor > 1
   double render_ms = 0, prepare_ms = 0;
 
   void choose(const Camera& first);
@@ -157,6 +187,9 @@ void SurfelRepresentation::Impl::choose(const Camera& first) {
       2 * std::tan(first.fov_y / 2) / first.height;  // world size per unit distance
   surfels = 0;
   counts[0] = counts[1] = counts[2] = 0;
+  peripheral = 0;
+  std::vector<CameraFrame> frames;
+  for (const Camera& eye : eyes) frames.push_back(camera_frame(eye));
   for (size_t o = 0; o < list.objects.size(); ++o) {
     SurfelDrawObject& s = list.objects[o];
     s.transform = mesh_list.objects[o].transform;
@@ -168,9 +201,15 @@ void SurfelRepresentation::Impl::choose(const Camera& first) {
       const double scale = std::cbrt(std::abs(t.det));
       const Vec3 centre = t.linear(centres[s.prototype]) + t.translation();
       double d = std::numeric_limits<double>::infinity();
-      for (const Camera& eye : eyes) d = std::min(d, length(centre - eye.position));
+      double e = std::numeric_limits<double>::infinity();
+      for (size_t k = 0; k < eyes.size(); ++k) {
+        d = std::min(d, length(centre - eyes[k].position));
+        if (options.foveation.enabled) e = std::min(e, eccentricity(eyes[k], frames[k], centre));
+      }
       d = std::max(d - scale * radii[s.prototype], options.render.near);
-      const double radius = point_size / 2 * pixel * d / scale;  // object units
+      const double factor = foveation_factor(options.foveation, e);
+      if (factor > 1) ++peripheral;
+      const double radius = factor * point_size / 2 * pixel * d / scale;  // object units
       // Eq. 1 unclamped, to tell "needs more than the buffer holds" from "needs all of it".
       const double need = rec.prefix_count * std::pow(rec.prefix_radius / radius, 2);
       if (need <= rec.surfel_count) {
@@ -215,6 +254,9 @@ uint64_t SurfelRepresentation::surfels_drawn() const {
 }
 uint64_t SurfelRepresentation::triangles_drawn() const {
   return impl_->mesh->triangles_drawn();
+}
+uint32_t SurfelRepresentation::peripheral_objects() const {
+  return impl_->peripheral;
 }
 const SurfelDrawList& SurfelRepresentation::draw_list() const {
   return impl_->list;
@@ -280,6 +322,11 @@ RepresentationStats SurfelRepresentation::stats() const {
                             d.options.target_frame_ms > 0
                                 ? format(" (target %.1f ms)", d.options.target_frame_ms).c_str()
                                 : "")});
+  if (d.options.foveation.enabled) {
+    const SurfelFoveation& f = d.options.foveation;
+    out.entries.push_back({"foveation", format("x%.2g beyond %.2g, from %.2g; %u objects peripheral",
+                                               f.periphery_scale, f.outer, f.inner, d.peripheral)});
+  }
   out.entries.push_back({"prepare", format("%.2f ms", d.prepare_ms)});
   out.entries.push_back({"draw", format("%.1f ms", d.render_ms)});
   return out;

@@ -45,6 +45,7 @@ struct HeadlessArgs {
   uint32_t sheet_rows = 8;
   bool heat_maps = true;
   double surfel_target_ms = 0;  // --surfel-target-ms: report render times to the controller
+  bool surfel_foveation = false;  // --surfel-foveation: print the peripheral objects per pose
 };
 
 double median(std::vector<double> v) {
@@ -177,6 +178,7 @@ int run_headless(Playback& play, Playback* full, const HeadlessArgs& a) {
       if (SurfelRepresentation* sr = surfels_of(play)) {
         std::printf(", %llu surfels at %.2f px",
                     static_cast<unsigned long long>(sr->surfels_drawn()), sr->point_size());
+        if (a.surfel_foveation) std::printf(" (%u objects peripheral)", sr->peripheral_objects());
         // Headless has no display: the render time stands for the frame time the point-size
         // controller follows (only when it has a target; not the first, which compiles shaders).
         if (a.surfel_target_ms > 0 && k > 0) {
@@ -340,14 +342,22 @@ int main(int argc, char** argv) {
                  "with --surfel-target-ms), 1..64 (default 2)")
       ->check(CLI::Range(1.0, 64.0));
   app.add_option("--surfel-target-ms", so.target_frame_ms,
-                 "surfels: frame-time target in ms; the point size follows it between 1 and 16 "
-                 "px (headless: each pose's render time counts as its frame time) (default 0: "
-                 "fixed point size)")
-      ->check(CLI::Range(0.0, 10000.0));
+                 "surfels: frame-time target in ms, > 0 and <= 10000; the point size follows it "
+                 "between 1 and 16 px (headless: each pose's render time counts as its frame "
+                 "time) (default: none, a fixed point size)");
   app.add_option("--surfel-blend", so.blend_share,
                  "surfels: an object whose prefix needs more than this share of its surfels is "
                  "drawn from the mesh as well (0..1; 1: no blend zone) (default 0.5)")
       ->check(CLI::Range(0.0, 1.0));
+  std::vector<double> foveation;
+  app.add_option("--surfel-foveation", foveation,
+                 "surfels: fixed foveated rendering (paper 001 Sec. 4.4) as INNER,OUTER,SCALE: "
+                 "an object whose centre lies within INNER of the image centre (in units of the "
+                 "half-diagonal: 1 at the corners) keeps the point size, beyond OUTER it is "
+                 "SCALE times larger (a shorter prefix), linear between; e.g. 0.35,0.75,2 "
+                 "(default off)")
+      ->expected(3)
+      ->delimiter(',');
   app.add_option("--renderer", renderer,
                  "gl (OpenGL 4.5 ray-march, the product) or cpu (the scalar "
                  "reference; headless only) (default gl)")
@@ -389,6 +399,21 @@ int main(int argc, char** argv) {
   if (int rc = tools::parse_command_line(app, "calf-play", argc, argv); rc >= 0) return rc;
 
   play_options.use_gl = renderer == "gl";
+  if (app.count("--surfel-target-ms") > 0 &&
+      !(so.target_frame_ms > 0 && so.target_frame_ms <= 10000)) {
+    return contradiction("--surfel-target-ms " + std::to_string(so.target_frame_ms) +
+                         " is not a frame time in (0, 10000] ms (leave it out for a fixed "
+                         "point size)");
+  }
+  if (!foveation.empty()) {
+    so.foveation = {.enabled = true,
+                    .inner = foveation[0],
+                    .outer = foveation[1],
+                    .periphery_scale = foveation[2]};
+    if (Status s = validate_surfel_options(so); !s.ok()) {
+      return tools::print_error("calf-play", s, tools::kExitUsage);
+    }
+  }
   o.selection.priority = priority == "angle" ? ViewPriority::kAngle : ViewPriority::kDistance;
   if (headless && app.count("--frame-ms") == 0) o.selection.budget.target_frame_ms = 0;
   if (headless) {
@@ -418,6 +443,7 @@ int main(int argc, char** argv) {
       full = std::move(*f);
     }
     h.surfel_target_ms = so.target_frame_ms;
+    h.surfel_foveation = so.foveation.enabled;
     return run_headless(**play, full.get(), h);
   }
   if (!h.compare_clip.empty()) {

@@ -15,7 +15,12 @@
 //             exceed blend_share * N the object is also drawn from the mesh; past N (the buffer
 //             cannot cover the surface at that size) it is drawn from the mesh only. Between the
 //             two both are drawn and composited by depth (the blend zone: no hole opens while an
-//             object changes representation). A prototype without surfels is always a mesh;
+//             object changes representation). A prototype without surfels is always a mesh.
+//             With foveation on (paper 001 Sec. 4.4, fixed foveated rendering), the point size
+//             of an object grows with the screen position of its sphere's centre: e = the
+//             centre's distance from the image centre, 1 at the image corners (the smallest e
+//             over the eyes); size x 1 inside `inner`, x periphery_scale beyond `outer`, linear in
+//             e between, so the periphery draws shorter prefixes and changes quality smoothly;
 //   render:   the mesh objects through the mesh renderer, the surfel objects through the surfel
 //             splatter (surfel_renderer.h), composited by radial depth;
 //   report_frame_time: with target_frame_ms > 0, the point size follows the frame time:
@@ -41,6 +46,15 @@
 
 namespace calf::player {
 
+// Fixed foveated rendering (paper 001 Sec. 4.4): zones by e, the distance from the image centre
+// in units of the half-diagonal (0 at the centre, 1 at the corners, > 1 off screen or behind).
+struct SurfelFoveation {
+  bool enabled = false;
+  double inner = 0.35;           // the fovea: e <= inner keeps the point size, [0, outer]
+  double outer = 0.75;           // the periphery starts here, [inner, 4]
+  double periphery_scale = 2.0;  // point-size factor at e >= outer, [1, 16]
+};
+
 struct SurfelOptions {
   SurfelRenderOptions render;
   MeshOptions mesh;
@@ -56,6 +70,7 @@ struct SurfelOptions {
   // An object whose prefix would exceed blend_share * N surfels is drawn from the mesh as well,
   // [0, 1]; 1: no blend zone.
   double blend_share = 0.5;
+  SurfelFoveation foveation;
 };
 
 class SurfelRepresentation final : public Representation {
@@ -90,6 +105,8 @@ class SurfelRepresentation final : public Representation {
   double point_size() const;
   uint64_t surfels_drawn() const;
   uint64_t triangles_drawn() const;
+  // Objects drawn with a foveation factor above 1 at the prepared frame (0 without foveation).
+  uint32_t peripheral_objects() const;
   // The surfel draw list at the prepared frame.
   const SurfelDrawList& draw_list() const;
 
