@@ -80,13 +80,12 @@ Status validate_surfel_options(const SurfelOptions& o) {
   }
   const SurfelFoveation& f = o.foveation;
   if (!(f.inner >= 0 && f.inner <= f.outer && f.outer <= 4)) {
-    return option_error(
-        format("foveation zones inner %g, outer %g are not 0 <= inner <= outer <= 4", f.inner,
-               f.outer));
+    return option_error(format(
+        "foveation zones inner %g, outer %g are not 0 <= inner <= outer <= 4", f.inner, f.outer));
   }
   if (!(f.periphery_scale >= 1 && f.periphery_scale <= 16)) {
-    return option_error(format("foveation periphery scale %g is outside [1, 16]",
-                               f.periphery_scale));
+    return option_error(
+        format("foveation periphery scale %g is outside [1, 16]", f.periphery_scale));
   }
   return Status::Ok();
 }
@@ -108,7 +107,7 @@ struct SurfelRepresentation::Impl {
   std::vector<Camera> eyes;
   uint64_t surfels = 0;
   uint32_t counts[3] = {0, 0, 0};  // objects per Drawn
-  uint32_t peripheral = 0;          // objects drawn with a foveation factor > 1
+  uint32_t peripheral = 0;         // objects drawn with a foveation factor > 1
   double render_ms = 0, prepare_ms = 0;
 
   void choose(const Camera& first);
@@ -324,8 +323,9 @@ RepresentationStats SurfelRepresentation::stats() const {
                                 : "")});
   if (d.options.foveation.enabled) {
     const SurfelFoveation& f = d.options.foveation;
-    out.entries.push_back({"foveation", format("x%.2g beyond %.2g, from %.2g; %u objects peripheral",
-                                               f.periphery_scale, f.outer, f.inner, d.peripheral)});
+    out.entries.push_back(
+        {"foveation", format("x%.2g beyond %.2g, from %.2g; %u objects peripheral",
+                             f.periphery_scale, f.outer, f.inner, d.peripheral)});
   }
   out.entries.push_back({"prepare", format("%.2f ms", d.prepare_ms)});
   out.entries.push_back({"draw", format("%.1f ms", d.render_ms)});

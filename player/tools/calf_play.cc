@@ -44,7 +44,7 @@ struct HeadlessArgs {
   std::string compare_clip;
   uint32_t sheet_rows = 8;
   bool heat_maps = true;
-  double surfel_target_ms = 0;  // --surfel-target-ms: report render times to the controller
+  double surfel_target_ms = 0;    // --surfel-target-ms: report render times to the controller
   bool surfel_foveation = false;  // --surfel-foveation: print the peripheral objects per pose
 };
 

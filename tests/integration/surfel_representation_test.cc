@@ -59,9 +59,9 @@ encoder::SurfelsTrackInput plate_surfels() {
   const float step = 0.4f / kGrid;
   for (int k = 0; k < kGrid * kGrid; ++k) {
     const int i = (k * 2731) % (kGrid * kGrid);  // 2731 is prime to 4096: a permutation
-    p.positions.insert(p.positions.end(), {-0.2f + step * (static_cast<float>(i % kGrid) + 0.5f),
-                                           -0.2f + step * (static_cast<float>(i / kGrid) + 0.5f),
-                                           0.0f});
+    p.positions.insert(p.positions.end(),
+                       {-0.2f + step * (static_cast<float>(i % kGrid) + 0.5f),
+                        -0.2f + step * (static_cast<float>(i / kGrid) + 0.5f), 0.0f});
     p.normals.insert(p.normals.end(), {0, 0, 1});
     p.colours.insert(p.colours.end(), {0.5f, 0.5f, 0.5f});
   }
