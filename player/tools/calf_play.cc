@@ -339,7 +339,7 @@ int main(int argc, char** argv) {
   SurfelOptions& so = play_options.surfels;
   app.add_option("--surfel-point-size", so.point_size,
                  "surfels: disc diameter in pixels the prefixes are chosen for (the start value "
-                 "with --surfel-target-ms), 1..64 (default 2)")
+                 "with --surfel-target-ms), 1..64 (default 1.5)")
       ->check(CLI::Range(1.0, 64.0));
   app.add_option("--surfel-target-ms", so.target_frame_ms,
                  "surfels: frame-time target in ms, > 0 and <= 10000; the point size follows it "

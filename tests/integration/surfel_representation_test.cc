@@ -147,6 +147,7 @@ TEST(SurfelRepresentation, FoveationShortensOnlyPeripheralPrefixes) {
 TEST(SurfelRepresentation, ControllerMovesThePointSizeTowardsTheTargetWithinItsClamp) {
   Fixture f;
   SurfelOptions o;
+  o.point_size = 2;
   o.target_frame_ms = 10;
   auto rep = SurfelRepresentation::open(f.reader, 1, o, player::RenderBackend::kCpu, nullptr);
   ASSERT_TRUE(rep.ok()) << rep.status().to_string();
