@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
                calf::tools::kExitStatusHelp};
   app.set_version_flag("--version", std::string("calf ") + calf::kVersionString);
   app.require_subcommand(1);
+  app.fallthrough();  // --quiet may follow the subcommand
   calf::capture::IngestOptions options;
   std::string manifest, out;
   bool quiet = false;
