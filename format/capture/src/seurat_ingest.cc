@@ -164,8 +164,8 @@ double snap(double f) {
 }
 
 // Fills one viewpoint's faces from its prepared views. Returns E145 for a ray no view sees.
-Status resample_group(const std::vector<PreparedView>& views, const Vec3& centre,
-                      const std::string& where, uint32_t n, ViewFrame* out, bool* exact) {
+Status resample_group(const std::vector<PreparedView>& views, const std::string& where, uint32_t n,
+                      ViewFrame* out, bool* exact) {
   *exact = true;
   for (int f = 0; f < kCubeFaceCount; ++f) {
     const CubeFace face = cube_face_from_index(f);
@@ -223,7 +223,6 @@ Status resample_group(const std::vector<PreparedView>& views, const Vec3& centre
       }
     }
   }
-  (void)centre;
   return Status::Ok();
 }
 
@@ -301,7 +300,7 @@ Status ingest_seurat(const std::filesystem::path& manifest_path,
     }
     bool exact = false;
     if (s.ok()) {
-      s = resample_group(groups[g], m.viewpoints[g].position, where, m.face_size, &frame, &exact);
+      s = resample_group(groups[g], where, m.face_size, &frame, &exact);
     }
     groups[g].clear();  // release the pixels: one group in memory at a time
     if (s.ok()) s = writer.write(static_cast<uint32_t>(g), 0, frame);
