@@ -127,6 +127,7 @@ struct SeuratCase {
   const char* depth_channel = "R";  // in a separate depth EXR
   bool sky_as_zero = true;          // Unity's depth camera clears to 0
   bool png_colour = false;
+  bool alpha_sky = false;     // sky as colour alpha 0 (channel A) over a garbage depth of -5
   double yaw = 0, pitch = 0;  // rotate every face camera (a group that is not an exact cube map)
   uint32_t image_size = 0;    // 0: the face size
   double near = 0.05, far = 100;
@@ -203,6 +204,10 @@ fs::path write_seurat(const fs::path& dir, const std::vector<Vec3>& centres, uin
           if (std::isinf(h.t) && sc.depth_type != SeuratDepthType::kWindowZ) {
             v = sc.sky_as_zero ? 0.0 : INFINITY;
           }
+          if (std::isinf(h.t) && sc.alpha_sky) {
+            v = -5;
+            colour[3][p] = 0;
+          }
           depth[0][p] = static_cast<float>(v);
         }
       }
@@ -230,8 +235,9 @@ fs::path write_seurat(const fs::path& dir, const std::vector<Vec3>& centres, uin
               ", \"world_from_eye_matrix\": " + json_matrix(w) + ", \"depth_type\": \"" +
               depth_type + "\"},\n       \"depth_image_file\": {\"color\": {\"path\": \"" + cname +
               "\", \"channel_0\": \"R\", \"channel_1\": \"G\", \"channel_2\": \"B\", "
-              "\"channel_alpha\": \"CONSTANT_ONE\"}, \"depth\": {\"path\": \"" +
-              stem + "_Depth.exr\", \"channel_0\": \"" + sc.depth_channel + "\"}}}";
+              "\"channel_alpha\": \"" +
+              (sc.alpha_sky ? "A" : "CONSTANT_ONE") + "\"}, \"depth\": {\"path\": \"" + stem +
+              "_Depth.exr\", \"channel_0\": \"" + sc.depth_channel + "\"}}}";
     }
     json += "\n    ]}";
   }
@@ -376,6 +382,23 @@ TEST(SeuratIngest, RayDepthAndWindowZMatchNativeCapture) {
         EXPECT_EQ(c.depth_within, 1.0);
       }
     }
+  }
+}
+
+// Sky marked by colour alpha 0 (Seurat drops those samples): whatever the depth holds there.
+TEST(SeuratIngest, AlphaZeroIsSky) {
+  SeuratCase sc;
+  sc.alpha_sky = true;
+  const fs::path dir = scratch("alpha");
+  const fs::path manifest = write_seurat(dir / "seurat", kCentres, kN, sc);
+  const Status s = ingest_seurat(manifest, dir / "set", {});
+  ASSERT_TRUE(s.ok()) << s.to_string();
+  const auto converted = read_set(dir / "set");
+  const auto native = native_set(dir / "native", kCentres, kN);
+  for (size_t v = 0; v < 2; ++v) {
+    const Comparison c = compare(converted[v], native[v]);
+    EXPECT_EQ(c.max_colour, 0);
+    EXPECT_EQ(c.depth_within, 1.0);
   }
 }
 
