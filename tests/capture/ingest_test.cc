@@ -127,7 +127,10 @@ struct SeuratCase {
   const char* depth_channel = "R";  // in a separate depth EXR
   bool sky_as_zero = true;          // Unity's depth camera clears to 0
   bool png_colour = false;
-  bool alpha_sky = false;     // sky as colour alpha 0 (channel A) over a garbage depth of -5
+  // Sky as colour alpha 0 (channel A) over a garbage depth of -5.
+  bool alpha_sky = false;
+  // Matrices through float, cot(45 deg) as Unity writes it (0.99999994).
+  bool float_matrices = false;
   double yaw = 0, pitch = 0;  // rotate every face camera (a group that is not an exact cube map)
   uint32_t image_size = 0;    // 0: the face size
   double near = 0.05, far = 100;
@@ -160,8 +163,12 @@ fs::path write_seurat(const fs::path& dir, const std::vector<Vec3>& centres, uin
                            : sc.depth_type == SeuratDepthType::kRayDepth ? "RAY_DEPTH"
                                                                          : "WINDOW_Z";
   const double nr = sc.near, fr = sc.far;
-  const std::array<double, 16> clip = {
+  std::array<double, 16> clip = {
       1, 0, 0, 0, 0, 1, 0, 0, 0, 0, (nr + fr) / (nr - fr), 2 * nr * fr / (nr - fr), 0, 0, -1, 0};
+  if (sc.float_matrices) {
+    for (double& e : clip) e = static_cast<float>(e);
+    clip[0] = clip[5] = 0.99999994f;
+  }
   std::string json = "{\n  \"view_groups\": [\n";
   for (size_t g = 0; g < centres.size(); ++g) {
     json += std::string(g ? ",\n" : "") + "    {\"views\": [\n";
@@ -228,6 +235,9 @@ fs::path write_seurat(const fs::path& dir, const std::vector<Vec3>& centres, uin
         w[4 * r + 3] = component(centres[g], r);
       }
       w[15] = 1;
+      if (sc.float_matrices) {
+        for (double& e : w) e = static_cast<float>(e);
+      }
       json += std::string(k ? ",\n" : "") +
               "      {\"projective_camera\": {\"image_width\": " + std::to_string(size) +
               ", \"image_height\": " + std::to_string(size) +
@@ -383,6 +393,22 @@ TEST(SeuratIngest, RayDepthAndWindowZMatchNativeCapture) {
       }
     }
   }
+}
+
+// Matrices that went through float (as Unity's plugin writes them) still copy texel for texel.
+TEST(SeuratIngest, FloatMatricesStillCopyExactly) {
+  // Faces of 128: cot(45 deg) in float moves edge pixels by 4e-6 of a pixel.
+  SeuratCase sc;
+  sc.float_matrices = true;
+  const fs::path dir = scratch("float_matrices");
+  const fs::path manifest = write_seurat(dir / "seurat", kCentres, 128, sc);
+  IngestReport report;
+  const Status s = ingest_seurat(manifest, dir / "set", {}, &report);
+  ASSERT_TRUE(s.ok()) << s.to_string();
+  EXPECT_EQ(report.exact_groups, 2u);
+  const auto converted = read_set(dir / "set");
+  const auto native = native_set(dir / "native", kCentres, 128);
+  for (size_t v = 0; v < 2; ++v) EXPECT_EQ(compare(converted[v], native[v]).max_colour, 0);
 }
 
 // Sky marked by colour alpha 0 (Seurat drops those samples): whatever the depth holds there.

@@ -156,11 +156,12 @@ Status load_pixels(const SeuratView& v, const std::filesystem::path& dir, const 
   return Status::Ok();
 }
 
-// Snaps a continuous pixel coordinate (centres at integers) onto the centre it lies on within
-// rounding, so that an exact cube map is copied bit for bit.
+// Snaps a continuous pixel coordinate (centres at integers) onto a pixel centre within 1e-3 of a
+// pixel, so that an exact cube map is copied bit for bit even when its matrices went through
+// float (Unity writes cot(45 deg) as 0.99999994: 1e-4 of a pixel off at 1024 pixels).
 double snap(double f) {
   const double r = std::round(f);
-  return std::fabs(f - r) < 1e-6 ? r : f;
+  return std::fabs(f - r) < 1e-3 ? r : f;
 }
 
 // Fills one viewpoint's faces from its prepared views. Returns E145 for a ray no view sees.
