@@ -14,9 +14,10 @@
 // Sampling: every calf texel takes the ray through its centre (calf/format/cube.h). Colour is
 // filtered (bilinear in the source image; equirectangular input also supersamples each texel),
 // depth is the nearest source pixel's, so no depth is ever invented between a foreground and a
-// background. Where a Seurat view's pixel centres fall exactly on calf's texel centres (a group
-// that is an exact cube map of the same size, whatever its face order or orientation), the
-// sample is that pixel's, bit for bit: the conversion is then a permutation of pixels.
+// background. Where a Seurat view's pixel centre falls on calf's texel centre (within 1e-3 of a
+// pixel: a group that is an exact cube map of the same size, whatever its face order or
+// orientation, even with matrices rounded to float), the sample is that pixel's, bit for bit:
+// the conversion is then a permutation of pixels.
 #pragma once
 
 #include <array>
