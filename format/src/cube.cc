@@ -99,4 +99,13 @@ Texel texel_from_direction(const Vec3& d, uint32_t face_size) {
   return {c.face, clamp_texel(c.u), clamp_texel(c.v)};
 }
 
+UprightFace upright_face(CubeFace face) {
+  // up = -t_c's axis direction (row 0 of a face is t = 0, the top of the upright image).
+  const FaceAxes& f = kFaceAxes[cube_face_index(face)];
+  double fwd[3] = {0, 0, 0}, up[3] = {0, 0, 0};
+  fwd[f.major_axis] = f.major_sign;
+  up[f.tc_axis] = -f.tc_sign;
+  return {{fwd[0], fwd[1], fwd[2]}, {up[0], up[1], up[2]}};
+}
+
 }  // namespace calf

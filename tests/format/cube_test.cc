@@ -2,6 +2,8 @@
 // face order, orientation, pixel-centre rule or seam tie-break changed.
 #include "calf/format/cube.h"
 
+#include "calf/format/camera.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -166,6 +168,41 @@ TEST(CubeTest, EveryDirectionOnASphereMapsToATexelThatMapsBack) {
     const Texel t = texel_from_direction(d, n);
     const Vec3 c = direction_from_texel(t.face, t.x, t.y, n);
     EXPECT_LT(angle(d, c), std::atan(std::sqrt(2.0) / n) + 1e-12);
+  }
+}
+
+// Upright faces (issue 21): a 90-degree camera looking along a face's major axis with the face's
+// up vector, through the one camera model (camera.h, upright and unmirrored), sees at pixel
+// (i, j) exactly what texel (N - 1 - i, j) holds; and the up / right table in cube.h is right.
+TEST(CubeUprightFace, CameraPixelIsMirroredTexel) {
+  struct Expected {
+    Vec3 forward, up, right;
+  };
+  const Expected kTable[kCubeFaceCount] = {
+      {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}},   {{-1, 0, 0}, {0, 1, 0}, {0, 0, -1}},
+      {{0, 1, 0}, {0, 0, -1}, {-1, 0, 0}}, {{0, -1, 0}, {0, 0, 1}, {-1, 0, 0}},
+      {{0, 0, 1}, {0, 1, 0}, {-1, 0, 0}},  {{0, 0, -1}, {0, 1, 0}, {1, 0, 0}},
+  };
+  constexpr uint32_t kN = 7;
+  for (int f = 0; f < kCubeFaceCount; ++f) {
+    const CubeFace face = cube_face_from_index(f);
+    const UprightFace u = upright_face(face);
+    EXPECT_EQ(u.forward, kTable[f].forward) << cube_face_name(face);
+    EXPECT_EQ(u.up, kTable[f].up) << cube_face_name(face);
+    EXPECT_EQ(cross(u.forward, u.up), kTable[f].right) << cube_face_name(face);
+    Camera cam;
+    cam.forward = u.forward;
+    cam.up = u.up;
+    cam.fov_y = 1.5707963267948966;
+    cam.width = cam.height = kN;
+    for (uint32_t j = 0; j < kN; ++j) {
+      for (uint32_t i = 0; i < kN; ++i) {
+        const Texel t = texel_from_upright_pixel(face, i, j, kN);
+        EXPECT_EQ(t.face, face);
+        EXPECT_LT(length(camera_ray(cam, i, j) - direction_from_texel(face, t.x, t.y, kN)), 1e-12)
+            << cube_face_name(face) << " pixel " << i << ", " << j;
+      }
+    }
   }
 }
 

@@ -39,6 +39,8 @@ class ExrReader {
   // The index of a channel by exact name, or -1.
   int channel(const std::string& name) const;
   int channel_count() const { return static_cast<int>(names_.size()); }
+  // The channel names, in file order (for messages naming what an image has).
+  const std::vector<std::string>& names() const { return names_; }
   // Ok when channel `index` stores HALF or FLOAT samples, the only types format/CAPTURE.md
   // allows; E136 otherwise (the image library would normalise a UINT channel, so that depth 3
   // read back as ~7e-10: a misread, not an error, unless refused here).

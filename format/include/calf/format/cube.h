@@ -80,4 +80,22 @@ struct Texel {
 };
 Texel texel_from_direction(const Vec3& d, uint32_t face_size);
 
+// Upright faces: how renderers other than OpenGL (Unity's and Maya's face cameras, image viewers)
+// see a calf face. Face f's upright camera sits at the cube's centre with a 90-degree square
+// field of view, looking along f's major axis with the up vector below; its image has row 0 at
+// the top and is not mirrored (calf::Camera, calf/format/camera.h). Pixel (i, j) of that N x N
+// image is texel (N - 1 - i, j) of face f: the same rows, the columns reversed, on every face
+// (the GL table mirrors every face horizontally as seen from inside the cube). Up and right:
+//   +X: up +Y, right +Z     -X: up +Y, right -Z     +Y: up -Z, right -X
+//   -Y: up +Z, right -X     +Z: up +Y, right -X     -Z: up +Y, right +X
+// (right = cross(forward, up): a right-handed scene, as calf's camera model is.)
+struct UprightFace {
+  Vec3 forward, up;
+};
+UprightFace upright_face(CubeFace face);
+// The texel (x, y) of face `face` shown at pixel (i, j) of its upright N x N image: (N-1-i, j).
+inline Texel texel_from_upright_pixel(CubeFace face, uint32_t i, uint32_t j, uint32_t face_size) {
+  return {face, face_size - 1 - i, j};
+}
+
 }  // namespace calf

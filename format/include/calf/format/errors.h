@@ -100,6 +100,13 @@ enum class ErrorKind : uint8_t {
   X(kCaptureIndex, 140, kInvalidArgument, "a view or frame index is outside the set")           \
   X(kCaptureWriterMisuse, 141, kInvalidArgument, "the capture writer got a bad buffer or call") \
   X(kEyePathField, 142, kCorrupt, "an eye path field is missing or out of range")               \
+  X(kSeuratField, 143, kCorrupt, "a Seurat manifest field is missing, mistyped or unusable")    \
+  X(kSeuratHeadbox, 144, kInvalidArgument, "a Seurat headbox has zero extent")                  \
+  X(kSeuratViewGroup, 145, kCorrupt, "a Seurat view group is not one 360-degree viewpoint")     \
+  X(kSeuratChannel, 146, kCorrupt, "a channel a Seurat view names is missing from its image")   \
+  X(kSeuratImageSize, 147, kCorrupt, "Seurat colour and depth images differ in size")           \
+  X(kSeuratDepth, 148, kCorrupt, "a Seurat depth pixel lies outside its camera's frustum")      \
+  X(kEquirectInput, 149, kCorrupt, "an equirectangular input is malformed")                     \
   /* scene files: 150-169 (format/SCENE.md) */                                                  \
   X(kSceneFileSyntax, 150, kCorrupt, "a scene manifest is not valid JSON")                      \
   X(kSceneFileVersion, 151, kUnsupported, "a scene manifest has an unknown format or version")  \

@@ -1,0 +1,87 @@
+// calf-ingest: converts other renderers' captures into calf capture sets (format/CAPTURE.md,
+// "Ingest"); the library calls are calf/capture/ingest.h.
+#include <cstdio>
+#include <string>
+
+#include <fmt/core.h>
+#include <CLI/CLI.hpp>
+
+#include "calf/capture/ingest.h"
+#include "calf/format/version.h"
+#include "command_line.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{std::string("calf-ingest: convert a capture made by another renderer into a calf "
+                           "capture set (format/CAPTURE.md, \"Ingest\") that calf-encode reads.\n"
+                           "  calf-ingest seurat MANIFEST OUT_DIR     a Seurat capture manifest "
+                           "(Maya, Unity, Unreal): one viewpoint per view group\n"
+                           "  calf-ingest equirect MANIFEST OUT_DIR   equirectangular colour + "
+                           "radial depth per viewpoint and frame\n") +
+               calf::tools::kExitStatusHelp};
+  app.set_version_flag("--version", std::string("calf ") + calf::kVersionString);
+  app.require_subcommand(1);
+  app.fallthrough();  // --quiet may follow the subcommand
+  calf::capture::IngestOptions options;
+  std::string manifest, out;
+  bool quiet = false;
+  app.add_flag("--quiet", quiet, "print no summary line (default: print one)");
+
+  CLI::App* seurat = app.add_subcommand(
+      "seurat",
+      "Seurat manifest -> capture set: each view group becomes a viewpoint at its views' "
+      "common centre, its faces resampled from the views (an exact cube map is copied "
+      "texel for texel); colour bilinear, depth from the nearest pixel, made radial.");
+  seurat
+      ->add_option("MANIFEST", manifest, "the Seurat JSON manifest; image paths are relative to it")
+      ->required();
+  seurat->add_option("OUT_DIR", out, "the capture set to write (created; manifest.json last)")
+      ->required();
+  seurat
+      ->add_option("--face-size", options.face_size,
+                   "texels per face side; default 0 = the largest pixel density of any view "
+                   "(an exact cube map keeps its size)")
+      ->check(CLI::Range(0, 16384));
+  seurat
+      ->add_option("--headbox-size", options.headbox_size,
+                   "side of the view volume, centred on headbox_center (else on the groups' "
+                   "box); default 0 = the box of the view-group positions, which must not be a "
+                   "point")
+      ->check(CLI::Range(0.0, 1e12));
+  seurat->add_option("--fps", options.fps, "frames per second written to the manifest; default 30")
+      ->check(CLI::Range(1e-3, 1000.0));
+
+  CLI::App* equirect =
+      app.add_subcommand("equirect",
+                         "equirectangular set -> capture set: colour is the mean of k x k bilinear "
+                         "samples per texel, depth the nearest pixel's.");
+  equirect
+      ->add_option("MANIFEST", manifest,
+                   "the calf-equirect-set manifest (CAPTURE.md); images relative to it")
+      ->required();
+  equirect->add_option("OUT_DIR", out, "the capture set to write (created; manifest.json last)")
+      ->required();
+  equirect
+      ->add_option("--face-size", options.face_size,
+                   "texels per face side; default 0 = round(width / pi), the input's "
+                   "equatorial density at each face centre")
+      ->check(CLI::Range(0, 16384));
+  equirect
+      ->add_option("--supersample", options.supersample,
+                   "colour samples per texel side (k x k); default 2")
+      ->check(CLI::Range(1, 8));
+
+  if (int rc = calf::tools::parse_command_line(app, "calf-ingest", argc, argv); rc >= 0) return rc;
+  calf::capture::IngestReport report;
+  const bool is_seurat = seurat->parsed();
+  const calf::Status s = is_seurat
+                             ? calf::capture::ingest_seurat(manifest, out, options, &report)
+                             : calf::capture::ingest_equirect(manifest, out, options, &report);
+  if (!s.ok()) return calf::tools::print_error("calf-ingest", s);
+  if (!quiet) {
+    fmt::print("calf-ingest: wrote {} viewpoint(s) x {} frame(s), face size {}{} to {}\n",
+               report.viewpoints, report.frames, report.face_size,
+               is_seurat ? fmt::format(", {} group(s) copied exactly", report.exact_groups) : "",
+               out);
+  }
+  return 0;
+}
