@@ -117,7 +117,9 @@ Status load_model_textures(const aiScene& ai, const std::filesystem::path& model
     std::string key;
     std::filesystem::path file;
     if (embedded) {
-      key = "*" + std::to_string(embedded_index);
+      // Appends, not operator+ on a temporary: GCC 12 -O3 misfires -Wrestrict on that.
+      key = "*";
+      key.append(std::to_string(embedded_index));
     } else if (named[0] == '*') {
       return Status(ErrorId::kModelTexture,
                     where + ": the model embeds " + std::to_string(ai.mNumTextures) + " images");

@@ -813,6 +813,8 @@ Status decode_image(const std::string& name, OIIO::Filesystem::IOProxy* proxy, S
     // Unassociated alpha: the bytes of the file, not colour premultiplied by alpha.
     OIIO::ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);
+    // The readers of OpenImageIO 2.4 take the proxy from the configuration, not the argument.
+    if (proxy) config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
     std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(name, &config, proxy);
     if (!in) return Status(ErrorId::kSceneFileTexture, name + ": " + oiio_error("cannot decode"));
     const OIIO::ImageSpec& spec = in->spec();
