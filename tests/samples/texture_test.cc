@@ -402,7 +402,7 @@ TEST(Texture, ExportCarriesUvsAndTexturesIntoSceneFiles) {
   ASSERT_EQ(file->textures.size(), 1u);
   EXPECT_EQ(file->textures[0].width, 2u);
   EXPECT_EQ(file->textures[0].rgba, tex.rgba);  // the bytes as loaded, through PNG
-  ASSERT_EQ(file->objects.size(), 1u);  // (assimp adds a default material after the file's)
+  ASSERT_EQ(file->objects.size(), 1u);          // (assimp adds a default material after the file's)
   EXPECT_EQ(file->materials[file->objects[0].material].base_color_texture, 0u);
   ASSERT_EQ(file->meshes.size(), 1u);
   const capture::SceneMesh& mesh = file->meshes[0];
