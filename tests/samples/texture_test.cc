@@ -217,10 +217,12 @@ TEST(Texture, FarCheckerConvergesToItsMeanNearOneKeepsItsContrast) {
   // An 8 x 8 checker of black and white texels: linear mean exactly 0.5.
   const capture::SceneTexture checker = image(
       8, 8, [](uint32_t x, uint32_t y) { return (x + y) % 2 ? glm::u8vec3(255) : glm::u8vec3(0); });
-  // Far: the UVs repeat 64 times over the quad, 512 texels across 32 pixels (16 per pixel):
-  // point sampling would give 0 or 1 per pixel (an aliased pattern); the mip chain gives the
-  // 1 x 1 level's 0.5 (lod 4 > last level 3). Perspective and cube faces alike.
-  const Scene far = quad_scene(checker, 64, 0);
+  // Far: the UVs repeat 61.3 times over the quad, 490 texels across 32 pixels (15 per pixel):
+  // point or bilinear sampling of level 0 would give anything in [0, 1] per pixel (an aliased
+  // pattern; a whole number of repeats would put every pixel centre on a texel corner, where
+  // bilinear happens to give 0.5); the mip chain gives 0.5 exactly from level 1 on (every 2 x 2
+  // box of a one-texel checker averages 0.5; lod 3.9 here). Perspective and cube faces alike.
+  const Scene far = quad_scene(checker, 61.3f, 0);
   const capture::PerspectiveImage img = render_front(far, 32);
   EXPECT_LT(worst_deviation(img.color, 0.5f), 1e-4f);
   auto tracer = FrameTracer::create(far, 0, RenderOptions{1, 1, 0, 2, 0});
