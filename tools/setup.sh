@@ -19,6 +19,8 @@ PACKAGES=(
   libsquish-dev
   # capture ray tracer and scene loading
   libembree-dev libassimp-dev
+  # textured models the texture tests load when present (BoxTextured, CesiumMilkTruck)
+  assimp-testmodels
   # player: GL, window, headless, maths, HUD
   libglm-dev libglfw3-dev libosmesa6-dev libgl-dev libopengl-dev libglx-dev libegl-dev libimgui-dev xvfb xauth
   # tests and benchmarks; clang + its runtime for the libFuzzer run of tools/test.sh; clang-format

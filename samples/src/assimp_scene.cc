@@ -23,6 +23,7 @@
 #include "calf/format/coordinates.h"
 #include "calf/samples/scene.h"
 #include "model_prescan.h"
+#include "model_textures.h"
 
 namespace calf::samples {
 
@@ -237,6 +238,16 @@ Status check_imported(const aiScene* ai, const std::string& file) {
                           " is not finite or lies beyond the coordinate bound +-1e12");
       }
     }
+    if (mesh->mNumVertices > 0 && mesh->mTextureCoords[0]) {
+      for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+        const aiVector3D& t = mesh->mTextureCoords[0][v];
+        if (!std::isfinite(t.x) || !std::isfinite(t.y)) {
+          return Status(ErrorId::kSceneGeometry, file + ": mesh " + std::to_string(i) + " '" +
+                                                     mesh->mName.C_Str() + "' UV of vertex " +
+                                                     std::to_string(v) + " is not finite");
+        }
+      }
+    }
   }
   std::vector<const aiNode*> stack = {ai->mRootNode};
   while (!stack.empty()) {
@@ -327,6 +338,7 @@ Expected<Scene> load_scene_file(const std::filesystem::path& path) {
   for (unsigned i = 0; i < ai->mNumMaterials; ++i) {
     scene.materials.push_back(convert_material(ai->mMaterials[i]));
   }
+  CALF_RETURN_IF_ERROR(detail::load_model_textures(*ai, path, lower_ext == ".fbx", &scene));
   if (scene.materials.empty()) scene.materials.push_back(Material{});
 
   // The first animation drives the nodes it names.
@@ -368,6 +380,15 @@ Expected<Scene> load_scene_file(const std::filesystem::path& path) {
       for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
         const aiVector3D& p = mesh->mVertices[v];
         o.mesh.positions.emplace_back(p.x, p.y, p.z);
+      }
+      // UV channel 0, for a textured material only. assimp gives every format's UVs with v up
+      // from the image's bottom row (it flips glTF's); scenes count v down from the top row.
+      if (scene.materials[o.material].base_color_texture != capture::kNoTexture &&
+          mesh->mTextureCoords[0]) {
+        for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+          const aiVector3D& t = mesh->mTextureCoords[0][v];
+          o.mesh.uvs.emplace_back(t.x, 1.0f - t.y);
+        }
       }
       for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
         const aiFace& face = mesh->mFaces[f];

@@ -72,6 +72,15 @@ Status validate_mesh(const TriangleMesh& mesh, const std::string& what) {
       return bad("has triangle " + std::to_string(i) + " with a vertex index out of range");
     }
   }
+  if (!mesh.uvs.empty() && mesh.uvs.size() != v) {
+    return bad("has " + std::to_string(mesh.uvs.size()) + " UVs for " + std::to_string(v) +
+               " vertices");
+  }
+  for (size_t i = 0; i < mesh.uvs.size(); ++i) {
+    if (!std::isfinite(mesh.uvs[i].x) || !std::isfinite(mesh.uvs[i].y)) {
+      return bad("has a non-finite UV at vertex " + std::to_string(i));
+    }
+  }
   const size_t states = mesh.state_times.size();
   if (states > capture::kSceneMaxStates) {
     return bad("has " + std::to_string(states) + " vertex states, more than 4096");
@@ -102,14 +111,29 @@ Status validate_scene(const Scene& scene) {
   const std::string where = "scene '" + scene.name + "'";
   size_t primitives = 0;
   std::unordered_set<const TriangleMesh*> checked;
+  for (size_t i = 0; i < scene.textures.size(); ++i) {
+    const Texture* t = scene.textures[i].get();
+    const capture::SceneTexture* im = t ? &t->image : nullptr;
+    if (!im || im->width < 1 || im->height < 1 || im->width > capture::kSceneMaxTextureSize ||
+        im->height > capture::kSceneMaxTextureSize ||
+        im->rgba.size() != size_t{im->width} * im->height * 4 || t->levels.empty() ||
+        t->levels[0].width != im->width || t->levels[0].height != im->height) {
+      return Status(ErrorId::kSceneGeometry,
+                    where + ": texture " + std::to_string(i) +
+                        " is missing, empty, larger than 16384 x 16384 or not made by "
+                        "make_texture");
+    }
+  }
   for (size_t m = 0; m < scene.materials.size(); ++m) {
     const Material& mat = scene.materials[m];
     bool ok = finite(mat.albedo) && finite(mat.emission) && mat.reflect >= 0 && mat.refract >= 0 &&
               mat.reflect + mat.refract <= 1.0f + 1e-6f && std::isfinite(mat.ior) && mat.ior > 0 &&
-              glm::all(glm::greaterThanEqual(mat.emission, glm::vec3(0)));
+              glm::all(glm::greaterThanEqual(mat.emission, glm::vec3(0))) &&
+              (mat.base_color_texture == capture::kNoTexture ||
+               mat.base_color_texture < scene.textures.size());
     if (!ok) {
-      return Status(ErrorId::kSceneGeometry,
-                    where + ": material " + std::to_string(m) + " is out of range");
+      return Status(ErrorId::kSceneGeometry, where + ": material " + std::to_string(m) +
+                                                 " is out of range or names a missing texture");
     }
   }
   for (const Object& o : scene.objects) {

@@ -73,7 +73,15 @@ Expected<capture::SceneFile> export_scene(const Scene& scene, uint32_t frames) {
     sm.reflect = m.reflect;
     sm.refract = m.refract;
     sm.ior = m.ior;
+    sm.base_color_texture = m.base_color_texture;
     out.materials.push_back(sm);
+  }
+  // The sRGB bytes as loaded: the export neither re-encodes nor resamples. A texture without a
+  // scene-file name (a scene built in memory) gets one by its index.
+  for (size_t i = 0; i < scene.textures.size(); ++i) {
+    capture::SceneTexture t = scene.textures[i]->image;
+    if (t.path.empty()) t.path = "textures/texture" + std::to_string(i) + ".png";
+    out.textures.push_back(std::move(t));
   }
   auto time_of = [&](uint32_t f) { return static_cast<double>(f) / scene.fps; };
   // A shared mesh becomes one scene-file mesh at its first use; later objects point at it.
@@ -92,6 +100,7 @@ Expected<capture::SceneFile> export_scene(const Scene& scene, uint32_t frames) {
       capture::SceneMesh mesh;
       mesh.name = o.shared_mesh && !source.name.empty() ? source.name : o.name;
       mesh.positions = flatten(source.positions);
+      for (const glm::vec2& uv : source.uvs) mesh.uvs.insert(mesh.uvs.end(), {uv.x, uv.y});
       mesh.indices.reserve(source.triangles.size() * 3);
       for (const glm::uvec3& t : source.triangles)
         mesh.indices.insert(mesh.indices.end(), {t.x, t.y, t.z});

@@ -12,6 +12,7 @@
 
 #include "calf/format/cube.h"
 #include "calf/samples/render.h"
+#include "calf/samples/texture.h"
 #include "glm_vec.h"
 
 namespace calf::samples {
@@ -61,6 +62,7 @@ struct Geometry {
   bool spheres = false;
   std::vector<glm::vec3> positions;  // world space at the frame's time
   std::vector<glm::uvec3> triangles;
+  std::vector<glm::vec2> uvs;    // own triangles' UVs, kept only when the material is textured
   std::vector<glm::vec4> balls;  // world centre + radius
   // An instance: its prototype (index into Impl::prototypes) and the matrix taking the
   // prototype's face normals to world normals (the transform's 3 x 3 part, negated when it
@@ -122,6 +124,16 @@ struct LightAt {
 struct Hit {
   float t = 0;
   uint32_t geom = 0, prim = 0;
+  float u = 0, v = 0;  // Embree's barycentrics: the point is (1 - u - v) p0 + u p1 + v p2
+};
+
+// A ray cone (Akenine-Moeller et al. 2019): its width at the ray's origin and its spread angle.
+// A primary ray starts at width 0 with its pixel's angular width (pixel_spread); a mirror or glass
+// bounce continues from the width reached, with the same spread (surfaces treated as flat). The
+// width at a hit picks the texture's mip level.
+struct Cone {
+  float width = 0;
+  float spread = 0;
 };
 
 }  // namespace
@@ -132,6 +144,7 @@ struct FrameTracer::Impl {
   std::vector<Geometry> geometries;
   std::vector<Prototype> prototypes;
   std::vector<Material> materials;
+  std::vector<std::shared_ptr<const Texture>> textures;
   std::vector<LightAt> lights;
   Sky sky;
   glm::vec3 sun_dir{0, 1, 0};
@@ -170,6 +183,8 @@ struct FrameTracer::Impl {
     // own geometry (always 0) in geomID.
     hit->geom = rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? rh.hit.instID[0] : rh.hit.geomID;
     hit->prim = rh.hit.primID;
+    hit->u = rh.hit.u;
+    hit->v = rh.hit.v;
     return true;
   }
 
@@ -206,6 +221,34 @@ struct FrameTracer::Impl {
     }
     float len = glm::length(n);
     return len > 0 ? n / len : glm::vec3(0, 1, 0);
+  }
+
+  // The diffuse reflectance at hit `h` of a ray along unit `d`: the material's albedo times its
+  // base-colour texture, trilinearly filtered at the footprint of a cone `cone_width` wide at the
+  // hit (texture.h). Untextured materials, spheres and meshes without UVs give the albedo.
+  glm::vec3 albedo_at(const Hit& h, const Material& m, const glm::vec3& d, float cone_width) const {
+    if (m.base_color_texture >= textures.size()) return m.albedo;
+    const Geometry& g = geometries[h.geom];
+    if (g.spheres) return m.albedo;
+    const Prototype* pr =
+        g.prototype >= 0 ? &prototypes[static_cast<size_t>(g.prototype)] : nullptr;
+    const std::vector<glm::vec2>& uvs = pr ? pr->mesh->uvs : g.uvs;
+    if (uvs.empty()) return m.albedo;
+    const glm::uvec3& t = pr ? pr->mesh->triangles[h.prim] : g.triangles[h.prim];
+    const glm::vec2 uv = uvs[t.x] * (1 - h.u - h.v) + uvs[t.y] * h.u + uvs[t.z] * h.v;
+    // World-space edges: an instance's are its prototype's through the transform's 3 x 3 part
+    // (normal_matrix up to a sign, which the cross product's length ignores).
+    const std::vector<glm::vec3>& p = pr ? pr->positions : g.positions;
+    glm::vec3 e1 = p[t.y] - p[t.x], e2 = p[t.z] - p[t.x];
+    if (pr) e1 = g.normal_matrix * e1, e2 = g.normal_matrix * e2;
+    const glm::vec3 cross = glm::cross(e1, e2);
+    const float world_area = glm::length(cross);
+    const glm::vec2 t1 = uvs[t.y] - uvs[t.x], t2 = uvs[t.z] - uvs[t.x];
+    const float uv_area = std::fabs(t1.x * t2.y - t2.x * t1.y);
+    const float cos_incidence = world_area > 0 ? std::fabs(glm::dot(cross, d)) / world_area : 1;
+    const Texture& tex = *textures[m.base_color_texture];
+    const float lod = texture_lod(tex, cone_width, cos_incidence, uv_area, world_area);
+    return m.albedo * sample_texture(tex, uv, lod);
   }
 
   glm::vec3 sky_radiance(const glm::vec3& d) const {
@@ -265,9 +308,10 @@ struct FrameTracer::Impl {
     return color + albedo * ambient * visible;
   }
 
-  // Radiance along a ray; `primary` receives the first hit (t = +inf on a miss).
-  glm::vec3 trace(const glm::vec3& o, const glm::vec3& d, uint32_t bounce, Rng* rng, uint64_t* rays,
-                  Hit* primary, bool* hit_any) const {
+  // Radiance along a ray whose footprint is `cone`; `primary` receives the first hit (t = +inf on
+  // a miss).
+  glm::vec3 trace(const glm::vec3& o, const glm::vec3& d, const Cone& cone, uint32_t bounce,
+                  Rng* rng, uint64_t* rays, Hit* primary, bool* hit_any) const {
     Hit h;
     if (!intersect(o, d, 0, INFINITY, &h, rays)) {
       if (hit_any) *hit_any = false;
@@ -282,7 +326,10 @@ struct FrameTracer::Impl {
     const Material& m = materials[geometries[h.geom].material];
     glm::vec3 color = m.emission;
     const float w_diffuse = std::max(0.0f, 1 - m.reflect - m.refract);
-    if (w_diffuse > 0) color += w_diffuse * diffuse(p, n, m.albedo, rng, rays);
+    const Cone at_hit{cone.width + cone.spread * h.t, cone.spread};
+    if (w_diffuse > 0) {
+      color += w_diffuse * diffuse(p, n, albedo_at(h, m, d, at_hit.width), rng, rays);
+    }
     if (m.reflect > 0 || m.refract > 0) {
       const float eps = epsilon(p);
       if (bounce >= options.max_bounces) {
@@ -290,17 +337,17 @@ struct FrameTracer::Impl {
       } else {
         glm::vec3 reflected = d - 2 * glm::dot(d, n) * n;
         if (m.reflect > 0) {
-          color +=
-              m.reflect * trace(p + n * eps, reflected, bounce + 1, rng, rays, nullptr, nullptr);
+          color += m.reflect *
+                   trace(p + n * eps, reflected, at_hit, bounce + 1, rng, rays, nullptr, nullptr);
         }
         if (m.refract > 0) {
           float eta = front ? 1 / m.ior : m.ior;
           float cosi = -glm::dot(d, n);
           float k = 1 - eta * eta * (1 - cosi * cosi);
           glm::vec3 c =
-              k < 0 ? trace(p + n * eps, reflected, bounce + 1, rng, rays, nullptr, nullptr)
+              k < 0 ? trace(p + n * eps, reflected, at_hit, bounce + 1, rng, rays, nullptr, nullptr)
                     : trace(p - n * eps, glm::normalize(eta * d + (eta * cosi - std::sqrt(k)) * n),
-                            bounce + 1, rng, rays, nullptr, nullptr);
+                            at_hit, bounce + 1, rng, rays, nullptr, nullptr);
           color += m.refract * c;
         }
       }
@@ -308,13 +355,15 @@ struct FrameTracer::Impl {
     return color;
   }
 
-  // One pixel: colour, depth and material of the primary hit.
-  void shade_pixel(const glm::vec3& o, const glm::vec3& d, uint64_t key, uint64_t noise_key,
-                   float* rgb, float* depth, float* material, uint64_t* rays) const {
+  // One pixel: colour, depth and material of the primary hit; `spread` is the pixel's angular
+  // width (pixel_spread), which sets the texture filter's footprint.
+  void shade_pixel(const glm::vec3& o, const glm::vec3& d, float spread, uint64_t key,
+                   uint64_t noise_key, float* rgb, float* depth, float* material,
+                   uint64_t* rays) const {
     Rng rng(key);
     Hit h;
     bool hit = false;
-    glm::vec3 c = trace(o, d, 0, &rng, rays, &h, &hit);
+    glm::vec3 c = trace(o, d, Cone{0, spread}, 0, &rng, rays, &h, &hit);
     if (options.noise > 0) {
       Rng n(noise_key);
       c *= 1 + options.noise * (2 * n.uniform() - 1);
@@ -373,6 +422,7 @@ Expected<std::unique_ptr<FrameTracer>> FrameTracer::create(const Scene& scene, d
   auto impl = std::make_unique<Impl>();
   impl->options = options;
   impl->materials = scene.materials;
+  impl->textures = scene.textures;
   impl->sky = scene.sky;
   float sl = glm::length(scene.sky.sun_direction);
   impl->sun_dir = sl > 0 ? scene.sky.sun_direction / sl : glm::vec3(0, 1, 0);
@@ -439,6 +489,8 @@ Expected<std::unique_ptr<FrameTracer>> FrameTracer::create(const Scene& scene, d
       if (!g.spheres) {
         if (o.mesh.triangles.empty()) continue;
         g.triangles = o.mesh.triangles;
+        const Material& mat = scene.materials[o.material];
+        if (mat.base_color_texture != capture::kNoTexture) g.uvs = o.mesh.uvs;
         positions_at(o.mesh, time, &positions);
         g.positions.reserve(positions.size());
         for (const glm::vec3& p : positions) g.positions.emplace_back(m * glm::vec4(p, 1));
@@ -502,8 +554,11 @@ RenderStats FrameTracer::render_cube(const Vec3& center, uint32_t view, uint32_t
       const glm::vec3 d =
           to_fvec3(direction_from_texel(cube_face_from_index(static_cast<int>(face)), x, y, n));
       const size_t i = (static_cast<size_t>(face) * n + y) * n + x;
+      // A face is a pinhole image 2 wide at distance 1 along its major axis.
+      const float spread = pixel_spread(2.0f / static_cast<float>(n),
+                                        std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)}));
       // AO keys leave the frame out: static surfaces get the same samples every frame.
-      im.shade_pixel(o, d, pixel_key(im.options.seed, view, face, x, y),
+      im.shade_pixel(o, d, spread, pixel_key(im.options.seed, view, face, x, y),
                      pixel_key(im.options.seed ^ 0xA5A5A5A5ull, view, face * n + y, x, frame),
                      &out->color[3 * i], &out->depth[i],
                      with_material ? &out->material[3 * i] : nullptr, rays);
@@ -524,6 +579,9 @@ RenderStats FrameTracer::render_perspective(const capture::EyePose& pose, uint32
   const Camera camera = capture::camera_from_pose(pose, width, height);
   const CameraFrame frame = camera_frame(camera);
   const glm::vec3 o = to_fvec3(pose.position);
+  const glm::vec3 axis = to_fvec3(frame.forward);
+  const float plane_pixel =
+      static_cast<float>(2 * std::tan(camera.fov_y / 2) / static_cast<double>(height));
   RenderStats stats;
   stats.rays = im.parallel_rows(height, [&](uint32_t j, uint64_t* rays) {
     for (uint32_t i = 0; i < width; ++i) {
@@ -531,7 +589,8 @@ RenderStats FrameTracer::render_perspective(const capture::EyePose& pose, uint32
       const size_t k = static_cast<size_t>(j) * width + i;
       // Ground truth uses view id 2^32 - 1 - eye, never a capture view's.
       uint64_t view_id = 0xFFFFFFFFull - static_cast<uint64_t>(pose.eye);
-      im.shade_pixel(o, d, pixel_key(im.options.seed, view_id, 0, i, j),
+      im.shade_pixel(o, d, pixel_spread(plane_pixel, glm::dot(d, axis)),
+                     pixel_key(im.options.seed, view_id, 0, i, j),
                      pixel_key(im.options.seed ^ 0xA5A5A5A5ull, view_id, j, i, pose_index),
                      &out->color[3 * k], &out->depth[k], nullptr, rays);
     }

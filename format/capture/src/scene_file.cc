@@ -17,6 +17,7 @@
 #include <set>
 #include <system_error>
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include "calf/capture/capture_set.h"
@@ -806,13 +807,15 @@ std::string oiio_error(const std::string& fallback) {
   return e.empty() ? fallback : e;
 }
 
-Status read_texture(const std::filesystem::path& path, SceneTexture* t) {
-  const std::string name = path.string();
+// Decodes the image `name` (read through `proxy` when given, else from the file of that name).
+Status decode_image(const std::string& name, OIIO::Filesystem::IOProxy* proxy, SceneTexture* t) {
   try {
     // Unassociated alpha: the bytes of the file, not colour premultiplied by alpha.
     OIIO::ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);
-    std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(name, &config);
+    // The readers of OpenImageIO 2.4 take the proxy from the configuration, not the argument.
+    if (proxy) config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
+    std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(name, &config, proxy);
     if (!in) return Status(ErrorId::kSceneFileTexture, name + ": " + oiio_error("cannot decode"));
     const OIIO::ImageSpec& spec = in->spec();
     if (spec.width < 1 || spec.height < 1 || spec.width > static_cast<int>(kSceneMaxTextureSize) ||
@@ -1062,9 +1065,33 @@ Expected<SceneFile> read_scene_file(const std::filesystem::path& directory) {
     const std::string field = "textures[" + std::to_string(i) + "].uri";
     CALF_ASSIGN_OR_RETURN(std::filesystem::path path, confined(directory, t.path, field));
     CALF_RETURN_IF_ERROR(regular_file_size(path, "texture").status());
-    CALF_RETURN_IF_ERROR(read_texture(path, &t));
+    CALF_RETURN_IF_ERROR(read_texture_image(path, &t));
   }
   return scene;
+}
+
+Status read_texture_image(const std::filesystem::path& path, SceneTexture* texture) {
+  return decode_image(path.string(), nullptr, texture);
+}
+
+Status decode_texture_image(std::span<const uint8_t> bytes, std::string_view format_hint,
+                            std::string_view name, SceneTexture* texture) {
+  // OpenImageIO picks its reader by the name's extension; the magic numbers of the formats
+  // models embed win over a hint that may be wrong or empty.
+  std::string ext(format_hint);
+  if (bytes.size() >= 8 && std::memcmp(bytes.data(), "\x89PNG\r\n\x1a\n", 8) == 0) {
+    ext = "png";
+  } else if (bytes.size() >= 3 && bytes[0] == 0xff && bytes[1] == 0xd8 && bytes[2] == 0xff) {
+    ext = "jpg";
+  }
+  if (ext.empty() || ext.find_first_of("./\\") != std::string::npos) {
+    return Status(ErrorId::kSceneFileTexture,
+                  std::string(name) + ": an image of unknown format (not PNG or JPEG, no hint)");
+  }
+  OIIO::Filesystem::IOMemReader reader(bytes.data(), bytes.size());
+  Status s = decode_image("embedded." + ext, &reader, texture);
+  if (s.ok()) return s;
+  return Status(s.id(), std::string(name) + " (" + ext + "): " + s.message());
 }
 
 Status write_scene_file(const SceneFile& scene, const std::filesystem::path& directory) {

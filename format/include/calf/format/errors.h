@@ -141,6 +141,9 @@ enum class ErrorKind : uint8_t {
   X(kSurfelWriterMisuse, 187, kInvalidArgument, "the candidate writer got inconsistent arrays") \
   X(kSurfelOption, 188, kInvalidArgument, "a surfel-candidate option is outside its range")     \
   X(kSurfelSceneMismatch, 189, kInvalidArgument, "surfel candidates do not belong to the scene") \
+  /* model textures: 190-194 */                                                                \
+  X(kModelTextureMissing, 190, kIo, "a texture a model's material references is missing")       \
+  X(kModelTexture, 191, kCorrupt, "a model's texture cannot be decoded or is too large")         \
   /* encoder: 200-299 */                                                                        \
   X(kEncoderOption, 200, kInvalidArgument, "an encoder option is outside its range")          \
   X(kEncoderInput, 201, kCorrupt, "the capture set contradicts itself or the chosen options")  \

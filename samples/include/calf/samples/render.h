@@ -2,6 +2,9 @@
 //
 // Shading, per primary ray (paper 002's challenges: shading that changes where depth does not,
 // mirrors and glass):
+//   - diffuse reflectance = material albedo x base-colour texture, the texture filtered
+//     trilinearly at the hit's UV with a mip level from the ray cone's footprint (texture.h; the
+//     cone starts with the pixel's angular width and widens over mirror / glass bounces);
 //   - direct light from point lights and the sun, with shadow rays;
 //   - ambient occlusion: `ao_samples` cosine-distributed rays per diffuse hit, each lit by the
 //     scene's ambient radiance when it travels ao_distance unobstructed;

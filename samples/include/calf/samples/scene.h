@@ -22,6 +22,7 @@
 #include "calf/capture/capture_set.h"
 #include "calf/capture/eye_path.h"
 #include "calf/format/status.h"
+#include "calf/samples/texture.h"
 
 namespace calf::samples {
 
@@ -29,8 +30,12 @@ namespace calf::samples {
 // reflect * (mirror ray) + refract * (refracted ray); the weights are what a capture set's material
 // channels record at a primary hit (paper 002, Sec. 6.1). No Fresnel term: the weights are the
 // same from every direction, so that a reconstruction from the material stream can match.
+// The diffuse reflectance is albedo x the base-colour texture (when there is one and the hit
+// triangle's mesh has UVs), filtered at the hit (texture.h); glTF's base colour factor, OBJ's Kd.
 struct Material {
-  glm::vec3 albedo{0.7f};    // diffuse reflectance, each channel in [0, 1]
+  glm::vec3 albedo{0.7f};  // diffuse reflectance (factor), each channel in [0, 1]
+  // Index into Scene::textures, or capture::kNoTexture.
+  uint32_t base_color_texture = capture::kNoTexture;
   glm::vec3 emission{0.0f};  // emitted radiance, may exceed 1 (HDR)
   float reflect = 0;         // mirror weight in [0, 1]
   float refract = 0;         // glass weight in [0, 1], reflect + refract <= 1
@@ -50,6 +55,9 @@ struct Material {
 struct TriangleMesh {
   std::vector<glm::vec3> positions;
   std::vector<glm::uvec3> triangles;
+  // Empty, or one finite texture coordinate per vertex: a scene file's convention (u from the
+  // image's left edge, v down from its top row; texture.h). Vertex states do not move UVs.
+  std::vector<glm::vec2> uvs;
   std::vector<float> state_times;          // empty, or 1..4096 finite, >= 0, increasing
   std::vector<glm::vec3> state_positions;  // state_times.size() * positions.size(), state-major
   std::string name;                        // informative: the scene-file name of a shared mesh
@@ -122,6 +130,8 @@ struct Scene {
   std::string name;
   std::string description;
   std::vector<Material> materials;
+  // Base-colour textures, shared (a texture is decoded and mip-mapped once, at load).
+  std::vector<std::shared_ptr<const Texture>> textures;
   std::vector<Object> objects;
   std::vector<PointLight> lights;
   Sky sky;
@@ -142,7 +152,8 @@ struct Scene {
   size_t sphere_count() const;
 };
 
-// Checks indices, finiteness, radii, material ranges and vertex states (times finite, >= 0,
+// Checks indices, finiteness, radii, material ranges, texture indices and sizes, UVs (one finite
+// pair per vertex, or none) and vertex states (times finite, >= 0,
 // strictly increasing, at most 4096; one finite position per vertex per state) at time 0, each
 // shared mesh once. Errors: E173 empty, E174 (naming the object and what is wrong).
 Status validate_scene(const Scene& scene);
@@ -165,11 +176,18 @@ Expected<Scene> make_builtin_scene(std::string_view name);
 
 // Loads glTF / GLB / OBJ / PLY / FBX (anything assimp imports) with the node animations of its
 // first animation (sampled with linear / spherical interpolation, held at the ends). Materials: the
-// diffuse and emissive colours; reflectivity as mirror weight; 1 - opacity as glass weight with the
-// file's refraction index. Lights and cameras in the file are ignored: the scene gets a sun and
-// sky, a ring rig around the model's bounds and a validation path between its viewpoints. Frame
+// diffuse (glTF: base colour factor) and emissive colours; reflectivity as mirror weight;
+// 1 - opacity as glass weight with the file's refraction index; the base-colour texture (glTF
+// baseColorTexture, else the diffuse texture: OBJ map_Kd, FBX DiffuseColor) with the mesh's UV
+// channel 0, which the colour multiplies (FBX: the texture replaces the colour, as FBX tools
+// show it). A texture is an external file (relative to the model; backslashes read as '/'; then
+// the file's name alone in the model's folder) or one embedded in the model (GLB, FBX), decoded
+// by OpenImageIO (PNG, JPEG, ...). Lights and cameras in the file are ignored: the scene gets a sun
+// and sky, a ring rig around the model's bounds and a validation path between its viewpoints. Frame
 // count: the animation's duration at 30 fps (at least 1 frame), capped at 300. Errors: E002 missing
-// file, E172 unsupported extension, E171 import failure, E173 no triangles, E174 bad geometry.
+// file, E172 unsupported extension, E171 import failure, E173 no triangles, E174 bad geometry
+// (non-finite UVs too), E190 a referenced texture file is missing, E191 a texture cannot be
+// decoded or is larger than 16384 x 16384 (each naming the texture and the material).
 Expected<Scene> load_scene_file(const std::filesystem::path& path);
 
 // A built-in name, else a file path. E170 when it is neither.

@@ -110,6 +110,16 @@ struct SceneTexture {
   friend bool operator==(const SceneTexture&, const SceneTexture&) = default;
 };
 
+// Decodes an image file into `texture`'s width, height and 8-bit RGBA by SCENE.md "Texture"'s
+// rules (grey spreads to RGB, missing alpha is opaque, at most 16384 x 16384); `path` is left
+// alone. E159 when it cannot be decoded or is too large. read_scene_file reads textures with it.
+Status read_texture_image(const std::filesystem::path& path, SceneTexture* texture);
+// The same for an image in memory (one embedded in a model file): PNG and JPEG are recognised by
+// their first bytes, anything else OpenImageIO reads from memory by `format_hint` (an extension
+// such as "png", without the dot). `name` names the image in messages. E159 as above.
+Status decode_texture_image(std::span<const uint8_t> bytes, std::string_view format_hint,
+                            std::string_view name, SceneTexture* texture);
+
 // A surface (samples::Material plus a texture). Weights as CAPTURE.md "Conventions".
 struct SceneMaterial {
   std::string name;
