@@ -120,7 +120,9 @@ TEST(SurfelPrefixProperty, EveryPrefixRendersAndPrefixesNest) {
       const player::RenderedImage im = render(draw_list(c, built->order, length, 0.09f));
       size_t covered = 0;
       for (float d : im.depth) covered += std::isfinite(d) ? 1 : 0;
-      if (length == 0) EXPECT_EQ(covered, 0u);
+      if (length == 0) {
+        EXPECT_EQ(covered, 0u);
+      }
       if (length > 0) {
         // Nested: what the shorter prefix covers stays covered, never farther, and keeps its
         // colour where its depth is unchanged.
