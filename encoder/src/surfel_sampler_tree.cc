@@ -15,9 +15,11 @@
 // distance of every point in the box: a skipped candidate has distance >= bound >= node maximum
 // >= its current value, and the reference's minimum would have kept that value. The values are
 // therefore the reference's, bit for bit, and the choice (largest, then smallest candidate index)
-// is the same. The tree's shape only changes the speed, never the order.
+// is the same. The tree's shape only changes the speed, never the order. (This needs both files
+// to evaluate the expression alike: calf builds for baseline x86-64, where nothing is contracted
+// into a fused multiply-add; tests/encoder/surfel_sampler_test.cc compares the two orders.)
 //
-// The tree. Candidates are sorted along a Morton curve (30-bit codes, a stable radix sort) so that
+// The tree. Candidates are sorted along a Morton curve (24-bit codes, a stable radix sort) so that
 // runs of consecutive candidates are small boxes; the leaves are runs of kLeaf candidates, the
 // inner nodes a complete binary tree over them (heap order, leaves padded to a power of two).
 #include <algorithm>

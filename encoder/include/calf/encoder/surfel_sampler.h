@@ -23,11 +23,13 @@
 //   them; choosing a surfel updates only the nodes whose box is nearer to it than their largest
 //   distance (in effect the new surfel's Voronoi cell, about N / i candidates at step i), and the
 //   next surfel is the root's farthest. Single-threaded; `threads` does not change it. O(N)
-//   memory (about 36 bytes a candidate while the tree is built, 22 after).
+//   memory (about 36 bytes a candidate while the tree is built, 22 after). The options below
+//   marked "Progressive" do not apply; `seed` picks the first surfel.
 //
-// - kProgressive, the paper's sampler (Sec. 3.2), kept to compare with the paper. The first surfel
-// is drawn with `seed`
-//   from the input set (all candidates; the same draw as kExactGreedy's first). Then rounds:
+// - kProgressive, the paper's sampler (Sec. 3.2), kept to compare with the paper (its prefixes'
+//   r_min / r_max is 4-20 % below the greedy permutation's, docs/SURFELS.md). The first surfel is
+//   drawn with `seed` from the input set (all candidates; the same draw as kExactGreedy's first).
+//   Then rounds:
 //   1. Draw `round_samples` candidates uniformly without replacement from the input set (fewer
 //      when fewer remain) and find each one's distance to the chosen set with a hashed uniform
 //      grid over the chosen surfels (cell size following the current spacing, rebuilt whenever
