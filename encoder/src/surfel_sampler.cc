@@ -1,6 +1,6 @@
 // The entry points of the surfel orderings (calf/encoder/surfel_sampler.h): input checks, the
-// random baseline, r_m, and the prefix for a surfel radius (paper 001 Sec. 4.1). The progressive
-// sampler and the exact greedy permutation have a file each.
+// random baseline and r_m (paper 001 Sec. 4.1). The greedy permutation through a tree, the
+// progressive sampler and the plain exact greedy permutation have a file each.
 #include "calf/encoder/surfel_sampler.h"
 
 #include <algorithm>
@@ -22,9 +22,9 @@ Status option_error(const std::string& what) {
 
 Status check_options(const SurfelSamplerOptions& o) {
   if (o.method != SurfelOrderMethod::kProgressive && o.method != SurfelOrderMethod::kExactGreedy &&
-      o.method != SurfelOrderMethod::kRandom)
+      o.method != SurfelOrderMethod::kRandom && o.method != SurfelOrderMethod::kGreedyTree)
     return option_error("method " + std::to_string(static_cast<int>(o.method)) +
-                        " is not progressive (0), exact (1) or random (2)");
+                        " is not progressive (0), exact (1), random (2) or greedy-tree (3)");
   if (o.round_samples < 1 || o.round_samples > kSurfelMaxRoundSamples)
     return option_error("round_samples " + std::to_string(o.round_samples) + " is not in 1.." +
                         std::to_string(kSurfelMaxRoundSamples));
@@ -66,6 +66,8 @@ const char* surfel_order_method_name(SurfelOrderMethod method) {
       return "exact";
     case SurfelOrderMethod::kRandom:
       return "random";
+    case SurfelOrderMethod::kGreedyTree:
+      return "greedy-tree";
   }
   return "unknown";
 }
@@ -104,6 +106,9 @@ Expected<SurfelOrder> order_surfels(std::span<const Vec3> candidates, uint32_t n
       break;
     case SurfelOrderMethod::kRandom:
       result.order = order_random(candidates.size(), n, options.seed);
+      break;
+    case SurfelOrderMethod::kGreedyTree:
+      result.order = surfel_internal::order_greedy_tree(candidates, n, options);
       break;
   }
   if (result.order.size() != n)

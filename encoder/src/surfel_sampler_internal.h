@@ -110,5 +110,7 @@ std::vector<uint32_t> order_progressive(std::span<const Vec3> candidates, uint32
                                         const SurfelSamplerOptions& options);
 std::vector<uint32_t> order_exact_greedy(std::span<const Vec3> candidates, uint32_t n,
                                          const SurfelSamplerOptions& options);
+std::vector<uint32_t> order_greedy_tree(std::span<const Vec3> candidates, uint32_t n,
+                                        const SurfelSamplerOptions& options);
 
 }  // namespace calf::surfel_internal

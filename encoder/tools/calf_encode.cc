@@ -306,7 +306,7 @@ int main(int argc, char** argv) {
                           "docs/VISIBILITY.md")
                ->check(CLI::IsMember({"per-frame", "coupled"}))
                ->default_val("per-frame"));
-  std::string candidates, sampler = "progressive";
+  std::string candidates, sampler = "greedy-tree";
   calf::encoder::SurfelBuildOptions surfel_build;
   app.add_option("--surfel-candidates", candidates,
                  "surfels: the candidate file of the scene (calf-capture --surfel-candidates)");
@@ -316,19 +316,22 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1u, 1u << 26))
       ->default_val(65536);
   app.add_option("--surfel-sampler", sampler,
-                 "surfels: progressive (paper 001's approximate greedy permutation), exact (the "
-                 "greedy permutation, O(n N): slow) or random (default progressive)")
-      ->check(CLI::IsMember({"progressive", "exact", "random"}))
-      ->default_val("progressive");
+                 "surfels: greedy-tree (the greedy permutation through a tree of boxes, about "
+                 "O(N log n)), progressive (paper 001's approximate greedy permutation), exact "
+                 "(the same order as greedy-tree, plain O(n N): slow) or random (default "
+                 "greedy-tree)")
+      ->check(CLI::IsMember({"greedy-tree", "progressive", "exact", "random"}))
+      ->default_val("greedy-tree");
   if (int rc = calf::tools::parse_command_line(app, "calf-encode", argc, argv); rc >= 0) return rc;
   if (mode == "surfels") {
     if (candidates.empty() || vs.enabled) {
       return calf::tools::usage_error(
           "calf-encode", "--mode surfels needs --surfel-candidates and takes no --visible-set");
     }
-    surfel_build.sampler.method = sampler == "exact"    ? calf::SurfelOrderMethod::kExactGreedy
-                                  : sampler == "random" ? calf::SurfelOrderMethod::kRandom
-                                                        : calf::SurfelOrderMethod::kProgressive;
+    surfel_build.sampler.method = sampler == "exact"         ? calf::SurfelOrderMethod::kExactGreedy
+                                  : sampler == "random"      ? calf::SurfelOrderMethod::kRandom
+                                  : sampler == "progressive" ? calf::SurfelOrderMethod::kProgressive
+                                                             : calf::SurfelOrderMethod::kGreedyTree;
     surfel_build.sampler.threads = o.threads;
     return encode_surfels(manifest, candidates, out, super, o.threads, surfel_build);
   }

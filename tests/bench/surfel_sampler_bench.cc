@@ -11,10 +11,10 @@
 //   plane  a --candidates grid on the unit square (flat; spacing known: 1 / sqrt(n) for n
 //          surfels ideally)
 //
-// Limits beside the figures (issue 20): the progressive sampler >= 50x faster than the exact
-// permutation at 10k surfels; its r_min / r_max within 10 % of the exact one's.
-// Times: the median of --repeats runs (exact: one run, it takes seconds), wall clock on this
-// machine with --threads workers (the exact permutation is the only parallel part).
+// Limits beside the figures (issue 20): the sampler >= 50x faster than the exact permutation at
+// 10k surfels; its r_min / r_max within 10 % of the exact one's.
+// Times: the median of --repeats runs (exact: one run, it takes seconds), wall clock and process
+// CPU time with --threads workers (the exact permutation is the only parallel part).
 #include <fmt/core.h>
 #include <CLI/CLI.hpp>
 
@@ -91,6 +91,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--extend-below", base.extend_below, "progressive: extend a poor round")
       ->capture_default_str();
+  bool skip_progressive = false;
+  app.add_flag("--skip-progressive", skip_progressive, "leave the paper's sampler out");
   CLI11_PARSE(app, argc, argv);
   base.threads = threads;
 
@@ -102,18 +104,20 @@ int main(int argc, char** argv) {
       surface, points.size(), threads, base.round_samples, base.growth_period, base.max_accept,
       base.vicinity);
 
-  const calf::SurfelOrderMethod methods[] = {calf::SurfelOrderMethod::kProgressive,
-                                             calf::SurfelOrderMethod::kExactGreedy,
-                                             calf::SurfelOrderMethod::kRandom};
+  const calf::SurfelOrderMethod methods[] = {
+      calf::SurfelOrderMethod::kGreedyTree, calf::SurfelOrderMethod::kProgressive,
+      calf::SurfelOrderMethod::kExactGreedy, calf::SurfelOrderMethod::kRandom};
+  constexpr int kMethods = 4, kExact = 2;
   fmt::print(
-      "milliseconds, wall / CPU (median of runs); limit: exact / progressive >= 50 at 10k\n");
-  fmt::print("{:>8} {:>20} {:>20} {:>20} {:>16}\n", "surfels", "progressive", "exact", "random",
-             "exact/progr. cpu");
-  std::vector<std::vector<uint32_t>> longest(3);
+      "milliseconds, wall / CPU (median of runs); limit: exact / sampler >= 50 at 10k (CPU)\n");
+  fmt::print("{:>8} {:>20} {:>20} {:>20} {:>20} {:>12} {:>12}\n", "surfels", "greedy-tree",
+             "progressive", "exact", "random", "exact/tree", "exact/progr");
+  std::vector<std::vector<uint32_t>> longest(kMethods);
   for (uint32_t n : sizes) {
     if (n > points.size()) continue;
-    double ms[3] = {NAN, NAN, NAN}, cpu[3] = {NAN, NAN, NAN};
-    for (int m = 0; m < 3; ++m) {
+    double ms[kMethods] = {NAN, NAN, NAN, NAN}, cpu[kMethods] = {NAN, NAN, NAN, NAN};
+    for (int m = 0; m < kMethods; ++m) {
+      if (methods[m] == calf::SurfelOrderMethod::kProgressive && skip_progressive) continue;
       if (methods[m] == calf::SurfelOrderMethod::kExactGreedy && n > exact_max) continue;
       calf::SurfelSamplerOptions o = base;
       o.method = methods[m];
@@ -138,14 +142,25 @@ int main(int argc, char** argv) {
       cpu[m] = cpus[cpus.size() / 2];
     }
     auto cell = [](double w, double c) { return fmt::format("{:.1f} / {:.1f}", w, c); };
-    fmt::print("{:>8} {:>20} {:>20} {:>20} {:>16.1f}\n", n, cell(ms[0], cpu[0]),
-               cell(ms[1], cpu[1]), cell(ms[2], cpu[2]), cpu[1] / cpu[0]);
+    fmt::print("{:>8} {:>20} {:>20} {:>20} {:>20} {:>12.1f} {:>12.1f}\n", n, cell(ms[0], cpu[0]),
+               cell(ms[1], cpu[1]), cell(ms[2], cpu[2]), cell(ms[3], cpu[3]), cpu[kExact] / cpu[0],
+               cpu[kExact] / cpu[1]);
+  }
+  {
+    const size_t common = std::min(longest[0].size(), longest[kExact].size());
+    if (common > 0)
+      fmt::print(
+          "greedy-tree order {} the exact permutation's on its first {} surfels\n",
+          std::equal(longest[0].begin(), longest[0].begin() + common, longest[kExact].begin())
+              ? "equals"
+              : "DIFFERS FROM",
+          common);
   }
   std::fflush(stdout);
 
   fmt::print(
       "\nspacing of prefixes (nearest-neighbour distance within the prefix; limit: "
-      "progressive r_min/r_max within 10 % of exact's)\n");
+      "the sampler's r_min/r_max within 10 % of exact's)\n");
   fmt::print("{:>8} {:>12} {:>10} {:>10} {:>10} {:>10} {:>12}\n", "prefix", "method", "r_min",
              "r_median", "r_max", "min/max", "vs exact");
   std::vector<uint32_t> prefixes = {1000, 5000};
@@ -154,7 +169,7 @@ int main(int argc, char** argv) {
   prefixes.erase(std::unique(prefixes.begin(), prefixes.end()), prefixes.end());
   for (uint32_t p : prefixes) {
     double exact_rho = NAN;
-    for (int m : {1, 0, 2}) {
+    for (int m : {kExact, 0, 1, 3}) {
       if (longest[m].size() < p) continue;
       auto s = calf::prefix_spacing(points, longest[m], p, threads);
       if (!s.ok()) {
@@ -162,7 +177,7 @@ int main(int argc, char** argv) {
         return 1;
       }
       const double rho = s->r_min / s->r_max;
-      if (m == 1) exact_rho = rho;
+      if (m == kExact) exact_rho = rho;
       fmt::print("{:>8} {:>12} {:>10.5f} {:>10.5f} {:>10.5f} {:>10.3f} {:>11.1f}%\n", p,
                  calf::surfel_order_method_name(methods[m]), s->r_min, s->r_median, s->r_max, rho,
                  100.0 * (rho / exact_rho - 1.0));

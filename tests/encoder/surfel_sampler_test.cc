@@ -1,7 +1,8 @@
 // Tests of the surfel orderings (encoder/include/calf/encoder/surfel_sampler.h): orders are
 // permutations whose prefixes nest, the exact greedy permutation meets its definition (brute
-// force), the progressive sampler spreads prefixes far better than random, results do not
-// depend on the thread count, p(r) on hand-computed values, and every error id.
+// force), the greedy permutation through a tree is the exact one element for element, the
+// progressive sampler spreads prefixes far better than random, results do not depend on the
+// thread count, r_m on hand-computed values, and every error id.
 #include "calf/encoder/surfel_sampler.h"
 
 #include <gtest/gtest.h>
@@ -16,7 +17,8 @@ namespace calf {
 namespace {
 
 constexpr SurfelOrderMethod kMethods[] = {
-    SurfelOrderMethod::kProgressive, SurfelOrderMethod::kExactGreedy, SurfelOrderMethod::kRandom};
+    SurfelOrderMethod::kGreedyTree, SurfelOrderMethod::kProgressive,
+    SurfelOrderMethod::kExactGreedy, SurfelOrderMethod::kRandom};
 
 // side x side grid on the unit square (z = 0): a flat surface whose ideal spacing is known.
 std::vector<Vec3> plane_grid(int side) {
@@ -113,6 +115,49 @@ TEST(SurfelSamplerTest, ExactGreedySatisfiesItsDefinition) {
     radius.push_back(r);
   }
   for (size_t i = 1; i < radius.size(); ++i) EXPECT_LE(radius[i], radius[i - 1] * (1 + 1e-6));
+}
+
+// The tree (kGreedyTree) against the plain reference (kExactGreedy): the same order, element for
+// element, to the last candidate, on inputs that stress its pruning and its ties: a closed
+// surface; a volume with a far slab; a grid (many exactly equal distances, ties to the smallest
+// index); coincident points (distance 0 among the remaining, a leaf whose candidates are all
+// covered); a line; far outliers (boxes of very different sizes); more candidates than a leaf
+// holds by one; and one or two candidates.
+TEST(SurfelSamplerTest, GreedyTreeIsTheExactGreedyPermutation) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<std::pair<const char*, std::vector<Vec3>>> inputs;
+  inputs.emplace_back("sphere", sphere(2000));
+  std::vector<Vec3> slab;
+  for (int i = 0; i < 700; ++i) slab.push_back({u(rng), u(rng), u(rng)});
+  for (int i = 0; i < 300; ++i) slab.push_back({u(rng), 0.25 * u(rng), 2.0});
+  inputs.emplace_back("volume and slab", slab);
+  inputs.emplace_back("grid", plane_grid(37));
+  std::vector<Vec3> dup;
+  for (int i = 0; i < 300; ++i) dup.push_back({double(i % 7), 0.0, double(i % 3)});
+  for (int i = 0; i < 90; ++i) dup.push_back({0.5, 0.5, 0.5});
+  inputs.emplace_back("coincident", dup);
+  std::vector<Vec3> line;
+  for (int i = 0; i < 500; ++i) line.push_back({0.001 * ((i * 37) % 500), 0.0, 0.0});
+  inputs.emplace_back("line", line);
+  std::vector<Vec3> outliers = sphere(600);
+  outliers.push_back({1e4, -3e3, 7});
+  outliers.push_back({-2e3, 5e3, 1e-3});
+  for (Vec3& p : outliers) p.x *= 1e-3;  // a very flat sphere beside far points
+  inputs.emplace_back("outliers", outliers);
+  inputs.emplace_back("33 points", sphere(33));
+  inputs.emplace_back("one", std::vector<Vec3>{{1, 2, 3}});
+  inputs.emplace_back("two", std::vector<Vec3>{{1, 2, 3}, {1, 2, 3.5}});
+  for (const auto& [name, c] : inputs) {
+    SCOPED_TRACE(name);
+    const auto n = static_cast<uint32_t>(c.size());
+    for (uint64_t seed : {7u, 8u}) {
+      const SurfelOrder tree = order(c, n, with(SurfelOrderMethod::kGreedyTree, 1, seed));
+      const SurfelOrder exact = order(c, n, with(SurfelOrderMethod::kExactGreedy, 2, seed));
+      EXPECT_EQ(tree.order, exact.order) << "seed " << seed;
+      EXPECT_EQ(tree.r_m, exact.r_m);
+    }
+  }
 }
 
 // Spreading on a known surface: 40,000 candidates drawn uniformly on the unit square (not a grid,

@@ -14,19 +14,22 @@
 // surfels track) and every distance below is the Euclidean distance between those float points,
 // computed in float (squared distances compared; no square root decides anything).
 //
-// The three methods (SurfelOrderMethod):
+// The four methods (SurfelOrderMethod):
 //
-// - kExactGreedy, the reference: the greedy permutation (farthest-first traversal, Eppstein et
-//   al. 2015). The first surfel is a candidate drawn with `seed`; each next one is the remaining
-//   candidate whose distance to the chosen set is largest (ties: the smallest candidate index).
-//   Every prefix P is then an r-net for r = the distance at which its last point was chosen
-//   (paper Sec. 4.1). It keeps one distance per candidate and updates all of them per accepted
-//   surfel: O(n N) time for n surfels of N candidates, O(N) memory, split over `threads` (the
-//   reduction "largest distance, then smallest index" is exact, so the result does not depend on
-//   how the candidates are split). Meant as the quality reference and for small objects.
+// - kGreedyTree (default): the greedy permutation below (kExactGreedy's order, element for
+//   element, proven so in encoder/src/surfel_sampler_tree.cc and tested against it), computed in
+//   about O(N log n) instead of O(n N). The candidates sit in the leaves of a binary tree of
+//   boxes (Morton order, 32 a leaf) whose nodes keep the largest distance to the chosen set below
+//   them; choosing a surfel updates only the nodes whose box is nearer to it than their largest
+//   distance (in effect the new surfel's Voronoi cell, about N / i candidates at step i), and the
+//   next surfel is the root's farthest. Single-threaded; `threads` does not change it. O(N)
+//   memory (about 36 bytes a candidate while the tree is built, 22 after). The options below
+//   marked "Progressive" do not apply; `seed` picks the first surfel.
 //
-// - kProgressive (default), the paper's sampler (Sec. 3.2). The first surfel is drawn with `seed`
-//   from the input set (all candidates; the same draw as kExactGreedy's first). Then rounds:
+// - kProgressive, the paper's sampler (Sec. 3.2), kept to compare with the paper (its prefixes'
+//   r_min / r_max is 4-20 % below the greedy permutation's, docs/SURFELS.md). The first surfel is
+//   drawn with `seed` from the input set (all candidates; the same draw as kExactGreedy's first).
+//   Then rounds:
 //   1. Draw `round_samples` candidates uniformly without replacement from the input set (fewer
 //      when fewer remain) and find each one's distance to the chosen set with a hashed uniform
 //      grid over the chosen surfels (cell size following the current spacing, rebuilt whenever
@@ -94,12 +97,13 @@
 namespace calf {
 
 enum class SurfelOrderMethod : uint8_t {
-  kProgressive = 0,  // the paper's randomized rounds (default)
-  kExactGreedy = 1,  // the exact greedy permutation (reference)
+  kProgressive = 0,  // the paper's randomized rounds
+  kExactGreedy = 1,  // the greedy permutation, plain O(n N) (reference)
   kRandom = 2,       // a uniformly random permutation (baseline)
+  kGreedyTree = 3,   // the greedy permutation through a tree of boxes (default)
 };
 
-// "progressive", "exact", "random".
+// "progressive", "exact", "random", "greedy-tree".
 const char* surfel_order_method_name(SurfelOrderMethod method);
 
 // Limits of the options (checked by order_surfels: CALF-E243).
@@ -108,7 +112,7 @@ inline constexpr uint32_t kSurfelMaxThreads = 256;
 inline constexpr uint32_t kSurfelMaxExtensions = 4;
 
 struct SurfelSamplerOptions {
-  SurfelOrderMethod method = SurfelOrderMethod::kProgressive;
+  SurfelOrderMethod method = SurfelOrderMethod::kGreedyTree;
   // Seeds the first surfel (all methods) and the random draws (progressive, random).
   uint64_t seed = 0x243f6a8885a308d3ull;
   // Progressive: samples drawn per round, 1 .. kSurfelMaxRoundSamples (paper: ~200 "yield a
@@ -131,8 +135,8 @@ struct SurfelSamplerOptions {
   double extend_below = 0.9;
   // The prefix length whose median nearest-neighbour distance is r_m (paper: p_m = 1000), >= 1.
   uint32_t p_m = 1000;
-  // Worker threads for the exact greedy permutation and for r_m (0: hardware concurrency), at
-  // most kSurfelMaxThreads. The order never depends on it.
+  // Worker threads for kExactGreedy and for r_m (0: hardware concurrency), at most
+  // kSurfelMaxThreads. The order never depends on it.
   uint32_t threads = 0;
 };
 
