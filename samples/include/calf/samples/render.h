@@ -87,8 +87,9 @@ class FrameTracer {
   FrameTracer& operator=(const FrameTracer&) = delete;
 
   // Renders the cube map centred at `center` into `out` (resized to `face_size`, with material
-  // channels when `with_material`). `view` and `frame` only seed random numbers. Each texel's ray
-  // is calf::direction_from_texel(face, x, y, face_size).
+  // channels when `with_material`). `view` and `frame` only seed random numbers. Each texel's
+  // centre ray (depth, material; the colour when spp is 1) is calf::direction_from_texel(face, x,
+  // y, face_size); colour samples lie in its square, calf::direction_from_texel_coord.
   RenderStats render_cube(const Vec3& center, uint32_t view, uint32_t frame, uint32_t face_size,
                           bool with_material, capture::ViewFrame* out) const;
 
