@@ -40,6 +40,8 @@ int contradiction(const std::string& message) {
 
 struct HeadlessArgs {
   std::string eye_path, out, compare, format = "png", contact_sheet;
+  // --noise-floor: ground truth of the same path with another seed (default GT_DIR/noise-floor).
+  std::string noise_floor;
   // --compare-clip: the full-scene clip played beside CLIP for epsilon (paper 004).
   std::string compare_clip;
   uint32_t sheet_rows = 8;
@@ -103,6 +105,31 @@ int run_headless(Playback& play, Playback* full, const HeadlessArgs& a) {
     return fail(Status(ErrorId::kPlaybackOption,
                        path_file.string() + " names no ground-truth images to compare with"));
   }
+  // The noise floor: the ground truth against the same poses rendered with another seed
+  // (format/CAPTURE.md, "Noise floor"); no figure measures the reconstruction more finely.
+  fs::path floor_dir;
+  if (!gt_dir.empty()) {
+    std::error_code ec;
+    if (!a.noise_floor.empty()) {
+      floor_dir = a.noise_floor;
+    } else if (fs::exists(gt_dir / capture::kNoiseFloorDirName / capture::kEyePathFileName, ec)) {
+      floor_dir = gt_dir / capture::kNoiseFloorDirName;
+    }
+  }
+  capture::EyePath floor_path;
+  if (!floor_dir.empty()) {
+    auto f = capture::read_eye_path(floor_dir / capture::kEyePathFileName);
+    if (!f.ok()) return fail(f.status());
+    floor_path = std::move(*f);
+    if (floor_path.image_pattern.empty() || floor_path.poses != path.poses ||
+        floor_path.width != path.width || floor_path.height != path.height) {
+      return fail(Status(ErrorId::kPlaybackOption,
+                         (floor_dir / capture::kEyePathFileName).string() +
+                             " is not ground truth of the same poses and image size"));
+    }
+  }
+  double floor_sum_psnr = 0, floor_sum_ssim = 0, floor_min_psnr = INFINITY;
+  size_t floor_min_pose = 0;
   if (!a.out.empty()) {
     std::error_code ec;
     fs::create_directories(a.out, ec);
@@ -217,6 +244,20 @@ int run_headless(Playback& play, Playback* full, const HeadlessArgs& a) {
         auto s = ssim(rgb_ref(image), rgb_ref(*gt));
         if (!s.ok()) return fail(s.status());
         std::printf(", PSNR %.2f dB, SSIM %.4f", *p, *s);
+        if (!floor_dir.empty()) {
+          auto other = capture::read_perspective_image(floor_dir /
+                                                       capture::eye_image_file_name(floor_path, k));
+          if (!other.ok()) return fail(other.status());
+          auto fp = psnr(rgb_ref(*gt), rgb_ref(*other));
+          if (!fp.ok()) return fail(fp.status());
+          auto fssim = ssim(rgb_ref(*gt), rgb_ref(*other));
+          if (!fssim.ok()) return fail(fssim.status());
+          const double clamped = std::min(*fp, 100.0);
+          std::printf(" (noise floor %.2f dB, %.4f)", clamped, *fssim);
+          floor_sum_psnr += clamped;
+          floor_sum_ssim += *fssim;
+          if (clamped < floor_min_psnr) floor_min_psnr = clamped, floor_min_pose = k;
+        }
         sum_psnr += std::min(*p, 100.0);  // an exact frame counts as 100 dB, not infinity
         sum_ssim += *s;
         ++compared;
@@ -263,6 +304,18 @@ int run_headless(Playback& play, Playback* full, const HeadlessArgs& a) {
     std::printf("mean PSNR %.2f dB, mean SSIM %.4f\n", sum_psnr / compared, sum_ssim / compared);
     std::printf("worst pose: PSNR %.2f dB (pose %zu), SSIM %.4f (pose %zu)\n", min_psnr,
                 min_psnr_pose, min_ssim, min_ssim_pose);
+    if (!floor_dir.empty()) {
+      std::printf(
+          "noise floor (ground truth against %s, another seed): mean PSNR %.2f dB, mean SSIM "
+          "%.4f, lowest %.2f dB (pose %zu)\n",
+          floor_dir.string().c_str(), floor_sum_psnr / compared, floor_sum_ssim / compared,
+          floor_min_psnr, floor_min_pose);
+    } else {
+      std::printf(
+          "noise floor: unknown (no %s/%s: calf-capture --ground-truth writes it, or give "
+          "--noise-floor)\n",
+          gt_dir.string().c_str(), capture::kNoiseFloorDirName);
+    }
   }
   if (!sheet.empty()) {
     std::vector<ContactSheetRow> rows;
@@ -323,6 +376,11 @@ int main(int argc, char** argv) {
                  "ground-truth directory written by calf-capture "
                  "--ground-truth: per-pose PSNR / SSIM and heat maps");
   app.add_flag("!--no-heat-maps", h.heat_maps, "with --compare and --out: do not write heat maps");
+  app.add_option("--noise-floor", h.noise_floor,
+                 "with --compare: ground truth of the same eye path rendered with another seed; "
+                 "its PSNR / SSIM against GT_DIR (the noise floor, what no figure can measure "
+                 "below) is printed beside every figure (default: GT_DIR/noise-floor, which "
+                 "calf-capture --ground-truth writes, when it exists)");
   app.add_option("--compare-clip", h.compare_clip,
                  "headless: also play FULL.calf (the full scene of a visible-set clip) along the "
                  "same eye path with the same renderer and print per pose and overall epsilon "
@@ -422,6 +480,9 @@ int main(int argc, char** argv) {
     }
     if (!h.contact_sheet.empty() && h.compare.empty()) {
       return contradiction("--contact-sheet needs --compare");
+    }
+    if (!h.noise_floor.empty() && h.compare.empty()) {
+      return contradiction("--noise-floor needs --compare");
     }
     if (!h.compare_clip.empty() && fs::path(h.compare_clip) == fs::path(clip)) {
       return contradiction("--compare-clip names CLIP itself");

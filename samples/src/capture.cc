@@ -87,6 +87,9 @@ Expected<RenderStats> render_capture_set(const Scene& scene, const CaptureReques
       RenderStats s = (*tracer)->render_cube(manifest.viewpoints[v].position, v, f,
                                              request.face_size, manifest.material, &image);
       stats.rays += s.rays;
+      stats.images += s.images;
+      stats.pixels += s.pixels;
+      stats.samples += s.samples;
       if (Status st = writer.write(v, f, image); !st.ok()) {
         writer.abandon();
         return st;
@@ -145,6 +148,9 @@ Expected<RenderStats> render_ground_truth(const Scene& scene, const capture::Eye
     RenderStats s =
         (*tracer)->render_perspective(path.poses[i], path.width, path.height, i, &image);
     stats.rays += s.rays;
+    stats.images += s.images;
+    stats.pixels += s.pixels;
+    stats.samples += s.samples;
     std::filesystem::path file = directory / capture::eye_image_file_name(path, i);
     if (Status st = capture::write_perspective_image(file, image); !st.ok()) return fail(st);
     written.push_back(file);

@@ -10,7 +10,9 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "calf/format/colour.h"
 #include "calf/format/cube.h"
+#include "calf/samples/pixel_samples.h"
 #include "calf/samples/render.h"
 #include "calf/samples/texture.h"
 #include "glm_vec.h"
@@ -31,8 +33,17 @@ uint64_t mix64(uint64_t z) {
 }
 
 // A counter-based stream: the same key gives the same numbers on every thread and every run.
+// With `net` set (spp > 1) ambient occlusion takes its directions from the pixel's scrambled
+// (0, 2)-sequence instead: sample s of the pixel uses points [s * ao_samples, (s + 1) *
+// ao_samples), so the AO rays of all the pixel's samples at a surface are one stratified set;
+// each AO evaluation along the sample's path (the primary surface, then what mirrors and glass
+// show) has its own scramble, the same for every sample of the pixel.
 struct Rng {
   uint64_t state;
+  bool net = false;
+  uint64_t net_key = 0;    // the pixel's key
+  uint32_t net_index = 0;  // the sample's first sequence point
+  uint32_t net_calls = 0;  // AO evaluations so far along this sample's path
   explicit Rng(uint64_t key) : state(mix64(key)) {}
   float uniform() {  // [0, 1)
     state += 0x9E3779B97F4A7C15ull;
@@ -293,11 +304,21 @@ struct FrameTracer::Impl {
       glm::vec3 t, b;
       basis(n, &t, &b);
       uint32_t open = 0;
+      const uint64_t scramble =
+          rng->net ? mix64(rng->net_key ^ (0xD1B54A32D192ED03ull * ++rng->net_calls)) : 0;
       for (uint32_t s = 0; s < options.ao_samples; ++s) {
-        // Cosine-distributed direction, stratified in the first dimension.
-        float u1 =
-            (static_cast<float>(s) + rng->uniform()) / static_cast<float>(options.ao_samples);
-        float u2 = rng->uniform();
+        // Cosine-distributed direction, stratified in the first dimension (spp 1) or in both, over
+        // all of the pixel's samples (spp > 1).
+        float u1, u2;
+        if (rng->net) {
+          const SamplePoint q =
+              scrambled_sequence_point(rng->net_index + s, static_cast<uint32_t>(scramble),
+                                       static_cast<uint32_t>(scramble >> 32));
+          u1 = q.x, u2 = q.y;
+        } else {
+          u1 = (static_cast<float>(s) + rng->uniform()) / static_cast<float>(options.ao_samples);
+          u2 = rng->uniform();
+        }
         float r = std::sqrt(u1), phi = 2 * kPi * u2;
         glm::vec3 d = t * (r * std::cos(phi)) + b * (r * std::sin(phi)) +
                       n * std::sqrt(std::max(0.0f, 1 - u1));
@@ -355,15 +376,67 @@ struct FrameTracer::Impl {
     return color;
   }
 
-  // One pixel: colour, depth and material of the primary hit; `spread` is the pixel's angular
-  // width (pixel_spread), which sets the texture filter's footprint.
-  void shade_pixel(const glm::vec3& o, const glm::vec3& d, float spread, uint64_t key,
-                   uint64_t noise_key, float* rgb, float* depth, float* material,
-                   uint64_t* rays) const {
-    Rng rng(key);
+  // The colour of a pixel as the mean of its samples (RenderOptions: rounds doubling the count
+  // until the sRGB-encoded standard error is at most `tolerance` or spp samples are taken).
+  // `dir_at(x, y)` is the ray through position (x, y) in [0, 1)^2 of the pixel's square. Every
+  // sample filters textures over the whole pixel's footprint `spread` (pixel_spread): the count
+  // of samples varies per pixel, and the same footprint keeps each sample's texel the pixel's.
+  template <typename DirFn>
+  glm::vec3 converged_color(const glm::vec3& o, const DirFn& dir_at, float spread, uint64_t key,
+                            uint64_t* rays, uint64_t* samples) const {
+    const uint64_t scramble = mix64(key ^ 0x3C6EF372FE94F82Bull);
+    const uint32_t sx = static_cast<uint32_t>(scramble), sy = static_cast<uint32_t>(scramble >> 32);
+    const uint32_t max_n = options.spp;
+    const double tol2 = static_cast<double>(options.tolerance) * options.tolerance;
+    glm::dvec3 sum(0), mean_y(0), m2_y(0);  // Welford over the sRGB-encoded samples
+    uint32_t n = 0, target = std::min(std::max(options.min_spp, 1u), max_n);
+    for (;;) {
+      for (; n < target; ++n) {
+        const SamplePoint p = scrambled_sequence_point(n, sx, sy);
+        Rng rng(key);
+        rng.net = true;
+        rng.net_key = key;
+        rng.net_index = n * options.ao_samples;
+        const glm::vec3 c =
+            trace(o, dir_at(p.x, p.y), Cone{0, spread}, 0, &rng, rays, nullptr, nullptr);
+        for (int i = 0; i < 3; ++i) {
+          const float v = std::clamp(std::isfinite(c[i]) ? c[i] : 0.0f, 0.0f, kMaxRadiance);
+          sum[i] += v;
+          const double y = srgb_from_linear(v);
+          const double delta = y - mean_y[i];
+          mean_y[i] += delta / (n + 1);
+          m2_y[i] += delta * (y - mean_y[i]);
+        }
+      }
+      if (n >= max_n) break;
+      // Standard error squared of the mean: sample variance / n. Stratified samples err less than
+      // this, so the test is conservative.
+      const double worst = std::max({m2_y[0], m2_y[1], m2_y[2]}) / (static_cast<double>(n - 1) * n);
+      if (n > 1 && worst <= tol2) break;
+      target = std::min(max_n, 2 * n);
+    }
+    *samples += n;
+    return glm::vec3(sum / static_cast<double>(n));
+  }
+
+  // One pixel: colour (one centre sample when spp is 1, else converged_color), and the depth and
+  // material of the primary hit of the ray through the pixel centre, `centre`. `spread` is the
+  // pixel's angular width (pixel_spread), which sets the texture filter's footprint.
+  template <typename DirFn>
+  void shade_pixel(const glm::vec3& o, const glm::vec3& centre, const DirFn& dir_at, float spread,
+                   uint64_t key, uint64_t noise_key, float* rgb, float* depth, float* material,
+                   uint64_t* rays, uint64_t* samples) const {
     Hit h;
     bool hit = false;
-    glm::vec3 c = trace(o, d, Cone{0, spread}, 0, &rng, rays, &h, &hit);
+    glm::vec3 c;
+    if (options.spp <= 1) {
+      Rng rng(key);
+      c = trace(o, centre, Cone{0, spread}, 0, &rng, rays, &h, &hit);
+      ++*samples;
+    } else {
+      hit = intersect(o, centre, 0, INFINITY, &h, rays);
+      c = converged_color(o, dir_at, spread, key, rays, samples);
+    }
     if (options.noise > 0) {
       Rng n(noise_key);
       c *= 1 + options.noise * (2 * n.uniform() - 1);
@@ -380,9 +453,13 @@ struct FrameTracer::Impl {
     }
   }
 
+  // Runs fn(row, &counts) for every row on the arena's threads; returns the summed counts.
+  struct Counts {
+    uint64_t rays = 0, samples = 0;
+  };
   template <typename RowFn>
-  uint64_t parallel_rows(uint32_t rows, const RowFn& fn) const {
-    std::vector<uint64_t> counts(rows, 0);
+  Counts parallel_rows(uint32_t rows, const RowFn& fn) const {
+    std::vector<Counts> counts(rows);
     tbb::task_arena arena(options.threads == 0 ? tbb::task_arena::automatic
                                                : static_cast<int>(options.threads));
     arena.execute([&] {
@@ -393,8 +470,8 @@ struct FrameTracer::Impl {
                           }
                         });
     });
-    uint64_t total = 0;
-    for (uint64_t c : counts) total += c;
+    Counts total;
+    for (const Counts& c : counts) total.rays += c.rays, total.samples += c.samples;
     return total;
   }
 };
@@ -409,6 +486,15 @@ Status validate_render_options(const RenderOptions& o) {
     return bad("max-bounces " + std::to_string(o.max_bounces) + " is outside 0..32");
   }
   if (!(o.noise >= 0 && o.noise <= 1)) return bad("noise must be in [0, 1]");
+  if (o.spp < 1 || o.spp > 4096) return bad("spp " + std::to_string(o.spp) + " is outside 1..4096");
+  if (o.min_spp < 1 || o.min_spp > 4096) {
+    return bad("min-spp " + std::to_string(o.min_spp) + " is outside 1..4096");
+  }
+  if (!(o.tolerance >= 0 && o.tolerance <= 1)) return bad("tolerance must be in [0, 1]");
+  // A pixel's AO rays are sequence points [0, spp * ao_samples): they must fit 32 bits.
+  if (static_cast<uint64_t>(o.spp) * o.ao_samples > (1ull << 24)) {
+    return bad("spp x ao-samples is above 2^24");
+  }
   return Status::Ok();
 }
 
@@ -548,22 +634,30 @@ RenderStats FrameTracer::render_cube(const Vec3& center, uint32_t view, uint32_t
   const glm::vec3 o = to_fvec3(center);
   const uint32_t n = face_size;
   RenderStats stats;
-  stats.rays = im.parallel_rows(6 * n, [&](uint32_t row, uint64_t* rays) {
+  const Impl::Counts counts = im.parallel_rows(6 * n, [&](uint32_t row, Impl::Counts* c) {
     const uint32_t face = row / n, y = row % n;
+    const CubeFace cf = cube_face_from_index(static_cast<int>(face));
     for (uint32_t x = 0; x < n; ++x) {
-      const glm::vec3 d =
-          to_fvec3(direction_from_texel(cube_face_from_index(static_cast<int>(face)), x, y, n));
+      const glm::vec3 d = to_fvec3(direction_from_texel(cf, x, y, n));
+      // A sample at (sx, sy) of the texel's square in face coordinates.
+      auto dir_at = [&](float sx, float sy) {
+        return to_fvec3(direction_from_texel_coord({cf, x + double{sx}, y + double{sy}}, n));
+      };
       const size_t i = (static_cast<size_t>(face) * n + y) * n + x;
       // A face is a pinhole image 2 wide at distance 1 along its major axis.
       const float spread = pixel_spread(2.0f / static_cast<float>(n),
                                         std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)}));
       // AO keys leave the frame out: static surfaces get the same samples every frame.
-      im.shade_pixel(o, d, spread, pixel_key(im.options.seed, view, face, x, y),
+      im.shade_pixel(o, d, dir_at, spread, pixel_key(im.options.seed, view, face, x, y),
                      pixel_key(im.options.seed ^ 0xA5A5A5A5ull, view, face * n + y, x, frame),
                      &out->color[3 * i], &out->depth[i],
-                     with_material ? &out->material[3 * i] : nullptr, rays);
+                     with_material ? &out->material[3 * i] : nullptr, &c->rays, &c->samples);
     }
   });
+  stats.rays = counts.rays;
+  stats.samples = counts.samples;
+  stats.images = 1;
+  stats.pixels = 6ull * n * n;
   return stats;
 }
 
@@ -582,19 +676,35 @@ RenderStats FrameTracer::render_perspective(const capture::EyePose& pose, uint32
   const glm::vec3 axis = to_fvec3(frame.forward);
   const float plane_pixel =
       static_cast<float>(2 * std::tan(camera.fov_y / 2) / static_cast<double>(height));
+  // Sub-pixel rays: the image plane at unit distance along forward is linear in the pixel
+  // position, so the point of any position follows from three of the camera model's own rays
+  // (camera_ray, the one formula) without a second copy of it: the centre of pixel (0, 0) and
+  // its steps to pixels (1, 0) and (0, 1).
+  auto on_plane = [&](const Vec3& d) { return d * (1.0 / dot(d, frame.forward)); };
+  const Vec3 p00 = on_plane(camera_ray(camera, frame, 0, 0));
+  const Vec3 step_x = on_plane(camera_ray(camera, frame, 1, 0)) - p00;
+  const Vec3 step_y = on_plane(camera_ray(camera, frame, 0, 1)) - p00;
+  const Vec3 corner = p00 - step_x * 0.5 - step_y * 0.5;  // pixel (0, 0)'s top-left corner
   RenderStats stats;
-  stats.rays = im.parallel_rows(height, [&](uint32_t j, uint64_t* rays) {
+  const Impl::Counts counts = im.parallel_rows(height, [&](uint32_t j, Impl::Counts* c) {
     for (uint32_t i = 0; i < width; ++i) {
       const glm::vec3 d = to_fvec3(camera_ray(camera, frame, i, j));
+      auto dir_at = [&](float sx, float sy) {
+        return to_fvec3(normalize(corner + step_x * (i + double{sx}) + step_y * (j + double{sy})));
+      };
       const size_t k = static_cast<size_t>(j) * width + i;
       // Ground truth uses view id 2^32 - 1 - eye, never a capture view's.
       uint64_t view_id = 0xFFFFFFFFull - static_cast<uint64_t>(pose.eye);
-      im.shade_pixel(o, d, pixel_spread(plane_pixel, glm::dot(d, axis)),
+      im.shade_pixel(o, d, dir_at, pixel_spread(plane_pixel, glm::dot(d, axis)),
                      pixel_key(im.options.seed, view_id, 0, i, j),
                      pixel_key(im.options.seed ^ 0xA5A5A5A5ull, view_id, j, i, pose_index),
-                     &out->color[3 * k], &out->depth[k], nullptr, rays);
+                     &out->color[3 * k], &out->depth[k], nullptr, &c->rays, &c->samples);
     }
   });
+  stats.rays = counts.rays;
+  stats.samples = counts.samples;
+  stats.images = 1;
+  stats.pixels = static_cast<uint64_t>(width) * height;
   return stats;
 }
 

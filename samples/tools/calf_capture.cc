@@ -92,9 +92,10 @@ int main(int argc, char** argv) {
           std::string(calf::tools::kExitStatusHelp),
       "calf-capture"};
   std::string scene_arg, out_dir, rig_arg = "default", eye_path_file, export_dir;
-  uint32_t face_size = 256, frames = 0, threads = 0, ao_samples = 8, max_bounces = 6;
-  uint64_t seed = 1;
-  float noise = 0;
+  uint32_t face_size = 256, frames = 0, threads = 0;
+  // Rendering defaults are RenderOptions' (calf/samples/render.h), one place.
+  samples::RenderOptions render;
+  bool noise_floor = true;
   std::string gt_size = "256x256";
   bool list = false, ground_truth = false, quiet = false;
   std::string surfel_path, surfel_corners = "cube";
@@ -114,14 +115,34 @@ int main(int argc, char** argv) {
                  "count")
       ->check(CLI::Range(0u, calf::tools::kMaxThreads))
       ->capture_default_str();
-  app.add_option("--seed", seed, "seed of AO directions and noise")->capture_default_str();
-  app.add_option("--ao-samples", ao_samples, "ambient-occlusion rays per diffuse hit, 0..256")
+  app.add_option("--seed", render.seed, "seed of sample positions, AO directions and noise")
       ->capture_default_str();
-  app.add_option("--max-bounces", max_bounces, "mirror/glass recursion depth, 0..32")
+  app.add_option("--spp", render.spp,
+                 "most colour samples per pixel (texel), 1..4096, at stratified positions in the "
+                 "pixel's square, averaged (a box filter); 1 = one ray through the pixel centre, "
+                 "calf's rendering before anti-aliasing, bit for bit. Depth and material are "
+                 "always the centre ray's (docs/RENDERING.md, \"Converged capture\")")
       ->capture_default_str();
-  app.add_option("--noise", noise,
+  app.add_option("--min-spp", render.min_spp,
+                 "samples of the first round, 1..4096; rounds double the count until the "
+                 "pixel's standard error is within --tolerance or --spp samples are taken")
+      ->capture_default_str();
+  app.add_option("--tolerance", render.tolerance,
+                 "target standard error of a pixel's mean, in sRGB-encoded units (1 = full "
+                 "scale), [0, 1]; 0 = always --spp samples")
+      ->capture_default_str();
+  app.add_option("--ao-samples", render.ao_samples,
+                 "ambient-occlusion rays per diffuse hit of each sample, 0..256 (a pixel's AO rays "
+                 "at a surface: samples x this, stratified together)")
+      ->capture_default_str();
+  app.add_option("--max-bounces", render.max_bounces, "mirror/glass recursion depth, 0..32")
+      ->capture_default_str();
+  app.add_option("--noise", render.noise,
                  "per-frame colour noise amplitude in [0, 1] mimicking a path tracer (0 = off)")
       ->capture_default_str();
+  app.add_flag("!--no-noise-floor", noise_floor,
+               "ground truth: do not also render DIR/noise-floor/ (the same poses with --seed + 1, "
+               "from which calf-play --compare prints the noise floor of every figure)");
   app.add_flag("--ground-truth", ground_truth,
                "render perspective colour + depth along the scene's validation eye path instead "
                "of a capture set; writes DIR/gt_NNNNN.exr and DIR/eye_path.json (last)");
@@ -168,12 +189,7 @@ int main(int argc, char** argv) {
         "calf-capture", "--scene and --out (or --export-scene, --surfel-candidates) are required");
   }
 
-  samples::RenderOptions render;
   render.threads = threads;
-  render.seed = seed;
-  render.ao_samples = ao_samples;
-  render.max_bounces = max_bounces;
-  render.noise = noise;
   if (Status s = samples::validate_render_options(render); !s.ok()) return bad_option(s);
   if (face_size < 1 || face_size > 4096) {
     return bad_option(Status(calf::ErrorId::kCaptureOption,
@@ -239,6 +255,18 @@ int main(int argc, char** argv) {
       }
       path = scene->validation_path(frame_count, scene->fps, w, h);
     }
+    // The noise floor first, so that DIR/eye_path.json, written last, marks both complete: the
+    // same poses with the next seed, what calf-play --compare measures the ground truth against
+    // itself with.
+    if (noise_floor) {
+      samples::RenderOptions other = render;
+      other.seed = render.seed + 1;
+      Progress progress("noise-floor pose", quiet);
+      auto result = samples::render_ground_truth(
+          *scene, path, other, std::filesystem::path(out_dir) / calf::capture::kNoiseFloorDirName,
+          [&](uint64_t d, uint64_t t) { progress(d, t); });
+      if (!result.ok()) return fail(result.status());
+    }
     Progress progress("ground truth pose", quiet);
     auto result = samples::render_ground_truth(*scene, path, render, out_dir,
                                                [&](uint64_t d, uint64_t t) { progress(d, t); });
@@ -264,10 +292,16 @@ int main(int argc, char** argv) {
     stats = *result;
   }
   if (!quiet) {
-    std::fprintf(stderr, "calf-capture: %s: %.1f Mrays in %.2f s, %.2f Mrays/s, %u threads\n",
+    const bool gt = ground_truth || !eye_path_file.empty();
+    const double images = static_cast<double>(stats.images);
+    std::fprintf(stderr,
+                 "calf-capture: %s: %.1f Mrays in %.2f s, %.2f Mrays/s, %u threads, %.2f samples "
+                 "per pixel, %.3f s per %s\n",
                  out_dir.c_str(), static_cast<double>(stats.rays) * 1e-6, stats.seconds,
                  stats.mrays_per_second(),
-                 threads ? threads : std::max(1u, std::thread::hardware_concurrency()));
+                 threads ? threads : std::max(1u, std::thread::hardware_concurrency()),
+                 stats.pixels ? static_cast<double>(stats.samples) / stats.pixels : 0.0,
+                 images > 0 ? stats.seconds / images : 0.0, gt ? "pose" : "view-frame");
   }
   return 0;
 }

@@ -11,18 +11,33 @@
 //   - mirror and glass by recursion up to `max_bounces` (total internal reflection reflects);
 //   - optional multiplicative noise, uniform in [-noise, +noise], that mimics a path tracer's
 //     per-frame noise.
-// Depth is the radial distance of the primary hit from the ray origin (the viewpoint centre), so
-// for mirror and glass it is the depth of the mirror or glass surface; material channels are the
-// primary surface's (reflect, refract, ior), (0, 0, 1) where nothing reflective is hit or on sky.
+// Anti-aliasing and convergence (docs/RENDERING.md "Converged capture"): a pixel's colour is the
+// mean over its square (a texel's square in face coordinates, a perspective pixel's in the image
+// plane: a box filter) of up to `spp` samples at stratified positions, taken in rounds that
+// double the count, from min(min_spp, spp) on, until the standard error of the mean, estimated
+// from the samples' sRGB-encoded values, is at most `tolerance` in every channel. Positions and AO
+// directions are points of a per-pixel scrambled (0, 2)-sequence (calf/samples/pixel_samples.h):
+// every round's samples, and the AO rays of all of a pixel's samples at a surface together, are
+// stratified. spp = 1 is one sample through the texel centre with the AO pattern of calf before
+// issue 16, bit for bit.
+// Depth is the radial distance of the primary hit of the ray through the pixel centre from the
+// ray origin (the viewpoint centre), whatever `spp`: the player re-projects each texel along its
+// centre direction at its depth, so the depth must be the surface on that very ray (a mean of
+// depths across an edge would be a point in mid-air, the nearest sample's would move slanted
+// surfaces towards the viewer and grow silhouettes by half a texel beyond what the player's own
+// depth footprint already allows). For mirror and glass it is the depth of the mirror or glass
+// surface; material channels are the centre ray's surface's (reflect, refract, ior), (0, 0, 1)
+// where nothing reflective is hit or on sky.
 //
 // Determinism: every pixel is a pure function of (scene, time, viewpoint, texel, seed): its random
-// numbers come from a counter-based hash of (seed, view, face, x, y, sample), AO patterns are the
-// same every frame (static surfaces stay bit-identical) and only the noise option also hashes the
-// frame. Threads share no mutable state, so output bytes do not depend on the thread count.
-// They can depend on the host, in the last bits of some hits: Embree picks its kernels for the
-// CPU it runs on (SSE4.2, AVX2 or AVX-512), and their float arithmetic differs (measured: the
-// same build forced to SSE4.2 on an AVX2 host changes every file of a 128² interior set; two
-// calf-bench runs of the same code on two hosts gave clips within 0.13 % in bytes and 0.013 dB).
+// numbers come from a counter-based hash of (seed, view, face, x, y) and the sample's index, AO
+// patterns are the same every frame (static surfaces stay bit-identical) and only the noise option
+// also hashes the frame. Threads share no mutable state, so output bytes do not depend on the
+// thread count. They can depend on the host, in the last bits of some hits: Embree picks its
+// kernels for the CPU it runs on (SSE4.2, AVX2 or AVX-512), and their float arithmetic differs
+// (measured: the same build forced to SSE4.2 on an AVX2 host changes every file of a 128² interior
+// set; two calf-bench runs of the same code on two hosts gave clips within 0.13 % in bytes and
+// 0.013 dB).
 #pragma once
 
 #include <cstdint>
@@ -40,9 +55,14 @@ namespace calf::samples {
 struct RenderOptions {
   uint32_t threads = 0;      // 0: all hardware threads; 1..256 otherwise
   uint64_t seed = 1;         // seeds AO directions and noise
-  uint32_t ao_samples = 8;   // 0..256; 0 disables ambient occlusion (ambient then unshadowed)
+  uint32_t ao_samples = 4;   // per diffuse hit of each sample, 0..256; 0: no ambient occlusion
   uint32_t max_bounces = 6;  // mirror / glass recursion depth, 0..32
   float noise = 0;           // per-frame colour noise amplitude in [0, 1]
+  // Anti-aliasing and convergence (above; defaults measured in docs/RENDERING.md).
+  uint32_t spp = 64;         // most samples per pixel, 1..4096; 1: the texel-centre ray alone
+  uint32_t min_spp = 8;      // samples of the first round, 1..4096 (at most spp are taken)
+  float tolerance = 0.004f;  // target standard error of a pixel's sRGB-encoded mean, [0, 1];
+                             // 0: always spp samples
 };
 // E177 when an option is outside its range.
 Status validate_render_options(const RenderOptions& options);
@@ -50,6 +70,9 @@ Status validate_render_options(const RenderOptions& options);
 // Rays traced (primary, shadow, AO, secondary) and wall time, for Mrays/s.
 struct RenderStats {
   uint64_t rays = 0;
+  uint64_t images = 0;   // view-frames or poses rendered
+  uint64_t pixels = 0;   // pixels (texels) shaded
+  uint64_t samples = 0;  // colour samples taken over them (samples / pixels: the mean spp)
   double seconds = 0;
   double mrays_per_second() const { return seconds > 0 ? rays / seconds * 1e-6 : 0; }
 };
@@ -67,8 +90,9 @@ class FrameTracer {
   FrameTracer& operator=(const FrameTracer&) = delete;
 
   // Renders the cube map centred at `center` into `out` (resized to `face_size`, with material
-  // channels when `with_material`). `view` and `frame` only seed random numbers. Each texel's ray
-  // is calf::direction_from_texel(face, x, y, face_size).
+  // channels when `with_material`). `view` and `frame` only seed random numbers. Each texel's
+  // centre ray (depth, material; the colour when spp is 1) is calf::direction_from_texel(face, x,
+  // y, face_size); colour samples lie in its square, calf::direction_from_texel_coord.
   RenderStats render_cube(const Vec3& center, uint32_t view, uint32_t frame, uint32_t face_size,
                           bool with_material, capture::ViewFrame* out) const;
 

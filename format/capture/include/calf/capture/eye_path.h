@@ -47,6 +47,9 @@ struct EyePath {
 
 inline constexpr const char* kEyePathFileName = "eye_path.json";
 inline constexpr const char* kDefaultImagePattern = "gt_{pose:05}.exr";
+// The subdirectory of a ground-truth directory holding the same poses rendered with another seed
+// (CAPTURE.md, "Noise floor"): its own eye_path.json and images.
+inline constexpr const char* kNoiseFloorDirName = "noise-floor";
 inline constexpr uint32_t kMaxEyePoses = 1000000;
 
 // Parses and validates eye-path JSON. A pose gives its orientation as exactly one of
