@@ -61,8 +61,8 @@ out vec2 g_uv;
 flat out vec3 g_base;
 flat out vec3 g_emission;
 flat out int g_textured;
-// texture.x: the base-colour texture, 0xffffffff for none.
-struct Material { vec4 base; vec4 emission; uvec4 texture; };
+// texture_index.x: the base-colour texture, 0xffffffff for none.
+struct Material { vec4 base; vec4 emission; uvec4 texture_index; };
 layout(std430, binding = 0) readonly buffer Materials { Material materials[]; };
 layout(std430, binding = 1) readonly buffer TriangleMaterials { uint triangle_materials[]; };
 layout(std430, binding = 2) readonly buffer Subset { uint subset[]; };
@@ -79,7 +79,7 @@ void main() {
   uint triangle = has_subset ? subset[gl_PrimitiveIDIn] : uint(gl_PrimitiveIDIn);
   uint m = has_triangle_materials ? triangle_materials[triangle] : object_material;
   if (m == 0xffffffffu) m = object_material;  // kMeshObjectMaterial
-  uint tex = has_uvs ? materials[m].texture.x : 0xffffffffu;
+  uint tex = has_uvs ? materials[m].texture_index.x : 0xffffffffu;
   if (tex != pass_texture) return;
   for (int i = 0; i < 3; ++i) {
     gl_Position = gl_in[i].gl_Position;

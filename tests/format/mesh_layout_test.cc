@@ -285,10 +285,10 @@ TEST(MeshLayout, UvsRoundTripAfterColoursAndAreChecked) {
 TEST(MeshLayout, TextureIsLosslessMedPlanes) {
   const TextureRecord r{3, 2};
   TextureTexels t{3, 2, {}};
-  // Row 0: (10, 200, 0, 255) (20, 190, 5, 255) (30, 180, 250, 255);
+  // Row 0: (10, 200, 0, 255) (20, 190, 20, 255) (30, 180, 250, 255);
   // row 1: (15, 100, 1, 128) (40, 0, 7, 128) (25, 255, 3, 0).
-  t.rgba = {10, 200, 0, 255, 20, 190, 5, 255, 30, 180, 250, 255,
-            15, 100, 1, 128, 40, 0,   7, 128, 25, 255, 3,   0};
+  t.rgba = {10, 200, 0, 255, 20, 190, 20, 255, 30, 180, 250, 255,
+            15, 100, 1, 128, 40, 0,   7,  128, 25, 255, 3,   0};
   auto bytes = encode_texture(r, t);
   ASSERT_TRUE(bytes.ok()) << bytes.status().to_string();
   ASSERT_EQ(bytes->size(), 24u);
@@ -299,8 +299,8 @@ TEST(MeshLayout, TextureIsLosslessMedPlanes) {
   EXPECT_EQ(red, (std::vector<uint8_t>{10, 10, 10, 5, 20, 241}));
   // Green (1, 1): a = 100, b = 190, c = 200 >= max -> min = 100, 0 - 100 = 156.
   EXPECT_EQ((*bytes)[6 + 4], 156);
-  // Blue (2, 1): a = 7, b = 250, c = 5: between -> a + b - c = 252, 3 - 252 = 7.
-  EXPECT_EQ((*bytes)[12 + 5], 7);
+  // Blue (2, 1): a = 7, b = 250, c = 20: between -> a + b - c = 237, 3 - 237 = 22.
+  EXPECT_EQ((*bytes)[12 + 5], 22);
   TextureTexels back;
   ASSERT_TRUE(decode_texture(*bytes, r, &back, "tex").ok());
   EXPECT_EQ(back.rgba, t.rgba);
