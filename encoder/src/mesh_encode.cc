@@ -324,16 +324,15 @@ Status encode_mesh_track(const capture::SceneFile& scene,
     return Status(ErrorId::kEncoderOption, cat("threads ", options.threads, " is above 256"));
   if (static_cast<uint16_t>(options.supercompression) >= container::kCompressionCount)
     return Status(ErrorId::kEncoderOption, "unknown supercompression");
-  CALF_ASSIGN_OR_RETURN(const Plan plan, make_plan(scene, visible, options));
-  const auto& x = plan.index;
+  CALF_ASSIGN_OR_RETURN(Plan plan, make_plan(scene, visible, options));
+  auto& x = plan.index;
   const size_t np = x.prototypes.size(), no = x.objects.size(), nt = x.textures.size();
 
-  Part index_part;
-  CALF_RETURN_IF_ERROR(compress_into(index_part, MeshStream::kIndex, 0,
-                                     mesh::serialize_index(x, plan.header.frame_count), options,
-                                     "mesh index"));
-  // Independent parts: prototypes then objects, each coded into its own slot.
+  // Independent parts: prototypes, objects, then textures, each coded into its own slot. A
+  // texture is coded both ways (SPEC §11.4.6) and keeps the one that stores fewer bytes after
+  // supercompression (MED on a tie); the index, written after, records the choice.
   std::vector<Part> parts(np + no + nt);
+  std::vector<uint32_t> codings(nt, mesh::kTextureSrgba8Med);
   tbb::task_arena arena(options.threads == 0 ? tbb::task_arena::automatic
                                              : static_cast<int>(options.threads));
   arena.execute([&] {
@@ -358,9 +357,19 @@ Status encode_mesh_track(const capture::SceneFile& scene,
               const size_t t = i - np - no;
               const auto& st = scene.textures[t];
               const mesh::TextureTexels texels{st.width, st.height, st.rgba};
-              part.status = compress_into(part, MeshStream::kTextures, static_cast<uint32_t>(t),
-                                          mesh::encode_texture(x.textures[t], texels), options,
-                                          cat("scene texture ", t));
+              Part ways[2];
+              for (uint32_t c : {mesh::kTextureSrgba8Med, mesh::kTextureSrgba8Plain}) {
+                mesh::TextureRecord r = x.textures[t];
+                r.coding = c;
+                ways[c].status = compress_into(
+                    ways[c], MeshStream::kTextures, static_cast<uint32_t>(t),
+                    mesh::encode_texture(r, texels), options, cat("scene texture ", t));
+              }
+              const bool plain =
+                  ways[0].status.ok() && ways[1].status.ok() &&
+                  ways[1].chunks[0].second.bytes.size() < ways[0].chunks[0].second.bytes.size();
+              codings[t] = plain ? mesh::kTextureSrgba8Plain : mesh::kTextureSrgba8Med;
+              part = std::move(ways[plain ? 1 : 0]);
             } else {
               const size_t o = i - np;
               const auto& r = x.objects[o];
@@ -373,6 +382,11 @@ Status encode_mesh_track(const capture::SceneFile& scene,
         });
   });
 
+  for (size_t t = 0; t < nt; ++t) x.textures[t].coding = codings[t];
+  Part index_part;
+  CALF_RETURN_IF_ERROR(compress_into(index_part, MeshStream::kIndex, 0,
+                                     mesh::serialize_index(x, plan.header.frame_count), options,
+                                     "mesh index"));
   CALF_ASSIGN_OR_RETURN(const uint16_t track, writer->add_track(plan.header));
   MeshEncodeStats s;
   s.materials = static_cast<uint32_t>(x.materials.size());

@@ -259,6 +259,7 @@ Expected<std::vector<ExportedFile>> export_mesh_track(const decoder::MeshTrack& 
         make_material(materials[i], i, t < texture_paths.size() ? texture_paths[t] : ""));
   }
 
+  std::map<uint32_t, uint32_t> untextured;  // track material -> its untextured copy
   std::vector<std::unique_ptr<aiMesh>> meshes;
   std::vector<std::unique_ptr<aiNode>> nodes;
   // Meshes of whole prototypes, shared by the objects that draw them whole (by prototype and
@@ -289,8 +290,21 @@ Expected<std::vector<ExportedFile>> export_mesh_track(const decoder::MeshTrack& 
         for (uint32_t t = 0; t < triangles.size(); ++t) triangles[t] = t;
       }
       decoder::positions_at(prototype, time, &positions);
-      for (const MeshPart& part :
+      for (MeshPart& part :
            split_by_material(prototype, object.prototype, object.material, triangles)) {
+        // A prototype without UVs draws a textured material untextured (the renderers' rule);
+        // glTF forbids a baseColorTexture without TEXCOORD_0, so it gets an untextured copy.
+        if (prototype.uvs.empty() &&
+            materials[part.material].base_colour_texture < texture_paths.size()) {
+          auto [at, added] = untextured.try_emplace(part.material, ai_materials.size());
+          if (added) {
+            ai_materials.push_back(make_material(materials[part.material], part.material, ""));
+            const aiString name("material " + std::to_string(part.material) + " untextured");
+            ai_materials.back()->RemoveProperty(AI_MATKEY_NAME);
+            ai_materials.back()->AddProperty(&name, AI_MATKEY_NAME);
+          }
+          part.material = at->second;
+        }
         const std::string name =
             whole ? "prototype " + std::to_string(object.prototype) + " material " +
                         std::to_string(part.material)

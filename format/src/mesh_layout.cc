@@ -117,7 +117,7 @@ Status check_index(const IndexChunk& x, uint32_t frame_count, const std::string&
                        " for layout ", x.layout_version));
   }
   for (size_t i = 0; i < x.textures.size(); ++i) {
-    if (x.textures[i].coding != kTextureSrgba8Med || x.textures[i].flags != 0)
+    if (x.textures[i].coding > kTextureSrgba8Plain || x.textures[i].flags != 0)
       return error(ErrorId::kMeshUnsupported, what,
                    cat("textures[", i, "]: coding ", x.textures[i].coding, " or flags ",
                        x.textures[i].flags, " unknown"));
@@ -528,6 +528,7 @@ Expected<std::vector<uint8_t>> encode_texture(const TextureRecord& t, const Text
                   cat("mesh texture: ", texels.width, " x ", texels.height, " texels of ",
                       texels.rgba.size(), " bytes for a ", t.width, " x ", t.height, " record"));
   }
+  if (t.coding == kTextureSrgba8Plain) return texels.rgba;
   const size_t w = t.width, h = t.height, n = w * h;
   std::vector<uint8_t> out(4 * n);
   for (size_t ch = 0; ch < 4; ++ch) {
@@ -551,6 +552,10 @@ Status decode_texture(std::span<const uint8_t> raw, const TextureRecord& t, Text
   const size_t w = t.width, h = t.height, n = w * h;
   out->width = t.width;
   out->height = t.height;
+  if (t.coding == kTextureSrgba8Plain) {
+    out->rgba.assign(raw.begin(), raw.end());
+    return Status::Ok();
+  }
   out->rgba.assign(4 * n, 0);
   uint8_t* rgba = out->rgba.data();
   for (size_t y = 0; y < h; ++y) {

@@ -1,11 +1,12 @@
 // The mesh track's texture coding (format/SPEC.md §11.4.6) against the alternatives it was chosen
 // over, on 8-bit sRGB textures from outside the project (default: the textures of Debian's
 // assimp-testmodels glTF samples). Per texture: the raw RGBA8 bytes; the raw bytes supercompressed
-// whole (zstd -19, LZMA2 preset 6: what a track storing plain texels would hold); calf's MED
-// channel planes with the same two; and BC7 (quality 1) and BC1 (range fit) blocks of the whole
-// mip chain (what a GPU-ready track would store), zstd -19 on top, with the PSNR of their level 0
-// against the texture (RGB, sRGB bytes) and of the mip chain's levels 1.. against calf's derived
-// levels. Also the time to decode the MED planes (median of --repeats) beside a memcpy.
+// whole (zstd -19, LZMA2 preset 6: calf's coding 1, plain texels); calf's MED channel planes
+// (coding 0) with the same two (the encoder keeps the smaller of the two codings); and BC7 (quality
+// 1) and BC1 (range fit) blocks of the whole mip chain (what a GPU-ready track would store), zstd
+// -19 on top, with the PSNR of their level 0 against the texture (RGB, sRGB bytes) and of the mip
+// chain's levels 1.. against calf's derived levels. Also the time to decode the MED planes (median
+// of --repeats) beside a memcpy.
 //
 //   bench-mesh_texture_bench [--repeats 5] [FILE.png ...]
 #include <algorithm>
@@ -61,7 +62,7 @@ double psnr(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
   size_t n = 0;
   for (size_t i = 0; i < a.size(); ++i) {
     if (i % 4 == 3) continue;
-    const double d = double{a[i]} - double{b[i]};
+    const double d = static_cast<double>(a[i]) - static_cast<double>(b[i]);
     se += d * d;
     ++n;
   }
@@ -97,7 +98,7 @@ BcResult bc_chain(const std::vector<mesh::TextureTexels>& chain, bc::Format f) {
     } else {
       for (size_t i = 0; i < back.size(); ++i) {
         if (i % 4 == 3) continue;
-        const double d = double{back[i]} - double{l.rgba[i]};
+        const double d = static_cast<double>(back[i]) - static_cast<double>(l.rgba[i]);
         se_mips += d * d;
         ++n_mips;
       }
@@ -121,9 +122,9 @@ int main(int argc, char** argv) {
   app.add_option("--repeats", repeats, "timed repeats (median reported)")->capture_default_str();
   app.add_option("FILES", files, "8-bit textures (default: two assimp-testmodels textures)");
   CLI11_PARSE(app, argc, argv);
-  std::printf("%-22s %11s | %9s %9s | %9s %9s | %9s %9s %7s %7s | %9s %7s | %9s %9s\n", "texture",
-              "raw RGBA8", "raw+zstd", "raw+lzma", "MED+zstd", "MED+lzma", "BC7 mips", "+zstd",
-              "dB L0", "dB mip", "BC1+zstd", "dB L0", "MED dec ms", "memcpy ms");
+  std::printf("%-30s %9s | %8s %8s | %8s %8s | %9s %8s %6s %6s | %8s %6s | %8s %8s\n", "texture",
+              "RGBA8", "raw+zstd", "raw+lzma", "MED+zstd", "MED+lzma", "BC7 mips", "+zstd", "dB L0",
+              "dB mip", "BC1+zstd", "dB L0", "MED dec", "memcpy");
   for (const std::string& path : files) {
     mesh::TextureTexels t;
     if (!load(path, &t)) {
@@ -132,6 +133,7 @@ int main(int argc, char** argv) {
     }
     const mesh::TextureRecord record{t.width, t.height};
     const std::vector<uint8_t> med = *mesh::encode_texture(record, t);
+
     const auto chain = mesh::mip_chain(t);
     const BcResult bc7 = bc_chain(chain, bc::Format::kBc7);
     const BcResult bc1 = bc_chain(chain, bc::Format::kBc1);
@@ -151,7 +153,8 @@ int main(int argc, char** argv) {
     if (back.rgba != t.rgba) std::fprintf(stderr, "%s: MED round trip differs\n", path.c_str());
     const std::string name = path.substr(path.find_last_of('/') + 1);
     std::printf(
-        "%-22s %11zu | %9zu %9zu | %9zu %9zu | %9zu %9zu %7.2f %7.2f | %9zu %7.2f | %9.2f %9.3f\n",
+        "%-30s %9zu | %8zu %8zu | %8zu %8zu | %9zu %8zu %6.2f %6.2f | %8zu %6.2f | "
+        "%6.2fms %6.3fms\n",
         (name + " " + std::to_string(t.width) + "x" + std::to_string(t.height)).c_str(),
         t.rgba.size(), stored(t.rgba, container::Compression::kZstd),
         stored(t.rgba, container::Compression::kLzma2), stored(med, container::Compression::kZstd),

@@ -229,13 +229,13 @@ TEST(MeshLayout, Layout2IndexRoundTripAndChecks) {
   std::vector<uint8_t> bad = *bytes;
   bad[bad.size() - 4] = 2;
   EXPECT_EQ(parse_index(bad, 3, "index").status().id(), ErrorId::kMeshIndex);
-  // Texture 0's width 0 (E223), coding 1 (E221), width above 16384 (E224).
+  // Texture 0's width 0 (E223), coding 2 (E221), width above 16384 (E224).
   const size_t tex0 = 8 + 48 + 52 + 44 + 52 + 4;
   bad = *bytes;
   bad[tex0] = 0;
   EXPECT_EQ(parse_index(bad, 3, "index").status().id(), ErrorId::kMeshValue);
   bad = *bytes;
-  bad[tex0 + 8] = 1;
+  bad[tex0 + 8] = 2;
   EXPECT_EQ(parse_index(bad, 3, "index").status().id(), ErrorId::kMeshUnsupported);
   bad = *bytes;
   bad[tex0 + 2] = 1;  // width 65539
@@ -310,6 +310,13 @@ TEST(MeshLayout, TextureIsLosslessMedPlanes) {
   TextureTexels wrong = t;
   wrong.rgba.pop_back();
   EXPECT_EQ(encode_texture(r, wrong).status().id(), ErrorId::kContainerWriterMisuse);
+  // Plain: the texels as they are.
+  const TextureRecord plain{3, 2, kTextureSrgba8Plain};
+  auto same = encode_texture(plain, t);
+  ASSERT_TRUE(same.ok());
+  EXPECT_EQ(*same, t.rgba);
+  ASSERT_TRUE(decode_texture(*same, plain, &back, "tex").ok());
+  EXPECT_EQ(back.rgba, t.rgba);
 }
 
 TEST(MeshTexture, MipChainAveragesInLinearLight) {

@@ -467,6 +467,8 @@ MeshDrawList textured_scene() {
 
 // GL (sRGB array texture, LINEAR_MIPMAP_LINEAR, REPEAT, coarse derivatives on llvmpipe) against
 // the CPU reference's trilinear filter: colour PSNR where both show the same surface, printed.
+// Measured on llvmpipe: 55.2 and 51.2 dB (max difference 0.012 and 0.015), no depth differs;
+// 57.3 dB after the texture swap. GL without mips (GL_LINEAR minification) gives 16-17 dB.
 TEST(MeshGlRenderer, TexturedAgreesWithCpuReference) {
   REQUIRE_GL();
   const MeshDrawList list = textured_scene();
@@ -504,7 +506,7 @@ TEST(MeshGlRenderer, TexturedAgreesWithCpuReference) {
         "image), max colour difference %.4f, %zu covered pixels, %zu of %zu depths differ\n",
         p_same, p, max_diff, textured, differing, c.depth.size());
     EXPECT_GT(textured, c.depth.size() / 3);
-    EXPECT_GE(p_same, 35.0);
+    EXPECT_GE(p_same, 45.0);
     EXPECT_LE(differing, c.depth.size() / 200);
   }
   // A material switching texture between frames: re-uploaded materials, new passes.
@@ -515,7 +517,7 @@ TEST(MeshGlRenderer, TexturedAgreesWithCpuReference) {
   ASSERT_TRUE((*gl)->render(swapped, poses[0], {}, &g).ok());
   const double p = *psnr(rgb_ref(g), rgb_ref(cpu(swapped, poses[0])));
   std::printf("textured GL vs CPU after a texture swap: PSNR %.2f dB\n", p);
-  EXPECT_GE(p, 30.0);
+  EXPECT_GE(p, 45.0);
   swapped.materials[0].base_colour_texture = 2;
   EXPECT_EQ((*gl)->update_materials(swapped).id(), ErrorId::kMeshGlStructure);
 }

@@ -11,9 +11,11 @@
 //     triangles use; positions at the frame's time when the prototype has vertex states;
 //   - normals (the prototype's, or none: the importer computes flat ones), vertex colours
 //     (linear, as COLOR_0), UVs (TEXCOORD_0 / vt) and materials (base colour, emission and the
-//     base-colour texture as PNG: embedded in the binary buffer of a .glb / .gltf as glTF's
+//     base-colour texture as PNG: embedded in a .glb's binary buffer / a .gltf's data URI as glTF's
 //     baseColorTexture, a side file <stem>_texture<n>.png named by map_Kd beside an .obj;
-//     textures no material uses are left out); triangles with a
+//     textures no material uses are left out; a prototype without UVs placed with a textured
+//     material gets an untextured copy of it, "material <i> untextured", as the renderers draw
+//     it untextured and glTF needs TEXCOORD_0 for a texture); triangles with a
 //     per-triangle material are split into one mesh per material, as glTF primitives carry one
 //     material each.
 // Triangle counts are preserved exactly: the export of a track whose objects draw T triangles in

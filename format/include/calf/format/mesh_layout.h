@@ -157,11 +157,14 @@ static_assert(container::fixed_size<ObjectRecord>() == 24);
 
 // A base-colour texture (layout 2): its size and coding; its texels are the textures chunk of the
 // same index (§11.4.6). 16 bytes.
-inline constexpr uint32_t kTextureSrgba8Med = 0;  // the one coding: sRGB RGBA8, MED residuals
+// Codings of the texels (sRGB RGBA8, lossless): MED residuals in channel planes, or the texels
+// as they are, interleaved (flat graphics, whose runs of equal texels supercompress better so).
+inline constexpr uint32_t kTextureSrgba8Med = 0;
+inline constexpr uint32_t kTextureSrgba8Plain = 1;
 struct TextureRecord {
-  uint32_t width = 0, height = 0;  // 1 .. kMaxTextureSize
-  uint32_t coding = kTextureSrgba8Med;
-  uint32_t flags = 0;  // reserved, 0
+  uint32_t width = 0, height = 0;       // 1 .. kMaxTextureSize
+  uint32_t coding = kTextureSrgba8Med;  // kTextureSrgba8Med or kTextureSrgba8Plain
+  uint32_t flags = 0;                   // reserved, 0
   template <class Self, class V>
   static constexpr void fields(Self& s, V& v) {
     v(s.width, "width", container::Range{1, kMaxTextureSize});
@@ -278,8 +281,8 @@ struct TextureTexels {
 };
 // The exact raw size of a textures chunk of `t` (4 * width * height).
 uint64_t texture_chunk_size(const TextureRecord& t);
-// Codes `texels` (its size must be t's: kContainerWriterMisuse otherwise) as MED residuals in
-// channel planes (lossless).
+// Codes `texels` (its size must be t's: kContainerWriterMisuse otherwise) as t.coding says: MED
+// residuals in channel planes, or the texels as they are (both lossless).
 Expected<std::vector<uint8_t>> encode_texture(const TextureRecord& t, const TextureTexels& texels);
 // Decodes (size E220; every byte value is valid). Replaces `out`.
 Status decode_texture(std::span<const uint8_t> raw, const TextureRecord& t, TextureTexels* out,
