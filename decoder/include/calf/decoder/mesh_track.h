@@ -1,7 +1,7 @@
 // Reading a mesh track (kind 4, format/SPEC.md §11.4): objects placing prototype meshes with a
 // material and a rigid transform per frame, optionally reduced to a visible set (paper 004). The
 // track is readable per object: open() reads the index chunk only, object() decodes one object's
-// prototype and triangle subset on demand.
+// prototype and triangle subset on demand, texture() one base-colour texture (layout 2).
 //
 // The player's MeshRepresentation (player/mesh_representation.h) renders what this returns; the
 // encoder side is encoder/mesh_encode.h.

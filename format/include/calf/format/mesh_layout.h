@@ -2,7 +2,8 @@
 // holds what the frozen 1.0 file (tests/conformance/container/valid/v1_frozen.calf) fixed for
 // the kind: its track header and stream tags. Below them (issue 19) the byte layout of its chunks,
 // both directions: the versioned index chunk (stream 0) declared once with the fields visitor
-// (container_fields.h), and the coded arrays of the vertices, triangles and visibility chunks.
+// (container_fields.h), and the coded arrays of the vertices, triangles, visibility and (layout 2)
+// textures chunks.
 // The encoder (encoder/mesh_encode.h) writes chunks with the serialize_* / encode_* functions,
 // every decoder (decoder/mesh_track.h) reads them with parse_index / decode_*. This is the one
 // place that knows the predictions and byte planes of §11.4.
