@@ -16,6 +16,7 @@ struct MeshTrack::Index {
   mesh::IndexChunk chunk;
   std::vector<uint32_t> vertices, triangles;  // chunk id per prototype
   std::vector<uint32_t> visibility;           // chunk id per object
+  std::vector<uint32_t> textures;             // chunk id per texture
 };
 
 namespace {
@@ -44,6 +45,10 @@ uint32_t MeshTrack::prototype_count() const {
   return index_ ? static_cast<uint32_t>(index_->chunk.prototypes.size()) : 0;
 }
 
+uint32_t MeshTrack::texture_count() const {
+  return index_ ? static_cast<uint32_t>(index_->chunk.textures.size()) : 0;
+}
+
 const mesh::IndexChunk& MeshTrack::index() const {
   static const mesh::IndexChunk kEmpty;
   return index_ ? index_->chunk : kEmpty;
@@ -62,7 +67,7 @@ Expected<MeshTrack> MeshTrack::open(const container::Reader& reader, uint16_t tr
     return Status(ErrorId::kMeshUnsupported,
                   cat("mesh track header: reserved flags in ", t.header_.flags));
 
-  // One pass over the chunk index: the keys of every chunk of streams 0-3 (§11.4.1).
+  // One pass over the chunk index: the keys of every chunk of streams 0-4 (§11.4.1).
   std::vector<uint32_t> index_ids;
   struct Keyed {
     uint32_t id;
@@ -73,7 +78,7 @@ Expected<MeshTrack> MeshTrack::open(const container::Reader& reader, uint16_t tr
   const auto& chunks = reader.chunks();
   for (uint32_t id = 0; id < chunks.size(); ++id) {
     const auto& k = chunks[id].keys;
-    if (k.track != track || k.stream > static_cast<uint16_t>(MeshStream::kVisibility)) continue;
+    if (k.track != track || k.stream > static_cast<uint16_t>(MeshStream::kTextures)) continue;
     if (k.view || k.face || k.layer || k.first_frame || k.frame_count ||
         (k.stream == 0 && k.region)) {
       return corrupt(cat("chunk ", id, " (", stream_text(k.stream),
@@ -92,25 +97,30 @@ Expected<MeshTrack> MeshTrack::open(const container::Reader& reader, uint16_t tr
                         mesh::parse_index(*raw, t.header_.frame_count, "mesh index"));
 
   auto index = std::make_shared<Index>();
-  const size_t np = x.prototypes.size(), no = x.objects.size();
+  const size_t np = x.prototypes.size(), no = x.objects.size(), nt = x.textures.size();
   index->vertices.assign(np, kNone);
   index->triangles.assign(np, kNone);
   index->visibility.assign(no, kNone);
+  index->textures.assign(nt, kNone);
   for (const Keyed& c : keyed) {
     const bool object = c.stream == static_cast<uint16_t>(MeshStream::kVisibility);
-    const size_t count = object ? no : np;
+    const bool texture = c.stream == static_cast<uint16_t>(MeshStream::kTextures);
+    // A layout-1 track has no texture: its stream-4 chunks are a later version's, ignored.
+    if (texture && x.layout_version < 2) continue;
+    const size_t count = object ? no : texture ? nt : np;
+    const char* unit = object ? "object" : texture ? "texture" : "prototype";
     if (c.region >= count) {
       return corrupt(cat("chunk ", c.id, " (", stream_text(c.stream), ") region ", c.region, " of ",
-                         count, object ? " objects" : " prototypes"));
+                         count, " ", unit, "s"));
     }
     std::vector<uint32_t>& slot = c.stream == static_cast<uint16_t>(MeshStream::kVertices)
                                       ? index->vertices
-                                  : object ? index->visibility
-                                           : index->triangles;
+                                  : object  ? index->visibility
+                                  : texture ? index->textures
+                                            : index->triangles;
     if (slot[c.region] != kNone) {
       return corrupt(cat("chunks ", slot[c.region], " and ", c.id, " are both the ",
-                         stream_text(c.stream), " chunk of ", object ? "object " : "prototype ",
-                         c.region));
+                         stream_text(c.stream), " chunk of ", unit, " ", c.region));
     }
     slot[c.region] = c.id;
   }
@@ -148,6 +158,14 @@ Expected<MeshTrack> MeshTrack::open(const container::Reader& reader, uint16_t tr
     }
     triangles += x.objects[o].triangle_count;
   }
+  for (size_t i = 0; i < nt; ++i) {
+    const uint32_t id = index->textures[i];
+    if (id == kNone) return corrupt(cat("texture ", i, " has no textures chunk"));
+    if (chunks[id].raw_size != mesh::texture_chunk_size(x.textures[i])) {
+      return corrupt(cat("texture ", i, " chunk ", id, " holds ", chunks[id].raw_size,
+                         " bytes, the index gives ", mesh::texture_chunk_size(x.textures[i])));
+    }
+  }
   if (vertices != t.header_.vertex_count || triangles != t.header_.triangle_count) {
     return corrupt(cat("the header gives ", t.header_.vertex_count, " vertices and ",
                        t.header_.triangle_count, " triangles, the index ", vertices, " and ",
@@ -155,12 +173,14 @@ Expected<MeshTrack> MeshTrack::open(const container::Reader& reader, uint16_t tr
   }
   t.view_volume_ = Box3{{x.view_min[0], x.view_min[1], x.view_min[2]},
                         {x.view_max[0], x.view_max[1], x.view_max[2]}};
-  for (const auto& m : x.materials) {
+  for (size_t i = 0; i < x.materials.size(); ++i) {
+    const auto& m = x.materials[i];
     MeshMaterial mm;
     for (int c = 0; c < 3; ++c) {
       mm.base_colour[c] = m.base_colour[c];
       mm.emission[c] = m.emission[c];
     }
+    mm.base_colour_texture = x.material_texture(i);
     t.materials_.push_back(mm);
   }
   index->chunk = std::move(x);
@@ -209,11 +229,21 @@ Status MeshTrack::prototype(uint32_t i, MeshPrototype* out) const {
   out->positions = std::move(v.positions);
   out->normals = std::move(v.normals);
   out->colours = std::move(v.colours);
+  out->uvs = std::move(v.uvs);
   out->state_times = std::move(v.state_times);
   out->state_positions = std::move(v.state_positions);
   out->indices = std::move(tri.indices);
   out->triangle_materials = std::move(tri.triangle_materials);
   return Status::Ok();
+}
+
+Status MeshTrack::texture(uint32_t i, mesh::TextureTexels* out) const {
+  if (i >= texture_count())
+    return Status(ErrorId::kInvalidArgument, cat("texture ", i, " of ", texture_count()));
+  const std::string what = cat("texture ", i, " textures chunk ", index_->textures[i]);
+  Expected<std::vector<uint8_t>> raw = reader_->read_chunk(index_->textures[i]);
+  if (!raw.ok()) return std::move(raw).status().with_context(what);
+  return mesh::decode_texture(*raw, index_->chunk.textures[i], out, what);
 }
 
 const MeshTransform& transform_at(const MeshObject& object, uint32_t frame) {

@@ -37,6 +37,15 @@ uint64_t prototype_hash(const MeshPrototype& p) {
   put_words(b, p.triangle_materials);
   put_floats(b, p.state_times);
   put_floats(b, p.state_positions);
+  put_floats(b, p.uvs);
+  return container::hash64(b);
+}
+
+uint64_t texture_hash(const mesh::TextureTexels& t) {
+  std::vector<uint8_t> b;
+  put(b, t.width);
+  put(b, t.height);
+  b.insert(b.end(), t.rgba.begin(), t.rgba.end());
   return container::hash64(b);
 }
 
@@ -91,6 +100,16 @@ MeshVerifyResult verify_mesh_track(const container::Reader& reader, uint16_t tra
     }
     ++result.objects_decoded;
     if (with_hashes) result.hash_lines.push_back(line(track, "object", i, object_hash(o)));
+  }
+  mesh::TextureTexels texels;
+  for (uint32_t i = 0; i < t->texture_count() && result.problems.size() < max_problems; ++i) {
+    const Status st = t->texture(i, &texels);
+    if (!st.ok()) {
+      if (note(st)) break;
+      continue;
+    }
+    ++result.textures_decoded;
+    if (with_hashes) result.hash_lines.push_back(line(track, "texture", i, texture_hash(texels)));
   }
   if (!result.problems.empty()) result.hash_lines.clear();
   return result;

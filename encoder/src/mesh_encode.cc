@@ -79,6 +79,21 @@ Expected<Plan> make_plan(const capture::SceneFile& scene,
       r.emission[c] = m.emission[c];
     }
     x.materials.push_back(r);
+    x.material_textures.push_back(m.base_color_texture);
+  }
+  // Textures (layout 2): every scene texture, in scene order, with its pixels.
+  for (size_t t = 0; t < scene.textures.size(); ++t) {
+    const auto& st = scene.textures[t];
+    if (st.width == 0 || st.height == 0 || st.width > mesh::kMaxTextureSize ||
+        st.height > mesh::kMaxTextureSize || st.rgba.size() != size_t{4} * st.width * st.height) {
+      return input_error(cat("scene texture ", t, " '", st.path, "': ", st.width, " x ", st.height,
+                             " with ", st.rgba.size(),
+                             " bytes of pixels (not loaded, or outside 1 .. 16384 per side)"));
+    }
+    mesh::TextureRecord r;
+    r.width = st.width;
+    r.height = st.height;
+    x.textures.push_back(r);
   }
   // Scene meshes to prototypes: only those a kept object uses, in mesh order.
   std::vector<uint32_t> mesh_triangles(scene.meshes.size());
@@ -136,6 +151,12 @@ Expected<Plan> make_plan(const capture::SceneFile& scene,
     x.prototypes.push_back(record);
     h.vertex_count += plan.prototypes[p].record.vertex_count;
   }
+  // Layout 1 unless something needs layout 2 (mesh_layout.h kLayoutVersionUntextured).
+  bool textured = !x.textures.empty();
+  for (const auto& p : x.prototypes) textured = textured || (p.flags & mesh::kHasUvs) != 0;
+  for (uint32_t t : x.material_textures) textured = textured || t != mesh::kNoTexture;
+  x.layout_version = textured ? mesh::kLayoutVersion : mesh::kLayoutVersionUntextured;
+  if (!textured) x.material_textures.clear();
   for (size_t o = 0; o < scene.objects.size(); ++o) {
     if (!kept[o]) continue;
     const auto& so = scene.objects[o];
@@ -179,6 +200,7 @@ Status add_part(container::Writer* writer, uint16_t track, Part& part, MeshEncod
         keys.stream == static_cast<uint16_t>(MeshStream::kIndex)       ? &s.index
         : keys.stream == static_cast<uint16_t>(MeshStream::kVertices)  ? &s.vertices_stream
         : keys.stream == static_cast<uint16_t>(MeshStream::kTriangles) ? &s.triangles_stream
+        : keys.stream == static_cast<uint16_t>(MeshStream::kTextures)  ? &s.textures
                                                                        : &s.visibility;
     b->raw += chunk.raw_size;
     b->stored += chunk.bytes.size();
@@ -217,7 +239,9 @@ uint64_t plain_bytes(const Plan& plan) {
               p.vertices.state_times.size() + p.vertices.state_positions.size() +
               p.triangles.indices.size() + p.triangles.triangle_materials.size());
   }
+  for (const auto& p : plan.prototypes) n += 4 * p.vertices.uvs.size();
   for (const auto& v : plan.visibility) n += 48 * v.transforms.size() + 4 * v.triangles.size();
+  for (const auto& t : plan.index.textures) n += mesh::texture_chunk_size(t);
   return n;
 }
 
@@ -253,7 +277,8 @@ Expected<MeshPrototypeArrays> prototype_arrays(const capture::SceneMesh& m) {
   r.state_count = static_cast<uint32_t>(m.state_times.size());
   const bool normals = !m.normals.empty() || (m.indices.empty() && !m.spheres.empty());
   r.flags = (normals ? mesh::kHasNormals : 0u) | (m.colors.empty() ? 0u : mesh::kHasColours) |
-            (m.triangle_materials.empty() ? 0u : mesh::kHasTriangleMaterials);
+            (m.triangle_materials.empty() ? 0u : mesh::kHasTriangleMaterials) |
+            (m.uvs.empty() ? 0u : mesh::kHasUvs);
   auto& a = out.vertices;
   auto& tri = out.triangles;
   a.positions = m.positions;
@@ -272,6 +297,9 @@ Expected<MeshPrototypeArrays> prototype_arrays(const capture::SceneMesh& m) {
   for (size_t i = m.indices.size(); i < tri.indices.size(); ++i) tri.indices[i] += base;
   a.positions.insert(a.positions.end(), sphere_positions.begin(), sphere_positions.end());
   if (!m.colors.empty()) a.colours.resize(3 * v, 1.0f);
+  // A sphere's vertices get UV (0, 0) (SPEC §11.4.3: spheres are not textured by the tracer).
+  a.uvs = m.uvs;
+  if (!m.uvs.empty()) a.uvs.resize(2 * v, 0.0f);
   if (!m.triangle_materials.empty()) tri.triangle_materials.resize(t, mesh::kObjectMaterial);
   a.state_times = m.state_times;
   if (!m.state_times.empty()) {
@@ -296,21 +324,21 @@ Status encode_mesh_track(const capture::SceneFile& scene,
     return Status(ErrorId::kEncoderOption, cat("threads ", options.threads, " is above 256"));
   if (static_cast<uint16_t>(options.supercompression) >= container::kCompressionCount)
     return Status(ErrorId::kEncoderOption, "unknown supercompression");
-  CALF_ASSIGN_OR_RETURN(const Plan plan, make_plan(scene, visible, options));
-  const auto& x = plan.index;
-  const size_t np = x.prototypes.size(), no = x.objects.size();
+  CALF_ASSIGN_OR_RETURN(Plan plan, make_plan(scene, visible, options));
+  auto& x = plan.index;
+  const size_t np = x.prototypes.size(), no = x.objects.size(), nt = x.textures.size();
 
-  Part index_part;
-  CALF_RETURN_IF_ERROR(compress_into(index_part, MeshStream::kIndex, 0,
-                                     mesh::serialize_index(x, plan.header.frame_count), options,
-                                     "mesh index"));
-  // Independent parts: prototypes then objects, each coded into its own slot.
-  std::vector<Part> parts(np + no);
+  // Independent parts: prototypes, objects, then textures, each coded into its own slot. A
+  // texture is coded both ways (SPEC §11.4.6) and keeps the one that stores fewer bytes after
+  // supercompression (MED on a tie); the index, written after, records the choice.
+  std::vector<Part> parts(np + no + nt);
+  std::vector<uint32_t> codings(nt, mesh::kTextureSrgba8Med);
   tbb::task_arena arena(options.threads == 0 ? tbb::task_arena::automatic
                                              : static_cast<int>(options.threads));
   arena.execute([&] {
     tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, np + no, 1), [&](const tbb::blocked_range<size_t>& range) {
+        tbb::blocked_range<size_t>(0, np + no + nt, 1),
+        [&](const tbb::blocked_range<size_t>& range) {
           for (size_t i = range.begin(); i < range.end(); ++i) {
             Part& part = parts[i];
             if (i < np) {
@@ -325,6 +353,23 @@ Status encode_mesh_track(const capture::SceneFile& scene,
                     compress_into(part, MeshStream::kTriangles, region,
                                   mesh::encode_triangles(p.record, p.triangles), options, what);
               }
+            } else if (i >= np + no) {
+              const size_t t = i - np - no;
+              const auto& st = scene.textures[t];
+              const mesh::TextureTexels texels{st.width, st.height, st.rgba};
+              Part ways[2];
+              for (uint32_t c : {mesh::kTextureSrgba8Med, mesh::kTextureSrgba8Plain}) {
+                mesh::TextureRecord r = x.textures[t];
+                r.coding = c;
+                ways[c].status = compress_into(
+                    ways[c], MeshStream::kTextures, static_cast<uint32_t>(t),
+                    mesh::encode_texture(r, texels), options, cat("scene texture ", t));
+              }
+              const bool plain =
+                  ways[0].status.ok() && ways[1].status.ok() &&
+                  ways[1].chunks[0].second.bytes.size() < ways[0].chunks[0].second.bytes.size();
+              codings[t] = plain ? mesh::kTextureSrgba8Plain : mesh::kTextureSrgba8Med;
+              part = std::move(ways[plain ? 1 : 0]);
             } else {
               const size_t o = i - np;
               const auto& r = x.objects[o];
@@ -337,6 +382,11 @@ Status encode_mesh_track(const capture::SceneFile& scene,
         });
   });
 
+  for (size_t t = 0; t < nt; ++t) x.textures[t].coding = codings[t];
+  Part index_part;
+  CALF_RETURN_IF_ERROR(compress_into(index_part, MeshStream::kIndex, 0,
+                                     mesh::serialize_index(x, plan.header.frame_count), options,
+                                     "mesh index"));
   CALF_ASSIGN_OR_RETURN(const uint16_t track, writer->add_track(plan.header));
   MeshEncodeStats s;
   s.materials = static_cast<uint32_t>(x.materials.size());

@@ -3,14 +3,18 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <map>
 #include <memory>
 #include <string_view>
 #include <utility>
 
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
 #include <assimp/material.h>
 #include <assimp/mesh.h>
 #include <assimp/scene.h>
+#include <assimp/texture.h>
 #include <assimp/Exporter.hpp>
 
 namespace calf::exporter {
@@ -72,8 +76,13 @@ std::unique_ptr<aiMesh> make_mesh(const decoder::MeshPrototype& prototype,
   mesh->mVertices = new aiVector3D[used.size()];
   const bool normals = !prototype.normals.empty();
   const bool colours = !prototype.colours.empty();
+  const bool uvs = !prototype.uvs.empty();
   if (normals) mesh->mNormals = new aiVector3D[used.size()];
   if (colours) mesh->mColors[0] = new aiColor4D[used.size()];
+  if (uvs) {
+    mesh->mTextureCoords[0] = new aiVector3D[used.size()];
+    mesh->mNumUVComponents[0] = 2;
+  }
   for (size_t i = 0; i < used.size(); ++i) {
     const size_t v = used[i];
     mesh->mVertices[i] = aiVector3D(positions[v * 3], positions[v * 3 + 1], positions[v * 3 + 2]);
@@ -84,6 +93,12 @@ std::unique_ptr<aiMesh> make_mesh(const decoder::MeshPrototype& prototype,
     if (colours) {
       mesh->mColors[0][i] = aiColor4D(prototype.colours[v * 3], prototype.colours[v * 3 + 1],
                                       prototype.colours[v * 3 + 2], 1.0f);
+    }
+    if (uvs) {
+      // assimp's UVs have v up (OpenGL's convention); its glTF exporter flips them back to
+      // glTF's v down, and OBJ's vt is v up too.
+      mesh->mTextureCoords[0][i] =
+          aiVector3D(prototype.uvs[v * 2], 1.0f - prototype.uvs[v * 2 + 1], 0.0f);
     }
   }
   mesh->mNumFaces = static_cast<unsigned>(part.triangles.size());
@@ -99,8 +114,17 @@ std::unique_ptr<aiMesh> make_mesh(const decoder::MeshPrototype& prototype,
   return mesh;
 }
 
-std::unique_ptr<aiMaterial> make_material(const decoder::MeshMaterial& m, uint32_t index) {
+// `texture_path`: the file (or assimp's "*<n>" for the n-th embedded texture) of its base-colour
+// texture, empty for none.
+std::unique_ptr<aiMaterial> make_material(const decoder::MeshMaterial& m, uint32_t index,
+                                          const std::string& texture_path) {
   auto material = std::make_unique<aiMaterial>();
+  if (!texture_path.empty()) {
+    // The diffuse slot: assimp's glTF 2.0 exporter writes it as baseColorTexture, its OBJ
+    // exporter as map_Kd.
+    const aiString path(texture_path);
+    material->AddProperty(&path, AI_MATKEY_TEXTURE(aiTextureType_DIFFUSE, 0));
+  }
   const aiString name("material " + std::to_string(index));
   material->AddProperty(&name, AI_MATKEY_NAME);
   const aiColor4D base(m.base_colour[0], m.base_colour[1], m.base_colour[2], 1.0f);
@@ -118,6 +142,24 @@ std::unique_ptr<aiMaterial> make_material(const decoder::MeshMaterial& m, uint32
 aiMatrix4x4 node_matrix(const decoder::MeshTransform& m) {
   return aiMatrix4x4(m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8], m[9], m[10], m[11], 0, 0,
                      0, 1);
+}
+
+// A texture as PNG bytes (8-bit RGBA, unassociated alpha, the texels as they are: sRGB).
+Expected<std::vector<uint8_t>> png_bytes(const mesh::TextureTexels& t, uint32_t index) {
+  std::vector<unsigned char> bytes;
+  OIIO::Filesystem::IOVecOutput proxy(bytes);
+  auto out = OIIO::ImageOutput::create("texture.png");
+  OIIO::ImageSpec spec(static_cast<int>(t.width), static_cast<int>(t.height), 4,
+                       OIIO::TypeDesc::UINT8);
+  spec.attribute("oiio:UnassociatedAlpha", 1);
+  spec.attribute("oiio:ColorSpace", "sRGB");
+  if (!out || !out->set_ioproxy(&proxy) || !out->open("texture.png", spec) ||
+      !out->write_image(OIIO::TypeDesc::UINT8, t.rgba.data()) || !out->close()) {
+    return Status(ErrorId::kExportWrite, "texture " + std::to_string(index) +
+                                             ": PNG encoding failed" +
+                                             (out ? ": " + out->geterror() : std::string()));
+  }
+  return std::vector<uint8_t>(bytes.begin(), bytes.end());
 }
 
 const char* assimp_format_id(MeshExportFormat format) {
@@ -189,11 +231,35 @@ Expected<std::vector<ExportedFile>> export_mesh_track(const decoder::MeshTrack& 
   // Materials: the track's, in order (a mesh's mMaterialIndex is the track's material index).
   const auto& materials = track.materials();
   if (materials.empty()) return export_error("the mesh track has no material");
+  // Textures: PNG, embedded in a glTF (assimp's "*<n>" paths, written into the binary buffer) or
+  // side files <stem>_texture<n>.png beside an OBJ.
+  std::vector<std::vector<uint8_t>> pngs(track.texture_count());
+  std::vector<bool> needed(track.texture_count(), false);
+  for (const auto& m : materials) {
+    if (m.base_colour_texture < needed.size()) needed[m.base_colour_texture] = true;
+  }
+  std::vector<std::string> texture_paths(track.texture_count());
+  std::vector<uint32_t> embedded;  // track texture of each embedded texture
+  for (uint32_t t = 0; t < track.texture_count(); ++t) {
+    if (!needed[t]) continue;
+    mesh::TextureTexels texels;
+    if (Status s = track.texture(t, &texels); !s.ok()) return s;
+    CALF_ASSIGN_OR_RETURN(pngs[t], png_bytes(texels, t));
+    if (format == MeshExportFormat::kObj) {
+      texture_paths[t] = stem + "_texture" + std::to_string(t) + ".png";
+    } else {
+      texture_paths[t] = "*" + std::to_string(embedded.size());
+      embedded.push_back(t);
+    }
+  }
   std::vector<std::unique_ptr<aiMaterial>> ai_materials;
   for (uint32_t i = 0; i < materials.size(); ++i) {
-    ai_materials.push_back(make_material(materials[i], i));
+    const uint32_t t = materials[i].base_colour_texture;
+    ai_materials.push_back(
+        make_material(materials[i], i, t < texture_paths.size() ? texture_paths[t] : ""));
   }
 
+  std::map<uint32_t, uint32_t> untextured;  // track material -> its untextured copy
   std::vector<std::unique_ptr<aiMesh>> meshes;
   std::vector<std::unique_ptr<aiNode>> nodes;
   // Meshes of whole prototypes, shared by the objects that draw them whole (by prototype and
@@ -224,8 +290,21 @@ Expected<std::vector<ExportedFile>> export_mesh_track(const decoder::MeshTrack& 
         for (uint32_t t = 0; t < triangles.size(); ++t) triangles[t] = t;
       }
       decoder::positions_at(prototype, time, &positions);
-      for (const MeshPart& part :
+      for (MeshPart& part :
            split_by_material(prototype, object.prototype, object.material, triangles)) {
+        // A prototype without UVs draws a textured material untextured (the renderers' rule);
+        // glTF forbids a baseColorTexture without TEXCOORD_0, so it gets an untextured copy.
+        if (prototype.uvs.empty() &&
+            materials[part.material].base_colour_texture < texture_paths.size()) {
+          auto [at, added] = untextured.try_emplace(part.material, ai_materials.size());
+          if (added) {
+            ai_materials.push_back(make_material(materials[part.material], part.material, ""));
+            const aiString name("material " + std::to_string(part.material) + " untextured");
+            ai_materials.back()->RemoveProperty(AI_MATKEY_NAME);
+            ai_materials.back()->AddProperty(&name, AI_MATKEY_NAME);
+          }
+          part.material = at->second;
+        }
         const std::string name =
             whole ? "prototype " + std::to_string(object.prototype) + " material " +
                         std::to_string(part.material)
@@ -263,8 +342,24 @@ Expected<std::vector<ExportedFile>> export_mesh_track(const decoder::MeshTrack& 
     nodes[n]->mParent = scene->mRootNode;
     scene->mRootNode->mChildren[n] = nodes[n].release();
   }
+  if (!embedded.empty()) {
+    scene->mNumTextures = static_cast<unsigned>(embedded.size());
+    scene->mTextures = new aiTexture*[embedded.size()];
+    for (size_t e = 0; e < embedded.size(); ++e) {
+      const std::vector<uint8_t>& png = pngs[embedded[e]];
+      auto* tex = new aiTexture();
+      tex->mWidth = static_cast<unsigned>(png.size());  // mHeight 0: compressed, mWidth bytes
+      tex->mHeight = 0;
+      std::snprintf(tex->achFormatHint, sizeof tex->achFormatHint, "png");
+      tex->pcData = reinterpret_cast<aiTexel*>(new uint8_t[png.size()]);
+      std::copy(png.begin(), png.end(), reinterpret_cast<uint8_t*>(tex->pcData));
+      scene->mTextures[e] = tex;
+    }
+  }
   local.objects = nodes.size();
   local.meshes = scene->mNumMeshes;
+  local.textures =
+      pngs.size() - static_cast<size_t>(std::count(needed.begin(), needed.end(), false));
 
   Assimp::Exporter exporter;
   const aiExportDataBlob* blob = exporter.ExportToBlob(scene.get(), assimp_format_id(format), 0);
@@ -281,6 +376,11 @@ Expected<std::vector<ExportedFile>> export_mesh_track(const decoder::MeshTrack& 
     files.push_back(std::move(file));
   }
   if (files.size() > 1) rename_side_files(&files[0].bytes, stem);
+  if (format == MeshExportFormat::kObj) {
+    for (uint32_t t = 0; t < pngs.size(); ++t) {
+      if (needed[t]) files.push_back({"_texture" + std::to_string(t) + ".png", std::move(pngs[t])});
+    }
+  }
   if (stats != nullptr) *stats = local;
   return files;
 }

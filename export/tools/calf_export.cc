@@ -38,8 +38,10 @@ int main(int argc, char** argv) {
       "with its buffer OUT.bin beside it) or .obj (with its material library OUT.mtl beside it). "
       "Objects become nodes with their transform at --frame; objects drawing a whole prototype "
       "share its mesh (glTF instancing); a visible-set object gets a mesh of its visible "
-      "triangles only. Vertex colours, normals and material base colour / emission (clamped to "
-      "1) are kept. Each file is written whole or not at all (a temporary file renamed into "
+      "triangles only. Vertex colours, normals, UVs and material base colour / emission (clamped "
+      "to 1) are kept, and base-colour textures as PNG (embedded in a .glb / .gltf's buffer; "
+      "OUT_texture<n>.png beside an .obj)."
+      " Each file is written whole or not at all (a temporary file renamed into "
       "place).\n" +
       std::string(calf::tools::kExitStatusHelp)};
   std::string clip, out;
@@ -104,11 +106,13 @@ int main(int argc, char** argv) {
     if (calf::Status s = temp.commit(); !s.ok()) return fail(s);
   }
   if (!quiet) {
-    std::printf("%s: frame %u: %llu objects, %llu meshes, %llu vertices, %llu triangles\n",
-                out.c_str(), frame, static_cast<unsigned long long>(stats.objects),
-                static_cast<unsigned long long>(stats.meshes),
-                static_cast<unsigned long long>(stats.vertices),
-                static_cast<unsigned long long>(stats.triangles));
+    std::printf(
+        "%s: frame %u: %llu objects, %llu meshes, %llu vertices, %llu triangles, %llu textures\n",
+        out.c_str(), frame, static_cast<unsigned long long>(stats.objects),
+        static_cast<unsigned long long>(stats.meshes),
+        static_cast<unsigned long long>(stats.vertices),
+        static_cast<unsigned long long>(stats.triangles),
+        static_cast<unsigned long long>(stats.textures));
   }
   return calf::tools::kExitOk;
 }

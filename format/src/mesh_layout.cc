@@ -1,6 +1,7 @@
 // The mesh track's chunk layouts (format/SPEC.md §11.4); the rules are in mesh_layout.h.
 #include "calf/format/mesh_layout.h"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 
@@ -67,6 +68,23 @@ void get_vec3(const uint8_t* in, float* a, const float* ref, size_t v) {
   }
 }
 
+// A vec2 array of `v` vertices (UVs) as component planes, unpredicted: word c*v + i is component
+// c of vertex i.
+void put_vec2(std::vector<uint8_t>& out, const float* a, size_t v) {
+  std::vector<uint32_t> words(2 * v);
+  for (size_t c = 0; c < 2; ++c) {
+    for (size_t i = 0; i < v; ++i) words[c * v + i] = bits(a[2 * i + c]);
+  }
+  put_planes(out, words);
+}
+void get_vec2(const uint8_t* in, float* a, size_t v) {
+  std::vector<uint32_t> words(2 * v);
+  get_planes(in, 2 * v, words.data());
+  for (size_t c = 0; c < 2; ++c) {
+    for (size_t i = 0; i < v; ++i) a[2 * i + c] = from_bits(words[c * v + i]);
+  }
+}
+
 // A sequence of words as deltas from the previous word (the first from 0), as byte planes.
 void put_sequence(std::vector<uint8_t>& out, std::span<const uint32_t> values) {
   std::vector<uint32_t> words(values.size());
@@ -91,10 +109,18 @@ namespace {
 Status check_index(const IndexChunk& x, uint32_t frame_count, const std::string& what) {
   if (x.flags != 0)
     return error(ErrorId::kMeshUnsupported, what, cat("reserved flags ", x.flags, " set"));
+  const bool v1 = x.layout_version < 2;
   for (size_t i = 0; i < x.prototypes.size(); ++i) {
-    if (x.prototypes[i].flags & ~kPrototypeFlags)
+    if (x.prototypes[i].flags & ~(v1 ? kPrototypeFlagsV1 : kPrototypeFlags))
       return error(ErrorId::kMeshUnsupported, what,
-                   cat("prototypes[", i, "]: reserved flags in ", x.prototypes[i].flags));
+                   cat("prototypes[", i, "]: reserved flags in ", x.prototypes[i].flags,
+                       " for layout ", x.layout_version));
+  }
+  for (size_t i = 0; i < x.textures.size(); ++i) {
+    if (x.textures[i].coding > kTextureSrgba8Plain || x.textures[i].flags != 0)
+      return error(ErrorId::kMeshUnsupported, what,
+                   cat("textures[", i, "]: coding ", x.textures[i].coding, " or flags ",
+                       x.textures[i].flags, " unknown"));
   }
   for (size_t i = 0; i < x.objects.size(); ++i) {
     if (x.objects[i].flags & ~kAllTriangles)
@@ -151,12 +177,20 @@ Status check_index(const IndexChunk& x, uint32_t frame_count, const std::string&
                                                  : " exceeds its prototype's ",
                        t));
   }
+  for (size_t m = 0; m < x.material_textures.size(); ++m) {
+    const uint32_t t = x.material_textures[m];
+    if (t != kNoTexture && t >= x.textures.size())
+      return error(ErrorId::kMeshIndex, what,
+                   cat("material_textures[", m, "] ", t, " of ", x.textures.size(), " textures"));
+  }
   return Status::Ok();
 }
 
 }  // namespace
 
 Expected<std::vector<uint8_t>> serialize_index(const IndexChunk& index, uint32_t frame_count) {
+  if (index.layout_version < 2 && (!index.textures.empty() || !index.material_textures.empty()))
+    return Status(ErrorId::kContainerWriterMisuse, "mesh index: layout 1 holds no textures");
   std::vector<uint8_t> out;
   CALF_RETURN_IF_ERROR(container::write_fields(index, out, "mesh index"));
   Expected<IndexChunk> back = parse_index(out, frame_count, "mesh index");
@@ -170,8 +204,9 @@ Expected<IndexChunk> parse_index(std::span<const uint8_t> raw, uint32_t frame_co
   if (raw.size() < 4)
     return error(ErrorId::kMeshChunk, what, cat(raw.size(), " bytes, too short for a version"));
   const uint32_t version = static_cast<uint32_t>(container::load_le(raw.data(), 4));
-  if (version != kLayoutVersion)
-    return error(ErrorId::kMeshUnsupported, what, cat("layout version ", version, ", expected 1"));
+  if (version != kLayoutVersion && version != kLayoutVersionUntextured)
+    return error(ErrorId::kMeshUnsupported, what,
+                 cat("layout version ", version, ", expected 1 or 2"));
   IndexChunk x;
   container::FieldReader r(raw, ErrorId::kMeshChunk, ErrorId::kMeshValue, what,
                            ErrorId::kMeshLimit);
@@ -187,7 +222,7 @@ Expected<IndexChunk> parse_index(std::span<const uint8_t> raw, uint32_t frame_co
 uint64_t vertices_chunk_size(const PrototypeRecord& p) {
   const uint64_t v = p.vertex_count, s = p.state_count;
   uint64_t arrays = 1 + ((p.flags & kHasNormals) ? 1 : 0) + ((p.flags & kHasColours) ? 1 : 0);
-  return 12 * v * arrays + 4 * s + 12 * v * s;
+  return 12 * v * arrays + ((p.flags & kHasUvs) ? 8 * v : 0) + 4 * s + 12 * v * s;
 }
 
 Expected<std::vector<uint8_t>> encode_vertices(const PrototypeRecord& p, const VertexArrays& a) {
@@ -201,6 +236,8 @@ Expected<std::vector<uint8_t>> encode_vertices(const PrototypeRecord& p, const V
     return bad("normals", a.normals.size(), (p.flags & kHasNormals) ? 3 * v : 0);
   if (a.colours.size() != ((p.flags & kHasColours) ? 3 * v : 0))
     return bad("colours", a.colours.size(), (p.flags & kHasColours) ? 3 * v : 0);
+  if (a.uvs.size() != ((p.flags & kHasUvs) ? 2 * v : 0))
+    return bad("uvs", a.uvs.size(), (p.flags & kHasUvs) ? 2 * v : 0);
   if (a.state_times.size() != s) return bad("state_times", a.state_times.size(), s);
   if (a.state_positions.size() != 3 * v * s)
     return bad("state_positions", a.state_positions.size(), 3 * v * s);
@@ -209,6 +246,7 @@ Expected<std::vector<uint8_t>> encode_vertices(const PrototypeRecord& p, const V
   put_vec3(out, a.positions.data(), nullptr, v);
   if (p.flags & kHasNormals) put_vec3(out, a.normals.data(), nullptr, v);
   if (p.flags & kHasColours) put_vec3(out, a.colours.data(), nullptr, v);
+  if (p.flags & kHasUvs) put_vec2(out, a.uvs.data(), v);
   std::vector<uint32_t> times(s);
   for (size_t k = 0; k < s; ++k) times[k] = bits(a.state_times[k]);
   put_sequence(out, times);
@@ -246,6 +284,11 @@ Status decode_vertices(std::span<const uint8_t> raw, const PrototypeRecord& p, V
     get_vec3(in, out->colours.data(), nullptr, v);
     in += 12 * v;
   }
+  if (p.flags & kHasUvs) {
+    out->uvs.resize(2 * v);
+    get_vec2(in, out->uvs.data(), v);
+    in += 8 * v;
+  }
   std::vector<uint32_t> times(s);
   get_sequence(in, s, times.data());
   in += 4 * s;
@@ -277,6 +320,11 @@ Status decode_vertices(std::span<const uint8_t> raw, const PrototypeRecord& p, V
     if (!(c >= 0.0f && c <= 1.0f))
       return error(ErrorId::kMeshValue, what,
                    cat(vertex_text(i / 3), " colour ", c, " is outside [0, 1]"));
+  }
+  for (size_t i = 0; i < out->uvs.size(); ++i) {
+    if (!std::isfinite(out->uvs[i]))
+      return error(ErrorId::kMeshValue, what,
+                   cat(vertex_text(i / 2), " uv ", out->uvs[i], " is not finite"));
   }
   for (size_t k = 0; k < s; ++k) {
     const float t = out->state_times[k];
@@ -443,6 +491,81 @@ Status decode_visibility(std::span<const uint8_t> raw, const ObjectRecord& o,
     return error(
         ErrorId::kMeshIndex, what,
         cat("the runs hold ", out->triangles.size(), " triangles, the object ", o.triangle_count));
+  return Status::Ok();
+}
+
+// ---- Textures ----
+
+namespace {
+
+// The MED predictor (LOCO-I / JPEG-LS) of a texel channel from its left (a), upper (b) and
+// upper-left (c) neighbours: an edge-detecting choice between a, b and a + b - c.
+uint8_t med(int a, int b, int c) {
+  if (c >= std::max(a, b)) return static_cast<uint8_t>(std::min(a, b));
+  if (c <= std::min(a, b)) return static_cast<uint8_t>(std::max(a, b));
+  return static_cast<uint8_t>(a + b - c);
+}
+
+// The prediction of channel `ch` of texel (x, y) from already known texels of `rgba`: MED inside,
+// the left texel on row 0, the upper texel in column 0, 0 at (0, 0).
+uint8_t predict(const uint8_t* rgba, size_t w, size_t x, size_t y, size_t ch) {
+  const auto at = [&](size_t xx, size_t yy) { return int{rgba[4 * (yy * w + xx) + ch]}; };
+  if (y == 0) return x == 0 ? 0 : static_cast<uint8_t>(at(x - 1, 0));
+  if (x == 0) return static_cast<uint8_t>(at(0, y - 1));
+  return med(at(x - 1, y), at(x, y - 1), at(x - 1, y - 1));
+}
+
+}  // namespace
+
+uint64_t texture_chunk_size(const TextureRecord& t) {
+  return 4 * uint64_t{t.width} * t.height;
+}
+
+Expected<std::vector<uint8_t>> encode_texture(const TextureRecord& t, const TextureTexels& texels) {
+  if (texels.width != t.width || texels.height != t.height ||
+      texels.rgba.size() != texture_chunk_size(t)) {
+    return Status(ErrorId::kContainerWriterMisuse,
+                  cat("mesh texture: ", texels.width, " x ", texels.height, " texels of ",
+                      texels.rgba.size(), " bytes for a ", t.width, " x ", t.height, " record"));
+  }
+  if (t.coding == kTextureSrgba8Plain) return texels.rgba;
+  const size_t w = t.width, h = t.height, n = w * h;
+  std::vector<uint8_t> out(4 * n);
+  for (size_t ch = 0; ch < 4; ++ch) {
+    for (size_t y = 0; y < h; ++y) {
+      for (size_t x = 0; x < w; ++x) {
+        out[ch * n + y * w + x] = static_cast<uint8_t>(texels.rgba[4 * (y * w + x) + ch] -
+                                                       predict(texels.rgba.data(), w, x, y, ch));
+      }
+    }
+  }
+  return out;
+}
+
+Status decode_texture(std::span<const uint8_t> raw, const TextureRecord& t, TextureTexels* out,
+                      const std::string& what) {
+  if (raw.size() != texture_chunk_size(t)) {
+    return error(ErrorId::kMeshChunk, what,
+                 cat(raw.size(), " bytes, expected ", texture_chunk_size(t), " for ", t.width,
+                     " x ", t.height, " texels"));
+  }
+  const size_t w = t.width, h = t.height, n = w * h;
+  out->width = t.width;
+  out->height = t.height;
+  if (t.coding == kTextureSrgba8Plain) {
+    out->rgba.assign(raw.begin(), raw.end());
+    return Status::Ok();
+  }
+  out->rgba.assign(4 * n, 0);
+  uint8_t* rgba = out->rgba.data();
+  for (size_t y = 0; y < h; ++y) {
+    for (size_t x = 0; x < w; ++x) {
+      for (size_t ch = 0; ch < 4; ++ch) {
+        rgba[4 * (y * w + x) + ch] =
+            static_cast<uint8_t>(raw[ch * n + y * w + x] + predict(rgba, w, x, y, ch));
+      }
+    }
+  }
   return Status::Ok();
 }
 

@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
                "also print the conformance hash of every decoded face, one line each: "
                "'track T frame F view V face X <XXH3-64 hex>' (SPEC §14), and of every mesh "
                "prototype and object: 'track T prototype P <hex>', 'track T object O <hex>' "
-               "(SPEC §11.4.6), and of every surfels prototype: 'track T surfels P <hex>' "
+               "(SPEC §11.4.7), and of every surfels prototype: 'track T surfels P <hex>' "
                "(SPEC §11.3.6); a file with problems prints none")
       ->excludes("--container-only");
   app.add_option("--max-problems", max_problems,

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "calf/player/mesh_renderer.h"
+#include "mesh_texture_sampler.h"
 #include "object_transform.h"
 
 namespace calf::player {
@@ -81,6 +82,8 @@ struct TriangleShade {
   Vec3 p[3];        // eye-relative world positions
   Vec3 n[3];        // world normals (vertex normals through the normal matrix), or unused
   Vec3 colour[3];   // vertex colours (1 when none)
+  double uv[3][2];  // vertex UVs, when textured
+  const std::vector<mesh::TextureTexels>* texture = nullptr;  // its mip chain, or untextured
   Vec3 face;        // unnormalised face normal (p1 - p0) x (p2 - p0)
   double side = 1;  // -1 when the front faces away from the eye
   bool vertex_normals = false;
@@ -89,9 +92,39 @@ struct TriangleShade {
 
 struct Target {
   const Camera* camera;
+  const CameraFrame* frame;
   const std::vector<Vec3>* rays;
   RenderedImage* out;
 };
+
+// The UV where ray `d` meets the triangle's plane (also outside the triangle), through the
+// barycentric coordinates of the hit point.
+void uv_on_plane(const TriangleShade& s, const Vec3& d, double* u, double* v) {
+  const double dist = dot(s.face, s.p[0]) / dot(s.face, d);
+  const Vec3 x = d * dist;
+  const double nn = dot(s.face, s.face);
+  const double l1 = dot(s.face, cross(x - s.p[0], s.p[2] - s.p[0])) / nn;
+  const double l2 = dot(s.face, cross(s.p[1] - s.p[0], x - s.p[0])) / nn;
+  const double l0 = 1 - l1 - l2;
+  *u = s.uv[0][0] * l0 + s.uv[1][0] * l1 + s.uv[2][0] * l2;
+  *v = s.uv[0][1] * l0 + s.uv[1][1] * l1 + s.uv[2][1] * l2;
+}
+
+// The texture's linear colour at pixel (i, j): UVs at the pixel centre, the level of detail from
+// the UVs at the pixel's 2 x 2 quad (GL's coarse derivatives, mesh_draw_list.h).
+Vec3 texture_at(const TriangleShade& s, const Target& t, const Vec3& d, uint32_t i, uint32_t j) {
+  double u, v;
+  uv_on_plane(s, d, &u, &v);
+  const uint32_t qx = i & ~1u, qy = j & ~1u;
+  double u00, v00, u10, v10, u01, v01;
+  uv_on_plane(s, camera_ray(*t.camera, *t.frame, qx, qy), &u00, &v00);
+  uv_on_plane(s, camera_ray(*t.camera, *t.frame, qx + 1, qy), &u10, &v10);
+  uv_on_plane(s, camera_ray(*t.camera, *t.frame, qx, qy + 1), &u01, &v01);
+  const auto& chain = *s.texture;
+  const double lod =
+      internal::mesh_texture_lod(chain[0], u10 - u00, v10 - v00, u01 - u00, v01 - v00);
+  return internal::sample_mesh_texture(chain, u, v, lod);
+}
 
 void shade_pixel(const TriangleShade& s, const Target& t, uint32_t i, uint32_t j) {
   const size_t k = size_t{j} * t.camera->width + i;
@@ -113,7 +146,8 @@ void shade_pixel(const TriangleShade& s, const Target& t, uint32_t i, uint32_t j
   const Vec3 light{kMeshKeyLight[0], kMeshKeyLight[1], kMeshKeyLight[2]};
   const double lit = kMeshAmbient + (1 - double{kMeshAmbient}) * std::max(0.0, dot(normal, light));
   const MeshDrawMaterial& m = *s.material;
-  const double c[3] = {vc.x, vc.y, vc.z};
+  const Vec3 tex = s.texture ? texture_at(s, t, d, i, j) : Vec3{1, 1, 1};
+  const double c[3] = {vc.x * tex.x, vc.y * tex.y, vc.z * tex.z};
   t.out->depth[k] = depth;
   for (int ch = 0; ch < 3; ++ch) {
     t.out->color[3 * k + ch] = static_cast<float>(m.base_colour[ch] * c[ch] * lit + m.emission[ch]);
@@ -164,7 +198,7 @@ Status render_mesh_cpu(const MeshDrawList& list, const Camera& camera,
     for (uint32_t i = 0; i < width; ++i)
       rays[size_t{j} * width + i] = camera_ray(camera, frame, i, j);
   }
-  const Target target{&camera, &rays, out};
+  const Target target{&camera, &frame, &rays, out};
   const double h = std::tan(camera.fov_y / 2);
   const double aspect = static_cast<double>(width) / height;
   // View coordinates -> image coordinates (the inverse of camera_ray's pixel -> direction).
@@ -216,6 +250,14 @@ Status render_mesh_cpu(const MeshDrawList& list, const Camera& camera,
       const uint32_t own =
           proto.triangle_materials.empty() ? kMeshObjectMaterial : proto.triangle_materials[tri];
       s.material = &list.materials[own == kMeshObjectMaterial ? object.material : own];
+      if (s.material->base_colour_texture != kMeshNoTexture && !proto.uvs.empty()) {
+        s.texture = &list.textures[s.material->base_colour_texture];
+        for (int c = 0; c < 3; ++c) {
+          const uint32_t v = proto.indices[3 * size_t{tri} + c];
+          s.uv[c][0] = proto.uvs[2 * size_t{v}];
+          s.uv[c][1] = proto.uvs[2 * size_t{v} + 1];
+        }
+      }
       std::array<ViewVertex, 4> poly;
       const int n = clip_near(view, options.near, &poly);
       if (n < 3) continue;

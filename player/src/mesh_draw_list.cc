@@ -1,6 +1,7 @@
 // Validation of a mesh draw list (rules in mesh_draw_list.h).
 #include "calf/player/mesh_draw_list.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -35,6 +36,11 @@ Status check_prototype(const MeshDrawPrototype& p, size_t index, size_t material
     return list_error(name + ": " + std::to_string(p.colours.size()) + " colour floats for " +
                       std::to_string(n) + " vertices");
   }
+  if (!p.uvs.empty() && p.uvs.size() != 2 * n) {
+    return list_error(name + ": " + std::to_string(p.uvs.size()) + " uv floats for " +
+                      std::to_string(n) + " vertices");
+  }
+  if (!all_finite(p.uvs)) return list_error(name + ": a uv is not finite");
   if (p.indices.size() % 3 != 0) {
     return list_error(name + ": " + std::to_string(p.indices.size()) +
                       " indices, not 3 per triangle");
@@ -98,10 +104,37 @@ Status check_object(const MeshDrawObject& o, size_t index, const MeshDrawList& l
   return Status::Ok();
 }
 
+Status check_texture(const std::vector<mesh::TextureTexels>& chain, size_t index) {
+  const std::string name = "texture " + std::to_string(index);
+  if (chain.empty() || chain[0].width == 0 || chain[0].height == 0 ||
+      chain.size() != mesh::mip_level_count(chain[0].width, chain[0].height)) {
+    return list_error(name + ": not a whole mip chain");
+  }
+  for (size_t k = 0; k < chain.size(); ++k) {
+    const mesh::TextureTexels& l = chain[k];
+    const uint32_t w = std::max(1u, chain[0].width >> k), h = std::max(1u, chain[0].height >> k);
+    if (l.width != w || l.height != h || l.rgba.size() != size_t{4} * w * h) {
+      return list_error(name + ", level " + std::to_string(k) + ": " + std::to_string(l.width) +
+                        " x " + std::to_string(l.height) + " with " +
+                        std::to_string(l.rgba.size()) + " bytes, expected " + std::to_string(w) +
+                        " x " + std::to_string(h));
+    }
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status validate_mesh_draw_list(const MeshDrawList& list) {
+  for (size_t t = 0; t < list.textures.size(); ++t) {
+    CALF_RETURN_IF_ERROR(check_texture(list.textures[t], t));
+  }
   for (size_t m = 0; m < list.materials.size(); ++m) {
+    const uint32_t tex = list.materials[m].base_colour_texture;
+    if (tex != kMeshNoTexture && tex >= list.textures.size()) {
+      return list_error("material " + std::to_string(m) + ": texture " + std::to_string(tex) +
+                        " >= texture count " + std::to_string(list.textures.size()));
+    }
     for (int c = 0; c < 3; ++c) {
       const float b = list.materials[m].base_colour[c], e = list.materials[m].emission[c];
       if (!(std::isfinite(b) && b >= 0 && std::isfinite(e) && e >= 0)) {

@@ -100,7 +100,13 @@ Expected<std::unique_ptr<MeshRepresentation>> MeshRepresentation::open(
   }
   MeshDrawList& list = impl->list;
   for (const decoder::MeshMaterial& mat : m.materials()) {
-    list.materials.push_back({mat.base_colour, mat.emission});
+    list.materials.push_back({mat.base_colour, mat.emission, mat.base_colour_texture});
+  }
+  // Textures: decoded once, each with its mip chain (calf/format/mesh_texture.h).
+  for (uint32_t t = 0; t < m.texture_count(); ++t) {
+    mesh::TextureTexels texels;
+    CALF_RETURN_IF_ERROR(m.texture(t, &texels));
+    list.textures.push_back(mesh::mip_chain(texels));
   }
   impl->prototypes.resize(m.prototype_count());
   for (uint32_t p = 0; p < m.prototype_count(); ++p) {
@@ -112,6 +118,7 @@ Expected<std::unique_ptr<MeshRepresentation>> MeshRepresentation::open(
     // list takes the rest, so a static scene is held once.
     d.normals = std::move(proto.normals);
     d.colours = std::move(proto.colours);
+    d.uvs = std::move(proto.uvs);
     d.indices = std::move(proto.indices);
     d.triangle_materials = std::move(proto.triangle_materials);
     if (!proto.state_times.empty()) {

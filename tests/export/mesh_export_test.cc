@@ -6,15 +6,18 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <unistd.h>
 
+#include <OpenImageIO/imageio.h>
 #include <assimp/scene.h>
 #include <gtest/gtest.h>
 #include <assimp/Importer.hpp>
@@ -245,6 +248,118 @@ TEST(MeshExport, ObjWithItsMaterialLibrary) {
   EXPECT_EQ(got.materials, scene.materials.size());
   EXPECT_EQ(got.triangles, want);
   expect_boxes_near(got.box, want_box, 1e-4);
+}
+
+// The PNG bytes of an export decoded back to RGBA8 (OpenImageIO, alpha unassociated).
+// Through a file: this OpenImageIO's PNG reader takes no memory proxy.
+std::vector<uint8_t> decode_png(const uint8_t* data, size_t size, uint32_t* w, uint32_t* h) {
+  const std::filesystem::path path = std::filesystem::temp_directory_path() /
+                                     ("calf_export_png_" + std::to_string(getpid()) + ".png");
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  auto in = OIIO::ImageInput::open(path.string(), &config);
+  EXPECT_TRUE(in) << OIIO::geterror();
+  if (!in) return {};
+  *w = static_cast<uint32_t>(in->spec().width);
+  *h = static_cast<uint32_t>(in->spec().height);
+  std::vector<uint8_t> rgba(size_t{*w} * *h * 4);
+  EXPECT_EQ(in->spec().nchannels, 4);
+  EXPECT_TRUE(in->read_image(0, 0, 0, 4, OIIO::TypeDesc::UINT8, rgba.data()));
+  in->close();
+  std::filesystem::remove(path);
+  return rgba;
+}
+
+// The UVs of the imported meshes in SCENE.md's convention (assimp's v is up): each mesh's set of
+// (u, v) pairs, sorted.
+std::vector<std::pair<float, float>> uv_pairs(const aiMesh* m) {
+  std::vector<std::pair<float, float>> out;
+  if (m->mTextureCoords[0] == nullptr) return out;
+  for (unsigned i = 0; i < m->mNumVertices; ++i)
+    out.emplace_back(m->mTextureCoords[0][i].x, 1.0f - m->mTextureCoords[0][i].y);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+TEST(MeshExport, TexturesAndUvsTravelIntoGlbAndObj) {
+  const capture::SceneFile scene = test::make_textured_mesh_test_scene();
+  const std::vector<uint8_t> clip = encode(scene, nullptr);
+  exporter::MeshExportStats stats;
+  auto glb = export_clip(clip, 0, MeshExportFormat::kGlb, &stats);
+  ASSERT_TRUE(glb.ok()) << glb.status().to_string();
+  ASSERT_EQ(glb->size(), 1u);
+  EXPECT_EQ(stats.textures, 2u);  // the unused texture is left out
+  Assimp::Importer importer;
+  const aiScene* got =
+      importer.ReadFileFromMemory(glb->front().bytes.data(), glb->front().bytes.size(), 0, "glb");
+  ASSERT_NE(got, nullptr) << importer.GetErrorString();
+  ASSERT_EQ(got->mNumTextures, 2u);
+  // Each embedded image decodes to the scene's texels, and the material that names it does so.
+  for (unsigned t = 0; t < 2; ++t) {
+    const aiTexture* tex = got->mTextures[t];
+    ASSERT_EQ(tex->mHeight, 0u);
+    uint32_t w = 0, h = 0;
+    const auto rgba =
+        decode_png(reinterpret_cast<const uint8_t*>(tex->pcData), tex->mWidth, &w, &h);
+    bool matched = false;
+    for (const capture::SceneTexture& st : scene.textures)
+      matched = matched || (st.width == w && st.height == h && st.rgba == rgba);
+    EXPECT_TRUE(matched) << "embedded texture " << t << " (" << w << " x " << h << ")";
+  }
+  unsigned textured_materials = 0;
+  for (unsigned m = 0; m < got->mNumMaterials; ++m) {
+    aiString path;
+    if (got->mMaterials[m]->GetTexture(aiTextureType_DIFFUSE, 0, &path) == AI_SUCCESS ||
+        got->mMaterials[m]->GetTexture(aiTextureType_BASE_COLOR, 0, &path) == AI_SUCCESS) {
+      ++textured_materials;
+      EXPECT_EQ(path.C_Str()[0], '*') << path.C_Str();
+    }
+  }
+  EXPECT_EQ(textured_materials, 2u);
+  // The tetrahedron has no UVs: its textured material 2 is written as an untextured copy (glTF
+  // needs TEXCOORD_0 for a texture; the renderers draw it untextured).
+  bool copy = false;
+  for (unsigned m = 0; m < got->mNumMaterials; ++m)
+    copy = copy || std::string(got->mMaterials[m]->GetName().C_Str()) == "material 2 untextured";
+  EXPECT_TRUE(copy);
+  // The floor (scene mesh 0, drawn whole with its material) keeps its UVs, beyond [0, 1] too.
+  std::vector<std::pair<float, float>> want;
+  for (size_t i = 0; i < scene.meshes[0].uvs.size(); i += 2)
+    want.emplace_back(scene.meshes[0].uvs[i], scene.meshes[0].uvs[i + 1]);
+  std::sort(want.begin(), want.end());
+  bool found = false;
+  for (unsigned m = 0; m < got->mNumMeshes; ++m) {
+    if (got->mMeshes[m]->mNumVertices != 4 || got->mMeshes[m]->mTextureCoords[0] == nullptr)
+      continue;
+    const auto pairs = uv_pairs(got->mMeshes[m]);
+    bool same = pairs.size() == want.size();
+    for (size_t i = 0; same && i < pairs.size(); ++i)
+      same = std::abs(pairs[i].first - want[i].first) < 1e-6f &&
+             std::abs(pairs[i].second - want[i].second) < 1e-6f;
+    found = found || same;
+  }
+  EXPECT_TRUE(found) << "no mesh with the floor's UVs";
+
+  // OBJ: the textures are side files named by map_Kd.
+  auto obj = export_clip(clip, 0, MeshExportFormat::kObj);
+  ASSERT_TRUE(obj.ok()) << obj.status().to_string();
+  ASSERT_EQ(obj->size(), 4u);
+  EXPECT_EQ((*obj)[2].suffix, "_texture0.png");
+  EXPECT_EQ((*obj)[3].suffix, "_texture1.png");
+  const std::string mtl((*obj)[1].bytes.begin(), (*obj)[1].bytes.end());
+  EXPECT_NE(mtl.find("map_Kd scene_texture0.png"), std::string::npos) << mtl;
+  uint32_t w = 0, h = 0;
+  EXPECT_EQ(decode_png((*obj)[3].bytes.data(), (*obj)[3].bytes.size(), &w, &h),
+            scene.textures[1].rgba);
+  const std::string text((*obj)[0].bytes.begin(), (*obj)[0].bytes.end());
+  EXPECT_NE(text.find("\nvt "), std::string::npos);
+  const Imported back = import_files(*obj, "scene", ".obj");
+  uint64_t triangles = 0;
+  Box box;
+  expected(scene, 0, nullptr, &triangles, &box);
+  EXPECT_EQ(back.triangles, triangles);
 }
 
 TEST(MeshExport, SameTrackSameBytes) {

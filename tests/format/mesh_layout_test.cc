@@ -7,7 +7,9 @@
 #include <cmath>
 #include <limits>
 
+#include "calf/format/colour.h"
 #include "calf/format/mesh_layout.h"
+#include "calf/format/mesh_texture.h"
 
 namespace calf::mesh {
 namespace {
@@ -62,10 +64,14 @@ TEST(MeshLayout, IndexRoundTripAndSize) {
 TEST(MeshLayout, IndexVersionIsCheckedFirst) {
   auto bytes = serialize_index(small_index(), 3);
   ASSERT_TRUE(bytes.ok());
+  std::vector<uint8_t> v3 = *bytes;
+  v3[0] = 3;
+  v3.resize(6);  // a later layout may be anything after its version
+  EXPECT_EQ(parse_index(v3, 3, "index").status().id(), ErrorId::kMeshUnsupported);
+  // Layout 2 after a layout-1 body: its texture arrays are missing.
   std::vector<uint8_t> v2 = *bytes;
   v2[0] = 2;
-  v2.resize(6);  // a later layout may be anything after its version
-  EXPECT_EQ(parse_index(v2, 3, "index").status().id(), ErrorId::kMeshUnsupported);
+  EXPECT_EQ(parse_index(v2, 3, "index").status().id(), ErrorId::kMeshChunk);
   EXPECT_EQ(parse_index(std::span<const uint8_t>(bytes->data(), 3), 3, "index").status().id(),
             ErrorId::kMeshChunk);
   std::vector<uint8_t> cut(bytes->begin(), bytes->end() - 1);
@@ -192,6 +198,155 @@ TEST(MeshLayout, VisibilityRunsRoundTrip) {
   EXPECT_EQ(b1->size(), 48u);
   b1->push_back(0);
   EXPECT_EQ(decode_visibility(*b1, all, p, &back, "vis").id(), ErrorId::kMeshChunk);
+}
+
+// ---- Layout 2: textures and UVs ----
+
+IndexChunk textured_index() {
+  IndexChunk x = small_index();
+  x.layout_version = kLayoutVersion;
+  x.prototypes[1].flags = kHasUvs;
+  x.textures.push_back({3, 2});
+  x.textures.push_back({1, 1});
+  x.material_textures = {kNoTexture, 1};
+  return x;
+}
+
+TEST(MeshLayout, Layout2IndexRoundTripAndChecks) {
+  const IndexChunk x = textured_index();
+  auto bytes = serialize_index(x, 3);
+  ASSERT_TRUE(bytes.ok()) << bytes.status().to_string();
+  // Layout 1's bytes, then u32 X + 2 x 16 texture bytes, then 2 material textures (no count).
+  EXPECT_EQ(bytes->size(), 8u + 48 + 52 + 44 + 52 + 4 + 32 + 8);
+  auto back = parse_index(*bytes, 3, "index");
+  ASSERT_TRUE(back.ok()) << back.status().to_string();
+  ASSERT_EQ(back->textures.size(), 2u);
+  EXPECT_EQ(back->textures[0].width, 3u);
+  EXPECT_EQ(back->textures[0].height, 2u);
+  EXPECT_EQ(back->material_texture(0), kNoTexture);
+  EXPECT_EQ(back->material_texture(1), 1u);
+  // The last word is material 1's texture: 2 is out of range (E222).
+  std::vector<uint8_t> bad = *bytes;
+  bad[bad.size() - 4] = 2;
+  EXPECT_EQ(parse_index(bad, 3, "index").status().id(), ErrorId::kMeshIndex);
+  // Texture 0's width 0 (E223), coding 2 (E221), width above 16384 (E224).
+  const size_t tex0 = 8 + 48 + 52 + 44 + 52 + 4;
+  bad = *bytes;
+  bad[tex0] = 0;
+  EXPECT_EQ(parse_index(bad, 3, "index").status().id(), ErrorId::kMeshValue);
+  bad = *bytes;
+  bad[tex0 + 8] = 2;
+  EXPECT_EQ(parse_index(bad, 3, "index").status().id(), ErrorId::kMeshUnsupported);
+  bad = *bytes;
+  bad[tex0 + 2] = 1;  // width 65539
+  EXPECT_EQ(parse_index(bad, 3, "index").status().id(), ErrorId::kMeshLimit);
+  // Layout 1 has neither UVs nor textures.
+  IndexChunk v1 = x;
+  v1.layout_version = kLayoutVersionUntextured;
+  EXPECT_EQ(serialize_index(v1, 3).status().id(), ErrorId::kContainerWriterMisuse);
+  v1.textures.clear();
+  v1.material_textures.clear();
+  EXPECT_EQ(serialize_index(v1, 3).status().id(), ErrorId::kContainerWriterMisuse);  // UV flag
+  v1.prototypes[1].flags = 0;
+  EXPECT_TRUE(serialize_index(v1, 3).ok());
+  // A layout-2 index needs one texture entry per material.
+  IndexChunk short_list = x;
+  short_list.material_textures.pop_back();
+  EXPECT_EQ(serialize_index(short_list, 3).status().id(), ErrorId::kContainerWriterMisuse);
+}
+
+TEST(MeshLayout, UvsRoundTripAfterColoursAndAreChecked) {
+  const PrototypeRecord p{2, 0, kHasColours | kHasUvs, 0};
+  VertexArrays a;
+  a.positions = {0, 0, 0, 1, 0, 0};
+  a.colours = {1, 1, 1, 0, 0, 0};
+  a.uvs = {0.25f, -3.5f, 1e6f, 0.75f};
+  auto bytes = encode_vertices(p, a);
+  ASSERT_TRUE(bytes.ok()) << bytes.status().to_string();
+  ASSERT_EQ(bytes->size(), 24u + 24 + 16);
+  // UV component planes after the colours: word 0 u0 (0.25f = 0x3e800000), word 2 v0 (-3.5f =
+  // 0xc0600000); byte plane 3 starts 12 bytes in.
+  EXPECT_EQ((*bytes)[48 + 12], 0x3e);
+  EXPECT_EQ((*bytes)[48 + 14], 0xc0);
+  VertexArrays back;
+  ASSERT_TRUE(decode_vertices(*bytes, p, &back, "v").ok());
+  EXPECT_EQ(bits_of(back.uvs), bits_of(a.uvs));
+  std::vector<uint8_t> inf = *bytes;
+  inf[48 + 12 + 1] = 0x7f;  // u1 = 0x7f800000 (+inf), byte by byte
+  inf[48 + 8 + 1] = 0x80;
+  inf[48 + 4 + 1] = 0x00;
+  inf[48 + 1] = 0x00;
+  EXPECT_EQ(decode_vertices(inf, p, &back, "v").id(), ErrorId::kMeshValue);
+  VertexArrays missing = a;
+  missing.uvs.pop_back();
+  EXPECT_EQ(encode_vertices(p, missing).status().id(), ErrorId::kContainerWriterMisuse);
+}
+
+TEST(MeshLayout, TextureIsLosslessMedPlanes) {
+  const TextureRecord r{3, 2};
+  TextureTexels t{3, 2, {}};
+  // Row 0: (10, 200, 0, 255) (20, 190, 20, 255) (30, 180, 250, 255);
+  // row 1: (15, 100, 1, 128) (40, 0, 7, 128) (25, 255, 3, 0).
+  t.rgba = {10, 200, 0, 255, 20, 190, 20, 255, 30, 180, 250, 255,
+            15, 100, 1, 128, 40, 0,   7,  128, 25, 255, 3,   0};
+  auto bytes = encode_texture(r, t);
+  ASSERT_TRUE(bytes.ok()) << bytes.status().to_string();
+  ASSERT_EQ(bytes->size(), 24u);
+  // Red plane by hand: 10 (from 0), 20 - 10, 30 - 20 (left on row 0); 15 - 10 (above in column
+  // 0); texel (1, 1): a = 15, b = 20, c = 10 <= min -> max(a, b) = 20, 40 - 20 = 20; texel
+  // (2, 1): a = 40, b = 30, c = 20 <= min -> 40, 25 - 40 = -15 = 241.
+  const std::vector<uint8_t> red(bytes->begin(), bytes->begin() + 6);
+  EXPECT_EQ(red, (std::vector<uint8_t>{10, 10, 10, 5, 20, 241}));
+  // Green (1, 1): a = 100, b = 190, c = 200 >= max -> min = 100, 0 - 100 = 156.
+  EXPECT_EQ((*bytes)[6 + 4], 156);
+  // Blue (2, 1): a = 7, b = 250, c = 20: between -> a + b - c = 237, 3 - 237 = 22.
+  EXPECT_EQ((*bytes)[12 + 5], 22);
+  TextureTexels back;
+  ASSERT_TRUE(decode_texture(*bytes, r, &back, "tex").ok());
+  EXPECT_EQ(back.rgba, t.rgba);
+  EXPECT_EQ(back.width, 3u);
+  std::vector<uint8_t> cut(bytes->begin(), bytes->end() - 1);
+  EXPECT_EQ(decode_texture(cut, r, &back, "tex").id(), ErrorId::kMeshChunk);
+  TextureTexels wrong = t;
+  wrong.rgba.pop_back();
+  EXPECT_EQ(encode_texture(r, wrong).status().id(), ErrorId::kContainerWriterMisuse);
+  // Plain: the texels as they are.
+  const TextureRecord plain{3, 2, kTextureSrgba8Plain};
+  auto same = encode_texture(plain, t);
+  ASSERT_TRUE(same.ok());
+  EXPECT_EQ(*same, t.rgba);
+  ASSERT_TRUE(decode_texture(*same, plain, &back, "tex").ok());
+  EXPECT_EQ(back.rgba, t.rgba);
+}
+
+TEST(MeshTexture, MipChainAveragesInLinearLight) {
+  EXPECT_EQ(mip_level_count(1, 1), 1u);
+  EXPECT_EQ(mip_level_count(5, 3), 3u);  // 5x3, 2x1, 1x1
+  EXPECT_EQ(mip_level_count(256, 16), 9u);
+  // 3 x 2: level 1 is 1 x 1 from texels (0..1, 0..1); column 2 is not part of it.
+  TextureTexels t{3, 2, {}};
+  t.rgba = {0, 255, 10, 0,   255, 255, 10, 255, 99, 99, 99, 99,
+            0, 255, 10, 100, 255, 255, 10, 101, 99, 99, 99, 99};
+  const auto chain = mip_chain(t);
+  ASSERT_EQ(chain.size(), 2u);
+  ASSERT_EQ(chain[1].width, 1u);
+  ASSERT_EQ(chain[1].height, 1u);
+  // Red: half 0, half 1 in linear light = 0.5 linear = sRGB byte 188 (0.7354 * 255 = 187.5..).
+  EXPECT_EQ(chain[1].rgba[0], srgb8_from_linear(0.5f));
+  EXPECT_EQ(chain[1].rgba[0], 188);
+  EXPECT_EQ(chain[1].rgba[1], 255);
+  EXPECT_EQ(chain[1].rgba[2], 10);
+  // Alpha as bytes: (0 + 255 + 100 + 101 + 2) / 4 = 114.
+  EXPECT_EQ(chain[1].rgba[3], 114);
+  // A side of 1 averages its one texel twice: 1 x 4 -> 1 x 2 -> 1 x 1.
+  TextureTexels column{1, 4, std::vector<uint8_t>(16, 7)};
+  column.rgba[12] = 200;
+  const auto c2 = mip_chain(column);
+  ASSERT_EQ(c2.size(), 3u);
+  EXPECT_EQ(c2[1].width, 1u);
+  EXPECT_EQ(c2[1].height, 2u);
+  EXPECT_EQ(c2[1].rgba[0], 7);
+  EXPECT_EQ(c2[1].rgba[4], srgb8_from_linear((linear_from_srgb8(7) + linear_from_srgb8(200)) / 2));
 }
 
 }  // namespace

@@ -96,4 +96,73 @@ inline capture::SceneFile make_mesh_test_scene(uint32_t frame_count = 3, bool sp
   return s;
 }
 
+// A textured scene (mesh track layout 2): a quad with UVs beyond [0, 1] (repeat) drawing an 8 x 4
+// texture through its object's material, a strip with UVs whose triangle materials mix a 3 x 5
+// texture (not a power of two), the untextured material and the 8 x 4 one, an untextured
+// tetrahedron without UVs placed with the textured material (drawn untextured), and a texture no
+// material uses. Texels are a deterministic pattern with varying alpha.
+inline capture::SceneFile make_textured_mesh_test_scene() {
+  capture::SceneFile s;
+  s.name = "mesh-textured";
+  s.fps = 24;
+  s.frame_count = 2;
+  s.view_region_min = {-1, 1.5, -1};
+  s.view_region_max = {1, 1.7, 1};
+  const auto texture = [](const char* path, uint32_t w, uint32_t h, uint32_t seed) {
+    capture::SceneTexture t;
+    t.path = path;
+    t.width = w;
+    t.height = h;
+    for (uint32_t y = 0; y < h; ++y) {
+      for (uint32_t x = 0; x < w; ++x) {
+        const uint32_t k = (x * 37 + y * 101 + seed * 53) % 256;
+        t.rgba.insert(t.rgba.end(), {static_cast<uint8_t>(k), static_cast<uint8_t>(255 - k),
+                                     static_cast<uint8_t>((x * 255) / (w > 1 ? w - 1 : 1)),
+                                     static_cast<uint8_t>(255 - 16 * y)});
+      }
+    }
+    return t;
+  };
+  s.textures = {texture("textures/checker.png", 8, 4, 1), texture("textures/odd.png", 3, 5, 2),
+                texture("textures/unused.png", 2, 2, 3)};
+  s.materials.push_back({"plain", {0.5f, 0.5f, 0.5f}, capture::kNoTexture, {0, 0, 0}, 0, 0, 1.5f});
+  s.materials.push_back({"checker", {1, 1, 1}, 0, {0, 0, 0}, 0, 0, 1.5f});
+  s.materials.push_back({"odd", {0.9f, 0.8f, 0.7f}, 1, {0.1f, 0, 0}, 0, 0, 1.5f});
+
+  capture::SceneMesh quad;
+  quad.name = "quad";
+  quad.positions = {-1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1};
+  quad.normals = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
+  quad.uvs = {0, 0, 2, 0, 2, 1.5f, -0.5f, 1.5f};
+  quad.indices = {0, 2, 1, 0, 3, 2};
+  s.meshes.push_back(quad);
+
+  capture::SceneMesh strip;
+  strip.name = "strip";
+  for (int i = 0; i < 4; ++i) {
+    const float x = static_cast<float>(i) * 0.3f - 0.45f;
+    strip.positions.insert(strip.positions.end(), {x, 0.0f, 3.0f, x, 1.0f, 3.0f});
+    strip.uvs.insert(strip.uvs.end(), {static_cast<float>(i) / 3, 1, static_cast<float>(i) / 3, 0});
+  }
+  strip.colors.assign(strip.positions.size(), 0.75f);
+  for (uint32_t i = 0; i < 3; ++i) {
+    const uint32_t a = 2 * i, b = a + 1, c = a + 2, d = a + 3;
+    strip.indices.insert(strip.indices.end(), {a, c, b, b, c, d});
+  }
+  strip.triangle_materials = {2, 2, 0, 0, 1, 1};
+  s.meshes.push_back(strip);
+
+  capture::SceneMesh tetra;
+  tetra.name = "tetra";
+  tetra.positions = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+  tetra.indices = {0, 1, 2, 0, 3, 1, 1, 3, 2, 2, 3, 0};
+  s.meshes.push_back(tetra);
+
+  capture::SceneObject floor{"floor", 0, 1, {}};
+  capture::SceneObject banner{"banner", 1, 1, {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, -1}}};
+  capture::SceneObject rock{"rock", 2, 2, {{1, 0, 0, 0.5f, 0, 1, 0, 0, 0, 0, 1, -2}}};
+  s.objects = {floor, banner, rock};
+  return s;
+}
+
 }  // namespace calf::test

@@ -362,7 +362,7 @@ TEST(MeshTrack, DamagedChunksGiveTheTrackIds) {
     ErrorId id;
   };
   std::vector<Case> cases = {
-      {"layout version 2", on(MeshStream::kIndex, 0, [](auto& r) { r[0] = 2; }),
+      {"layout version 3", on(MeshStream::kIndex, 0, [](auto& r) { r[0] = 3; }),
        ErrorId::kMeshUnsupported},
       {"index flags", on(MeshStream::kIndex, 0, [](auto& r) { r[4] = 1; }),
        ErrorId::kMeshUnsupported},
@@ -441,6 +441,87 @@ TEST(MeshTrack, DamagedChunksGiveTheTrackIds) {
   }
 }
 
+// ---- Layout 2: UVs and textures ----
+
+TEST(MeshTrack, TexturedRoundTripAndUntexturedStaysLayout1) {
+  const capture::SceneFile scene = test::make_textured_mesh_test_scene();
+  encoder::MeshEncodeStats stats;
+  const auto file = encode(scene, nullptr, {}, &stats);
+  const auto reader = open_reader(file);
+  auto track = MeshTrack::open(reader, 0);
+  ASSERT_TRUE(track.ok()) << track.status().to_string();
+  EXPECT_EQ(track->index().layout_version, 2u);
+  ASSERT_EQ(track->texture_count(), 3u);
+  ASSERT_EQ(track->materials().size(), 3u);
+  for (size_t m = 0; m < 3; ++m)
+    EXPECT_EQ(track->materials()[m].base_colour_texture, scene.materials[m].base_color_texture);
+  for (uint32_t t = 0; t < 3; ++t) {
+    mesh::TextureTexels got;
+    ASSERT_TRUE(track->texture(t, &got).ok());
+    EXPECT_EQ(got.width, scene.textures[t].width);
+    EXPECT_EQ(got.height, scene.textures[t].height);
+    EXPECT_EQ(got.rgba, scene.textures[t].rgba);
+  }
+  for (uint32_t p = 0; p < 3; ++p) {
+    MeshPrototype got;
+    ASSERT_TRUE(track->prototype(p, &got).ok());
+    EXPECT_TRUE(same_bits(got.uvs, scene.meshes[p].uvs)) << p;
+    EXPECT_EQ(got.indices, scene.meshes[p].indices);
+  }
+  EXPECT_EQ(stats.textures.chunks, 3u);
+  EXPECT_EQ(stats.textures.raw, 4u * (32 + 15 + 4));
+  // Threads never change the bytes.
+  encoder::MeshEncodeOptions four;
+  four.threads = 4;
+  EXPECT_EQ(encode(scene, nullptr, four), file);
+  // A texture without its pixels is the encoder's input error.
+  capture::SceneFile unloaded = scene;
+  unloaded.textures[1].rgba.clear();
+  std::vector<uint8_t> sink;
+  auto w = container::Writer::create(container::memory_sink(&sink));
+  ASSERT_TRUE(w.ok());
+  EXPECT_EQ(encoder::encode_mesh_track(unloaded, nullptr, {}, &*w).id(), ErrorId::kEncoderInput);
+  // Without textures and UVs the track is written in layout 1 (the 1.0 bytes).
+  const auto plain = open_reader(encode(test::make_mesh_test_scene(2), nullptr));
+  auto plain_track = MeshTrack::open(plain, 0);
+  ASSERT_TRUE(plain_track.ok());
+  EXPECT_EQ(plain_track->index().layout_version, 1u);
+  EXPECT_EQ(plain_track->texture_count(), 0u);
+}
+
+TEST(MeshTrack, DamagedTexturedChunksGiveTheTrackIds) {
+  const auto good = encode(test::make_textured_mesh_test_scene(), nullptr);
+  ASSERT_EQ(damage_id(rebuild(good, {})), ErrorId::kOk);
+  const auto on = [](MeshStream s, uint32_t region, std::function<void(std::vector<uint8_t>&)> f) {
+    Edit e;
+    e.chunk = [=](const container::ChunkKeys& k, std::vector<uint8_t>& raw, bool&) {
+      if (is(k, s, region)) f(raw);
+    };
+    return e;
+  };
+  // The index ends with the 3 materials' textures: material 2's is the last word.
+  EXPECT_EQ(damage_id(rebuild(good, on(MeshStream::kIndex, 0, [](auto& r) { r.back() = 1; }))),
+            ErrorId::kMeshIndex)
+      << "material texture 0x01000001";
+  EXPECT_EQ(damage_id(rebuild(good, on(MeshStream::kTextures, 1, [](auto& r) { shrink(r, 1); }))),
+            ErrorId::kMeshChunk)
+      << "texture chunk short";
+  // Prototype 0's UVs follow its positions and normals (96 bytes): u of vertex 0 made +inf.
+  EXPECT_EQ(damage_id(rebuild(
+                good, on(MeshStream::kVertices, 0,
+                         [](auto& r) { r[96] = 0, r[104] = 0, r[112] = 0x80, r[120] = 0x7f; }))),
+            ErrorId::kMeshValue)
+      << "uv inf";
+  Edit drop;
+  drop.chunk = [](const container::ChunkKeys& k, std::vector<uint8_t>&, bool& d) {
+    d = is(k, MeshStream::kTextures, 2);
+  };
+  EXPECT_EQ(damage_id(rebuild(good, drop)), ErrorId::kMeshChunk) << "texture chunk missing";
+  Edit extra;
+  extra.duplicate_last = true;  // the last chunk is texture 2's
+  EXPECT_EQ(damage_id(rebuild(good, extra)), ErrorId::kMeshChunk) << "texture chunk twice";
+}
+
 // ---- The frozen conformance clips (tests/conformance/mesh/) ----
 
 std::string source_path(const std::string& rel) {
@@ -457,14 +538,21 @@ struct Clip {
   const char* name;
   bool subset;
   Compression compression;
+  bool textured = false;  // layout 2: the textured scene (mesh_scene.h), all triangles
 };
 // The conformance clips are of the scene without spheres (a few KB): the decoder sees a sphere
 // as triangles like any other, and the round trips above cover the spheres.
 constexpr Clip kClips[] = {{"full_none", false, Compression::kNone},
                            {"subset_zstd", true, Compression::kZstd},
-                           {"full_lzma2", false, Compression::kLzma2}};
+                           {"full_lzma2", false, Compression::kLzma2},
+                           {"textured_zstd", false, Compression::kZstd, true}};
 
 std::vector<uint8_t> make_clip(const Clip& c) {
+  if (c.textured) {
+    encoder::MeshEncodeOptions o;
+    o.supercompression = c.compression;
+    return encode(test::make_textured_mesh_test_scene(), nullptr, o);
+  }
   const capture::SceneFile scene = test::make_mesh_test_scene(3, false);
   const auto visible = test_subset(false);
   encoder::MeshEncodeOptions o;
@@ -501,18 +589,34 @@ TEST(MeshConformance, Generator) {
     };
     write(fuzz + "/" + name + ".calf", rebuild(subset, e));
   };
-  damaged("bad_index_version", MeshStream::kIndex, 0, 0, 2);
+  damaged("bad_index_version", MeshStream::kIndex, 0, 0, 3);
   damaged("bad_position_nan", MeshStream::kVertices, 0, 36, 0x7f);
   damaged("bad_vertex_index", MeshStream::kTriangles, 0, 0, 100);
   damaged("bad_run_gap", MeshStream::kVisibility, 0, 52, 200);
+  // Layout 2 seeds: the textured clip stored, and damaged in its texture and UV parts.
+  const auto textured = make_clip(kClips[3]);
+  write(fuzz + "/valid_textured_none.calf", rebuild(textured, {}));
+  const auto damaged_textured = [&](const char* name, MeshStream stream, uint32_t region, size_t at,
+                                    uint8_t value) {
+    Edit e;
+    e.chunk = [=](const container::ChunkKeys& k, std::vector<uint8_t>& raw, bool&) {
+      if (is(k, stream, region) && at < raw.size()) raw[at] = value;
+    };
+    write(fuzz + "/" + name + ".calf", rebuild(textured, e));
+  };
+  damaged_textured("bad_texture_width", MeshStream::kIndex, 0,
+                   8 + 48 + 4 + 3 * 24 + 4 + 3 * 20 + 4 + 3 * 24 + 4 + 1, 0x40);
+  damaged_textured("bad_uv_nan", MeshStream::kVertices, 0, 126, 0x7f);  // v of vertex 2: NaN
 }
 
 // The runner: each committed clip decodes to the scene it was made from, and to its hashes.
 TEST(MeshConformance, CommittedClipsDecodeToTheSceneAndTheirHashes) {
-  const capture::SceneFile scene = test::make_mesh_test_scene(3, false);
+  const capture::SceneFile plain = test::make_mesh_test_scene(3, false);
+  const capture::SceneFile textured = test::make_textured_mesh_test_scene();
   const auto visible = test_subset(false);
   for (const Clip& c : kClips) {
     SCOPED_TRACE(c.name);
+    const capture::SceneFile& scene = c.textured ? textured : plain;
     const auto bytes =
         read_bytes(source_path(std::string("tests/conformance/mesh/") + c.name + ".calf"));
     ASSERT_FALSE(bytes.empty());
@@ -523,6 +627,13 @@ TEST(MeshConformance, CommittedClipsDecodeToTheSceneAndTheirHashes) {
       MeshPrototype got;
       ASSERT_TRUE(track->prototype(p, &got).ok());
       expect_prototype(got, expected_prototype(scene.meshes[p]), p);
+      EXPECT_TRUE(same_bits(got.uvs, scene.meshes[p].uvs));
+    }
+    EXPECT_EQ(track->texture_count(), scene.textures.size());
+    for (uint32_t t = 0; t < track->texture_count(); ++t) {
+      mesh::TextureTexels got;
+      ASSERT_TRUE(track->texture(t, &got).ok());
+      EXPECT_EQ(got.rgba, scene.textures[t].rgba);
     }
     for (uint32_t o = 0; o < track->object_count(); ++o) {
       MeshObject got;

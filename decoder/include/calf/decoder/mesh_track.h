@@ -1,7 +1,7 @@
 // Reading a mesh track (kind 4, format/SPEC.md §11.4): objects placing prototype meshes with a
 // material and a rigid transform per frame, optionally reduced to a visible set (paper 004). The
 // track is readable per object: open() reads the index chunk only, object() decodes one object's
-// prototype and triangle subset on demand.
+// prototype and triangle subset on demand, texture() one base-colour texture (layout 2).
 //
 // The player's MeshRepresentation (player/mesh_representation.h) renders what this returns; the
 // encoder side is encoder/mesh_encode.h.
@@ -22,10 +22,13 @@ namespace calf::decoder {
 // A row-major 3 x 4 object-to-world matrix: world = M * (x, y, z, 1) (as SCENE.md).
 using MeshTransform = std::array<float, 12>;
 
-// A surface (SCENE.md "Material", without textures in this version of the track).
+// A surface (SCENE.md "Material"; reflect, refract and ior are not part of the track).
 struct MeshMaterial {
   std::array<float, 3> base_colour{0.7f, 0.7f, 0.7f};  // linear diffuse reflectance, [0, 1]
   std::array<float, 3> emission{0, 0, 0};              // emitted radiance, >= 0
+  // Its base-colour texture (< MeshTrack::texture_count()) or mesh::kNoTexture. The reflectance
+  // is base_colour x the texture's linear colour at the vertex UVs x the vertex colour.
+  uint32_t base_colour_texture = mesh::kNoTexture;
 };
 
 // A prototype mesh in object space, as it lies in the track (SCENE.md "Mesh").
@@ -33,6 +36,7 @@ struct MeshPrototype {
   std::vector<float> positions;   // 3 per vertex (the rest pose when there are states)
   std::vector<float> normals;     // empty (use face normals) or 3 per vertex
   std::vector<float> colours;     // empty or 3 per vertex, linear, multiplies the material
+  std::vector<float> uvs;         // empty or 2 per vertex (u, v), v = 0 at the texture's top row
   std::vector<uint32_t> indices;  // 3 per triangle
   std::vector<uint32_t> triangle_materials;  // empty or 1 per triangle (material index)
   // Piecewise-linear vertex states (SCENE.md "Vertex states"): times in seconds, strictly
@@ -71,6 +75,7 @@ class MeshTrack {
 
   uint32_t object_count() const;
   uint32_t prototype_count() const;
+  uint32_t texture_count() const;
   const std::vector<MeshMaterial>& materials() const { return materials_; }
   // The index chunk as read (format/mesh_layout.h): the prototype and object records with their
   // counts and flags, e.g. for figures without decoding (calf-verify, tests).
@@ -81,6 +86,9 @@ class MeshTrack {
   Status object(uint32_t index, MeshObject* out) const;
   // Decodes prototype `index`; errors name the chunk.
   Status prototype(uint32_t index, MeshPrototype* out) const;
+  // Decodes texture `index` (level 0, sRGB RGBA8, row 0 at the top; calf/format/mesh_texture.h
+  // makes its mip chain); errors name the chunk.
+  Status texture(uint32_t index, mesh::TextureTexels* out) const;
 
  private:
   MeshTrack() = default;

@@ -3,11 +3,12 @@
 // computed by compute_visible_set in calf/encoder/visible_set.h).
 //
 // What the track holds of a scene:
-//   materials   every scene material's base colour and emission (textures, UVs, reflect, refract
-//               and ior are not part of this version of the track);
+//   materials   every scene material's base colour, emission and base-colour texture (reflect,
+//               refract and ior are not part of the track);
+//   textures    every scene texture, in scene order, its pixels losslessly (SPEC §11.4.6);
 //   prototypes  the scene meshes that some kept object uses, in mesh order: positions, normals,
-//               vertex colours, triangles, per-triangle materials and vertex states as the scene
-//               has them, with each analytic sphere appended as a fixed icosphere
+//               vertex colours, UVs, triangles, per-triangle materials and vertex states as the
+//               scene has them, with each analytic sphere appended as a fixed icosphere
 //               (calf/encoder/sphere_mesh.h: sphere s of a mesh of T triangles is prototype
 //               triangles [T + s * kSphereTriangles, ...), its vertices held in every state);
 //               see prototype_arrays();
@@ -17,10 +18,14 @@
 //               is left out (it draws nothing); one whose subset is every triangle is stored as
 //               "all triangles". ObjectRecord::source_object keeps its scene index.
 //
+// The index is written in layout 1 (the 1.0 bytes) when nothing needs layout 2: no texture, no
+// material naming one and no mesh with UVs; else in layout 2.
+//
 // Passes (DESIGN.md): the plan (every count, the index chunk and the track header) is made
-// first from the scene alone; then every prototype's vertices and triangles chunks and every
-// object's visibility chunk are coded independently (options.threads at a time); then they are
-// added in a fixed order: index, per prototype (vertices, triangles), per object (visibility).
+// first from the scene alone; then every prototype's vertices and triangles chunks, every
+// object's visibility chunk and every texture's chunk are coded independently (options.threads at
+// a time); then they are added in a fixed order: index, per prototype (vertices, triangles), per
+// object (visibility), per texture (textures).
 // The bytes depend on the scene, the visible set and the options only, never on `threads`.
 #pragma once
 
@@ -61,14 +66,15 @@ struct MeshEncodeStats {
   uint64_t triangles = 0;        // drawn by the objects (the header's triangle_count)
   uint64_t scene_triangles = 0;  // the scene's, spheres tessellated, instances counted each time
   uint64_t plain_bytes = 0;      // the arrays as plain little-endian f32 / u32 (the baseline)
-  MeshStreamBytes index, vertices_stream, triangles_stream, visibility;
+  MeshStreamBytes index, vertices_stream, triangles_stream, visibility, textures;
 };
 
 // A scene mesh as the track stores it (spheres appended, see above), and its record's flags:
 // normals are kept when the mesh has them, or when it has no triangles of its own (a sphere-only
 // mesh, smooth-shaded); a mesh of both triangles without normals and spheres has none (face
-// normals). Colours: a sphere's vertices get (1, 1, 1). Triangle materials: a sphere's triangles
-// get mesh::kObjectMaterial. Errors: kEncoderInput (a mesh too large for u32 counts).
+// normals). Colours: a sphere's vertices get (1, 1, 1); UVs (when the mesh has them): (0, 0).
+// Triangle materials: a sphere's triangles get mesh::kObjectMaterial. Errors: kEncoderInput (a mesh
+// too large for u32 counts).
 struct MeshPrototypeArrays {
   mesh::PrototypeRecord record;  // counts and flags
   mesh::VertexArrays vertices;
@@ -82,8 +88,8 @@ Expected<MeshPrototypeArrays> prototype_arrays(const capture::SceneMesh& mesh);
 // above). `stats` (optional) receives the figures. Errors: the scene validator's (E152-E161);
 // kEncoderOption (threads above 256, an unknown supercompression); kEncoderInput (a visible set
 // of the wrong size, a list not strictly increasing or beyond its mesh's triangles, a position
-// beyond the coordinate bound); kMeshLimit (a chunk above the container's 1 GiB, a count above
-// §11.4's limits); container errors passed through.
+// beyond the coordinate bound, a texture without its pixels); kMeshLimit (a chunk above the
+// container's 1 GiB, a count above §11.4's limits); container errors passed through.
 //
 // The lead's --visible-set flags of calf-encode call this with the builder's lists and
 // options.segment_count set.

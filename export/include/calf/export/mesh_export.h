@@ -10,7 +10,12 @@
 //     instancing), and one mesh per object drawing a subset, holding only the vertices its
 //     triangles use; positions at the frame's time when the prototype has vertex states;
 //   - normals (the prototype's, or none: the importer computes flat ones), vertex colours
-//     (linear, as COLOR_0) and materials (base colour and emission); triangles with a
+//     (linear, as COLOR_0), UVs (TEXCOORD_0 / vt) and materials (base colour, emission and the
+//     base-colour texture as PNG: embedded in a .glb's binary buffer / a .gltf's data URI as glTF's
+//     baseColorTexture, a side file <stem>_texture<n>.png named by map_Kd beside an .obj;
+//     textures no material uses are left out; a prototype without UVs placed with a textured
+//     material gets an untextured copy of it, "material <i> untextured", as the renderers draw
+//     it untextured and glTF needs TEXCOORD_0 for a texture); triangles with a
 //     per-triangle material are split into one mesh per material, as glTF primitives carry one
 //     material each.
 // Triangle counts are preserved exactly: the export of a track whose objects draw T triangles in
@@ -37,7 +42,7 @@ enum class MeshExportFormat : uint8_t {
 Expected<MeshExportFormat> mesh_export_format_from_path(const std::string& path);
 
 // One file of an export: its name suffix ("" for the main file, ".bin" for a .gltf's buffer,
-// ".mtl" for OBJ's material library) and its bytes.
+// ".mtl" for OBJ's material library, "_texture<n>.png" for an OBJ's textures) and its bytes.
 struct ExportedFile {
   std::string suffix;
   std::vector<uint8_t> bytes;
@@ -48,6 +53,7 @@ struct MeshExportStats {
   uint64_t meshes = 0;     // meshes written (after splitting by material)
   uint64_t vertices = 0;   // over meshes
   uint64_t triangles = 0;  // over objects (instances counted each time)
+  uint64_t textures = 0;   // textures written
 };
 
 // Exports `track` at `frame` (< frame_count, else CALF-E480) in `format`. The side files are

@@ -2,7 +2,8 @@
 // holds what the frozen 1.0 file (tests/conformance/container/valid/v1_frozen.calf) fixed for
 // the kind: its track header and stream tags. Below them (issue 19) the byte layout of its chunks,
 // both directions: the versioned index chunk (stream 0) declared once with the fields visitor
-// (container_fields.h), and the coded arrays of the vertices, triangles and visibility chunks.
+// (container_fields.h), and the coded arrays of the vertices, triangles, visibility and (layout 2)
+// textures chunks.
 // The encoder (encoder/mesh_encode.h) writes chunks with the serialize_* / encode_* functions,
 // every decoder (decoder/mesh_track.h) reads them with parse_index / decode_*. This is the one
 // place that knows the predictions and byte planes of §11.4.
@@ -28,9 +29,10 @@
 namespace calf::container {
 
 // Stream tags (SPEC.md §11.4).
-#define CALF_MESH_STREAMS(X) \
-  X(kIndex, 0, "index")      \
-  X(kVertices, 1, "vertices") X(kTriangles, 2, "triangles") X(kVisibility, 3, "visibility")
+#define CALF_MESH_STREAMS(X)  \
+  X(kIndex, 0, "index")       \
+  X(kVertices, 1, "vertices") \
+  X(kTriangles, 2, "triangles") X(kVisibility, 3, "visibility") X(kTextures, 4, "textures")
 enum class MeshStream : uint16_t { CALF_MESH_STREAMS(CALF_STREAM_ENUM) };
 
 // Track header (34 bytes), frozen in 1.0; later fields are appended.
@@ -60,7 +62,7 @@ struct MeshTrackHeader {
 };
 static_assert(fixed_size<MeshTrackHeader>() == 34);
 static_assert(std::size(MeshTrackHeader::kStreamNames) ==
-              static_cast<size_t>(MeshStream::kVisibility) + 1);
+              static_cast<size_t>(MeshStream::kTextures) + 1);
 
 }  // namespace calf::container
 
@@ -68,13 +70,21 @@ namespace calf::mesh {
 
 // ---- Constants (SPEC.md §11.4) ----
 
-inline constexpr uint32_t kLayoutVersion = 1;
+// Layout 2 (textures and UVs) adds the index chunk's textures, the UV array of the vertices chunk
+// and the textures stream; layout 1 is layout 2 without them. Readers accept both; calf's encoder
+// writes 1 when a track has no UVs and no textures, so such tracks keep their 1.0 bytes.
+inline constexpr uint32_t kLayoutVersion = 2;
+inline constexpr uint32_t kLayoutVersionUntextured = 1;
 inline constexpr uint16_t kHeaderVisibleSet = 1;  // MeshTrackHeader::flags bit 0
 // Limits (a larger count is CALF-E224); the scene file's (SCENE.md "Limits").
 inline constexpr uint32_t kMaxMaterials = 1u << 16;
 inline constexpr uint32_t kMaxPrototypes = 1u << 20;
 inline constexpr uint32_t kMaxObjects = 1u << 24;
 inline constexpr uint32_t kMaxStates = 4096;  // vertex states per prototype
+inline constexpr uint32_t kMaxTextures = 1u << 12;
+inline constexpr uint32_t kMaxTextureSize = 16384;  // texels per side
+// A material's texture of this value: the material has none.
+inline constexpr uint32_t kNoTexture = 0xffffffffu;
 // A triangle material of this value means "the object's material" (an analytic sphere's
 // triangles in a mesh with per-triangle materials).
 inline constexpr uint32_t kObjectMaterial = 0xffffffffu;
@@ -83,7 +93,9 @@ inline constexpr uint32_t kObjectMaterial = 0xffffffffu;
 inline constexpr uint32_t kHasNormals = 1;
 inline constexpr uint32_t kHasColours = 2;
 inline constexpr uint32_t kHasTriangleMaterials = 4;
-inline constexpr uint32_t kPrototypeFlags = 7;
+inline constexpr uint32_t kHasUvs = 8;  // layout 2 only
+inline constexpr uint32_t kPrototypeFlagsV1 = 7;
+inline constexpr uint32_t kPrototypeFlags = 15;
 // ObjectRecord::flags bit 0: the object draws every triangle of its prototype (no subset).
 inline constexpr uint32_t kAllTriangles = 1;
 
@@ -144,16 +156,41 @@ struct ObjectRecord {
 };
 static_assert(container::fixed_size<ObjectRecord>() == 24);
 
+// A base-colour texture (layout 2): its size and coding; its texels are the textures chunk of the
+// same index (§11.4.6). 16 bytes.
+// Codings of the texels (sRGB RGBA8, lossless): MED residuals in channel planes, or the texels
+// as they are, interleaved (flat graphics, whose runs of equal texels supercompress better so).
+inline constexpr uint32_t kTextureSrgba8Med = 0;
+inline constexpr uint32_t kTextureSrgba8Plain = 1;
+struct TextureRecord {
+  uint32_t width = 0, height = 0;       // 1 .. kMaxTextureSize
+  uint32_t coding = kTextureSrgba8Med;  // kTextureSrgba8Med or kTextureSrgba8Plain
+  uint32_t flags = 0;                   // reserved, 0
+  template <class Self, class V>
+  static constexpr void fields(Self& s, V& v) {
+    v(s.width, "width", container::Range{1, kMaxTextureSize});
+    v(s.height, "height", container::Range{1, kMaxTextureSize});
+    v(s.coding, "coding");
+    v(s.flags, "flags");
+  }
+};
+static_assert(container::fixed_size<TextureRecord>() == 16);
+
 // The whole index chunk: u32 layout version, u32 flags (0), the view region, then three counted
-// arrays. Nothing may follow the objects.
+// arrays; layout 2 adds the textures and one base-colour texture per material. Nothing may follow.
 struct IndexChunk {
-  uint32_t layout_version = kLayoutVersion;
+  // 1 by default (what an untextured track writes); set kLayoutVersion for textures or UVs.
+  uint32_t layout_version = kLayoutVersionUntextured;
   uint32_t flags = 0;              // reserved, 0
   double view_min[3] = {0, 0, 0};  // the box the eye may move in, min <= max
   double view_max[3] = {0, 0, 0};
   std::vector<MaterialRecord> materials;
   std::vector<PrototypeRecord> prototypes;
   std::vector<ObjectRecord> objects;
+  // Layout 2 only (empty in layout 1): the textures, and per material its base-colour texture
+  // (< textures.size() or kNoTexture), one per material, no count on disk.
+  std::vector<TextureRecord> textures;
+  std::vector<uint32_t> material_textures;
   template <class Self, class V>
   static constexpr void fields(Self& s, V& v) {
     v(s.layout_version, "layout_version");
@@ -163,25 +200,37 @@ struct IndexChunk {
     v(s.materials, "materials", container::Range{0, kMaxMaterials});
     v(s.prototypes, "prototypes", container::Range{0, kMaxPrototypes});
     v(s.objects, "objects", container::Range{0, kMaxObjects});
+    if (s.layout_version >= 2) {
+      v(s.textures, "textures", container::Range{0, kMaxTextures});
+      v(s.material_textures, "material_textures", container::Length{s.materials.size()});
+    }
+  }
+  // The texture of material m (kNoTexture in layout 1).
+  uint32_t material_texture(size_t m) const {
+    return m < material_textures.size() ? material_textures[m] : kNoTexture;
   }
 };
 
 // Writes the index chunk. Errors: kContainerWriterMisuse for anything parse_index refuses.
 Expected<std::vector<uint8_t>> serialize_index(const IndexChunk& index, uint32_t frame_count);
-// Reads and checks the index chunk in §11.4.2's order: the layout version first (E221), every
-// count and size (E220, E224), flags (E221), values (E223), then references: object prototype,
-// material, transform count and drawn triangle count (E222).
+// Reads and checks the index chunk in §11.4.2's order: the layout version first (1 or 2, else
+// E221), every count and size (E220, E224), flags (E221; prototype flag bit 3 and texture flags
+// need layout 2, texture coding 0), values (E223), then references: object prototype, material,
+// transform count and drawn triangle count, material texture (E222). serialize_index writes
+// index.layout_version as given (a layout-1 index must have no textures).
 Expected<IndexChunk> parse_index(std::span<const uint8_t> raw, uint32_t frame_count,
                                  const std::string& what);
 
 // ---- Vertices chunk (stream 1, §11.4.3) ----
 
 // A prototype's vertex arrays as they are in memory: 3 floats per vertex (positions, normals,
-// colours; state positions 3 per vertex per state, state-major) and one time per state.
+// colours; state positions 3 per vertex per state, state-major), 2 per vertex for UVs and one
+// time per state.
 struct VertexArrays {
   std::vector<float> positions;
   std::vector<float> normals;  // empty unless kHasNormals
   std::vector<float> colours;  // empty unless kHasColours
+  std::vector<float> uvs;      // empty unless kHasUvs: (u, v), v = 0 at the image's top row
   std::vector<float> state_times;
   std::vector<float> state_positions;
 };
@@ -222,5 +271,22 @@ Status decode_visibility(std::span<const uint8_t> raw, const ObjectRecord& o,
                          const PrototypeRecord& p, Visibility* out, const std::string& what);
 // The smallest raw size of a visibility chunk of `o` (transforms, plus the run count of a subset).
 uint64_t visibility_chunk_min_size(const ObjectRecord& o);
+
+// ---- Textures chunk (stream 4, layout 2, §11.4.6) ----
+
+// A texture's texels: 8-bit RGBA, sRGB-encoded colour and linear alpha (as glTF), row 0 at the
+// top, width * height * 4 bytes.
+struct TextureTexels {
+  uint32_t width = 0, height = 0;
+  std::vector<uint8_t> rgba;
+};
+// The exact raw size of a textures chunk of `t` (4 * width * height).
+uint64_t texture_chunk_size(const TextureRecord& t);
+// Codes `texels` (its size must be t's: kContainerWriterMisuse otherwise) as t.coding says: MED
+// residuals in channel planes, or the texels as they are (both lossless).
+Expected<std::vector<uint8_t>> encode_texture(const TextureRecord& t, const TextureTexels& texels);
+// Decodes (size E220; every byte value is valid). Replaces `out`.
+Status decode_texture(std::span<const uint8_t> raw, const TextureRecord& t, TextureTexels* out,
+                      const std::string& what);
 
 }  // namespace calf::mesh

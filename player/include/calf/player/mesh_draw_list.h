@@ -19,8 +19,10 @@
 // from both sides (no back-face culling). Depth ties keep the first drawn (objects in list order,
 // triangles in increasing index order).
 //
-// Shading (deterministic, identical in both renderers up to float rounding):
-//   colour = base * vertex_colour * (kMeshAmbient + (1 - kMeshAmbient) * max(0, n . L)) + emission
+// Shading (deterministic, identical in both renderers up to float rounding and the texture
+// footprint, below):
+//   colour = base * texture * vertex_colour * (kMeshAmbient + (1 - kMeshAmbient) * max(0, n . L))
+//            + emission
 // with L = kMeshKeyLight (a unit vector towards a fixed key light, world space), base and emission
 // the triangle's material (the object's, or the prototype's per-triangle material when it has
 // them and it is not kMeshObjectMaterial), vertex_colour the prototype's colours interpolated
@@ -29,12 +31,27 @@
 // interpolated perspective-correctly, or the face normal normalize((p1 - p0) x (p2 - p0)) when the
 // prototype has none; flipped when the triangle's front (the side (p1 - p0) x (p2 - p0) points to)
 // faces away from the eye.
+//
+// Texture: 1 unless the triangle's material has a base-colour texture and the prototype has UVs;
+// then the texture's linear RGB (alpha is not used: surfaces are opaque) at the UV interpolated
+// perspective-correctly, filtered trilinearly as GL's LINEAR_MIPMAP_LINEAR with REPEAT wrapping
+// on the texture's mip chain (calf/format/mesh_texture.h; sRGB decoded per texel before
+// filtering): bilinear on level floor(lambda) and floor(lambda) + 1, blended by the fraction,
+// with lambda = log2(rho) clamped to [0, levels - 1] and rho = max(|d(uv * size)/dx|,
+// |d(uv * size)/dy|) (Euclidean lengths); lambda <= 0 is magnification: bilinear on level 0. UV
+// (0, 0) is texel (0, 0)'s corner at the image's top-left; texel (i, j)'s centre is
+// ((i + 0.5) / w, (j + 0.5) / h). The derivatives are those of the 2 x 2 pixel quad the pixel is
+// in (pixels (2a, 2b) .. (2a + 1, 2b + 1)): d/dx from its top pair, d/dy from its left pair, the
+// UVs there taken on the triangle's plane (also outside the triangle) — GL's coarse derivatives,
+// which llvmpipe computes; a GPU may pick fine derivatives or approximate rho and pick a nearby
+// level (the renderer test measures how far the two agree).
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <vector>
 
+#include "calf/format/mesh_texture.h"
 #include "calf/format/status.h"
 
 namespace calf::player {
@@ -48,10 +65,14 @@ inline constexpr float kMeshAmbient = 0.3f;
 // mesh::kObjectMaterial: an analytic sphere's triangles in a mesh with per-triangle materials).
 inline constexpr uint32_t kMeshObjectMaterial = 0xffffffffu;
 
-// A surface: linear diffuse reflectance and emitted radiance.
+// A material without a texture.
+inline constexpr uint32_t kMeshNoTexture = 0xffffffffu;
+
+// A surface: linear diffuse reflectance, emitted radiance and a base-colour texture.
 struct MeshDrawMaterial {
   std::array<float, 3> base_colour{0.7f, 0.7f, 0.7f};
   std::array<float, 3> emission{0, 0, 0};
+  uint32_t base_colour_texture = kMeshNoTexture;  // index into MeshDrawList::textures
 };
 
 // A mesh in object space. `positions` are those at the frame being drawn (MeshRepresentation puts
@@ -60,6 +81,7 @@ struct MeshDrawPrototype {
   std::vector<float> positions;   // 3 per vertex
   std::vector<float> normals;     // empty (face normals) or 3 per vertex
   std::vector<float> colours;     // empty (white) or 3 per vertex, linear
+  std::vector<float> uvs;         // empty (untextured) or 2 per vertex, v = 0 at the top row
   std::vector<uint32_t> indices;  // 3 per triangle, each < vertex count
   // Empty (every triangle takes its object's material) or 1 per triangle: an index into
   // MeshDrawList::materials, or kMeshObjectMaterial for the object's.
@@ -93,6 +115,8 @@ struct MeshDrawList {
   std::vector<MeshDrawPrototype> prototypes;
   std::vector<MeshDrawObject> objects;
   std::vector<MeshDrawMaterial> materials;
+  // Each texture as its whole mip chain (mesh::mip_chain of the track's texture).
+  std::vector<std::vector<mesh::TextureTexels>> textures;
 };
 
 // Options both renderers take.
@@ -104,7 +128,9 @@ struct MeshRenderOptions {
 // CALF-E470 unless `list` is drawable, naming the first fault: a buffer whose length is not a
 // multiple of 3 or not one per vertex / triangle, a vertex index, material index, prototype index
 // or subset triangle out of range, a subset not strictly increasing, a non-finite position,
-// normal, colour, material value or transform, or a transform whose 3 x 3 part is singular.
+// normal, colour, UV, material value or transform, a transform whose 3 x 3 part is singular, a
+// material texture out of range, or a texture that is not a whole mip chain (level sizes as
+// mesh_texture.h, 4 bytes per texel).
 // Materials' colours must be finite and >= 0. Both renderers call it.
 [[nodiscard]] Status validate_mesh_draw_list(const MeshDrawList& list);
 

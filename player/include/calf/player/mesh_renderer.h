@@ -17,7 +17,12 @@
 // uploaded once; positions re-uploaded when the caller says they changed), one index buffer per
 // prototype and one per object drawing a subset, a storage buffer of materials and of each
 // prototype's triangle materials / object's subset (so a primitive finds its prototype triangle);
-// one glDrawElements per object with its transform as a uniform. A geometry shader makes the face
+// one glDrawElements per object and texture its triangles use, with its transform as a uniform
+// (the geometry shader drops the triangles of another texture's pass; so depth ties between
+// triangles of different textures in one object keep the pass drawn first: ascending texture
+// index, untextured last — the CPU keeps the lower triangle index). Each texture is an
+// SRGB8_ALPHA8 array texture of one layer holding the mip chain of calf/format/mesh_texture.h,
+// sampled LINEAR_MIPMAP_LINEAR with REPEAT. A geometry shader makes the face
 // normal and the side the eye sees; the fragment shader shades with the formula of
 // mesh_draw_list.h and writes the radial distance of the interpolated eye-relative position.
 // Depth test: reversed Z into a 32-bit float depth buffer with an infinite far plane
@@ -81,9 +86,11 @@ class GlMeshRenderer {
   void release_buffers();
 
   struct PrototypeBuffers {
-    GLuint vao = 0, positions = 0, normals = 0, colours = 0, indices = 0, triangle_materials = 0;
+    GLuint vao = 0, positions = 0, normals = 0, colours = 0, indices = 0, triangle_materials = 0,
+           uvs = 0;
     uint32_t vertex_count = 0, triangle_count = 0;
-    bool has_normals = false, has_colours = false, has_triangle_materials = false;
+    bool has_normals = false, has_colours = false, has_triangle_materials = false, has_uvs = false;
+    std::vector<uint32_t> used_materials;  // distinct triangle materials (object's: sentinel)
   };
   struct ObjectBuffers {
     GLuint indices = 0, triangles = 0;  // 0 when the object draws all its prototype's triangles
@@ -95,6 +102,7 @@ class GlMeshRenderer {
     GLint model_x = -1, model_y = -1, model_z = -1, model_t = -1;
     GLint normal_x = -1, normal_y = -1, normal_z = -1;
     GLint has_normals = -1, has_triangle_materials = -1, has_subset = -1, object_material = -1;
+    GLint has_uvs = -1, pass_texture = -1;
   };
   const GlFunctions* gl_;
   GLuint program_ = 0, materials_ = 0;
@@ -102,6 +110,8 @@ class GlMeshRenderer {
   std::vector<PrototypeBuffers> prototypes_;
   std::vector<ObjectBuffers> objects_;
   size_t material_count_ = 0;
+  std::vector<uint32_t> material_textures_;  // each material's texture, as last uploaded
+  std::vector<GLuint> textures_;             // one array texture per list texture
   std::unique_ptr<internal::GlRasterTarget> target_;
 };
 
