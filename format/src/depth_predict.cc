@@ -1,8 +1,6 @@
 #include "calf/format/depth_predict.h"
 
 #include <cstddef>
-#include <utility>
-#include <vector>
 
 namespace calf::lf {
 
@@ -28,29 +26,35 @@ void predict_depth_rect(const uint16_t* codes, uint32_t w, uint32_t h, size_t st
 
 void reconstruct_depth_rect(const uint8_t* hi, const uint8_t* lo, uint32_t w, uint32_t h,
                             uint8_t* out) {
-  // Two rows of codes are all the predictor reads; the output is written as bytes, so keep the
-  // previous row's codes apart rather than reading the little-endian output back.
-  std::vector<uint16_t> rows(size_t{w} * 2);
-  uint16_t* prev = rows.data();
-  uint16_t* cur = rows.data() + w;
-  for (uint32_t y = 0; y < h; ++y) {
+  // The predictor reads the codes already written: the output's little-endian pairs (no scratch
+  // buffer, so a small rectangle costs no allocation). The first row and column are apart so the
+  // inner loop has no edge test.
+  auto code_at = [out](size_t i) {
+    return static_cast<uint16_t>(out[2 * i] | out[2 * i + 1] << 8);
+  };
+  auto put = [out](size_t i, uint16_t code) {
+    out[2 * i] = static_cast<uint8_t>(code);
+    out[2 * i + 1] = static_cast<uint8_t>(code >> 8);
+  };
+  auto residual = [hi, lo](size_t i) { return static_cast<uint16_t>(hi[i] << 8 | lo[i]); };
+  if (w == 0 || h == 0) return;
+  uint16_t left = unzigzag16(residual(0), 0);
+  put(0, left);
+  for (uint32_t x = 1; x < w; ++x) {
+    left = unzigzag16(residual(x), left);
+    put(x, left);
+  }
+  for (uint32_t y = 1; y < h; ++y) {
     const size_t base = size_t{y} * w;
-    for (uint32_t x = 0; x < w; ++x) {
-      const auto e = static_cast<uint16_t>(hi[base + x] << 8 | lo[base + x]);
-      uint16_t pred;
-      if (y == 0) {
-        pred = x > 0 ? cur[x - 1] : 0;
-      } else if (x == 0) {
-        pred = prev[0];
-      } else {
-        pred = depth_predict_inner(cur[x - 1], prev[x], prev[x - 1]);
-      }
-      const uint16_t code = unzigzag16(e, pred);
-      cur[x] = code;
-      out[2 * (base + x)] = static_cast<uint8_t>(code);
-      out[2 * (base + x) + 1] = static_cast<uint8_t>(code >> 8);
+    uint16_t up_left = code_at(base - w);
+    left = unzigzag16(residual(base), up_left);
+    put(base, left);
+    for (uint32_t x = 1; x < w; ++x) {
+      const uint16_t up = code_at(base - w + x);
+      left = unzigzag16(residual(base + x), depth_predict_inner(left, up, up_left));
+      put(base + x, left);
+      up_left = up;
     }
-    std::swap(prev, cur);
   }
 }
 
