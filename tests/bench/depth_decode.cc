@@ -126,9 +126,9 @@ int run(const std::string& path, int repeat) {
     t_copy.push_back(now_ms() - t3);
   }
   const double dec = median(t_dec), codes = median(t_codes), copy = median(t_copy);
-  fmt::print("| {} | {} | {} | {} | {} | {} | {:.2f} | {:.2f} | {:.2f} | {:.3f} | {:.0f} |\n",
-             path, container::pixel_format_name(h->depth_format), chunks.size(), texels, stored,
-             raw, dec, codes, dec + codes, copy, texels / ((dec + codes) * 1e3));
+  fmt::print("| {} | {} | {} | {} | {} | {} | {:.2f} | {:.2f} | {:.2f} | {:.3f} | {:.0f} |\n", path,
+             container::pixel_format_name(h->depth_format), chunks.size(), texels, stored, raw, dec,
+             codes, dec + codes, copy, texels / ((dec + codes) * 1e3));
   return 0;
 }
 
@@ -143,7 +143,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 1000));
   CLI11_PARSE(app, argc, argv);
   fmt::print(
-      "| clip | depth format | chunks | texels decoded | stored bytes | raw bytes | decompress ms | "
+      "| clip | depth format | chunks | texels decoded | stored bytes | raw bytes | decompress ms "
+      "| "
       "codes ms | total ms | memcpy ms | Mtexel/s |\n|---|---|---:|---:|---:|---:|---:|---:|---:|"
       "---:|---:|\n");
   int rc = 0;

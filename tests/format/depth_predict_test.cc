@@ -26,7 +26,8 @@ std::vector<uint16_t> round_trip(const std::vector<uint16_t>& codes, uint32_t w,
   }
   reconstruct_depth_rect(hi.data(), lo.data(), w, h, out.data());
   std::vector<uint16_t> back(codes.size());
-  for (size_t i = 0; i < back.size(); ++i) back[i] = static_cast<uint16_t>(out[2 * i] | out[2 * i + 1] << 8);
+  for (size_t i = 0; i < back.size(); ++i)
+    back[i] = static_cast<uint16_t>(out[2 * i] | out[2 * i + 1] << 8);
   return back;
 }
 
@@ -73,7 +74,8 @@ TEST(DepthPredict, InverseIsExactOnAnyCodes) {
         const uint32_t x = i % w, y = static_cast<uint32_t>(i / w);
         random[i] = static_cast<uint16_t>(rng());
         // Finite depth with sky above a diagonal and single sky texels inside the surface.
-        sky_edge[i] = x + y * 2 < w || rng() % 9 == 0 ? 65535 : static_cast<uint16_t>(20000 + 7 * x + 3 * y);
+        sky_edge[i] =
+            x + y * 2 < w || rng() % 9 == 0 ? 65535 : static_cast<uint16_t>(20000 + 7 * x + 3 * y);
         extremes[i] = (x + y) % 2 == 0 ? 0 : (rng() % 2 ? 65535 : 65534);
         smooth[i] = static_cast<uint16_t>(65000 + 13 * x + 2 * y);  // wraps past 65535
       }
@@ -88,7 +90,8 @@ TEST(DepthPredict, RegionChunkPayloadDecodesToCodes) {
   // An 8 x 4 tile, 2 frames: the keyframe (0, 0, 8, 4), then (3, 2, 2, 1); the payload is the
   // residuals of both rectangles, each predicted on its own, as two planes.
   std::vector<uint16_t> key(32), rect = {40000, 65535};
-  for (uint32_t i = 0; i < 32; ++i) key[i] = i % 8 < 3 ? 65535 : static_cast<uint16_t>(30000 + 11 * i);
+  for (uint32_t i = 0; i < 32; ++i)
+    key[i] = i % 8 < 3 ? 65535 : static_cast<uint16_t>(30000 + 11 * i);
   std::vector<uint16_t> e(34);
   predict_depth_rect(key.data(), 8, 4, 8, e.data());
   predict_depth_rect(rect.data(), 2, 1, 2, e.data() + 32);

@@ -52,7 +52,8 @@ inline uint16_t zigzag16(uint16_t code, uint16_t pred) {
   return static_cast<uint16_t>(d >= 0 ? 2 * d : -2 * d - 1);
 }
 inline uint16_t unzigzag16(uint16_t e, uint16_t pred) {
-  const uint16_t d = (e & 1) != 0 ? static_cast<uint16_t>(~(e >> 1)) : static_cast<uint16_t>(e >> 1);
+  const uint16_t d =
+      (e & 1) != 0 ? static_cast<uint16_t>(~(e >> 1)) : static_cast<uint16_t>(e >> 1);
   return static_cast<uint16_t>(pred + d);
 }
 
