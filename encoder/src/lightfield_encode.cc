@@ -21,6 +21,7 @@
 #include "calf/encoder/color_keyframes.h"
 #include "calf/encoder/depth_aabb.h"
 #include "calf/format/bc.h"
+#include "calf/format/depth_predict.h"
 #include "calf/format/files.h"
 #include "calf/format/grid.h"
 #include "calf/format/lightfield_layout.h"
@@ -351,7 +352,8 @@ ChangeMask material_change_mask(const TileFrames& t, uint32_t first, uint32_t cu
   return mask;
 }
 
-enum class RegionCoding : uint8_t { kRaw, kBc5, kBc1 };
+// kRawPredicted: depth only, raw codes replaced by their prediction residuals per rectangle.
+enum class RegionCoding : uint8_t { kRaw, kRawPredicted, kBc5, kBc1 };
 
 // Codes frames [first, first + count) of a tile into one chunk (SPEC §11.1 "Region chunk").
 // `decoded` is the decoder's tile state (bytes_per_texel == 2 only), for the BC5 error report.
@@ -380,7 +382,8 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
   }
   AabbOptions ao;
   ao.max_boxes = o.max_aabbs;
-  ao.alignment = coding == RegionCoding::kRaw ? 1 : 4;
+  const bool raw_texels = coding == RegionCoding::kRaw || coding == RegionCoding::kRawPredicted;
+  ao.alignment = raw_texels ? 1 : 4;
   rects[0].push_back({0, 0, t.width, t.height});
   for (uint32_t f = 1; f < count; ++f) {
     ChangeMask mask;
@@ -409,6 +412,7 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
   const size_t header = raw.size();
   uint64_t covered = 0;
   std::vector<uint8_t> texels, blocks, rect_bytes, decoded_rect;
+  std::vector<uint16_t> rect_codes, residuals;
   for (uint32_t f = 0; f < count; ++f) {
     if (f == 0) {
       s.depth_keyframes += is_depth ? 1 : 0;
@@ -425,6 +429,19 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
       }
       if (coding == RegionCoding::kRaw) {
         texels.insert(texels.end(), rect_bytes.begin(), rect_bytes.end());
+        continue;
+      }
+      if (coding == RegionCoding::kRawPredicted) {
+        const size_t n = size_t{r.width} * r.height;
+        rect_codes.resize(n);
+        residuals.resize(n);
+        for (size_t i = 0; i < n; ++i)
+          rect_codes[i] = static_cast<uint16_t>(rect_bytes[2 * i] << 8 | rect_bytes[2 * i + 1]);
+        lf::predict_depth_rect(rect_codes.data(), r.width, r.height, r.width, residuals.data());
+        for (uint16_t e : residuals) {
+          texels.push_back(static_cast<uint8_t>(e >> 8));
+          texels.push_back(static_cast<uint8_t>(e));
+        }
         continue;
       }
       const bc::Format bf = coding == RegionCoding::kBc5 ? bc::Format::kBc5 : bc::Format::kBc1;
@@ -469,7 +486,7 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
       }
     }
   }
-  if (coding == RegionCoding::kRaw) {
+  if (raw_texels) {
     lf::append_planes(raw, texels, t.bytes_per_texel);
   } else {
     lf::append_block_split(raw, blocks, coding == RegionCoding::kBc5 ? 16 : 8,
@@ -506,7 +523,9 @@ void region_task(const Context& ctx, uint32_t face, uint32_t tile, bool is_depth
     }
   }
   const bool lossy = ctx.options->depth == DepthCoding::kBc5;
-  const RegionCoding coding = !lossy     ? RegionCoding::kRaw
+  const bool predicted = is_depth && ctx.options->depth == DepthCoding::kRaw16Predicted;
+  const RegionCoding coding = predicted  ? RegionCoding::kRawPredicted
+                              : !lossy   ? RegionCoding::kRaw
                               : is_depth ? RegionCoding::kBc5
                                          : RegionCoding::kBc1;
   std::vector<uint16_t> decoded;

@@ -255,9 +255,11 @@ int main(int argc, char** argv) {
       ->default_val("auto");
   app.add_option(
          "--depth-format", depth,
-         "raw16 (exact after log-16 quantisation; material raw) or bc5 (hi/lo bytes, lossy; "
-         "material BC1; the error is printed) (default raw16)")
-      ->check(CLI::IsMember({"raw16", "bc5"}))
+         "raw16 (exact after log-16 quantisation; material raw), pred16 (the same codes, "
+         "lossless, as spatial-prediction residuals: format r16p, smaller; a reader of format "
+         "1.0 without r16p refuses it) or bc5 (hi/lo bytes, lossy; material BC1; the error is "
+         "printed) (default raw16)")
+      ->check(CLI::IsMember({"raw16", "pred16", "bc5"}))
       ->default_val("raw16");
   app.add_option(
          "--depth-window", o.depth_window,
@@ -349,7 +351,9 @@ int main(int argc, char** argv) {
       {"bc7", calf::ColourCoding::kBc7},     {"bc6h", calf::ColourCoding::kBc6h},
       {"rgba8", calf::ColourCoding::kRgba8}, {"rgba16f", calf::ColourCoding::kRgba16f}};
   o.colour = colours.at(colour);
-  o.depth = depth == "bc5" ? calf::DepthCoding::kBc5 : calf::DepthCoding::kRaw16;
+  o.depth = depth == "bc5"      ? calf::DepthCoding::kBc5
+            : depth == "pred16" ? calf::DepthCoding::kRaw16Predicted
+                                : calf::DepthCoding::kRaw16;
   o.supercompression = super == "lzma2"  ? calf::container::Compression::kLzma2
                        : super == "none" ? calf::container::Compression::kNone
                                          : calf::container::Compression::kZstd;

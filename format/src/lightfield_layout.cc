@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "calf/format/bc.h"
+#include "calf/format/depth_predict.h"
 
 namespace calf::lf {
 namespace {
@@ -167,6 +168,7 @@ Expected<CellTimeline> parse_t_chunk(std::span<const uint8_t> raw, uint32_t fram
 
 Expected<RegionCoding> depth_coding(uint16_t depth_format) {
   if (is(depth_format, PixelFormat::kR16)) return RegionCoding::kR16;
+  if (is(depth_format, PixelFormat::kR16Predicted)) return RegionCoding::kR16Predicted;
   if (is(depth_format, PixelFormat::kBc5)) return RegionCoding::kBc5;
   return Status(ErrorId::kLightfieldFormat, "depth format " + std::to_string(depth_format) + " (" +
                                                 container::pixel_format_name(depth_format) + ")");
@@ -187,6 +189,7 @@ bool region_coding_is_block(RegionCoding coding) {
 container::PixelFormat region_gpu_format(RegionCoding coding) {
   switch (coding) {
     case RegionCoding::kR16:
+    case RegionCoding::kR16Predicted:
       return PixelFormat::kR16;
     case RegionCoding::kBc5:
       return PixelFormat::kBc5;
@@ -202,6 +205,7 @@ namespace {
 size_t unit_bytes(RegionCoding coding) {
   switch (coding) {
     case RegionCoding::kR16:
+    case RegionCoding::kR16Predicted:
       return 2;
     case RegionCoding::kBc5:
       return 16;
@@ -282,6 +286,10 @@ void region_rect_gpu_bytes(const RegionChunk& chunk, size_t index, std::vector<u
       }
       return;
     }
+    case RegionCoding::kR16Predicted:
+      out.resize(size_t{r.w} * r.h * 2);
+      reconstruct_depth_rect(&p[r.first_unit], &p[units + r.first_unit], r.w, r.h, out.data());
+      return;
     case RegionCoding::kRgb8: {
       const size_t n = size_t{r.w} * r.h;
       out.resize(n * 4);

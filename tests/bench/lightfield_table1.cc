@@ -6,7 +6,12 @@
 // of the raw log-16 depth stream (per-view z_near / z_far from the data, as the encoder quantises).
 // Also encode seconds and peak RSS (getrusage). Prints markdown.
 //
+// With --depth-format pred16 the depth column is the predicted coding (format r16p) and one more
+// zstd encode gives the raw16 depth bytes beside it; --no-colour-peers skips the colour peers
+// (most of the run's time on noisy colour) when only depth is being measured.
+//
 //   bench-lightfield_table1 --capture DIR [--capture DIR ...] [--threads N]
+//       [--depth-format raw16|pred16] [--no-colour-peers]
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -148,9 +153,10 @@ struct EncodeRun {
   uint64_t file_bytes = 0;
 };
 Expected<EncodeRun> encode(const fs::path& capture, const fs::path& out, uint32_t threads,
-                           container::Compression sc) {
+                           container::Compression sc, DepthCoding depth) {
   LightfieldEncodeOptions o;
   o.threads = threads;
+  o.depth = depth;
   o.supercompression = sc;
   EncodeRun r;
   const double t0 = now_s();
@@ -178,12 +184,22 @@ const char* format_name(uint16_t f) {
       return "RGBA16F";
     case PixelFormat::kR16:
       return "raw16";
+    case PixelFormat::kR16Predicted:
+      return "pred16 (r16p)";
     default:
       return "?";
   }
 }
 
-int run_one(const fs::path& dir, uint32_t threads, bool have_xz, bool have_zstd) {
+struct Run {
+  uint32_t threads = 0;
+  bool have_xz = false, have_zstd = false, colour_peers = true;
+  DepthCoding depth = DepthCoding::kRaw16;
+};
+
+int run_one(const fs::path& dir, const Run& run) {
+  const uint32_t threads = run.threads;
+  const bool have_xz = run.have_xz, have_zstd = run.have_zstd;
   auto in = capture::CaptureSetReader::open(dir);
   if (!in.ok()) {
     fmt::print(stderr, "{}: {}\n", dir.string(), in.status().to_string());
@@ -192,10 +208,21 @@ int run_one(const fs::path& dir, uint32_t threads, bool have_xz, bool have_zstd)
   const auto& m = in->manifest();
   const fs::path tmp = fs::temp_directory_path() / fmt::format("calf-table1-{}", ::getpid());
   fs::create_directories(tmp);
-  auto z = encode(dir, tmp / "zstd.calf", threads, container::Compression::kZstd);
+  auto z = encode(dir, tmp / "zstd.calf", threads, container::Compression::kZstd, run.depth);
   const uint64_t rss_after_zstd = peak_rss_kib(RUSAGE_SELF);
-  auto x = z.ok() ? encode(dir, tmp / "lzma2.calf", threads, container::Compression::kLzma2)
-                  : Expected<EncodeRun>(z.status());
+  auto x = z.ok()
+               ? encode(dir, tmp / "lzma2.calf", threads, container::Compression::kLzma2, run.depth)
+               : Expected<EncodeRun>(z.status());
+  // The raw16 depth bytes beside predicted ones (one more zstd encode).
+  std::optional<EncodeRun> z16;
+  if (x.ok() && run.depth != DepthCoding::kRaw16) {
+    auto r = encode(dir, tmp / "zstd16.calf", threads, container::Compression::kZstd,
+                    DepthCoding::kRaw16);
+    if (!r.ok())
+      x = r.status();
+    else
+      z16 = *r;
+  }
   const uint64_t rss_after_lzma = peak_rss_kib(RUSAGE_SELF);
   if (!z.ok() || !x.ok()) {
     fmt::print(stderr, "{}: {}\n", dir.string(), (z.ok() ? x : z).status().to_string());
@@ -218,11 +245,11 @@ int run_one(const fs::path& dir, uint32_t threads, bool have_xz, bool have_zstd)
                              fs::file_size(rc), fs::file_size(rd));
     }
     if (have_xz) {
-      xz_c = run_peer("xz -9 -T1", rc);
+      if (run.colour_peers) xz_c = run_peer("xz -9 -T1", rc);
       xz_d = run_peer("xz -9 -T1", rd);
     }
     if (have_zstd) {
-      zs_c = run_peer("zstd -19 -q -T1", rc);
+      if (run.colour_peers) zs_c = run_peer("zstd -19 -q -T1", rc);
       zs_d = run_peer("zstd -19 -q -T1", rd);
     }
   }
@@ -245,6 +272,7 @@ int run_one(const fs::path& dir, uint32_t threads, bool have_xz, bool have_zstd)
   row("+spatial (BCn)", s.colour.spatial, s.depth.spatial);
   row("+zstd (level 19, per chunk)", s.colour.stored, s.depth.stored);
   row("+LZMA2 (preset 6, per chunk)", sx.colour.stored, sx.depth.stored);
+  if (z16) row("+zstd, depth raw16 (no prediction)", {}, z16->stats.depth.stored);
   row("peer: `zstd -19` of raw", zs_c.size, zs_d.size);
   row("peer: `xz -9` of raw", xz_c.size, xz_d.size);
   fmt::print("\n");
@@ -287,12 +315,23 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Paper 002 Table 1 for the lightfield track of each capture set, with xz / zstd peers"};
   std::vector<std::string> captures;
-  uint32_t threads = 0;
+  Run run;
+  std::string depth = "raw16";
+  bool no_colour_peers = false;
   app.add_option("--capture", captures, "capture-set directory (repeatable)")->required();
-  app.add_option("--threads", threads, "encoder threads, 0 = all cores (default 0)");
+  app.add_option("--threads", run.threads, "encoder threads, 0 = all cores (default 0)");
+  app.add_option("--depth-format", depth,
+                 "depth coding: raw16, or pred16 (then raw16's zstd bytes are printed beside "
+                 "it) (default raw16)")
+      ->check(CLI::IsMember({"raw16", "pred16"}));
+  app.add_flag("--no-colour-peers", no_colour_peers,
+               "skip xz / zstd on the raw colour stream (default: run them)");
   CLI11_PARSE(app, argc, argv);
-  const bool have_xz = have_tool("xz"), have_zstd = have_tool("zstd");
+  run.depth = depth == "pred16" ? DepthCoding::kRaw16Predicted : DepthCoding::kRaw16;
+  run.colour_peers = !no_colour_peers;
+  run.have_xz = have_tool("xz");
+  run.have_zstd = have_tool("zstd");
   int rc = 0;
-  for (const auto& c : captures) rc |= run_one(c, threads, have_xz, have_zstd);
+  for (const auto& c : captures) rc |= run_one(c, run);
   return rc;
 }

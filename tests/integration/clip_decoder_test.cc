@@ -25,6 +25,7 @@
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/format/container.h"
 #include "calf/format/container_io.h"
+#include "calf/format/log_depth.h"
 #include "synthetic_capture.h"
 
 namespace calf::decoder {
@@ -407,9 +408,17 @@ TEST(ClipDecoder, UpdatesDoNotDependOnCullingPathThreadOrCache) {
   EXPECT_EQ(run(o), base);
 }
 
-// Sec. 7.1: a seek restarts depth from the group keyframe and then steps W frames at a time.
-TEST(ClipDecoder, DepthSeekStepsThroughTheWindow) {
+// Sec. 7.1: a seek restarts depth from the group keyframe and then steps W frames at a time —
+// with predicted depth (r16p) too, whose rectangles decode on their own.
+class DepthSeek : public ::testing::TestWithParam<DepthCoding> {};
+INSTANTIATE_TEST_SUITE_P(Codings, DepthSeek,
+                         ::testing::Values(DepthCoding::kRaw16, DepthCoding::kRaw16Predicted),
+                         [](const auto& p) {
+                           return std::string(p.param == DepthCoding::kRaw16 ? "raw16" : "pred16");
+                         });
+TEST_P(DepthSeek, StepsThroughTheWindow) {
   ClipSpec spec;
+  spec.options.depth = GetParam();
   spec.seed = 41;
   spec.views = 1;
   spec.frames = 12;
@@ -446,7 +455,63 @@ TEST(ClipDecoder, DepthSeekStepsThroughTheWindow) {
     uint64_t depth_updates = 0;
     for (const TextureUpdate& u : fu.updates) depth_updates += u.target == UpdateTarget::kDepth;
     EXPECT_EQ(depth_updates, expected) << "frame " << target;
+    // Random access: the seek reads one depth chunk per tile (the group's) and one t chunk plus
+    // one or two keyframe chunks per cell — nothing more for predicted depth than for raw16.
+    const uint32_t cells =
+        6 * (spec.face / spec.options.cell_size) * (spec.face / spec.options.cell_size);
+    EXPECT_GE(fu.stats.chunks_needed, 6 * tiles_per_face + 2 * cells) << "frame " << target;
+    EXPECT_LE(fu.stats.chunks_needed, 6 * tiles_per_face + 3 * cells) << "frame " << target;
   }
+}
+
+// Depth format r16p is lossless: every decoded depth code of every view, face and frame equals
+// raw16's, sky (a half face and a moving square's edges beside finite depth) included; the
+// seek reads as many chunks; and on this smooth synthetic depth the depth stream is smaller.
+TEST(ClipDecoder, PredictedDepthDecodesToRaw16Codes) {
+  ClipSpec spec;
+  spec.seed = 43;
+  spec.frames = 7;
+  spec.material = true;
+  spec.options.cell_size = 8;
+  spec.options.depth_keyframe_interval = 4;
+  const Clip raw = make_clip(spec);
+  spec.options.depth = DepthCoding::kRaw16Predicted;
+  const Clip pred = make_clip(spec);
+  auto a = LightfieldReference::open(*raw.reader, 0);
+  auto b = LightfieldReference::open(*pred.reader, 0);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(b->header().depth_format, static_cast<uint16_t>(container::PixelFormat::kR16Predicted));
+  size_t sky = 0;
+  for (uint32_t v = 0; v < spec.views; ++v) {
+    for (uint32_t face = 0; face < 6; ++face) {
+      for (uint32_t f = 0; f < spec.frames; ++f) {
+        LightfieldFace fa, fb;
+        ASSERT_TRUE(a->decode_face(v, face, f, &fa).ok());
+        ASSERT_TRUE(b->decode_face(v, face, f, &fb).ok());
+        ASSERT_EQ(fa.depth, fb.depth) << "view " << v << " face " << face << " frame " << f;
+        EXPECT_EQ(fa.material, fb.material);
+        for (uint16_t c : fb.depth) sky += c == kLog16Sky;
+      }
+    }
+  }
+  EXPECT_GT(sky, 0u);
+  // The view-dependent decoder's seek to frame 6 applies the same codes from as many chunks.
+  for (const Clip* c : {&raw, &pred}) {
+    ClipDecoderOptions o;
+    o.view_dependent = false;
+    ClipDecoder d = open_decoder(*c, o);
+    CpuTextures tex = textures_for(d);
+    const FrameUpdates fu = advance_ok(d, tex, 6, {});
+    expect_matches_reference(*c, tex, fu, 6, c == &raw ? "raw16 seek" : "pred16 seek");
+  }
+  uint64_t depth_raw = 0, depth_pred = 0;
+  for (const auto& [clip, sum] : {std::pair{&raw, &depth_raw}, std::pair{&pred, &depth_pred}}) {
+    for (const auto& e : clip->reader->chunks()) {
+      if (e.keys.stream == static_cast<uint16_t>(container::LightfieldStream::kDepth))
+        *sum += e.stored_size;
+    }
+  }
+  EXPECT_LT(depth_pred, depth_raw);
 }
 
 // Nothing visible without viewers; a viewer looking away from a view sees fewer cells.

@@ -47,6 +47,11 @@ const PinCase kCases[] = {
     {"rgba8_raw16_none",   {.face = 8, .frames = 4, .views = 1},                    ColourCoding::kRgba8,   DepthCoding::kRaw16, container::Compression::kNone,  "26f6acc8e30259fa"},
     {"rgba16f_bc5_zstd",   {.face = 8, .frames = 3, .views = 2, .hdr = true},       ColourCoding::kRgba16f, DepthCoding::kBc5,   container::Compression::kZstd,  "aa687605ccacb1d4"},
     {"auto_raw16_static",  {.face = 16, .frames = 6, .views = 2, .animated = false, .material = true}, ColourCoding::kAuto, DepthCoding::kRaw16, container::Compression::kZstd, "382569247fa8c205"},
+    // Depth format r16p (SPEC §11.1.8, issue 17): the raw16 clips' scenes and codings with predicted
+    // depth; they decode to their raw16 twins' hashes (lightfield_conformance_test).
+    {"bc1_pred16_zstd",    {.face = 16, .frames = 5, .views = 2},                   ColourCoding::kBc1,     DepthCoding::kRaw16Predicted, container::Compression::kZstd,  "4f52fb389266f4ed"},
+    {"bc6h_pred16_lzma2",  {.face = 8, .frames = 3, .views = 2, .hdr = true},       ColourCoding::kBc6h,    DepthCoding::kRaw16Predicted, container::Compression::kLzma2, "3a4515816c9670ef"},
+    {"auto_pred16_static", {.face = 16, .frames = 6, .views = 2, .animated = false, .material = true}, ColourCoding::kAuto, DepthCoding::kRaw16Predicted, container::Compression::kZstd, "8792a19d652f5f4f"},
 };
 // clang-format on
 

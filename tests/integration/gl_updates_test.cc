@@ -550,6 +550,10 @@ TEST(GlUpdates, RefusesLayoutsTheGpuCannotHold) {
   EXPECT_EQ(l->views[1].range.z_far(), 40.0f);
   EXPECT_TRUE(GlViews::make(gl, *l).ok());
   EXPECT_EQ(layout_for_clip(h, {infos.data(), 1}).status().number(), 410);
+  // Predicted depth (r16p) is decoded to r16 codes on the CPU, kept compressed or not.
+  h.depth_format = static_cast<uint16_t>(PixelFormat::kR16Predicted);
+  EXPECT_EQ(layout_for_clip(h, infos)->depth_format, PixelFormat::kR16);
+  EXPECT_EQ(layout_for_clip(h, infos, true)->depth_format, PixelFormat::kR16);
   h.depth_format = static_cast<uint16_t>(PixelFormat::kBc1);
   EXPECT_EQ(layout_for_clip(h, infos).status().number(), 410);
 }

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,27 @@ TEST(LightfieldConformance, SuiteIsComplete) {
   for (const auto& n : names) {
     EXPECT_TRUE(fs::exists(suite_dir() / (n + ".hashes"))) << n;
   }
+}
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+// Depth format r16p is lossless: each predicted clip (same scene and codings as a raw16 clip, depth
+// predicted) decodes to the hashes frozen for its raw16 twin before r16p existed.
+TEST(LightfieldConformance, PredictedDepthClipsDecodeAsTheirRaw16Twins) {
+  size_t twins = 0;
+  for (const auto& n : clip_names()) {
+    const size_t at = n.find("_pred16_");
+    if (at == std::string::npos) continue;
+    const std::string twin = n.substr(0, at) + "_raw16_" + n.substr(at + 8);
+    const std::string mine = read_text(suite_dir() / (n + ".hashes"));
+    EXPECT_FALSE(mine.empty()) << n;
+    EXPECT_EQ(mine, read_text(suite_dir() / (twin + ".hashes"))) << n << " vs " << twin;
+    ++twins;
+  }
+  EXPECT_GE(twins, 3u);
 }
 
 container::Reader open_clip(const std::string& name) {

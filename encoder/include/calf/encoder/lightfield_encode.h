@@ -62,7 +62,10 @@ namespace calf {
 
 // Colour format choice; kAuto = BC1 for LDR input (every colour value <= 1), BC6H for HDR.
 enum class ColourCoding : uint8_t { kAuto, kBc1, kBc7, kBc6h, kRgba8, kRgba16f };
-enum class DepthCoding : uint8_t { kRaw16, kBc5 };
+// kRaw16: log-16 codes as 16-bit planes (SPEC §11.1.6); kRaw16Predicted: the same codes as
+// spatial-prediction residuals (depth format r16p, SPEC §11.1.8), lossless like kRaw16 and
+// smaller once supercompressed; kBc5: lossy.
+enum class DepthCoding : uint8_t { kRaw16, kBc5, kRaw16Predicted };
 
 struct LightfieldEncodeOptions {
   uint32_t cell_size = 64;  // colour cell side (px), 4..16384 and a multiple of 4

@@ -77,7 +77,8 @@ enum class PixelFormat : uint16_t {
   kBc5 = 6,
   kBc6h = 7,
   kBc7 = 8,
-  kRg8 = 9
+  kRg8 = 9,
+  kR16Predicted = 10,  // depth only: r16 codes as spatial-prediction residuals (SPEC §11.1.8)
 };
 const char* pixel_format_name(uint16_t format);
 

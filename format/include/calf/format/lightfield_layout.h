@@ -158,10 +158,11 @@ Expected<CellTimeline> parse_t_chunk(std::span<const uint8_t> raw, uint32_t fram
 
 // How a region chunk's payload is coded (§11.1.6), from the track's depth / material format.
 enum class RegionCoding : uint8_t {
-  kR16,   // depth, two 16-bit planes
-  kBc5,   // depth, BC5 with block split
-  kRgb8,  // material, three byte planes
-  kBc1,   // material, BC1 with block split
+  kR16,           // depth, two 16-bit planes
+  kR16Predicted,  // depth, two 16-bit planes of prediction residuals (depth_predict.h)
+  kBc5,           // depth, BC5 with block split
+  kRgb8,          // material, three byte planes
+  kBc1,           // material, BC1 with block split
 };
 // Errors: CALF-E203 for a format §11.1 does not allow for the stream.
 Expected<RegionCoding> depth_coding(uint16_t depth_format);
@@ -214,8 +215,8 @@ Expected<RegionChunk> parse_region_chunk(std::span<const uint8_t> raw, uint32_t 
                                          RegionCoding coding, const std::string& what);
 
 // The GPU-ready bytes (clip_decoder.h's update formats) of rect `index` of a parsed region chunk:
-// kR16 -> little-endian u16 codes; kBc5 / kBc1 -> whole blocks, row-major; kRgb8 -> RGBA8
-// (reflect, refract, ior, 255). Replaces `out`.
+// kR16, kR16Predicted -> little-endian u16 codes; kBc5 / kBc1 -> whole blocks, row-major; kRgb8 ->
+// RGBA8 (reflect, refract, ior, 255). Replaces `out`.
 void region_rect_gpu_bytes(const RegionChunk& chunk, size_t index, std::vector<uint8_t>& out);
 // The GPU format of those bytes.
 container::PixelFormat region_gpu_format(RegionCoding coding);

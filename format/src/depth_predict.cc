@@ -1,0 +1,61 @@
+#include "calf/format/depth_predict.h"
+
+#include <cstddef>
+
+namespace calf::lf {
+
+void predict_depth_rect(const uint16_t* codes, uint32_t w, uint32_t h, size_t stride,
+                        uint16_t* residuals) {
+  for (uint32_t y = 0; y < h; ++y) {
+    const uint16_t* row = codes + y * stride;
+    const uint16_t* up = y > 0 ? row - stride : nullptr;
+    uint16_t* e = residuals + size_t{y} * w;
+    for (uint32_t x = 0; x < w; ++x) {
+      uint16_t pred;
+      if (up == nullptr) {
+        pred = x > 0 ? row[x - 1] : 0;
+      } else if (x == 0) {
+        pred = up[0];
+      } else {
+        pred = depth_predict_inner(row[x - 1], up[x], up[x - 1]);
+      }
+      e[x] = zigzag16(row[x], pred);
+    }
+  }
+}
+
+void reconstruct_depth_rect(const uint8_t* hi, const uint8_t* lo, uint32_t w, uint32_t h,
+                            uint8_t* out) {
+  // The predictor reads the codes already written: the output's little-endian pairs (no scratch
+  // buffer, so a small rectangle costs no allocation). The first row and column are apart so the
+  // inner loop has no edge test.
+  auto code_at = [out](size_t i) {
+    return static_cast<uint16_t>(out[2 * i] | out[2 * i + 1] << 8);
+  };
+  auto put = [out](size_t i, uint16_t code) {
+    out[2 * i] = static_cast<uint8_t>(code);
+    out[2 * i + 1] = static_cast<uint8_t>(code >> 8);
+  };
+  auto residual = [hi, lo](size_t i) { return static_cast<uint16_t>(hi[i] << 8 | lo[i]); };
+  if (w == 0 || h == 0) return;
+  uint16_t left = unzigzag16(residual(0), 0);
+  put(0, left);
+  for (uint32_t x = 1; x < w; ++x) {
+    left = unzigzag16(residual(x), left);
+    put(x, left);
+  }
+  for (uint32_t y = 1; y < h; ++y) {
+    const size_t base = size_t{y} * w;
+    uint16_t up_left = code_at(base - w);
+    left = unzigzag16(residual(base), up_left);
+    put(base, left);
+    for (uint32_t x = 1; x < w; ++x) {
+      const uint16_t up = code_at(base - w + x);
+      left = unzigzag16(residual(base + x), depth_predict_inner(left, up, up_left));
+      put(base + x, left);
+      up_left = up;
+    }
+  }
+}
+
+}  // namespace calf::lf

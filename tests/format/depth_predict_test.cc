@@ -1,0 +1,126 @@
+// Depth format r16p (format/SPEC.md §11.1.8): the residuals of hand-computed examples, the
+// region chunk's predicted payload decoded back to codes, and the inverse exact on any codes —
+// random, sky beside finite depth, extremes, every rectangle shape down to one texel.
+#include "calf/format/depth_predict.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+#include "calf/format/container_fields.h"
+#include "calf/format/lightfield_layout.h"
+
+namespace calf::lf {
+namespace {
+
+// Residuals as the region chunk stores them (high plane, then low plane), decoded through the
+// public inverse into codes.
+std::vector<uint16_t> round_trip(const std::vector<uint16_t>& codes, uint32_t w, uint32_t h) {
+  std::vector<uint16_t> e(codes.size());
+  predict_depth_rect(codes.data(), w, h, w, e.data());
+  std::vector<uint8_t> hi(e.size()), lo(e.size()), out(e.size() * 2);
+  for (size_t i = 0; i < e.size(); ++i) {
+    hi[i] = static_cast<uint8_t>(e[i] >> 8);
+    lo[i] = static_cast<uint8_t>(e[i]);
+  }
+  reconstruct_depth_rect(hi.data(), lo.data(), w, h, out.data());
+  std::vector<uint16_t> back(codes.size());
+  for (size_t i = 0; i < back.size(); ++i)
+    back[i] = static_cast<uint16_t>(out[2 * i] | out[2 * i + 1] << 8);
+  return back;
+}
+
+TEST(DepthPredict, HandComputedResiduals) {
+  // 2 x 2: (0,0) predicted 0 -> +10 -> 20; (1,0) from the left 10 -> +2 -> 4; (0,1) from above
+  // 10 -> +1 -> 2; (1,1) the plane a + b - c = 11 + 12 - 10 = 13, 65535 - 13 = -14 as int16 -> 27.
+  const std::vector<uint16_t> codes = {10, 12, 11, 65535};
+  std::vector<uint16_t> e(4);
+  predict_depth_rect(codes.data(), 2, 2, 2, e.data());
+  EXPECT_EQ(e, (std::vector<uint16_t>{20, 4, 2, 27}));
+  // A plane 1000 + 3x + 5y is predicted exactly inside; the first row steps by 3 (-> 6), the
+  // first column by 5 (-> 10).
+  std::vector<uint16_t> plane(4 * 3);
+  for (uint32_t y = 0; y < 3; ++y)
+    for (uint32_t x = 0; x < 4; ++x) plane[y * 4 + x] = static_cast<uint16_t>(1000 + 3 * x + 5 * y);
+  std::vector<uint16_t> pe(plane.size());
+  predict_depth_rect(plane.data(), 4, 3, 4, pe.data());
+  EXPECT_EQ(pe, (std::vector<uint16_t>{2000, 6, 6, 6, 10, 0, 0, 0, 10, 0, 0, 0}));
+  // A stride wider than the rectangle reads only the rectangle's texels.
+  std::vector<uint16_t> sub(2);
+  predict_depth_rect(plane.data() + 5, 2, 1, 4, sub.data());
+  EXPECT_EQ(sub, (std::vector<uint16_t>{2016, 6}));  // 1008 -> 2016, then +3
+  // Sky runs predict sky: a row of sky under sky costs zeros after its first texel.
+  const std::vector<uint16_t> sky(6, 65535);
+  std::vector<uint16_t> se(6);
+  predict_depth_rect(sky.data(), 3, 2, 3, se.data());
+  EXPECT_EQ(se, (std::vector<uint16_t>{1, 0, 0, 0, 0, 0}));  // 65535 = -1 -> 1
+  // Sky beside finite depth: (1, 0) from the sky on its left, 20000 - 65535 = 20001 (mod 65536)
+  // -> 40002; (0, 1) sky from sky -> 0; (1, 1) has sky neighbours, so the median: c = 65535 >=
+  // max(a, b) gives min = 20000 (the finite texel above), +7 -> 14.
+  const std::vector<uint16_t> edge = {65535, 20000, 65535, 20007};
+  std::vector<uint16_t> ee(4);
+  predict_depth_rect(edge.data(), 2, 2, 2, ee.data());
+  EXPECT_EQ(ee, (std::vector<uint16_t>{1, 40002, 0, 14}));
+}
+
+TEST(DepthPredict, InverseIsExactOnAnyCodes) {
+  std::mt19937 rng(7);
+  for (uint32_t w : {1u, 2u, 3u, 17u, 32u}) {
+    for (uint32_t h : {1u, 2u, 5u, 32u}) {
+      const size_t n = size_t{w} * h;
+      std::vector<uint16_t> random(n), sky_edge(n), extremes(n), smooth(n);
+      for (size_t i = 0; i < n; ++i) {
+        const uint32_t x = i % w, y = static_cast<uint32_t>(i / w);
+        random[i] = static_cast<uint16_t>(rng());
+        // Finite depth with sky above a diagonal and single sky texels inside the surface.
+        sky_edge[i] =
+            x + y * 2 < w || rng() % 9 == 0 ? 65535 : static_cast<uint16_t>(20000 + 7 * x + 3 * y);
+        extremes[i] = (x + y) % 2 == 0 ? 0 : (rng() % 2 ? 65535 : 65534);
+        smooth[i] = static_cast<uint16_t>(65000 + 13 * x + 2 * y);  // wraps past 65535
+      }
+      for (const auto* codes : {&random, &sky_edge, &extremes, &smooth}) {
+        EXPECT_EQ(round_trip(*codes, w, h), *codes) << w << "x" << h;
+      }
+    }
+  }
+}
+
+TEST(DepthPredict, RegionChunkPayloadDecodesToCodes) {
+  // An 8 x 4 tile, 2 frames: the keyframe (0, 0, 8, 4), then (3, 2, 2, 1); the payload is the
+  // residuals of both rectangles, each predicted on its own, as two planes.
+  std::vector<uint16_t> key(32), rect = {40000, 65535};
+  for (uint32_t i = 0; i < 32; ++i)
+    key[i] = i % 8 < 3 ? 65535 : static_cast<uint16_t>(30000 + 11 * i);
+  std::vector<uint16_t> e(34);
+  predict_depth_rect(key.data(), 8, 4, 8, e.data());
+  predict_depth_rect(rect.data(), 2, 1, 2, e.data() + 32);
+  // The second rectangle's residuals, by hand: 40000 = -25536 as int16 -> 51071; then
+  // 65535 - 40000 = 25535 -> 51070.
+  EXPECT_EQ(e[32], 51071);
+  EXPECT_EQ(e[33], 51070);
+  RegionHead head;
+  head.rect_counts = {1, 1};
+  head.rects = {{0, 0, 8, 4, 0}, {3, 2, 2, 1, 0}};
+  std::vector<uint8_t> raw;
+  ASSERT_TRUE(container::write_fields(head, raw).ok());
+  for (uint16_t v : e) raw.push_back(static_cast<uint8_t>(v >> 8));
+  for (uint16_t v : e) raw.push_back(static_cast<uint8_t>(v));
+  auto depth = depth_coding(static_cast<uint16_t>(container::PixelFormat::kR16Predicted));
+  ASSERT_TRUE(depth.ok());
+  EXPECT_EQ(region_gpu_format(*depth), container::PixelFormat::kR16);
+  auto c = parse_region_chunk(raw, 2, 8, 4, *depth, "tile");
+  ASSERT_TRUE(c.ok()) << c.status().to_string();
+  std::vector<uint8_t> out;
+  region_rect_gpu_bytes(*c, 0, out);
+  ASSERT_EQ(out.size(), 64u);
+  for (size_t i = 0; i < 32; ++i) EXPECT_EQ(out[2 * i] | out[2 * i + 1] << 8, key[i]) << i;
+  region_rect_gpu_bytes(*c, 1, out);
+  EXPECT_EQ(out, (std::vector<uint8_t>{0x40, 0x9C, 0xFF, 0xFF}));
+  // A payload one texel short is E202, as for r16.
+  raw.pop_back();
+  EXPECT_EQ(parse_region_chunk(raw, 2, 8, 4, *depth, "t").status().id(), ErrorId::kLightfieldChunk);
+}
+
+}  // namespace
+}  // namespace calf::lf
