@@ -85,7 +85,7 @@ if [ -n "$VS_SCENE" ]; then
   # The walk: the scene's validation eye path inside the region. calf-capture writes it with
   # --ground-truth; the mesh comparison uses its poses only, so the images are the cheapest kind.
   run vs-walk "$BUILD"/calf-capture --scene "$VS_SCENE" --out "$VS/walk" --ground-truth \
-    --gt-size 320x240 --ao-samples 0 --max-bounces 0 --frames "$VS_FRAMES" --quiet
+    --gt-size 320x240 --ao-samples 0 --max-bounces 0 --spp 1 --no-noise-floor --frames "$VS_FRAMES" --quiet
   run vs-play "$BUILD"/calf-play "$VS/visible.calf" --headless --eye-path "$VS/walk/eye_path.json" \
     --compare-clip "$VS/full.calf"
 fi

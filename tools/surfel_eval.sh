@@ -43,9 +43,9 @@ echo "== build ($SCENE, candidates at $RES, at most $SURFELS surfels per prototy
 "$B/calf-encode" --mode mesh "$W/scene" -o "$W/full.calf" -q
 # The walks: calf-capture writes the scene's validation path with its cheapest ground truth.
 "$B/calf-capture" --scene "$SCENE" --out "$W/walk" --ground-truth --gt-size "$GT_SIZE" \
-  --ao-samples 0 --max-bounces 0 --frames 4 --quiet
+  --ao-samples 0 --max-bounces 0 --spp 1 --no-noise-floor --frames 4 --quiet
 "$B/calf-capture" --scene "$SCENE" --out "$W/walk$POSES" --ground-truth --gt-size "$GT_SIZE" \
-  --ao-samples 0 --max-bounces 0 --frames "$POSES" --quiet
+  --ao-samples 0 --max-bounces 0 --spp 1 --no-noise-floor --frames "$POSES" --quiet
 
 runs=()
 for size in $SIZES; do runs+=("$size:"); done

@@ -17,6 +17,7 @@
 #            own, walked with 12 poses) and the cube face size of the builder (paper 004: 800);
 #   MODEL    the model file from outside the project (default: assimp-testmodels' 2CylinderEngine
 #            glTF, apt-get install assimp-testmodels);
+#   RIG      a calf-capture --rig for the view region and walk (default: each scene's own);
 #   GT_SIZE  pose image size (default 320x240); THREADS (default 0: all cores);
 #   BENCH    arguments of bench-visible_set_bench ("" skips it; default: the paper's face 800).
 #
@@ -30,6 +31,7 @@ W=${2:-/tmp/calf-visible-set-eval}
 MODEL=${MODEL:-/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb}
 SCENES=${SCENES:-"spheres:24:800 city:12:800 blades:12:800 MODEL:0:800"}
 GT_SIZE=${GT_SIZE:-320x240}
+RIG=${RIG:-default}
 THREADS=${THREADS:-0}
 BENCH=${BENCH-"--face 800"}
 mkdir -p "$W"
@@ -50,7 +52,8 @@ for spec in $SCENES; do
   walk_args=(--frames 12) # a static model has 1 frame: still walk 12 poses
   ((frames > 0)) && frame_args=(--frames "$frames") && walk_args=(--frames "$frames")
   echo "== $name (frames ${frames/#0/scene\'s}, face $face)"
-  "$B/calf-capture" --scene "$scene" --export-scene "$d/scene" "${frame_args[@]}" --quiet
+  "$B/calf-capture" --scene "$scene" --export-scene "$d/scene" "${frame_args[@]}" --rig "$RIG" \
+    --quiet
   "$B/calf-encode" --mode mesh "$d/scene" -o "$d/full.calf" --threads "$THREADS" -q \
     2>"$d/full.log"
   t0=$(now)
@@ -58,7 +61,7 @@ for spec in $SCENES; do
     --visibility-face-size "$face" --threads "$THREADS" 2>&1 | tee "$d/visible.log"
   t1=$(now)
   "$B/calf-capture" --scene "$scene" --out "$d/walk" --ground-truth --gt-size "$GT_SIZE" \
-    --ao-samples 0 --max-bounces 0 "${walk_args[@]}" --quiet
+    --ao-samples 0 --max-bounces 0 --spp 1 --no-noise-floor "${walk_args[@]}" --quiet
   for r in gl cpu; do
     "$B/calf-play" "$d/visible.calf" --headless --eye-path "$d/walk/eye_path.json" \
       --compare-clip "$d/full.calf" --renderer "$r" >"$d/play-$r.log" 2>&1

@@ -151,9 +151,13 @@ Expected<Prepared> prepare(const capture::SceneFile& scene, const VisibleSetOpti
   return out;
 }
 
+// The box is the bounds grown by twice their largest side: every rig calf-capture gives a model
+// (a ring of radius 2 x the half-diagonal <= sqrt(3) x the largest side around the centre) lies
+// inside it, elongated models included, while a point thousands of scene sizes away, where the
+// projections lose their precision, is still refused.
 Status check_point(const Prepared& prepared, const Vec3& p, const std::string& what) {
   const double side = largest_side(prepared.bounds);
-  const Vec3 grow{side, side, side};
+  const Vec3 grow{2 * side, 2 * side, 2 * side};
   const Box3 box{prepared.bounds.min - grow, prepared.bounds.max + grow};
   if (is_finite(p) && box.contains(p)) return Status::Ok();
   auto str = [](const Vec3& v) {
@@ -163,7 +167,7 @@ Status check_point(const Prepared& prepared, const Vec3& p, const std::string& w
   };
   return Status(ErrorId::kVisibleSetOutside,
                 what + " " + str(p) + " lies outside the scene bounds " + str(prepared.bounds.min) +
-                    " .. " + str(prepared.bounds.max) + " grown by their largest side " +
+                     " .. " + str(prepared.bounds.max) + " grown by twice their largest side " +
                     std::to_string(side));
 }
 

@@ -187,8 +187,8 @@ struct VisibleSet {
 // transforms per frame, piecewise-linear vertex states, spheres). Errors (one line each, naming
 // the culprit): no segment (E110), a degenerate (zero-length or non-finite) segment (E111), a
 // segment endpoint outside the scene's bounds (E112: the box of every primitive over the frames
-// solved, grown on every side by its largest side), a scene without triangles or spheres (E113),
-// an option out of range (E114), more primitives than 2^31 (E115).
+// solved, grown on every side by twice its largest side), a scene without triangles or spheres
+// (E113), an option out of range (E114), more primitives than 2^31 (E115).
 Expected<VisibleSet> compute_visible_set(const capture::SceneFile& scene,
                                          std::span<const ViewSegment> segments,
                                          const VisibleSetOptions& options);
