@@ -167,7 +167,7 @@ Status check_point(const Prepared& prepared, const Vec3& p, const std::string& w
   };
   return Status(ErrorId::kVisibleSetOutside,
                 what + " " + str(p) + " lies outside the scene bounds " + str(prepared.bounds.min) +
-                     " .. " + str(prepared.bounds.max) + " grown by twice their largest side " +
+                    " .. " + str(prepared.bounds.max) + " grown by twice their largest side " +
                     std::to_string(side));
 }
 
