@@ -102,10 +102,18 @@ Scene quad_scene(capture::SceneTexture tex, float span, float z) {
   return s;
 }
 
+// One sample through each pixel centre, no AO, no noise: these tests check the texture lookup at
+// a ray (pixel anti-aliasing, RenderOptions::spp, is tests/samples/antialias_test.cc's).
+RenderOptions centre_ray_options() {
+  RenderOptions o{1, 1, 0, 2, 0};
+  o.spp = 1;
+  return o;
+}
+
 // A camera at `eye` looking down -Z with a 90-degree field of view: the quad z = eye.z - 1,
 // x, y in [-1, 1] fills its square image exactly, pixel i's centre at x = 2 (i + 0.5) / n - 1.
 capture::PerspectiveImage render_front(const Scene& s, uint32_t n, glm::dvec3 eye = {0, 0, 1}) {
-  auto tracer = FrameTracer::create(s, 0, RenderOptions{1, 1, 0, 2, 0});
+  auto tracer = FrameTracer::create(s, 0, centre_ray_options());
   EXPECT_TRUE(tracer.ok()) << tracer.status().to_string();
   capture::PerspectiveImage img;
   if (!tracer.ok()) return img;
@@ -225,7 +233,7 @@ TEST(Texture, FarCheckerConvergesToItsMeanNearOneKeepsItsContrast) {
   const Scene far = quad_scene(checker, 61.3f, 0);
   const capture::PerspectiveImage img = render_front(far, 32);
   EXPECT_LT(worst_deviation(img.color, 0.5f), 1e-4f);
-  auto tracer = FrameTracer::create(far, 0, RenderOptions{1, 1, 0, 2, 0});
+  auto tracer = FrameTracer::create(far, 0, centre_ray_options());
   ASSERT_TRUE(tracer.ok());
   capture::ViewFrame cube;
   // From (0, 0, 1) the quad z = 0 fills the -Z face exactly.
