@@ -482,7 +482,8 @@ TEST(MeshTrack, TexturedRoundTripAndUntexturedStaysLayout1) {
   ASSERT_TRUE(w.ok());
   EXPECT_EQ(encoder::encode_mesh_track(unloaded, nullptr, {}, &*w).id(), ErrorId::kEncoderInput);
   // Without textures and UVs the track is written in layout 1 (the 1.0 bytes).
-  const auto plain = open_reader(encode(test::make_mesh_test_scene(2), nullptr));
+  const std::vector<uint8_t> plain_bytes = encode(test::make_mesh_test_scene(2), nullptr);
+  const auto plain = open_reader(plain_bytes);  // reads plain_bytes in place
   auto plain_track = MeshTrack::open(plain, 0);
   ASSERT_TRUE(plain_track.ok());
   EXPECT_EQ(plain_track->index().layout_version, 1u);
