@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <string_view>
 
 #include "calf/format/status.h"
@@ -30,5 +31,9 @@ Status prescan_gltf_json(std::string_view json, std::string_view name,
                          bool has_glb_bin);
 Status prescan_glb(std::string_view bytes, std::string_view name,
                    const std::filesystem::path& folder);
+
+// Decodes %XX escapes (assimp and the glTF spec treat URIs as percent-encoded, e.g. "my%20tex.png"
+// names "my tex.png"); a malformed escape is kept as it is.
+std::string percent_decode(std::string_view s);
 
 }  // namespace calf::samples::detail

@@ -13,6 +13,7 @@
 #include <assimp/texture.h>
 
 #include "calf/capture/scene_file.h"
+#include "model_prescan.h"
 
 namespace calf::samples::detail {
 
@@ -31,26 +32,6 @@ std::string base_color_path(const aiMaterial& m) {
   return {};
 }
 
-// %XX escapes of a URI (glTF image URIs are URIs; a file "my tex.png" is "my%20tex.png").
-std::string percent_decoded(const std::string& s) {
-  std::string out;
-  for (size_t i = 0; i < s.size(); ++i) {
-    auto hex = [](char c) {
-      return c >= '0' && c <= '9'   ? c - '0'
-             : c >= 'a' && c <= 'f' ? c - 'a' + 10
-             : c >= 'A' && c <= 'F' ? c - 'A' + 10
-                                    : -1;
-    };
-    if (s[i] == '%' && i + 2 < s.size() && hex(s[i + 1]) >= 0 && hex(s[i + 2]) >= 0) {
-      out.push_back(static_cast<char>(hex(s[i + 1]) * 16 + hex(s[i + 2])));
-      i += 2;
-    } else {
-      out.push_back(s[i]);
-    }
-  }
-  return out;
-}
-
 bool is_file(const std::filesystem::path& p) {
   std::error_code ec;
   return std::filesystem::is_regular_file(p, ec);
@@ -62,7 +43,7 @@ bool is_file(const std::filesystem::path& p) {
 std::filesystem::path resolve(const std::filesystem::path& folder, std::string named) {
   if (named.rfind("file://", 0) == 0) named.erase(0, 7);
   for (char& c : named) c = c == '\\' ? '/' : c;
-  for (const std::string& candidate : {named, percent_decoded(named)}) {
+  for (const std::string& candidate : {named, percent_decode(named)}) {
     const std::filesystem::path p = folder / std::filesystem::path(candidate);
     if (is_file(p)) return p;
   }
