@@ -7,12 +7,11 @@
 namespace calf::player {
 namespace {
 
-// Below this coefficient of variation of the recent work, a fitted slope is mostly noise.
-constexpr double kMinSpread = 0.05;
 // Bisection steps on log s: 2^-40 of the range, far below a prefix's rounding.
 constexpr int kBisections = 40;
-// The smallest slope a fit may take, as a share of the mean time per unit of work.
-constexpr double kMinSlopeShare = 0.1;
+// The proportional shares of the passes' models (why these, and why fixed: the header).
+constexpr double kSurfelShare = 1.0;
+constexpr double kMeshShare = 0.75;
 
 }  // namespace
 
@@ -20,34 +19,21 @@ void SurfelFrameController::Fit::add(double work, double ms, double memory) {
   w = memory * w + 1;
   x = memory * x + work;
   y = memory * y + ms;
-  xx = memory * xx + work * work;
-  xy = memory * xy + work * ms;
-  const double mx = x / w, my = y / w;
-  const double ratio = mx > 0 ? my / mx : 0;
-  const double var = std::max(0.0, xx / w - mx * mx);
-  const double fitted = var > kMinSpread * kMinSpread * mx * mx ? (xy / w - mx * my) / var : -1;
-  // A fit is kept only when it is physical: more work never costs less (a negative slope is a
-  // change of load or noise across the spread, not the pass's cost). Before the first, half the
-  // time is taken as fixed, half as proportional: a guess the first spread of work replaces.
-  if (fitted >= 0) {
-    slope = fitted;
-  } else if (slope < 0) {
-    slope = 0.5 * ratio;
-  }
-  // No negative fixed part; and at least kMinSlopeShare of the time proportional, so that the
-  // model never concludes the work does not matter (then any size would do).
-  slope = std::clamp(slope, kMinSlopeShare * ratio, ratio);
 }
 
 double SurfelFrameController::Fit::predict(double work) const {
   if (work <= 0 || w <= 0) return 0;  // the pass is skipped, or never measured
   const double mx = x / w, my = y / w;
-  return std::max(0.0, my + slope * (work - mx));
+  // The line through the recent mean whose proportional part is `share` of it.
+  return my * (1 - share) + share * my * work / mx;
 }
 
 SurfelFrameController::SurfelFrameController(const SurfelControllerOptions& options,
                                              double point_size)
-    : options_(options), size_(point_size) {}
+    : options_(options), size_(point_size) {
+  mesh_.share = kMeshShare;
+  surfels_.share = kSurfelShare;
+}
 
 double SurfelFrameController::predict(const SurfelWork& work) const {
   if (other_w_ <= 0) return 0;

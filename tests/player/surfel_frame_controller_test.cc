@@ -44,7 +44,7 @@ struct Machine {
   }
   SurfelFrameTimes run(const SurfelWork& w, double s) {
     SurfelFrameTimes t;
-    t.mesh_ms = w.triangles > 0 ? load * (30 + 0.012 * w.triangles) * jitter() : 0;
+    t.mesh_ms = w.triangles > 0 ? load * (25 + 0.004 * w.triangles) * jitter() : 0;
     t.surfels_ms =
         w.surfels > 0 ? load * (15 + 0.002 * w.surfels + 5e-5 * w.surfels * s * s) * jitter() : 0;
     t.frame_ms = t.mesh_ms + t.surfels_ms + load * 5 * jitter();
@@ -109,9 +109,10 @@ TEST(SurfelFrameController, ConvergesOnAStaticViewWithoutOscillating) {
     SurfelFrameController c(options(300), start);
     Machine m;
     const Trace t = play(&c, &m, std::vector<View>(30, View{}));
-    // The first frame only measures; the plan after it is a model of one point (half its time
-    // fixed), the next ones refit. Within +-10 % from the fourth frame on, every frame.
-    EXPECT_EQ(within(t.frame_ms, 3, 300, 0.10), 27);
+    // The first frame only measures; the plans after it scale from the recent mean costs, whose
+    // fixed parts the model partly misses, so a step falls short (from 8 px: 93, 141, 220, 274
+    // ms). Within +-10 % from the sixth frame on, every frame.
+    EXPECT_EQ(within(t.frame_ms, 5, 300, 0.10), 25);
     EXPECT_LE(reversals(t.sizes, 0), 1);
     // Settled: the deadband holds the size over the last 20 frames.
     for (size_t i = 11; i < t.sizes.size(); ++i) EXPECT_EQ(t.sizes[i], t.sizes[10]) << i;

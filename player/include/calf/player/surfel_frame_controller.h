@@ -7,16 +7,16 @@
 // view. A controller that sees only the sum lags every such change (on the factory's walk, 9-11
 // of 19 poses within +-10 %, docs/SURFELS.md). This one models the passes apart and looks ahead:
 //
-//   model:   frame_ms = other + mesh(T) + surfels(S), each pass a line fitted to its measured
-//            times: mesh(T) = a_m + b_m T for T > 0 (0 for T = 0, the pass is skipped), the same
-//            for surfels. Each line is a least-squares fit over the frames so far, weighting a
-//            frame by memory^age (memory 0.7: about the last 3 frames, the paper's window). A
-//            fitted slope is taken only when it is >= 0 (more work never costs less; a negative
-//            fit is a change of load) and the recent work has spread (coefficient of variation
-//            >= 5 %); otherwise the last one stays, at first half the mean time per unit. The
-//            slope is clamped to [0.1, 1] x mean time / mean work: no negative fixed part, and
-//            the work always matters (else any size would do). `other` (the frame outside both
-//            passes) is the same weighted mean of frame_ms - mesh - surfels, at least 0.
+//   model:   frame_ms = other + mesh(T) + surfels(S). Each term is the weighted mean of its
+//            recent measurements (a frame weighs memory^age; memory 0.7: about the last 3
+//            frames, the paper's window), and each pass scales from its mean work to the work
+//            asked: surfels(S) = mean_ms * S / mean_S (proportional: the surfel pass's cost is
+//            the surfels'), mesh(T) = mean_ms * (1/4 + 3/4 * T / mean_T) (the near meshes cost
+//            per triangle and per covered pixel, which the triangles predict only in part);
+//            a skipped pass (no work) costs 0. The shares are fixed, not fitted: a slope fitted
+//            from the controller's own frames confounds the load's swings with the work's
+//            (measured on the factory: fits went flat and sent the size to its maximum), and
+//            a share at or above the true one can only make steps too short, never overshoot.
 //   plan:    before a frame, the caller gives the work its view needs at any point size
 //            (work(s), exact: the prefixes and mesh choices the representation would make). The
 //            predicted time at the current size p(s) = model(work(s)) is the feed-forward term:
@@ -76,10 +76,10 @@ class SurfelFrameController {
   double predict(const SurfelWork& work) const;
 
  private:
-  // One pass's weighted line fit.
+  // One pass's model: decayed sums of its work and times.
   struct Fit {
-    double w = 0, x = 0, y = 0, xx = 0, xy = 0;  // decayed sums
-    double slope = -1;                           // the last fitted slope; < 0: none yet
+    double w = 0, x = 0, y = 0;
+    double share = 1;  // the proportional share of the time
     void add(double work, double ms, double memory);
     double predict(double work) const;
   };
