@@ -8,7 +8,11 @@
 # `city` (1.4 M triangles): export the scene file, encode the full scene and the triangles visible
 # from the view region's perimeter as mesh clips, and play the visible set against the full scene
 # along a walk inside the region (epsilon = share of pixels where a triangle is missing, PSNR,
-# SSIM, frame times). Every step's full output is kept in build/demo/logs/. A second run skips
+# SSIM, frame times). Then the surfel mode (paper 001, docs/SURFELS.md) on the built-in
+# `factory` (28 M triangles counting instances): export the scene file, ray-cast surfel
+# candidates at a small G-buffer size, build the surfel clip and the full mesh clip, and play the
+# surfels against the full mesh along the factory's ground-level walk (bytes, build s, render ms,
+# PSNR / SSIM). Every step's full output is kept in build/demo/logs/. A second run skips
 # installed packages and rebuilds incrementally.
 #
 # Environment: CALF_DEMO_SCENE (default interior; see calf-capture --list-scenes),
@@ -16,9 +20,14 @@
 # CALF_DEMO_GT (ground-truth size WxH, default 128x128); visible-set part: CALF_DEMO_VS_SCENE
 # (default city; empty skips the part), CALF_DEMO_VS_FACE (the builder's cube face, default 200;
 # the paper's 800 takes minutes), CALF_DEMO_VS_FRAMES (frames solved and walk poses, default 6);
+# surfel part: CALF_DEMO_SURFEL_SCENE (default factory; empty skips the part),
+# CALF_DEMO_SURFEL_RES (candidate G-buffer size, default 128; docs/SURFELS.md measures 256),
+# CALF_DEMO_SURFEL_COUNT (most surfels per prototype, default 8192), CALF_DEMO_SURFEL_POSES
+# (walk poses, default 2: the full mesh takes tens of seconds a pose on llvmpipe);
 # CALF_DEMO_BUILD (build directory, default build/release).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+DEMO_T0=$(date +%s.%N)
 ./tools/setup.sh
 BUILD=${CALF_DEMO_BUILD:-build/release}
 cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
@@ -36,6 +45,12 @@ LOGS=$OUT/logs
 CLIP=$OUT/$SCENE.calf
 SHEET=$OUT/contact_sheet.png
 VS=$OUT/visible-set
+# --- surfel mode settings (paper 001)
+SF_SCENE=${CALF_DEMO_SURFEL_SCENE-factory}
+SF_RES=${CALF_DEMO_SURFEL_RES:-128}
+SF_COUNT=${CALF_DEMO_SURFEL_COUNT:-8192}
+SF_POSES=${CALF_DEMO_SURFEL_POSES:-2}
+SF=$OUT/surfels
 rm -rf "$OUT"
 mkdir -p "$LOGS"
 
@@ -90,6 +105,28 @@ if [ -n "$VS_SCENE" ]; then
     --compare-clip "$VS/full.calf"
 fi
 
+# --- surfel mode (paper 001): a self-contained block; its report lines are printed below.
+if [ -n "$SF_SCENE" ]; then
+  echo "calf demo: surfel mode on $SF_SCENE, candidates at ${SF_RES}², at most $SF_COUNT surfels" \
+    "per prototype, $SF_POSES poses"
+  run sf-export-scene "$BUILD"/calf-capture --scene "$SF_SCENE" --export-scene "$SF/scene" \
+    --frames "$SF_POSES" --quiet
+  run sf-candidates "$BUILD"/calf-capture --scene "$SF/scene" --surfel-candidates "$SF/c.cand" \
+    --surfel-resolution "$SF_RES"
+  SF_CAND_S=$LAST_SECONDS
+  run sf-encode-surfels "$BUILD"/calf-encode --mode surfels "$SF/scene" \
+    --surfel-candidates "$SF/c.cand" -o "$SF/surfels.calf" --surfels "$SF_COUNT"
+  SF_BUILD_S=$LAST_SECONDS
+  run sf-encode-full "$BUILD"/calf-encode --mode mesh "$SF/scene" -o "$SF/full.calf"
+  # The walk: the scene's ground-level validation path (its poses only; the cheapest images).
+  run sf-walk "$BUILD"/calf-capture --scene "$SF_SCENE" --out "$SF/walk" --ground-truth \
+    --gt-size 320x240 --ao-samples 0 --max-bounces 0 --spp 1 --no-noise-floor --frames "$SF_POSES" \
+    --quiet
+  run sf-play "$BUILD"/calf-play "$SF/surfels.calf" --headless \
+    --eye-path "$SF/walk/eye_path.json" --compare-clip "$SF/full.calf"
+fi
+# --- end of the surfel mode
+
 PLAY=$LOGS/calf-play.log
 ENC=$LOGS/calf-encode.log
 CAPTURE_BYTES=$(du -sb "$OUT/capture" | cut -f1)
@@ -126,5 +163,26 @@ if [ -n "$VS_SCENE" ]; then
   echo "          $(line_of "$VSPLAY" '^against the full scene' | sed -E 's/ \(an identical[^)]*\)//')"
   echo "          (epsilon: share of pixels where a triangle is missing; paper 004: <= 0.19 % mean)"
 fi
+# --- surfel mode report
+if [ -n "$SF_SCENE" ]; then
+  SFENC=$LOGS/sf-encode-surfels.log
+  SFPLAY=$LOGS/sf-play.log
+  echo "surfels   $SF_SCENE (paper 001): $(line_of "$SFENC" 'wrote' |
+    grep -oE '[0-9]+ surfels of [0-9]+ candidates')," \
+    "$(line_of "$SFENC" 'wrote' | grep -oE '[0-9.]+ bytes per surfel')"
+  awk -v s="$(stat -c %s "$SF/surfels.calf")" -v f="$(stat -c %s "$SF/full.calf")" \
+    -v c="$SF_CAND_S" -v b="$SF_BUILD_S" 'BEGIN {
+    printf "          clip %.2f MB (mesh + surfels; the full mesh alone %.2f MB); build %.1f s" \
+           " (candidates %.1f s + surfels %.1f s)\n", s / 1e6, f / 1e6, c + b, c, b }'
+  line_of "$SFPLAY" '^frame time' | awk '{
+    match($0, /: [0-9.]+ ms this/); a = substr($0, RSTART + 2, RLENGTH - 12) + 0
+    match($0, /, [0-9.]+ ms full/); b = substr($0, RSTART + 2, RLENGTH - 10) + 0
+    if (a > 0) printf "          render %.0f ms a pose (the full mesh %.0f ms: %.0fx the frame rate;" \
+      " GL on llvmpipe, 320x240)\n", a, b, b / a
+    else print "          render n/a" }'
+  echo "          $(line_of "$SFPLAY" '^against the full scene' |
+    sed -E 's/ \(an identical[^)]*\)//; s/epsilon[^;]*; //')"
+fi
+echo "total     $(seconds_since "$DEMO_T0") s wall, the whole demo (setup and build included)"
 echo "files     capture set $OUT/capture, frames and heat maps $OUT/play, logs $LOGS"
 echo "=================================================================================="

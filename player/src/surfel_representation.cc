@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <limits>
 #include <string>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "calf/decoder/surfels_track.h"
 #include "calf/format/surfels_layout.h"
 #include "calf/player/rendered_image.h"
+#include "calf/player/surfel_frame_controller.h"
 #include "calf/player/surfel_renderer.h"
 #include "object_transform.h"
 
@@ -22,6 +24,17 @@ namespace {
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
+
+// A pass's wall and process CPU time (std::clock: every thread of the process, llvmpipe's
+// rasteriser threads included).
+struct PassTimer {
+  std::chrono::steady_clock::time_point wall = std::chrono::steady_clock::now();
+  std::clock_t cpu = std::clock();
+  void add_to(double* wall_ms, double* cpu_ms) const {
+    *wall_ms += ms_since(wall);
+    *cpu_ms += 1000.0 * static_cast<double>(std::clock() - cpu) / CLOCKS_PER_SEC;
+  }
+};
 
 std::string format(const char* fmt, auto... args) {
   char buf[160];
@@ -72,8 +85,8 @@ Status validate_surfel_options(const SurfelOptions& o) {
     return option_error(
         format("target frame time %g ms is not finite and >= 0", o.target_frame_ms));
   }
-  if (!(o.controller_gain > 0 && o.controller_gain <= 1)) {
-    return option_error(format("controller gain %g is outside (0, 1]", o.controller_gain));
+  if (!(o.controller_deadband >= 0 && o.controller_deadband < 1)) {
+    return option_error(format("controller deadband %g is outside [0, 1)", o.controller_deadband));
   }
   if (!(o.blend_share >= 0 && o.blend_share <= 1)) {
     return option_error(format("blend share %g is outside [0, 1]", o.blend_share));
@@ -102,6 +115,14 @@ struct SurfelRepresentation::Impl {
   std::vector<double> radii;
   SurfelDrawList list;
   std::vector<Drawn> drawn;
+  // Per object at the prepared view: the disc radius at point size 1 in object units (the
+  // foveation factor included; 0 for a prototype without surfels) and its mesh's triangles.
+  std::vector<double> unit_radius;
+  std::vector<uint64_t> triangles;
+  std::unique_ptr<SurfelFrameController> controller;  // with a target frame time
+  SurfelWork work;                                    // the prepared frame's
+  // The passes' times since the latest prepare: [0] wall, [1] process CPU, ms.
+  double mesh_ms[2] = {0, 0}, surfels_ms[2] = {0, 0}, frame_ms[2] = {0, 0};
   std::unique_ptr<GlSurfelRenderer> gl;
   RenderedImage layer;  // the surfels' image before compositing
   std::vector<Camera> eyes;
@@ -110,7 +131,13 @@ struct SurfelRepresentation::Impl {
   uint32_t peripheral = 0;         // objects drawn with a foveation factor > 1
   double render_ms = 0, prepare_ms = 0;
 
-  void choose(const Camera& first);
+  // Fills unit_radius for the prepared eyes.
+  void measure(const Camera& first);
+  // How object o is drawn at point size s, and its prefix (0 unless surfels are drawn).
+  Drawn classify(size_t o, double s, uint32_t* count, double* radius) const;
+  SurfelWork work_at(double s) const;
+  // Sets the draw list, the mesh's visible objects and the counts for point size s.
+  void apply(double s);
 };
 
 SurfelRepresentation::SurfelRepresentation(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -168,6 +195,17 @@ Expected<std::unique_ptr<SurfelRepresentation>> SurfelRepresentation::open(
     impl->list.objects.push_back(s);
   }
   impl->drawn.assign(impl->list.objects.size(), Drawn::kMesh);
+  for (const MeshDrawObject& o : mesh_list.objects) {
+    impl->triangles.push_back(o.drawn_triangles(mesh_list.prototypes[o.prototype]));
+  }
+  if (options.target_frame_ms > 0) {
+    SurfelControllerOptions c;
+    c.target_ms = options.target_frame_ms;
+    c.min_point_size = options.min_point_size;
+    c.max_point_size = options.max_point_size;
+    c.deadband = options.controller_deadband;
+    impl->controller = std::make_unique<SurfelFrameController>(c, options.point_size);
+  }
   CALF_RETURN_IF_ERROR(validate_surfel_draw_list(impl->list));
   if (backend == RenderBackend::kGl) {
     if (gl == nullptr) {
@@ -180,48 +218,74 @@ Expected<std::unique_ptr<SurfelRepresentation>> SurfelRepresentation::open(
   return std::unique_ptr<SurfelRepresentation>(new SurfelRepresentation(std::move(impl)));
 }
 
-void SurfelRepresentation::Impl::choose(const Camera& first) {
+void SurfelRepresentation::Impl::measure(const Camera& first) {
   const MeshDrawList& mesh_list = mesh->draw_list();
   const double pixel =
       2 * std::tan(first.fov_y / 2) / first.height;  // world size per unit distance
-  surfels = 0;
-  counts[0] = counts[1] = counts[2] = 0;
   peripheral = 0;
   std::vector<CameraFrame> frames;
   for (const Camera& eye : eyes) frames.push_back(camera_frame(eye));
+  unit_radius.assign(list.objects.size(), 0);
   for (size_t o = 0; o < list.objects.size(); ++o) {
     SurfelDrawObject& s = list.objects[o];
     s.transform = mesh_list.objects[o].transform;
-    const surfels::PrototypeRecord& rec = records[s.prototype];
-    Drawn how = Drawn::kMesh;
-    s.count = 0;
-    if (rec.surfel_count > 0) {
-      const internal::ObjectTransform t(s.transform);
-      const double scale = std::cbrt(std::abs(t.det));
-      const Vec3 centre = t.linear(centres[s.prototype]) + t.translation();
-      double d = std::numeric_limits<double>::infinity();
-      double e = std::numeric_limits<double>::infinity();
-      for (size_t k = 0; k < eyes.size(); ++k) {
-        d = std::min(d, length(centre - eyes[k].position));
-        if (options.foveation.enabled) e = std::min(e, eccentricity(eyes[k], frames[k], centre));
-      }
-      d = std::max(d - scale * radii[s.prototype], options.render.near);
-      const double factor = foveation_factor(options.foveation, e);
-      if (factor > 1) ++peripheral;
-      const double radius = factor * point_size / 2 * pixel * d / scale;  // object units
-      // Eq. 1 unclamped, to tell "needs more than the buffer holds" from "needs all of it".
-      const double need = rec.prefix_count * std::pow(rec.prefix_radius / radius, 2);
-      if (need <= rec.surfel_count) {
-        s.count = surfels::prefix_for_radius(rec, radius);
-        s.radius = static_cast<float>(radius);
-        how = need > options.blend_share * rec.surfel_count ? Drawn::kBoth : Drawn::kSurfels;
-      }
+    if (records[s.prototype].surfel_count == 0) continue;
+    const internal::ObjectTransform t(s.transform);
+    const double scale = std::cbrt(std::abs(t.det));
+    const Vec3 centre = t.linear(centres[s.prototype]) + t.translation();
+    double d = std::numeric_limits<double>::infinity();
+    double e = std::numeric_limits<double>::infinity();
+    for (size_t k = 0; k < eyes.size(); ++k) {
+      d = std::min(d, length(centre - eyes[k].position));
+      if (options.foveation.enabled) e = std::min(e, eccentricity(eyes[k], frames[k], centre));
     }
+    d = std::max(d - scale * radii[s.prototype], options.render.near);
+    const double factor = foveation_factor(options.foveation, e);
+    if (factor > 1) ++peripheral;
+    unit_radius[o] = factor / 2 * pixel * d / scale;  // object units at point size 1
+  }
+}
+
+Drawn SurfelRepresentation::Impl::classify(size_t o, double s, uint32_t* count,
+                                           double* radius) const {
+  *count = 0;
+  *radius = 0;
+  if (unit_radius[o] <= 0) return Drawn::kMesh;
+  const surfels::PrototypeRecord& rec = records[list.objects[o].prototype];
+  *radius = unit_radius[o] * s;
+  // Eq. 1 unclamped, to tell "needs more than the buffer holds" from "needs all of it".
+  const double need = rec.prefix_count * std::pow(rec.prefix_radius / *radius, 2);
+  if (need > rec.surfel_count) return Drawn::kMesh;
+  *count = surfels::prefix_for_radius(rec, *radius);
+  return need > options.blend_share * rec.surfel_count ? Drawn::kBoth : Drawn::kSurfels;
+}
+
+SurfelWork SurfelRepresentation::Impl::work_at(double s) const {
+  SurfelWork w;
+  for (size_t o = 0; o < list.objects.size(); ++o) {
+    uint32_t count;
+    double radius;
+    if (classify(o, s, &count, &radius) != Drawn::kSurfels) w.triangles += triangles[o];
+    w.surfels += count;
+  }
+  return w;
+}
+
+void SurfelRepresentation::Impl::apply(double s) {
+  counts[0] = counts[1] = counts[2] = 0;
+  for (size_t o = 0; o < list.objects.size(); ++o) {
+    SurfelDrawObject& obj = list.objects[o];
+    double radius;
+    const Drawn how = classify(o, s, &obj.count, &radius);
+    obj.radius = static_cast<float>(radius);
     drawn[o] = how;
     ++counts[static_cast<int>(how)];
-    surfels += s.count;
     mesh->set_object_visible(o, how != Drawn::kSurfels);
   }
+  work.surfels = 0;
+  for (const SurfelDrawObject& obj : list.objects) work.surfels += obj.count;
+  work.triangles = mesh->triangles_drawn();
+  surfels = work.surfels;
 }
 
 std::string_view SurfelRepresentation::kind() const {
@@ -248,6 +312,20 @@ uint16_t SurfelRepresentation::mesh_track() const {
 double SurfelRepresentation::point_size() const {
   return impl_->point_size;
 }
+double SurfelRepresentation::predicted_frame_ms() const {
+  return impl_->controller ? impl_->controller->predicted_ms() : 0;
+}
+SurfelPassTimes SurfelRepresentation::last_pass_times() const {
+  const Impl& d = *impl_;
+  SurfelPassTimes t;
+  t.mesh_ms = d.mesh_ms[0];
+  t.surfels_ms = d.surfels_ms[0];
+  t.frame_ms = d.frame_ms[0];
+  t.mesh_cpu_ms = d.mesh_ms[1];
+  t.surfels_cpu_ms = d.surfels_ms[1];
+  t.frame_cpu_ms = d.frame_ms[1];
+  return t;
+}
 uint64_t SurfelRepresentation::surfels_drawn() const {
   return impl_->surfels;
 }
@@ -266,7 +344,13 @@ Status SurfelRepresentation::prepare(uint32_t frame, std::span<const Camera> eye
   const auto t0 = std::chrono::steady_clock::now();
   CALF_RETURN_IF_ERROR(d.mesh->prepare(frame, eyes));
   d.eyes.assign(eyes.begin(), eyes.end());
-  d.choose(eyes.front());
+  d.measure(eyes.front());
+  if (d.controller) {
+    // The feed-forward: the controller sees what this view costs at every point size.
+    d.point_size = d.controller->plan([&d](double s) { return d.work_at(s); });
+  }
+  d.apply(d.point_size);
+  for (int c = 0; c < 2; ++c) d.mesh_ms[c] = d.surfels_ms[c] = d.frame_ms[c] = 0;
   d.prepare_ms = ms_since(t0);
   return Status::Ok();
 }
@@ -274,19 +358,28 @@ Status SurfelRepresentation::prepare(uint32_t frame, std::span<const Camera> eye
 Status SurfelRepresentation::render(const Camera& camera, RenderedImage* out) {
   Impl& d = *impl_;
   const auto t0 = std::chrono::steady_clock::now();
+  const PassTimer frame;
   // A pass is skipped when it draws nothing: with no mesh object the surfels render straight into
-  // `out`; with no surfel the mesh does.
+  // `out`; with no surfel the mesh does. Each pass is timed apart: the controller models them
+  // apart (both passes read their image back, so a pass's time is its whole cost).
   const bool meshes = d.mesh->triangles_drawn() > 0;
-  if (meshes || d.surfels == 0) CALF_RETURN_IF_ERROR(d.mesh->render(camera, out));
+  if (meshes || d.surfels == 0) {
+    const PassTimer pass;
+    CALF_RETURN_IF_ERROR(d.mesh->render(camera, out));
+    pass.add_to(&d.mesh_ms[0], &d.mesh_ms[1]);
+  }
   if (d.surfels > 0) {
     RenderedImage* target = meshes ? &d.layer : out;
+    const PassTimer pass;
     if (d.gl) {
       CALF_RETURN_IF_ERROR(d.gl->render(d.list, camera, d.options.render, target));
     } else {
       CALF_RETURN_IF_ERROR(render_surfels_cpu(d.list, camera, d.options.render, target));
     }
+    pass.add_to(&d.surfels_ms[0], &d.surfels_ms[1]);
     if (meshes) CALF_RETURN_IF_ERROR(composite_nearest(d.layer, out));
   }
+  frame.add_to(&d.frame_ms[0], &d.frame_ms[1]);
   d.render_ms = ms_since(t0);
   return Status::Ok();
 }
@@ -297,10 +390,12 @@ Status SurfelRepresentation::report_frame_time(double frame_ms) {
     return Status(ErrorId::kViewSelectFrameTime,
                   "frame time " + std::to_string(frame_ms) + " ms is negative or not finite");
   }
-  const SurfelOptions& o = d.options;
-  if (o.target_frame_ms > 0 && frame_ms > 0) {
-    const double factor = std::pow(frame_ms / o.target_frame_ms, o.controller_gain / 2);
-    d.point_size = std::clamp(d.point_size * factor, o.min_point_size, o.max_point_size);
+  if (d.controller && frame_ms > 0) {
+    // Wall clock: the caller's frame time, the passes inside it; CPU clock: the process CPU
+    // time of the renders since the prepare and of their passes.
+    const int c = d.options.controller_clock == SurfelClock::kCpu ? 1 : 0;
+    d.controller->report(d.work,
+                         {d.mesh_ms[c], d.surfels_ms[c], c == 1 ? d.frame_ms[1] : frame_ms});
   }
   return Status::Ok();
 }

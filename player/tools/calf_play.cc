@@ -206,6 +206,11 @@ int run_headless(Playback& play, Playback* full, const HeadlessArgs& a) {
         std::printf(", %llu surfels at %.2f px",
                     static_cast<unsigned long long>(sr->surfels_drawn()), sr->point_size());
         if (a.surfel_foveation) std::printf(" (%u objects peripheral)", sr->peripheral_objects());
+        // The passes the controller models apart, wall and process CPU time; its prediction.
+        const SurfelPassTimes pt = sr->last_pass_times();
+        std::printf(" (passes: mesh %.1f + surfels %.1f ms; CPU %.1f + %.1f of %.1f ms)",
+                    pt.mesh_ms, pt.surfels_ms, pt.mesh_cpu_ms, pt.surfels_cpu_ms, pt.frame_cpu_ms);
+        if (a.surfel_target_ms > 0) std::printf(", predicted %.1f ms", sr->predicted_frame_ms());
         // Headless has no display: the render time stands for the frame time the point-size
         // controller follows (only when it has a target; not the first, which compiles shaders).
         if (a.surfel_target_ms > 0 && k > 0) {
@@ -403,6 +408,12 @@ int main(int argc, char** argv) {
                  "surfels: frame-time target in ms, > 0 and <= 10000; the point size follows it "
                  "between 1 and 16 px (headless: each pose's render time counts as its frame "
                  "time) (default: none, a fixed point size)");
+  std::string surfel_clock = "wall";
+  app.add_option("--surfel-clock", surfel_clock,
+                 "surfels: the time --surfel-target-ms holds: wall (the frame time) or cpu (the "
+                 "process CPU time of the renders, all threads; steadier on a loaded machine) "
+                 "(default wall)")
+      ->check(CLI::IsMember({"wall", "cpu"}));
   app.add_option("--surfel-blend", so.blend_share,
                  "surfels: an object whose prefix needs more than this share of its surfels is "
                  "drawn from the mesh as well (0..1; 1: no blend zone) (default 0.5)")
@@ -457,6 +468,7 @@ int main(int argc, char** argv) {
   if (int rc = tools::parse_command_line(app, "calf-play", argc, argv); rc >= 0) return rc;
 
   play_options.use_gl = renderer == "gl";
+  so.controller_clock = surfel_clock == "cpu" ? SurfelClock::kCpu : SurfelClock::kWall;
   if (app.count("--surfel-target-ms") > 0 &&
       !(so.target_frame_ms > 0 && so.target_frame_ms <= 10000)) {
     return contradiction("--surfel-target-ms " + std::to_string(so.target_frame_ms) +

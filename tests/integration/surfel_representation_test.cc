@@ -144,25 +144,51 @@ TEST(SurfelRepresentation, FoveationShortensOnlyPeripheralPrefixes) {
   EXPECT_GT(on[1], on[2]);
 }
 
+// The controller's wiring (its law is tested on a simulated cost in
+// tests/player/surfel_frame_controller_test.cc): prepare asks it for the size, report_frame_time
+// feeds it the frame and the passes' times; far too slow frames drive the size to its maximum,
+// fast ones to its minimum.
 TEST(SurfelRepresentation, ControllerMovesThePointSizeTowardsTheTargetWithinItsClamp) {
   Fixture f;
+  const Camera c = eye();
+  const std::span<const Camera> eyes(&c, 1);
+  player::RenderedImage image;
+  // Renders one frame and reports `frame_ms` for it (the CPU clock ignores the value).
+  const auto frame = [&](SurfelRepresentation& r, double frame_ms) {
+    ASSERT_TRUE(r.prepare(0, eyes).ok());
+    ASSERT_TRUE(r.render(c, &image).ok());
+    const player::SurfelPassTimes t = r.last_pass_times();
+    EXPECT_GE(t.frame_ms, t.surfels_ms + t.mesh_ms);
+    EXPECT_GT(t.surfels_ms, 0) << "the plates are drawn as surfels";
+    ASSERT_TRUE(r.report_frame_time(frame_ms).ok());
+  };
   SurfelOptions o;
   o.point_size = 2;
   o.target_frame_ms = 10;
   auto rep = SurfelRepresentation::open(f.reader, 1, o, player::RenderBackend::kCpu, nullptr);
   ASSERT_TRUE(rep.ok()) << rep.status().to_string();
   SurfelRepresentation& r = **rep;
-  EXPECT_EQ(r.point_size(), 2.0);
-  ASSERT_TRUE(r.report_frame_time(40).ok());  // 4x too slow: size x 4^(0.5 / 2) = sqrt 2
-  EXPECT_NEAR(r.point_size(), 2.0 * std::sqrt(2.0), 1e-12);
-  ASSERT_TRUE(r.report_frame_time(10).ok());  // on target: unchanged
-  EXPECT_NEAR(r.point_size(), 2.0 * std::sqrt(2.0), 1e-12);
-  for (int i = 0; i < 100; ++i) ASSERT_TRUE(r.report_frame_time(1000).ok());
+  frame(r, 40);
+  EXPECT_EQ(r.point_size(), 2.0) << "no model before the first report";
+  frame(r, 40);  // 4x too slow: the next prepare picks a larger size
+  EXPECT_GT(r.point_size(), 2.0);
+  EXPECT_GT(r.predicted_frame_ms(), 0);
+  for (int i = 0; i < 10; ++i) frame(r, 1000);
   EXPECT_EQ(r.point_size(), 16.0) << "clamped at max_point_size";
-  for (int i = 0; i < 100; ++i) ASSERT_TRUE(r.report_frame_time(0.001).ok());
-  EXPECT_EQ(r.point_size(), 1.0) << "clamped at min_point_size";
   EXPECT_EQ(r.report_frame_time(-1).id(), ErrorId::kViewSelectFrameTime);
   EXPECT_EQ(r.report_frame_time(std::nan("")).id(), ErrorId::kViewSelectFrameTime);
+
+  // A target far above what the plates cost: the smallest size, the best image; with either clock.
+  for (const player::SurfelClock clock : {player::SurfelClock::kWall, player::SurfelClock::kCpu}) {
+    o.target_frame_ms = 10000;
+    o.point_size = 4;
+    o.controller_clock = clock;
+    auto fast = SurfelRepresentation::open(f.reader, 1, o, player::RenderBackend::kCpu, nullptr);
+    ASSERT_TRUE(fast.ok()) << fast.status().to_string();
+    for (int i = 0; i < 3; ++i) frame(**fast, 0.5);
+    EXPECT_EQ((*fast)->point_size(), 1.0) << "clamped at min_point_size";
+  }
+
   // A larger point size means shorter prefixes (the controller's lever).
   SurfelOptions small, large;
   small.point_size = 1;
@@ -185,6 +211,7 @@ TEST(SurfelRepresentation, BadOptionsNameTheOption) {
       {"foveation periphery scale", [](SurfelOptions* o) { o->foveation.periphery_scale = 17; }},
       {"target frame time", [](SurfelOptions* o) { o->target_frame_ms = -1; }},
       {"point size", [](SurfelOptions* o) { o->point_size = 100; }},
+      {"controller deadband", [](SurfelOptions* o) { o->controller_deadband = 1; }},
   };
   for (const Case& c : cases) {
     SurfelOptions o;

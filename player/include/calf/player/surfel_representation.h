@@ -23,16 +23,20 @@
 //             e between, so the periphery draws shorter prefixes and changes quality smoothly;
 //   render:   the mesh objects through the mesh renderer, the surfel objects through the surfel
 //             splatter (surfel_renderer.h), composited by radial depth;
-//   report_frame_time: with target_frame_ms > 0, the point size follows the frame time:
-//             point_size *= (frame_ms / target)^(gain / 2), clamped to [min, max] — the surfel
-//             count goes as 1 / point_size², so gain 1 would undo the whole error in one frame;
-//             the default 0.5 undoes about half of it per frame and never oscillates on a cost
-//             linear in the count.
+//             With target_frame_ms > 0, prepare first asks the frame-time controller
+//             (surfel_frame_controller.h) for the point size: it is given the exact work (surfels
+//             and mesh triangles) this view needs at any point size and picks the size its model
+//             of the two passes predicts to meet the target;
+//   render:   the mesh pass and the surfel pass are timed apart (wall and process CPU time);
+//   report_frame_time: the frame (every render since the prepare) took frame_ms: its work and
+//             its passes' times refit the controller's model (controller_clock kCpu: the
+//             renders' process CPU times stand for the frame time instead).
 //
 // stats(): objects as surfels / mesh / both, surfels and triangles drawn, point size, and the last
 // prepare's and render's times in ms.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <string_view>
@@ -55,6 +59,15 @@ struct SurfelFoveation {
   double periphery_scale = 2.0;  // point-size factor at e >= outer, [1, 16]
 };
 
+enum class SurfelClock : uint8_t { kWall, kCpu };
+
+// The passes' times of the renders since the latest prepare, ms: wall clock and process CPU time.
+// frame_* is every render() call whole (both passes, the compositing and what lies between).
+struct SurfelPassTimes {
+  double mesh_ms = 0, surfels_ms = 0, frame_ms = 0;
+  double mesh_cpu_ms = 0, surfels_cpu_ms = 0, frame_cpu_ms = 0;
+};
+
 struct SurfelOptions {
   SurfelRenderOptions render;
   MeshOptions mesh;
@@ -67,8 +80,13 @@ struct SurfelOptions {
   double max_point_size = 16.0;
   // Frame-time target in ms (finite, >= 0); 0: the point size stays fixed.
   double target_frame_ms = 0.0;
-  // The controller's gain, (0, 1].
-  double controller_gain = 0.5;
+  // The controller keeps the point size while its predicted frame time is within +-deadband x
+  // target, [0, 1).
+  double controller_deadband = 0.05;
+  // The time the controller follows: the reported frame time (kWall), or the process CPU time of
+  // the renders (kCpu: all threads, llvmpipe's included; less sensitive to other processes on a
+  // shared machine, but CPU ms, not display ms).
+  SurfelClock controller_clock = SurfelClock::kWall;
   // An object whose prefix would exceed blend_share * N surfels is drawn from the mesh as well,
   // [0, 1]; 1: no blend zone.
   double blend_share = 0.5;
@@ -105,6 +123,10 @@ class SurfelRepresentation final : public Representation {
   // The mesh track this representation also plays (Playback does not open it again).
   uint16_t mesh_track() const;
   double point_size() const;
+  // The controller's predicted frame time for the prepared point size (0 without a target or
+  // before the first report).
+  double predicted_frame_ms() const;
+  SurfelPassTimes last_pass_times() const;
   uint64_t surfels_drawn() const;
   uint64_t triangles_drawn() const;
   // Objects drawn with a foveation factor above 1 at the prepared frame (0 without foveation).
