@@ -35,6 +35,11 @@ Status validate_tile_set(const TileSet& set) {
                      " bytes, not 4 x " + std::to_string(set.atlas_width) + " x " +
                      std::to_string(set.atlas_height));
   }
+  for (const Vec3& v : {set.view_region.min, set.view_region.max}) {
+    if (!(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z))) {
+      return set_error("the tile set's view region is not finite");
+    }
+  }
   if (!set.tiles.empty() && texels == 0) {
     return set_error(std::to_string(set.tiles.size()) + " tiles have an empty atlas");
   }

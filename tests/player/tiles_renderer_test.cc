@@ -382,8 +382,10 @@ TileSet random_set(int n, uint32_t seed, bool opaque) {
 }
 
 // GL against the CPU reference on synthesized sets, opaque and semi-transparent, from two poses,
-// in both blend modes: colour PSNR >= 45 dB; depth equal (1e-4 relative) but at a few tile edges
-// (the GPU's snapped vertices); fragment counts within 1 %.
+// in both blend modes: depth equal (1e-4 relative) but at a few tile edges (<= 0.5 % of the
+// pixels: where the GPU's snapped vertices put a pixel centre on the other side of an edge),
+// colour PSNR >= 45 dB where the depths agree and >= 40 dB over the whole image (one 96 x 72
+// pixel showing another tile costs about 43 dB); fragment counts within 1 %.
 TEST(TilesGlRenderer, AgreesWithCpuReference) {
   REQUIRE_GL();
   Camera poses[2] = {front_camera(96, 72), front_camera(96, 72)};
@@ -400,20 +402,26 @@ TEST(TilesGlRenderer, AgreesWithCpuReference) {
         const RenderedImage c = cpu(set, cam, o, &sc);
         ASSERT_EQ(g.color.size(), c.color.size());
         const double p = *psnr(rgb_ref(g), rgb_ref(c));
+        // GL where both show the same nearest tile, CPU at the pixels whose depth differs.
+        RenderedImage same_surface = g;
         size_t differing = 0;
         for (size_t k = 0; k < g.depth.size(); ++k) {
           const float x = g.depth[k], y = c.depth[k];
           const bool same =
               (std::isinf(x) && std::isinf(y)) || std::abs(x - y) <= 1e-4f * std::min(x, y);
-          differing += same ? 0 : 1;
+          if (same) continue;
+          ++differing;
+          for (int ch = 0; ch < 3; ++ch) same_surface.color[3 * k + ch] = c.color[3 * k + ch];
         }
+        const double p_same = *psnr(rgb_ref(same_surface), rgb_ref(c));
         std::printf(
-            "tiles GL vs CPU (%s, %s): PSNR %.1f dB, depth differs at %zu of %zu, "
-            "overdraw %.3f / %.3f, peak %u / %u\n",
-            opaque ? "opaque" : "transparent", tiles_blend_name(blend).data(), p, differing,
+            "tiles GL vs CPU (%s, %s): PSNR %.1f dB (%.1f dB where the depth agrees), depth "
+            "differs at %zu of %zu, overdraw %.3f / %.3f, peak %u / %u\n",
+            opaque ? "opaque" : "transparent", tiles_blend_name(blend).data(), p, p_same, differing,
             g.depth.size(), sg.mean_overdraw(), sc.mean_overdraw(), sg.peak, sc.peak);
-        EXPECT_GE(p, 45.0);
-        EXPECT_LE(differing, g.depth.size() / 50);
+        EXPECT_GE(p_same, 45.0);
+        EXPECT_GE(p, 40.0);  // one pixel showing another tile costs ~43 dB at this size
+        EXPECT_LE(differing, g.depth.size() / 200);
         EXPECT_NEAR(static_cast<double>(sg.fragments), static_cast<double>(sc.fragments),
                     0.01 * sc.fragments);
         EXPECT_GT(sc.fragments, 0u);

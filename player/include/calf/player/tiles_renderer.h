@@ -113,8 +113,9 @@ struct TilesLinearAtlas {
 };
 
 // CALF-E477 unless `set` is drawable, naming the first fault: an atlas of other than width x
-// height x 4 bytes, tiles with an empty atlas, a non-finite corner position or uvw, or a w not > 0
-// (or not finite U / W, V / W). An empty set (no tiles, any valid atlas) is drawable.
+// height x 4 bytes, tiles with an empty atlas, a non-finite view region, corner position or uvw,
+// or a w not > 0 (or not finite U / W, V / W). An empty set (no tiles, any valid atlas) is
+// drawable.
 [[nodiscard]] Status validate_tile_set(const TileSet& set);
 // CALF-E478 unless `options` are valid (near > 0 and finite, a listed blend mode).
 [[nodiscard]] Status validate_tiles_render_options(const TilesRenderOptions& options);
