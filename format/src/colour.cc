@@ -27,4 +27,10 @@ float linear_from_srgb8(uint8_t v) {
   return table[v];
 }
 
+float linear_from_srgb(float v) {
+  if (!(v > 0.0f)) return 0.0f;
+  const double c = v >= 1.0f ? 1.0 : v;
+  return static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+}
+
 }  // namespace calf

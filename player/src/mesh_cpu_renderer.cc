@@ -6,76 +6,15 @@
 #include <limits>
 
 #include "calf/player/mesh_renderer.h"
+#include "cpu_raster.h"
 #include "mesh_texture_sampler.h"
 #include "object_transform.h"
 
 namespace calf::player {
 namespace {
 
-// A vertex in the camera's frame: x along right, y along up, z along forward (eye at 0).
-struct ViewVertex {
-  double x, y, z;
-};
-
-// A point in image coordinates: x to the right, y down, pixel centres at half-integers.
-struct ImagePoint {
-  double x, y;
-};
-
-// Lexicographic order, so that an edge's computations run in one order whichever triangle asks.
-bool before(const ViewVertex& a, const ViewVertex& b) {
-  if (a.x != b.x) return a.x < b.x;
-  if (a.y != b.y) return a.y < b.y;
-  return a.z < b.z;
-}
-bool before(const ImagePoint& a, const ImagePoint& b) {
-  return a.x != b.x ? a.x < b.x : a.y < b.y;
-}
-
-// The point of edge a-b at z = near (a and b on either side), computed from the edge's endpoints
-// in canonical order so that two triangles sharing the edge clip it to the same point.
-ViewVertex clip_point(ViewVertex a, ViewVertex b, double near) {
-  if (before(b, a)) std::swap(a, b);
-  const double s = (near - a.z) / (b.z - a.z);
-  return {a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), near};
-}
-
-// Sutherland-Hodgman against z >= near: 0, 3 or 4 vertices.
-int clip_near(const std::array<ViewVertex, 3>& in, double near, std::array<ViewVertex, 4>* out) {
-  int n = 0;
-  for (int i = 0; i < 3; ++i) {
-    const ViewVertex& a = in[i];
-    const ViewVertex& b = in[(i + 1) % 3];
-    const bool a_in = a.z >= near, b_in = b.z >= near;
-    if (a_in) (*out)[n++] = a;
-    if (a_in != b_in) (*out)[n++] = clip_point(a, b, near);
-  }
-  return n;
-}
-
-// The edge function of a -> b at p: > 0 on the side the triangle's interior is on once the
-// triangle is oriented (see cover()). Evaluated from the endpoints in canonical order and negated
-// when they were swapped, so the two triangles sharing an edge get exactly opposite values.
-double edge(ImagePoint a, ImagePoint b, double px, double py) {
-  double sign = 1;
-  if (before(b, a)) {
-    std::swap(a, b);
-    sign = -1;
-  }
-  return sign * ((b.x - a.x) * (py - a.y) - (b.y - a.y) * (px - a.x));
-}
-
-// The top-left rule for edge a -> b of a triangle whose interior is on the edge function's
-// positive side: a left edge (interior to its right: the function grows with x) or a top edge
-// (horizontal, interior below it in the y-down image: the function grows with y).
-bool top_left(const ImagePoint& a, const ImagePoint& b) {
-  const double ddx = -(b.y - a.y), ddy = b.x - a.x;
-  return ddx > 0 || (ddx == 0 && ddy > 0);
-}
-
-bool inside(double e, bool tl) {
-  return e > 0 || (e == 0 && tl);
-}
+using internal::ViewProjector;
+using internal::ViewVertex;
 
 // Everything one triangle's pixels need.
 struct TriangleShade {
@@ -154,32 +93,6 @@ void shade_pixel(const TriangleShade& s, const Target& t, uint32_t i, uint32_t j
   }
 }
 
-// Rasterises the image-space triangle a, b, c (one piece of the clipped triangle) with the
-// top-left rule, shading the covered pixels from the whole triangle `s`.
-void cover(ImagePoint a, ImagePoint b, ImagePoint c, const TriangleShade& s, const Target& t) {
-  const double area = edge(a, b, c.x, c.y);
-  if (area == 0 || !std::isfinite(area)) return;
-  if (area < 0) std::swap(b, c);
-  const bool tl0 = top_left(a, b), tl1 = top_left(b, c), tl2 = top_left(c, a);
-  const double w = t.camera->width, h = t.camera->height;
-  // Pixel centres i + 0.5 within the bounds: i from ceil(min - 0.5) to floor(max - 0.5).
-  const double x0 = std::max(0.0, std::ceil(std::min({a.x, b.x, c.x}) - 0.5));
-  const double x1 = std::min(w - 1, std::floor(std::max({a.x, b.x, c.x}) - 0.5));
-  const double y0 = std::max(0.0, std::ceil(std::min({a.y, b.y, c.y}) - 0.5));
-  const double y1 = std::min(h - 1, std::floor(std::max({a.y, b.y, c.y}) - 0.5));
-  if (!(x0 <= x1 && y0 <= y1)) return;
-  for (double y = y0; y <= y1; ++y) {
-    const double py = y + 0.5;
-    for (double x = x0; x <= x1; ++x) {
-      const double px = x + 0.5;
-      if (inside(edge(a, b, px, py), tl0) && inside(edge(b, c, px, py), tl1) &&
-          inside(edge(c, a, px, py), tl2)) {
-        shade_pixel(s, t, static_cast<uint32_t>(x), static_cast<uint32_t>(y));
-      }
-    }
-  }
-}
-
 }  // namespace
 
 Status render_mesh_cpu(const MeshDrawList& list, const Camera& camera,
@@ -199,13 +112,7 @@ Status render_mesh_cpu(const MeshDrawList& list, const Camera& camera,
       rays[size_t{j} * width + i] = camera_ray(camera, frame, i, j);
   }
   const Target target{&camera, &frame, &rays, out};
-  const double h = std::tan(camera.fov_y / 2);
-  const double aspect = static_cast<double>(width) / height;
-  // View coordinates -> image coordinates (the inverse of camera_ray's pixel -> direction).
-  const auto project = [&](const ViewVertex& v) {
-    const double a = v.x / (v.z * h * aspect), b = v.y / (v.z * h);
-    return ImagePoint{(a + 1) * 0.5 * width, (1 - b) * 0.5 * height};
-  };
+  const ViewProjector project(camera);
 
   for (const MeshDrawObject& object : list.objects) {
     if (!object.visible) continue;
@@ -258,11 +165,8 @@ Status render_mesh_cpu(const MeshDrawList& list, const Camera& camera,
           s.uv[c][1] = proto.uvs[2 * size_t{v} + 1];
         }
       }
-      std::array<ViewVertex, 4> poly;
-      const int n = clip_near(view, options.near, &poly);
-      if (n < 3) continue;
-      const ImagePoint p0 = project(poly[0]);
-      for (int k = 1; k + 1 < n; ++k) cover(p0, project(poly[k]), project(poly[k + 1]), s, target);
+      internal::rasterise_clipped(view, options.near, project, width, height,
+                                  [&](uint32_t i, uint32_t j) { shade_pixel(s, target, i, j); });
     }
   }
   return Status::Ok();

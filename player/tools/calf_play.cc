@@ -19,6 +19,7 @@
 #include "calf/player/mesh_representation.h"
 #include "calf/player/playback.h"
 #include "calf/player/surfel_representation.h"
+#include "calf/player/tiles_representation.h"
 #include "calf_play/play_window.h"
 #include "command_line.h"
 
@@ -427,6 +428,12 @@ int main(int argc, char** argv) {
                  "(default off)")
       ->expected(3)
       ->delimiter(',');
+  std::string tiles_blend = "sort";
+  app.add_option("--tiles-blend", tiles_blend,
+                 "tiles: sort (back to front by distance from the eye each frame, premultiplied "
+                 "over; paper 000) or alpha-test (depth test, texels below 50 % alpha dropped, "
+                 "any order; hard silhouettes) (default sort)")
+      ->check(CLI::IsMember({"sort", "alpha-test"}));
   app.add_option("--renderer", renderer,
                  "gl (OpenGL 4.5 ray-march, the product) or cpu (the scalar "
                  "reference; headless only) (default gl)")
@@ -469,6 +476,7 @@ int main(int argc, char** argv) {
 
   play_options.use_gl = renderer == "gl";
   so.controller_clock = surfel_clock == "cpu" ? SurfelClock::kCpu : SurfelClock::kWall;
+  play_options.tiles.render.blend = *tiles_blend_from_name(tiles_blend);  // checked above
   if (app.count("--surfel-target-ms") > 0 &&
       !(so.target_frame_ms > 0 && so.target_frame_ms <= 10000)) {
     return contradiction("--surfel-target-ms " + std::to_string(so.target_frame_ms) +

@@ -13,5 +13,9 @@ float srgb_from_linear(float linear);
 uint8_t srgb8_from_linear(float linear);
 // sRGB byte -> linear, exact to float (a 256-entry table).
 float linear_from_srgb8(uint8_t encoded);
+// sRGB-encoded value in [0, 1] -> linear (values outside are clamped to [0, 1] first; NaN gives 0).
+// The same curve as linear_from_srgb8, for encoded values that are not bytes (a premultiplied
+// texel divided by its alpha).
+float linear_from_srgb(float encoded);
 
 }  // namespace calf

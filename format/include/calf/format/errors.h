@@ -193,6 +193,8 @@ enum class ErrorKind : uint8_t {
   X(kSurfelDrawList, 474, kInvalidArgument, "a surfel draw list is inconsistent or not finite") \
   X(kSurfelRenderOptions, 475, kInvalidArgument, "a surfel render option is outside its range") \
   X(kSurfelGlStructure, 476, kInvalidArgument, "a surfel draw list differs from its GL upload") \
+  X(kTilesDraw, 477, kInvalidArgument, "a tile set cannot be drawn or played as asked")       \
+  X(kTilesRenderOptions, 478, kInvalidArgument, "a tiles render option is outside its range")  \
   X(kExportInput, 480, kInvalidArgument, "a track cannot be exported as asked")                \
   X(kExportWrite, 481, kInternal, "the glTF / OBJ exporter failed")                             \
   /* end of the list: every line above ends with a backslash */

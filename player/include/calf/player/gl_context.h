@@ -104,7 +104,9 @@ using GlGetProc = GlProc (*)(const char* name);
   X(PFNGLENABLEVERTEXATTRIBARRAYPROC, EnableVertexAttribArray)      \
   X(PFNGLDISABLEVERTEXATTRIBARRAYPROC, DisableVertexAttribArray)    \
   X(PFNGLVERTEXATTRIB3FPROC, VertexAttrib3f)                        \
-  X(PFNGLBUFFERSUBDATAPROC, BufferSubData)
+  X(PFNGLBUFFERSUBDATAPROC, BufferSubData)                          \
+  X(PFNGLBLENDFUNCSEPARATEPROC, BlendFuncSeparate)                  \
+  X(PFNGLBLENDEQUATIONSEPARATEPROC, BlendEquationSeparate)
 // clang-format on
 
 // The loaded table plus what the context offers. Valid only while the context it was loaded in

@@ -23,6 +23,7 @@
 #include "calf/player/mesh_representation.h"
 #include "calf/player/representation.h"
 #include "calf/player/surfel_representation.h"
+#include "calf/player/tiles_representation.h"
 
 namespace calf::player {
 
@@ -36,6 +37,8 @@ struct PlaybackOptions {
   MeshOptions mesh;
   // Options of every surfels track's representation (which also plays its paired mesh track).
   SurfelOptions surfels;
+  // Options of every tiles track's representation.
+  TilesOptions tiles;
 };
 
 class Playback {
