@@ -109,6 +109,18 @@ function(calf_add_test source)
   add_executable(${name} ${source})
   target_link_libraries(${name} PRIVATE ${T_UNPARSED_ARGUMENTS} GTest::gtest GTest::gtest_main
                         calf_options)
+  # A test's own file is a driver: the libraries it calls, where the work and the bugs are, keep
+  # AddressSanitizer + UBSan at -O2, and every allocation (the test's too) stays under ASan's
+  # allocator. The test file keeps ASan (its own reads and writes are checked) but drops UBSan and
+  # compiles at -O1. Measured on mesh_track_test.cc back to back on the loaded 2-core machine:
+  # 128 s with ASan + UBSan at -O2, 26 s with ASan alone at -O1 (alone: 60 s at -O2; both at -O1:
+  # 64 s). Test files were ~60 % of the sanitized build's compile time. At -O1 GCC 12 reports
+  # -Wstringop-overflow on std::vector::resize after a subtraction it cannot bound (a known false
+  # positive of its value-range analysis; the -O2 build of the same files keeps the warning).
+  if(CALF_SANITIZE)
+    set_source_files_properties(${source} TARGET_DIRECTORY ${name} PROPERTIES
+                                COMPILE_OPTIONS "-fno-sanitize=undefined;-O1;-Wno-stringop-overflow")
+  endif()
   set(prefix "")
   if(T_TEST_PREFIX)
     set(prefix TEST_PREFIX ${T_TEST_PREFIX})
