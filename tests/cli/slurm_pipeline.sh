@@ -137,7 +137,8 @@ ids=$("$src/tools/farm/slurm_submit.sh" "${common[@]}" --work "$T/work1" --encod
 read -r _ _ _ merge <<< "$ids"
 s=$(wait_job "$merge")
 [[ $s == COMPLETED ]] || fail "view-shard pipeline: merge job $merge ended $s"
-"$bin/calf-encode" "$T/work1/capture" -o "$T/work1/one-machine.calf" -q --threads 1 ||
+"$bin/calf-encode" "$T/work1/capture" -o "$T/work1/one-machine.calf" -q --threads 1 \
+  2> "$T/one-machine1.log" ||
   fail "one-machine encode failed"
 cmp "$T/work1/clip.calf" "$T/work1/one-machine.calf" ||
   fail "the merged clip differs from the one-machine encode"
@@ -151,7 +152,8 @@ ids=$("$src/tools/farm/slurm_submit.sh" "${common[@]}" --work "$T/work2" --encod
 read -r _ _ _ merge <<< "$ids"
 s=$(wait_job "$merge")
 [[ $s == COMPLETED ]] || fail "frame-shard pipeline: merge job $merge ended $s"
-"$bin/calf-encode" "$T/work2/capture" -o "$T/work2/one-machine.calf" -q --threads 1 "${seg[@]}" ||
+"$bin/calf-encode" "$T/work2/capture" -o "$T/work2/one-machine.calf" -q --threads 1 "${seg[@]}" \
+  2> "$T/one-machine2.log" ||
   fail "one-machine segmented encode failed"
 cmp "$T/work2/clip.calf" "$T/work2/one-machine.calf" ||
   fail "the merged frame-shard clip differs from the one-machine encode"
