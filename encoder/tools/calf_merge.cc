@@ -16,9 +16,10 @@ int main(int argc, char** argv) {
   CLI::App app{
       "calf-merge: join the shard files of a sharded light-field encode into one .calf clip "
       "(docs/FARM.md).\n"
-      "Every shard must come from the given analysis file (CALF-E163 otherwise), no view may be "
-      "in two shards (CALF-E164) and every view must be in one (CALF-E165); the stored chunks are "
-      "copied view by view without recompression, so the clip is byte for byte the one "
+      "Every shard must come from the given analysis file (CALF-E163 otherwise), no view-frame "
+      "may be in two shards (CALF-E164) and every view-frame must be in one (CALF-E165); the "
+      "stored chunks are copied view by view without recompression (the t chunks of frame-range "
+      "shards are joined and compressed as one encode does), so the clip is byte for byte the one "
       "calf-encode writes on one machine with the options recorded in the analysis file. The "
       "output is written whole or not at all (a temporary file renamed into place; removed on an "
       "error or on SIGINT / SIGTERM / SIGHUP); an output that is one of the inputs is refused "
