@@ -143,6 +143,11 @@ Status parse_record(const std::string& path, const std::string& text, Lightfield
     f.has_material = material == 1;
     f.hdr = hdr == 1;
     if (has_range) {
+      // Checked before the conversion: a double beyond float's range has no float value.
+      if (!(z_near > 0 && z_near <= std::numeric_limits<float>::max() && z_far > 0 &&
+            z_far <= std::numeric_limits<float>::max())) {
+        return bad_record(path, what + ": depth range outside float's");
+      }
       Expected<LogDepthRange> r =
           LogDepthRange::make(static_cast<float>(z_near), static_cast<float>(z_far));
       if (!r.ok()) return bad_record(path, what + ": " + r.status().message());
