@@ -28,6 +28,7 @@ T=$(mktemp -d /tmp/calf-slurm.XXXXXX)
 pids=()
 cleanup() {
   local rc=$?
+  if [[ -n ${watchdog:-} ]]; then pkill -P "$watchdog" 2>/dev/null; kill "$watchdog" 2>/dev/null; fi
   for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
   [[ -f $T/munge/munged.pid ]] && kill "$(cat "$T/munge/munged.pid")" 2>/dev/null
   for p in "${pids[@]}"; do
@@ -43,7 +44,11 @@ cleanup() {
   exit "$rc"
 }
 trap cleanup EXIT
-trap 'exit 1' INT TERM HUP
+trap 'say "FAIL: interrupted or past the 240 s watchdog"; exit 1' INT TERM HUP
+# A watchdog below ctest's 300 s timeout: ctest's kill would skip the trap, and munged (which
+# daemonizes) would outlive the test.
+( sleep 240; kill -TERM $$ ) > /dev/null 2>&1 < /dev/null &
+watchdog=$!
 
 # munged: its own key, socket and files (never the system's).
 mkdir -p "$T/munge" "$T/state" "$T/spool"
