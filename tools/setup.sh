@@ -28,6 +28,9 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev clang-format
   # measurement peers and plots
   ffmpeg zstd xz-utils gnuplot-nox
+  # sharded pipeline (docs/FARM.md): the single-node Slurm of tests/cli/slurm_pipeline.sh, GNU
+  # parallel for tools/farm/parallel_run.sh, GNU time for the per-task time and memory lines
+  slurmctld slurmd slurm-client munge parallel time
 )
 
 # node and npm for the glTF-Validator below, from Debian when the machine has none.

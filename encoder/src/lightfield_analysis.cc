@@ -43,6 +43,11 @@ Status validate_options(const LightfieldEncodeOptions& o) {
   if (o.depth_keyframe_interval < 1) {
     return bad("--depth-keyframe-interval 0: expected >= 1");
   }
+  if (o.segment_frames != 0 && o.segment_frames % o.depth_keyframe_interval != 0) {
+    return bad("--segment-frames " + std::to_string(o.segment_frames) +
+               ": expected a multiple of --depth-keyframe-interval " +
+               std::to_string(o.depth_keyframe_interval) + " (or 0, no segments)");
+  }
   // 256 as calf-capture's: beyond it oneTBB prints warnings of its own (a library never prints).
   if (o.threads > 256) return bad("--threads " + std::to_string(o.threads) + ": expected [0, 256]");
   if (static_cast<uint16_t>(o.supercompression) >= container::kCompressionCount) {
@@ -87,6 +92,13 @@ Expected<LightfieldViewFacts> ViewFactsBuilder::finish() const {
     facts.depth_range = r;
   }
   return facts;
+}
+
+bool ViewFactsBuilder::within(const LightfieldViewFacts& whole) const {
+  if ((has_material_ && !whole.has_material) || (hdr_ && !whole.hdr)) return false;
+  if (hi_ == 0) return true;  // only sky in these frames
+  return whole.depth_range && lo_ >= whole.depth_range->z_near() &&
+         hi_ <= whole.depth_range->z_far();
 }
 
 bool same_facts(const LightfieldViewFacts& a, const LightfieldViewFacts& b) {

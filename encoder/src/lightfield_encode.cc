@@ -66,19 +66,20 @@ struct ViewData {
 // Reads every frame of `view` and checks that the images still say what the analysis saw
 // (`expected`): the depth codes are taken in the analysis's range.
 Status read_view(const capture::CaptureSetReader& input, uint32_t view,
-                 const LightfieldViewFacts& expected, ViewData* out) {
+                 const LightfieldViewFacts& expected, uint32_t first_frame, uint32_t frame_count,
+                 ViewData* out) {
   const capture::CaptureManifest& m = input.manifest();
-  out->frames = m.frame_count;
+  out->frames = frame_count;
   out->face_size = m.face_size;
   out->texels = size_t{6} * m.face_size * m.face_size;
-  out->colour.assign(out->texels * 3 * m.frame_count, 0);
+  out->colour.assign(out->texels * 3 * frame_count, 0);
   out->material.clear();
-  if (m.material) out->material.assign(out->texels * 3 * m.frame_count, 0);
-  std::vector<float> depth(out->texels * m.frame_count);
+  if (m.material) out->material.assign(out->texels * 3 * frame_count, 0);
+  std::vector<float> depth(out->texels * frame_count);
   lightfield_internal::ViewFactsBuilder facts;
   capture::ViewFrame vf;
-  for (uint32_t f = 0; f < m.frame_count; ++f) {
-    CALF_RETURN_IF_ERROR(lightfield_internal::read_frame(input, view, f, &vf));
+  for (uint32_t f = 0; f < frame_count; ++f) {
+    CALF_RETURN_IF_ERROR(lightfield_internal::read_frame(input, view, first_frame + f, &vf));
     facts.add(vf);
     uint16_t* c = &out->colour[f * out->texels * 3];
     for (size_t i = 0; i < out->texels * 3; ++i) c[i] = half_from_colour(vf.color[i]);
@@ -93,7 +94,9 @@ Status read_view(const capture::CaptureSetReader& input, uint32_t view,
     }
   }
   CALF_ASSIGN_OR_RETURN(const LightfieldViewFacts seen, facts.finish());
-  if (!lightfield_internal::same_facts(seen, expected)) {
+  // All frames must say exactly what the analysis saw; a range of them only what fits it.
+  const bool whole = first_frame == 0 && frame_count == m.frame_count;
+  if (whole ? !lightfield_internal::same_facts(seen, expected) : !facts.within(expected)) {
     return Status(ErrorId::kEncoderInput,
                   "view " + std::to_string(view) + " (" + input.image_path(view, 0).string() +
                       ", ...): its depth range, material or HDR colour changed since the analysis");
@@ -137,13 +140,17 @@ struct Context {
   ColourCoding colour;  // resolved (never kAuto)
   bool hdr;
   FaceGrid cells, tiles;
+  uint32_t first_frame;  // the clip frame of the view data's frame 0
+  bool partial;          // a frame range short of the clip: t chunks stay raw for the merge
 };
 
 Status add_chunk(const Context& ctx, TaskOut& out, ChunkKeys keys, const std::vector<uint8_t>& raw,
-                 StreamBytes& bytes) {
+                 StreamBytes& bytes, bool uncompressed = false) {
   keys.view = ctx.view_index;  // keys.track: set by LightfieldTrackWriter
-  CALF_ASSIGN_OR_RETURN(StoredChunk c, container::compress_chunk(raw, ctx.options->supercompression,
-                                                                 ctx.options->levels));
+  CALF_ASSIGN_OR_RETURN(StoredChunk c,
+                        container::compress_chunk(
+                            raw, uncompressed ? Compression::kNone : ctx.options->supercompression,
+                            ctx.options->levels));
   bytes.spatial += raw.size();
   bytes.stored += c.bytes.size();
   bytes.chunks += 1;
@@ -284,11 +291,26 @@ void colour_task(const Context& ctx, uint32_t face, uint32_t cell, TaskOut& out)
   const CellQualityFn quality = ctx.hdr ? CellQualityFn(psnr_log2) : CellQualityFn(psnr_srgb);
   KeyframeOptions ko;
   ko.min_quality_db = ctx.options->min_psnr_db;
-  auto k = select_cell_keyframes(shown_all, frames, static_cast<uint32_t>(n), shown, quality, ko);
-  if (!k.ok()) {
-    out.status = k.status();
-    return;
+  // Closed segments: the search restarts at every segment's first frame (ctx.first_frame is a
+  // segment boundary), so a segment's keyframes and t depend on its own frames only.
+  const uint32_t segment = ctx.options->segment_frames ? ctx.options->segment_frames : frames;
+  CellKeyframes all;
+  all.min_quality_db = kInf;
+  for (uint32_t s0 = 0; s0 < frames; s0 += segment) {
+    const uint32_t len = std::min(segment, frames - s0);
+    const ShownKeyframeFn shown_in = [&](uint32_t f) { return shown(s0 + f); };
+    auto part = select_cell_keyframes(
+        std::span<const float>(shown_all).subspan(s0 * n * 3, size_t{len} * n * 3), len,
+        static_cast<uint32_t>(n), shown_in, quality, ko);
+    if (!part.ok()) {
+      out.status = part.status();
+      return;
+    }
+    for (const uint32_t kf : part->keyframes) all.keyframes.push_back(s0 + kf);
+    all.t.insert(all.t.end(), part->t.begin(), part->t.end());
+    all.min_quality_db = std::min(all.min_quality_db, part->min_quality_db);
   }
+  const CellKeyframes* k = &all;
   TaskStats& s = out.stats;
   s.keyframes += k->keyframes.size();
   s.min_quality = std::min(s.min_quality, k->min_quality_db);
@@ -303,9 +325,9 @@ void colour_task(const Context& ctx, uint32_t face, uint32_t cell, TaskOut& out)
   keys.stream = static_cast<uint16_t>(LightfieldStream::kTParams);
   keys.face = face;
   keys.region = cell;
-  keys.first_frame = 0;
+  keys.first_frame = ctx.first_frame;
   keys.frame_count = frames;
-  out.status = add_chunk(ctx, out, keys, raw, s.colour);
+  out.status = add_chunk(ctx, out, keys, raw, s.colour, ctx.partial);
   if (!out.status.ok()) return;
   for (size_t i = 0; i < k->keyframes.size(); ++i) {
     const uint32_t kf = k->keyframes[i];
@@ -313,7 +335,7 @@ void colour_task(const Context& ctx, uint32_t face, uint32_t cell, TaskOut& out)
     raw.clear();
     append_colour_payload(ctx.colour, coded[kf].bytes, raw);
     keys.stream = static_cast<uint16_t>(LightfieldStream::kColour);
-    keys.first_frame = kf;
+    keys.first_frame = ctx.first_frame + kf;
     keys.frame_count = end - kf;
     out.status = add_chunk(ctx, out, keys, raw, s.colour);
     if (!out.status.ok()) return;
@@ -543,7 +565,7 @@ void region_task(const Context& ctx, uint32_t face, uint32_t tile, bool is_depth
         static_cast<uint16_t>(is_depth ? LightfieldStream::kDepth : LightfieldStream::kMaterial);
     keys.face = face;
     keys.region = tile;
-    keys.first_frame = first;
+    keys.first_frame = ctx.first_frame + first;
     keys.frame_count = count;
     out.status = add_chunk(ctx, out, keys, raw, bytes);
     if (!out.status.ok()) return;
@@ -626,11 +648,45 @@ Expected<LightfieldViewEncoding> encode_lightfield_view(const capture::CaptureSe
                                                         const LightfieldAnalysis& analysis,
                                                         uint32_t v,
                                                         const LightfieldEncodeOptions& options) {
+  return encode_lightfield_view_frames(input, analysis, v, 0, input.manifest().frame_count,
+                                       options);
+}
+
+Expected<std::vector<uint8_t>> join_t_chunks(std::span<const std::vector<uint8_t>> parts,
+                                             std::span<const uint32_t> frame_counts) {
+  lf::CellTimeline all;
+  uint32_t offset = 0;
+  for (size_t i = 0; i < parts.size() && i < frame_counts.size(); ++i) {
+    CALF_ASSIGN_OR_RETURN(const lf::CellTimeline part,
+                          lf::parse_t_chunk(parts[i], frame_counts[i], "t chunk of a segment"));
+    for (const uint32_t kf : part.keyframes) all.keyframes.push_back(offset + kf);
+    all.t.insert(all.t.end(), part.t.begin(), part.t.end());
+    offset += frame_counts[i];
+  }
+  std::vector<uint8_t> raw;
+  CALF_RETURN_IF_ERROR(container::write_fields(all, raw, "t chunk"));
+  return raw;
+}
+
+Expected<LightfieldViewEncoding> encode_lightfield_view_frames(
+    const capture::CaptureSetReader& input, const LightfieldAnalysis& analysis, uint32_t v,
+    uint32_t first_frame, uint32_t frame_count, const LightfieldEncodeOptions& options) {
   CALF_RETURN_IF_ERROR(lightfield_internal::validate_options(options));
   const capture::CaptureManifest& m = input.manifest();
   if (v >= m.viewpoints.size()) {
     return Status(ErrorId::kEncoderInput, "view " + std::to_string(v) + " of a capture set of " +
                                               std::to_string(m.viewpoints.size()) + " views");
+  }
+  const bool whole = first_frame == 0 && frame_count == m.frame_count;
+  const uint32_t seg = options.segment_frames;
+  if (!whole &&
+      (seg == 0 || frame_count == 0 || first_frame % seg != 0 || first_frame > m.frame_count ||
+       frame_count > m.frame_count - first_frame ||
+       ((first_frame + frame_count) % seg != 0 && first_frame + frame_count != m.frame_count))) {
+    return Status(ErrorId::kEncoderInput,
+                  "frames " + std::to_string(first_frame) + "+" + std::to_string(frame_count) +
+                      " of " + std::to_string(m.frame_count) +
+                      " are not whole segments of --segment-frames " + std::to_string(seg));
   }
   // The analysis is a pure function of (manifest, facts, options): planning it again tells
   // whether it belongs to this capture set and these options.
@@ -656,7 +712,7 @@ Expected<LightfieldViewEncoding> encode_lightfield_view(const capture::CaptureSe
   stats.hdr = analysis.hdr;
   stats.min_colour_quality_db = kInf;
   ViewData view;
-  CALF_RETURN_IF_ERROR(read_view(input, v, analysis.views[v], &view));
+  CALF_RETURN_IF_ERROR(read_view(input, v, analysis.views[v], first_frame, frame_count, &view));
   if (view.has_material) stats.material_views += 1;
 
   // The view's index chunk (SPEC §11.1 "View index chunk").
@@ -675,13 +731,16 @@ Expected<LightfieldViewEncoding> encode_lightfield_view(const capture::CaptureSe
   ikeys.view = v;
   CALF_ASSIGN_OR_RETURN(StoredChunk ic,
                         container::compress_chunk(index, Compression::kNone, options.levels));
-  stats.index_bytes += ic.bytes.size();
-  out.chunks.push_back({ikeys, std::move(ic)});
+  if (first_frame == 0) {  // one index chunk per view, with the range that starts the clip
+    stats.index_bytes += ic.bytes.size();
+    out.chunks.push_back({ikeys, std::move(ic)});
+  }
 
   tbb::task_arena arena(options.threads == 0 ? tbb::task_arena::automatic
                                              : static_cast<int>(options.threads));
   const uint64_t total = uint64_t{6} * m.viewpoints.size();
-  const Context ctx{&options, &view, v, analysis.colour, analysis.hdr, cells, tiles};
+  const Context ctx{&options, &view, v,           analysis.colour, analysis.hdr,
+                    cells,    tiles, first_frame, !whole};
   for (uint32_t face = 0; face < 6; ++face) {
     // Tasks of one face in file order: cells, depth tiles, material tiles.
     const uint32_t nc = cells.cell_count(), nt = tiles.cell_count();

@@ -26,6 +26,9 @@ class ViewFactsBuilder {
   void add(const capture::ViewFrame& frame);
   // The facts of the frames added (kDepthRange when the depths admit no range).
   Expected<LightfieldViewFacts> finish() const;
+  // Whether the frames added could be some of the frames of a view with facts `whole`: no
+  // material or HDR colour it lacks, every finite depth inside its range.
+  bool within(const LightfieldViewFacts& whole) const;
 
  private:
   float lo_ = std::numeric_limits<float>::infinity(), hi_ = 0;  // finite depths seen

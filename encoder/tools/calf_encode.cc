@@ -18,7 +18,9 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "calf/capture/capture_shard.h"
 #include "calf/encoder/lightfield_encode.h"
+#include "calf/encoder/lightfield_shard.h"
 #include "calf/encoder/mesh_encode.h"
 #include "calf/encoder/surfels_build.h"
 #include "calf/encoder/visible_set.h"
@@ -270,11 +272,36 @@ int main(int argc, char** argv) {
   app.add_option("--depth-keyframe-interval", o.depth_keyframe_interval,
                  "a depth / material keyframe every K frames (default 30)")
       ->default_val(30);
+  app.add_option("--segment-frames", o.segment_frames,
+                 "closed colour segments of N frames, like a closed GOP: the colour keyframe "
+                 "search restarts every N frames (frame N, 2N, ... is a keyframe), so frame-range "
+                 "shards (--frame-range) code apart into the bytes of one encode; a multiple of "
+                 "--depth-keyframe-interval; costs bytes (docs/FARM.md) (default 0: no segments)")
+      ->default_val(0);
   app.add_option("--supercompression", super,
                  "per chunk: zstd (level 19), lzma2 (preset 6), none (default zstd)")
       ->check(CLI::IsMember({"zstd", "lzma2", "none"}))
       ->default_val("zstd");
   app.add_flag("-q,--quiet", quiet, "no progress line");
+  bool analysis_only = false;
+  std::string analysis_path, views_text, frames_text;
+  app.add_flag("--analysis-only", analysis_only,
+               "lightfield, sharded encode step 1 (docs/FARM.md): run only the analysis pass "
+               "over the whole capture set and write the analysis file (a small .calf: the track "
+               "header, every view's depth range, material and HDR facts, these options) to -o "
+               "(default off)");
+  app.add_option("--analysis", analysis_path,
+                 "lightfield, sharded encode step 2: code only --views with the options recorded "
+                 "in this analysis file (giving lightfield options too is a usage error) and "
+                 "write a shard file to -o; calf-merge joins the shards into the clip, "
+                 "byte-identical to a one-machine encode");
+  app.add_option("--views", views_text,
+                 "with --analysis: the views of the shard, e.g. 0-2,5 (inclusive ranges, "
+                 "ascending, 0-based manifest order)");
+  app.add_option(
+      "--frame-range", frames_text,
+      "with --analysis: the shard's frames FIRST-LAST (inclusive), whole segments of the "
+      "analysis's --segment-frames (default: every frame)");
   VisibleSetFlags vs;
   auto* vs_flag = app.add_flag(
       "--visible-set", vs.enabled,
@@ -361,6 +388,75 @@ int main(int argc, char** argv) {
   std::filesystem::path dir = manifest;
   if (dir.filename() == "manifest.json") dir = dir.parent_path();
   if (dir.empty()) dir = ".";
+
+  if (analysis_only && !analysis_path.empty()) {
+    return calf::tools::usage_error("calf-encode",
+                                    "--analysis-only and --analysis exclude each other");
+  }
+  if (analysis_path.empty() != views_text.empty() ||
+      (analysis_path.empty() && !frames_text.empty())) {
+    return calf::tools::usage_error("calf-encode",
+                                    "--analysis and --views go together; --frame-range needs them");
+  }
+  if (analysis_only) {
+    const auto t0 = std::chrono::steady_clock::now();
+    auto a = calf::write_lightfield_analysis(dir, out, o);
+    if (!a.ok()) return fail(a.status());
+    if (!quiet) {
+      std::fprintf(stderr, "calf-encode: analysis %s of %u views in %.2f s, peak RSS %.1f MiB\n",
+                   a->id.c_str(), a->analysis.header.view_count,
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                   peak_rss_mib());
+    }
+    return 0;
+  }
+  if (!analysis_path.empty()) {
+    for (const char* opt :
+         {"--cell", "--psnr", "--color-format", "--depth-format", "--depth-window", "--max-aabbs",
+          "--depth-keyframe-interval", "--supercompression", "--segment-frames"}) {
+      if (app.get_option(opt)->count() > 0) {
+        return calf::tools::usage_error(
+            "calf-encode",
+            std::string(opt) + " with --analysis: the options are the analysis file's");
+      }
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    auto a = calf::read_lightfield_analysis(analysis_path);
+    if (!a.ok()) return fail(a.status());
+    auto views =
+        calf::capture::parse_index_list(views_text, a->analysis.header.view_count, "views");
+    if (!views.ok()) {
+      return calf::tools::print_error("calf-encode", views.status(), calf::tools::kExitUsage);
+    }
+    uint32_t first = 0, count = a->analysis.header.frame_count;
+    if (!frames_text.empty()) {
+      auto f = calf::capture::parse_index_list(frames_text, count, "frames");
+      if (!f.ok() || f->back() - f->front() + 1 != f->size()) {
+        return calf::tools::print_error(
+            "calf-encode",
+            f.ok() ? calf::Status(calf::ErrorId::kShardRange,
+                                  "--frame-range '" + frames_text + "' is not one range")
+                   : f.status(),
+            calf::tools::kExitUsage);
+      }
+      first = f->front();
+      count = static_cast<uint32_t>(f->size());
+    }
+    auto s = calf::encode_lightfield_shard(dir, *a, *views, first, count, o.threads, out);
+    if (!s.ok()) return fail(s.status());
+    if (!quiet) {
+      std::fprintf(
+          stderr,
+          "calf-encode: shard %s (views %s, %llu colour keyframes, %llu bytes stored) in "
+          "%.2f s, peak RSS %.1f MiB\n",
+          out.c_str(), calf::capture::index_list_text(*views).c_str(),
+          static_cast<unsigned long long>(s->colour_keyframes),
+          static_cast<unsigned long long>(s->colour.stored + s->depth.stored + s->material.stored),
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+          peak_rss_mib());
+    }
+    return 0;
+  }
 
   const bool tty = isatty(2) != 0;
   const auto start = std::chrono::steady_clock::now();

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <system_error>
 
+#include "calf/capture/capture_shard.h"
 #include "calf/format/files.h"
 #include "calf/samples/render.h"
 
@@ -68,22 +69,56 @@ Expected<RenderStats> render_capture_set(const Scene& scene, const CaptureReques
   manifest.scene = scene.name;
   manifest.generator = request.generator;
   CALF_RETURN_IF_ERROR(capture::validate_manifest(manifest));
-  CALF_RETURN_IF_ERROR(check_viewpoints(scene, request.rig, frames, scene.fps, request.render));
+  // The shard's views and frames (the whole set unless request.shard).
+  std::vector<uint32_t> views = request.views;
+  if (views.empty()) {
+    for (uint32_t v = 0; v < manifest.viewpoints.size(); ++v) views.push_back(v);
+  }
+  const uint32_t first = request.shard ? request.first_frame : 0;
+  const uint32_t last = request.shard ? request.last_frame : frames - 1;
+  if (first > last || last >= frames) {
+    return Status(ErrorId::kShardRange, "frames " + std::to_string(first) + "-" +
+                                            std::to_string(last) + " are outside the set's " +
+                                            std::to_string(frames) + " frames");
+  }
+  for (size_t i = 0; i < views.size(); ++i) {
+    if (views[i] >= manifest.viewpoints.size() || (i > 0 && views[i] <= views[i - 1])) {
+      return Status(ErrorId::kShardRange, "views " + capture::index_list_text(views) +
+                                              ": not ascending within the rig's " +
+                                              std::to_string(manifest.viewpoints.size()));
+    }
+  }
+  if (request.shard) {
+    // Only this shard's viewpoints and frames: another shard checks its own.
+    for (uint32_t f = first; f <= last; ++f) {
+      CALF_ASSIGN_OR_RETURN(auto tracer, FrameTracer::create(scene, f / scene.fps, request.render));
+      for (const uint32_t v : views) {
+        if (tracer->inside_geometry(request.rig.viewpoints[v].position)) {
+          return Status(ErrorId::kViewpointInsideGeometry,
+                        "viewpoint " + std::to_string(v) + " '" + request.rig.viewpoints[v].name +
+                            "' at " + point_text(request.rig.viewpoints[v].position) +
+                            " is inside geometry at frame " + std::to_string(f));
+        }
+      }
+    }
+  } else {
+    CALF_RETURN_IF_ERROR(check_viewpoints(scene, request.rig, frames, scene.fps, request.render));
+  }
 
   CALF_ASSIGN_OR_RETURN(capture::CaptureSetWriter writer,
                         capture::CaptureSetWriter::create(directory, manifest));
   const auto start = std::chrono::steady_clock::now();
   RenderStats stats;
   capture::ViewFrame image;
-  const uint64_t total = static_cast<uint64_t>(frames) * manifest.viewpoints.size();
+  const uint64_t total = static_cast<uint64_t>(last - first + 1) * views.size();
   uint64_t done = 0;
-  for (uint32_t f = 0; f < frames; ++f) {
+  for (uint32_t f = first; f <= last; ++f) {
     auto tracer = FrameTracer::create(scene, f / scene.fps, request.render);
     if (!tracer.ok()) {
       writer.abandon();
       return tracer.status();
     }
-    for (uint32_t v = 0; v < manifest.viewpoints.size(); ++v) {
+    for (const uint32_t v : views) {
       RenderStats s = (*tracer)->render_cube(manifest.viewpoints[v].position, v, f,
                                              request.face_size, manifest.material, &image);
       stats.rays += s.rays;
@@ -97,9 +132,12 @@ Expected<RenderStats> render_capture_set(const Scene& scene, const CaptureReques
       if (progress) progress(++done, total);
     }
   }
-  if (Status st = writer.finish(); !st.ok()) {
+  const Status finished =
+      request.shard ? capture::write_capture_shard_marker(directory, manifest, views, first, last)
+                    : writer.finish();
+  if (!finished.ok()) {
     writer.abandon();
-    return st;
+    return finished;
   }
   stats.seconds = seconds_since(start);
   return stats;

@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "calf/capture/capture_shard.h"
 #include "calf/samples/render.h"
 #include "calf/samples/scene.h"
 #include "calf/samples/scene_export.h"
@@ -172,6 +173,20 @@ int main(int argc, char** argv) {
                  "the diagonals, a flat or long part is never seen edge-on) or box (the bounding "
                  "box's own corners, the paper's rule)")
       ->capture_default_str();
+  std::string shard_views, shard_frames;
+  bool join = false;
+  app.add_option("--views", shard_views,
+                 "render a capture shard (docs/FARM.md): only these views, e.g. 0-2,5 (inclusive "
+                 "ranges, ascending, 0-based rig order); the shard writes its images and "
+                 "DIR/capture-shard.v<views>.f<first>-<last>.json, never manifest.json "
+                 "(default: every view, a complete set)");
+  app.add_option("--frame-range", shard_frames,
+                 "render a capture shard of frames FIRST-LAST only (inclusive, 0-based) (default: "
+                 "every frame)");
+  app.add_flag("--join", join,
+               "join the capture shards rendered into --out: check that every shard marker holds "
+               "the same manifest and every image is there, write manifest.json, remove the "
+               "markers; nothing is rendered");
   app.add_flag("--list-scenes", list, "print the built-in scenes and exit");
   app.add_flag("--quiet", quiet, "no progress or summary lines on stderr");
   if (int rc = calf::tools::parse_command_line(app, "calf-capture", argc, argv); rc >= 0) return rc;
@@ -181,6 +196,18 @@ int main(int argc, char** argv) {
       auto scene = samples::make_builtin_scene(s.name);
       std::printf("%-11s %s; default rig %s, %u frames at %g fps\n", s.name, s.description,
                   scene->default_rig.description.c_str(), scene->frame_count, scene->fps);
+    }
+    return 0;
+  }
+  if (join) {
+    if (out_dir.empty() || !scene_arg.empty() || !shard_views.empty() || !shard_frames.empty()) {
+      return calf::tools::usage_error("calf-capture", "--join takes --out only");
+    }
+    auto joined = calf::capture::join_capture_shards(out_dir);
+    if (!joined.ok()) return fail(joined.status());
+    if (!quiet) {
+      std::fprintf(stderr, "calf-capture: %s: joined %u capture shards\n", out_dir.c_str(),
+                   *joined);
     }
     return 0;
   }
@@ -284,6 +311,31 @@ int main(int argc, char** argv) {
       auto rig = samples::parse_rig(rig_arg);
       if (!rig.ok()) return fail(rig.status());
       request.rig = std::move(*rig);
+    }
+    if (!shard_views.empty() || !shard_frames.empty()) {
+      if (ground_truth || !eye_path_file.empty()) {
+        return calf::tools::usage_error("calf-capture",
+                                        "--views / --frame-range make capture sets");
+      }
+      request.shard = true;
+      request.first_frame = 0;
+      request.last_frame = frame_count - 1;
+      if (!shard_views.empty()) {
+        auto v = calf::capture::parse_index_list(
+            shard_views, static_cast<uint32_t>(request.rig.viewpoints.size()), "views");
+        if (!v.ok()) return bad_option(v.status());
+        request.views = std::move(*v);
+      }
+      if (!shard_frames.empty()) {
+        auto f = calf::capture::parse_index_list(shard_frames, frame_count, "frames");
+        if (!f.ok()) return bad_option(f.status());
+        if (f->back() - f->front() + 1 != f->size()) {
+          return bad_option(calf::Status(calf::ErrorId::kShardRange,
+                                         "--frame-range '" + shard_frames + "' is not one range"));
+        }
+        request.first_frame = f->front();
+        request.last_frame = f->back();
+      }
     }
     Progress progress("view-frame", quiet);
     auto result = samples::render_capture_set(*scene, request, out_dir,

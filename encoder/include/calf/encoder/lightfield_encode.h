@@ -76,6 +76,12 @@ struct LightfieldEncodeOptions {
   uint32_t depth_window = 2;              // W, >= 1
   uint32_t max_aabbs = 2;                 // A, 1..64
   uint32_t depth_keyframe_interval = 30;  // a depth keyframe every K frames, >= 1
+  // Closed colour segments (like a video encoder's closed GOP): 0 = none; else the colour
+  // keyframe search of every cell restarts every N frames (frame N, 2N, ... is a keyframe), so
+  // that frame ranges of whole segments code apart into the very bytes of one encode
+  // (lightfield_shard.h). A multiple of depth_keyframe_interval, so depth groups never straddle
+  // a segment. Costs bytes (docs/FARM.md).
+  uint32_t segment_frames = 0;
   container::Compression supercompression = container::Compression::kZstd;
   container::CompressionOptions levels;  // zstd level / LZMA preset (fixed per clip)
   uint32_t threads = 1;                  // 0 = all cores; never changes the output
@@ -186,6 +192,23 @@ Expected<LightfieldViewEncoding> encode_lightfield_view(const capture::CaptureSe
                                                         const LightfieldAnalysis& analysis,
                                                         uint32_t view,
                                                         const LightfieldEncodeOptions& options);
+
+// The same for frames [first_frame, first_frame + frame_count) of the view only: whole segments
+// (options.segment_frames > 0, first_frame a multiple of it and the range ending on a segment
+// boundary or at the clip's end). The view's index chunk comes with the range holding frame 0.
+// A range short of the whole clip is a partial encoding: its cells' t chunks cover the range only
+// and are stored uncompressed, for merge_lightfield_shards() to join (kEncoderInput for a range
+// that is not whole segments; the images are checked against the analysis as far as the range
+// tells: depths inside its range, no material or HDR colour it did not see).
+Expected<LightfieldViewEncoding> encode_lightfield_view_frames(
+    const capture::CaptureSetReader& input, const LightfieldAnalysis& analysis, uint32_t view,
+    uint32_t first_frame, uint32_t frame_count, const LightfieldEncodeOptions& options);
+
+// Joins the t chunks of consecutive whole segments of one cell (raw bytes, in frame order, each
+// with its frame count) into the cell's t chunk for all of them, raw: exactly what an encode of
+// the whole range writes. Errors: kLightfieldChunk (a t chunk that does not parse).
+Expected<std::vector<uint8_t>> join_t_chunks(std::span<const std::vector<uint8_t>> parts,
+                                             std::span<const uint32_t> frame_counts);
 
 // ---- Assembly ----
 

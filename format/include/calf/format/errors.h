@@ -120,6 +120,12 @@ enum class ErrorKind : uint8_t {
   X(kSceneFileTexture, 159, kCorrupt, "a scene texture cannot be decoded or is too large")      \
   X(kSceneFileLimit, 160, kLimit, "a scene exceeds a documented size limit")                    \
   X(kSceneFileWriterMisuse, 161, kInvalidArgument, "the scene writer got mismatched array sizes")\
+  /* sharded capture and encode: 162-168 (docs/FARM.md) */                                      \
+  X(kShardFile, 162, kCorrupt, "a file is not an analysis or shard file, or its record is bad")  \
+  X(kShardMismatch, 163, kInvalidArgument, "shards come from different analyses or captures")   \
+  X(kShardOverlap, 164, kInvalidArgument, "two shards hold the same view or frame")              \
+  X(kShardMissing, 165, kInvalidArgument, "a view or frame is in no shard")                      \
+  X(kShardRange, 166, kInvalidArgument, "a shard's views or frames are outside the set")         \
   /* calf-capture: 170-199 */                                                                   \
   X(kSceneUnknown, 170, kInvalidArgument, "no built-in scene has that name")                    \
   X(kSceneLoad, 171, kCorrupt, "a scene file could not be imported")                            \

@@ -44,6 +44,8 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "calf/capture/capture_set.h"
 #include "calf/capture/eye_path.h"
@@ -119,6 +121,12 @@ struct CaptureRequest {
   Rig rig;
   RenderOptions render;
   std::string generator = "calf-capture";  // recorded in the manifest
+  // A capture shard (calf/capture/capture_shard.h, docs/FARM.md): only these views (ascending;
+  // empty = every view) x frames [first_frame, last_frame] (last_frame 0 with first_frame 0 =
+  // every frame). A shard writes its images and a shard marker, never manifest.json.
+  std::vector<uint32_t> views;
+  uint32_t first_frame = 0, last_frame = 0;
+  bool shard = false;
 };
 
 // Called after each view-frame or pose with (done, total); used for progress lines.
