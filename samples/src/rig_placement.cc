@@ -206,7 +206,9 @@ Expected<PlacementOptions> parse_placement(std::string_view text) {
     const std::string_view value = eq == item.npos ? std::string_view() : item.substr(eq + 1);
     double v = 0;
     auto bad = [&](const char* range) {
-      return placement_error(text, "'" + std::string(item) + "': " + range);
+      std::string why = "'";
+      why.append(item).append("': ").append(range);
+      return placement_error(text, why);
     };
     if (key == "specular" && eq == item.npos) {
       o.specular = true;
@@ -240,19 +242,20 @@ Expected<PlacementOptions> parse_placement(std::string_view text) {
       double b[6];
       size_t pos = 0;
       int n = 0;
-      while (n < 6) {
+      bool last = false;
+      while (n < 6 && !last) {
         const size_t comma = value.find(',', pos);
         if (!parse_double(value.substr(pos, comma == value.npos ? value.npos : comma - pos),
                           &b[n])) {
           return bad("six numbers X0,Y0,Z0,X1,Y1,Z1");
         }
         ++n;
-        if (comma == value.npos) break;
+        last = comma == value.npos;
         pos = comma + 1;
       }
-      if (n != 6 || value.find(',', pos) != value.npos || std::fabs(b[0]) > 1e12 ||
-          std::fabs(b[1]) > 1e12 || std::fabs(b[2]) > 1e12 || std::fabs(b[3]) > 1e12 ||
-          std::fabs(b[4]) > 1e12 || std::fabs(b[5]) > 1e12) {
+      if (n != 6 || !last || std::fabs(b[0]) > 1e12 || std::fabs(b[1]) > 1e12 ||
+          std::fabs(b[2]) > 1e12 || std::fabs(b[3]) > 1e12 || std::fabs(b[4]) > 1e12 ||
+          std::fabs(b[5]) > 1e12) {
         return bad("six numbers X0,Y0,Z0,X1,Y1,Z1 within +-1e12");
       }
       if (b[0] > b[3] || b[1] > b[4] || b[2] > b[5]) return bad("X0 <= X1, Y0 <= Y1, Z0 <= Z1");
@@ -293,13 +296,15 @@ Expected<PlacementResult> place_cameras(const Scene& scene, const PlacementOptio
                                                std::min(options.frames, frames)));
   }
   // Every point that may be evaluated: the grid, then for each n the Hammersley sets of n to
-  // n + kGrow points (the first with n points outside geometry is used). One pass over all
+  // 2n points (the first with n points outside geometry is used). One pass over all
   // capture frames flags those inside geometry at any of them; the Eq. 7 frames stay built.
-  constexpr uint32_t kGrow = 4;
+  constexpr uint32_t kGrow = 4;  // sizes n + j ceil(n / 4), j = 0..kGrow: up to twice n
+  auto grown = [](uint32_t n, uint32_t j) { return n + j * ((n + 3) / 4); };
   std::vector<Vec3> probe = grid;
   std::vector<std::vector<size_t>> sets;  // probe indices of the Hammersley set of size (n, extra)
   for (uint32_t n = 1; n <= m; ++n) {
-    for (uint32_t size = n; size <= n + kGrow; ++size) {
+    for (uint32_t j = 0; j <= kGrow; ++j) {
+      const uint32_t size = grown(n, j);
       sets.emplace_back();
       for (uint32_t i = 0; i < size; ++i) {
         sets.back().push_back(probe.size());
@@ -351,7 +356,7 @@ Expected<PlacementResult> place_cameras(const Scene& scene, const PlacementOptio
     if (hammersley[n - 1].empty()) {
       return Status(ErrorId::kPlacementVolume,
                     "--rig '" + options.text + "': fewer than " + std::to_string(n) + " of " +
-                        std::to_string(n + kGrow) +
+                        std::to_string(grown(n, kGrow)) +
                         " Hammersley points of the view volume lie outside geometry");
     }
   }

@@ -97,7 +97,7 @@ std::string placement_svg(const PlacementResult& r, std::string_view title) {
     for (const CoverageRow& row : r.curve) {
       const double v = row.*se.value;
       if (v < 0) continue;
-      path += (path.empty() ? "M" : "L") + format("%g %g", x_of(row.cameras), y_of(v));
+      path.append(path.empty() ? "M" : "L").append(format("%g %g", x_of(row.cameras), y_of(v)));
     }
     if (!path.empty()) {
       s += "<path d=\"" + path + "\" stroke=\"" + se.colour +

@@ -1,5 +1,5 @@
 // Camera placement (calf/samples/rig_placement.h, paper 002 Alg. 1): known answers on a scene
-// whose wall hides part of the floor from one side of the view volume, the specular and dynamic
+// whose pillar hides part of the floor from one side of the view volume, the specular and dynamic
 // variants, the curve's monotonicity, the stopping rule, determinism, the Hammersley comparison
 // rig, and the errors.
 #include <gtest/gtest.h>
@@ -13,16 +13,17 @@
 namespace calf::samples {
 namespace {
 
-constexpr double kWallX = 1.5;
+// A pillar (a closed box x in [1, 2], y in [0, 2], z in [-1, 1]) standing on a floor y = 0 over
+// x in [-2, 3], z in [-1, 1]. The view volume is the segment y = 1, z = 0, x in [-2, 3], which
+// passes through the pillar (its candidates there are inside geometry, never chosen). Left of the
+// pillar: 6 units of floor and its 4-unit left face, seen only from the left; right: 2 units of
+// floor and the 4-unit right face, seen only from the right. With `pillar_moves`, the pillar
+// stands 100 units away at time 0 and in place from time 1 on (fps 1).
+constexpr double kPillarLeft = 1, kPillarRight = 2;
 
-// A floor y = 0 over x in [-2, 3], z in [-1, 1], and a wall in the plane x = 1.5 up to y = 0.95.
-// The view volume is the segment y = 1, z = 0, x in [-2, 3]: the floor right of the wall (3 of
-// its 10 square units) is seen only from viewpoints right of the wall, the floor left of it only
-// from the left (the wall's top is 5 cm below the segment). With `wall_moves`, the wall stands
-// 100 units away (out of the way) at time 0 and at x = 1.5 from time 1 on (fps 1).
-Scene wall_scene(bool wall_moves = false) {
+Scene pillar_scene(bool pillar_moves = false) {
   Scene s;
-  s.name = "wall";
+  s.name = "pillar";
   s.materials.push_back(Material{});
   s.fps = 1;
   s.frame_count = 2;
@@ -30,22 +31,22 @@ Scene wall_scene(bool wall_moves = false) {
   floor.name = "floor";
   add_quad(&floor.mesh, {-2, 0, 1}, {3, 0, 1}, {3, 0, -1}, {-2, 0, -1});
   s.objects.push_back(floor);
-  Object wall;
-  wall.name = "wall";
-  add_quad(&wall.mesh, {kWallX, 0, 1}, {kWallX, 0, -1}, {kWallX, 0.95f, -1}, {kWallX, 0.95f, 1});
-  if (wall_moves) {
-    wall.transform = [](double t) {
+  Object pillar;
+  pillar.name = "pillar";
+  add_box(&pillar.mesh, glm::vec3(kPillarLeft, 0, -1), glm::vec3(kPillarRight, 2, 1));
+  if (pillar_moves) {
+    pillar.transform = [](double t) {
       glm::mat4 m(1);
       if (t < 0.5) m[3] = glm::vec4(100, 0, 0, 1);
       return m;
     };
   }
-  s.objects.push_back(wall);
+  s.objects.push_back(pillar);
   s.default_rig = list_rig({{-2, 1, 0}, {3, 1, 0}});
   return s;
 }
 
-PlacementOptions wall_options() {
+PlacementOptions pillar_options() {
   PlacementOptions o;
   o.text = "auto (test)";
   o.candidates = 51;  // every 0.1 along the segment
@@ -58,27 +59,28 @@ PlacementOptions wall_options() {
 }
 
 TEST(RigPlacement, SecondCameraGoesWhereOnlyOneSideSees) {
-  const Scene scene = wall_scene();
-  auto r = place_cameras(scene, wall_options(), 1);
+  const Scene scene = pillar_scene();
+  auto r = place_cameras(scene, pillar_options(), 1);
   ASSERT_TRUE(r.ok()) << r.status().to_string();
   ASSERT_GE(r->curve.size(), 2u);
-  // The larger part (7 units) is left of the wall; the rest only a camera right of it sees.
-  EXPECT_LT(r->curve[0].position.x, kWallX);
-  EXPECT_GT(r->curve[1].position.x, kWallX);
-  EXPECT_GT(r->curve[0].gain, 0.6);
-  EXPECT_LT(r->curve[0].gain, 0.8);
+  // The larger part (10 of 16 units) is left of the pillar; the rest only a camera right of it
+  // sees.
+  EXPECT_LT(r->curve[0].position.x, kPillarLeft);
+  EXPECT_GT(r->curve[1].position.x, kPillarRight);
+  EXPECT_GT(r->curve[0].gain, 0.5);
+  EXPECT_LT(r->curve[0].gain, 0.7);
   EXPECT_GT(r->curve[1].coverage, 0.95);
   ASSERT_EQ(r->rig.viewpoints.size(), r->curve.size());
   EXPECT_EQ(r->rig.viewpoints[1].position, r->curve[1].position);
-  EXPECT_EQ(r->rig.view_volume, wall_options().volume);
+  EXPECT_EQ(r->rig.view_volume, pillar_options().volume);
   // The hand-made rig (both ends) sees both sides as well, but from farther away.
   EXPECT_EQ(r->hand_made_count, 2u);
   EXPECT_GT(r->hand_made_coverage, 0.8);
 }
 
 TEST(RigPlacement, CoverageIsMonotoneAndTheStoppingRuleStops) {
-  const Scene scene = wall_scene();
-  PlacementOptions o = wall_options();
+  const Scene scene = pillar_scene();
+  PlacementOptions o = pillar_options();
   o.k = 2;  // proximity matters: every new camera nearer some point gains a little
   o.max_cameras = 40;
   o.stop = 0.02;
@@ -105,8 +107,8 @@ TEST(RigPlacement, CoverageIsMonotoneAndTheStoppingRuleStops) {
 }
 
 TEST(RigPlacement, SpecularVariantWantsMoreDirections) {
-  const Scene scene = wall_scene();
-  PlacementOptions o = wall_options();
+  const Scene scene = pillar_scene();
+  PlacementOptions o = pillar_options();
   o.k = 0;
   o.stop = 0.01;
   o.max_cameras = 12;
@@ -127,10 +129,10 @@ TEST(RigPlacement, SpecularVariantWantsMoreDirections) {
 }
 
 TEST(RigPlacement, DynamicSceneIntegratesOverFrames) {
-  // The wall stands at x = 1.5 only from frame 1 on: frame 0 alone needs one camera, Eq. 7 over
-  // both frames a second one right of the wall.
-  const Scene scene = wall_scene(/*wall_moves=*/true);
-  PlacementOptions o = wall_options();
+  // The pillar stands between the sides only from frame 1 on: frame 0 alone needs one camera,
+  // Eq. 7 over both frames a second one right of the pillar.
+  const Scene scene = pillar_scene(/*pillar_moves=*/true);
+  PlacementOptions o = pillar_options();
   o.k = 0;
   o.stop = 0;
   auto first_frame = place_cameras(scene, o, 2);
@@ -140,13 +142,13 @@ TEST(RigPlacement, DynamicSceneIntegratesOverFrames) {
   auto both = place_cameras(scene, o, 2);
   ASSERT_TRUE(both.ok());
   ASSERT_EQ(both->curve.size(), 2u) << both->stop_reason;
-  EXPECT_LT(both->curve[0].position.x, kWallX);
-  EXPECT_GT(both->curve[1].position.x, kWallX);
+  EXPECT_LT(both->curve[0].position.x, kPillarLeft);
+  EXPECT_GT(both->curve[1].position.x, kPillarRight);
 }
 
 TEST(RigPlacement, SameResultForAnyThreadCount) {
-  const Scene scene = wall_scene();
-  PlacementOptions o = wall_options();
+  const Scene scene = pillar_scene();
+  PlacementOptions o = pillar_options();
   o.k = 1;
   o.max_cameras = 6;
   o.stop = 0;
@@ -177,7 +179,7 @@ TEST(RigPlacement, HammersleyPoints) {
   const Box3 box{{-1, 2, 10}, {1, 2, 14}};
   EXPECT_EQ(hammersley_point(1, 2, box), (Vec3{0, 2, 10 + 4.0 / 3}));
 
-  const Scene scene = wall_scene();
+  const Scene scene = pillar_scene();
   auto spec = parse_placement("hammersley:5:samples=1024:candidates=11:volume=-2,1,0,3,1,0");
   ASSERT_TRUE(spec.ok()) << spec.status().to_string();
   auto r = place_cameras(scene, *spec, 1);
@@ -280,8 +282,8 @@ TEST(RigPlacement, VolumeInsideGeometryIsAnError) {
 }
 
 TEST(RigPlacement, ReportFiles) {
-  const Scene scene = wall_scene();
-  auto r = place_cameras(scene, wall_options(), 1);
+  const Scene scene = pillar_scene();
+  auto r = place_cameras(scene, pillar_options(), 1);
   ASSERT_TRUE(r.ok());
   const std::string table = placement_table(*r);
   EXPECT_EQ(table.rfind("cameras\tx\ty\tz\tgain\tcoverage\thammersley\thand_made\n", 0), 0u);

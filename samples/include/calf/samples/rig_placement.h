@@ -25,8 +25,9 @@
 // direction, so it may exceed 1.
 //
 // Candidates inside geometry at any of the capture's frames (FrameTracer::inside_geometry) are
-// never chosen, and Hammersley points inside geometry are skipped (the set grows until N are
-// outside). Deterministic: every candidate's gain is a sum in a fixed order, whatever `threads`.
+// never chosen, and Hammersley points inside geometry are skipped (the set grows, up to 2N, until N
+// are outside). Deterministic: every candidate's gain is a sum in a fixed order, whatever
+// `threads`.
 #pragma once
 
 #include <cstdint>
