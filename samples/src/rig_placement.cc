@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <memory>
 #include <string>
@@ -35,9 +36,22 @@ const char* const kPlacementSyntaxHelp =
 
 namespace {
 
+// One line whatever the text holds: control characters are written as \xNN.
 Status placement_error(std::string_view text, const std::string& why) {
-  return Status(ErrorId::kPlacementSyntax,
-                "--rig '" + std::string(text) + "': " + why + " (see --help for auto/hammersley)");
+  const std::string raw =
+      "--rig '" + std::string(text) + "': " + why + " (see --help for auto/hammersley)";
+  std::string line;
+  for (char c : raw) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", u);
+      line += buf;
+    } else {
+      line += c;
+    }
+  }
+  return Status(ErrorId::kPlacementSyntax, line);
 }
 
 bool parse_double(std::string_view s, double* v) {
