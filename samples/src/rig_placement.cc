@@ -227,7 +227,7 @@ Expected<PlacementOptions> parse_placement(std::string_view text) {
     if (key == "specular" && eq == item.npos) {
       o.specular = true;
     } else if (eq == item.npos) {
-      return placement_error(text, "'" + std::string(item) + "' is not KEY=VALUE");
+      return placement_error(text, std::string("'").append(item).append("' is not KEY=VALUE"));
     } else if (key == "max") {
       if (o.kind == PlacementOptions::Kind::kHammersley) return bad("hammersley's count is N");
       if (!parse_count(value, 1, 256, &o.max_cameras)) return bad("max is an integer in 1..256");
