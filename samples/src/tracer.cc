@@ -737,4 +737,14 @@ bool FrameTracer::inside_geometry(const Vec3& point) const {
   return inside_votes > 13;
 }
 
+bool FrameTracer::segment_clear(const Vec3& from, const Vec3& to) const {
+  const glm::vec3 o = to_fvec3(from), d = to_fvec3(to) - o;
+  const float length = glm::length(d);
+  if (!(length > 0)) return true;
+  const float stop = length - 1e-4f * (1 + length);
+  if (!(stop > 0)) return true;
+  uint64_t rays = 0;
+  return !impl_->occluded(o, d / length, stop, &rays);
+}
+
 }  // namespace calf::samples

@@ -15,6 +15,7 @@
 
 #include "calf/capture/capture_shard.h"
 #include "calf/samples/render.h"
+#include "calf/samples/rig_placement.h"
 #include "calf/samples/scene.h"
 #include "calf/samples/scene_export.h"
 #include "calf/samples/surfel_candidates.h"
@@ -81,6 +82,47 @@ int write_candidates(const calf::capture::SceneFile& scene,
   return 0;
 }
 
+// --rig auto / hammersley: the curve and the rig on stdout, the table and plot into `out_dir`.
+int report_placement(const samples::PlacementResult& r, const samples::PlacementOptions& o,
+                     const std::string& scene, const std::string& hand_made,
+                     const std::string& out_dir) {
+  const std::string table = samples::placement_table(r);
+  std::printf(
+      "calf-capture: placement %s on %s: %u candidates outside geometry, %u surface points, "
+      "%.1f M visibility rays, %.2f s; Alg. 1 stopped: %s\n%s",
+      o.text.c_str(), scene.c_str(), r.candidates, r.surface_samples,
+      static_cast<double>(r.rays) * 1e-6, r.seconds, r.stop_reason.c_str(), table.c_str());
+  std::printf("hand-made rig %s: %u views, coverage %.6f\n", hand_made.c_str(), r.hand_made_count,
+              r.hand_made_coverage);
+  std::string list;
+  for (const calf::capture::Viewpoint& v : r.rig.viewpoints) {
+    list += fmt::format("{}{},{},{}", list.empty() ? "list:" : "/", v.position.x, v.position.y,
+                        v.position.z);
+  }
+  std::printf("rig (%zu views, coverage %.6f): %s\n", r.rig.viewpoints.size(),
+              o.kind == samples::PlacementOptions::Kind::kAuto
+                  ? (r.curve.empty() ? 0.0 : r.curve.back().coverage)
+                  : r.hammersley_coverage,
+              list.c_str());
+  std::fflush(stdout);
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) {
+    return fail(
+        Status(calf::ErrorId::kFileWrite, "cannot create " + out_dir + ": " + ec.message()));
+  }
+  const std::filesystem::path dir(out_dir);
+  if (Status s = calf::capture::write_file_atomically(dir / "rig_placement.tsv", table); !s.ok()) {
+    return fail(s);
+  }
+  const std::string svg =
+      samples::placement_svg(r, "coverage vs cameras: " + scene + ", --rig " + o.text);
+  if (Status s = calf::capture::write_file_atomically(dir / "rig_placement.svg", svg); !s.ok()) {
+    return fail(s);
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -109,8 +151,17 @@ int main(int argc, char** argv) {
   app.add_option("--frames", frames,
                  "frames to render, 1..100000 (default: the scene's own, 30 for built-ins)")
       ->check(CLI::Range(1u, 100000u));
-  app.add_option("--rig", rig_arg, std::string("viewpoints, one of:\n") + samples::kRigSyntaxHelp)
+  app.add_option("--rig", rig_arg,
+                 std::string("viewpoints, one of:\n") + samples::kRigSyntaxHelp + "\n" +
+                     samples::kPlacementSyntaxHelp +
+                     "\nauto and hammersley print the coverage-versus-count curve and the rig, "
+                     "and write DIR/rig_placement.tsv and DIR/rig_placement.svg "
+                     "(docs/CAPTURE.md \"Camera placement\")")
       ->capture_default_str();
+  bool rig_only = false;
+  app.add_flag("--rig-only", rig_only,
+               "with --rig auto or hammersley: choose the rig, print and write its report, and "
+               "render nothing");
   app.add_option("--threads", threads,
                  "render threads 0..256, 0 = all hardware threads; output is identical for any "
                  "count")
@@ -216,6 +267,9 @@ int main(int argc, char** argv) {
         "calf-capture", "--scene and --out (or --export-scene, --surfel-candidates) are required");
   }
 
+  if (rig_only && !samples::is_placement_rig(rig_arg)) {
+    return calf::tools::usage_error("calf-capture", "--rig-only needs --rig auto or hammersley");
+  }
   render.threads = threads;
   if (Status s = samples::validate_render_options(render); !s.ok()) return bad_option(s);
   if (face_size < 1 || face_size > 4096) {
@@ -307,6 +361,20 @@ int main(int argc, char** argv) {
     request.generator = "calf-capture";
     if (rig_arg == "default") {
       request.rig = scene->default_rig;
+    } else if (samples::is_placement_rig(rig_arg)) {
+      auto placement = samples::parse_placement(rig_arg);
+      if (!placement.ok()) return bad_option(placement.status());
+      placement->threads = threads;
+      auto placed = samples::place_cameras(*scene, *placement, frame_count);
+      if (!placed.ok()) return fail(placed.status());
+      if (int rc = report_placement(*placed, *placement, scene->name,
+                                    scene->default_rig.description, out_dir);
+          rc != 0) {
+        return rc;
+      }
+      if (rig_only) return 0;
+      request.rig = std::move(placed->rig);
+      request.generator = "calf-capture --rig " + rig_arg;
     } else {
       auto rig = samples::parse_rig(rig_arg);
       if (!rig.ok()) return fail(rig.status());

@@ -150,6 +150,9 @@ enum class ErrorKind : uint8_t {
   /* model textures: 190-194 */                                                                \
   X(kModelTextureMissing, 190, kIo, "a texture a model's material references is missing")       \
   X(kModelTexture, 191, kCorrupt, "a model's texture cannot be decoded or is too large")         \
+  /* camera placement: 195-198 (calf-capture --rig auto / hammersley) */                        \
+  X(kPlacementSyntax, 195, kInvalidArgument, "an auto / hammersley rig cannot be parsed")       \
+  X(kPlacementVolume, 196, kInvalidArgument, "no usable viewpoint in the placement volume")     \
   /* encoder: 200-299 */                                                                        \
   X(kEncoderOption, 200, kInvalidArgument, "an encoder option is outside its range")          \
   X(kEncoderInput, 201, kCorrupt, "the capture set contradicts itself or the chosen options")  \

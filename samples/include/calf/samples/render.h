@@ -107,6 +107,11 @@ class FrameTracer {
   // a surface lies closer than 1e-4 scene units. Needs consistently wound closed meshes.
   bool inside_geometry(const Vec3& point) const;
 
+  // Whether nothing lies between `from` and `to`: one occlusion ray from `from` that stops
+  // 1e-4 x (1 + distance) short of `to`, so that a point sampled on a surface does not hide
+  // itself (camera placement's visibility, rig_placement.h).
+  bool segment_clear(const Vec3& from, const Vec3& to) const;
+
  private:
   struct Impl;
   explicit FrameTracer(std::unique_ptr<Impl> impl);
