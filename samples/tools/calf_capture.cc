@@ -156,7 +156,7 @@ int main(int argc, char** argv) {
                      samples::kPlacementSyntaxHelp +
                      "\nauto and hammersley print the coverage-versus-count curve and the rig, "
                      "and write DIR/rig_placement.tsv and DIR/rig_placement.svg "
-                     "(docs/CAPTURE.md \"Camera placement\")")
+                     "(docs/CAMERA_PLACEMENT.md)")
       ->capture_default_str();
   bool rig_only = false;
   app.add_flag("--rig-only", rig_only,

@@ -1,7 +1,7 @@
 // Camera placement (paper 002 Sec. 4, Alg. 1): `--rig auto:...` chooses capture viewpoints inside
 // a view volume greedily by coverage gain, and `--rig hammersley:N` places N viewpoints in the
 // same volume at the points of a 3D Hammersley set (the Seurat-style placement it is compared
-// with). docs/CAPTURE.md "Camera placement" gives the model, the defaults and measured figures.
+// with). docs/CAMERA_PLACEMENT.md gives the model, the defaults and measured figures.
 //
 // The coverage model (Eqs. 2-7). The surfaces S are sampled uniformly by area (surface_points.h):
 // `samples` points spread over `frames` frames of the scene (Eq. 7: the integral over time is a
