@@ -32,7 +32,7 @@ Status input_error(const std::string& message) {
 double psnr(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
   double se = 0;
   for (size_t i = 0; i < a.size(); ++i) {
-    const double d = double{a[i]} - double{b[i]};
+    const double d = static_cast<double>(a[i]) - static_cast<double>(b[i]);
     se += d * d;
   }
   if (se == 0 || a.empty()) return std::numeric_limits<double>::infinity();

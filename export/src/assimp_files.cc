@@ -69,7 +69,10 @@ std::string embed_png(aiScene* scene, const std::vector<uint8_t>& png) {
   textures[scene->mNumTextures] = tex;
   delete[] scene->mTextures;
   scene->mTextures = textures;
-  return "*" + std::to_string(scene->mNumTextures++);
+  // (Appended rather than "*" + to_string: GCC 12 warns about that temporary, -Wrestrict.)
+  std::string path = "*";
+  path += std::to_string(scene->mNumTextures++);
+  return path;
 }
 
 Expected<std::vector<ExportedFile>> write_scene(const aiScene& scene, MeshExportFormat format,

@@ -141,7 +141,7 @@ struct TilesFigures {
     return tiles ? static_cast<double>(quads_stored) / static_cast<double>(tiles) : 0.0;
   }
   double bits_per_texel() const {
-    return width * height
+    return width && height
                ? 8.0 * static_cast<double>(atlas_stored) / static_cast<double>(width * height)
                : 0.0;
   }

@@ -87,15 +87,18 @@ TEST(TilesExport, GlbHasTwoTrianglesPerTileAndTheAtlas) {
     }
   }
   EXPECT_GT(checked, 1000u);
-  ASSERT_EQ(got->mNumMaterials, 1u);
+  ASSERT_EQ(got->mNumMeshes, 1u);
+  ASSERT_LT(got->mMeshes[0]->mMaterialIndex, got->mNumMaterials);
+  const aiMaterial* material = got->mMaterials[got->mMeshes[0]->mMaterialIndex];
   aiString mode;
-  ASSERT_EQ(got->mMaterials[0]->Get(AI_MATKEY_GLTF_ALPHAMODE, mode), AI_SUCCESS);
+  ASSERT_EQ(material->Get(AI_MATKEY_GLTF_ALPHAMODE, mode), AI_SUCCESS);
   EXPECT_STREQ(mode.C_Str(), "BLEND");
   int two_sided = 1;
-  got->mMaterials[0]->Get(AI_MATKEY_TWOSIDED, two_sided);
+  material->Get(AI_MATKEY_TWOSIDED, two_sided);
   EXPECT_EQ(two_sided, 0);
   const std::string json(glb->front().bytes.begin(), glb->front().bytes.end());
   EXPECT_NE(json.find("\"alphaMode\":\"BLEND\""), std::string::npos);
+  EXPECT_NE(json.find("KHR_materials_unlit"), std::string::npos);
   // Corner texture coordinates: (U / W, V / W) of the set, at some vertex of the import.
   const aiMesh* mesh = got->mMeshes[0];
   ASSERT_NE(mesh->mTextureCoords[0], nullptr);
