@@ -100,10 +100,8 @@ Expected<std::vector<ExportedFile>> export_tile_set(const TileSet& set, MeshExpo
   material->AddProperty(&two_sided, 1, AI_MATKEY_TWOSIDED);
   const int unlit = aiShadingMode_Unlit;
   material->AddProperty(&unlit, 1, AI_MATKEY_SHADING_MODEL);
-  // assimp 5.2's glTF 2.0 exporter writes KHR_materials_unlit from this key (AI_MATKEY_GLTF_UNLIT
-  // of its deprecated pbrmaterial.h), not from the shading model.
-  const int one = 1;
-  material->AddProperty(&one, 1, "$mat.gltf.unlit", 0, 0);
+  // KHR_materials_unlit: assimp 5.2.5's exporter wrote it neither for the shading model nor for
+  // an integer "$mat.gltf.unlit" (measured; docs/EXPORT.md), so the file's material is lit.
 
   // Vertices of one triangle's grid: (i, j) with i + j <= n at barycentric (i / n, j / n) of
   // (Q, R); a tile's second triangle (c0, c2, c3) shares the first's (c0, c1, c2) edge c0-c2.

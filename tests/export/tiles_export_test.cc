@@ -98,7 +98,6 @@ TEST(TilesExport, GlbHasTwoTrianglesPerTileAndTheAtlas) {
   EXPECT_EQ(two_sided, 0);
   const std::string json(glb->front().bytes.begin(), glb->front().bytes.end());
   EXPECT_NE(json.find("\"alphaMode\":\"BLEND\""), std::string::npos);
-  EXPECT_NE(json.find("KHR_materials_unlit"), std::string::npos);
   // Corner texture coordinates: (U / W, V / W) of the set, at some vertex of the import.
   const aiMesh* mesh = got->mMeshes[0];
   ASSERT_NE(mesh->mTextureCoords[0], nullptr);

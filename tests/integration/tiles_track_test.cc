@@ -274,7 +274,9 @@ std::vector<uint8_t> rebuild(const std::vector<uint8_t>& file, const Edit& edit)
     last = *raw;
     last_keys = keys;
   }
-  if (edit.duplicate_last) EXPECT_TRUE(w->add_chunk(last_keys, last, Compression::kNone).ok());
+  if (edit.duplicate_last) {
+    EXPECT_TRUE(w->add_chunk(last_keys, last, Compression::kNone).ok());
+  }
   EXPECT_TRUE(w->finish().ok());
   return out;
 }

@@ -7,8 +7,9 @@
 // (0, 1, 2), (0, 2, 3) as the tiles representation draws it (counter-clockwise seen from the view
 // region's centre, so an engine's back-face culling keeps the side the tile faces), and one
 // material "tiles atlas": the atlas as its base-colour texture (PNG, embedded in a .glb / .gltf,
-// <stem>_atlas.png beside an .obj), alphaMode BLEND, doubleSided false, unlit (the atlas holds
-// baked radiance: KHR_materials_unlit where assimp writes it), base colour factor 1.
+// <stem>_atlas.png beside an .obj), alphaMode BLEND, doubleSided false, base colour factor 1,
+// metallic 0 (unlit shading is requested, but assimp 5.2.5 does not write KHR_materials_unlit:
+// docs/EXPORT.md).
 //
 // Colour: the atlas is premultiplied (tile_set.h); glTF's BLEND and PNG expect straight alpha, so
 // each texel's colour is divided by its alpha (round(c * 255 / a), at most 255; colour 0 where a is
