@@ -2,20 +2,17 @@
 #include "calf/export/mesh_export.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cstdio>
 #include <map>
 #include <memory>
-#include <string_view>
 #include <utility>
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
 #include <assimp/material.h>
 #include <assimp/mesh.h>
 #include <assimp/scene.h>
 #include <assimp/texture.h>
-#include <assimp/Exporter.hpp>
+
+#include "assimp_files.h"
 
 namespace calf::exporter {
 namespace {
@@ -144,49 +141,6 @@ aiMatrix4x4 node_matrix(const decoder::MeshTransform& m) {
                      0, 1);
 }
 
-// A texture as PNG bytes (8-bit RGBA, unassociated alpha, the texels as they are: sRGB).
-Expected<std::vector<uint8_t>> png_bytes(const mesh::TextureTexels& t, uint32_t index) {
-  std::vector<unsigned char> bytes;
-  OIIO::Filesystem::IOVecOutput proxy(bytes);
-  auto out = OIIO::ImageOutput::create("texture.png");
-  OIIO::ImageSpec spec(static_cast<int>(t.width), static_cast<int>(t.height), 4,
-                       OIIO::TypeDesc::UINT8);
-  spec.attribute("oiio:UnassociatedAlpha", 1);
-  spec.attribute("oiio:ColorSpace", "sRGB");
-  if (!out || !out->set_ioproxy(&proxy) || !out->open("texture.png", spec) ||
-      !out->write_image(OIIO::TypeDesc::UINT8, t.rgba.data()) || !out->close()) {
-    return Status(ErrorId::kExportWrite, "texture " + std::to_string(index) +
-                                             ": PNG encoding failed" +
-                                             (out ? ": " + out->geterror() : std::string()));
-  }
-  return std::vector<uint8_t>(bytes.begin(), bytes.end());
-}
-
-const char* assimp_format_id(MeshExportFormat format) {
-  switch (format) {
-    case MeshExportFormat::kGlb:
-      return "glb2";
-    case MeshExportFormat::kGltf:
-      return "gltf2";
-    case MeshExportFormat::kObj:
-      return "obj";
-  }
-  return "glb2";
-}
-
-// assimp's exporters name the side files of a blob export after "$blobfile" (OBJ's
-// "mtllib $blobfile.mtl", glTF's buffer uri "$blobfile.bin"); the files are written as
-// `<stem>.mtl` / `<stem>.bin`, so the main file's references say so.
-void rename_side_files(std::vector<uint8_t>* bytes, const std::string& stem) {
-  static constexpr std::string_view kBlobName = "$blobfile";
-  std::string text(bytes->begin(), bytes->end());
-  for (size_t at = text.find(kBlobName); at != std::string::npos;
-       at = text.find(kBlobName, at + stem.size())) {
-    text.replace(at, kBlobName.size(), stem);
-  }
-  bytes->assign(text.begin(), text.end());
-}
-
 }  // namespace
 
 Expected<MeshExportFormat> mesh_export_format_from_path(const std::string& path) {
@@ -213,16 +167,7 @@ Expected<std::vector<ExportedFile>> export_mesh_track(const decoder::MeshTrack& 
   }
   // The main file names its side files by `stem`: keep it to characters that need no escaping
   // in a glTF uri or an OBJ mtllib line.
-  if (format != MeshExportFormat::kGlb) {
-    const bool plain = !stem.empty() && std::all_of(stem.begin(), stem.end(), [](char c) {
-      return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
-    });
-    if (!plain) {
-      return export_error("output name '" + stem +
-                          "': a .gltf or .obj names its side file after it, so it may hold only "
-                          "A-Z a-z 0-9 _ - .");
-    }
-  }
+  CALF_RETURN_IF_ERROR(check_stem(stem, format));
   if (track.object_count() == 0) return export_error("the mesh track has no object");
   const double time = static_cast<double>(frame) / track.fps();
   MeshExportStats local;
@@ -244,7 +189,8 @@ Expected<std::vector<ExportedFile>> export_mesh_track(const decoder::MeshTrack& 
     if (!needed[t]) continue;
     mesh::TextureTexels texels;
     if (Status s = track.texture(t, &texels); !s.ok()) return s;
-    CALF_ASSIGN_OR_RETURN(pngs[t], png_bytes(texels, t));
+    CALF_ASSIGN_OR_RETURN(pngs[t], png_bytes(texels.rgba.data(), texels.width, texels.height,
+                                             "texture " + std::to_string(t)));
     if (format == MeshExportFormat::kObj) {
       texture_paths[t] = stem + "_texture" + std::to_string(t) + ".png";
     } else {
@@ -361,21 +307,7 @@ Expected<std::vector<ExportedFile>> export_mesh_track(const decoder::MeshTrack& 
   local.textures =
       pngs.size() - static_cast<size_t>(std::count(needed.begin(), needed.end(), false));
 
-  Assimp::Exporter exporter;
-  const aiExportDataBlob* blob = exporter.ExportToBlob(scene.get(), assimp_format_id(format), 0);
-  if (blob == nullptr) {
-    return Status(ErrorId::kExportWrite,
-                  std::string("assimp's exporter failed: ") + exporter.GetErrorString());
-  }
-  std::vector<ExportedFile> files;
-  for (const aiExportDataBlob* b = blob; b != nullptr; b = b->next) {
-    ExportedFile file;
-    file.suffix = b == blob ? "" : "." + std::string(b->name.C_Str());
-    const auto* data = static_cast<const uint8_t*>(b->data);
-    file.bytes.assign(data, data + b->size);
-    files.push_back(std::move(file));
-  }
-  if (files.size() > 1) rename_side_files(&files[0].bytes, stem);
+  CALF_ASSIGN_OR_RETURN(std::vector<ExportedFile> files, write_scene(*scene, format, stem));
   if (format == MeshExportFormat::kObj) {
     for (uint32_t t = 0; t < pngs.size(); ++t) {
       if (needed[t]) files.push_back({"_texture" + std::to_string(t) + ".png", std::move(pngs[t])});

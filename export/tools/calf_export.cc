@@ -1,5 +1,6 @@
-// calf-export: a mesh track of a .calf clip (a full scene or its visible set) to glTF 2.0 (.glb /
-// .gltf) or OBJ (+ .mtl) through assimp's exporters (calf/export/mesh_export.h, docs/EXPORT.md).
+// calf-export: a mesh track of a .calf clip (a full scene or its visible set) or a tiles track
+// (layered quad tiles and their atlas) to glTF 2.0 (.glb / .gltf) or OBJ (+ .mtl) through
+// assimp's exporters (calf/export/mesh_export.h, calf/export/tiles_export.h, docs/EXPORT.md).
 // Errors are one line with a stable id and exit status 1; usage errors exit 2; every file is
 // written whole or not at all.
 #include <cstdio>
@@ -10,7 +11,9 @@
 #include <CLI/CLI.hpp>
 
 #include "calf/decoder/mesh_track.h"
+#include "calf/decoder/tiles_track.h"
 #include "calf/export/mesh_export.h"
+#include "calf/export/tiles_export.h"
 #include "calf/format/container.h"
 #include "calf/format/files.h"
 #include "command_line.h"
@@ -40,7 +43,12 @@ int main(int argc, char** argv) {
       "share its mesh (glTF instancing); a visible-set object gets a mesh of its visible "
       "triangles only. Vertex colours, normals, UVs and material base colour / emission (clamped "
       "to 1) are kept, and base-colour textures as PNG (embedded in a .glb / .gltf's buffer; "
-      "OUT_texture<n>.png beside an .obj)."
+      "OUT_texture<n>.png beside an .obj).\n"
+      "A tiles track (layered quad tiles, SPEC §11.2) becomes one mesh of two triangles per tile "
+      "(2 x N^2 with --subdivide N) with one unlit material: the atlas as PNG with straight "
+      "alpha, alphaMode BLEND, single-sided (embedded in a .glb / .gltf; OUT_atlas.png beside an "
+      ".obj). Texture coordinates are the tiles' projective ones divided out per vertex (affine "
+      "inside a triangle: --subdivide bounds the difference; the largest is printed in texels)."
       " Each file is written whole or not at all (a temporary file renamed into "
       "place).\n" +
       std::string(calf::tools::kExitStatusHelp)};
@@ -48,13 +56,19 @@ int main(int argc, char** argv) {
   uint32_t frame = 0;
   int track_option = -1;
   bool quiet = false;
-  app.add_option("CLIP", clip, "input .calf holding a mesh track")->required();
+  uint32_t subdivide = 1;
+  app.add_option("CLIP", clip, "input .calf holding a mesh or tiles track")->required();
   app.add_option("-o,--output", out, "output .glb, .gltf or .obj")->required();
   app.add_option("--frame", frame,
                  "the frame whose transforms and vertex states are exported (default 0)")
       ->default_val(0);
   app.add_option("--track", track_option,
-                 "index of the mesh track in the clip (default: the first mesh track)");
+                 "index of the mesh or tiles track in the clip (default: the first mesh or tiles "
+                 "track)");
+  app.add_option("--subdivide", subdivide,
+                 "tiles track: split each of a tile's two triangles into N x N, 1..16, to bound "
+                 "the affine texture approximation (default 1)")
+      ->default_val(1);
   app.add_flag("-q,--quiet", quiet, "print nothing on success");
   if (const int exit = calf::tools::parse_command_line(app, kCommand, argc, argv); exit >= 0) {
     return exit;
@@ -65,32 +79,70 @@ int main(int argc, char** argv) {
   auto reader = calf::container::Reader::open(clip);
   if (!reader.ok()) return fail(reader.status());
   const auto& tracks = reader.value().tracks();
+  const auto kind_of = [&](size_t t) {
+    return static_cast<calf::container::TrackKind>(tracks[t].record.kind);
+  };
+  const auto exportable = [&](size_t t) {
+    return kind_of(t) == calf::container::TrackKind::kMesh ||
+           kind_of(t) == calf::container::TrackKind::kTiles;
+  };
   int track = track_option;
   if (track < 0) {
     for (size_t i = 0; i < tracks.size(); ++i) {
-      if (tracks[i].record.kind == static_cast<uint16_t>(calf::container::TrackKind::kMesh)) {
+      if (exportable(i)) {
         track = static_cast<int>(i);
         break;
       }
     }
     if (track < 0) {
-      return fail(calf::Status(calf::ErrorId::kExportInput, clip + ": the clip has no mesh track"));
+      return fail(calf::Status(calf::ErrorId::kExportInput,
+                               clip + ": the clip has no mesh track and no tiles track"));
     }
   }
-  if (static_cast<size_t>(track) >= tracks.size() ||
-      tracks[track].record.kind != static_cast<uint16_t>(calf::container::TrackKind::kMesh)) {
-    return fail(calf::Status(calf::ErrorId::kExportInput,
-                             fmt::format("{}: track {} is not a mesh track", clip, track)));
+  if (static_cast<size_t>(track) >= tracks.size() || !exportable(track)) {
+    return fail(
+        calf::Status(calf::ErrorId::kExportInput,
+                     fmt::format("{}: track {} is not a mesh or tiles track", clip, track)));
   }
-  auto mesh = calf::decoder::MeshTrack::open(reader.value(), static_cast<uint16_t>(track));
-  if (!mesh.ok()) return fail(mesh.status().with_context(clip));
 
   // The side files (.bin of a .gltf, .mtl of an .obj) go beside the output, named after it.
   const std::string base = out.substr(0, out.find_last_of('.'));
-  calf::exporter::MeshExportStats stats;
-  auto files = calf::exporter::export_mesh_track(mesh.value(), frame, format.value(),
-                                                 file_name(base), &stats);
-  if (!files.ok()) return fail(files.status().with_context(clip));
+  calf::Expected<std::vector<calf::exporter::ExportedFile>> files =
+      std::vector<calf::exporter::ExportedFile>{};
+  std::string summary;
+  if (kind_of(track) == calf::container::TrackKind::kTiles) {
+    if (frame != 0) {
+      return fail(
+          calf::Status(calf::ErrorId::kExportInput,
+                       fmt::format("{}: frame {} is past the tiles track's 1 frame", clip, frame)));
+    }
+    auto set = calf::decoder::decode_tiles_track(reader.value(), static_cast<uint16_t>(track));
+    if (!set.ok()) return fail(set.status().with_context(clip));
+    calf::exporter::TilesExportOptions options;
+    options.subdivide = subdivide;
+    calf::exporter::TilesExportStats stats;
+    files = calf::exporter::export_tile_set(set.value(), format.value(), file_name(base), options,
+                                            &stats);
+    if (!files.ok()) {
+      const bool usage = files.status().id() == calf::ErrorId::kExportTilesOption;
+      return calf::tools::print_error(kCommand, files.status().with_context(clip), usage ? 2 : 1);
+    }
+    summary = fmt::format(
+        "{}: {} tiles, {} vertices, {} triangles, atlas {} x {}, largest affine texture error "
+        "{:.3f} texels",
+        out, stats.tiles, stats.vertices, stats.triangles, stats.atlas_width, stats.atlas_height,
+        stats.max_texel_error);
+  } else {
+    auto mesh = calf::decoder::MeshTrack::open(reader.value(), static_cast<uint16_t>(track));
+    if (!mesh.ok()) return fail(mesh.status().with_context(clip));
+    calf::exporter::MeshExportStats stats;
+    files = calf::exporter::export_mesh_track(mesh.value(), frame, format.value(), file_name(base),
+                                              &stats);
+    if (!files.ok()) return fail(files.status().with_context(clip));
+    summary = fmt::format(
+        "{}: frame {}: {} objects, {} meshes, {} vertices, {} triangles, {} textures", out, frame,
+        stats.objects, stats.meshes, stats.vertices, stats.triangles, stats.textures);
+  }
 
   // Every file is written to its temporary name first and renamed only when all were written.
   std::vector<calf::files::TempFile> temps;
@@ -105,14 +157,6 @@ int main(int argc, char** argv) {
   for (auto& temp : temps) {
     if (calf::Status s = temp.commit(); !s.ok()) return fail(s);
   }
-  if (!quiet) {
-    std::printf(
-        "%s: frame %u: %llu objects, %llu meshes, %llu vertices, %llu triangles, %llu textures\n",
-        out.c_str(), frame, static_cast<unsigned long long>(stats.objects),
-        static_cast<unsigned long long>(stats.meshes),
-        static_cast<unsigned long long>(stats.vertices),
-        static_cast<unsigned long long>(stats.triangles),
-        static_cast<unsigned long long>(stats.textures));
-  }
+  if (!quiet) std::printf("%s\n", summary.c_str());
   return calf::tools::kExitOk;
 }

@@ -1,6 +1,7 @@
 // calf-info: an ffprobe-like summary of a .calf clip: version, tracks (kind, frames, fps, views,
 // face size, formats; a mesh track's objects, prototypes and triangles; a surfels track's
-// prototypes, surfels and bytes per surfel), metadata, and bytes per
+// prototypes, surfels and bytes per surfel; a tiles track's tiles, atlas and bytes per tile),
+// metadata, and bytes per
 // stream with the ratio to raw. --json prints the
 // same as one JSON object; --chunks adds the chunk index. Reads only the header and directory.
 #include <fmt/core.h>
@@ -131,6 +132,38 @@ std::optional<SurfelsFigures> surfels_figures(const Reader& r, const Track& t) {
   return f;
 }
 
+// A tiles track's figures from its header and directory alone (SPEC §11.2: the quads chunk is
+// stream 2, the atlas bands stream 1), or nothing for another kind.
+struct TilesFigures {
+  uint64_t tiles = 0, width = 0, height = 0, quads_stored = 0, atlas_stored = 0;
+  std::string format;
+  double bytes_per_tile() const {
+    return tiles ? static_cast<double>(quads_stored) / static_cast<double>(tiles) : 0.0;
+  }
+  double bits_per_texel() const {
+    return width && height
+               ? 8.0 * static_cast<double>(atlas_stored) / static_cast<double>(width * height)
+               : 0.0;
+  }
+};
+std::optional<TilesFigures> tiles_figures(const Reader& r, const Track& t) {
+  const auto* h = std::get_if<TilesTrackHeader>(&t.header);
+  if (!h) return std::nullopt;
+  TilesFigures f;
+  f.tiles = h->tile_count;
+  f.width = h->atlas_width;
+  f.height = h->atlas_height;
+  f.format = pixel_format_name(h->atlas_format);
+  for (const auto& c : r.chunks()) {
+    if (c.keys.track != t.id) continue;
+    if (c.keys.stream == static_cast<uint16_t>(TilesStream::kQuads))
+      f.quads_stored += c.stored_size;
+    if (c.keys.stream == static_cast<uint16_t>(TilesStream::kAtlas))
+      f.atlas_stored += c.stored_size;
+  }
+  return f;
+}
+
 void print_text(const std::string& path, const Reader& r, bool list_chunks) {
   const auto& h = r.header();
   StreamStats total;
@@ -166,6 +199,13 @@ void print_text(const std::string& path, const Reader& r, bool list_chunks) {
           "  surfels: {} prototypes ({} with surfels), {} surfels, {} stored bytes, {:.3f} "
           "bytes per surfel\n",
           m->prototypes, m->with_surfels, m->surfels, m->stored, m->bytes_per_surfel());
+    }
+    if (const auto m = tiles_figures(r, t)) {
+      fmt::print(
+          "  tiles: {} tiles, {} triangles, quads {} stored bytes ({:.3f} bytes per tile), atlas "
+          "{} x {} {} {} stored bytes ({:.3f} bits per texel)\n",
+          m->tiles, 2 * m->tiles, m->quads_stored, m->bytes_per_tile(), m->width, m->height,
+          m->format, m->atlas_stored, m->bits_per_texel());
     }
     fmt::print("  {:<12} {:>8} {:>14} {:>14} {:>8}\n", "stream", "chunks", "stored bytes",
                "raw bytes", "ratio");
@@ -226,6 +266,14 @@ void print_json(const std::string& path, const Reader& r, bool list_chunks) {
           ",\"surfels\":{{\"prototypes\":{},\"with_surfels\":{},\"surfels\":{},"
           "\"stored_bytes\":{},\"bytes_per_surfel\":{:.3f}}}",
           m->prototypes, m->with_surfels, m->surfels, m->stored, m->bytes_per_surfel());
+    }
+    if (const auto m = tiles_figures(r, t)) {
+      o += fmt::format(
+          ",\"tiles\":{{\"tiles\":{},\"triangles\":{},\"quads_stored_bytes\":{},"
+          "\"bytes_per_tile\":{:.3f},\"atlas_width\":{},\"atlas_height\":{},\"atlas_format\":{},"
+          "\"atlas_stored_bytes\":{},\"atlas_bits_per_texel\":{:.3f}}}",
+          m->tiles, 2 * m->tiles, m->quads_stored, m->bytes_per_tile(), m->width, m->height,
+          json_string(m->format), m->atlas_stored, m->bits_per_texel());
     }
     o += ",\"streams\":[";
     bool first = true;

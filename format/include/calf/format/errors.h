@@ -158,6 +158,11 @@ enum class ErrorKind : uint8_t {
   X(kEncoderInput, 201, kCorrupt, "the capture set contradicts itself or the chosen options")  \
   X(kLightfieldChunk, 202, kCorrupt, "a lightfield chunk is missing or contradicts its layout") \
   X(kLightfieldFormat, 203, kUnsupported, "a lightfield track uses a format the decoder lacks") \
+  X(kTilesChunk, 210, kCorrupt, "a tiles chunk is missing, repeated or contradicts its layout") \
+  X(kTilesUnsupported, 211, kUnsupported, "a tiles track's layout, format, flag or frame count is unknown") \
+  X(kTilesValue, 212, kCorrupt, "a tiles value is NaN, infinite or outside its range")        \
+  X(kTilesLimit, 213, kLimit, "a tiles track count or chunk size exceeds its limit")          \
+  X(kTilesInput, 214, kInvalidArgument, "a tile set given to the encoder is inconsistent")    \
   X(kMeshChunk, 220, kCorrupt, "a mesh chunk is missing, repeated or contradicts its layout")  \
   X(kMeshUnsupported, 221, kUnsupported, "a mesh track's layout version or flag is unknown")    \
   X(kMeshIndex, 222, kCorrupt, "a mesh vertex, triangle, prototype or material index is invalid") \
@@ -206,6 +211,8 @@ enum class ErrorKind : uint8_t {
   X(kTilesRenderOptions, 478, kInvalidArgument, "a tiles render option is outside its range")  \
   X(kExportInput, 480, kInvalidArgument, "a track cannot be exported as asked")                \
   X(kExportWrite, 481, kInternal, "the glTF / OBJ exporter failed")                             \
+  X(kExportTilesOption, 482, kInvalidArgument, "a tiles export option is outside its range")  \
+  X(kExportTilesEmpty, 483, kInvalidArgument, "a tile set to export has no tile or no atlas")  \
   /* end of the list: every line above ends with a backslash */
 // clang-format on
 

@@ -1,0 +1,207 @@
+// Tile set -> assimp scene -> assimp's glTF 2.0 / OBJ exporters (tiles_export.h).
+#include "calf/export/tiles_export.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <memory>
+#include <utility>
+
+#include <assimp/GltfMaterial.h>
+#include <assimp/material.h>
+#include <assimp/mesh.h>
+#include <assimp/scene.h>
+
+#include "assimp_files.h"
+
+namespace calf::exporter {
+namespace {
+
+constexpr uint32_t kMaxSubdivide = 16;
+
+// A point of a tile's triangle: position and projective texture coordinate, in binary64.
+struct Point {
+  std::array<double, 3> p, uvw;
+};
+
+Point corner(const TileCorner& c) {
+  return {{c.position[0], c.position[1], c.position[2]}, {c.uvw[0], c.uvw[1], c.uvw[2]}};
+}
+
+// P + (Q - P) a + (R - P) b, for positions and (U, V, W) alike: perspective-correct
+// interpolation is linear in the triangle's plane, so this is the exact (U, V, W) at that point.
+Point lerp(const Point& P, const Point& Q, const Point& R, double a, double b) {
+  Point x;
+  for (int c = 0; c < 3; ++c) {
+    x.p[c] = P.p[c] + (Q.p[c] - P.p[c]) * a + (R.p[c] - P.p[c]) * b;
+    x.uvw[c] = P.uvw[c] + (Q.uvw[c] - P.uvw[c]) * a + (R.uvw[c] - P.uvw[c]) * b;
+  }
+  return x;
+}
+
+// The atlas with straight (unassociated) alpha, as glTF and PNG expect.
+std::vector<uint8_t> unpremultiply(const std::vector<uint8_t>& rgba) {
+  std::vector<uint8_t> out(rgba.size());
+  for (size_t i = 0; i < rgba.size(); i += 4) {
+    const unsigned a = rgba[i + 3];
+    for (int c = 0; c < 3; ++c) {
+      out[i + c] =
+          a == 0 ? 0 : static_cast<uint8_t>(std::min(255u, (rgba[i + c] * 255u + a / 2) / a));
+    }
+    out[i + 3] = static_cast<uint8_t>(a);
+  }
+  return out;
+}
+
+}  // namespace
+
+Expected<std::vector<ExportedFile>> export_tile_set(const TileSet& set, MeshExportFormat format,
+                                                    const std::string& stem,
+                                                    const TilesExportOptions& options,
+                                                    TilesExportStats* stats) {
+  const uint32_t n = options.subdivide;
+  if (n < 1 || n > kMaxSubdivide)
+    return Status(
+        ErrorId::kExportTilesOption,
+        "subdivide " + std::to_string(n) + " is not in 1 .. " + std::to_string(kMaxSubdivide));
+  if (set.tiles.empty()) return Status(ErrorId::kExportTilesEmpty, "the tile set has no tile");
+  const size_t texels = size_t{set.atlas_width} * set.atlas_height;
+  if (texels == 0 || set.atlas_rgba.size() != 4 * texels)
+    return Status(ErrorId::kExportTilesEmpty, "the tile set's atlas is " +
+                                                  std::to_string(set.atlas_width) + " x " +
+                                                  std::to_string(set.atlas_height) + " with " +
+                                                  std::to_string(set.atlas_rgba.size()) + " bytes");
+  CALF_RETURN_IF_ERROR(check_stem(stem, format));
+  if (uint64_t{set.tiles.size()} * 2 * n * n > (uint64_t{1} << 31))
+    return Status(ErrorId::kExportTilesOption, "subdivide " + std::to_string(n) + " of " +
+                                                   std::to_string(set.tiles.size()) +
+                                                   " tiles gives more than 2^31 triangles");
+
+  auto scene = std::make_unique<aiScene>();
+  const std::vector<uint8_t> straight = unpremultiply(set.atlas_rgba);
+  CALF_ASSIGN_OR_RETURN(std::vector<uint8_t> png,
+                        png_bytes(straight.data(), set.atlas_width, set.atlas_height, "atlas"));
+  const std::string texture =
+      format == MeshExportFormat::kObj ? stem + "_atlas.png" : embed_png(scene.get(), png);
+
+  auto material = std::make_unique<aiMaterial>();
+  const aiString path(texture);
+  material->AddProperty(&path, AI_MATKEY_TEXTURE(aiTextureType_DIFFUSE, 0));
+  const aiString name("tiles atlas");
+  material->AddProperty(&name, AI_MATKEY_NAME);
+  const aiColor4D white(1, 1, 1, 1);
+  const aiColor3D white3(1, 1, 1), black(0, 0, 0);
+  material->AddProperty(&white, 1, AI_MATKEY_BASE_COLOR);
+  material->AddProperty(&white3, 1, AI_MATKEY_COLOR_DIFFUSE);
+  material->AddProperty(&black, 1, AI_MATKEY_COLOR_EMISSIVE);
+  const aiString blend("BLEND");
+  material->AddProperty(&blend, AI_MATKEY_GLTF_ALPHAMODE);
+  const int two_sided = 0;
+  material->AddProperty(&two_sided, 1, AI_MATKEY_TWOSIDED);
+  const int unlit = aiShadingMode_Unlit;
+  material->AddProperty(&unlit, 1, AI_MATKEY_SHADING_MODEL);
+  // KHR_materials_unlit: assimp 5.2.5's exporter wrote it neither for the shading model nor for
+  // an integer "$mat.gltf.unlit" (measured; docs/EXPORT.md), so the file's material is lit.
+
+  // Vertices of one triangle's grid: (i, j) with i + j <= n at barycentric (i / n, j / n) of
+  // (Q, R); a tile's second triangle (c0, c2, c3) shares the first's (c0, c1, c2) edge c0-c2.
+  std::vector<aiVector3D> positions, uvs;
+  std::vector<std::array<unsigned, 3>> faces;
+  double worst = 0;
+  const double aw = set.atlas_width, ah = set.atlas_height;
+  std::vector<unsigned> grid(size_t{n + 1} * (n + 1));
+  std::vector<unsigned> edge(n + 1);  // c0-c2 edge vertices of the first triangle, by step
+  std::vector<Point> points(size_t{n + 1} * (n + 1));
+  for (const Tile& tile : set.tiles) {
+    const Point c[4] = {corner(tile.corners[0]), corner(tile.corners[1]), corner(tile.corners[2]),
+                        corner(tile.corners[3])};
+    for (int half = 0; half < 2; ++half) {
+      const Point& P = c[0];
+      const Point& Q = half == 0 ? c[1] : c[2];
+      const Point& R = half == 0 ? c[2] : c[3];
+      for (uint32_t i = 0; i <= n; ++i) {
+        for (uint32_t j = 0; i + j <= n; ++j) {
+          const size_t at = size_t{i} * (n + 1) + j;
+          const Point x = lerp(P, Q, R, double(i) / n, double(j) / n);
+          points[at] = x;
+          // The shared edge c0-c2: j = k of the first triangle is i = k of the second.
+          if (half == 1 && j == 0) {
+            grid[at] = edge[i];
+            continue;
+          }
+          grid[at] = static_cast<unsigned>(positions.size());
+          if (half == 0 && i == 0) edge[j] = grid[at];
+          positions.emplace_back(static_cast<float>(x.p[0]), static_cast<float>(x.p[1]),
+                                 static_cast<float>(x.p[2]));
+          // assimp's UVs have v up; its glTF exporter flips them back to glTF's v down, and
+          // OBJ's vt is v up too.
+          uvs.emplace_back(static_cast<float>(x.uvw[0] / x.uvw[2]),
+                           static_cast<float>(1.0 - x.uvw[1] / x.uvw[2]), 0.0f);
+        }
+      }
+      const auto add = [&](uint32_t i0, uint32_t j0, uint32_t i1, uint32_t j1, uint32_t i2,
+                           uint32_t j2) {
+        const size_t a = size_t{i0} * (n + 1) + j0, b = size_t{i1} * (n + 1) + j1,
+                     d = size_t{i2} * (n + 1) + j2;
+        faces.push_back({grid[a], grid[b], grid[d]});
+        // The affine texture coordinate at the centroid against the projective one there.
+        double affine[2] = {0, 0}, sum[3] = {0, 0, 0};
+        for (const Point* p : {&points[a], &points[b], &points[d]}) {
+          affine[0] += p->uvw[0] / p->uvw[2] / 3;
+          affine[1] += p->uvw[1] / p->uvw[2] / 3;
+          for (int k = 0; k < 3; ++k) sum[k] += p->uvw[k];
+        }
+        const double du = (affine[0] - sum[0] / sum[2]) * aw;
+        const double dv = (affine[1] - sum[1] / sum[2]) * ah;
+        worst = std::max(worst, std::sqrt(du * du + dv * dv));
+      };
+      for (uint32_t i = 0; i < n; ++i) {
+        for (uint32_t j = 0; i + j < n; ++j) {
+          add(i, j, i + 1, j, i, j + 1);
+          if (i + j + 2 <= n) add(i + 1, j, i + 1, j + 1, i, j + 1);
+        }
+      }
+    }
+  }
+
+  auto mesh = std::make_unique<aiMesh>();
+  mesh->mName = aiString("tiles");
+  mesh->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+  mesh->mMaterialIndex = 0;
+  mesh->mNumVertices = static_cast<unsigned>(positions.size());
+  mesh->mVertices = new aiVector3D[positions.size()];
+  std::copy(positions.begin(), positions.end(), mesh->mVertices);
+  mesh->mTextureCoords[0] = new aiVector3D[uvs.size()];
+  std::copy(uvs.begin(), uvs.end(), mesh->mTextureCoords[0]);
+  mesh->mNumUVComponents[0] = 2;
+  mesh->mNumFaces = static_cast<unsigned>(faces.size());
+  mesh->mFaces = new aiFace[faces.size()];
+  for (size_t f = 0; f < faces.size(); ++f) {
+    mesh->mFaces[f].mNumIndices = 3;
+    mesh->mFaces[f].mIndices = new unsigned[3]{faces[f][0], faces[f][1], faces[f][2]};
+  }
+
+  TilesExportStats local;
+  local.tiles = set.tiles.size();
+  local.triangles = faces.size();
+  local.vertices = positions.size();
+  local.atlas_width = set.atlas_width;
+  local.atlas_height = set.atlas_height;
+  local.max_texel_error = worst;
+
+  // Hand everything to the scene, which owns and frees it.
+  scene->mNumMaterials = 1;
+  scene->mMaterials = new aiMaterial* [1] { material.release() };
+  scene->mNumMeshes = 1;
+  scene->mMeshes = new aiMesh* [1] { mesh.release() };
+  scene->mRootNode = new aiNode("calf tiles");
+  scene->mRootNode->mNumMeshes = 1;
+  scene->mRootNode->mMeshes = new unsigned[1]{0};
+
+  CALF_ASSIGN_OR_RETURN(std::vector<ExportedFile> files, write_scene(*scene, format, stem));
+  if (format == MeshExportFormat::kObj) files.push_back({"_atlas.png", std::move(png)});
+  if (stats != nullptr) *stats = local;
+  return files;
+}
+
+}  // namespace calf::exporter
