@@ -165,6 +165,12 @@ enum class ErrorKind : uint8_t {
   X(kSurfelPosition, 242, kInvalidArgument, "a candidate surfel position is not finite")    \
   X(kSurfelSamplerOption, 243, kInvalidArgument, "a surfel sampler option is outside its range")   \
   X(kSurfelRadius, 244, kInvalidArgument, "a surfel radius, r_m or p_m is invalid")         \
+  /* tiles builder: 250-256 (docs/TILES.md) */                                                  \
+  X(kTilesOption, 250, kInvalidArgument, "a tiles build option is outside its range")           \
+  X(kTilesFrame, 251, kInvalidArgument, "the frame to build tiles from is not in the capture set") \
+  X(kTilesEmpty, 252, kInvalidArgument, "the capture frame has no view or no finite depth")     \
+  X(kTilesBudget, 253, kInvalidArgument, "the tile budget cannot cover the view region")        \
+  X(kTilesAtlas, 254, kLimit, "the tile textures do not fit the largest atlas")                 \
   /* decoder: 300-399 */                                                                        \
   X(kDecoderArgument, 300, kInvalidArgument, "a decoder option, frame, view or eye is invalid") \
   /* player: 400-499 */                                                                         \
