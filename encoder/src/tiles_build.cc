@@ -67,6 +67,7 @@ Status validate_tiles_build_options(const TilesBuildOptions& o) {
   if (!(o.ransac_threshold > 0) || !std::isfinite(o.ransac_threshold)) {
     return bad_option(sformat("ransac_threshold %g is not a finite number > 0", o.ransac_threshold));
   }
+  if (o.min_cell_points < 1) return bad_option("min_cell_points must be >= 1");
   if (o.refine_iterations < 1) return bad_option("refine_iterations must be >= 1");
   if (o.refine_sample_limit < 16) {
     return bad_option(sformat("refine_sample_limit %u is below 16", o.refine_sample_limit));

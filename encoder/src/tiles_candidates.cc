@@ -248,6 +248,7 @@ Candidates generate_candidates(const MergedPoints& points, const Frame& f,
       CandidateCell child;
       child.id = {id.face, static_cast<uint8_t>(id.level + 1), 2 * id.i + (q & 1),
                   2 * id.j + (q >> 1)};
+      child.parent = static_cast<int32_t>(k);
       range_of(child.id, &child.point_begin, &child.point_end);
       if (child.point_begin == child.point_end) continue;
       out.cells[k].children[q] = static_cast<int32_t>(out.cells.size());
@@ -263,7 +264,7 @@ Candidates generate_candidates(const MergedPoints& points, const Frame& f,
   std::vector<Local> local(out.cells.size());
   const double r_min = std::max(1e-9, 0.01 * f.region_radius);
   const double r_max = 4.0 * std::max(points.max_radius, r_min * 4);
-  parallel_for(options.threads, out.cells.size(), [&](size_t ci) {
+  auto fit_cell = [&](size_t ci) {
     const CandidateCell& cell = out.cells[ci];
     CellFit fit{&points.position, &points.weight, {}, {}, r_min, r_max, &options};
     for (int k = 0; k < 4; ++k) {
@@ -279,6 +280,45 @@ Candidates generate_candidates(const MergedPoints& points, const Frame& f,
     const uint32_t begin = cell.point_begin, end = cell.point_end, n = end - begin;
     double total_weight = 0;
     for (uint32_t k = begin; k < end; ++k) total_weight += points.weight[k];
+    if (n < options.min_cell_points && cell.parent >= 0) {
+      // Too few points to fit a plane (a fronto-parallel plane through one point fits it
+      // exactly and is wrong): the parent's tilings restricted to the planes these points choose.
+      const Local& up = local[cell.parent];
+      Local& L = local[ci];
+      uint32_t last_count = 0;
+      double last_d = 1e300;
+      for (const Tiling& pt : up.tilings) {
+        std::vector<double> chosen(pt.plane_count, -1);
+        double d = 0;
+        for (uint32_t k = begin; k < end; ++k) {
+          double e = 2;
+          uint32_t arg = 0;
+          for (uint32_t p = 0; p < pt.plane_count; ++p) {
+            const double ep = energy(up.planes[pt.first_plane + p], points.position[k]);
+            if (ep < e) e = ep, arg = p;
+          }
+          chosen[arg] = 1;
+          d += e * points.weight[k];
+        }
+        Tiling t;
+        t.first_plane = static_cast<uint32_t>(L.planes.size());
+        for (uint32_t p = 0; p < pt.plane_count; ++p) {
+          const Plane& plane = up.planes[pt.first_plane + p];
+          if (chosen[p] > 0 && fit.valid(plane)) L.planes.push_back(plane);
+        }
+        t.plane_count = static_cast<uint32_t>(L.planes.size()) - t.first_plane;
+        t.distortion = d;
+        if (t.plane_count > last_count && d < last_d && t.plane_count == std::count(chosen.begin(), chosen.end(), 1.0)) {
+          L.tilings.push_back(t);
+          last_count = t.plane_count;
+          last_d = d;
+        } else {
+          L.planes.resize(t.first_plane);
+        }
+      }
+      if (!L.tilings.empty()) return;
+      L.planes.clear();
+    }
     // The strided subset used by RANSAC scoring and intermediate refits.
     std::vector<uint32_t> subset;
     const uint32_t stride = std::max<uint32_t>(1, n / options.refine_sample_limit);
@@ -427,7 +467,14 @@ Candidates generate_candidates(const MergedPoints& points, const Frame& f,
         break;
       }
     }
-  });
+  };
+  // Level by level (cells are breadth first), so that parents are fitted before their children.
+  for (size_t first = 0; first < out.cells.size();) {
+    size_t last = first;
+    while (last < out.cells.size() && out.cells[last].id.level == out.cells[first].id.level) ++last;
+    parallel_for(options.threads, last - first, [&](size_t k) { fit_cell(first + k); });
+    first = last;
+  }
 
   for (size_t ci = 0; ci < out.cells.size(); ++ci) {
     out.cells[ci].first_tiling = static_cast<uint32_t>(out.tilings.size());

@@ -85,10 +85,11 @@ struct CandidateCell {
   CellId id;
   uint32_t first_tiling = 0, tiling_count = 0;  // into Candidates::tilings
   int32_t children[4] = {-1, -1, -1, -1};       // indices into Candidates::cells, -1 = empty
+  int32_t parent = -1;
   uint32_t point_begin = 0, point_end = 0;      // range into MergedPoints
 };
 struct Candidates {
-  std::vector<CandidateCell> cells;  // roots first (in face, j, i order), children after
+  std::vector<CandidateCell> cells;  // breadth first: by level, roots in (face, j, i) order
   std::vector<uint32_t> roots;
   std::vector<Tiling> tilings;
   std::vector<Plane> planes;

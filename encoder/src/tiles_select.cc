@@ -190,32 +190,20 @@ Expected<Selection> select_tiles(const Candidates& candidates, const Frame& f,
                                  const TilesBuildOptions& options) {
   Selector sel(candidates, f, options);
   const size_t dims = 2 + sel.view_count();
-  // The coarsest selection (very large equal multipliers on every resource): it needs the least
-  // of each; when it breaks a bound the budget cannot cover the captured directions.
+  // One tile per covered root cell is the fewest triangles any valid selection has.
+  const uint64_t least_triangles = 2 * uint64_t{candidates.roots.size()};
+  if (least_triangles > options.max_triangles) {
+    return Status(ErrorId::kTilesBudget,
+                  "budget too small to cover the view region: the triangle budget " +
+                      std::to_string(options.max_triangles) + " is below the " +
+                      std::to_string(least_triangles) +
+                      " triangles of one tile per covered root cell (level " +
+                      std::to_string(options.min_level) + ")");
+  }
   std::vector<double> mu(dims, 0);
   Totals totals;
   Totals coarse;
-  {
-    std::vector<double> big(dims, 1e30);
-    sel.evaluate(big, &coarse);
-  }
-  if (!sel.feasible(coarse)) {
-    std::string what;
-    if (coarse.triangles > options.max_triangles) {
-      what = "the triangle budget " + std::to_string(options.max_triangles) +
-             " is below the " + std::to_string(static_cast<uint64_t>(coarse.triangles)) +
-             " triangles of one tile per covered root cell (level " +
-             std::to_string(options.min_level) + ")";
-    } else if (coarse.area > options.max_average_overdraw) {
-      what = "the average overdraw bound " + std::to_string(options.max_average_overdraw) +
-             " is below the " + std::to_string(coarse.area) + " the coarsest tiling needs";
-    } else {
-      what = "the peak overdraw bound " + std::to_string(options.max_peak_overdraw) +
-             " is below the " + std::to_string(Selector::peak(coarse)) +
-             " the coarsest tiling needs";
-    }
-    return Status(ErrorId::kTilesBudget, "budget too small to cover the view region: " + what);
-  }
+  sel.evaluate(std::vector<double>(dims, 1e30), &coarse);
   const double scale = std::max(coarse.distortion, 1e-12);
 
   Selection out;
@@ -293,12 +281,32 @@ Expected<Selection> select_tiles(const Candidates& candidates, const Frame& f,
           lo = mid;
         }
       }
-    } else {
-      // The coarsest selection is feasible (checked above).
-      best_mu.assign(dims, 1e30);
     }
   }
-  if (best_mu.empty()) best_mu.assign(dims, 1e30);
+  if (best_mu.empty() && sel.feasible(coarse)) best_mu.assign(dims, 1e30);
+  if (best_mu.empty()) {
+    // No feasible selection: name the bound the most frugal selections still break.
+    auto least = [&](size_t j0, size_t j1) {
+      std::vector<double> m(dims, 0);
+      for (size_t j = j0; j < j1; ++j) m[j] = 1e30;
+      Totals t;
+      sel.evaluate(m, &t);
+      return t;
+    };
+    const Totals by_area = least(1, 2), by_fill = least(2, dims);
+    std::string what;
+    if (by_area.area > options.max_average_overdraw) {
+      what = "the average overdraw bound " + std::to_string(options.max_average_overdraw) +
+             " is below the " + std::to_string(by_area.area) + " the covered directions need";
+    } else if (Selector::peak(by_fill) > options.max_peak_overdraw) {
+      what = "the peak overdraw bound " + std::to_string(options.max_peak_overdraw) +
+             " is below the " + std::to_string(Selector::peak(by_fill)) +
+             " the covered directions need";
+    } else {
+      what = "no selection meets the triangle, average and peak overdraw bounds together";
+    }
+    return Status(ErrorId::kTilesBudget, "budget too small to cover the view region: " + what);
+  }
   sel.evaluate(best_mu, &totals);
   sel.collect(&totals, &out.tiles);
   if (!sel.feasible(totals)) {

@@ -77,6 +77,10 @@ struct TilesBuildOptions {
   // and the inlier threshold on |1 - t_hit| (relative radial error), > 0.
   uint32_t ransac_trials = 32;
   double ransac_threshold = 0.01;
+  // Cells (below the roots) with fewer merged points than this take their parent's planes (those
+  // their points choose) instead of fitting their own: a plane through one or two points fits
+  // them exactly and says nothing of the surface. >= 1.
+  uint32_t min_cell_points = 16;
   // k-means iterations (assign, refit) after each split, >= 1.
   uint32_t refine_iterations = 4;
   // Most points each refit uses (an evenly strided subset; the final assignment and the energy
