@@ -95,8 +95,7 @@ TileSet write_tile_set(const Frame& f, const Box3& view_region, const Selection&
       for (int x = -1; x <= side; ++x) {
         const int sx = std::clamp(x, 0, side - 1), sy = std::clamp(y, 0, side - 1);
         const float* src = &tex.rgba[(size_t(sy) * side + sx) * 4];
-        uint8_t* dst =
-            &set.atlas_rgba[((size_t(at.y) + y) * width + (size_t(at.x) + x)) * 4];
+        uint8_t* dst = &set.atlas_rgba[((size_t(at.y) + y) * width + (size_t(at.x) + x)) * 4];
         const float alpha = std::clamp(src[3], 0.0f, 1.0f);
         for (int ch = 0; ch < 3; ++ch) {
           dst[ch] = static_cast<uint8_t>(std::lround(srgb_from_linear(src[ch]) * alpha * 255.0f));

@@ -41,17 +41,19 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }  // namespace
 
 Status validate_tiles_build_options(const TilesBuildOptions& o) {
-  if (o.max_triangles < 2) return bad_option(sformat("max_triangles %u is below 2", o.max_triangles));
+  if (o.max_triangles < 2)
+    return bad_option(sformat("max_triangles %u is below 2", o.max_triangles));
   if (!(o.max_average_overdraw > 0) || !std::isfinite(o.max_average_overdraw)) {
-    return bad_option(sformat("max_average_overdraw %g is not a finite number > 0",
-                              o.max_average_overdraw));
+    return bad_option(
+        sformat("max_average_overdraw %g is not a finite number > 0", o.max_average_overdraw));
   }
   if (!(o.max_peak_overdraw > 0) || !std::isfinite(o.max_peak_overdraw)) {
     return bad_option(
         sformat("max_peak_overdraw %g is not a finite number > 0", o.max_peak_overdraw));
   }
   if (o.overdraw_directions < 6 || o.overdraw_directions > 4096) {
-    return bad_option(sformat("overdraw_directions %u is outside [6, 4096]", o.overdraw_directions));
+    return bad_option(
+        sformat("overdraw_directions %u is outside [6, 4096]", o.overdraw_directions));
   }
   if (o.merge_resolution > 16384) {
     return bad_option(sformat("merge_resolution %u is above 16384", o.merge_resolution));
@@ -65,7 +67,8 @@ Status validate_tiles_build_options(const TilesBuildOptions& o) {
   }
   if (o.ransac_trials < 1) return bad_option("ransac_trials must be >= 1");
   if (!(o.ransac_threshold > 0) || !std::isfinite(o.ransac_threshold)) {
-    return bad_option(sformat("ransac_threshold %g is not a finite number > 0", o.ransac_threshold));
+    return bad_option(
+        sformat("ransac_threshold %g is not a finite number > 0", o.ransac_threshold));
   }
   if (o.min_cell_points < 1) return bad_option("min_cell_points must be >= 1");
   if (o.refine_iterations < 1) return bad_option("refine_iterations must be >= 1");
@@ -73,7 +76,8 @@ Status validate_tiles_build_options(const TilesBuildOptions& o) {
     return bad_option(sformat("refine_sample_limit %u is below 16", o.refine_sample_limit));
   }
   if (!(o.split_stop_energy >= 0) || !std::isfinite(o.split_stop_energy)) {
-    return bad_option(sformat("split_stop_energy %g is not a finite number >= 0", o.split_stop_energy));
+    return bad_option(
+        sformat("split_stop_energy %g is not a finite number >= 0", o.split_stop_energy));
   }
   if (!(o.tile_dilation >= 0 && o.tile_dilation <= 0.25)) {
     return bad_option(sformat("tile_dilation %g is outside [0, 0.25]", o.tile_dilation));
@@ -182,7 +186,8 @@ Expected<TileSet> build_tiles(const capture::CaptureSetReader& reader, uint32_t 
     const Vec3 a = cell_corner_direction(c, options.tile_dilation, 0);
     const Vec3 b = cell_corner_direction(c, options.tile_dilation, 1);
     const Vec3 d = cell_corner_direction(c, options.tile_dilation, 3);
-    degrees[k] = std::max(angle_between(a, b), angle_between(a, d)) * (180.0 / 3.14159265358979323846);
+    degrees[k] =
+        std::max(angle_between(a, b), angle_between(a, d)) * (180.0 / 3.14159265358979323846);
   }
   std::vector<uint32_t> sides(selection.tiles.size());
   std::vector<AtlasPlacement> placements;
@@ -250,25 +255,28 @@ std::string format_tiles_report(const TilesBuildReport& r) {
   s += sformat("candidates %llu cells, %llu tilings, %llu tiles\n",
                (unsigned long long)r.candidate_cells, (unsigned long long)r.candidate_tilings,
                (unsigned long long)r.candidate_tiles);
-  s += sformat("selection  %u tiles, %u triangles (bound %u), distortion %.6g (dual bound %.6g), "
-               "%u evaluations\n",
-               r.tiles, r.triangles, r.max_triangles, r.distortion, r.dual_bound,
-               r.selection_evaluations);
+  s += sformat(
+      "selection  %u tiles, %u triangles (bound %u), distortion %.6g (dual bound %.6g), "
+      "%u evaluations\n",
+      r.tiles, r.triangles, r.max_triangles, r.distortion, r.dual_bound, r.selection_evaluations);
   s += sformat("overdraw   modelled: average %.3f (bound %g), peak %.3f (bound %g)\n",
                r.model_average_overdraw, r.max_average_overdraw, r.model_peak_overdraw,
                r.max_peak_overdraw);
-  s += sformat("overdraw   measured over %u views: mean %.3f (bound %g), peak %.3f (bound %g), "
-               "most layers on a pixel %u\n",
-               r.measured_views, r.measured_mean_overdraw, r.max_average_overdraw,
-               r.measured_peak_overdraw, r.max_peak_overdraw, r.measured_max_layers);
-  s += sformat("texture    %llu tile texels at %.2f texels/degree (scale %.3f), atlas %u x %u, "
-               "occupancy %.1f %%\n",
-               (unsigned long long)r.tile_texels, r.texels_per_degree, r.texture_scale,
-               r.atlas_width, r.atlas_height, r.atlas_occupancy);
-  s += sformat("seconds    merge %.2f, candidates %.2f, select %.2f, texture %.2f, atlas %.2f, "
-               "measure %.2f, total %.2f\n",
-               r.seconds_merge, r.seconds_candidates, r.seconds_select, r.seconds_texture,
-               r.seconds_atlas, r.seconds_measure, r.seconds_total);
+  s += sformat(
+      "overdraw   measured over %u views: mean %.3f (bound %g), peak %.3f (bound %g), "
+      "most layers on a pixel %u\n",
+      r.measured_views, r.measured_mean_overdraw, r.max_average_overdraw, r.measured_peak_overdraw,
+      r.max_peak_overdraw, r.measured_max_layers);
+  s += sformat(
+      "texture    %llu tile texels at %.2f texels/degree (scale %.3f), atlas %u x %u, "
+      "occupancy %.1f %%\n",
+      (unsigned long long)r.tile_texels, r.texels_per_degree, r.texture_scale, r.atlas_width,
+      r.atlas_height, r.atlas_occupancy);
+  s += sformat(
+      "seconds    merge %.2f, candidates %.2f, select %.2f, texture %.2f, atlas %.2f, "
+      "measure %.2f, total %.2f\n",
+      r.seconds_merge, r.seconds_candidates, r.seconds_select, r.seconds_texture, r.seconds_atlas,
+      r.seconds_measure, r.seconds_total);
   return s;
 }
 

@@ -88,7 +88,8 @@ Vec3 smallest_eigenvector(std::array<std::array<double, 3>, 3> a) {
       for (int q = p + 1; q < 3; ++q) {
         if (a[p][q] == 0) continue;
         const double theta = (a[q][q] - a[p][p]) / (2 * a[p][q]);
-        const double t = (theta >= 0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1));
+        const double t =
+            (theta >= 0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1));
         const double c = 1 / std::sqrt(t * t + 1), s = t * c;
         for (int k = 0; k < 3; ++k) {
           const double akp = a[k][p], akq = a[k][q];
@@ -218,12 +219,18 @@ Candidates generate_candidates(const MergedPoints& points, const Frame& f,
     size_t a = 0, b = points.face.size();
     while (a < b) {
       const size_t m = (a + b) / 2;
-      if (key_less(m, c.face, lo)) a = m + 1; else b = m;
+      if (key_less(m, c.face, lo))
+        a = m + 1;
+      else
+        b = m;
     }
     size_t a2 = a, b2 = points.face.size();
     while (a2 < b2) {
       const size_t m = (a2 + b2) / 2;
-      if (key_less(m, c.face, hi)) a2 = m + 1; else b2 = m;
+      if (key_less(m, c.face, hi))
+        a2 = m + 1;
+      else
+        b2 = m;
     }
     *begin = static_cast<uint32_t>(a);
     *end = static_cast<uint32_t>(a2);
@@ -308,7 +315,8 @@ Candidates generate_candidates(const MergedPoints& points, const Frame& f,
         }
         t.plane_count = static_cast<uint32_t>(L.planes.size()) - t.first_plane;
         t.distortion = d;
-        if (t.plane_count > last_count && d < last_d && t.plane_count == std::count(chosen.begin(), chosen.end(), 1.0)) {
+        if (t.plane_count > last_count && d < last_d &&
+            t.plane_count == std::count(chosen.begin(), chosen.end(), 1.0)) {
           L.tilings.push_back(t);
           last_count = t.plane_count;
           last_d = d;
@@ -334,8 +342,8 @@ Candidates generate_candidates(const MergedPoints& points, const Frame& f,
         const uint32_t a = subset[rng.below(static_cast<uint32_t>(subset.size()))];
         const uint32_t b = subset[rng.below(static_cast<uint32_t>(subset.size()))];
         const uint32_t c = subset[rng.below(static_cast<uint32_t>(subset.size()))];
-        Vec3 nrm = cross(points.position[b] - points.position[a],
-                         points.position[c] - points.position[a]);
+        Vec3 nrm =
+            cross(points.position[b] - points.position[a], points.position[c] - points.position[a]);
         const double len = length(nrm);
         if (!(len > 0)) continue;
         nrm = nrm / len;
@@ -344,8 +352,7 @@ Candidates generate_candidates(const MergedPoints& points, const Frame& f,
         if (!fit.valid(p)) continue;
         double score = 0;
         for (uint32_t k : subset) {
-          if (energy(p, points.position[k]) <
-              options.ransac_threshold * options.ransac_threshold) {
+          if (energy(p, points.position[k]) < options.ransac_threshold * options.ransac_threshold) {
             score += points.weight[k];
           }
         }
@@ -403,11 +410,10 @@ Candidates generate_candidates(const MergedPoints& points, const Frame& f,
     emit(d);
     uint32_t emitted_count = 1;
     double emitted_d = d;
-    while (planes.size() < options.max_planes &&
-           d > options.split_stop_energy * total_weight) {
+    while (planes.size() < options.max_planes && d > options.split_stop_energy * total_weight) {
       // Split the worst cluster: a new fronto-parallel plane through its worst point.
-      const size_t worst = std::max_element(cluster_energy.begin(), cluster_energy.end()) -
-                           cluster_energy.begin();
+      const size_t worst =
+          std::max_element(cluster_energy.begin(), cluster_energy.end()) - cluster_energy.begin();
       double worst_e = -1;
       uint32_t worst_k = 0;
       for (uint32_t k = 0; k < n; ++k) {
@@ -421,7 +427,8 @@ Candidates generate_candidates(const MergedPoints& points, const Frame& f,
       const Vec3 q = points.position[begin + worst_k];
       const double r = length(q);
       Plane fresh{q / r, r};
-      if (!fit.valid(fresh)) fresh = Plane{fit.centre, std::clamp(dot(fit.centre, q), r_min, r_max)};
+      if (!fit.valid(fresh))
+        fresh = Plane{fit.centre, std::clamp(dot(fit.centre, q), r_min, r_max)};
       if (!fit.valid(fresh)) break;
       planes.push_back(fresh);
       for (uint32_t it = 0; it < options.refine_iterations; ++it) {

@@ -50,7 +50,7 @@ double cell_solid_angle(const CellId& c, double dilation);
 
 // The frame of one capture set view, shared by the stages.
 struct Frame {
-  Vec3 origin;        // O, the view volume's centre
+  Vec3 origin;               // O, the view volume's centre
   double region_radius = 0;  // half the view volume's diagonal
   uint32_t face_size = 0;
   std::vector<Vec3> viewpoints;
@@ -61,7 +61,7 @@ struct MergedPoints {
   // Relative to O, sorted by (face, Morton code of the leaf cell at level 30 / enough bits), so
   // that every quadtree cell's points are one contiguous range.
   std::vector<Vec3> position;
-  std::vector<float> weight;    // samples merged into each point
+  std::vector<float> weight;  // samples merged into each point
   std::vector<uint8_t> face;
   std::vector<uint64_t> morton;  // of the cell at kMortonLevel
   uint64_t samples = 0;
@@ -74,8 +74,8 @@ Expected<MergedPoints> merge_points(const capture::CaptureSetReader& reader, uin
 
 // --- candidates (tiles_candidates.cc) ---
 struct Plane {
-  Vec3 normal;          // unit
-  double offset = 0;    // dot(normal, x) = offset for points x (relative to O) on the plane, > 0
+  Vec3 normal;        // unit
+  double offset = 0;  // dot(normal, x) = offset for points x (relative to O) on the plane, > 0
 };
 struct Tiling {
   uint32_t first_plane = 0, plane_count = 0;  // into Candidates::planes
@@ -86,7 +86,7 @@ struct CandidateCell {
   uint32_t first_tiling = 0, tiling_count = 0;  // into Candidates::tilings
   int32_t children[4] = {-1, -1, -1, -1};       // indices into Candidates::cells, -1 = empty
   int32_t parent = -1;
-  uint32_t point_begin = 0, point_end = 0;      // range into MergedPoints
+  uint32_t point_begin = 0, point_end = 0;  // range into MergedPoints
 };
 struct Candidates {
   std::vector<CandidateCell> cells;  // breadth first: by level, roots in (face, j, i) order
@@ -121,8 +121,8 @@ Expected<Selection> select_tiles(const Candidates& candidates, const Frame& f,
 
 // --- texturing (tiles_texture.cc) ---
 struct TileTexture {
-  uint32_t side = 0;            // texels per side (corners on texel centres)
-  std::vector<float> rgba;      // side * side * 4: linear RGB (not premultiplied), alpha
+  uint32_t side = 0;        // texels per side (corners on texel centres)
+  std::vector<float> rgba;  // side * side * 4: linear RGB (not premultiplied), alpha
 };
 // The scene-space (relative to O) corners of a selected tile.
 std::array<Vec3, 4> tile_corners(const Selected& t, double dilation);

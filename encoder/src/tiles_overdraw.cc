@@ -89,8 +89,8 @@ OverdrawMeasure measure_overdraw(const TileSet& set, const std::vector<Vec3>& ey
           for (size_t k = 0; k < px.size() && inside; ++k) {
             const auto& a = px[k];
             const auto& b = px[(k + 1) % px.size()];
-            const double e = (b.first - a.first) * (cy - a.second) -
-                             (b.second - a.second) * (cx - a.first);
+            const double e =
+                (b.first - a.first) * (cy - a.second) - (b.second - a.second) * (cx - a.first);
             inside = e * sign >= 0;
           }
           if (inside) {

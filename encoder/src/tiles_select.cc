@@ -34,8 +34,8 @@ std::vector<ViewAxes> overdraw_view_axes(uint32_t count) {
 namespace {
 
 struct CellWeights {
-  double area = 0;                                  // solid angle / 4 pi (one tile)
-  std::vector<std::pair<uint32_t, double>> fill;    // (view, fill of one tile before its bound)
+  double area = 0;                                // solid angle / 4 pi (one tile)
+  std::vector<std::pair<uint32_t, double>> fill;  // (view, fill of one tile before its bound)
 };
 struct TilingWeights {
   uint32_t tiles = 0;

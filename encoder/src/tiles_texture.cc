@@ -37,7 +37,8 @@ namespace {
 // The selected tiles grouped by cell, found from a direction through dense per-level tables.
 class CellLookup {
  public:
-  CellLookup(const Selection& sel, const TilesBuildOptions& o) : min_(o.min_level), max_(o.max_level) {
+  CellLookup(const Selection& sel, const TilesBuildOptions& o)
+      : min_(o.min_level), max_(o.max_level) {
     for (int f = 0; f < 6; ++f) {
       for (uint32_t l = min_; l <= max_; ++l) {
         table_[f].emplace_back(size_t{1} << (2 * l), -1);
@@ -58,8 +59,10 @@ class CellLookup {
     const int f = static_cast<int>(fc.face);
     for (uint32_t l = min_; l <= max_; ++l) {
       const uint32_t side = 1u << l;
-      const uint32_t i = std::min<uint32_t>(static_cast<uint32_t>(std::max(0.0, fc.s * side)), side - 1);
-      const uint32_t j = std::min<uint32_t>(static_cast<uint32_t>(std::max(0.0, fc.t * side)), side - 1);
+      const uint32_t i =
+          std::min<uint32_t>(static_cast<uint32_t>(std::max(0.0, fc.s * side)), side - 1);
+      const uint32_t j =
+          std::min<uint32_t>(static_cast<uint32_t>(std::max(0.0, fc.t * side)), side - 1);
       const int32_t slot = table_[f][l - min_][size_t{j} * side + i];
       if (slot >= 0) return groups_[slot];
     }
@@ -214,8 +217,8 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
           const Texel tx = texel_from_direction(ray, n);
           const size_t t = view.texel_index(tx.face, tx.x, tx.y);
           const float depth = view.depth[t];
-          const bool through = !std::isfinite(depth) ||
-                               (len < depth * (1.0 - thresh) && primary[t] != int32_t(k));
+          const bool through =
+              !std::isfinite(depth) || (len < depth * (1.0 - thresh) && primary[t] != int32_t(k));
           if (through) work[k].marks[size_t{sy} * g + sx] |= 2;
         }
       }

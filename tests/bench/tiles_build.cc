@@ -47,8 +47,12 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--threads", o.threads, "worker threads")->capture_default_str();
   app.add_option("--repeats", repeats, "builds to time (median)")->capture_default_str();
+  bool no_region_bound = false;
+  app.add_flag("--no-region-bound", no_region_bound,
+               "model each tile's fill from O only (not bounded over the view region)");
   app.add_flag("--quiet", quiet, "no progress on stderr");
   CLI11_PARSE(app, argc, argv);
+  o.overdraw_region_bound = !no_region_bound;
 
   auto reader = calf::capture::CaptureSetReader::open(dir);
   if (!reader.ok()) {

@@ -188,10 +188,10 @@ TEST(TilesBuild, AtlasReproducesCapturedColourAtTileCentres) {
     const auto [dist, hit] = trace({0, 0, 0}, normalize(centre));
     // Only tiles whose centre is on the surface seen there (not a hidden layer or a sliver).
     if (std::abs(dist - length(centre)) > 0.01 * dist) continue;
-    const uint32_t x = std::min<uint32_t>(static_cast<uint32_t>(u * set->atlas_width),
-                                          set->atlas_width - 1);
-    const uint32_t y = std::min<uint32_t>(static_cast<uint32_t>(v * set->atlas_height),
-                                          set->atlas_height - 1);
+    const uint32_t x =
+        std::min<uint32_t>(static_cast<uint32_t>(u * set->atlas_width), set->atlas_width - 1);
+    const uint32_t y =
+        std::min<uint32_t>(static_cast<uint32_t>(v * set->atlas_height), set->atlas_height - 1);
     const uint8_t* px = &set->atlas_rgba[(size_t{y} * set->atlas_width + x) * 4];
     if (px[3] < 250) continue;
     ++checked;

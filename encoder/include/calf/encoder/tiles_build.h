@@ -14,12 +14,12 @@
 //      frustum from O.
 //   3. Selection (tiles_select.cc): one tiling per covered cell or the union of its children's
 //      (the And/Or tree of the quadtrees), minimising the total energy subject to
-//      triangles <= max_triangles, average overdraw (sum of solid angles / 4 pi) <= max_average
-//      _overdraw and, for each of `overdraw_directions` 90-degree views from O, the modelled fill
-//      (bounded over the view region) <= max_peak_overdraw, by Lagrangian relaxation with
-//      subgradient ascent on the dual and a final scaling of the multipliers (exponential probe
-//      then bisection) that makes the answer feasible. The returned set always satisfies the three
-//      modelled bounds; the triangle bound is exact.
+//      triangles <= max_triangles, average overdraw (sum of solid angles / 4 pi) <=
+//      max_average_overdraw and, for each of `overdraw_directions` 90-degree views from O, the
+//      modelled fill (bounded over the view region) <= max_peak_overdraw, by Lagrangian
+//      relaxation with subgradient ascent on the dual and a final scaling of the multipliers
+//      (exponential probe then bisection) that makes the answer feasible. The returned set always
+//      satisfies the three modelled bounds; the triangle bound is exact.
 //   4. Texturing (tiles_texture.cc): per tile a square texture sized by its angular extent
 //      (texels_per_degree), corners on texel centres, projective (homogeneous) coordinates.
 //      Silhouettes by carving: each sample is projected from O onto its cell's tiles (solid
@@ -130,13 +130,13 @@ struct TilesBuildOptions {
 struct TilesBuildReport {
   // Input.
   uint32_t views = 0, face_size = 0;
-  uint64_t samples = 0;         // finite-depth texels read
-  uint64_t merged_points = 0;   // after point merging
+  uint64_t samples = 0;        // finite-depth texels read
+  uint64_t merged_points = 0;  // after point merging
   uint64_t candidate_cells = 0, candidate_tilings = 0, candidate_tiles = 0;
   // Selection.
   uint32_t tiles = 0, triangles = 0;
-  double distortion = 0;          // sum over merged points of weight x E of the selection
-  double dual_bound = 0;          // best Lagrangian dual value (a lower bound on distortion)
+  double distortion = 0;  // sum over merged points of weight x E of the selection
+  double dual_bound = 0;  // best Lagrangian dual value (a lower bound on distortion)
   uint32_t selection_evaluations = 0;
   // Modelled (what the selection constrained) and measured overdraw, with their bounds.
   double model_average_overdraw = 0, model_peak_overdraw = 0;
@@ -146,9 +146,9 @@ struct TilesBuildReport {
   uint32_t max_triangles = 0;
   double max_average_overdraw = 0, max_peak_overdraw = 0;
   // Texture.
-  uint64_t tile_texels = 0;   // sum of tile texture areas (without pads)
+  uint64_t tile_texels = 0;  // sum of tile texture areas (without pads)
   uint32_t atlas_width = 0, atlas_height = 0;
-  double atlas_occupancy = 0;  // tile_texels / atlas area, percent
+  double atlas_occupancy = 0;                       // tile_texels / atlas area, percent
   double texels_per_degree = 0, texture_scale = 1;  // the density used and the fit-down factor
   // Wall seconds per stage (informative).
   double seconds_merge = 0, seconds_candidates = 0, seconds_select = 0, seconds_texture = 0,
@@ -165,8 +165,7 @@ Status validate_tiles_build_options(const TilesBuildOptions& options);
 // E254 the atlas cannot hold the textures at the smallest tile size; the reader's errors (E135 -
 // E140) for unreadable images.
 Expected<TileSet> build_tiles(const capture::CaptureSetReader& reader, uint32_t frame,
-                              const TilesBuildOptions& options,
-                              TilesBuildReport* report = nullptr);
+                              const TilesBuildOptions& options, TilesBuildReport* report = nullptr);
 
 // The report as a few lines of text (stage seconds, triangles, overdraw against the bounds,
 // texels, atlas), for commands and benches.
