@@ -12,9 +12,9 @@
 #include <cmath>
 #include <limits>
 
+#include "../scratch_dir.h"
 #include "calf/format/colour.h"
 #include "calf/format/cube.h"
-#include "scratch_dir.h"
 
 namespace calf {
 namespace {
