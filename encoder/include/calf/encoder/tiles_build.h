@@ -1,0 +1,174 @@
+// The tiles builder (paper 000, Seurat): one frame of a capture set of a static view region in,
+// a TileSet (calf/format/tile_set.h: budgeted layered quads with an RGBA atlas) out.
+//
+// Stages (docs/TILES.md describes each, what it keeps of the paper and what it changes):
+//   1. Point merging (tiles_points.cc): every finite-depth texel of every view becomes a scene
+//      point; points are binned into six perspective-space voxel grids around the view region's
+//      centre O (face x face texel x log-radius) and each non-empty voxel keeps one merged point
+//      (the weighted mean of its samples) with the count of samples it stands for.
+//   2. Candidate tiles (tiles_candidates.cc): on each cube face's quadtree (levels min_level ..
+//      max_level), every cell holding points is fitted with 1 .. max_planes planes (a RANSAC plane
+//      with a deterministic seed per cell, refined by robust reweighted least squares on Seurat's
+//      radial energy E = (1 - t_hit)^2, then divisive k-means style splitting); each k gives one
+//      candidate tiling of the cell, a tile being the plane cut by the cell's (slightly dilated)
+//      frustum from O.
+//   3. Selection (tiles_select.cc): one tiling per covered cell or the union of its children's
+//      (the And/Or tree of the quadtrees), minimising the total energy subject to
+//      triangles <= max_triangles, average overdraw (sum of solid angles / 4 pi) <=
+//      max_average_overdraw and, for each of `overdraw_directions` 90-degree views from O, the
+//      modelled fill (bounded over the view region) <= max_peak_overdraw, by Lagrangian
+//      relaxation with subgradient ascent on the dual and a final scaling of the multipliers
+//      (exponential probe then bisection) that makes the answer feasible. The returned set always
+//      satisfies the three modelled bounds; the triangle bound is exact.
+//   4. Texturing (tiles_texture.cc): per tile a square texture sized by its angular extent
+//      (texels_per_degree), corners on texel centres, projective (homogeneous) coordinates.
+//      Silhouettes by carving: each sample is projected from O onto its cell's tiles (solid
+//      constraints and colour), and each capture view marks the tile points it sees through as
+//      free space; alpha is the share of supersamples nearer a solid than a free constraint.
+//   5. Atlas (tiles_atlas.cc): textures sorted by size and packed in shelves with a one-texel pad
+//      (edge texels repeated), RGB sRGB-encoded and premultiplied, as tile_set.h specifies.
+//   6. Measurement (tiles_overdraw.cc): the built tiles rasterised (coverage count, alpha ignored:
+//      what the GPU fills) in 90-degree views from O and from every capture viewpoint.
+//
+// Deterministic: the same capture set and options give the same TileSet bytes for any `threads`.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <string_view>
+
+#include "calf/capture/capture_set.h"
+#include "calf/format/status.h"
+#include "calf/format/tile_set.h"
+
+namespace calf::encoder {
+
+struct TilesBuildOptions {
+  // --- budget (Seurat's L_tris, L_area, L_peakOD and F) ---
+  // Most triangles in the output (2 per tile); respected exactly. >= 2.
+  uint32_t max_triangles = 72000;
+  // Most average overdraw: the tiles' total solid angle seen from O over 4 pi. > 0.
+  double max_average_overdraw = 3.0;
+  // Most modelled fill of any of the `overdraw_directions` 90-degree views from O, each tile's
+  // solid angle bounded over the view region (see overdraw_region_bound). > 0.
+  double max_peak_overdraw = 5.0;
+  // F, the number of view directions (a spherical Fibonacci set) the peak bound is modelled on.
+  // 6 .. 4096.
+  uint32_t overdraw_directions = 126;
+  // Whether a tile's fill is bounded over the view region: its solid angle times
+  // (r / (r - R))^2, r its nearest corner's distance from O, R the view region's half diagonal
+  // (r - R clamped to r / 4). Off: the solid angle from O.
+  bool overdraw_region_bound = true;
+
+  // --- point merging ---
+  // Voxel grid resolution per cube face (texels of the merge grid across a face); 0 = the capture
+  // set's face size. The radial bins have the same relative size (2 / resolution in log radius).
+  uint32_t merge_resolution = 0;
+
+  // --- candidate tiles ---
+  // Quadtree levels (cells 2^level across a face): roots at min_level, leaves at max_level.
+  // 0 <= min_level <= max_level <= 10.
+  uint32_t min_level = 3;
+  uint32_t max_level = 7;
+  // Most planes (tiles) per cell, K. 1 .. 16.
+  uint32_t max_planes = 8;
+  // RANSAC trials of the first plane of each cell (seeded by the cell, so deterministic), >= 1,
+  // and the inlier threshold on |1 - t_hit| (relative radial error), > 0.
+  uint32_t ransac_trials = 32;
+  double ransac_threshold = 0.01;
+  // Cells (below the roots) with fewer merged points than this take their parent's planes (those
+  // their points choose) instead of fitting their own: a plane through one or two points fits
+  // them exactly and says nothing of the surface. >= 1.
+  uint32_t min_cell_points = 16;
+  // k-means iterations (assign, refit) after each split, >= 1.
+  uint32_t refine_iterations = 4;
+  // Most points each refit uses (an evenly strided subset; the final assignment and the energy
+  // use every point), >= 16.
+  uint32_t refine_sample_limit = 2048;
+  // A cell stops splitting once its tiling's mean energy falls below this (relative radial error
+  // squared), >= 0.
+  double split_stop_energy = 1e-6;
+  // Each tile's cell is dilated by this fraction of its width on every side so that neighbouring
+  // tiles overlap instead of cracking (Seurat dilates its tiles too). 0 .. 0.25.
+  double tile_dilation = 0.02;
+
+  // --- selection ---
+  // Subgradient iterations on the dual, >= 1.
+  uint32_t selection_iterations = 150;
+
+  // --- texturing ---
+  // Texels per degree of a tile's angular width seen from O; 0 = match the capture (face size /
+  // 90), Seurat's "at least one texel per pixel" at the capture's resolution.
+  double texels_per_degree = 0;
+  // Smallest and largest tile texture side (texels, corners included). 2 <= min <= max <= 1024.
+  uint32_t min_tile_texels = 2;
+  uint32_t max_tile_texels = 64;
+  // Largest atlas side; when the textures do not fit, every tile side is scaled down uniformly
+  // until they do (no content-adaptive choice). 16 .. 16384.
+  uint32_t max_atlas_size = 8192;
+  // Seurat's thresh_solid: a sample makes secondary solid constraints on other layers with
+  // |t_hit - 1| below it, and a view marks free space only where its ray passes a tile more than
+  // this relative distance before its surface. (0, 1).
+  double solid_threshold = 0.01;
+  // Alpha supersampling: S x S silhouette samples per texel. 1 .. 8.
+  uint32_t alpha_supersampling = 2;
+
+  // --- measurement ---
+  // Directions of the measured overdraw (per eye: O and every capture viewpoint), >= 6, and the
+  // side of each measured 90-degree view in pixels, 8 .. 1024.
+  uint32_t measure_directions = 126;
+  uint32_t measure_resolution = 64;
+
+  // --- execution ---
+  // Worker threads, >= 1. The output does not depend on it.
+  uint32_t threads = 1;
+  // Called from the calling thread with a stage name and the fraction done in [0, 1] (optional).
+  std::function<void(std::string_view stage, double fraction)> progress;
+};
+
+struct TilesBuildReport {
+  // Input.
+  uint32_t views = 0, face_size = 0;
+  uint64_t samples = 0;        // finite-depth texels read
+  uint64_t merged_points = 0;  // after point merging
+  uint64_t candidate_cells = 0, candidate_tilings = 0, candidate_tiles = 0;
+  // Selection.
+  uint32_t tiles = 0, triangles = 0;
+  double distortion = 0;  // sum over merged points of weight x E of the selection
+  double dual_bound = 0;  // best Lagrangian dual value (a lower bound on distortion)
+  uint32_t selection_evaluations = 0;
+  // Modelled (what the selection constrained) and measured overdraw, with their bounds.
+  double model_average_overdraw = 0, model_peak_overdraw = 0;
+  double measured_mean_overdraw = 0, measured_peak_overdraw = 0;
+  uint32_t measured_max_layers = 0;  // the largest per-pixel tile count seen
+  uint32_t measured_views = 0;       // eyes x directions
+  uint32_t max_triangles = 0;
+  double max_average_overdraw = 0, max_peak_overdraw = 0;
+  // Texture.
+  uint64_t tile_texels = 0;  // sum of tile texture areas (without pads)
+  uint32_t atlas_width = 0, atlas_height = 0;
+  double atlas_occupancy = 0;                       // tile_texels / atlas area, percent
+  double texels_per_degree = 0, texture_scale = 1;  // the density used and the fit-down factor
+  // Wall seconds per stage (informative).
+  double seconds_merge = 0, seconds_candidates = 0, seconds_select = 0, seconds_texture = 0,
+         seconds_atlas = 0, seconds_measure = 0, seconds_total = 0;
+};
+
+// Checks every option's range (CALF-E250 naming the option and its range).
+Status validate_tiles_build_options(const TilesBuildOptions& options);
+
+// Builds the tile set of frame `frame` of `reader`'s capture set for its view volume.
+// Errors: E250 an option out of range; E251 `frame` outside the set; E252 an empty capture (no
+// finite depth in the frame); E253 the budget cannot cover the captured directions (even one tile
+// per covered root cell breaks a bound; the message names the bound and the least it needs);
+// E254 the atlas cannot hold the textures at the smallest tile size; the reader's errors (E135 -
+// E140) for unreadable images.
+Expected<TileSet> build_tiles(const capture::CaptureSetReader& reader, uint32_t frame,
+                              const TilesBuildOptions& options, TilesBuildReport* report = nullptr);
+
+// The report as a few lines of text (stage seconds, triangles, overdraw against the bounds,
+// texels, atlas), for commands and benches.
+std::string format_tiles_report(const TilesBuildReport& report);
+
+}  // namespace calf::encoder

@@ -1,0 +1,157 @@
+// The tiles builder's stages (calf/encoder/tiles_build.h), shared between its files; private to
+// the encoder.
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <thread>
+#include <vector>
+
+#include "calf/capture/capture_set.h"
+#include "calf/encoder/tiles_build.h"
+#include "calf/format/cube.h"
+#include "calf/format/geometry.h"
+#include "calf/format/status.h"
+
+namespace calf::encoder::tiles {
+
+// Runs body(i) for i in [0, count) on `threads` threads. Each i must write only its own outputs,
+// so the result does not depend on the thread count or the schedule.
+template <typename Body>
+void parallel_for(uint32_t threads, size_t count, const Body& body) {
+  if (threads <= 1 || count <= 1) {
+    for (size_t i = 0; i < count; ++i) body(i);
+    return;
+  }
+  std::atomic<size_t> next{0};
+  auto work = [&] {
+    for (size_t i = next++; i < count; i = next++) body(i);
+  };
+  std::vector<std::thread> pool;
+  const size_t n = std::min<size_t>(threads, count);
+  for (size_t t = 1; t < n; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+}
+
+// A quadtree cell of a cube face: level L has 2^L x 2^L cells; (i, j) index s and t.
+struct CellId {
+  uint8_t face = 0, level = 0;
+  uint32_t i = 0, j = 0;
+};
+// The face coordinates of a cell's corner k (0: (s0, t0), 1: (s1, t0), 2: (s1, t1), 3: (s0, t1)),
+// dilated by `dilation` of the cell width on every side.
+void cell_corner_st(const CellId& c, double dilation, int k, double* s, double* t);
+// The unit direction from O through a cell's (dilated) corner k.
+Vec3 cell_corner_direction(const CellId& c, double dilation, int k);
+// The solid angle of a cell (dilated), exact for the spherical quadrilateral.
+double cell_solid_angle(const CellId& c, double dilation);
+
+// The frame of one capture set view, shared by the stages.
+struct Frame {
+  Vec3 origin;               // O, the view volume's centre
+  double region_radius = 0;  // half the view volume's diagonal
+  uint32_t face_size = 0;
+  std::vector<Vec3> viewpoints;
+};
+
+// --- point merging (tiles_points.cc) ---
+struct MergedPoints {
+  // Relative to O, sorted by (face, Morton code of the leaf cell at level 30 / enough bits), so
+  // that every quadtree cell's points are one contiguous range.
+  std::vector<Vec3> position;
+  std::vector<float> weight;  // samples merged into each point
+  std::vector<uint8_t> face;
+  std::vector<uint64_t> morton;  // of the cell at kMortonLevel
+  uint64_t samples = 0;
+  double max_radius = 0;
+};
+inline constexpr uint32_t kMortonLevel = 16;
+uint64_t morton_code(uint32_t i, uint32_t j);
+Expected<MergedPoints> merge_points(const capture::CaptureSetReader& reader, uint32_t frame,
+                                    const Frame& f, const TilesBuildOptions& options);
+
+// --- candidates (tiles_candidates.cc) ---
+struct Plane {
+  Vec3 normal;        // unit
+  double offset = 0;  // dot(normal, x) = offset for points x (relative to O) on the plane, > 0
+};
+struct Tiling {
+  uint32_t first_plane = 0, plane_count = 0;  // into Candidates::planes
+  double distortion = 0;
+};
+struct CandidateCell {
+  CellId id;
+  uint32_t first_tiling = 0, tiling_count = 0;  // into Candidates::tilings
+  int32_t children[4] = {-1, -1, -1, -1};       // indices into Candidates::cells, -1 = empty
+  int32_t parent = -1;
+  uint32_t point_begin = 0, point_end = 0;  // range into MergedPoints
+};
+struct Candidates {
+  std::vector<CandidateCell> cells;  // breadth first: by level, roots in (face, j, i) order
+  std::vector<uint32_t> roots;
+  std::vector<Tiling> tilings;
+  std::vector<Plane> planes;
+};
+// Where plane `p` meets the ray from O along unit `d`: the distance, or a negative value when it
+// does not (parallel or behind).
+double plane_distance_along(const Plane& p, const Vec3& d);
+Candidates generate_candidates(const MergedPoints& points, const Frame& f,
+                               const TilesBuildOptions& options);
+
+// --- selection (tiles_select.cc) ---
+struct Selected {
+  CellId cell;
+  Plane plane;
+};
+struct Selection {
+  std::vector<Selected> tiles;
+  double distortion = 0, dual_bound = 0;
+  double average_overdraw = 0, peak_overdraw = 0;  // as modelled
+  uint32_t evaluations = 0;
+};
+// The unit directions of the F overdraw views, with right and up axes (90-degree square views).
+struct ViewAxes {
+  Vec3 forward, right, up;
+};
+std::vector<ViewAxes> overdraw_view_axes(uint32_t count);
+Expected<Selection> select_tiles(const Candidates& candidates, const Frame& f,
+                                 const TilesBuildOptions& options);
+
+// --- texturing (tiles_texture.cc) ---
+struct TileTexture {
+  uint32_t side = 0;        // texels per side (corners on texel centres)
+  std::vector<float> rgba;  // side * side * 4: linear RGB (not premultiplied), alpha
+};
+// The scene-space (relative to O) corners of a selected tile.
+std::array<Vec3, 4> tile_corners(const Selected& t, double dilation);
+Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader& reader,
+                                                 uint32_t frame, const Frame& f,
+                                                 const Selection& selection,
+                                                 const std::vector<uint32_t>& sides,
+                                                 const TilesBuildOptions& options);
+
+// --- atlas (tiles_atlas.cc) ---
+struct AtlasPlacement {
+  uint32_t x = 0, y = 0;  // top-left texel of the tile's texture (inside its pad)
+};
+// Packs squares of `sides` (each with a 1-texel pad) into shelves of a power-of-two wide atlas no
+// wider than max_size; false when they do not fit in max_size x max_size.
+bool pack_atlas(const std::vector<uint32_t>& sides, uint32_t max_size,
+                std::vector<AtlasPlacement>* placements, uint32_t* width, uint32_t* height);
+// Writes the tile set: corners, projective coordinates and the RGBA8 atlas.
+TileSet write_tile_set(const Frame& f, const Box3& view_region, const Selection& selection,
+                       const std::vector<TileTexture>& textures,
+                       const std::vector<AtlasPlacement>& placements, uint32_t width,
+                       uint32_t height, double dilation);
+
+// --- measurement (tiles_overdraw.cc) ---
+struct OverdrawMeasure {
+  double mean = 0, peak = 0;
+  uint32_t max_layers = 0, views = 0;
+};
+OverdrawMeasure measure_overdraw(const TileSet& set, const std::vector<Vec3>& eyes,
+                                 uint32_t directions, uint32_t resolution, uint32_t threads);
+
+}  // namespace calf::encoder::tiles

@@ -1,0 +1,329 @@
+// Texturing (paper 000 Sec. 5): RGBA textures for the selected tiles from the capture samples.
+//
+// A tile's texture covers its dilated cell in face coordinates (s, t), so texture space is the
+// cube face's own (projective from O); corners sit on texel centres. Per capture view:
+//   - Solid constraints (scatter): each sample is projected from O onto the tiles of its cell; the
+//     tile whose plane is nearest in relative radius (t_hit nearest 1) gets a primary solid
+//     constraint and the sample's colour (a bilinear splat), others within solid_threshold get
+//     secondary ones (Seurat's crack mitigation at intersecting tiles).
+//   - Free-space constraints (gather): each alpha supersample of each tile is looked up in the
+//     view; when the view's ray passes it more than solid_threshold before reaching its surface
+//     (or reaches no surface), and that surface's primary tile is another tile, the supersample is
+//     free space. Seurat traces each sample's ray through the tiles; gathering per supersample
+//     asks the same question and costs one depth look-up.
+// Supersamples holding both kinds are dropped (ambiguous); every supersample then takes the class
+// of its nearest constraint (a two-pass chamfer transform), and a texel's alpha is the share of
+// its supersamples that are solid. Texels no sample coloured are filled from their neighbours
+// (iterated averaging; Seurat solves a Laplace equation by multigrid).
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "tiles_internal.h"
+
+namespace calf::encoder::tiles {
+
+std::array<Vec3, 4> tile_corners(const Selected& t, double dilation) {
+  std::array<Vec3, 4> out;
+  for (int k = 0; k < 4; ++k) {
+    const Vec3 d = cell_corner_direction(t.cell, dilation, k);
+    out[k] = d * plane_distance_along(t.plane, d);
+  }
+  return out;
+}
+
+namespace {
+
+// The selected tiles grouped by cell, found from a direction through dense per-level tables.
+class CellLookup {
+ public:
+  CellLookup(const Selection& sel, const TilesBuildOptions& o)
+      : min_(o.min_level), max_(o.max_level) {
+    for (int f = 0; f < 6; ++f) {
+      for (uint32_t l = min_; l <= max_; ++l) {
+        table_[f].emplace_back(size_t{1} << (2 * l), -1);
+      }
+    }
+    for (uint32_t k = 0; k < sel.tiles.size(); ++k) {
+      const CellId& c = sel.tiles[k].cell;
+      int32_t& slot = table_[c.face][c.level - min_][size_t{c.j} * (1u << c.level) + c.i];
+      if (slot < 0) {
+        slot = static_cast<int32_t>(groups_.size());
+        groups_.push_back({k, 0});
+      }
+      ++groups_[slot].second;
+    }
+  }
+  // The (first tile, count) of the cell that contains face coordinate `fc`, or count 0.
+  std::pair<uint32_t, uint32_t> find(const FaceCoord& fc) const {
+    const int f = static_cast<int>(fc.face);
+    for (uint32_t l = min_; l <= max_; ++l) {
+      const uint32_t side = 1u << l;
+      const uint32_t i =
+          std::min<uint32_t>(static_cast<uint32_t>(std::max(0.0, fc.s * side)), side - 1);
+      const uint32_t j =
+          std::min<uint32_t>(static_cast<uint32_t>(std::max(0.0, fc.t * side)), side - 1);
+      const int32_t slot = table_[f][l - min_][size_t{j} * side + i];
+      if (slot >= 0) return groups_[slot];
+    }
+    return {0, 0};
+  }
+
+ private:
+  uint32_t min_, max_;
+  std::array<std::vector<std::vector<int32_t>>, 6> table_;
+  std::vector<std::pair<uint32_t, uint32_t>> groups_;
+};
+
+// A tile's face-coordinate frame: (s, t) = (s0 + a ds, t0 + b dt) for texture position (a, b).
+struct TileFrame {
+  CubeFace face;
+  double s0, t0, ds, dt;
+};
+TileFrame tile_frame(const Selected& t, double dilation) {
+  double s0, t0, s1, t1;
+  cell_corner_st(t.cell, dilation, 0, &s0, &t0);
+  cell_corner_st(t.cell, dilation, 2, &s1, &t1);
+  return {cube_face_from_index(t.cell.face), s0, t0, s1 - s0, t1 - t0};
+}
+
+struct TileWork {
+  std::vector<float> colour;   // side^2 x (r, g, b, weight)
+  std::vector<uint8_t> marks;  // (side S)^2: bit 0 solid, bit 1 free
+};
+
+}  // namespace
+
+Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader& reader,
+                                                 uint32_t frame, const Frame& f,
+                                                 const Selection& selection,
+                                                 const std::vector<uint32_t>& sides,
+                                                 const TilesBuildOptions& options) {
+  const auto& manifest = reader.manifest();
+  const uint32_t n = manifest.face_size;
+  const uint32_t ss = options.alpha_supersampling;
+  const double thresh = options.solid_threshold;
+  const size_t count = selection.tiles.size();
+  CellLookup lookup(selection, options);
+  std::vector<TileFrame> frames(count);
+  std::vector<TileWork> work(count);
+  for (size_t k = 0; k < count; ++k) {
+    frames[k] = tile_frame(selection.tiles[k], options.tile_dilation);
+    work[k].colour.assign(size_t{sides[k]} * sides[k] * 4, 0.0f);
+    work[k].marks.assign(size_t{sides[k]} * ss * sides[k] * ss, 0);
+  }
+
+  const size_t texels = size_t{6} * n * n;
+  std::vector<int32_t> primary(texels);
+  std::vector<float> sample_a(texels), sample_b(texels);
+  capture::ViewFrame view;
+  for (uint32_t v = 0; v < manifest.viewpoints.size(); ++v) {
+    if (options.progress) options.progress("texture", double(v) / manifest.viewpoints.size());
+    CALF_RETURN_IF_ERROR(reader.read(v, frame, &view));
+    const Vec3 eye = f.viewpoints[v];
+    // Each sample's primary tile and texture position (per row in parallel).
+    parallel_for(options.threads, size_t{6} * n, [&](size_t row) {
+      const CubeFace face = cube_face_from_index(static_cast<int>(row / n));
+      const uint32_t y = static_cast<uint32_t>(row % n);
+      for (uint32_t x = 0; x < n; ++x) {
+        const size_t t = view.texel_index(face, x, y);
+        primary[t] = -1;
+        const float depth = view.depth[t];
+        if (!std::isfinite(depth)) continue;
+        const Vec3 q = eye + direction_from_texel(face, x, y, n) * double{depth} - f.origin;
+        const double r = length(q);
+        if (!(r > 0)) continue;
+        const Vec3 d = q / r;
+        const FaceCoord fc = face_coord_from_direction(d);
+        const auto [first, cnt] = lookup.find(fc);
+        double best = 1e300;
+        for (uint32_t k = first; k < first + cnt; ++k) {
+          const double dist = plane_distance_along(selection.tiles[k].plane, d);
+          if (!(dist > 0)) continue;
+          const double err = std::abs(dist / r - 1.0);
+          if (err < best) {
+            best = err;
+            primary[t] = static_cast<int32_t>(k);
+          }
+        }
+        if (primary[t] >= 0) {
+          const TileFrame& tf = frames[primary[t]];
+          sample_a[t] = static_cast<float>((fc.s - tf.s0) / tf.ds);
+          sample_b[t] = static_cast<float>((fc.t - tf.t0) / tf.dt);
+        }
+      }
+    });
+    // Solid constraints and colour, accumulated in texel order (the sums do not depend on the
+    // thread count).
+    for (size_t t = 0; t < texels; ++t) {
+      const int32_t p = primary[t];
+      if (p < 0) continue;
+      const CubeFace face = cube_face_from_index(static_cast<int>(t / (size_t{n} * n)));
+      const uint32_t x = static_cast<uint32_t>(t % n), y = static_cast<uint32_t>((t / n) % n);
+      const double depth = view.depth[t];
+      const Vec3 q = eye + direction_from_texel(face, x, y, n) * depth - f.origin;
+      const double r = length(q);
+      const Vec3 d = q / r;
+      const auto [first, cnt] = lookup.find(face_coord_from_direction(d));
+      for (uint32_t k = first; k < first + cnt; ++k) {
+        if (static_cast<int32_t>(k) != p) {
+          const double dist = plane_distance_along(selection.tiles[k].plane, d);
+          if (!(dist > 0) || std::abs(dist / r - 1.0) >= thresh) continue;
+        }
+        const uint32_t side = sides[k];
+        const double u = sample_a[t] * (side - 1.0), w = sample_b[t] * (side - 1.0);
+        const uint32_t g = side * ss;
+        const int sx = std::clamp(static_cast<int>(std::floor((u + 0.5) * ss)), 0, int(g) - 1);
+        const int sy = std::clamp(static_cast<int>(std::floor((w + 0.5) * ss)), 0, int(g) - 1);
+        work[k].marks[size_t(sy) * g + sx] |= 1;
+        // Bilinear splat of the colour onto the four nearest texel centres.
+        const double fu = std::clamp(u, 0.0, side - 1.0), fw = std::clamp(w, 0.0, side - 1.0);
+        const uint32_t x0 = std::min<uint32_t>(static_cast<uint32_t>(fu), side - 2);
+        const uint32_t y0 = std::min<uint32_t>(static_cast<uint32_t>(fw), side - 2);
+        const double ax = fu - x0, ay = fw - y0;
+        const float* c = &view.color[3 * t];
+        for (int dy = 0; dy < 2; ++dy) {
+          for (int dx = 0; dx < 2; ++dx) {
+            const double wgt = (dx ? ax : 1 - ax) * (dy ? ay : 1 - ay);
+            if (wgt <= 0) continue;
+            float* dst = &work[k].colour[(size_t{y0 + dy} * side + x0 + dx) * 4];
+            dst[0] += static_cast<float>(wgt * c[0]);
+            dst[1] += static_cast<float>(wgt * c[1]);
+            dst[2] += static_cast<float>(wgt * c[2]);
+            dst[3] += static_cast<float>(wgt);
+          }
+        }
+      }
+    }
+    // Free space: each tile's supersamples against this view (per tile in parallel).
+    parallel_for(options.threads, count, [&](size_t k) {
+      const Selected& tile = selection.tiles[k];
+      const TileFrame& tf = frames[k];
+      const uint32_t side = sides[k], g = side * ss;
+      for (uint32_t sy = 0; sy < g; ++sy) {
+        for (uint32_t sx = 0; sx < g; ++sx) {
+          const double a = ((sx + 0.5) / ss - 0.5) / (side - 1.0);
+          const double b = ((sy + 0.5) / ss - 0.5) / (side - 1.0);
+          FaceCoord fc;
+          fc.face = tf.face;
+          fc.s = tf.s0 + a * tf.ds;
+          fc.t = tf.t0 + b * tf.dt;
+          const Vec3 d = direction_from_face_coord(fc);
+          const double dist = plane_distance_along(tile.plane, d);
+          if (!(dist > 0)) continue;
+          const Vec3 ray = f.origin + d * dist - eye;
+          const double len = length(ray);
+          if (!(len > 0)) continue;
+          const Texel tx = texel_from_direction(ray, n);
+          const size_t t = view.texel_index(tx.face, tx.x, tx.y);
+          const float depth = view.depth[t];
+          const bool through =
+              !std::isfinite(depth) || (len < depth * (1.0 - thresh) && primary[t] != int32_t(k));
+          if (through) work[k].marks[size_t{sy} * g + sx] |= 2;
+        }
+      }
+    });
+  }
+  if (options.progress) options.progress("texture", 1.0);
+
+  // Resolve alpha and colour per tile.
+  std::vector<TileTexture> out(count);
+  parallel_for(options.threads, count, [&](size_t k) {
+    const uint32_t side = sides[k], g = side * ss;
+    TileWork& w = work[k];
+    // Nearest constraint by a two-pass chamfer (3-4) transform; label 1 solid, 2 free, 0 none.
+    std::vector<uint32_t> dist(size_t{g} * g, UINT32_MAX);
+    std::vector<uint8_t> label(size_t{g} * g, 0);
+    for (size_t i = 0; i < dist.size(); ++i) {
+      const uint8_t m = w.marks[i];
+      if (m == 1 || m == 2) {
+        dist[i] = 0;
+        label[i] = m;
+      }
+    }
+    auto relax = [&](size_t i, size_t from, uint32_t cost) {
+      if (dist[from] == UINT32_MAX) return;
+      const uint32_t d = dist[from] + cost;
+      // Ties go to solid: a crack costs more than a sliver.
+      if (d < dist[i] || (d == dist[i] && label[from] == 1 && label[i] == 2)) {
+        dist[i] = d;
+        label[i] = label[from];
+      }
+    };
+    for (uint32_t y = 0; y < g; ++y) {
+      for (uint32_t x = 0; x < g; ++x) {
+        const size_t i = size_t{y} * g + x;
+        if (x > 0) relax(i, i - 1, 3);
+        if (y > 0) {
+          relax(i, i - g, 3);
+          if (x > 0) relax(i, i - g - 1, 4);
+          if (x + 1 < g) relax(i, i - g + 1, 4);
+        }
+      }
+    }
+    for (uint32_t y = g; y-- > 0;) {
+      for (uint32_t x = g; x-- > 0;) {
+        const size_t i = size_t{y} * g + x;
+        if (x + 1 < g) relax(i, i + 1, 3);
+        if (y + 1 < g) {
+          relax(i, i + g, 3);
+          if (x + 1 < g) relax(i, i + g + 1, 4);
+          if (x > 0) relax(i, i + g - 1, 4);
+        }
+      }
+    }
+    TileTexture& tex = out[k];
+    tex.side = side;
+    tex.rgba.assign(size_t{side} * side * 4, 0.0f);
+    std::vector<uint8_t> known(size_t{side} * side, 0);
+    for (uint32_t y = 0; y < side; ++y) {
+      for (uint32_t x = 0; x < side; ++x) {
+        uint32_t solid = 0;
+        for (uint32_t qy = 0; qy < ss; ++qy) {
+          for (uint32_t qx = 0; qx < ss; ++qx) {
+            solid += label[size_t{y * ss + qy} * g + x * ss + qx] == 1;
+          }
+        }
+        const size_t i = size_t{y} * side + x;
+        tex.rgba[4 * i + 3] = static_cast<float>(solid) / float(ss * ss);
+        const float wsum = w.colour[4 * i + 3];
+        if (wsum > 0) {
+          for (int c = 0; c < 3; ++c) tex.rgba[4 * i + c] = w.colour[4 * i + c] / wsum;
+          known[i] = 1;
+        }
+      }
+    }
+    // Fill uncoloured texels from coloured neighbours, one ring per pass.
+    for (uint32_t pass = 0; pass < 2 * side; ++pass) {
+      std::vector<uint8_t> next = known;
+      bool changed = false;
+      for (uint32_t y = 0; y < side; ++y) {
+        for (uint32_t x = 0; x < side; ++x) {
+          const size_t i = size_t{y} * side + x;
+          if (known[i]) continue;
+          float sum[3] = {0, 0, 0};
+          int cnt = 0;
+          const int nx[4] = {int(x) - 1, int(x) + 1, int(x), int(x)};
+          const int ny[4] = {int(y), int(y), int(y) - 1, int(y) + 1};
+          for (int q = 0; q < 4; ++q) {
+            if (nx[q] < 0 || ny[q] < 0 || nx[q] >= int(side) || ny[q] >= int(side)) continue;
+            const size_t j = size_t(ny[q]) * side + nx[q];
+            if (!known[j]) continue;
+            for (int c = 0; c < 3; ++c) sum[c] += tex.rgba[4 * j + c];
+            ++cnt;
+          }
+          if (cnt == 0) continue;
+          for (int c = 0; c < 3; ++c) tex.rgba[4 * i + c] = sum[c] / cnt;
+          next[i] = 1;
+          changed = true;
+        }
+      }
+      known.swap(next);
+      if (!changed) break;
+    }
+    w = TileWork{};  // free the work buffers early
+  });
+  return out;
+}
+
+}  // namespace calf::encoder::tiles
