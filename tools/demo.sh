@@ -12,6 +12,9 @@
 # `factory` (28 M triangles counting instances): export the scene file, ray-cast surfel
 # candidates at a small G-buffer size, build the surfel clip and the full mesh clip, and play the
 # surfels against the full mesh along the factory's ground-level walk (bytes, build s, render ms,
+# PSNR / SSIM). Then the tiles mode (paper 000, docs/TILES.md): layered quad tiles with an RGBA
+# atlas built from frame 0 of the same capture set, played along the ground-truth path with the
+# scene held at frame 0, beside the light field on the same poses (bytes, build s, render ms,
 # PSNR / SSIM). Every step's full output is kept in build/demo/logs/. A second run skips
 # installed packages and rebuilds incrementally.
 #
@@ -24,6 +27,8 @@
 # CALF_DEMO_SURFEL_RES (candidate G-buffer size, default 128; docs/SURFELS.md measures 256),
 # CALF_DEMO_SURFEL_COUNT (most surfels per prototype, default 8192), CALF_DEMO_SURFEL_POSES
 # (walk poses, default 2: the full mesh takes tens of seconds a pose on llvmpipe);
+# tiles part: CALF_DEMO_TILES (default 1; empty skips the part), CALF_DEMO_TILES_TRIANGLES
+# (the triangle budget, default 72000);
 # CALF_DEMO_BUILD (build directory, default build/release).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -51,6 +56,10 @@ SF_RES=${CALF_DEMO_SURFEL_RES:-128}
 SF_COUNT=${CALF_DEMO_SURFEL_COUNT:-8192}
 SF_POSES=${CALF_DEMO_SURFEL_POSES:-2}
 SF=$OUT/surfels
+# --- tiles mode settings (paper 000)
+TL_ON=${CALF_DEMO_TILES-1}
+TL_TRIANGLES=${CALF_DEMO_TILES_TRIANGLES:-72000}
+TL=$OUT/tiles
 rm -rf "$OUT"
 mkdir -p "$LOGS"
 
@@ -88,6 +97,25 @@ run ground-truth "$BUILD"/calf-capture --scene "$SCENE" --ground-truth --out "$O
   --frames "$FRAMES" --gt-size "$GT"
 run calf-play "$BUILD"/calf-play "$CLIP" --headless --compare "$OUT/ground-truth" \
   --out "$OUT/play" --contact-sheet "$SHEET"
+
+# --- tiles mode (paper 000): a self-contained block; its report lines are printed below.
+if [ -n "$TL_ON" ]; then
+  echo "calf demo: tiles mode from frame 0 of the same capture, at most $TL_TRIANGLES triangles"
+  mkdir -p "$TL"
+  run tl-encode "$BUILD"/calf-encode --mode tiles "$OUT/capture/manifest.json" -o "$TL/tiles.calf" \
+    --tiles-triangles "$TL_TRIANGLES" --quiet
+  TL_BUILD_S=$LAST_SECONDS
+  # Tiles hold one frame (a static view region): the ground truth's poses with the scene held at
+  # frame 0 (every pose's time set to 0), and the light field played on the same poses beside them.
+  sed -E 's/"time": *[-+0-9.eE]+/"time": 0/' "$OUT/ground-truth/eye_path.json" >"$TL/frame0_path.json"
+  run tl-ground-truth "$BUILD"/calf-capture --scene "$SCENE" --ground-truth --eye-path \
+    "$TL/frame0_path.json" --out "$TL/ground-truth" --quiet
+  run tl-play "$BUILD"/calf-play "$TL/tiles.calf" --headless --compare "$TL/ground-truth" \
+    --out "$TL/play"
+  run tl-play-lightfield "$BUILD"/calf-play "$CLIP" --headless --compare "$TL/ground-truth" \
+    --out "$TL/play-lightfield"
+fi
+# --- end of the tiles mode
 
 if [ -n "$VS_SCENE" ]; then
   echo "calf demo: visible-set mesh mode on $VS_SCENE, face $VS_FACE, $VS_FRAMES frames"
@@ -162,6 +190,20 @@ if [ -n "$VS_SCENE" ]; then
     "(GL on llvmpipe, median after the first pose)"
   echo "          $(line_of "$VSPLAY" '^against the full scene' | sed -E 's/ \(an identical[^)]*\)//')"
   echo "          (epsilon: share of pixels where a triangle is missing; paper 004: <= 0.19 % mean)"
+fi
+# --- tiles mode report
+if [ -n "$TL_ON" ]; then
+  TLENC=$LOGS/tl-encode.log
+  TLPLAY=$LOGS/tl-play.log
+  echo "tiles     frame 0 of $SCENE (paper 000): $(line_of "$TLENC" 'wrote' |
+    grep -oE '[0-9]+ tiles, [0-9]+ triangles, atlas [0-9]+ x [0-9]+')" \
+    "(budget $TL_TRIANGLES); build $TL_BUILD_S s wall"
+  awk -v t="$(stat -c %s "$TL/tiles.calf")" 'BEGIN { printf "          clip %.1f KB\n", t / 1e3 }'
+  echo "          $(line_of "$TLENC" 'overdraw' | sed -E 's/^ +//')"
+  echo "          render $(line_of "$TLPLAY" '^[0-9]+ poses: ' | sed -E 's/^[0-9]+ poses: //')"
+  echo "          tiles:       $(line_of "$TLPLAY" '^mean PSNR')"
+  echo "          light field: $(line_of "$LOGS/tl-play-lightfield.log" '^mean PSNR')"
+  echo "          (the same poses, the scene held at frame 0; ground truth at $GT)"
 fi
 # --- surfel mode report
 if [ -n "$SF_SCENE" ]; then

@@ -178,7 +178,7 @@ Expected<TileSet> build_tiles(const capture::CaptureSetReader& reader, uint32_t 
 
   // 4. Texture sizes by angular extent, scaled down uniformly until the atlas fits.
   t0 = std::chrono::steady_clock::now();
-  const double tpd = options.texels_per_degree > 0 ? options.texels_per_degree : m.face_size / 90.0;
+  const double tpd = options.texels_per_degree > 0 ? options.texels_per_degree : m.face_size / 45.0;
   r.texels_per_degree = tpd;
   std::vector<double> degrees(selection.tiles.size());
   for (size_t k = 0; k < selection.tiles.size(); ++k) {

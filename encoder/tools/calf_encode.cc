@@ -5,6 +5,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -24,6 +26,7 @@
 #include "calf/encoder/mesh_encode.h"
 #include "calf/encoder/surfels_build.h"
 #include "calf/encoder/visible_set.h"
+#include "calf_encode/tiles_mode.h"
 #include "command_line.h"
 
 namespace {
@@ -221,7 +224,13 @@ int main(int argc, char** argv) {
       "(format/SURFEL_CANDIDATES.md, from calf-capture --surfel-candidates); the output holds the "
       "mesh track of the whole scene and a surfels track (format/SPEC.md 11.3): per prototype up "
       "to --surfels surfels ordered so every prefix is a level of detail (paper 001; "
-      "docs/SURFELS.md).\n" +
+      "docs/SURFELS.md).\n"
+      "--mode tiles: INPUT is a capture set; one frame of it (--tiles-frame) becomes layered quad "
+      "tiles with an RGBA atlas for its view volume (paper 000, Seurat: point merging, "
+      "candidate tiles on each face's quadtree, selection under --tiles-triangles / "
+      "--tiles-overdraw / --tiles-peak-overdraw by Lagrangian relaxation, carving for alpha; "
+      "docs/TILES.md), written as a tiles track (format/SPEC.md 11.2); its errors: "
+      "CALF-E250..E254.\n" +
       std::string(calf::tools::kExitStatusHelp)};
   calf::LightfieldEncodeOptions o;
   std::string manifest, out;
@@ -234,8 +243,9 @@ int main(int argc, char** argv) {
   app.add_option("--mode", mode,
                  "lightfield (a capture set into a lightfield track), mesh (a scene file into "
                  "a mesh track) or surfels (a scene file and its surfel candidates into a mesh "
-                 "track and a surfels track) (default lightfield)")
-      ->check(CLI::IsMember({"lightfield", "mesh", "surfels"}))
+                 "track and a surfels track) or tiles (one frame of a capture set into a tiles "
+                 "track) (default lightfield)")
+      ->check(CLI::IsMember({"lightfield", "mesh", "surfels", "tiles"}))
       ->default_val("lightfield");
   app.add_option("-o,--output", out, "output .calf (written whole or not at all)")->required();
   app.add_option("--threads", o.threads,
@@ -351,7 +361,137 @@ int main(int argc, char** argv) {
                  "greedy-tree)")
       ->check(CLI::IsMember({"greedy-tree", "progressive", "exact", "random"}))
       ->default_val("greedy-tree");
+  // --mode tiles (docs/TILES.md): every knob of the builder and the track encoder.
+  calf::tools::TilesModeOptions tiles;
+  std::string tiles_atlas = "bc7";
+  std::vector<uint32_t> tiles_levels;
+  {
+    calf::encoder::TilesBuildOptions& b = tiles.build;
+    app.add_option("--tiles-frame", tiles.frame,
+                   "tiles: the capture frame the tiles are built from (default 0)")
+        ->default_val(0);
+    app.add_option("--tiles-triangles", b.max_triangles,
+                   "tiles: L_tris, most triangles (2 per tile), respected exactly, >= 2 "
+                   "(default 72000)")
+        ->default_val(72000);
+    app.add_option("--tiles-overdraw", b.max_average_overdraw,
+                   "tiles: L_area, most average overdraw (the tiles' solid angle from the view "
+                   "region's centre over 4 pi), > 0 (default 3)")
+        ->default_val(3.0);
+    app.add_option("--tiles-peak-overdraw", b.max_peak_overdraw,
+                   "tiles: most modelled overdraw of any 90-degree view, > 0 (default 5)")
+        ->default_val(5.0);
+    app.add_option("--tiles-directions", b.overdraw_directions,
+                   "tiles: F, the 90-degree view directions the peak bound is modelled on, "
+                   "6..4096 (default 126)")
+        ->default_val(126);
+    app.add_option("--tiles-merge-resolution", b.merge_resolution,
+                   "tiles: point-merging grid texels across a cube face, 0 = the capture's face "
+                   "size (default 0)")
+        ->default_val(0);
+    app.add_option("--tiles-levels", tiles_levels,
+                   "tiles: MIN,MAX quadtree levels of the candidate cells (2^level cells across "
+                   "a face), 0 <= MIN <= MAX <= 10 (default 3,7)")
+        ->delimiter(',')
+        ->expected(2);
+    app.add_option("--tiles-planes", b.max_planes,
+                   "tiles: K, most planes (tiles) per cell, 1..16 (default 8)")
+        ->default_val(8);
+    app.add_option("--tiles-ransac-trials", b.ransac_trials,
+                   "tiles: RANSAC trials of each cell's first plane, >= 1 (default 32)")
+        ->default_val(32);
+    app.add_option("--tiles-ransac-threshold", b.ransac_threshold,
+                   "tiles: RANSAC inlier bound on the relative radial error, > 0 (default 0.01)")
+        ->default_val(0.01);
+    app.add_option("--tiles-min-cell-points", b.min_cell_points,
+                   "tiles: a cell with fewer merged points takes its parent's planes, >= 1 "
+                   "(default 16)")
+        ->default_val(16);
+    app.add_option("--tiles-refine-iterations", b.refine_iterations,
+                   "tiles: assign-and-refit iterations after each plane split, >= 1 (default 4)")
+        ->default_val(4);
+    app.add_option("--tiles-refine-samples", b.refine_sample_limit,
+                   "tiles: most points per plane refit, >= 16 (default 2048)")
+        ->default_val(2048);
+    app.add_option("--tiles-split-stop", b.split_stop_energy,
+                   "tiles: a cell stops splitting below this mean energy (relative radial error "
+                   "squared), >= 0 (default 1e-6)")
+        ->default_val(1e-6);
+    app.add_option("--tiles-dilation", b.tile_dilation,
+                   "tiles: each tile's cell grows by this fraction of its width per side, so "
+                   "neighbours overlap instead of cracking, 0..0.25 (default 0.02)")
+        ->default_val(0.02);
+    app.add_option("--tiles-selection-iterations", b.selection_iterations,
+                   "tiles: subgradient iterations of the Lagrangian selection, >= 1 (default 150)")
+        ->default_val(150);
+    app.add_option("--tiles-texels-per-degree", b.texels_per_degree,
+                   "tiles: texture density per degree of a tile's angular width, 0 = twice "
+                   "the capture's (face size / 45) (default 0)")
+        ->default_val(0.0);
+    app.add_option("--tiles-min-texels", b.min_tile_texels,
+                   "tiles: smallest tile texture side in texels, >= 2 (default 2)")
+        ->default_val(2);
+    app.add_option("--tiles-max-texels", b.max_tile_texels,
+                   "tiles: largest tile texture side in texels, <= 1024 (default 64)")
+        ->default_val(64);
+    app.add_option("--tiles-max-atlas", b.max_atlas_size,
+                   "tiles: largest atlas side; textures shrink uniformly to fit, 16..16384 "
+                   "(default 8192)")
+        ->default_val(8192);
+    app.add_option("--tiles-solid-threshold", b.solid_threshold,
+                   "tiles: Seurat's thresh_solid, relative distance of solid / free-space "
+                   "carving, (0, 1) (default 0.05; Seurat's 0.01 carves holes into coarse "
+                   "tiles, docs/TILES.md)")
+        ->default_val(0.05);
+    app.add_option("--tiles-alpha-samples", b.alpha_supersampling,
+                   "tiles: S x S carving samples per texel for alpha, 1..8 (default 2)")
+        ->default_val(2);
+    app.add_option("--tiles-measure-directions", b.measure_directions,
+                   "tiles: 90-degree views per eye in which the built tiles' overdraw is "
+                   "measured, >= 6 (default 126)")
+        ->default_val(126);
+    app.add_option("--tiles-measure-resolution", b.measure_resolution,
+                   "tiles: side in px of each measured view, 8..1024 (default 64)")
+        ->default_val(64);
+    app.add_option("--tiles-atlas", tiles_atlas,
+                   "tiles: atlas coding, bc7 (GPU-native, lossy) or rgba8 (lossless) "
+                   "(default bc7)")
+        ->check(CLI::IsMember({"bc7", "rgba8"}))
+        ->default_val("bc7");
+    app.add_option("--tiles-bc7-quality", tiles.encode.bc7_quality,
+                   "tiles: BC7 search effort 0 (fast), 1, 2 (slow) (default 1)")
+        ->default_val(1);
+  }
   if (int rc = calf::tools::parse_command_line(app, "calf-encode", argc, argv); rc >= 0) return rc;
+  bool tiles_option_given = false;
+  for (const CLI::Option* opt : app.get_options()) {
+    if (opt->get_name().rfind("--tiles-", 0) == 0 && opt->count() > 0) tiles_option_given = true;
+  }
+  if (mode == "tiles") {
+    if (vs.enabled || !candidates.empty()) {
+      return calf::tools::usage_error("calf-encode",
+                                      "--mode tiles takes no --visible-set or --surfel-candidates");
+    }
+    if (!tiles_levels.empty()) {
+      tiles.build.min_level = tiles_levels[0];
+      tiles.build.max_level = tiles_levels[1];
+    }
+    tiles.build.threads =
+        o.threads > 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency());
+    tiles.encode.threads = o.threads;
+    tiles.encode.atlas_format = tiles_atlas == "rgba8" ? calf::encoder::TilesAtlasFormat::kRgba8
+                                                       : calf::encoder::TilesAtlasFormat::kBc7;
+    tiles.encode.supercompression = super == "lzma2"  ? calf::container::Compression::kLzma2
+                                    : super == "none" ? calf::container::Compression::kNone
+                                                      : calf::container::Compression::kZstd;
+    tiles.quiet = quiet;
+    if (calf::Status s = calf::encoder::validate_tiles_build_options(tiles.build); !s.ok()) {
+      return calf::tools::print_error("calf-encode", s, calf::tools::kExitUsage);
+    }
+    return calf::tools::encode_tiles(manifest, out, tiles);
+  }
+  if (tiles_option_given)
+    return calf::tools::usage_error("calf-encode", "--tiles-* options need --mode tiles");
   if (mode == "surfels") {
     if (candidates.empty() || vs.enabled) {
       return calf::tools::usage_error(

@@ -7,6 +7,7 @@
 #include "calf/format/container.h"
 #include "calf/player/mesh_representation.h"
 #include "calf/player/surfel_representation.h"
+#include "calf/player/tiles_representation.h"
 
 namespace calf::player {
 
@@ -61,11 +62,16 @@ Expected<std::unique_ptr<Playback>> Playback::open(const std::string& clip_path,
                             MeshRepresentation::open(*impl->reader, static_cast<uint16_t>(t),
                                                      options.mesh, backend, gl));
       impl->owned.push_back(std::move(mesh));
+    } else if (std::holds_alternative<container::TilesTrackHeader>(header)) {
+      CALF_ASSIGN_OR_RETURN(std::unique_ptr<TilesRepresentation> tiles,
+                            TilesRepresentation::open(*impl->reader, static_cast<uint16_t>(t),
+                                                      options.tiles, backend, gl));
+      impl->owned.push_back(std::move(tiles));
     }
   }
   if (impl->owned.empty()) {
     return Status(ErrorId::kPlaybackClip,
-                  clip_path + ": no lightfield, mesh or surfels track to play");
+                  clip_path + ": no lightfield, tiles, mesh or surfels track to play");
   }
   impl->volume = impl->owned.front()->view_volume();
   for (const auto& r : impl->owned) {

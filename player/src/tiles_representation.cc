@@ -5,6 +5,9 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <variant>
+
+#include "calf/decoder/tiles_track.h"
 
 namespace calf::player {
 
@@ -62,6 +65,16 @@ Expected<std::unique_ptr<TilesRepresentation>> TilesRepresentation::make(
     impl->atlas = TilesLinearAtlas{};  // on the GPU now
   }
   return std::unique_ptr<TilesRepresentation>(new TilesRepresentation(std::move(impl)));
+}
+
+Expected<std::unique_ptr<TilesRepresentation>> TilesRepresentation::open(
+    const container::Reader& reader, uint16_t track, const TilesOptions& options,
+    RenderBackend backend, const GlFunctions* gl) {
+  CALF_ASSIGN_OR_RETURN(TileSet tiles, decoder::decode_tiles_track(reader, track));
+  const auto& header = std::get<container::TilesTrackHeader>(reader.tracks()[track].header);
+  const double fps =
+      static_cast<double>(header.fps_numerator) / static_cast<double>(header.fps_denominator);
+  return make(std::move(tiles), track, fps, options, backend, gl);
 }
 
 std::string_view TilesRepresentation::kind() const {

@@ -16,6 +16,7 @@
 #include <span>
 #include <string_view>
 
+#include "calf/format/container.h"
 #include "calf/format/status.h"
 #include "calf/format/tile_set.h"
 #include "calf/player/gl_context.h"
@@ -36,6 +37,13 @@ class TilesRepresentation final : public Representation {
   // fps is not > 0), CALF-E478 (options), CALF-E404 / E412 from the GL side.
   static Expected<std::unique_ptr<TilesRepresentation>> make(TileSet tiles, uint16_t track,
                                                              double fps,
+                                                             const TilesOptions& options,
+                                                             RenderBackend backend,
+                                                             const GlFunctions* gl);
+  // Decodes tiles track `track` of `reader` (calf/decoder/tiles_track.h; its errors CALF-E210 -
+  // E213 pass through) and plays it as make() does, at the track's frame rate.
+  static Expected<std::unique_ptr<TilesRepresentation>> open(const container::Reader& reader,
+                                                             uint16_t track,
                                                              const TilesOptions& options,
                                                              RenderBackend backend,
                                                              const GlFunctions* gl);
