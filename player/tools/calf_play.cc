@@ -84,6 +84,13 @@ uint64_t mesh_triangles(const Playback& play) {
 }
 
 // The first surfels track's representation, or nullptr.
+TilesRepresentation* tiles_of(const Playback& play) {
+  for (Representation* r : play.representations()) {
+    if (auto* t = dynamic_cast<TilesRepresentation*>(r)) return t;
+  }
+  return nullptr;
+}
+
 SurfelRepresentation* surfels_of(const Playback& play) {
   for (Representation* r : play.representations()) {
     if (auto* s = dynamic_cast<SurfelRepresentation*>(r)) return s;
@@ -199,6 +206,11 @@ int run_headless(Playback& play, Playback* full, const HeadlessArgs& a) {
             "render %.1f ms",
             k, frame, lf->last_selection().active.size(), st.visible_cells, st.total_cells,
             st.mbps_at_24fps(), st.decode_ms, play.last_render_ms());
+      } else if (const TilesRepresentation* tr = tiles_of(play)) {
+        const TilesFrameStats& ts = tr->last_frame_stats();
+        std::printf("pose %zu frame %u: %zu tiles, overdraw mean %.2f peak %u, render %.1f ms", k,
+                    frame, tr->tile_set().tiles.size(), ts.mean_overdraw(), ts.peak,
+                    play.last_render_ms());
       } else {
         std::printf("pose %zu frame %u: %llu triangles, render %.1f ms", k, frame,
                     static_cast<unsigned long long>(mesh_triangles(play)), play.last_render_ms());
