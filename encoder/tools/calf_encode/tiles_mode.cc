@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <string_view>
+#include <system_error>
 
 #include "calf/capture/capture_set.h"
 #include "calf/format/container.h"
@@ -68,7 +69,9 @@ int encode_tiles(const std::string& input, const std::string& out,
 
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const uint64_t bytes = std::filesystem::file_size(out);
+  std::error_code ec;  // the size is informative: 0 if the file cannot be stat'ed
+  const uintmax_t size = std::filesystem::file_size(out, ec);
+  const uint64_t bytes = ec ? 0 : size;
   std::fprintf(stderr, "%s", encoder::format_tiles_report(report).c_str());
   std::fprintf(
       stderr,
