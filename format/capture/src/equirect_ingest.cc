@@ -1,8 +1,9 @@
 // Equirectangular colour + radial depth -> calf cube faces (format/CAPTURE.md, "Ingest"): colour
-// is the mean of k x k bilinear samples per texel (the equirectangular image oversamples towards
-// its poles, so one sample would alias there), depth the nearest pixel's.
+// is the mean of k x k filtered samples per texel (the equirectangular image oversamples towards
+// its poles, so one sample would alias there), depth the nearest pixel's (or edge-aware bilinear).
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <numbers>
 #include <string>
@@ -103,14 +104,114 @@ Status load(const std::filesystem::path& path, Equirect* e) {
   return Status::Ok();
 }
 
-void resample(const Equirect& e, uint32_t n, uint32_t ss, ViewFrame* out) {
-  const auto wrap = [&](double x) {
-    const double m = std::fmod(x, static_cast<double>(e.w));
-    return static_cast<uint32_t>(m < 0 ? m + e.w : m) % e.w;
-  };
-  const auto clamp_row = [&](double y) {
-    return static_cast<uint32_t>(std::clamp(y, 0.0, static_cast<double>(e.h - 1)));
-  };
+// Reads an equirectangular image between pixel centres: longitude wraps, latitude clamps at the
+// poles' rows.
+class EquirectSampler {
+ public:
+  EquirectSampler(const Equirect& e, EquirectFilter filter, double sharpen)
+      : e_(e), filter_(filter) {
+    if (sharpen > 0) sharpen_pixels(sharpen);
+  }
+
+  // Colour at image position (u, v) (pixel (i, j)'s centre is (i + 0.5, j + 0.5)).
+  void colour(double u, double v, double rgb[3]) const {
+    const double fx = u - 0.5, fy = v - 0.5;
+    const double x0 = std::floor(fx), y0 = std::floor(fy);
+    const double tx = fx - x0, ty = fy - y0;
+    const auto x = static_cast<int64_t>(x0), y = static_cast<int64_t>(y0);
+    rgb[0] = rgb[1] = rgb[2] = 0;
+    if (filter_ == EquirectFilter::kBilinear) {
+      const double wx[2] = {1 - tx, tx}, wy[2] = {1 - ty, ty};
+      for (int b = 0; b < 2; ++b) {
+        for (int a = 0; a < 2; ++a) add(x + a, y + b, wx[a] * wy[b], rgb);
+      }
+      return;
+    }
+    double wx[4], wy[4];
+    catmull_rom(tx, wx);
+    catmull_rom(ty, wy);
+    for (int b = 0; b < 4; ++b) {
+      for (int a = 0; a < 4; ++a) add(x + a - 1, y + b - 1, wx[a] * wy[b], rgb);
+    }
+    for (int c = 0; c < 3; ++c) rgb[c] = std::max(0.0, rgb[c]);
+  }
+
+  // Depth along image position (u, v).
+  float depth(double u, double v, EquirectDepth mode) const {
+    const float nearest =
+        e_.depth[index(static_cast<int64_t>(std::floor(u)), static_cast<int64_t>(std::floor(v)))];
+    if (mode == EquirectDepth::kNearest) return nearest;
+    const double fx = u - 0.5, fy = v - 0.5;
+    const double x0 = std::floor(fx), y0 = std::floor(fy);
+    const double tx = fx - x0, ty = fy - y0;
+    const auto x = static_cast<int64_t>(x0), y = static_cast<int64_t>(y0);
+    float z[4];
+    float lo = INFINITY, hi = 0;
+    for (int k = 0; k < 4; ++k) {
+      z[k] = e_.depth[index(x + (k & 1), y + (k >> 1))];
+      lo = std::min(lo, z[k]);
+      hi = std::max(hi, z[k]);
+    }
+    // Sky (+inf) or two surfaces: no depth between them is real.
+    if (!std::isfinite(hi) || hi > 1.02f * lo) return nearest;
+    return static_cast<float>((1 - ty) * ((1 - tx) * z[0] + tx * z[1]) +
+                              ty * ((1 - tx) * z[2] + tx * z[3]));
+  }
+
+ private:
+  static void catmull_rom(double t, double w[4]) {
+    const double t2 = t * t, t3 = t2 * t;
+    w[0] = 0.5 * (-t + 2 * t2 - t3);
+    w[1] = 0.5 * (2 - 5 * t2 + 3 * t3);
+    w[2] = 0.5 * (t + 4 * t2 - 3 * t3);
+    w[3] = 0.5 * (-t2 + t3);
+  }
+
+  size_t index(int64_t x, int64_t y) const {
+    const int64_t w = e_.w, h = e_.h;
+    const int64_t xm = ((x % w) + w) % w;
+    const int64_t ym = std::clamp<int64_t>(y, 0, h - 1);
+    return static_cast<size_t>(ym * w + xm);
+  }
+
+  void add(int64_t x, int64_t y, double weight, double rgb[3]) const {
+    const float* p = (sharp_.empty() ? e_.rgb.data() : sharp_.data()) + 3 * index(x, y);
+    for (int c = 0; c < 3; ++c) rgb[c] += weight * p[c];
+  }
+
+  // [-a, 1 + 2a, -a] along x, then along y (variance -2a pixel^2; a one-pixel box's is +1/12).
+  void sharpen_pixels(double a) {
+    const size_t n = size_t{e_.w} * e_.h;
+    std::vector<float> row(3 * n);
+    for (int64_t y = 0; y < e_.h; ++y) {
+      for (int64_t x = 0; x < e_.w; ++x) {
+        for (int c = 0; c < 3; ++c) {
+          const double l = e_.rgb[3 * index(x - 1, y) + c], m = e_.rgb[3 * index(x, y) + c],
+                       r = e_.rgb[3 * index(x + 1, y) + c];
+          row[3 * index(x, y) + c] = static_cast<float>((1 + 2 * a) * m - (l + r) * a);
+        }
+      }
+    }
+    sharp_.resize(3 * n);
+    for (int64_t y = 0; y < e_.h; ++y) {
+      for (int64_t x = 0; x < e_.w; ++x) {
+        for (int c = 0; c < 3; ++c) {
+          const double t = row[3 * index(x, y - 1) + c], m = row[3 * index(x, y) + c],
+                       b = row[3 * index(x, y + 1) + c];
+          sharp_[3 * index(x, y) + c] = static_cast<float>((1 + 2 * a) * m - (t + b) * a);
+        }
+      }
+    }
+  }
+
+  const Equirect& e_;
+  EquirectFilter filter_;
+  std::vector<float> sharp_;  // the sharpened colour (empty: none)
+};
+
+void resample(const Equirect& e, uint32_t n, const IngestOptions& options, ViewFrame* out) {
+  const EquirectSampler sampler(e, options.equirect_filter, options.equirect_sharpen);
+  const uint32_t ss = options.supersample;
   for (int f = 0; f < kCubeFaceCount; ++f) {
     const CubeFace face = cube_face_from_index(f);
     for (uint32_t y = 0; y < n; ++y) {
@@ -120,27 +221,17 @@ void resample(const Equirect& e, uint32_t n, uint32_t ss, ViewFrame* out) {
           for (uint32_t a = 0; a < ss; ++a) {
             const Vec3 d =
                 direction_from_texel_coord({face, x + (a + 0.5) / ss, y + (b + 0.5) / ss}, n);
-            double u, v;
+            double u, v, rgb[3];
             equirect_from_direction(d, e.w, e.h, &u, &v);
-            const double fx = u - 0.5, fy = v - 0.5;
-            const double x0 = std::floor(fx), y0 = std::floor(fy);
-            const double tx = fx - x0, ty = fy - y0;
-            const uint32_t xa = wrap(x0), xb = wrap(x0 + 1);
-            const uint32_t ya = clamp_row(y0), yb = clamp_row(y0 + 1);
-            for (int c = 0; c < 3; ++c) {
-              const auto at = [&](uint32_t i, uint32_t j) {
-                return static_cast<double>(e.rgb[3 * (size_t{j} * e.w + i) + c]);
-              };
-              sum[c] += (1 - ty) * ((1 - tx) * at(xa, ya) + tx * at(xb, ya)) +
-                        ty * ((1 - tx) * at(xa, yb) + tx * at(xb, yb));
-            }
+            sampler.colour(u, v, rgb);
+            for (int c = 0; c < 3; ++c) sum[c] += rgb[c];
           }
         }
         const size_t t = out->texel_index(face, x, y);
         for (int c = 0; c < 3; ++c) out->color[3 * t + c] = static_cast<float>(sum[c] / (ss * ss));
         double u, v;
         equirect_from_direction(direction_from_texel(face, x, y, n), e.w, e.h, &u, &v);
-        out->depth[t] = e.depth[size_t{clamp_row(std::floor(v))} * e.w + wrap(std::floor(u))];
+        out->depth[t] = sampler.depth(u, v, options.equirect_depth);
       }
     }
   }
@@ -155,6 +246,10 @@ Status ingest_equirect(const std::filesystem::path& manifest_path,
   if (options.supersample < 1 || options.supersample > 8) {
     return Status(ErrorId::kInvalidArgument,
                   "supersample " + std::to_string(options.supersample) + " is outside 1..8");
+  }
+  if (!(options.equirect_sharpen >= 0 && options.equirect_sharpen <= 0.25)) {
+    return Status(ErrorId::kInvalidArgument,
+                  "sharpen " + std::to_string(options.equirect_sharpen) + " is outside 0..0.25");
   }
   CALF_ASSIGN_OR_RETURN(std::string text, read_small_file(manifest_path));
   CALF_ASSIGN_OR_RETURN(CaptureManifest input, parse_equirect_manifest(text, source));
@@ -177,7 +272,7 @@ Status ingest_equirect(const std::filesystem::path& manifest_path,
       Status s;
       if (v != 0 || f != 0) s = load(dir / capture_file_name(input, v, f), &image);
       if (s.ok()) {
-        resample(image, m.face_size, options.supersample, &frame);
+        resample(image, m.face_size, options, &frame);
         s = writer.write(v, f, frame);
       }
       if (!s.ok()) {

@@ -22,7 +22,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.fallthrough();  // --quiet may follow the subcommand
   calf::capture::IngestOptions options;
-  std::string manifest, out;
+  std::string manifest, out, filter = "catmull-rom", depth = "nearest";
   bool quiet = false;
   app.add_flag("--quiet", quiet, "print no summary line (default: print one)");
 
@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
 
   CLI::App* equirect =
       app.add_subcommand("equirect",
-                         "equirectangular set -> capture set: colour is the mean of k x k bilinear "
+                         "equirectangular set -> capture set: colour is the mean of k x k filtered "
                          "samples per texel, depth the nearest pixel's.");
   equirect
       ->add_option("MANIFEST", manifest,
@@ -69,8 +69,29 @@ int main(int argc, char** argv) {
       ->add_option("--supersample", options.supersample,
                    "colour samples per texel side (k x k); default 2")
       ->check(CLI::Range(1, 8));
+  equirect
+      ->add_option("--filter", filter,
+                   "how a colour sample reads the (sharpened) image: catmull-rom (default: "
+                   "bicubic over 4 x 4 pixels, clamped at 0) or bilinear (softer)")
+      ->check(CLI::IsMember({"catmull-rom", "bilinear"}));
+  equirect
+      ->add_option("--sharpen", options.equirect_sharpen,
+                   "sharpen each pixel by [-a, 1 + 2a, -a] per axis before sampling, undoing the "
+                   "renderer's pixel box (1/24 undoes it to second order); default 0.125, "
+                   "measured best on the interior scene; 0 = none")
+      ->check(CLI::Range(0.0, 0.25));
+  equirect
+      ->add_option("--depth", depth,
+                   "how a texel's depth is read: nearest (default: the nearest pixel's, never a "
+                   "depth between two surfaces) or edge-aware (bilinear where the 2 x 2 nearest "
+                   "pixels agree within 2 %, else nearest)")
+      ->check(CLI::IsMember({"nearest", "edge-aware"}));
 
   if (int rc = calf::tools::parse_command_line(app, "calf-ingest", argc, argv); rc >= 0) return rc;
+  options.equirect_filter = filter == "bilinear" ? calf::capture::EquirectFilter::kBilinear
+                                                 : calf::capture::EquirectFilter::kCatmullRom;
+  options.equirect_depth = depth == "edge-aware" ? calf::capture::EquirectDepth::kEdgeAware
+                                                 : calf::capture::EquirectDepth::kNearest;
   calf::capture::IngestReport report;
   const bool is_seurat = seurat->parsed();
   const calf::Status s = is_seurat

@@ -12,12 +12,13 @@
 // Both write a capture set with CaptureSetWriter: every file whole, manifest.json last.
 //
 // Sampling: every calf texel takes the ray through its centre (calf/format/cube.h). Colour is
-// filtered (bilinear in the source image; equirectangular input also supersamples each texel),
-// depth is the nearest source pixel's, so no depth is ever invented between a foreground and a
-// background. Where a Seurat view's pixel centre falls on calf's texel centre (within 1e-3 of a
-// pixel: a group that is an exact cube map of the same size, whatever its face order or
-// orientation, even with matrices rounded to float), the sample is that pixel's, bit for bit:
-// the conversion is then a permutation of pixels.
+// filtered (bilinear in a Seurat view; in an equirectangular image sharpened, then Catmull-Rom
+// by default, and supersampled per texel), depth is the nearest source pixel's (equirectangular:
+// optionally edge-aware), so no depth is ever invented between a foreground and a background. Where
+// a Seurat view's pixel centre falls on calf's texel centre (within 1e-3 of a pixel: a group that
+// is an exact cube map of the same size, whatever its face order or orientation, even with matrices
+// rounded to float), the sample is that pixel's, bit for bit: the conversion is then a permutation
+// of pixels.
 #pragma once
 
 #include <array>
@@ -65,6 +66,22 @@ struct SeuratCapture {
 // channel names, image paths). Errors: E130 syntax, E143 fields; `source` prefixes messages.
 Expected<SeuratCapture> parse_seurat_manifest(std::string_view json, std::string_view source);
 
+// How an equirectangular colour sample between pixel centres is read (after the sharpening of
+// IngestOptions::equirect_sharpen).
+enum class EquirectFilter : uint8_t {
+  kBilinear,    // the 2 x 2 nearest pixels (a tent: softer)
+  kCatmullRom,  // Catmull-Rom bicubic over the 4 x 4 nearest pixels; a sample below zero (the
+                // kernel's lobes next to an HDR edge) is clamped to zero
+};
+
+// How an equirectangular texel's depth is read.
+enum class EquirectDepth : uint8_t {
+  kNearest,  // the nearest pixel's: no depth is ever invented between a foreground and background
+  // Bilinear between the 2 x 2 nearest pixels where their depths agree within 2 % (one surface),
+  // else the nearest pixel's: smooth surfaces lose the half-pixel position error of kNearest.
+  kEdgeAware,
+};
+
 struct IngestOptions {
   // Texels per cube face side; 0 chooses it from the input: Seurat, the largest pixel density at
   // any view's centre (an exact cube map keeps its size); equirectangular, round(width / pi),
@@ -75,8 +92,18 @@ struct IngestOptions {
   double headbox_size = 0;
   // Seurat: frames per second written to the manifest (a Seurat capture is one frame).
   double fps = 30;
-  // Equirectangular: colour samples per texel side (k x k bilinear samples), 1..8.
+  // Equirectangular: colour samples per texel side (k x k samples of the filter below), 1..8.
   uint32_t supersample = 2;
+  // Equirectangular: how a colour sample reads the image (EquirectFilter).
+  EquirectFilter equirect_filter = EquirectFilter::kCatmullRom;
+  // Equirectangular: each pixel is first sharpened by [-a, 1 + 2a, -a] along each axis, 0..0.25.
+  // An anti-aliased renderer's pixel is a box average; resampling it into cube texels blurs by that
+  // box once more, which a = 1/24 undoes to second order. The default 1/8 is measured: the
+  // interior scene at faces of 16 and 64 played closest to its native capture there (CAPTURE.md
+  // "Ingest").
+  double equirect_sharpen = 0.125;
+  // Equirectangular: how a texel's depth is read (EquirectDepth).
+  EquirectDepth equirect_depth = EquirectDepth::kNearest;
 };
 
 // What a conversion did, for the command's summary line.
