@@ -4,9 +4,12 @@
 #   1. calf-capture: one frame of SCENE (a built-in or a model file) at FACE² faces (converged
 #      defaults unless CAPTURE_OPTS says otherwise);
 #   2. calf-encode: the light-field clip and the tiles clip (TILES_OPTS, e.g. --tiles-triangles);
-#   3. ground truth at the capture viewpoints (Seurat's protocol: every viewpoint, 4 horizontal
-#      directions at 90° x 90°) and along the scene's eye path with the scene held at frame 0
-#      (novel views inside the view region);
+#   3. ground truth at the capture viewpoints (Seurat's protocol, Sec. 6: re-render each capture
+#      viewpoint and compare with the captured samples: here its 6 cube faces at 90° x 90° and the
+#      capture's own FACE² resolution, so every pixel is a capture texel, rendered again by
+#      calf-capture with the capture's sampling; the noise floor says how far two renders of the
+#      same samples differ) and along the scene's eye path at GT_SIZE with the scene held at
+#      frame 0 (novel views inside the view region);
 #   4. calf-play --headless --compare of both clips against both: PSNR / SSIM with the noise floor.
 # Usage: tools/tiles_eval.sh BUILD_DIR OUT_DIR [SCENE] [FACE] [GT_SIZE]
 # Environment: CAPTURE_OPTS (extra calf-capture options, e.g. "--rig box:..."), TILES_OPTS (extra
@@ -34,23 +37,25 @@ timed "$BUILD"/calf-encode --mode tiles "$OUT/capture" -o "$OUT/tiles.calf" --qu
   "${tiles_opts[@]}" 2>"$OUT/tiles.log"
 TL_S=$(cat "$OUT/.t")
 
-# The capture viewpoints' eye path: 4 horizontal directions of 90° from every viewpoint.
-W=${GT%x*}
-awk -v w="$W" '
+# The capture viewpoints' eye path: the 6 cube faces of every viewpoint (calf/format/cube.h's
+# upright_face: forward and up per face), FACE x FACE at 90°.
+awk -v w="$FACE" '
   /"position": \[/ { inpos = 1; n = 0; next }
   inpos && /\]/ { inpos = 0; views[++count] = p[1] " " p[2] " " p[3]; next }
   inpos { gsub(/[ ,]/, ""); p[++n] = $0 }
   END {
     printf "{\n  \"format\": \"calf-eye-path\",\n  \"version\": 1,\n  \"width\": %d,\n  \"height\": %d,\n  \"poses\": [\n", w, w
-    split("1 0 0|0 0 1|-1 0 0|0 0 -1", dirs, "|")
+    split("1 0 0;0 1 0|-1 0 0;0 1 0|0 1 0;0 0 -1|0 -1 0;0 0 1|0 0 1;0 1 0|0 0 -1;0 1 0", dirs, "|")
     first = 1
     for (v = 1; v <= count; ++v) {
       split(views[v], q, " ")
-      for (d = 1; d <= 4; ++d) {
+      for (d = 1; d <= 6; ++d) {
         if (!first) printf ",\n"
         first = 0
-        split(dirs[d], f, " ")
-        printf "    {\"time\": 0, \"position\": [%s, %s, %s], \"forward\": [%s, %s, %s], \"fov_y_degrees\": 90}", q[1], q[2], q[3], f[1], f[2], f[3]
+        split(dirs[d], fu, ";")
+        split(fu[1], f, " ")
+        split(fu[2], u, " ")
+        printf "    {\"time\": 0, \"position\": [%s, %s, %s], \"forward\": [%s, %s, %s], \"up\": [%s, %s, %s], \"fov_y_degrees\": 90}", q[1], q[2], q[3], f[1], f[2], f[3], u[1], u[2], u[3]
       }
     }
     printf "\n  ]\n}\n"

@@ -58,6 +58,9 @@ Status validate_tiles_build_options(const TilesBuildOptions& o) {
   if (o.merge_resolution > 16384) {
     return bad_option(sformat("merge_resolution %u is above 16384", o.merge_resolution));
   }
+  if (o.min_cell_texels > 16384) {
+    return bad_option(sformat("min_cell_texels %u is above 16384", o.min_cell_texels));
+  }
   if (o.max_level > 10 || o.min_level > o.max_level) {
     return bad_option(sformat("levels %u .. %u are not 0 <= min_level <= max_level <= 10",
                               o.min_level, o.max_level));
@@ -113,11 +116,17 @@ Status validate_tiles_build_options(const TilesBuildOptions& o) {
 }
 
 Expected<TileSet> build_tiles(const capture::CaptureSetReader& reader, uint32_t frame,
-                              const TilesBuildOptions& options, TilesBuildReport* report) {
+                              const TilesBuildOptions& requested, TilesBuildReport* report) {
   using namespace tiles;
   const auto t_start = std::chrono::steady_clock::now();
-  CALF_RETURN_IF_ERROR(validate_tiles_build_options(options));
+  CALF_RETURN_IF_ERROR(validate_tiles_build_options(requested));
   const capture::CaptureManifest& m = reader.manifest();
+  TilesBuildOptions options = requested;
+  if (options.min_cell_texels > 0) {
+    uint32_t level = 0;
+    while (level < 10 && (m.face_size >> (level + 1)) >= options.min_cell_texels) ++level;
+    options.max_level = std::max(options.min_level, std::min(options.max_level, level));
+  }
   if (frame >= m.frame_count) {
     return Status(ErrorId::kTilesFrame,
                   sformat("%s: frame %u is outside the capture set's %u frames (0 .. %u)",
@@ -131,6 +140,8 @@ Expected<TileSet> build_tiles(const capture::CaptureSetReader& reader, uint32_t 
   TilesBuildReport r;
   r.views = static_cast<uint32_t>(m.viewpoints.size());
   r.face_size = m.face_size;
+  r.min_level = options.min_level;
+  r.max_level = options.max_level;
   r.max_triangles = options.max_triangles;
   r.max_average_overdraw = options.max_average_overdraw;
   r.max_peak_overdraw = options.max_peak_overdraw;
@@ -252,9 +263,9 @@ std::string format_tiles_report(const TilesBuildReport& r) {
   std::string s;
   s += sformat("input      %u views x 6 x %u^2, %llu samples -> %llu merged points\n", r.views,
                r.face_size, (unsigned long long)r.samples, (unsigned long long)r.merged_points);
-  s += sformat("candidates %llu cells, %llu tilings, %llu tiles\n",
-               (unsigned long long)r.candidate_cells, (unsigned long long)r.candidate_tilings,
-               (unsigned long long)r.candidate_tiles);
+  s += sformat("candidates %llu cells at levels %u .. %u, %llu tilings, %llu tiles\n",
+               (unsigned long long)r.candidate_cells, r.min_level, r.max_level,
+               (unsigned long long)r.candidate_tilings, (unsigned long long)r.candidate_tiles);
   s += sformat(
       "selection  %u tiles, %u triangles (bound %u), distortion %.6g (dual bound %.6g), "
       "%u evaluations\n",
