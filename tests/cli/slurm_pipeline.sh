@@ -28,6 +28,9 @@ T=$(mktemp -d /tmp/calf-slurm.XXXXXX)
 pids=()
 cleanup() {
   local rc=$?
+  # Stopping the watchdog ends its sleep, after which it may still send its TERM: ignored from
+  # here on (that race once turned a PASS into "FAIL: interrupted" as the test exited).
+  trap '' INT TERM HUP
   if [[ -n ${watchdog:-} ]]; then pkill -P "$watchdog" 2>/dev/null; kill "$watchdog" 2>/dev/null; fi
   for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
   [[ -f $T/munge/munged.pid ]] && kill "$(cat "$T/munge/munged.pid")" 2>/dev/null
