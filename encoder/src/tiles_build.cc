@@ -125,7 +125,8 @@ Expected<TileSet> build_tiles(const capture::CaptureSetReader& reader, uint32_t 
   if (options.min_cell_texels > 0) {
     uint32_t level = 0;
     while (level < 10 && (m.face_size >> (level + 1)) >= options.min_cell_texels) ++level;
-    options.max_level = std::max(options.min_level, std::min(options.max_level, level));
+    level = std::max(level, options.min_level + 1);
+    options.max_level = std::min(options.max_level, level);
   }
   if (frame >= m.frame_count) {
     return Status(ErrorId::kTilesFrame,

@@ -396,9 +396,10 @@ int main(int argc, char** argv) {
         ->expected(2);
     app.add_option("--tiles-min-cell-texels", b.min_cell_texels,
                    "tiles: leaves are never finer than this many capture texels across (the "
-                   "leaf level becomes min(MAX, log2(face size / N)), not below MIN); 0 = off "
-                   "(default 4: finer cells hold a point or two and carve into holes)")
-        ->default_val(4)
+                   "leaf level becomes min(MAX, log2(face size / N)), at least MIN + 1); 0 = off "
+                   "(default 8: Seurat's levels 3-7 at 1024² faces; finer leaves carve into "
+                   "holes or let coarse many-layer cells win)")
+        ->default_val(8)
         ->check(CLI::Range(0u, 16384u));
     app.add_option("--tiles-planes", b.max_planes,
                    "tiles: K, most planes (tiles) per cell, 1..16 (default 8)")

@@ -170,13 +170,16 @@ TEST(TilesBuild, LeavesAreNeverFinerThanMinCellTexels) {
   TilesBuildReport r;
   ASSERT_TRUE(build(o, &r).ok());
   EXPECT_EQ(r.max_level, 5u);  // off: the levels asked for
-  o.min_cell_texels = 4;       // the default: 32 / 2^3 = 4 texels across
+  o.min_cell_texels = 4;       // 32 / 2^3 = 4 texels across
   TilesBuildReport capped;
   auto set = build(o, &capped);
   ASSERT_TRUE(set.ok()) << set.status().to_string();
   EXPECT_EQ(capped.min_level, 2u);
   EXPECT_EQ(capped.max_level, 3u);
-  o.min_cell_texels = 64;  // coarser than the roots: the roots are the leaves
+  o.min_cell_texels = 64;  // coarser than the roots: still one level below them
+  ASSERT_TRUE(build(o, &capped).ok());
+  EXPECT_EQ(capped.max_level, 3u);
+  o.max_level = 2;  // ... unless max_level says otherwise
   ASSERT_TRUE(build(o, &capped).ok());
   EXPECT_EQ(capped.max_level, 2u);
 }
