@@ -158,7 +158,7 @@ TEST(TilesBuild, OverdrawIsReportedWithinItsBounds) {
   // The bounds bind here, so the multipliers are searched: the selection kept must stay near the
   // dual bound (measured 0.000677 against 0.000528). Before the periodic repair and the step
   // target at the best dual value it kept 0.00172 against 0.00058, and on the interior scene with
-  // --tiles-dilation 0.03 a degenerate selection (2051 against 0.119) that rendered with holes.
+  // --tiles-dilation 0.03 a degenerate selection (2051 against 0.119).
   std::printf("tight bounds: distortion %g, dual bound %g, %u evaluations\n", r.distortion,
               r.dual_bound, r.selection_evaluations);
   EXPECT_GT(r.selection_evaluations, 3u);
