@@ -125,14 +125,15 @@ class EquirectSampler {
       for (int b = 0; b < 2; ++b) {
         for (int a = 0; a < 2; ++a) add(x + a, y + b, wx[a] * wy[b], rgb);
       }
-      return;
+    } else {
+      double wx[4], wy[4];
+      catmull_rom(tx, wx);
+      catmull_rom(ty, wy);
+      for (int b = 0; b < 4; ++b) {
+        for (int a = 0; a < 4; ++a) add(x + a - 1, y + b - 1, wx[a] * wy[b], rgb);
+      }
     }
-    double wx[4], wy[4];
-    catmull_rom(tx, wx);
-    catmull_rom(ty, wy);
-    for (int b = 0; b < 4; ++b) {
-      for (int a = 0; a < 4; ++a) add(x + a - 1, y + b - 1, wx[a] * wy[b], rgb);
-    }
+    // The kernel's lobes (and the sharpening's) undershoot next to an HDR edge.
     for (int c = 0; c < 3; ++c) rgb[c] = std::max(0.0, rgb[c]);
   }
 

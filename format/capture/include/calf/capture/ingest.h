@@ -67,11 +67,11 @@ struct SeuratCapture {
 Expected<SeuratCapture> parse_seurat_manifest(std::string_view json, std::string_view source);
 
 // How an equirectangular colour sample between pixel centres is read (after the sharpening of
-// IngestOptions::equirect_sharpen).
+// IngestOptions::equirect_sharpen). Either way a sample below zero (the kernel's or the
+// sharpening's lobes next to an HDR edge) is clamped to zero.
 enum class EquirectFilter : uint8_t {
   kBilinear,    // the 2 x 2 nearest pixels (a tent: softer)
-  kCatmullRom,  // Catmull-Rom bicubic over the 4 x 4 nearest pixels; a sample below zero (the
-                // kernel's lobes next to an HDR edge) is clamped to zero
+  kCatmullRom,  // Catmull-Rom bicubic over the 4 x 4 nearest pixels
 };
 
 // How an equirectangular texel's depth is read.
