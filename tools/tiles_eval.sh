@@ -37,8 +37,9 @@ timed "$BUILD"/calf-encode --mode tiles "$OUT/capture" -o "$OUT/tiles.calf" --qu
   "${tiles_opts[@]}" 2>"$OUT/tiles.log"
 TL_S=$(cat "$OUT/.t")
 
-# The capture viewpoints' eye path: the 6 cube faces of every viewpoint (calf/format/cube.h's
-# upright_face: forward and up per face), FACE x FACE at 90°.
+# The capture viewpoints' eye path: 6 axis-aligned 90° views of every viewpoint at FACE x FACE, so
+# each pixel centre is a capture texel centre. Any up vector along a face axis would do (the image
+# only turns); these are upright, +Y up except looking up or down.
 awk -v w="$FACE" '
   /"position": \[/ { inpos = 1; n = 0; next }
   inpos && /\]/ { inpos = 0; views[++count] = p[1] " " p[2] " " p[3]; next }
