@@ -100,6 +100,13 @@ Status validate_tiles_build_options(const TilesBuildOptions& o) {
   if (!(o.solid_threshold > 0 && o.solid_threshold < 1)) {
     return bad_option(sformat("solid_threshold %g is outside (0, 1)", o.solid_threshold));
   }
+  if (o.texture_solve_iterations > 1000) {
+    return bad_option(
+        sformat("texture_solve_iterations %u is above 1000", o.texture_solve_iterations));
+  }
+  if (!(o.texture_smoothness >= 0 && o.texture_smoothness <= 100)) {
+    return bad_option(sformat("texture_smoothness %g is outside [0, 100]", o.texture_smoothness));
+  }
   if (o.alpha_supersampling < 1 || o.alpha_supersampling > 8) {
     return bad_option(sformat("alpha_supersampling %u is outside [1, 8]", o.alpha_supersampling));
   }

@@ -124,6 +124,25 @@ struct TileTexture {
   uint32_t side = 0;        // texels per side (corners on texel centres)
   std::vector<float> rgba;  // side * side * 4: linear RGB (not premultiplied), alpha
 };
+// --- least-squares colour (tiles_texture_solve.cc) ---
+// The normal equations of one tile's colour fit, accumulated sample by sample: per texel the
+// diagonal and four of its eight couplings (the others are the neighbours' entries), and the
+// right-hand side per channel.
+struct TileNormals {
+  enum : int { kDiag = 0, kRight = 1, kDown = 2, kDownRight = 3, kDownLeft = 4 };
+  uint32_t side = 0;
+  std::vector<float> coupling;  // side * side * 5
+  std::vector<float> rhs;       // side * side * 3
+  void reset(uint32_t side);
+  // A sample of linear RGB `colour` at texture position (u, w) in texels (corners on centres).
+  void add(double u, double w, const float* colour);
+};
+// Refines `rgba` (side * side * 4, the splat's colour as the start) towards the texel values whose
+// bilinear interpolation best fits the samples, with a membrane term of weight `smoothness` times
+// the tile's mean diagonal; `iterations` conjugate-gradient steps (0: leaves rgba as it is).
+void solve_tile_colour(const TileNormals& normals, double smoothness, uint32_t iterations,
+                       float* rgba);
+
 // The scene-space (relative to O) corners of a selected tile.
 std::array<Vec3, 4> tile_corners(const Selected& t, double dilation);
 Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader& reader,

@@ -2,19 +2,28 @@
 //
 // A tile's texture covers its dilated cell in face coordinates (s, t), so texture space is the
 // cube face's own (projective from O); corners sit on texel centres. Per capture view:
-//   - Solid constraints (scatter): each sample is projected from O onto the tiles of its cell; the
-//     tile whose plane is nearest in relative radius (t_hit nearest 1) gets a primary solid
-//     constraint and the sample's colour (a bilinear splat), others within solid_threshold get
-//     secondary ones (Seurat's crack mitigation at intersecting tiles).
-//   - Free-space constraints (gather): each alpha supersample of each tile is looked up in the
-//     view; when the view's ray passes it more than solid_threshold before reaching its surface
-//     (or reaches no surface), and that surface's primary tile is another tile, the supersample is
-//     free space. Seurat traces each sample's ray through the tiles; gathering per supersample
-//     asks the same question and costs one depth look-up.
-// Supersamples holding both kinds are dropped (ambiguous); every supersample then takes the class
-// of its nearest constraint (a two-pass chamfer transform), and a texel's alpha is the share of
-// its supersamples that are solid. Texels no sample coloured are filled from their neighbours
-// (iterated averaging; Seurat solves a Laplace equation by multigrid).
+//   - Colour (scatter): each sample is projected from O onto the tiles of its cell; the tile whose
+//     plane is nearest in relative radius (t_hit nearest 1) is its primary tile and gets the
+//     sample's colour, and so do the others within solid_threshold (Seurat's crack mitigation at
+//     intersecting tiles): a bilinear splat, then the least-squares fit of
+//     tiles_texture_solve.cc, which undoes the renderer's bilinear magnification instead of
+//     adding a second blur.
+//   - Alpha (gather): each alpha supersample of each tile is looked up in the view. The view's ray
+//     passes it more than solid_threshold before reaching its surface (or reaches no surface), and
+//     that surface's primary tile is another tile: the view sees through the tile there. The
+//     view's surface lies within solid_threshold of it and its primary tile is this tile: the
+//     view sees the tile's own surface there. Seurat traces each sample's ray through the tiles;
+//     gathering per supersample asks the same question and costs one depth look-up.
+// Alpha from view votes (the default): a supersample's alpha is the share of the views that saw
+// the tile's surface there among those that saw it or saw through it. Each view's silhouette is a
+// staircase of its own pixels at its own sub-pixel offset, so the share is an anti-aliased edge
+// where the hard constraints below are a jagged one.
+// Alpha from constraints (Seurat's): the primary and secondary tiles of each sample get a solid
+// constraint at the sample's position, seeing through gives free-space ones; supersamples holding
+// both are dropped (ambiguous), every supersample takes the class of its nearest constraint (a
+// two-pass chamfer transform), and a texel's alpha is the share of its supersamples that are solid.
+// Texels no sample coloured are filled from their neighbours (iterated averaging, then the fit's
+// membrane term; Seurat solves a Laplace equation by multigrid).
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -89,8 +98,85 @@ TileFrame tile_frame(const Selected& t, double dilation) {
 
 struct TileWork {
   std::vector<float> colour;   // side^2 x (r, g, b, weight)
-  std::vector<uint8_t> marks;  // (side S)^2: bit 0 solid, bit 1 free
+  std::vector<uint8_t> marks;  // constraints: (side S)^2, bit 0 solid, bit 1 free
+  std::vector<uint8_t> votes;  // view votes: (side S)^2 x (solid, free), saturating at 255
+  TileNormals normals;         // the least-squares fit's (when texture_solve_iterations > 0)
 };
+
+// A two-pass 3-4 chamfer transform over a g x g grid: `relax(i, from, cost)` offers cell i the
+// seed reached through its neighbour `from` at that step cost. Both alpha estimates use it to give
+// every supersample without a constraint or vote the value of its nearest one.
+template <class Relax>
+void chamfer(uint32_t g, Relax relax) {
+  for (uint32_t y = 0; y < g; ++y) {
+    for (uint32_t x = 0; x < g; ++x) {
+      const size_t i = size_t{y} * g + x;
+      if (x > 0) relax(i, i - 1, 3);
+      if (y > 0) {
+        relax(i, i - g, 3);
+        if (x > 0) relax(i, i - g - 1, 4);
+        if (x + 1 < g) relax(i, i - g + 1, 4);
+      }
+    }
+  }
+  for (uint32_t y = g; y-- > 0;) {
+    for (uint32_t x = g; x-- > 0;) {
+      const size_t i = size_t{y} * g + x;
+      if (x + 1 < g) relax(i, i + 1, 3);
+      if (y + 1 < g) {
+        relax(i, i + g, 3);
+        if (x + 1 < g) relax(i, i + g + 1, 4);
+        if (x > 0) relax(i, i + g - 1, 4);
+      }
+    }
+  }
+}
+
+// Alpha per supersample from Seurat's constraints: supersamples holding both kinds are dropped,
+// the others take the class of the nearest constraint; 1 solid, 0 free.
+std::vector<float> coverage_from_constraints(const std::vector<uint8_t>& marks, uint32_t g) {
+  std::vector<uint32_t> dist(size_t{g} * g, UINT32_MAX);
+  std::vector<uint8_t> label(size_t{g} * g, 0);  // 1 solid, 2 free, 0 none
+  for (size_t i = 0; i < dist.size(); ++i) {
+    if (marks[i] == 1 || marks[i] == 2) {
+      dist[i] = 0;
+      label[i] = marks[i];
+    }
+  }
+  chamfer(g, [&](size_t i, size_t from, uint32_t cost) {
+    if (dist[from] == UINT32_MAX) return;
+    const uint32_t d = dist[from] + cost;
+    // Ties go to solid: a crack costs more than a sliver.
+    if (d < dist[i] || (d == dist[i] && label[from] == 1 && label[i] == 2)) {
+      dist[i] = d;
+      label[i] = label[from];
+    }
+  });
+  std::vector<float> cover(size_t{g} * g);
+  for (size_t i = 0; i < cover.size(); ++i) cover[i] = label[i] == 1 ? 1.0f : 0.0f;
+  return cover;
+}
+
+// Alpha per supersample from the views' votes: the share of the views that saw the tile's surface
+// there among those that saw it or saw through it; supersamples no view voted on take their
+// nearest voted one's share.
+std::vector<float> coverage_from_votes(const std::vector<uint8_t>& votes, uint32_t g) {
+  std::vector<uint32_t> dist(size_t{g} * g, UINT32_MAX);
+  std::vector<float> cover(size_t{g} * g, 0.0f);
+  for (size_t i = 0; i < cover.size(); ++i) {
+    const uint32_t solid = votes[2 * i], free = votes[2 * i + 1];
+    if (solid + free > 0) {
+      cover[i] = float(solid) / float(solid + free);
+      dist[i] = 0;
+    }
+  }
+  chamfer(g, [&](size_t i, size_t from, uint32_t cost) {
+    if (dist[from] == UINT32_MAX || dist[from] + cost >= dist[i]) return;
+    dist[i] = dist[from] + cost;
+    cover[i] = cover[from];
+  });
+  return cover;
+}
 
 }  // namespace
 
@@ -103,6 +189,7 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
   const uint32_t n = manifest.face_size;
   const uint32_t ss = options.alpha_supersampling;
   const double thresh = options.solid_threshold;
+  const bool votes = options.alpha_estimate == TilesAlphaEstimate::kViewVotes;
   const size_t count = selection.tiles.size();
   CellLookup lookup(selection, options);
   std::vector<TileFrame> frames(count);
@@ -110,7 +197,13 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
   for (size_t k = 0; k < count; ++k) {
     frames[k] = tile_frame(selection.tiles[k], options.tile_dilation);
     work[k].colour.assign(size_t{sides[k]} * sides[k] * 4, 0.0f);
-    work[k].marks.assign(size_t{sides[k]} * ss * sides[k] * ss, 0);
+    const size_t supersamples = size_t{sides[k]} * ss * sides[k] * ss;
+    if (votes) {
+      work[k].votes.assign(2 * supersamples, 0);
+    } else {
+      work[k].marks.assign(supersamples, 0);
+    }
+    if (options.texture_solve_iterations > 0) work[k].normals.reset(sides[k]);
   }
 
   const size_t texels = size_t{6} * n * n;
@@ -175,13 +268,14 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
         const uint32_t g = side * ss;
         const int sx = std::clamp(static_cast<int>(std::floor((u + 0.5) * ss)), 0, int(g) - 1);
         const int sy = std::clamp(static_cast<int>(std::floor((w + 0.5) * ss)), 0, int(g) - 1);
-        work[k].marks[size_t(sy) * g + sx] |= 1;
+        if (!votes) work[k].marks[size_t(sy) * g + sx] |= 1;
         // Bilinear splat of the colour onto the four nearest texel centres.
         const double fu = std::clamp(u, 0.0, side - 1.0), fw = std::clamp(w, 0.0, side - 1.0);
         const uint32_t x0 = std::min<uint32_t>(static_cast<uint32_t>(fu), side - 2);
         const uint32_t y0 = std::min<uint32_t>(static_cast<uint32_t>(fw), side - 2);
         const double ax = fu - x0, ay = fw - y0;
         const float* c = &view.color[3 * t];
+        if (options.texture_solve_iterations > 0) work[k].normals.add(u, w, c);
         for (int dy = 0; dy < 2; ++dy) {
           for (int dx = 0; dx < 2; ++dx) {
             const double wgt = (dx ? ax : 1 - ax) * (dy ? ay : 1 - ay);
@@ -219,7 +313,16 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
           const float depth = view.depth[t];
           const bool through =
               !std::isfinite(depth) || (len < depth * (1.0 - thresh) && primary[t] != int32_t(k));
-          if (through) work[k].marks[size_t{sy} * g + sx] |= 2;
+          if (!votes) {
+            if (through) work[k].marks[size_t{sy} * g + sx] |= 2;
+            continue;
+          }
+          // The view saw this tile's own surface here (its sample's primary tile is this one).
+          const bool on = std::isfinite(depth) && std::abs(len - depth) <= thresh * depth &&
+                          primary[t] == int32_t(k);
+          uint8_t* vote = &work[k].votes[2 * (size_t{sy} * g + sx)];
+          if (on && vote[0] < 255) ++vote[0];
+          if (through && vote[1] < 255) ++vote[1];
         }
       }
     });
@@ -231,61 +334,21 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
   parallel_for(options.threads, count, [&](size_t k) {
     const uint32_t side = sides[k], g = side * ss;
     TileWork& w = work[k];
-    // Nearest constraint by a two-pass chamfer (3-4) transform; label 1 solid, 2 free, 0 none.
-    std::vector<uint32_t> dist(size_t{g} * g, UINT32_MAX);
-    std::vector<uint8_t> label(size_t{g} * g, 0);
-    for (size_t i = 0; i < dist.size(); ++i) {
-      const uint8_t m = w.marks[i];
-      if (m == 1 || m == 2) {
-        dist[i] = 0;
-        label[i] = m;
-      }
-    }
-    auto relax = [&](size_t i, size_t from, uint32_t cost) {
-      if (dist[from] == UINT32_MAX) return;
-      const uint32_t d = dist[from] + cost;
-      // Ties go to solid: a crack costs more than a sliver.
-      if (d < dist[i] || (d == dist[i] && label[from] == 1 && label[i] == 2)) {
-        dist[i] = d;
-        label[i] = label[from];
-      }
-    };
-    for (uint32_t y = 0; y < g; ++y) {
-      for (uint32_t x = 0; x < g; ++x) {
-        const size_t i = size_t{y} * g + x;
-        if (x > 0) relax(i, i - 1, 3);
-        if (y > 0) {
-          relax(i, i - g, 3);
-          if (x > 0) relax(i, i - g - 1, 4);
-          if (x + 1 < g) relax(i, i - g + 1, 4);
-        }
-      }
-    }
-    for (uint32_t y = g; y-- > 0;) {
-      for (uint32_t x = g; x-- > 0;) {
-        const size_t i = size_t{y} * g + x;
-        if (x + 1 < g) relax(i, i + 1, 3);
-        if (y + 1 < g) {
-          relax(i, i + g, 3);
-          if (x + 1 < g) relax(i, i + g + 1, 4);
-          if (x > 0) relax(i, i + g - 1, 4);
-        }
-      }
-    }
+    const std::vector<float> cover =
+        votes ? coverage_from_votes(w.votes, g) : coverage_from_constraints(w.marks, g);
     TileTexture& tex = out[k];
     tex.side = side;
     tex.rgba.assign(size_t{side} * side * 4, 0.0f);
     std::vector<uint8_t> known(size_t{side} * side, 0);
     for (uint32_t y = 0; y < side; ++y) {
       for (uint32_t x = 0; x < side; ++x) {
-        uint32_t solid = 0;
+        float solid = 0;
         for (uint32_t qy = 0; qy < ss; ++qy) {
-          for (uint32_t qx = 0; qx < ss; ++qx) {
-            solid += label[size_t{y * ss + qy} * g + x * ss + qx] == 1;
-          }
+          for (uint32_t qx = 0; qx < ss; ++qx)
+            solid += cover[size_t{y * ss + qy} * g + x * ss + qx];
         }
         const size_t i = size_t{y} * side + x;
-        tex.rgba[4 * i + 3] = static_cast<float>(solid) / float(ss * ss);
+        tex.rgba[4 * i + 3] = solid / float(ss * ss);
         const float wsum = w.colour[4 * i + 3];
         if (wsum > 0) {
           for (int c = 0; c < 3; ++c) tex.rgba[4 * i + c] = w.colour[4 * i + c] / wsum;
@@ -321,6 +384,8 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
       known.swap(next);
       if (!changed) break;
     }
+    solve_tile_colour(w.normals, options.texture_smoothness, options.texture_solve_iterations,
+                      tex.rgba.data());
     w = TileWork{};  // free the work buffers early
   });
   return out;

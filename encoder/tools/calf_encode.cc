@@ -364,6 +364,7 @@ int main(int argc, char** argv) {
   // --mode tiles (docs/TILES.md): every knob of the builder and the track encoder.
   calf::tools::TilesModeOptions tiles;
   std::string tiles_atlas = "bc7";
+  std::string tiles_alpha = "votes";
   std::vector<uint32_t> tiles_levels;
   {
     calf::encoder::TilesBuildOptions& b = tiles.build;
@@ -450,6 +451,23 @@ int main(int argc, char** argv) {
                    "carving, (0, 1) (default 0.05; Seurat's 0.01 carves holes into coarse "
                    "tiles, docs/TILES.md)")
         ->default_val(0.05);
+    app.add_option("--tiles-texture-solve", b.texture_solve_iterations,
+                   "tiles: conjugate-gradient steps of the least-squares colour fit (texels "
+                   "whose bilinear magnification best reproduces the samples), 0..1000; 0 keeps "
+                   "Seurat's filtered splat (default 32)")
+        ->default_val(32);
+    app.add_option("--tiles-texture-smoothness", b.texture_smoothness,
+                   "tiles: membrane weight of the colour fit relative to a texel's sample "
+                   "weight, 0..100: larger is smoother, smaller follows the samples (default "
+                   "0.2)")
+        ->default_val(0.2);
+    app.add_option("--tiles-alpha", tiles_alpha,
+                   "tiles: alpha estimate: votes (each view votes solid where it sees the "
+                   "tile's surface, free where it sees through it; alpha is the solid share, "
+                   "anti-aliased) or constraints (Seurat's: nearest solid or free-space "
+                   "constraint, hard) (default votes)")
+        ->check(CLI::IsMember({"votes", "constraints"}))
+        ->default_val("votes");
     app.add_option("--tiles-alpha-samples", b.alpha_supersampling,
                    "tiles: S x S carving samples per texel for alpha, 1..8 (default 2)")
         ->default_val(2);
@@ -486,6 +504,9 @@ int main(int argc, char** argv) {
     tiles.build.threads =
         o.threads > 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency());
     tiles.encode.threads = o.threads;
+    tiles.build.alpha_estimate = tiles_alpha == "constraints"
+                                     ? calf::encoder::TilesAlphaEstimate::kConstraints
+                                     : calf::encoder::TilesAlphaEstimate::kViewVotes;
     tiles.encode.atlas_format = tiles_atlas == "rgba8" ? calf::encoder::TilesAtlasFormat::kRgba8
                                                        : calf::encoder::TilesAtlasFormat::kBc7;
     tiles.encode.supercompression = super == "lzma2"  ? calf::container::Compression::kLzma2

@@ -199,84 +199,112 @@ TEST(TilesBuild, TileCornersLieOnTheScenePlanes) {
   EXPECT_GE(on, total * 90 / 100) << on << " of " << total;
 }
 
-TEST(TilesBuild, AtlasReproducesCapturedColourAtTileCentres) {
-  auto set = build(small_options());
-  ASSERT_TRUE(set.ok()) << set.status().to_string();
-  ASSERT_EQ(set->atlas_rgba.size(), size_t{set->atlas_width} * set->atlas_height * 4);
-  size_t checked = 0, good = 0;
-  for (const Tile& t : set->tiles) {
-    Vec3 centre;
-    double u = 0, v = 0;
-    for (const TileCorner& c : t.corners) {
-      centre += Vec3{c.position[0], c.position[1], c.position[2]} * 0.25;
-      u += c.uvw[0] / c.uvw[2] * 0.25;
-      v += c.uvw[1] / c.uvw[2] * 0.25;
+// Each check of the texturing below runs with both alpha estimates, and the colour with and
+// without the least-squares fit.
+std::vector<TilesBuildOptions> texturing_variants() {
+  std::vector<TilesBuildOptions> out;
+  for (auto alpha :
+       {encoder::TilesAlphaEstimate::kViewVotes, encoder::TilesAlphaEstimate::kConstraints}) {
+    for (uint32_t solve : {32u, 0u}) {
+      TilesBuildOptions o = small_options();
+      o.alpha_estimate = alpha;
+      o.texture_solve_iterations = solve;
+      out.push_back(o);
     }
-    if (plane_error(centre) > 0.005) continue;
-    const auto [dist, hit] = trace({0, 0, 0}, normalize(centre));
-    // Only tiles whose centre is on the surface seen there (not a hidden layer or a sliver).
-    if (std::abs(dist - length(centre)) > 0.01 * dist) continue;
-    const uint32_t x =
-        std::min<uint32_t>(static_cast<uint32_t>(u * set->atlas_width), set->atlas_width - 1);
-    const uint32_t y =
-        std::min<uint32_t>(static_cast<uint32_t>(v * set->atlas_height), set->atlas_height - 1);
-    const uint8_t* px = &set->atlas_rgba[(size_t{y} * set->atlas_width + x) * 4];
-    if (px[3] < 250) continue;
-    ++checked;
-    bool match = true;
-    for (int c = 0; c < 3; ++c) {
-      match &= std::abs(int(px[c]) - int(srgb8_from_linear(kColour[hit][c]))) <= 3;
-    }
-    good += match;
   }
-  EXPECT_GE(checked, set->tiles.size() / 2);
-  EXPECT_GE(good, checked * 95 / 100) << good << " of " << checked;
+  return out;
+}
+
+std::string variant_name(const TilesBuildOptions& o) {
+  return std::string(o.alpha_estimate == encoder::TilesAlphaEstimate::kViewVotes ? "votes"
+                                                                                 : "constraints") +
+         (o.texture_solve_iterations > 0 ? ", least squares" : ", splat");
+}
+
+TEST(TilesBuild, AtlasReproducesCapturedColourAtTileCentres) {
+  for (const TilesBuildOptions& variant : texturing_variants()) {
+    SCOPED_TRACE(variant_name(variant));
+    auto set = build(variant);
+    ASSERT_TRUE(set.ok()) << set.status().to_string();
+    ASSERT_EQ(set->atlas_rgba.size(), size_t{set->atlas_width} * set->atlas_height * 4);
+    size_t checked = 0, good = 0;
+    for (const Tile& t : set->tiles) {
+      Vec3 centre;
+      double u = 0, v = 0;
+      for (const TileCorner& c : t.corners) {
+        centre += Vec3{c.position[0], c.position[1], c.position[2]} * 0.25;
+        u += c.uvw[0] / c.uvw[2] * 0.25;
+        v += c.uvw[1] / c.uvw[2] * 0.25;
+      }
+      if (plane_error(centre) > 0.005) continue;
+      const auto [dist, hit] = trace({0, 0, 0}, normalize(centre));
+      // Only tiles whose centre is on the surface seen there (not a hidden layer or a sliver).
+      if (std::abs(dist - length(centre)) > 0.01 * dist) continue;
+      const uint32_t x =
+          std::min<uint32_t>(static_cast<uint32_t>(u * set->atlas_width), set->atlas_width - 1);
+      const uint32_t y =
+          std::min<uint32_t>(static_cast<uint32_t>(v * set->atlas_height), set->atlas_height - 1);
+      const uint8_t* px = &set->atlas_rgba[(size_t{y} * set->atlas_width + x) * 4];
+      if (px[3] < 250) continue;
+      ++checked;
+      bool match = true;
+      for (int c = 0; c < 3; ++c) {
+        match &= std::abs(int(px[c]) - int(srgb8_from_linear(kColour[hit][c]))) <= 3;
+      }
+      good += match;
+    }
+    EXPECT_GE(checked, set->tiles.size() / 2);
+    EXPECT_GE(good, checked * 95 / 100) << good << " of " << checked;
+  }
 }
 
 TEST(TilesBuild, PanelSilhouetteIsCarved) {
   // A tile on the panel's plane reaching past its edge is transparent outside the panel.
-  auto set = build(small_options());
-  ASSERT_TRUE(set.ok()) << set.status().to_string();
-  size_t solid_inside = 0, clear_outside = 0, inside = 0, outside = 0;
-  for (const Tile& t : set->tiles) {
-    bool on_panel = true;
-    for (const TileCorner& c : t.corners) on_panel &= std::abs(c.position[0] - kPanelX) < 0.01;
-    if (!on_panel) continue;
-    // Sample the tile's texture on a 5 x 5 grid of its own (bilinear in uvw: the tile is planar
-    // and its w is constant along the panel's axis, x).
-    for (int j = 0; j < 5; ++j) {
-      for (int i = 0; i < 5; ++i) {
-        const double a = (i + 0.5) / 5, b = (j + 0.5) / 5;
-        double p[3] = {0, 0, 0}, uvw[3] = {0, 0, 0};
-        const double wgt[4] = {(1 - a) * (1 - b), a * (1 - b), a * b, (1 - a) * b};
-        for (int k = 0; k < 4; ++k) {
-          for (int c = 0; c < 3; ++c) {
-            p[c] += wgt[k] * t.corners[k].position[c];
-            uvw[c] += wgt[k] * t.corners[k].uvw[c];
+  for (const TilesBuildOptions& variant : texturing_variants()) {
+    SCOPED_TRACE(variant_name(variant));
+    auto set = build(variant);
+    ASSERT_TRUE(set.ok()) << set.status().to_string();
+    size_t solid_inside = 0, clear_outside = 0, inside = 0, outside = 0;
+    for (const Tile& t : set->tiles) {
+      bool on_panel = true;
+      for (const TileCorner& c : t.corners) on_panel &= std::abs(c.position[0] - kPanelX) < 0.01;
+      if (!on_panel) continue;
+      // Sample the tile's texture on a 5 x 5 grid of its own (bilinear in uvw: the tile is planar
+      // and its w is constant along the panel's axis, x).
+      for (int j = 0; j < 5; ++j) {
+        for (int i = 0; i < 5; ++i) {
+          const double a = (i + 0.5) / 5, b = (j + 0.5) / 5;
+          double p[3] = {0, 0, 0}, uvw[3] = {0, 0, 0};
+          const double wgt[4] = {(1 - a) * (1 - b), a * (1 - b), a * b, (1 - a) * b};
+          for (int k = 0; k < 4; ++k) {
+            for (int c = 0; c < 3; ++c) {
+              p[c] += wgt[k] * t.corners[k].position[c];
+              uvw[c] += wgt[k] * t.corners[k].uvw[c];
+            }
           }
-        }
-        const double margin = 0.08;
-        const double m = std::max(std::abs(p[1]), std::abs(p[2]));
-        if (std::abs(m - kPanelHalf) < margin) continue;
-        const uint32_t x = std::min<uint32_t>(
-            static_cast<uint32_t>(uvw[0] / uvw[2] * set->atlas_width), set->atlas_width - 1);
-        const uint32_t y = std::min<uint32_t>(
-            static_cast<uint32_t>(uvw[1] / uvw[2] * set->atlas_height), set->atlas_height - 1);
-        const uint8_t alpha = set->atlas_rgba[(size_t{y} * set->atlas_width + x) * 4 + 3];
-        if (m < kPanelHalf) {
-          ++inside;
-          solid_inside += alpha >= 200;
-        } else {
-          ++outside;
-          clear_outside += alpha <= 55;
+          const double margin = 0.08;
+          const double m = std::max(std::abs(p[1]), std::abs(p[2]));
+          if (std::abs(m - kPanelHalf) < margin) continue;
+          const uint32_t x = std::min<uint32_t>(
+              static_cast<uint32_t>(uvw[0] / uvw[2] * set->atlas_width), set->atlas_width - 1);
+          const uint32_t y = std::min<uint32_t>(
+              static_cast<uint32_t>(uvw[1] / uvw[2] * set->atlas_height), set->atlas_height - 1);
+          const uint8_t alpha = set->atlas_rgba[(size_t{y} * set->atlas_width + x) * 4 + 3];
+          if (m < kPanelHalf) {
+            ++inside;
+            solid_inside += alpha >= 200;
+          } else {
+            ++outside;
+            clear_outside += alpha <= 55;
+          }
         }
       }
     }
-  }
-  EXPECT_GT(inside, 0u);
-  EXPECT_GE(solid_inside, inside * 9 / 10) << solid_inside << " of " << inside;
-  if (outside > 0) {
-    EXPECT_GE(clear_outside, outside * 9 / 10) << clear_outside << " of " << outside;
+    EXPECT_GT(inside, 0u);
+    EXPECT_GE(solid_inside, inside * 9 / 10) << solid_inside << " of " << inside;
+    if (outside > 0) {
+      EXPECT_GE(clear_outside, outside * 9 / 10) << clear_outside << " of " << outside;
+    }
   }
 }
 
