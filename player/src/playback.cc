@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "calf/capture/eye_path.h"
 #include "calf/format/container.h"
 #include "calf/player/mesh_representation.h"
 #include "calf/player/surfel_representation.h"
@@ -89,9 +90,7 @@ double Playback::fps() const {
 }
 
 uint32_t Playback::frame_at_time(double seconds) const {
-  if (!(seconds > 0)) return 0;  // negative or NaN
-  const double f = std::floor(seconds * fps() + 1e-9);
-  return static_cast<uint32_t>(std::min<double>(f, frame_count() - 1));
+  return capture::frame_at_time(seconds, fps(), frame_count());
 }
 
 const Box3& Playback::view_volume() const {

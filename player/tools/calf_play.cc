@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +16,7 @@
 
 #include "calf/capture/eye_path.h"
 #include "calf/player/contact_sheet.h"
+#include "calf/player/error_breakdown.h"
 #include "calf/player/gl_context.h"
 #include "calf/player/image_compare.h"
 #include "calf/player/mesh_representation.h"
@@ -45,6 +48,9 @@ struct HeadlessArgs {
   std::string noise_floor;
   // --compare-clip: the full-scene clip played beside CLIP for epsilon (paper 004).
   std::string compare_clip;
+  // --breakdown: the capture set the clip was made from (error classes); --breakdown-lossless:
+  // a lossless clip of it (the codec class).
+  std::string breakdown, breakdown_lossless;
   uint32_t sheet_rows = 8;
   bool heat_maps = true;
   double surfel_target_ms = 0;    // --surfel-target-ms: report render times to the controller
@@ -100,7 +106,7 @@ SurfelRepresentation* surfels_of(const Playback& play) {
 
 // Plays `path` pose by pose; poses sharing a time (a stereo pair) are prepared together. With
 // `full`, the same poses are rendered from the full-scene clip too and compared (epsilon).
-int run_headless(Playback& play, Playback* full, const HeadlessArgs& a) {
+int run_headless(Playback& play, Playback* full, Playback* lossless, const HeadlessArgs& a) {
   fs::path gt_dir;
   capture::EyePath path;
   if (!a.compare.empty()) gt_dir = a.compare;
@@ -136,6 +142,16 @@ int run_headless(Playback& play, Playback* full, const HeadlessArgs& a) {
                              " is not ground truth of the same poses and image size"));
     }
   }
+  // The error breakdown: the capture set's views at the frame of each pose, loaded once a frame.
+  std::unique_ptr<capture::CaptureSetReader> breakdown_reader;
+  if (!a.breakdown.empty()) {
+    auto r = capture::CaptureSetReader::open(a.breakdown);
+    if (!r.ok()) return fail(r.status());
+    breakdown_reader = std::make_unique<capture::CaptureSetReader>(std::move(*r));
+  }
+  std::optional<CaptureVisibility> visibility;
+  ErrorBreakdown breakdown_sum;
+  RenderedImage lossless_image;
   double floor_sum_psnr = 0, floor_sum_ssim = 0, floor_min_psnr = INFINITY;
   size_t floor_min_pose = 0;
   if (!a.out.empty()) {
@@ -167,6 +183,19 @@ int run_headless(Playback& play, Playback* full, const HeadlessArgs& a) {
     for (size_t k = i; k < j; ++k) eyes.push_back(capture::camera_from_pose(path, k));
     const uint32_t frame = play.frame_at_time(path.poses[i].time);
     if (Status s = play.prepare(frame, eyes); !s.ok()) return fail(s);
+    if (lossless != nullptr) {
+      if (Status s = lossless->prepare(lossless->frame_at_time(path.poses[i].time), eyes); !s.ok())
+        return fail(s);
+    }
+    if (breakdown_reader) {
+      const capture::CaptureManifest& m = breakdown_reader->manifest();
+      const uint32_t cf = capture::frame_at_time(path.poses[i].time, m.fps, m.frame_count);
+      if (!visibility || visibility->frame() != cf) {
+        auto v = CaptureVisibility::load(*breakdown_reader, cf);
+        if (!v.ok()) return fail(v.status());
+        visibility = std::move(*v);
+      }
+    }
     if (full != nullptr) {
       if (Status s = full->prepare(full->frame_at_time(path.poses[i].time), eyes); !s.ok())
         return fail(s);
@@ -286,6 +315,31 @@ int run_headless(Playback& play, Playback* full, const HeadlessArgs& a) {
           if (Status hs = write_heat_map_png(heat, rgb_ref(image), rgb_ref(*gt)); !hs.ok())
             return fail(hs);
         }
+        if (visibility) {
+          if (lossless != nullptr) {
+            if (Status ls = lossless->render(cam, &lossless_image); !ls.ok()) return fail(ls);
+          }
+          const RgbImageRef lossless_ref = rgb_ref(lossless_image);
+          std::vector<uint8_t> classes;
+          std::vector<float> squared;
+          auto b = classify_errors(image, *gt, cam, *visibility,
+                                   lossless != nullptr ? &lossless_ref : nullptr, {}, &classes,
+                                   &squared);
+          if (!b.ok()) return fail(b.status());
+          std::printf(
+              ", error: disocclusion %.1f %% silhouette %.1f %% geometry %.1f %% shading %.1f %%",
+              100 * b->share(ErrorClass::kDisocclusion), 100 * b->share(ErrorClass::kSilhouette),
+              100 * b->share(ErrorClass::kGeometry), 100 * b->share(ErrorClass::kShading));
+          if (lossless != nullptr)
+            std::printf(" codec %.1f %%", 100 * b->share(ErrorClass::kCodec));
+          breakdown_sum += *b;
+          if (!a.out.empty()) {
+            const fs::path map = fs::path(a.out) / (std::string("classes_") + (name + 6) + ".png");
+            if (Status ws = write_error_class_png(map, cam.width, cam.height, classes, squared);
+                !ws.ok())
+              return fail(ws);
+          }
+        }
         if (std::binary_search(sheet_poses.begin(), sheet_poses.end(), k)) {
           sheet.push_back({image, std::move(*gt)});
         }
@@ -322,6 +376,23 @@ int run_headless(Playback& play, Playback* full, const HeadlessArgs& a) {
     std::printf("mean PSNR %.2f dB, mean SSIM %.4f\n", sum_psnr / compared, sum_ssim / compared);
     std::printf("worst pose: PSNR %.2f dB (pose %zu), SSIM %.4f (pose %zu)\n", min_psnr,
                 min_psnr_pose, min_ssim, min_ssim_pose);
+    if (visibility) {
+      const ErrorBreakdown& b = breakdown_sum;
+      std::printf(
+          "error breakdown (share of the squared error over all poses; share of the pixels): "
+          "disocclusion %.1f %% (%.1f %%), silhouette %.1f %% (%.1f %%), geometry %.1f %% "
+          "(%.1f %%), shading %.1f %% (%.1f %%), ",
+          100 * b.share(ErrorClass::kDisocclusion), 100 * b.pixel_share(ErrorClass::kDisocclusion),
+          100 * b.share(ErrorClass::kSilhouette), 100 * b.pixel_share(ErrorClass::kSilhouette),
+          100 * b.share(ErrorClass::kGeometry), 100 * b.pixel_share(ErrorClass::kGeometry),
+          100 * b.share(ErrorClass::kShading), 100 * b.pixel_share(ErrorClass::kShading));
+      if (b.codec_measured) {
+        std::printf("codec %.1f %% (%.1f %%)\n", 100 * b.share(ErrorClass::kCodec),
+                    100 * b.pixel_share(ErrorClass::kCodec));
+      } else {
+        std::printf("codec not measured (give --breakdown-lossless)\n");
+      }
+    }
     if (!floor_dir.empty()) {
       std::printf(
           "noise floor (ground truth against %s, another seed): mean PSNR %.2f dB, mean SSIM "
@@ -405,6 +476,20 @@ int main(int argc, char** argv) {
                  "(paper 004: the share of pixels whose depth lies farther than the full scene's "
                  "by more than 0.1 %, i.e. where a triangle is missing), PSNR and SSIM against it, "
                  "and the frame time of both");
+  app.add_option("--breakdown", h.breakdown,
+                 "with --compare: the capture set (manifest directory) the clip was made from; "
+                 "each pose's squared error is split into disocclusion (the ground truth's "
+                 "surface was seen by no capture view), silhouette (a depth edge within 1 pixel), "
+                 "geometry (the clip shows another surface: its depth is off by more than 2 %) "
+                 "and shading (the rest), printed per pose and over the path, with class maps "
+                 "(classes_NNNNN.png: red, yellow, magenta, blue, codec green; brightness the "
+                 "error) in --out "
+                 "(docs/PLAYER.md \"Error breakdown\")");
+  app.add_option(
+      "--breakdown-lossless", h.breakdown_lossless,
+      "with --breakdown: a lossless clip of the same capture (calf-encode --color-format "
+      "rgba16f --depth-format raw16) rendered at every pose too; the error CLIP adds to it is "
+      "the codec class (green)");
   app.add_option("--contact-sheet", h.contact_sheet,
                  "with --compare: write a PNG with one row per "
                  "pose: ground truth | calf | error heat map");
@@ -516,6 +601,12 @@ int main(int argc, char** argv) {
     if (!h.noise_floor.empty() && h.compare.empty()) {
       return contradiction("--noise-floor needs --compare");
     }
+    if (!h.breakdown.empty() && h.compare.empty()) {
+      return contradiction("--breakdown needs --compare");
+    }
+    if (!h.breakdown_lossless.empty() && h.breakdown.empty()) {
+      return contradiction("--breakdown-lossless needs --breakdown");
+    }
     if (!h.compare_clip.empty() && fs::path(h.compare_clip) == fs::path(clip)) {
       return contradiction("--compare-clip names CLIP itself");
     }
@@ -535,9 +626,18 @@ int main(int argc, char** argv) {
       if (!f.ok()) return fail(f.status());
       full = std::move(*f);
     }
+    std::unique_ptr<Playback> lossless;
+    if (!h.breakdown_lossless.empty()) {
+      auto f = Playback::open(h.breakdown_lossless, play_options, gl);
+      if (!f.ok()) return fail(f.status());
+      lossless = std::move(*f);
+    }
     h.surfel_target_ms = so.target_frame_ms;
     h.surfel_foveation = so.foveation.enabled;
-    return run_headless(**play, full.get(), h);
+    return run_headless(**play, full.get(), lossless.get(), h);
+  }
+  if (!h.breakdown.empty()) {
+    return contradiction("--breakdown works only with --headless");
   }
   if (!h.compare_clip.empty()) {
     return contradiction("--compare-clip works only with --headless");

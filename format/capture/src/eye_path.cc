@@ -290,4 +290,11 @@ Expected<PerspectiveImage> read_perspective_image(const std::filesystem::path& f
   return image;
 }
 
+uint32_t frame_at_time(double seconds, double fps, uint32_t frame_count) {
+  if (!(seconds > 0)) return 0;  // negative or NaN
+  // The epsilon keeps f / fps itself in frame f despite rounding of the division.
+  const double f = std::floor(seconds * fps + 1e-9);
+  return static_cast<uint32_t>(std::min<double>(f, frame_count - 1));
+}
+
 }  // namespace calf::capture

@@ -72,6 +72,10 @@ std::string eye_image_file_name(const EyePath& path, uint32_t index);
 // fov_y = fov_y_degrees * pi / 180 (radians). Every renderer, the ground-truth tracer and the
 // image comparisons take poses through this one function.
 Camera camera_from_pose(const EyePose& pose, uint32_t width, uint32_t height);
+// The frame of a clip or capture at `fps` frames a second shown at scene time `seconds`: frame f
+// spans [f / fps, (f + 1) / fps); times before 0 (or NaN) give frame 0, times after the last
+// frame give the last. frame_count >= 1, fps > 0.
+uint32_t frame_at_time(double seconds, double fps, uint32_t frame_count);
 // camera_from_pose(path.poses[index], path.width, path.height); index < path.poses.size().
 Camera camera_from_pose(const EyePath& path, size_t index);
 
