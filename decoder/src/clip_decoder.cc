@@ -55,6 +55,8 @@ struct ClipDecoder::Impl {
   lf::RegionCoding depth_coding = lf::RegionCoding::kR16;
   std::optional<lf::RegionCoding> material_coding;
   std::unique_ptr<ChunkCache> cache;
+  // Node directions of the colour-cell and depth-tile quadtrees, computed once (culling.h).
+  std::optional<GridCuller> cell_culler, tile_culler;
 
   // Chunks by (stream, view, face, region), sorted by first frame; a flat table because it is
   // consulted per visible cell and tile every frame.
@@ -103,9 +105,11 @@ struct ClipDecoder::Impl {
                    (exact_start ? " starts at frame " : " serves frame ") + std::to_string(frame));
   }
 
-  Expected<ChunkBytes> fetch(uint32_t id, FrameStats& stats) {
+  Expected<ChunkBytes> fetch(uint32_t id, FrameUpdates* out) {
+    FrameStats& stats = out->stats;
     bool here = false;
     CALF_ASSIGN_OR_RETURN(ChunkBytes bytes, cache->get(id, &here));
+    out->chunks.push_back(id);
     stats.chunks_needed += 1;
     stats.chunks_read_on_demand += here ? 1 : 0;
     in_use.push_back(bytes);
@@ -192,7 +196,7 @@ Status ClipDecoder::Impl::update_cell(uint32_t view, uint32_t face, uint32_t cel
   if (!s.timeline) {
     CALF_ASSIGN_OR_RETURN(uint32_t id,
                           chunk_serving(LightfieldStream::kTParams, view, face, cell, 0, true));
-    CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out->stats));
+    CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out));
     CALF_ASSIGN_OR_RETURN(lf::CellTimeline tl, lf::parse_t_chunk(*raw, header.frame_count,
                                                                  where(view, face, cell) + " t"));
     s.timeline = std::move(tl);
@@ -212,7 +216,7 @@ Status ClipDecoder::Impl::update_cell(uint32_t view, uint32_t face, uint32_t cel
     if (s.slot_keyframe[slot] == k) continue;
     CALF_ASSIGN_OR_RETURN(uint32_t id, chunk_serving(LightfieldStream::kColour, view, face, cell,
                                                      tl.keyframes[k], true));
-    CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out->stats));
+    CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out));
     CALF_RETURN_IF_ERROR(lf::colour_payload_gpu_bytes(header.colour_format, *raw, rect.width,
                                                       rect.height, gpu[slot],
                                                       where(view, face, cell) + " colour"));
@@ -244,7 +248,7 @@ Status ClipDecoder::Impl::update_tile(bool depth, uint32_t view, uint32_t face, 
   const LightfieldStream stream = depth ? LightfieldStream::kDepth : LightfieldStream::kMaterial;
   CALF_ASSIGN_OR_RETURN(uint32_t id, chunk_serving(stream, view, face, tile, frame, false));
   const container::ChunkKeys& keys = reader->chunks()[id].keys;
-  CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out->stats));
+  CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out));
   const PixelRect r = tiles.cell_rect(tile % tiles.cells_per_side(), tile / tiles.cells_per_side());
   const lf::RegionCoding coding = depth ? depth_coding : *material_coding;
   CALF_ASSIGN_OR_RETURN(
@@ -344,6 +348,8 @@ Expected<ClipDecoder> ClipDecoder::open(const container::Reader& reader, uint16_
     CALF_ASSIGN_OR_RETURN(impl->material_coding, lf::material_coding(impl->header.material_format));
   }
   CALF_RETURN_IF_ERROR(impl->open_tables());
+  impl->cell_culler.emplace(impl->cells);
+  impl->tile_culler.emplace(impl->tiles);
   impl->cache =
       std::make_unique<ChunkCache>(reader, options.cache_bytes, options.background_thread);
   return ClipDecoder(std::move(impl));
@@ -400,6 +406,7 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
   out->updates.clear();
   out->cells.clear();
   out->tiles.clear();
+  out->chunks.clear();
   out->stats = FrameStats{};
   FrameStats& stats = out->stats;
   stats.frame = frame;
@@ -415,12 +422,18 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
   std::vector<uint32_t> all_cells(d.cells.cell_count()), all_tiles(d.tiles.cell_count());
   for (uint32_t i = 0; i < all_cells.size(); ++i) all_cells[i] = i;
   for (uint32_t i = 0; i < all_tiles.size(); ++i) all_tiles[i] = i;
-  auto cull_cells = [&](const Vec3& apex, CubeFace face, const FaceGrid& grid, double z_near,
-                        double z_far, std::span<const Frustum> eye) {
-    return d.options.brute_force_culling
-               ? visible_cells_brute_force(apex, face, grid, z_near, z_far, eye, &cull)
-               : visible_cells_hierarchical(apex, face, grid, z_near, z_far, eye,
-                                            d.options.quadtree_levels, &cull);
+  std::vector<PreparedEye> prepared;
+  for (const Frustum& f : frusta) prepared.push_back(prepare_eye(f));
+  std::vector<uint32_t> by_eye;
+  auto cull_cells = [&](const Vec3& apex, CubeFace face, const GridCuller& culler, double z_near,
+                        double z_far, size_t eye) {
+    if (d.options.brute_force_culling) {
+      by_eye = visible_cells_brute_force(apex, face, culler.grid(), z_near, z_far,
+                                         std::span<const Frustum>(&frusta[eye], 1), &cull);
+    } else {
+      culler.visible(apex, face, z_near, z_far, std::span<const PreparedEye>(&prepared[eye], 1),
+                     d.options.quadtree_levels, &cull, &by_eye);
+    }
   };
   for (uint32_t v : active) {
     const LightfieldViewInfo& info = d.views[v];
@@ -440,17 +453,19 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
     const bool has_material = info.has_material && d.material_coding.has_value();
     for (uint32_t f = 0; f < 6; ++f) {
       const CubeFace face = static_cast<CubeFace>(f);
-      auto visible = [&](const FaceGrid& grid, const std::vector<uint32_t>& all) {
+      auto visible = [&](const GridCuller& culler, const std::vector<uint32_t>& all) {
         if (!d.options.view_dependent) return all;
-        std::vector<uint32_t> united;
+        std::vector<uint32_t> united, merged;
         for (size_t i = 0; i < eyes.size(); ++i) {
-          const std::span<const Frustum> one(&frusta[i], 1);
           const Vec3& e = eyes[i].position;
           const double sky_near = eyes[i].near, sky_far = 2 * eyes[i].far;
-          for (const std::vector<uint32_t>& by_eye :
-               {cull_cells(p, face, grid, info.z_near, z_far[i], one),
-                cull_cells(e, face, grid, sky_near, sky_far, one)}) {
-            std::vector<uint32_t> merged;
+          for (int pass = 0; pass < 2; ++pass) {
+            if (pass == 0) {
+              cull_cells(p, face, culler, info.z_near, z_far[i], i);
+            } else {
+              cull_cells(e, face, culler, sky_near, sky_far, i);
+            }
+            merged.clear();
             std::set_union(united.begin(), united.end(), by_eye.begin(), by_eye.end(),
                            std::back_inserter(merged));
             united.swap(merged);
@@ -458,8 +473,12 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
         }
         return united;
       };
-      const std::vector<uint32_t> vis_cells = visible(d.cells, all_cells);
-      const std::vector<uint32_t> vis_tiles = visible(d.tiles, all_tiles);
+      const auto cull_start = std::chrono::steady_clock::now();
+      const std::vector<uint32_t> vis_cells = visible(*d.cell_culler, all_cells);
+      const std::vector<uint32_t> vis_tiles = visible(*d.tile_culler, all_tiles);
+      stats.culling_ms +=
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cull_start)
+              .count();
       stats.total_cells += d.cells.cell_count();
       stats.total_tiles += d.tiles.cell_count();
       stats.visible_cells += static_cast<uint32_t>(vis_cells.size());
@@ -487,6 +506,7 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
   }
   stats.updates = static_cast<uint32_t>(out->updates.size());
   stats.culling_tests = cull.tests;
+  stats.culling_exact_tests = cull.exact_tests;
   // Nearest frames first; a chunk serving several of them once.
   std::unordered_set<uint32_t> queued;
   std::erase_if(d.prefetch_ids, [&](uint32_t id) { return !queued.insert(id).second; });
