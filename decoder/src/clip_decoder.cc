@@ -83,6 +83,31 @@ struct ClipDecoder::Impl {
   std::vector<ChunkBytes> in_use;  // keeps this frame's chunks alive
   std::vector<uint32_t> prefetch_ids;
 
+  // The visible cells and tiles of each view, per face, for the viewers and options below.
+  struct VisibleSets {
+    bool valid = false;
+    std::array<std::vector<uint32_t>, 6> cells, tiles;
+  };
+  std::vector<VisibleSets> visible_cache;  // per view
+  std::vector<EyeView> cache_eyes;
+  ClipDecoderOptions cache_options;
+  bool same_viewers(std::span<const EyeView> eyes) const {
+    auto same = [](const EyeView& a, const EyeView& b) {
+      return a.position == b.position && a.forward == b.forward && a.up == b.up &&
+             a.fov_y == b.fov_y && a.aspect == b.aspect && a.near == b.near && a.far == b.far;
+    };
+    if (eyes.size() != cache_eyes.size() ||
+        options.view_dependent != cache_options.view_dependent ||
+        options.quadtree_levels != cache_options.quadtree_levels ||
+        options.brute_force_culling != cache_options.brute_force_culling) {
+      return false;
+    }
+    for (size_t i = 0; i < eyes.size(); ++i) {
+      if (!same(eyes[i], cache_eyes[i])) return false;
+    }
+    return true;
+  }
+
   const std::vector<ChunkRef>* find(LightfieldStream s, uint32_t v, uint32_t f, uint32_t r) const {
     return &chunks[slot(static_cast<uint32_t>(s), v, f, r)];
   }
@@ -187,6 +212,7 @@ Status ClipDecoder::Impl::open_tables() {
   cell_state.assign(header.view_count, std::vector<CellState>(size_t{6} * cell_count));
   depth_state.assign(header.view_count, std::vector<TileState>(size_t{6} * tile_count));
   material_state.assign(header.view_count, std::vector<TileState>(size_t{6} * tile_count));
+  visible_cache.assign(header.view_count, {});
   return Status::Ok();
 }
 
@@ -422,6 +448,13 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
   std::vector<uint32_t> all_cells(d.cells.cell_count()), all_tiles(d.tiles.cell_count());
   for (uint32_t i = 0; i < all_cells.size(); ++i) all_cells[i] = i;
   for (uint32_t i = 0; i < all_tiles.size(); ++i) all_tiles[i] = i;
+  // The visible sets depend on the viewers and the culling options only (not on the frame): kept
+  // from frame to frame while those stay the same, recomputed per view when it is next needed.
+  if (!d.same_viewers(eyes)) {
+    for (Impl::VisibleSets& vs : d.visible_cache) vs.valid = false;
+    d.cache_eyes.assign(eyes.begin(), eyes.end());
+    d.cache_options = d.options;
+  }
   std::vector<PreparedEye> prepared;
   for (const Frustum& f : frusta) prepared.push_back(prepare_eye(f));
   std::vector<uint32_t> by_eye;
@@ -435,50 +468,64 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
                      d.options.quadtree_levels, &cull, &by_eye);
     }
   };
+  // Sky: it is at infinity, so the renderer reads every view's sky in the eye ray's own
+  // direction, not at a point in the viewer's frustum. A cell whose directions meet the viewer's
+  // is therefore needed too: its frustum placed at the eye, tested against the eye's frustum with
+  // a far cap beyond the eye's (so every shared direction has a shared point). That set is the
+  // same for every view: computed once per eye, face and grid, when first needed.
+  std::vector<std::array<std::optional<std::vector<uint32_t>>, 12>> sky(eyes.size());
+  auto sky_set = [&](size_t i, uint32_t f, bool tiles) -> const std::vector<uint32_t>& {
+    std::optional<std::vector<uint32_t>>& slot = sky[i][f * 2 + (tiles ? 1 : 0)];
+    if (!slot) {
+      cull_cells(eyes[i].position, static_cast<CubeFace>(f),
+                 tiles ? *d.tile_culler : *d.cell_culler, eyes[i].near, 2 * eyes[i].far, i);
+      slot = by_eye;
+    }
+    return *slot;
+  };
   for (uint32_t v : active) {
     const LightfieldViewInfo& info = d.views[v];
     const Vec3 p = info.position;
-    // Geometry: a cell frustum reaching past each viewer's far plane (seen from this viewpoint)
-    // holds every point the viewer can see through it. The far cap depends on the viewer, so each
-    // viewer is culled on its own and the visible sets are united: several viewers see exactly the
-    // union of each.
-    // Sky: it is at infinity, so the renderer reads every view's sky in the eye ray's own
-    // direction, not at a point in the viewer's frustum. A cell whose directions meet the
-    // viewer's is therefore needed too: its frustum placed at the eye, tested against the eye's
-    // frustum with a far cap beyond the eye's (so every shared direction has a shared point).
-    std::vector<double> z_far(eyes.size());
-    for (size_t i = 0; i < eyes.size(); ++i) {
-      z_far[i] = std::max<double>(info.z_far, length(eyes[i].position - p) + eyes[i].far);
-    }
     const bool has_material = info.has_material && d.material_coding.has_value();
-    for (uint32_t f = 0; f < 6; ++f) {
-      const CubeFace face = static_cast<CubeFace>(f);
-      auto visible = [&](const GridCuller& culler, const std::vector<uint32_t>& all) {
-        if (!d.options.view_dependent) return all;
-        std::vector<uint32_t> united, merged;
-        for (size_t i = 0; i < eyes.size(); ++i) {
-          const Vec3& e = eyes[i].position;
-          const double sky_near = eyes[i].near, sky_far = 2 * eyes[i].far;
-          for (int pass = 0; pass < 2; ++pass) {
-            if (pass == 0) {
-              cull_cells(p, face, culler, info.z_near, z_far[i], i);
-            } else {
-              cull_cells(e, face, culler, sky_near, sky_far, i);
-            }
-            merged.clear();
-            std::set_union(united.begin(), united.end(), by_eye.begin(), by_eye.end(),
-                           std::back_inserter(merged));
-            united.swap(merged);
+    Impl::VisibleSets& vs = d.visible_cache[v];
+    if (d.options.view_dependent && !vs.valid) {
+      const auto cull_start = std::chrono::steady_clock::now();
+      // Geometry: a cell frustum reaching past each viewer's far plane (seen from this viewpoint)
+      // holds every point the viewer can see through it. The far cap depends on the viewer, so
+      // each viewer is culled on its own and the visible sets are united: several viewers see
+      // exactly the union of each.
+      std::vector<double> z_far(eyes.size());
+      for (size_t i = 0; i < eyes.size(); ++i) {
+        z_far[i] = std::max<double>(info.z_far, length(eyes[i].position - p) + eyes[i].far);
+      }
+      std::vector<uint32_t> merged;
+      auto unite = [&](std::vector<uint32_t>& united, const std::vector<uint32_t>& more) {
+        merged.clear();
+        std::set_union(united.begin(), united.end(), more.begin(), more.end(),
+                       std::back_inserter(merged));
+        united.swap(merged);
+      };
+      for (uint32_t f = 0; f < 6; ++f) {
+        for (bool tiles : {false, true}) {
+          std::vector<uint32_t>& united = tiles ? vs.tiles[f] : vs.cells[f];
+          united.clear();
+          for (size_t i = 0; i < eyes.size(); ++i) {
+            cull_cells(p, static_cast<CubeFace>(f), tiles ? *d.tile_culler : *d.cell_culler,
+                       info.z_near, z_far[i], i);
+            unite(united, by_eye);
+            unite(united, sky_set(i, f, tiles));
           }
         }
-        return united;
-      };
-      const auto cull_start = std::chrono::steady_clock::now();
-      const std::vector<uint32_t> vis_cells = visible(*d.cell_culler, all_cells);
-      const std::vector<uint32_t> vis_tiles = visible(*d.tile_culler, all_tiles);
+      }
+      vs.valid = true;
       stats.culling_ms +=
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cull_start)
               .count();
+    }
+    for (uint32_t f = 0; f < 6; ++f) {
+      const CubeFace face = static_cast<CubeFace>(f);
+      const std::vector<uint32_t>& vis_cells = d.options.view_dependent ? vs.cells[f] : all_cells;
+      const std::vector<uint32_t>& vis_tiles = d.options.view_dependent ? vs.tiles[f] : all_tiles;
       stats.total_cells += d.cells.cell_count();
       stats.total_tiles += d.tiles.cell_count();
       stats.visible_cells += static_cast<uint32_t>(vis_cells.size());
