@@ -540,7 +540,9 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
           if (Status s = d.update_tile(false, v, f, t, frame, out); !s.ok()) report(s);
         }
       }
-      for (uint32_t ahead = 1; ahead <= d.options.prefetch_frames; ++ahead) {
+      // Without the background thread nothing would read the queue.
+      const uint32_t prefetch = d.options.background_thread ? d.options.prefetch_frames : 0;
+      for (uint32_t ahead = 1; ahead <= prefetch; ++ahead) {
         if (frame + ahead >= d.header.frame_count) break;
         for (uint32_t c : vis_cells) d.queue_prefetch(true, v, f, c, frame + ahead);
         for (uint32_t t : vis_tiles) d.queue_prefetch(false, v, f, t, frame + ahead);

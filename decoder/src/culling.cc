@@ -1,6 +1,7 @@
 #include "calf/decoder/culling.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -171,6 +172,8 @@ GridCuller::GridCuller(const FaceGrid& grid) : grid_(grid) {
           for (int i = 0; i < 4; ++i) {
             n.side[i] = cross(n.cell.dirs[i], n.cell.dirs[(i + 1) % 4]);
             if (dot(n.side[i], centre) < 0) n.side[i] = -n.side[i];
+            n.side_len[i] = length(n.side[i]);
+            n.axial[i] = n.cell.dirs[i] * (1 / n.cell.cos[i]);
           }
         }
       }
@@ -187,6 +190,7 @@ struct GridCuller::Search {
   CullStats* stats;
   std::vector<uint32_t>* out;
   Vec3 axis;  // the face axis: the caps are perpendicular to it
+  double axis_len;
 
   enum class Verdict { kOutside, kUndecided, kTouches, kInside };
 
@@ -196,8 +200,7 @@ struct GridCuller::Search {
   // (the frusta share a point with room to spare). Otherwise undecided.
   static Verdict classify(const std::array<Vec3, 8>& p, const PreparedEye& e) {
     bool all_in = true;
-    std::array<bool, 8> in;
-    in.fill(true);
+    unsigned in = 0xff;  // bit j: corner j inside every plane so far
     for (int k = 0; k < 6; ++k) {
       const Vec3& n = e.normals[k];
       double lo = INFINITY, hi = -INFINITY;
@@ -205,7 +208,7 @@ struct GridCuller::Search {
         const double d = dot(n, p[j]);
         lo = std::min(lo, d);
         hi = std::max(hi, d);
-        if (!(d - e.lo[k] > e.margin[k])) in[j] = false;
+        in &= ~(unsigned{!(d - e.lo[k] > e.margin[k])} << j);
       }
       const double extent =
           std::max({std::fabs(e.lo[k]), std::fabs(e.hi[k]), std::fabs(lo), std::fabs(hi)});
@@ -214,10 +217,7 @@ struct GridCuller::Search {
       if (!(lo - e.lo[k] > e.margin[k])) all_in = false;
     }
     if (all_in) return Verdict::kInside;
-    for (bool b : in) {
-      if (b) return Verdict::kTouches;
-    }
-    return Verdict::kUndecided;
+    return in != 0 ? Verdict::kTouches : Verdict::kUndecided;
   }
 
   // The eye's corners against the node's own planes (see the class comment). kOutside: all of
@@ -231,8 +231,8 @@ struct GridCuller::Search {
     std::array<bool, 8> in;
     in.fill(true);
     // Signed distances (times |normal|) of the eye's corners from each plane, inside positive.
-    auto plane = [&](const Vec3& n, double offset, double sign) {
-      const double m = margin * length(n);
+    auto plane = [&](const Vec3& n, double n_len, double offset, double sign) {
+      const double m = margin * n_len;
       bool all_out = true;
       for (int j = 0; j < 8; ++j) {
         const double d = sign * (dot(n, q[j]) - offset);
@@ -242,12 +242,16 @@ struct GridCuller::Search {
       return all_out;
     };
     for (int i = 0; i < 4; ++i) {
-      if (plane(node.side[i], dot(node.side[i], viewpoint), 1)) return Verdict::kOutside;
+      if (plane(node.side[i], node.side_len[i], dot(node.side[i], viewpoint), 1)) {
+        return Verdict::kOutside;
+      }
     }
     // The caps: the axial distances of the near and far corners (corner 0's, as
     // cell_frustum_corners places every corner of a cap at the same axial distance).
     const Vec3& a = axis;
-    if (plane(a, dot(a, p[0]), 1) || plane(a, dot(a, p[4]), -1)) return Verdict::kOutside;
+    if (plane(a, axis_len, dot(a, p[0]), 1) || plane(a, axis_len, dot(a, p[4]), -1)) {
+      return Verdict::kOutside;
+    }
     for (bool b : in) {
       if (b) return Verdict::kTouches;
     }
@@ -291,20 +295,97 @@ struct GridCuller::Search {
     return false;
   }
 
+  // Whether the node's cross-section at some axial depth in [t0, t1] lies inside every plane of
+  // `e` by its margin: 4 corners moving linearly with the depth, clipped plane by plane.
+  bool section_inside(const Node& node, const PreparedEye& e, double t0, double t1) const {
+    for (int k = 0; k < 6; ++k) {
+      const Vec3& n = e.normals[k];
+      const double g0 = dot(n, viewpoint) - e.lo[k] - e.margin[k];
+      for (int i = 0; i < 4; ++i) {
+        // g0 + t slope > 0 for every corner.
+        const double slope = dot(n, node.axial[i]);
+        if (slope == 0) {
+          if (!(g0 > 0)) return false;
+          continue;
+        }
+        const double t = -g0 / slope;
+        if (slope > 0) {
+          t0 = std::max(t0, t);
+        } else {
+          t1 = std::min(t1, t);
+        }
+        if (!(t0 < t1)) return false;
+      }
+    }
+    return true;
+  }
+
+  // A point of the eye's frustum inside the node's planes by the margin, looked for on the eye's
+  // 4 side edges and its centre line (an eye passing through a wide cell).
+  bool eye_reaches_into(const Node& node, const std::array<Vec3, 8>& p,
+                        const PreparedEye& e) const {
+    const std::array<Vec3, 8>& q = e.frustum->corners();
+    double reach = e.reach;
+    for (const Vec3& c : p) {
+      reach = std::max({reach, std::fabs(c.x), std::fabs(c.y), std::fabs(c.z)});
+    }
+    const double margin = 1e-9 * (1 + reach);
+    // Planes as n.x >= offset + margin |n|: 4 sides, the near cap, the far cap (flipped).
+    std::array<Vec3, 6> n;
+    std::array<double, 6> offset;
+    for (int i = 0; i < 4; ++i) {
+      n[i] = node.side[i];
+      offset[i] = dot(node.side[i], viewpoint) + margin * node.side_len[i];
+    }
+    n[4] = axis;
+    offset[4] = dot(axis, p[0]) + margin * axis_len;
+    n[5] = -axis;
+    offset[5] = -dot(axis, p[4]) + margin * axis_len;
+    auto segment = [&](const Vec3& a, const Vec3& b) {
+      double t0 = 0, t1 = 1;
+      const Vec3 ab = b - a;
+      for (int k = 0; k < 6; ++k) {
+        const double g0 = dot(n[k], a) - offset[k];
+        const double slope = dot(n[k], ab);
+        if (slope == 0) {
+          if (!(g0 > 0)) return false;
+          continue;
+        }
+        const double t = -g0 / slope;
+        if (slope > 0) {
+          t0 = std::max(t0, t);
+        } else {
+          t1 = std::min(t1, t);
+        }
+        if (!(t0 < t1)) return false;
+      }
+      return true;
+    };
+    if (segment((q[0] + q[1] + q[2] + q[3]) * 0.25, (q[4] + q[5] + q[6] + q[7]) * 0.25)) {
+      return true;
+    }
+    for (int i = 0; i < 4; ++i) {
+      if (segment(q[i], q[4 + i])) return true;
+    }
+    return false;
+  }
+
   void emit_all(const CellRange& r) {
     for (uint32_t y = r.y0; y < r.y1; ++y) {
       for (uint32_t x = r.x0; x < r.x1; ++x) out->push_back(culler.grid_.cell_index(x, y));
     }
   }
 
-  void visit(uint32_t level, uint32_t ix, uint32_t iy, const std::vector<uint32_t>& candidates) {
+  // `candidates`: bit e set for each eye (of at most 64) not yet separated from an ancestor.
+  void visit(uint32_t level, uint32_t ix, uint32_t iy, uint64_t candidates) {
     const Node& node = nodes[culler.level_start_[level] + iy * (1u << level) + ix];
     const CellRange& r = node.range;
     if (r.empty()) return;
     const std::array<Vec3, 8> p = cell_frustum_corners(node.cell, viewpoint, z_near, z_far);
     const bool leaf = r.x1 - r.x0 == 1 && r.y1 - r.y0 == 1;  // one cell, whatever its level
-    std::vector<uint32_t> undecided;
-    for (uint32_t e : candidates) {
+    uint64_t undecided = 0;
+    for (uint64_t left = candidates; left != 0; left &= left - 1) {
+      const int e = std::countr_zero(left);
       if (stats) ++stats->tests;
       const Verdict v = classify(p, eyes[e]);
       if (v == Verdict::kInside || (leaf && v == Verdict::kTouches)) {
@@ -312,17 +393,24 @@ struct GridCuller::Search {
         return;
       }
       if (v == Verdict::kOutside) continue;
+      // Every cell below spans the axial depths [z_near, z_far * min_cos] (its own near cap is
+      // at most z_near, its far cap at least z_far times its largest cosine).
+      if (!leaf && section_inside(node, eyes[e], z_near, z_far * node.cell.min_cos)) {
+        emit_all(r);
+        return;
+      }
       if (v == Verdict::kUndecided) {
         const Verdict w = eye_in_node(node, p, eyes[e]);
         if (w == Verdict::kOutside) continue;
-        if (leaf && (w == Verdict::kTouches || node_reaches_into(p, eyes[e]))) {
+        if (leaf && (w == Verdict::kTouches || node_reaches_into(p, eyes[e]) ||
+                     eye_reaches_into(node, p, eyes[e]))) {
           emit_all(r);
           return;
         }
       }
-      undecided.push_back(e);
+      undecided |= uint64_t{1} << e;
     }
-    if (undecided.empty()) return;
+    if (undecided == 0) return;
     if (!leaf) {
       for (uint32_t c = 0; c < 4; ++c) {
         visit(level + 1, 2 * ix + (c & 1), 2 * iy + (c >> 1), undecided);
@@ -331,9 +419,9 @@ struct GridCuller::Search {
     }
     // The exact test settles what the planes could not, on the frustum cell_frustum() builds.
     const Frustum f = frustum_of(p);
-    for (uint32_t e : undecided) {
+    for (uint64_t left = undecided; left != 0; left &= left - 1) {
       if (stats) ++stats->exact_tests;
-      if (frusta_intersect(*eyes[e].frustum, f)) {
+      if (frusta_intersect(*eyes[std::countr_zero(left)].frustum, f)) {
         out->push_back(culler.grid_.cell_index(r.x0, r.y0));
         return;
       }
@@ -348,21 +436,23 @@ void GridCuller::visible(const Vec3& viewpoint, CubeFace face, double z_near, do
   const uint32_t total = grid_.quadtree_levels();
   if (levels == 0 || levels > total) levels = total;
   const uint32_t start = total - levels;
-  std::vector<uint32_t> all_eyes(eyes.size());
-  for (uint32_t e = 0; e < eyes.size(); ++e) all_eyes[e] = e;
-  Search search{*this,
-                nodes_[cube_face_index(face)],
-                viewpoint,
-                z_near,
-                z_far,
-                eyes,
-                stats,
-                out,
-                direction_from_face_coord({face, 0.5, 0.5})};
-  for (uint32_t iy = 0; iy < (1u << start); ++iy) {
-    for (uint32_t ix = 0; ix < (1u << start); ++ix) search.visit(start, ix, iy, all_eyes);
+  const Vec3 axis = direction_from_face_coord({face, 0.5, 0.5});
+  // Eyes in groups of 64 (one bit each); a cell seen by several groups is listed once.
+  for (size_t first = 0; first < eyes.size(); first += 64) {
+    const std::span<const PreparedEye> group =
+        eyes.subspan(first, std::min<size_t>(64, eyes.size() - first));
+    const uint64_t all = group.size() == 64 ? ~uint64_t{0} : (uint64_t{1} << group.size()) - 1;
+    Search search{*this,     nodes_[cube_face_index(face)],
+                  viewpoint, z_near,
+                  z_far,     group,
+                  stats,     out,
+                  axis,      length(axis)};
+    for (uint32_t iy = 0; iy < (1u << start); ++iy) {
+      for (uint32_t ix = 0; ix < (1u << start); ++ix) search.visit(start, ix, iy, all);
+    }
   }
   std::sort(out->begin(), out->end());
+  out->erase(std::unique(out->begin(), out->end()), out->end());
   if (stats) stats->visible_cells += out->size();
 }
 

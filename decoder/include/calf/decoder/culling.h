@@ -86,12 +86,16 @@ PreparedEye prepare_eye(const Frustum& eye);
 // multiply-adds per node). Each node is then tested against each eye's 6 face planes only: the
 // same projections and tolerance as frusta_intersect()'s first 6 axes, so a node it rejects the
 // exact test rejects too. A node whose 8 corners all lie inside an eye frustum by a margin
-// (1e-9 relative, far above rounding) has every cell below it visible, without further tests;
+// (1e-9 relative, far above rounding) has every cell below it visible, without further tests; so
+// has a node whose cross-section at some axial depth every cell below it spans (from z_near to
+// z_far times the node's smallest cosine) lies inside by the margin (the far caps reach past the
+// eye's far plane, so the first rule rarely applies to them);
 // a cell whose corner lies inside by that margin is visible. Next the eye's corners are tested
 // against the node's own planes (side planes through the apex from the cached directions, caps
 // along the face axis): all outside one plane by the margin rejects the node (the exact test's
 // axis for that face differs from this one by rounding only, far below the margin), a corner
-// inside all by the margin makes a cell visible. Only the cells left undecided go
+// inside all by the margin makes a cell visible, and so does a segment (side edge or centre line)
+// of either frustum with a stretch inside the other by the margin. Only the cells left undecided go
 // through frusta_intersect(), on the frustum cell_frustum() builds (the same bits), which stays
 // the arbiter. The result is exactly visible_cells_hierarchical()'s and
 // visible_cells_brute_force()'s (tested on random frusta).
@@ -112,6 +116,8 @@ class GridCuller {
     CellDirections cell;
     CellRange range;
     std::array<Vec3, 4> side;  // side plane normals through the apex, inward
+    std::array<double, 4> side_len{};
+    std::array<Vec3, 4> axial;  // dirs[i] / cos[i]: corner i's offset per unit of axial depth
   };
   struct Search;
   FaceGrid grid_;
