@@ -267,5 +267,22 @@ TEST(CullingTest, CellFrustumFromCachedDirectionsIsBitIdentical) {
   }
 }
 
+// More eyes than one 64-bit group: the groups' sets are united without duplicates.
+TEST(CullingTest, GridCullerTakesMoreThan64Eyes) {
+  std::mt19937 rng(7);
+  const GridCuller culler(*FaceGrid::with_cell_size(64, 8));
+  const RandomScene s = random_scene(rng, 70);
+  std::vector<PreparedEye> eyes;
+  for (const Frustum& e : s.eyes) eyes.push_back(prepare_eye(e));
+  std::vector<uint32_t> got;
+  for (int f = 0; f < kCubeFaceCount; ++f) {
+    const CubeFace face = cube_face_from_index(f);
+    culler.visible(s.viewpoint, face, 0.2, 6, eyes, 0, nullptr, &got);
+    EXPECT_EQ(got,
+              visible_cells_brute_force(s.viewpoint, face, culler.grid(), 0.2, 6, s.eyes, nullptr))
+        << "face " << f;
+  }
+}
+
 }  // namespace
 }  // namespace calf
