@@ -399,11 +399,16 @@ struct GridCuller::Search {
         emit_all(r);
         return;
       }
-      if (v == Verdict::kUndecided) {
+      // A leaf neither rejected nor accepted by the eye's planes: a stretch of one of its segments
+      // inside the eye (the common case) first, then the eye against its own planes.
+      if (leaf && v == Verdict::kUndecided) {
+        if (node_reaches_into(p, eyes[e])) {
+          emit_all(r);
+          return;
+        }
         const Verdict w = eye_in_node(node, p, eyes[e]);
         if (w == Verdict::kOutside) continue;
-        if (leaf && (w == Verdict::kTouches || node_reaches_into(p, eyes[e]) ||
-                     eye_reaches_into(node, p, eyes[e]))) {
+        if (w == Verdict::kTouches || eye_reaches_into(node, p, eyes[e])) {
           emit_all(r);
           return;
         }
