@@ -55,6 +55,8 @@ struct ClipDecoder::Impl {
   lf::RegionCoding depth_coding = lf::RegionCoding::kR16;
   std::optional<lf::RegionCoding> material_coding;
   std::unique_ptr<ChunkCache> cache;
+  // Node directions of the colour-cell and depth-tile quadtrees, computed once (culling.h).
+  std::optional<GridCuller> cell_culler, tile_culler;
 
   // Chunks by (stream, view, face, region), sorted by first frame; a flat table because it is
   // consulted per visible cell and tile every frame.
@@ -81,6 +83,31 @@ struct ClipDecoder::Impl {
   std::vector<ChunkBytes> in_use;  // keeps this frame's chunks alive
   std::vector<uint32_t> prefetch_ids;
 
+  // The visible cells and tiles of each view, per face, for the viewers and options below.
+  struct VisibleSets {
+    bool valid = false;
+    std::array<std::vector<uint32_t>, 6> cells, tiles;
+  };
+  std::vector<VisibleSets> visible_cache;  // per view
+  std::vector<EyeView> cache_eyes;
+  ClipDecoderOptions cache_options;
+  bool same_viewers(std::span<const EyeView> eyes) const {
+    auto same = [](const EyeView& a, const EyeView& b) {
+      return a.position == b.position && a.forward == b.forward && a.up == b.up &&
+             a.fov_y == b.fov_y && a.aspect == b.aspect && a.near == b.near && a.far == b.far;
+    };
+    if (eyes.size() != cache_eyes.size() ||
+        options.view_dependent != cache_options.view_dependent ||
+        options.quadtree_levels != cache_options.quadtree_levels ||
+        options.brute_force_culling != cache_options.brute_force_culling) {
+      return false;
+    }
+    for (size_t i = 0; i < eyes.size(); ++i) {
+      if (!same(eyes[i], cache_eyes[i])) return false;
+    }
+    return true;
+  }
+
   const std::vector<ChunkRef>* find(LightfieldStream s, uint32_t v, uint32_t f, uint32_t r) const {
     return &chunks[slot(static_cast<uint32_t>(s), v, f, r)];
   }
@@ -103,9 +130,11 @@ struct ClipDecoder::Impl {
                    (exact_start ? " starts at frame " : " serves frame ") + std::to_string(frame));
   }
 
-  Expected<ChunkBytes> fetch(uint32_t id, FrameStats& stats) {
+  Expected<ChunkBytes> fetch(uint32_t id, FrameUpdates* out) {
+    FrameStats& stats = out->stats;
     bool here = false;
     CALF_ASSIGN_OR_RETURN(ChunkBytes bytes, cache->get(id, &here));
+    out->chunks.push_back(id);
     stats.chunks_needed += 1;
     stats.chunks_read_on_demand += here ? 1 : 0;
     in_use.push_back(bytes);
@@ -183,6 +212,7 @@ Status ClipDecoder::Impl::open_tables() {
   cell_state.assign(header.view_count, std::vector<CellState>(size_t{6} * cell_count));
   depth_state.assign(header.view_count, std::vector<TileState>(size_t{6} * tile_count));
   material_state.assign(header.view_count, std::vector<TileState>(size_t{6} * tile_count));
+  visible_cache.assign(header.view_count, {});
   return Status::Ok();
 }
 
@@ -192,7 +222,7 @@ Status ClipDecoder::Impl::update_cell(uint32_t view, uint32_t face, uint32_t cel
   if (!s.timeline) {
     CALF_ASSIGN_OR_RETURN(uint32_t id,
                           chunk_serving(LightfieldStream::kTParams, view, face, cell, 0, true));
-    CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out->stats));
+    CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out));
     CALF_ASSIGN_OR_RETURN(lf::CellTimeline tl, lf::parse_t_chunk(*raw, header.frame_count,
                                                                  where(view, face, cell) + " t"));
     s.timeline = std::move(tl);
@@ -212,7 +242,7 @@ Status ClipDecoder::Impl::update_cell(uint32_t view, uint32_t face, uint32_t cel
     if (s.slot_keyframe[slot] == k) continue;
     CALF_ASSIGN_OR_RETURN(uint32_t id, chunk_serving(LightfieldStream::kColour, view, face, cell,
                                                      tl.keyframes[k], true));
-    CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out->stats));
+    CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out));
     CALF_RETURN_IF_ERROR(lf::colour_payload_gpu_bytes(header.colour_format, *raw, rect.width,
                                                       rect.height, gpu[slot],
                                                       where(view, face, cell) + " colour"));
@@ -244,7 +274,7 @@ Status ClipDecoder::Impl::update_tile(bool depth, uint32_t view, uint32_t face, 
   const LightfieldStream stream = depth ? LightfieldStream::kDepth : LightfieldStream::kMaterial;
   CALF_ASSIGN_OR_RETURN(uint32_t id, chunk_serving(stream, view, face, tile, frame, false));
   const container::ChunkKeys& keys = reader->chunks()[id].keys;
-  CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out->stats));
+  CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out));
   const PixelRect r = tiles.cell_rect(tile % tiles.cells_per_side(), tile / tiles.cells_per_side());
   const lf::RegionCoding coding = depth ? depth_coding : *material_coding;
   CALF_ASSIGN_OR_RETURN(
@@ -344,6 +374,8 @@ Expected<ClipDecoder> ClipDecoder::open(const container::Reader& reader, uint16_
     CALF_ASSIGN_OR_RETURN(impl->material_coding, lf::material_coding(impl->header.material_format));
   }
   CALF_RETURN_IF_ERROR(impl->open_tables());
+  impl->cell_culler.emplace(impl->cells);
+  impl->tile_culler.emplace(impl->tiles);
   impl->cache =
       std::make_unique<ChunkCache>(reader, options.cache_bytes, options.background_thread);
   return ClipDecoder(std::move(impl));
@@ -400,6 +432,7 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
   out->updates.clear();
   out->cells.clear();
   out->tiles.clear();
+  out->chunks.clear();
   out->stats = FrameStats{};
   FrameStats& stats = out->stats;
   stats.frame = frame;
@@ -415,51 +448,84 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
   std::vector<uint32_t> all_cells(d.cells.cell_count()), all_tiles(d.tiles.cell_count());
   for (uint32_t i = 0; i < all_cells.size(); ++i) all_cells[i] = i;
   for (uint32_t i = 0; i < all_tiles.size(); ++i) all_tiles[i] = i;
-  auto cull_cells = [&](const Vec3& apex, CubeFace face, const FaceGrid& grid, double z_near,
-                        double z_far, std::span<const Frustum> eye) {
-    return d.options.brute_force_culling
-               ? visible_cells_brute_force(apex, face, grid, z_near, z_far, eye, &cull)
-               : visible_cells_hierarchical(apex, face, grid, z_near, z_far, eye,
-                                            d.options.quadtree_levels, &cull);
+  // The visible sets depend on the viewers and the culling options only (not on the frame): kept
+  // from frame to frame while those stay the same, recomputed per view when it is next needed.
+  if (!d.same_viewers(eyes)) {
+    for (Impl::VisibleSets& vs : d.visible_cache) vs.valid = false;
+    d.cache_eyes.assign(eyes.begin(), eyes.end());
+    d.cache_options = d.options;
+  }
+  std::vector<PreparedEye> prepared;
+  for (const Frustum& f : frusta) prepared.push_back(prepare_eye(f));
+  std::vector<uint32_t> by_eye;
+  auto cull_cells = [&](const Vec3& apex, CubeFace face, const GridCuller& culler, double z_near,
+                        double z_far, size_t eye) {
+    if (d.options.brute_force_culling) {
+      by_eye = visible_cells_brute_force(apex, face, culler.grid(), z_near, z_far,
+                                         std::span<const Frustum>(&frusta[eye], 1), &cull);
+    } else {
+      culler.visible(apex, face, z_near, z_far, std::span<const PreparedEye>(&prepared[eye], 1),
+                     d.options.quadtree_levels, &cull, &by_eye);
+    }
+  };
+  // Sky: it is at infinity, so the renderer reads every view's sky in the eye ray's own
+  // direction, not at a point in the viewer's frustum. A cell whose directions meet the viewer's
+  // is therefore needed too: its frustum placed at the eye, tested against the eye's frustum with
+  // a far cap beyond the eye's (so every shared direction has a shared point). That set is the
+  // same for every view: computed once per eye, face and grid, when first needed.
+  std::vector<std::array<std::optional<std::vector<uint32_t>>, 12>> sky(eyes.size());
+  auto sky_set = [&](size_t i, uint32_t f, bool tiles) -> const std::vector<uint32_t>& {
+    std::optional<std::vector<uint32_t>>& slot = sky[i][f * 2 + (tiles ? 1 : 0)];
+    if (!slot) {
+      cull_cells(eyes[i].position, static_cast<CubeFace>(f),
+                 tiles ? *d.tile_culler : *d.cell_culler, eyes[i].near, 2 * eyes[i].far, i);
+      slot = by_eye;
+    }
+    return *slot;
   };
   for (uint32_t v : active) {
     const LightfieldViewInfo& info = d.views[v];
     const Vec3 p = info.position;
-    // Geometry: a cell frustum reaching past each viewer's far plane (seen from this viewpoint)
-    // holds every point the viewer can see through it. The far cap depends on the viewer, so each
-    // viewer is culled on its own and the visible sets are united: several viewers see exactly the
-    // union of each.
-    // Sky: it is at infinity, so the renderer reads every view's sky in the eye ray's own
-    // direction, not at a point in the viewer's frustum. A cell whose directions meet the
-    // viewer's is therefore needed too: its frustum placed at the eye, tested against the eye's
-    // frustum with a far cap beyond the eye's (so every shared direction has a shared point).
-    std::vector<double> z_far(eyes.size());
-    for (size_t i = 0; i < eyes.size(); ++i) {
-      z_far[i] = std::max<double>(info.z_far, length(eyes[i].position - p) + eyes[i].far);
-    }
     const bool has_material = info.has_material && d.material_coding.has_value();
-    for (uint32_t f = 0; f < 6; ++f) {
-      const CubeFace face = static_cast<CubeFace>(f);
-      auto visible = [&](const FaceGrid& grid, const std::vector<uint32_t>& all) {
-        if (!d.options.view_dependent) return all;
-        std::vector<uint32_t> united;
-        for (size_t i = 0; i < eyes.size(); ++i) {
-          const std::span<const Frustum> one(&frusta[i], 1);
-          const Vec3& e = eyes[i].position;
-          const double sky_near = eyes[i].near, sky_far = 2 * eyes[i].far;
-          for (const std::vector<uint32_t>& by_eye :
-               {cull_cells(p, face, grid, info.z_near, z_far[i], one),
-                cull_cells(e, face, grid, sky_near, sky_far, one)}) {
-            std::vector<uint32_t> merged;
-            std::set_union(united.begin(), united.end(), by_eye.begin(), by_eye.end(),
-                           std::back_inserter(merged));
-            united.swap(merged);
+    Impl::VisibleSets& vs = d.visible_cache[v];
+    if (d.options.view_dependent && !vs.valid) {
+      const auto cull_start = std::chrono::steady_clock::now();
+      // Geometry: a cell frustum reaching past each viewer's far plane (seen from this viewpoint)
+      // holds every point the viewer can see through it. The far cap depends on the viewer, so
+      // each viewer is culled on its own and the visible sets are united: several viewers see
+      // exactly the union of each.
+      std::vector<double> z_far(eyes.size());
+      for (size_t i = 0; i < eyes.size(); ++i) {
+        z_far[i] = std::max<double>(info.z_far, length(eyes[i].position - p) + eyes[i].far);
+      }
+      std::vector<uint32_t> merged;
+      auto unite = [&](std::vector<uint32_t>& united, const std::vector<uint32_t>& more) {
+        merged.clear();
+        std::set_union(united.begin(), united.end(), more.begin(), more.end(),
+                       std::back_inserter(merged));
+        united.swap(merged);
+      };
+      for (uint32_t f = 0; f < 6; ++f) {
+        for (bool tiles : {false, true}) {
+          std::vector<uint32_t>& united = tiles ? vs.tiles[f] : vs.cells[f];
+          united.clear();
+          for (size_t i = 0; i < eyes.size(); ++i) {
+            cull_cells(p, static_cast<CubeFace>(f), tiles ? *d.tile_culler : *d.cell_culler,
+                       info.z_near, z_far[i], i);
+            unite(united, by_eye);
+            unite(united, sky_set(i, f, tiles));
           }
         }
-        return united;
-      };
-      const std::vector<uint32_t> vis_cells = visible(d.cells, all_cells);
-      const std::vector<uint32_t> vis_tiles = visible(d.tiles, all_tiles);
+      }
+      vs.valid = true;
+      stats.culling_ms +=
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cull_start)
+              .count();
+    }
+    for (uint32_t f = 0; f < 6; ++f) {
+      const CubeFace face = static_cast<CubeFace>(f);
+      const std::vector<uint32_t>& vis_cells = d.options.view_dependent ? vs.cells[f] : all_cells;
+      const std::vector<uint32_t>& vis_tiles = d.options.view_dependent ? vs.tiles[f] : all_tiles;
       stats.total_cells += d.cells.cell_count();
       stats.total_tiles += d.tiles.cell_count();
       stats.visible_cells += static_cast<uint32_t>(vis_cells.size());
@@ -474,7 +540,9 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
           if (Status s = d.update_tile(false, v, f, t, frame, out); !s.ok()) report(s);
         }
       }
-      for (uint32_t ahead = 1; ahead <= d.options.prefetch_frames; ++ahead) {
+      // Without the background thread nothing would read the queue.
+      const uint32_t prefetch = d.options.background_thread ? d.options.prefetch_frames : 0;
+      for (uint32_t ahead = 1; ahead <= prefetch; ++ahead) {
         if (frame + ahead >= d.header.frame_count) break;
         for (uint32_t c : vis_cells) d.queue_prefetch(true, v, f, c, frame + ahead);
         for (uint32_t t : vis_tiles) d.queue_prefetch(false, v, f, t, frame + ahead);
@@ -487,6 +555,7 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
   }
   stats.updates = static_cast<uint32_t>(out->updates.size());
   stats.culling_tests = cull.tests;
+  stats.culling_exact_tests = cull.exact_tests;
   // Nearest frames first; a chunk serving several of them once.
   std::unordered_set<uint32_t> queued;
   std::erase_if(d.prefetch_ids, [&](uint32_t id) { return !queued.insert(id).second; });

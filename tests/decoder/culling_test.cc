@@ -181,5 +181,108 @@ TEST(CullingTest, HierarchyMakesFewerTestsForANarrowEye) {
   EXPECT_EQ(tree.visible_cells, a.size());
 }
 
+// GridCuller (the decoder's culling) returns exactly the brute-force set: its plane test rejects
+// nothing the exact test accepts and its inside / corner-inside acceptances are never wrong, at
+// every level count, for one or several viewers. One culler per grid serves every trial, so a
+// changed viewpoint, depth range or eye needs nothing recomputed or invalidated (the culler holds
+// directions only).
+TEST(CullingTest, GridCullerEqualsBruteForce) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u01(0, 1);
+  std::vector<GridCuller> cullers;
+  for (int g = 0; g < 5; ++g) {
+    cullers.emplace_back(*FaceGrid::with_cell_size(32 + 16 * g, 8 + 4 * (g % 3)));
+  }
+  CullStats stats;
+  int partial = 0;
+  std::vector<uint32_t> got;
+  for (int trial = 0; trial < 300; ++trial) {
+    const GridCuller& culler = cullers[trial % cullers.size()];
+    const FaceGrid& grid = culler.grid();
+    const RandomScene s = random_scene(rng, 1 + trial % 3);
+    std::vector<PreparedEye> eyes;
+    for (const Frustum& e : s.eyes) eyes.push_back(prepare_eye(e));
+    // Depth ranges from a sliver to the decoder's far caps (eye far plus distance).
+    const double z_near = 0.05 + u01(rng), z_far = z_near * (1.01 + 100 * u01(rng) * u01(rng));
+    for (int f = 0; f < kCubeFaceCount; ++f) {
+      const CubeFace face = cube_face_from_index(f);
+      const auto brute =
+          visible_cells_brute_force(s.viewpoint, face, grid, z_near, z_far, s.eyes, nullptr);
+      for (uint32_t levels = 0; levels <= grid.quadtree_levels(); ++levels) {
+        culler.visible(s.viewpoint, face, z_near, z_far, eyes, levels, &stats, &got);
+        ASSERT_EQ(got, brute) << "trial " << trial << " face " << f << " levels " << levels;
+      }
+      partial += !brute.empty() && brute.size() < grid.cell_count();
+    }
+  }
+  EXPECT_GT(partial, 200);
+  // The planes settle most tests; the exact test is the exception.
+  EXPECT_LT(stats.exact_tests * 4, stats.tests);
+}
+
+// The eye at the apex (the decoder's sky pass) and eyes just touching a cell: the acceptances near
+// the tolerance still agree with the exact test.
+TEST(CullingTest, GridCullerEqualsBruteForceForEyesAtTheApexAndGrazing) {
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> u01(0, 1);
+  const GridCuller culler(*FaceGrid::with_cell_size(64, 8));
+  std::vector<uint32_t> got;
+  for (int trial = 0; trial < 200; ++trial) {
+    EyeView e;
+    const double th = u01(rng) * 2 * kPi, ph = std::acos(2 * u01(rng) - 1);
+    e.forward = v(std::sin(ph) * std::cos(th), std::sin(ph) * std::sin(th), std::cos(ph));
+    // Axis-aligned views put eye planes on cell boundaries (touching counts as meeting).
+    if (trial % 4 == 0) e.forward = v(trial % 8 == 0 ? 1 : 0, 0, trial % 8 == 0 ? 0 : -1);
+    e.up = std::fabs(e.forward.y) < 0.9 ? v(0, 1, 0) : v(1, 0, 0);
+    e.fov_y = trial % 4 == 0 ? kPi / 2 : 0.3 + u01(rng) * 1.5;
+    e.aspect = trial % 4 == 0 ? 1 : 0.5 + u01(rng) * 1.5;
+    e.near = 0.05;
+    e.far = 5 + 50 * u01(rng);
+    e.position = trial % 2 ? v(0.5, -0.25, 2) : v(0.5 + 0.1 * u01(rng), -0.25, 2);
+    const Frustum fr = eye_frustum(e);
+    const PreparedEye pe = prepare_eye(fr);
+    for (int f = 0; f < kCubeFaceCount; ++f) {
+      const CubeFace face = cube_face_from_index(f);
+      const Vec3 apex = v(0.5, -0.25, 2);
+      const auto brute = visible_cells_brute_force(apex, face, culler.grid(), e.near, 2 * e.far,
+                                                   std::span(&fr, 1), nullptr);
+      culler.visible(apex, face, e.near, 2 * e.far, std::span(&pe, 1), 0, nullptr, &got);
+      ASSERT_EQ(got, brute) << "trial " << trial << " face " << f;
+    }
+  }
+}
+
+// Cached directions give the very frustum cell_frustum() builds from scratch.
+TEST(CullingTest, CellFrustumFromCachedDirectionsIsBitIdentical) {
+  const FaceGrid grid = *FaceGrid::with_cell_size(96, 16);
+  for (int f = 0; f < kCubeFaceCount; ++f) {
+    const CubeFace face = cube_face_from_index(f);
+    for (uint32_t c = 0; c < grid.cell_count(); ++c) {
+      const PixelRect r = *grid.cell_rect(c);
+      const Frustum a = cell_frustum(v(1, 2, -3), face, 96, r, 0.3, 17);
+      const std::array<Vec3, 8> b =
+          cell_frustum_corners(cell_directions(face, 96, r), v(1, 2, -3), 0.3, 17);
+      for (int i = 0; i < 8; ++i) ASSERT_EQ(a.corners()[i], b[i]) << "face " << f << " cell " << c;
+    }
+  }
+}
+
+// More eyes than one 64-bit group: the groups' sets are united without duplicates.
+TEST(CullingTest, GridCullerTakesMoreThan64Eyes) {
+  std::mt19937 rng(7);
+  const GridCuller culler(*FaceGrid::with_cell_size(64, 8));
+  const RandomScene s = random_scene(rng, 70);
+  std::vector<PreparedEye> eyes;
+  for (const Frustum& e : s.eyes) eyes.push_back(prepare_eye(e));
+  std::vector<uint32_t> got;
+  for (int f = 0; f < kCubeFaceCount; ++f) {
+    const CubeFace face = cube_face_from_index(f);
+    culler.visible(s.viewpoint, face, 0.2, 6, eyes, 0, nullptr, &got);
+    EXPECT_EQ(got,
+              visible_cells_brute_force(s.viewpoint, face, culler.grid(), 0.2, 6, s.eyes, nullptr))
+        << "face " << f;
+  }
+}
+
 }  // namespace
 }  // namespace calf

@@ -9,6 +9,7 @@
 #include <unistd.h>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <random>
@@ -547,6 +548,67 @@ TEST(ClipDecoder, VisibilityFollowsTheViewers) {
   fu = advance_ok(d, tex, 2, std::vector<EyeView>{narrow});
   EXPECT_EQ(fu.stats.visible_cells, fu.stats.total_cells);
   expect_matches_reference(clip, tex, fu, 2, "view-dependent off");
+}
+
+// The decoder keeps its visible sets from frame to frame while the viewers and the culling options
+// stay the same (culling them again gives the same sets): any change of an eye — position,
+// direction, near or far plane, count — or of the options recomputes them. Each frame's sets equal
+// those of a fresh decoder given the same viewers.
+TEST(ClipDecoder, VisibleSetsAreKeptOnlyWhileTheViewersStay) {
+  ClipSpec spec;
+  spec.seed = 57;
+  spec.views = 3;
+  spec.options.cell_size = 4;
+  const Clip clip = make_clip(spec);
+  std::mt19937 rng(57);
+  const EyeView a = random_eye(rng), b = random_eye(rng);
+  EyeView a_near = a, a_far = a, a_moved = a, a_turned = a;
+  a_near.near = a.near * 4;
+  a_far.far = a.far / 3;
+  a_moved.position.x += 0.25;
+  a_turned.forward.y += 0.2;
+  const std::vector<std::vector<EyeView>> steps = {
+      {a}, {a}, {b}, {a}, {a_near}, {a_far}, {a_far}, {a_moved}, {a_turned}, {a, b}, {a, b}, {b}};
+  ClipDecoder kept = open_decoder(clip);
+  using Set = std::set<std::tuple<uint32_t, int, uint32_t>>;
+  auto sets = [](const FrameUpdates& fu) {
+    Set cells, tiles;
+    for (const CellParams& c : fu.cells) cells.insert({c.view, cube_face_index(c.face), c.cell});
+    for (const TileRef& t : fu.tiles) tiles.insert({t.view, cube_face_index(t.face), t.tile});
+    return std::make_pair(cells, tiles);
+  };
+  int changed = 0;
+  for (size_t i = 0; i < steps.size(); ++i) {
+    const uint32_t frame = static_cast<uint32_t>(i % spec.frames);
+    FrameUpdates fu, fresh_fu;
+    ASSERT_TRUE(kept.advance(frame, steps[i], {}, &fu).ok());
+    ClipDecoder fresh = open_decoder(clip);
+    ASSERT_TRUE(fresh.advance(frame, steps[i], {}, &fresh_fu).ok());
+    EXPECT_EQ(sets(fu), sets(fresh_fu)) << "step " << i;
+    const bool same =
+        i > 0 && steps[i].size() == steps[i - 1].size() &&
+        std::memcmp(steps[i].data(), steps[i - 1].data(), steps[i].size() * sizeof(EyeView)) == 0;
+    // Kept sets cost no culling; changed viewers are culled again.
+    if (same) {
+      EXPECT_EQ(fu.stats.culling_tests, 0u) << "step " << i;
+    } else {
+      EXPECT_GT(fu.stats.culling_tests, 0u) << "step " << i;
+      changed += sets(fu) != sets(FrameUpdates{}) ? 1 : 0;
+    }
+  }
+  EXPECT_GE(changed, 5);
+  // Options: brute force and view dependence switched per frame keep giving the fresh sets.
+  kept.set_view_dependent(false);
+  FrameUpdates fu;
+  ASSERT_TRUE(kept.advance(0, steps[0], {}, &fu).ok());
+  EXPECT_EQ(fu.stats.visible_cells, fu.stats.total_cells);
+  kept.set_view_dependent(true);
+  FrameUpdates again, fresh_fu;
+  ASSERT_TRUE(kept.advance(0, steps[0], {}, &again).ok());
+  ClipDecoder fresh = open_decoder(clip);
+  ASSERT_TRUE(fresh.advance(0, steps[0], {}, &fresh_fu).ok());
+  EXPECT_EQ(sets(again), sets(fresh_fu));
+  EXPECT_GT(again.stats.culling_tests, 0u);
 }
 
 // Sky is at infinity: the renderer reads each view's sky in the eye ray's own direction. A view

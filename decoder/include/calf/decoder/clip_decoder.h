@@ -84,10 +84,11 @@ struct TileRef {
 
 struct FrameStats {
   uint32_t frame = 0;
-  uint64_t culling_tests = 0;  // frustum-frustum tests, cells and tiles
-  uint32_t visible_cells = 0;  // colour cells of active views seen by a viewer
-  uint32_t total_cells = 0;    // colour cells of active views
-  uint32_t visible_tiles = 0;  // depth tiles of active views seen by a viewer
+  uint64_t culling_tests = 0;        // frustum-frustum tests, cells and tiles
+  uint64_t culling_exact_tests = 0;  // of those, full separating-axis tests (culling.h GridCuller)
+  uint32_t visible_cells = 0;        // colour cells of active views seen by a viewer
+  uint32_t total_cells = 0;          // colour cells of active views
+  uint32_t visible_tiles = 0;        // depth tiles of active views seen by a viewer
   uint32_t total_tiles = 0;
   uint32_t updates = 0;                                            // texture updates yielded
   uint64_t colour_bytes = 0, depth_bytes = 0, material_bytes = 0;  // update payload bytes
@@ -95,6 +96,7 @@ struct FrameStats {
   uint32_t chunks_read_on_demand = 0;  // of those, read by advance() itself (not prefetched)
   size_t cached_bytes = 0;             // decompressed chunks held by the cache after the frame
   double decode_ms = 0;                // wall time of advance()
+  double culling_ms = 0;               // of which the culling (visible sets of every view)
   uint32_t errors = 0;                 // chunks that failed this frame
   std::string first_error;  // the first of them, with its id, e.g. "CALF-E202 view 0 ..."
   uint64_t update_bytes() const { return colour_bytes + depth_bytes + material_bytes; }
@@ -108,6 +110,9 @@ struct FrameUpdates {
   std::vector<TextureUpdate> updates;  // in application order
   std::vector<CellParams> cells;       // every visible cell of every active view
   std::vector<TileRef> tiles;          // every visible tile of every active view
+  // The chunks this frame's updates were decoded from (stats.chunks_needed ids, in order of use;
+  // a chunk used twice is listed twice): what a benchmark decompresses to time "the limit".
+  std::vector<uint32_t> chunks;
   FrameStats stats;
 };
 

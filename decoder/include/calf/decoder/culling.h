@@ -32,10 +32,12 @@ namespace calf {
 Frustum cell_frustum(const Vec3& viewpoint, CubeFace face, uint32_t face_size,
                      const PixelRect& rect, double z_near, double z_far);
 
-// Counts of frustum-frustum tests, for Table 4 of the paper.
+// Counts of frustum-frustum tests, for Table 4 of the paper. `exact_tests` counts the full
+// separating-axis tests GridCuller falls back to (the reference searches below count none).
 struct CullStats {
   uint64_t tests = 0;
   uint64_t visible_cells = 0;
+  uint64_t exact_tests = 0;
 };
 
 // The cells of `face` (indices in `grid`, increasing) whose frustum meets at least one eye
@@ -51,5 +53,76 @@ std::vector<uint32_t> visible_cells_hierarchical(const Vec3& viewpoint, CubeFace
 std::vector<uint32_t> visible_cells_brute_force(const Vec3& viewpoint, CubeFace face,
                                                 const FaceGrid& grid, double z_near, double z_far,
                                                 std::span<const Frustum> eyes, CullStats* stats);
+
+// The parts of a cell frustum that depend on the cell alone (face, face size, texel rectangle):
+// its 4 corner directions (near/far corner i lies on direction i), their cosines with the face
+// axis, and the smallest and largest cosine over the cell. cell_frustum() is
+// cell_frustum_from(cell_directions(...), ...), so a frustum built from cached directions has the
+// very bits of one built from scratch.
+struct CellDirections {
+  std::array<Vec3, 4> dirs;
+  std::array<double, 4> cos{};
+  double min_cos = 1, max_cos = 1;
+};
+CellDirections cell_directions(CubeFace face, uint32_t face_size, const PixelRect& rect);
+// The 8 corners (near 0..3, far 0..3) of the frustum of `cell` seen from `viewpoint` for radial
+// depths [z_near, z_far].
+std::array<Vec3, 8> cell_frustum_corners(const CellDirections& cell, const Vec3& viewpoint,
+                                         double z_near, double z_far);
+
+// An eye frustum prepared for GridCuller: its face planes (inward normals) with the interval its
+// corners span on each, as the separating-axis test computes them.
+struct PreparedEye {
+  const Frustum* frustum = nullptr;
+  std::array<Vec3, 6> normals;
+  std::array<double, 6> lo{}, hi{}, margin{};
+  double reach = 0;  // the largest coordinate magnitude of a corner
+};
+PreparedEye prepare_eye(const Frustum& eye);
+
+// Culling for one grid, fast enough to run every frame (issue 17): the directions of every
+// quadtree node of every face are computed once, at construction (they depend on the face, the
+// face size and the node's rectangle only; the viewpoint and depth range enter per call through 8
+// multiply-adds per node). Each node is then tested against each eye's 6 face planes only: the
+// same projections and tolerance as frusta_intersect()'s first 6 axes, so a node it rejects the
+// exact test rejects too. A node whose 8 corners all lie inside an eye frustum by a margin
+// (1e-9 relative, far above rounding) has every cell below it visible, without further tests; so
+// has a node whose cross-section at some axial depth every cell below it spans (from z_near to
+// z_far times the node's smallest cosine) lies inside by the margin (the far caps reach past the
+// eye's far plane, so the first rule rarely applies to them);
+// a cell whose corner lies inside by that margin is visible. Next the eye's corners are tested
+// against the node's own planes (side planes through the apex from the cached directions, caps
+// along the face axis): all outside one plane by the margin rejects the node (the exact test's
+// axis for that face differs from this one by rounding only, far below the margin), a corner
+// inside all by the margin makes a cell visible, and so does a segment (side edge or centre line)
+// of either frustum with a stretch inside the other by the margin. Only the cells left undecided go
+// through frusta_intersect(), on the frustum cell_frustum() builds (the same bits), which stays
+// the arbiter. The result is exactly visible_cells_hierarchical()'s and
+// visible_cells_brute_force()'s (tested on random frusta).
+class GridCuller {
+ public:
+  explicit GridCuller(const FaceGrid& grid);
+
+  const FaceGrid& grid() const { return grid_; }
+  // The cells of `face` (increasing) whose frustum meets at least one of `eyes`; `levels` as for
+  // visible_cells_hierarchical (it only changes where the descent starts). Adds to `stats`
+  // (`tests` counts node-eye plane tests, `exact_tests` the full tests among them).
+  void visible(const Vec3& viewpoint, CubeFace face, double z_near, double z_far,
+               std::span<const PreparedEye> eyes, uint32_t levels, CullStats* stats,
+               std::vector<uint32_t>* out) const;
+
+ private:
+  struct Node {
+    CellDirections cell;
+    CellRange range;
+    std::array<Vec3, 4> side;  // side plane normals through the apex, inward
+    std::array<double, 4> side_len{};
+    std::array<Vec3, 4> axial;  // dirs[i] / cos[i]: corner i's offset per unit of axial depth
+  };
+  struct Search;
+  FaceGrid grid_;
+  std::vector<uint32_t> level_start_;  // first node of each level in nodes_[face]
+  std::array<std::vector<Node>, 6> nodes_;
+};
 
 }  // namespace calf
