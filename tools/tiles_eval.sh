@@ -13,7 +13,10 @@
 #   4. calf-play --headless --compare of both clips against both: PSNR / SSIM with the noise floor.
 # Usage: tools/tiles_eval.sh BUILD_DIR OUT_DIR [SCENE] [FACE] [GT_SIZE]
 # Environment: CAPTURE_OPTS (extra calf-capture options, e.g. "--rig box:..."), TILES_OPTS (extra
-# calf-encode --mode tiles options), POSES (eye-path poses, default 8).
+# calf-encode --mode tiles options), POSES (eye-path poses, default 8), NOVEL (path: the scene's
+# own eye path, the default; rig: novel poses between the capture viewpoints, at 1/4, 1/2 and 3/4
+# of the way from each to the next, looking at the world origin: for a rig placed outside a model,
+# whose own eye path does not stay inside the rig's view region).
 set -euo pipefail
 BUILD=${1:?usage: tools/tiles_eval.sh BUILD_DIR OUT_DIR [SCENE] [FACE] [GT_SIZE]}
 OUT=${2:?usage: tools/tiles_eval.sh BUILD_DIR OUT_DIR [SCENE] [FACE] [GT_SIZE]}
@@ -65,12 +68,35 @@ awk -v w="$FACE" '
 step "ground truth at the capture viewpoints"
 "$BUILD"/calf-capture --scene "$SCENE" --ground-truth --eye-path "$OUT/capture_views_path.json" \
   --out "$OUT/gt-capture-views" --quiet "${capture_opts[@]}"
-step "ground truth along the eye path, the scene at frame 0"
-# (only its poses are used: the cheapest images)
-"$BUILD"/calf-capture --scene "$SCENE" --ground-truth --frames "$POSES" --gt-size "$GT" \
-  --out "$OUT/gt-path-animated" --no-noise-floor --quiet --spp 1 --ao-samples 0
-sed -E 's/"time": *[-+0-9.eE]+/"time": 0/' "$OUT/gt-path-animated/eye_path.json" \
-  >"$OUT/frame0_path.json"
+if [ "${NOVEL:-path}" = rig ]; then
+  step "ground truth at novel poses between the capture viewpoints"
+  awk -v w="${GT%x*}" -v h="${GT#*x}" '
+    /"position": \[/ { inpos = 1; n = 0; next }
+    inpos && /\]/ { inpos = 0; ++count; x[count] = p[1]; y[count] = p[2]; z[count] = p[3]; next }
+    inpos { gsub(/[ ,]/, ""); p[++n] = $0 }
+    END {
+      printf "{\n  \"format\": \"calf-eye-path\",\n  \"version\": 1,\n  \"width\": %d,\n  \"height\": %d,\n  \"poses\": [\n", w, h
+      first = 1
+      for (v = 1; v <= count; ++v) {
+        u = v % count + 1
+        for (k = 1; k <= 3; ++k) {
+          t = k / 4
+          px = x[v] + t * (x[u] - x[v]); py = y[v] + t * (y[u] - y[v]); pz = z[v] + t * (z[u] - z[v])
+          if (!first) printf ",\n"
+          first = 0
+          printf "    {\"time\": 0, \"position\": [%.6f, %.6f, %.6f], \"forward\": [%.6f, %.6f, %.6f], \"up\": [0, 1, 0], \"fov_y_degrees\": 60}", px, py, pz, -px, -py, -pz
+        }
+      }
+      printf "\n  ]\n}\n"
+    }' "$OUT/capture/manifest.json" >"$OUT/frame0_path.json"
+else
+  step "ground truth along the eye path, the scene at frame 0"
+  # (only its poses are used: the cheapest images)
+  "$BUILD"/calf-capture --scene "$SCENE" --ground-truth --frames "$POSES" --gt-size "$GT" \
+    --out "$OUT/gt-path-animated" --no-noise-floor --quiet --spp 1 --ao-samples 0
+  sed -E 's/"time": *[-+0-9.eE]+/"time": 0/' "$OUT/gt-path-animated/eye_path.json" \
+    >"$OUT/frame0_path.json"
+fi
 "$BUILD"/calf-capture --scene "$SCENE" --ground-truth --eye-path "$OUT/frame0_path.json" \
   --out "$OUT/gt-path" --quiet "${capture_opts[@]}"
 
