@@ -183,9 +183,60 @@ Expected<TileSet> build_tiles(const capture::CaptureSetReader& reader, uint32_t 
   r.seconds_candidates = seconds_since(t0);
   if (options.progress) options.progress("candidates", 1.0);
 
+  // The sky layer: one far, opaque tile per root cell in which some view saw sky, so that a model
+  // against the sky does not play against black. Its triangles and fill come off the budgets the
+  // selection gets: the whole set stays within them.
+  std::vector<Selected> sky;
+  double sky_area = 0;
+  {
+    const uint32_t side = 1u << options.min_level;
+    // Far enough that moving through the view region barely moves it (1 % parallax at most).
+    const double distance = 100.0 * std::max(points.max_radius, f.region_radius);
+    for (size_t k = 0; k < points.sky_roots.size(); ++k) {
+      if (!points.sky_roots[k]) continue;
+      Selected s;
+      s.cell = {static_cast<uint8_t>(k / (size_t{side} * side)),
+                static_cast<uint8_t>(options.min_level), static_cast<uint32_t>(k % side),
+                static_cast<uint32_t>((k / side) % side)};
+      FaceCoord c;
+      c.face = cube_face_from_index(s.cell.face);
+      c.s = (s.cell.i + 0.5) / side;
+      c.t = (s.cell.j + 0.5) / side;
+      s.plane = {direction_from_face_coord(c), distance};
+      s.sky = true;
+      sky.push_back(s);
+      sky_area += cell_solid_angle(s.cell, options.tile_dilation) / (4 * 3.14159265358979323846);
+    }
+  }
+  r.sky_tiles = static_cast<uint32_t>(sky.size());
+  TilesBuildOptions selection_options = options;
+  if (!sky.empty()) {
+    const uint64_t sky_triangles = 2 * uint64_t{sky.size()};
+    if (sky_triangles + 2 * candidates.roots.size() > options.max_triangles ||
+        sky_area >= options.max_average_overdraw || options.max_peak_overdraw <= 1) {
+      return Status(
+          ErrorId::kTilesBudget,
+          sformat("budget too small to cover the view region and its sky: the sky "
+                  "layer needs %llu triangles, average overdraw %.3f and peak overdraw "
+                  "1 besides the %zu tiles of the coarsest tiling (budgets: %u "
+                  "triangles, average %g, peak %g; sky_layer false leaves the sky out)",
+                  (unsigned long long)sky_triangles, sky_area, candidates.roots.size(),
+                  options.max_triangles, options.max_average_overdraw, options.max_peak_overdraw));
+    }
+    selection_options.max_triangles = options.max_triangles - static_cast<uint32_t>(sky_triangles);
+    selection_options.max_average_overdraw = options.max_average_overdraw - sky_area;
+    // A sky tile adds one layer to any view at most.
+    selection_options.max_peak_overdraw = options.max_peak_overdraw - 1;
+  }
+
   // 3. Selection.
   t0 = std::chrono::steady_clock::now();
-  CALF_ASSIGN_OR_RETURN(const Selection selection, select_tiles(candidates, f, options));
+  CALF_ASSIGN_OR_RETURN(Selection selection, select_tiles(candidates, f, selection_options));
+  selection.tiles.insert(selection.tiles.end(), sky.begin(), sky.end());
+  if (!sky.empty()) {
+    selection.average_overdraw += sky_area;
+    selection.peak_overdraw += 1;
+  }
   r.tiles = static_cast<uint32_t>(selection.tiles.size());
   r.triangles = 2 * r.tiles;
   r.distortion = selection.distortion;
@@ -275,9 +326,10 @@ std::string format_tiles_report(const TilesBuildReport& r) {
                (unsigned long long)r.candidate_cells, r.min_level, r.max_level,
                (unsigned long long)r.candidate_tilings, (unsigned long long)r.candidate_tiles);
   s += sformat(
-      "selection  %u tiles, %u triangles (bound %u), distortion %.6g (dual bound %.6g), "
-      "%u evaluations\n",
-      r.tiles, r.triangles, r.max_triangles, r.distortion, r.dual_bound, r.selection_evaluations);
+      "selection  %u tiles (%u of them the sky layer), %u triangles (bound %u), distortion %.6g "
+      "(dual bound %.6g), %u evaluations\n",
+      r.tiles, r.sky_tiles, r.triangles, r.max_triangles, r.distortion, r.dual_bound,
+      r.selection_evaluations);
   s += sformat("overdraw   modelled: average %.3f (bound %g), peak %.3f (bound %g)\n",
                r.model_average_overdraw, r.max_average_overdraw, r.model_peak_overdraw,
                r.max_peak_overdraw);

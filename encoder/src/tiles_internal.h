@@ -66,6 +66,10 @@ struct MergedPoints {
   std::vector<uint64_t> morton;  // of the cell at kMortonLevel
   uint64_t samples = 0;
   double max_radius = 0;
+  // The sky layer: per root cell (face, j, i at min_level) whether some view saw sky (no depth)
+  // in its directions, and how many sky texels were read.
+  std::vector<uint8_t> sky_roots;
+  uint64_t sky_samples = 0;
 };
 inline constexpr uint32_t kMortonLevel = 16;
 uint64_t morton_code(uint32_t i, uint32_t j);
@@ -104,6 +108,7 @@ Candidates generate_candidates(const MergedPoints& points, const Frame& f,
 struct Selected {
   CellId cell;
   Plane plane;
+  bool sky = false;  // a tile of the sky layer: far, opaque, coloured by the views' sky texels
 };
 struct Selection {
   std::vector<Selected> tiles;

@@ -57,6 +57,7 @@ Expected<MergedPoints> merge_points(const capture::CaptureSetReader& reader, uin
   std::vector<uint64_t> view_keys(texels);
   std::vector<Vec3> view_points(texels);
   MergedPoints out;
+  out.sky_roots.assign(size_t{6} << (2 * options.min_level), 0);
   for (uint32_t v = 0; v < manifest.viewpoints.size(); ++v) {
     if (options.progress) options.progress("merge", double(v) / manifest.viewpoints.size());
     CALF_RETURN_IF_ERROR(reader.read(v, frame, &view));
@@ -78,6 +79,19 @@ Expected<MergedPoints> merge_points(const capture::CaptureSetReader& reader, uin
       }
     });
     for (size_t t = 0; t < texels; ++t) {
+      if (options.sky_layer && !std::isfinite(view.depth[t])) {
+        // Sky lies at infinity: its direction from the view is its direction from O.
+        const CubeFace face = cube_face_from_index(static_cast<int>(t / (size_t{n} * n)));
+        const uint32_t x = static_cast<uint32_t>(t % n), y = static_cast<uint32_t>((t / n) % n);
+        const FaceCoord c = face_coord_from_direction(direction_from_texel(face, x, y, n));
+        const uint32_t side = 1u << options.min_level;
+        const uint32_t i =
+            std::min<uint32_t>(static_cast<uint32_t>(std::max(0.0, c.s * side)), side - 1);
+        const uint32_t j =
+            std::min<uint32_t>(static_cast<uint32_t>(std::max(0.0, c.t * side)), side - 1);
+        out.sky_roots[(size_t{static_cast<uint8_t>(c.face)} * side + j) * side + i] = 1;
+        ++out.sky_samples;
+      }
       if (view_keys[t] == ~uint64_t{0}) continue;
       ++out.samples;
       auto [it, inserted] = index.try_emplace(view_keys[t], static_cast<uint32_t>(keys.size()));

@@ -43,7 +43,8 @@ std::array<Vec3, 4> tile_corners(const Selected& t, double dilation) {
 
 namespace {
 
-// The selected tiles grouped by cell, found from a direction through dense per-level tables.
+// The selected tiles (the sky layer's aside) grouped by cell, found from a direction through dense
+// per-level tables.
 class CellLookup {
  public:
   CellLookup(const Selection& sel, const TilesBuildOptions& o)
@@ -54,6 +55,7 @@ class CellLookup {
       }
     }
     for (uint32_t k = 0; k < sel.tiles.size(); ++k) {
+      if (sel.tiles[k].sky) continue;  // the sky layer has its own look-up
       const CellId& c = sel.tiles[k].cell;
       int32_t& slot = table_[c.face][c.level - min_][size_t{c.j} * (1u << c.level) + c.i];
       if (slot < 0) {
@@ -206,6 +208,38 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
     if (options.texture_solve_iterations > 0) work[k].normals.reset(sides[k]);
   }
 
+  // The sky layer's tiles by root cell (face, j, i); empty without any.
+  std::vector<int32_t> sky_of_root;
+  for (size_t k = 0; k < count; ++k) {
+    const Selected& tile = selection.tiles[k];
+    if (!tile.sky) continue;
+    const uint32_t root = 1u << options.min_level;
+    if (sky_of_root.empty()) sky_of_root.assign(size_t{6} * root * root, -1);
+    sky_of_root[(size_t{tile.cell.face} * root + tile.cell.j) * root + tile.cell.i] =
+        static_cast<int32_t>(k);
+  }
+  // A sample's colour at texture position (u, w) of tile k (in texels): a bilinear splat onto the
+  // four nearest texel centres and, for the least-squares fit, its normal equations.
+  auto add_colour = [&](size_t k, double u, double w, const float* c) {
+    const uint32_t side = sides[k];
+    if (options.texture_solve_iterations > 0) work[k].normals.add(u, w, c);
+    const double fu = std::clamp(u, 0.0, side - 1.0), fw = std::clamp(w, 0.0, side - 1.0);
+    const uint32_t x0 = std::min<uint32_t>(static_cast<uint32_t>(fu), side - 2);
+    const uint32_t y0 = std::min<uint32_t>(static_cast<uint32_t>(fw), side - 2);
+    const double ax = fu - x0, ay = fw - y0;
+    for (int dy = 0; dy < 2; ++dy) {
+      for (int dx = 0; dx < 2; ++dx) {
+        const double wgt = (dx ? ax : 1 - ax) * (dy ? ay : 1 - ay);
+        if (wgt <= 0) continue;
+        float* dst = &work[k].colour[(size_t{y0 + dy} * side + x0 + dx) * 4];
+        dst[0] += static_cast<float>(wgt * c[0]);
+        dst[1] += static_cast<float>(wgt * c[1]);
+        dst[2] += static_cast<float>(wgt * c[2]);
+        dst[3] += static_cast<float>(wgt);
+      }
+    }
+  };
+
   const size_t texels = size_t{6} * n * n;
   std::vector<int32_t> primary(texels);
   std::vector<float> sample_a(texels), sample_b(texels);
@@ -250,9 +284,26 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
     // thread count).
     for (size_t t = 0; t < texels; ++t) {
       const int32_t p = primary[t];
-      if (p < 0) continue;
       const CubeFace face = cube_face_from_index(static_cast<int>(t / (size_t{n} * n)));
       const uint32_t x = static_cast<uint32_t>(t % n), y = static_cast<uint32_t>((t / n) % n);
+      if (p < 0 && !sky_of_root.empty() && !std::isfinite(view.depth[t])) {
+        // Sky: at infinity, its direction from the view is its direction from O.
+        const FaceCoord fc = face_coord_from_direction(direction_from_texel(face, x, y, n));
+        const uint32_t root = 1u << options.min_level;
+        const uint32_t i =
+            std::min<uint32_t>(static_cast<uint32_t>(std::max(0.0, fc.s * root)), root - 1);
+        const uint32_t j =
+            std::min<uint32_t>(static_cast<uint32_t>(std::max(0.0, fc.t * root)), root - 1);
+        const int32_t k =
+            sky_of_root[(size_t{static_cast<uint8_t>(fc.face)} * root + j) * root + i];
+        if (k < 0) continue;
+        const TileFrame& tf = frames[k];
+        const double side1 = sides[k] - 1.0;
+        add_colour(static_cast<size_t>(k), (fc.s - tf.s0) / tf.ds * side1,
+                   (fc.t - tf.t0) / tf.dt * side1, &view.color[3 * t]);
+        continue;
+      }
+      if (p < 0) continue;
       const double depth = view.depth[t];
       const Vec3 q = eye + direction_from_texel(face, x, y, n) * depth - f.origin;
       const double r = length(q);
@@ -269,29 +320,13 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
         const int sx = std::clamp(static_cast<int>(std::floor((u + 0.5) * ss)), 0, int(g) - 1);
         const int sy = std::clamp(static_cast<int>(std::floor((w + 0.5) * ss)), 0, int(g) - 1);
         if (!votes) work[k].marks[size_t(sy) * g + sx] |= 1;
-        // Bilinear splat of the colour onto the four nearest texel centres.
-        const double fu = std::clamp(u, 0.0, side - 1.0), fw = std::clamp(w, 0.0, side - 1.0);
-        const uint32_t x0 = std::min<uint32_t>(static_cast<uint32_t>(fu), side - 2);
-        const uint32_t y0 = std::min<uint32_t>(static_cast<uint32_t>(fw), side - 2);
-        const double ax = fu - x0, ay = fw - y0;
-        const float* c = &view.color[3 * t];
-        if (options.texture_solve_iterations > 0) work[k].normals.add(u, w, c);
-        for (int dy = 0; dy < 2; ++dy) {
-          for (int dx = 0; dx < 2; ++dx) {
-            const double wgt = (dx ? ax : 1 - ax) * (dy ? ay : 1 - ay);
-            if (wgt <= 0) continue;
-            float* dst = &work[k].colour[(size_t{y0 + dy} * side + x0 + dx) * 4];
-            dst[0] += static_cast<float>(wgt * c[0]);
-            dst[1] += static_cast<float>(wgt * c[1]);
-            dst[2] += static_cast<float>(wgt * c[2]);
-            dst[3] += static_cast<float>(wgt);
-          }
-        }
+        add_colour(k, u, w, &view.color[3 * t]);
       }
     }
     // Free space: each tile's supersamples against this view (per tile in parallel).
     parallel_for(options.threads, count, [&](size_t k) {
       const Selected& tile = selection.tiles[k];
+      if (tile.sky) return;  // opaque: nothing is seen through the sky
       const TileFrame& tf = frames[k];
       const uint32_t side = sides[k], g = side * ss;
       for (uint32_t sy = 0; sy < g; ++sy) {
@@ -348,7 +383,7 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
             solid += cover[size_t{y * ss + qy} * g + x * ss + qx];
         }
         const size_t i = size_t{y} * side + x;
-        tex.rgba[4 * i + 3] = solid / float(ss * ss);
+        tex.rgba[4 * i + 3] = selection.tiles[k].sky ? 1.0f : solid / float(ss * ss);
         const float wsum = w.colour[4 * i + 3];
         if (wsum > 0) {
           for (int c = 0; c < 3; ++c) tex.rgba[4 * i + c] = w.colour[4 * i + c] / wsum;

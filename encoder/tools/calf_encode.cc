@@ -451,6 +451,10 @@ int main(int argc, char** argv) {
                    "carving, (0, 1) (default 0.05; Seurat's 0.01 carves holes into coarse "
                    "tiles, docs/TILES.md)")
         ->default_val(0.05);
+    app.add_flag("!--tiles-no-sky", b.sky_layer,
+                 "tiles: no sky layer (by default, where a view saw sky, one far opaque tile per "
+                 "root cell holds its colour, within the budgets; without it the set is "
+                 "transparent there)");
     app.add_option("--tiles-texture-solve", b.texture_solve_iterations,
                    "tiles: conjugate-gradient steps of the least-squares colour fit (texels "
                    "whose bilinear magnification best reproduces the samples), 0..1000; 0 keeps "

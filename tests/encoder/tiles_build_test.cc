@@ -57,8 +57,9 @@ std::pair<double, int> trace(const Vec3& e, const Vec3& d) {
   return {best, hit};
 }
 
-// Writes the room's capture set (`sky`: every depth +inf instead) and returns its directory.
-fs::path write_room(const std::string& name, bool sky = false) {
+// Writes the room's capture set (`sky`: every depth +inf instead; `open_top`: the +Y wall is sky,
+// still in its colour) and returns its directory.
+fs::path write_room(const std::string& name, bool sky = false, bool open_top = false) {
   const fs::path dir = test::scratch_dir("tiles_build_test") / name;
   capture::CaptureManifest m;
   m.frame_count = 1;
@@ -77,7 +78,8 @@ fs::path write_room(const std::string& name, bool sky = false) {
           const size_t t = f.texel_index(cf, x, y);
           const auto [depth, hit] =
               trace(m.viewpoints[v].position, direction_from_texel(cf, x, y, kFace));
-          f.depth[t] = sky ? std::numeric_limits<float>::infinity() : static_cast<float>(depth);
+          f.depth[t] = sky || (open_top && hit == 2) ? std::numeric_limits<float>::infinity()
+                                                     : static_cast<float>(depth);
           for (int c = 0; c < 3; ++c) f.color[3 * t + c] = kColour[hit][c];
         }
       }
@@ -306,6 +308,66 @@ TEST(TilesBuild, PanelSilhouetteIsCarved) {
       EXPECT_GE(clear_outside, outside * 9 / 10) << clear_outside << " of " << outside;
     }
   }
+}
+
+TEST(TilesBuild, SkyLayerHoldsTheSkyWithinTheBudgets) {
+  // The room without its +Y wall: the views see sky there. The sky layer puts one far, opaque
+  // tile in the sky's colour on each root cell of +Y (the whole face is sky) and on the side
+  // faces' root cells that see over the walls' tops; the set keeps every budget.
+  static const fs::path open = write_room("open_top", false, true);
+  TilesBuildOptions o = small_options();
+  o.max_triangles = 600;
+  TilesBuildReport r;
+  auto set = build(o, &r, 0, open);
+  ASSERT_TRUE(set.ok()) << set.status().to_string();
+  const uint32_t roots_per_face = (1u << o.min_level) * (1u << o.min_level);
+  EXPECT_GE(r.sky_tiles, roots_per_face);
+  EXPECT_LE(r.triangles, o.max_triangles);
+  EXPECT_EQ(r.triangles, 2 * set->tiles.size());
+  EXPECT_LE(r.model_average_overdraw, o.max_average_overdraw);
+  EXPECT_LE(r.model_peak_overdraw, o.max_peak_overdraw);
+  EXPECT_LE(r.measured_peak_overdraw, o.max_peak_overdraw);
+  // Sky tiles: far beyond the room (100 x its farthest point), opaque, in the +Y wall's colour.
+  size_t far = 0, checked = 0;
+  for (const Tile& t : set->tiles) {
+    Vec3 centre;
+    double u = 0, v = 0;
+    for (const TileCorner& c : t.corners) {
+      centre += Vec3{c.position[0], c.position[1], c.position[2]} * 0.25;
+      u += c.uvw[0] / c.uvw[2] * 0.25;
+      v += c.uvw[1] / c.uvw[2] * 0.25;
+    }
+    if (length(centre) < 50) continue;
+    ++far;
+    if (centre.y < 0.9 * length(centre)) continue;  // a tile of the +Y face's centre region
+    const uint32_t x =
+        std::min<uint32_t>(static_cast<uint32_t>(u * set->atlas_width), set->atlas_width - 1);
+    const uint32_t y =
+        std::min<uint32_t>(static_cast<uint32_t>(v * set->atlas_height), set->atlas_height - 1);
+    const uint8_t* px = &set->atlas_rgba[(size_t{y} * set->atlas_width + x) * 4];
+    ++checked;
+    EXPECT_EQ(px[3], 255);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(int(px[c]), int(srgb8_from_linear(kColour[2][c])), 3) << c;
+    }
+  }
+  EXPECT_EQ(far, r.sky_tiles);
+  EXPECT_GT(checked, 0u);
+  // Without the layer: no far tile; the closed room has none either.
+  o.sky_layer = false;
+  auto bare = build(o, &r, 0, open);
+  ASSERT_TRUE(bare.ok());
+  EXPECT_EQ(r.sky_tiles, 0u);
+  auto closed = build(small_options(), &r);
+  ASSERT_TRUE(closed.ok());
+  EXPECT_EQ(r.sky_tiles, 0u);
+  // A budget the sky layer alone uses up is refused, naming the sky.
+  o.sky_layer = true;
+  o.max_triangles = 2 * roots_per_face;
+  auto tight = build(o, nullptr, 0, open);
+  ASSERT_FALSE(tight.ok());
+  EXPECT_EQ(tight.status().id(), ErrorId::kTilesBudget);
+  EXPECT_NE(tight.status().message().find("sky"), std::string::npos) << tight.status().to_string();
 }
 
 bool same(const TileSet& a, const TileSet& b) {

@@ -107,6 +107,13 @@ struct TilesBuildOptions {
   // tiles overlap instead of cracking (Seurat dilates its tiles too). 0 .. 0.25.
   double tile_dilation = 0.02;
 
+  // The sky layer: where some view saw sky (no depth), one far (100 times the farthest point),
+  // opaque tile per root cell in those directions, coloured by the views' sky texels, drawn behind
+  // everything. Its triangles, its share of the average overdraw and one layer of peak overdraw
+  // come off the budgets before the selection. false: the set is transparent where the sky is
+  // (Seurat's scenes are closed; a model against the sky then plays against black).
+  bool sky_layer = true;
+
   // --- selection ---
   // Subgradient iterations on the dual, >= 1.
   uint32_t selection_iterations = 150;
@@ -173,9 +180,10 @@ struct TilesBuildReport {
   uint64_t candidate_cells = 0, candidate_tilings = 0, candidate_tiles = 0;
   uint32_t min_level = 0, max_level = 0;  // the quadtree levels used (after min_cell_texels)
   // Selection.
-  uint32_t tiles = 0, triangles = 0;
-  double distortion = 0;  // sum over merged points of weight x E of the selection
-  double dual_bound = 0;  // best Lagrangian dual value (a lower bound on distortion)
+  uint32_t tiles = 0, triangles = 0;  // the sky layer's included
+  uint32_t sky_tiles = 0;             // of them the sky layer's
+  double distortion = 0;              // sum over merged points of weight x E of the selection
+  double dual_bound = 0;              // best Lagrangian dual value (a lower bound on distortion)
   uint32_t selection_evaluations = 0;
   // Modelled (what the selection constrained) and measured overdraw, with their bounds.
   double model_average_overdraw = 0, model_peak_overdraw = 0;
