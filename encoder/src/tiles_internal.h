@@ -43,6 +43,14 @@ struct CellId {
 // The face coordinates of a cell's corner k (0: (s0, t0), 1: (s1, t0), 2: (s1, t1), 3: (s0, t1)),
 // dilated by `dilation` of the cell width on every side.
 void cell_corner_st(const CellId& c, double dilation, int k, double* s, double* t);
+// The index (face, j, i) among the 6 x 4^level cells of `level` of the cell holding face
+// coordinate `c`.
+inline size_t cell_index_at_level(const FaceCoord& c, uint32_t level) {
+  const uint32_t side = 1u << level;
+  const uint32_t i = std::min<uint32_t>(static_cast<uint32_t>(std::max(0.0, c.s * side)), side - 1);
+  const uint32_t j = std::min<uint32_t>(static_cast<uint32_t>(std::max(0.0, c.t * side)), side - 1);
+  return (size_t{static_cast<uint8_t>(c.face)} * side + j) * side + i;
+}
 // The unit direction from O through a cell's (dilated) corner k.
 Vec3 cell_corner_direction(const CellId& c, double dilation, int k);
 // The solid angle of a cell (dilated), exact for the spherical quadrilateral.

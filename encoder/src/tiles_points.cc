@@ -84,12 +84,7 @@ Expected<MergedPoints> merge_points(const capture::CaptureSetReader& reader, uin
         const CubeFace face = cube_face_from_index(static_cast<int>(t / (size_t{n} * n)));
         const uint32_t x = static_cast<uint32_t>(t % n), y = static_cast<uint32_t>((t / n) % n);
         const FaceCoord c = face_coord_from_direction(direction_from_texel(face, x, y, n));
-        const uint32_t side = 1u << options.min_level;
-        const uint32_t i =
-            std::min<uint32_t>(static_cast<uint32_t>(std::max(0.0, c.s * side)), side - 1);
-        const uint32_t j =
-            std::min<uint32_t>(static_cast<uint32_t>(std::max(0.0, c.t * side)), side - 1);
-        out.sky_roots[(size_t{static_cast<uint8_t>(c.face)} * side + j) * side + i] = 1;
+        out.sky_roots[cell_index_at_level(c, options.min_level)] = 1;
         ++out.sky_samples;
       }
       if (view_keys[t] == ~uint64_t{0}) continue;

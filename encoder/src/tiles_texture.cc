@@ -289,13 +289,7 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
       if (p < 0 && !sky_of_root.empty() && !std::isfinite(view.depth[t])) {
         // Sky: at infinity, its direction from the view is its direction from O.
         const FaceCoord fc = face_coord_from_direction(direction_from_texel(face, x, y, n));
-        const uint32_t root = 1u << options.min_level;
-        const uint32_t i =
-            std::min<uint32_t>(static_cast<uint32_t>(std::max(0.0, fc.s * root)), root - 1);
-        const uint32_t j =
-            std::min<uint32_t>(static_cast<uint32_t>(std::max(0.0, fc.t * root)), root - 1);
-        const int32_t k =
-            sky_of_root[(size_t{static_cast<uint8_t>(fc.face)} * root + j) * root + i];
+        const int32_t k = sky_of_root[cell_index_at_level(fc, options.min_level)];
         if (k < 0) continue;
         const TileFrame& tf = frames[k];
         const double side1 = sides[k] - 1.0;

@@ -201,6 +201,23 @@ TEST(TilesBuild, TileCornersLieOnTheScenePlanes) {
   EXPECT_GE(on, total * 90 / 100) << on << " of " << total;
 }
 
+// A tile's centre (the mean of its corners) and the atlas texel (RGBA8) at its centre's texture
+// coordinates.
+std::pair<Vec3, const uint8_t*> centre_texel(const TileSet& set, const Tile& t) {
+  Vec3 centre;
+  double u = 0, v = 0;
+  for (const TileCorner& c : t.corners) {
+    centre += Vec3{c.position[0], c.position[1], c.position[2]} * 0.25;
+    u += c.uvw[0] / c.uvw[2] * 0.25;
+    v += c.uvw[1] / c.uvw[2] * 0.25;
+  }
+  const uint32_t x =
+      std::min<uint32_t>(static_cast<uint32_t>(u * set.atlas_width), set.atlas_width - 1);
+  const uint32_t y =
+      std::min<uint32_t>(static_cast<uint32_t>(v * set.atlas_height), set.atlas_height - 1);
+  return {centre, &set.atlas_rgba[(size_t{y} * set.atlas_width + x) * 4]};
+}
+
 // Each check of the texturing below runs with both alpha estimates, and the colour with and
 // without the least-squares fit.
 std::vector<TilesBuildOptions> texturing_variants() {
@@ -231,22 +248,11 @@ TEST(TilesBuild, AtlasReproducesCapturedColourAtTileCentres) {
     ASSERT_EQ(set->atlas_rgba.size(), size_t{set->atlas_width} * set->atlas_height * 4);
     size_t checked = 0, good = 0;
     for (const Tile& t : set->tiles) {
-      Vec3 centre;
-      double u = 0, v = 0;
-      for (const TileCorner& c : t.corners) {
-        centre += Vec3{c.position[0], c.position[1], c.position[2]} * 0.25;
-        u += c.uvw[0] / c.uvw[2] * 0.25;
-        v += c.uvw[1] / c.uvw[2] * 0.25;
-      }
+      const auto [centre, px] = centre_texel(*set, t);
       if (plane_error(centre) > 0.005) continue;
       const auto [dist, hit] = trace({0, 0, 0}, normalize(centre));
       // Only tiles whose centre is on the surface seen there (not a hidden layer or a sliver).
       if (std::abs(dist - length(centre)) > 0.01 * dist) continue;
-      const uint32_t x =
-          std::min<uint32_t>(static_cast<uint32_t>(u * set->atlas_width), set->atlas_width - 1);
-      const uint32_t y =
-          std::min<uint32_t>(static_cast<uint32_t>(v * set->atlas_height), set->atlas_height - 1);
-      const uint8_t* px = &set->atlas_rgba[(size_t{y} * set->atlas_width + x) * 4];
       if (px[3] < 250) continue;
       ++checked;
       bool match = true;
@@ -330,21 +336,10 @@ TEST(TilesBuild, SkyLayerHoldsTheSkyWithinTheBudgets) {
   // Sky tiles: far beyond the room (100 x its farthest point), opaque, in the +Y wall's colour.
   size_t far = 0, checked = 0;
   for (const Tile& t : set->tiles) {
-    Vec3 centre;
-    double u = 0, v = 0;
-    for (const TileCorner& c : t.corners) {
-      centre += Vec3{c.position[0], c.position[1], c.position[2]} * 0.25;
-      u += c.uvw[0] / c.uvw[2] * 0.25;
-      v += c.uvw[1] / c.uvw[2] * 0.25;
-    }
+    const auto [centre, px] = centre_texel(*set, t);
     if (length(centre) < 50) continue;
     ++far;
     if (centre.y < 0.9 * length(centre)) continue;  // a tile of the +Y face's centre region
-    const uint32_t x =
-        std::min<uint32_t>(static_cast<uint32_t>(u * set->atlas_width), set->atlas_width - 1);
-    const uint32_t y =
-        std::min<uint32_t>(static_cast<uint32_t>(v * set->atlas_height), set->atlas_height - 1);
-    const uint8_t* px = &set->atlas_rgba[(size_t{y} * set->atlas_width + x) * 4];
     ++checked;
     EXPECT_EQ(px[3], 255);
     for (int c = 0; c < 3; ++c) {
