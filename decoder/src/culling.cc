@@ -181,6 +181,23 @@ GridCuller::GridCuller(const FaceGrid& grid) : grid_(grid) {
   }
 }
 
+namespace {
+
+// Narrows the interval [*t0, *t1] of a segment's parameter to where g0 + t slope > 0 (one
+// half-space); false once the interval is empty.
+bool keep_positive(double g0, double slope, double* t0, double* t1) {
+  if (slope == 0) return g0 > 0;
+  const double t = -g0 / slope;
+  if (slope > 0) {
+    *t0 = std::max(*t0, t);
+  } else {
+    *t1 = std::min(*t1, t);
+  }
+  return *t0 < *t1;
+}
+
+}  // namespace
+
 struct GridCuller::Search {
   const GridCuller& culler;
   const std::vector<Node>& nodes;
@@ -303,18 +320,7 @@ struct GridCuller::Search {
       const double g0 = dot(n, viewpoint) - e.lo[k] - e.margin[k];
       for (int i = 0; i < 4; ++i) {
         // g0 + t slope > 0 for every corner.
-        const double slope = dot(n, node.axial[i]);
-        if (slope == 0) {
-          if (!(g0 > 0)) return false;
-          continue;
-        }
-        const double t = -g0 / slope;
-        if (slope > 0) {
-          t0 = std::max(t0, t);
-        } else {
-          t1 = std::min(t1, t);
-        }
-        if (!(t0 < t1)) return false;
+        if (!keep_positive(g0, dot(n, node.axial[i]), &t0, &t1)) return false;
       }
     }
     return true;
@@ -345,19 +351,7 @@ struct GridCuller::Search {
       double t0 = 0, t1 = 1;
       const Vec3 ab = b - a;
       for (int k = 0; k < 6; ++k) {
-        const double g0 = dot(n[k], a) - offset[k];
-        const double slope = dot(n[k], ab);
-        if (slope == 0) {
-          if (!(g0 > 0)) return false;
-          continue;
-        }
-        const double t = -g0 / slope;
-        if (slope > 0) {
-          t0 = std::max(t0, t);
-        } else {
-          t1 = std::min(t1, t);
-        }
-        if (!(t0 < t1)) return false;
+        if (!keep_positive(dot(n[k], a) - offset[k], dot(n[k], ab), &t0, &t1)) return false;
       }
       return true;
     };
