@@ -219,7 +219,7 @@ Expected<TileSet> build_tiles(const capture::CaptureSetReader& reader, uint32_t 
           sformat("budget too small to cover the view region and its sky: the sky "
                   "layer needs %llu triangles, average overdraw %.3f and peak overdraw "
                   "1 besides the %zu tiles of the coarsest tiling (budgets: %u "
-                  "triangles, average %g, peak %g; sky_layer false leaves the sky out)",
+                  "triangles, average %g, peak %g; --tiles-no-sky leaves the sky out)",
                   (unsigned long long)sky_triangles, sky_area, candidates.roots.size(),
                   options.max_triangles, options.max_average_overdraw, options.max_peak_overdraw));
     }
