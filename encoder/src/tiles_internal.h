@@ -138,15 +138,17 @@ struct TileTexture {
   std::vector<float> rgba;  // side * side * 4: linear RGB (not premultiplied), alpha
 };
 // --- least-squares colour (tiles_texture_solve.cc) ---
-// The normal equations of one tile's colour fit, accumulated sample by sample: per texel the
-// diagonal and four of its eight couplings (the others are the neighbours' entries), and the
-// right-hand side per channel.
+// One tile's colour samples, accumulated sample by sample with their bilinear weights b: per
+// texel the weighted sums (sum b r, sum b g, sum b b, sum b), which are both Seurat's splat
+// (divided by the last) and the right-hand side of the least-squares fit, and, when the fit
+// runs, its normal matrix: the diagonal and four of the eight couplings (the others are the
+// neighbours' entries).
 struct TileNormals {
   enum : int { kDiag = 0, kRight = 1, kDown = 2, kDownRight = 3, kDownLeft = 4 };
   uint32_t side = 0;
-  std::vector<float> coupling;  // side * side * 5
-  std::vector<float> rhs;       // side * side * 3
-  void reset(uint32_t side);
+  std::vector<float> sums;      // side * side * 4
+  std::vector<float> coupling;  // side * side * 5, empty without the fit
+  void reset(uint32_t side, bool with_coupling);
   // A sample of linear RGB `colour` at texture position (u, w) in texels (corners on centres).
   void add(double u, double w, const float* colour);
 };

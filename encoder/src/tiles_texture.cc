@@ -99,10 +99,9 @@ TileFrame tile_frame(const Selected& t, double dilation) {
 }
 
 struct TileWork {
-  std::vector<float> colour;   // side^2 x (r, g, b, weight)
   std::vector<uint8_t> marks;  // constraints: (side S)^2, bit 0 solid, bit 1 free
   std::vector<uint8_t> votes;  // view votes: (side S)^2 x (solid, free), saturating at 255
-  TileNormals normals;         // the least-squares fit's (when texture_solve_iterations > 0)
+  TileNormals normals;         // colour sums (and the fit's matrix)
 };
 
 // A two-pass 3-4 chamfer transform over a g x g grid: `relax(i, from, cost)` offers cell i the
@@ -198,14 +197,13 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
   std::vector<TileWork> work(count);
   for (size_t k = 0; k < count; ++k) {
     frames[k] = tile_frame(selection.tiles[k], options.tile_dilation);
-    work[k].colour.assign(size_t{sides[k]} * sides[k] * 4, 0.0f);
     const size_t supersamples = size_t{sides[k]} * ss * sides[k] * ss;
     if (votes) {
       work[k].votes.assign(2 * supersamples, 0);
     } else {
       work[k].marks.assign(supersamples, 0);
     }
-    if (options.texture_solve_iterations > 0) work[k].normals.reset(sides[k]);
+    work[k].normals.reset(sides[k], options.texture_solve_iterations > 0);
   }
 
   // The sky layer's tiles by root cell (face, j, i); empty without any.
@@ -218,27 +216,6 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
     sky_of_root[(size_t{tile.cell.face} * root + tile.cell.j) * root + tile.cell.i] =
         static_cast<int32_t>(k);
   }
-  // A sample's colour at texture position (u, w) of tile k (in texels): a bilinear splat onto the
-  // four nearest texel centres and, for the least-squares fit, its normal equations.
-  auto add_colour = [&](size_t k, double u, double w, const float* c) {
-    const uint32_t side = sides[k];
-    if (options.texture_solve_iterations > 0) work[k].normals.add(u, w, c);
-    const double fu = std::clamp(u, 0.0, side - 1.0), fw = std::clamp(w, 0.0, side - 1.0);
-    const uint32_t x0 = std::min<uint32_t>(static_cast<uint32_t>(fu), side - 2);
-    const uint32_t y0 = std::min<uint32_t>(static_cast<uint32_t>(fw), side - 2);
-    const double ax = fu - x0, ay = fw - y0;
-    for (int dy = 0; dy < 2; ++dy) {
-      for (int dx = 0; dx < 2; ++dx) {
-        const double wgt = (dx ? ax : 1 - ax) * (dy ? ay : 1 - ay);
-        if (wgt <= 0) continue;
-        float* dst = &work[k].colour[(size_t{y0 + dy} * side + x0 + dx) * 4];
-        dst[0] += static_cast<float>(wgt * c[0]);
-        dst[1] += static_cast<float>(wgt * c[1]);
-        dst[2] += static_cast<float>(wgt * c[2]);
-        dst[3] += static_cast<float>(wgt);
-      }
-    }
-  };
 
   const size_t texels = size_t{6} * n * n;
   std::vector<int32_t> primary(texels);
@@ -293,8 +270,8 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
         if (k < 0) continue;
         const TileFrame& tf = frames[k];
         const double side1 = sides[k] - 1.0;
-        add_colour(static_cast<size_t>(k), (fc.s - tf.s0) / tf.ds * side1,
-                   (fc.t - tf.t0) / tf.dt * side1, &view.color[3 * t]);
+        work[k].normals.add((fc.s - tf.s0) / tf.ds * side1, (fc.t - tf.t0) / tf.dt * side1,
+                            &view.color[3 * t]);
         continue;
       }
       if (p < 0) continue;
@@ -314,7 +291,7 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
         const int sx = std::clamp(static_cast<int>(std::floor((u + 0.5) * ss)), 0, int(g) - 1);
         const int sy = std::clamp(static_cast<int>(std::floor((w + 0.5) * ss)), 0, int(g) - 1);
         if (!votes) work[k].marks[size_t(sy) * g + sx] |= 1;
-        add_colour(k, u, w, &view.color[3 * t]);
+        work[k].normals.add(u, w, &view.color[3 * t]);
       }
     }
     // Free space: each tile's supersamples against this view (per tile in parallel).
@@ -378,9 +355,9 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
         }
         const size_t i = size_t{y} * side + x;
         tex.rgba[4 * i + 3] = selection.tiles[k].sky ? 1.0f : solid / float(ss * ss);
-        const float wsum = w.colour[4 * i + 3];
+        const float wsum = w.normals.sums[4 * i + 3];
         if (wsum > 0) {
-          for (int c = 0; c < 3; ++c) tex.rgba[4 * i + c] = w.colour[4 * i + c] / wsum;
+          for (int c = 0; c < 3; ++c) tex.rgba[4 * i + c] = w.normals.sums[4 * i + c] / wsum;
           known[i] = 1;
         }
       }

@@ -19,10 +19,10 @@
 
 namespace calf::encoder::tiles {
 
-void TileNormals::reset(uint32_t side_in) {
+void TileNormals::reset(uint32_t side_in, bool with_coupling) {
   side = side_in;
-  coupling.assign(size_t{side} * side * 5, 0.0f);
-  rhs.assign(size_t{side} * side * 3, 0.0f);
+  sums.assign(size_t{side} * side * 4, 0.0f);
+  coupling.assign(with_coupling ? size_t{side} * side * 5 : 0, 0.0f);
 }
 
 void TileNormals::add(double u, double w, const float* colour) {
@@ -35,9 +35,11 @@ void TileNormals::add(double u, double w, const float* colour) {
   const size_t i00 = size_t{y0} * side + x0, i10 = i00 + 1, i01 = i00 + side, i11 = i01 + 1;
   const size_t idx[4] = {i00, i10, i01, i11};
   for (int k = 0; k < 4; ++k) {
-    coupling[5 * idx[k] + kDiag] += static_cast<float>(b[k] * b[k]);
-    for (int c = 0; c < 3; ++c) rhs[3 * idx[k] + c] += static_cast<float>(b[k] * colour[c]);
+    for (int c = 0; c < 3; ++c) sums[4 * idx[k] + c] += static_cast<float>(b[k] * colour[c]);
+    sums[4 * idx[k] + 3] += static_cast<float>(b[k]);
   }
+  if (coupling.empty()) return;
+  for (int k = 0; k < 4; ++k) coupling[5 * idx[k] + kDiag] += static_cast<float>(b[k] * b[k]);
   coupling[5 * i00 + kRight] += static_cast<float>(b[0] * b[1]);
   coupling[5 * i01 + kRight] += static_cast<float>(b[2] * b[3]);
   coupling[5 * i00 + kDown] += static_cast<float>(b[0] * b[2]);
@@ -49,7 +51,7 @@ void TileNormals::add(double u, double w, const float* colour) {
 void solve_tile_colour(const TileNormals& n, double smoothness, uint32_t iterations, float* rgba) {
   const uint32_t side = n.side;
   const size_t count = size_t{side} * side;
-  if (iterations == 0 || count == 0) return;
+  if (iterations == 0 || count == 0 || n.coupling.empty()) return;
   // The membrane weight scales with the samples' own weight, so the same smoothness means the
   // same thing at every texel density and view count.
   double diag_sum = 0;
@@ -121,7 +123,7 @@ void solve_tile_colour(const TileNormals& n, double smoothness, uint32_t iterati
     for (int ch = 0; ch < 3; ++ch) x[3 * i + ch] = rgba[4 * i + ch];
   }
   apply(x, &q);
-  for (size_t k = 0; k < 3 * count; ++k) r[k] = n.rhs[k] - q[k];
+  for (size_t k = 0; k < 3 * count; ++k) r[k] = n.sums[4 * (k / 3) + k % 3] - q[k];
   double rz[3] = {0, 0, 0};
   for (size_t k = 0; k < 3 * count; ++k) {
     z[k] = precond[k / 3] * r[k];

@@ -79,7 +79,7 @@ TEST(TilesTextureSolve, RecoversTexelsTheSamplesWereMadeFrom) {
   }
   std::vector<double> su, sw, value;
   TileNormals normals;
-  normals.reset(kSide);
+  normals.reset(kSide, true);
   for (uint64_t s = 0; s < 3000; ++s) {
     su.push_back(uniform(2 * s) * (kSide - 1));
     sw.push_back(uniform(2 * s + 1) * (kSide - 1));
@@ -111,7 +111,7 @@ TEST(TilesTextureSolve, FillsUnsampledTexelsHarmonically) {
   // linear ramp, whatever the start.
   constexpr uint32_t kSide = 12;
   TileNormals normals;
-  normals.reset(kSide);
+  normals.reset(kSide, true);
   for (uint32_t y = 0; y < kSide; ++y) {
     const float left[3] = {0.2f, 0.2f, 0.2f}, right[3] = {0.8f, 0.8f, 0.8f};
     normals.add(0.0, y, left);
@@ -133,7 +133,7 @@ TEST(TilesTextureSolve, OvershootIsClampedAndZeroIterationsKeepTheStart) {
   // A step from 0 to 1 between two texel centres: inverting the magnification rings below 0.
   constexpr uint32_t kSide = 8;
   TileNormals normals;
-  normals.reset(kSide);
+  normals.reset(kSide, true);
   for (uint64_t s = 0; s < 800; ++s) {
     const double u = uniform(2 * s) * (kSide - 1), w = uniform(2 * s + 1) * (kSide - 1);
     const float v = u < 3.5 ? 0.0f : 1.0f;
