@@ -520,6 +520,32 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
   return Status::Ok();
 }
 
+// The frames, from `first`, that one chunk of the tile serves: its group of `count` frames, and
+// then every following whole group over which the tile does not change at all (each of its frames
+// equals the frame before the group), up to a segment boundary. The chunk's P-frames there are
+// empty but for the first W - 1, which re-send what changed in the W frames before the group. A
+// seek anywhere in the span reads this one chunk, as it read one chunk before, and static content
+// costs one keyframe instead of one every K frames.
+uint32_t static_group_span(const Context& ctx, const TileFrames& t, uint32_t first,
+                           uint32_t count) {
+  const uint32_t k = ctx.options->depth_keyframe_interval;
+  const uint32_t segment = ctx.options->segment_frames;
+  const size_t frame_bytes = static_cast<size_t>(t.width) * t.height * t.bytes_per_texel;
+  while (first + count < t.frames) {
+    const uint32_t next = first + count;
+    if (segment != 0 && (ctx.first_frame + next) % segment == 0) break;
+    const uint32_t end = std::min(next + k, t.frames);
+    const uint8_t* before = t.texel(next - 1, 0, 0);
+    bool unchanged = true;
+    for (uint32_t f = next; f < end && unchanged; ++f) {
+      unchanged = std::memcmp(t.texel(f, 0, 0), before, frame_bytes) == 0;
+    }
+    if (!unchanged) break;
+    count = end - first;
+  }
+  return count;
+}
+
 void region_task(const Context& ctx, uint32_t face, uint32_t tile, bool is_depth, TaskOut& out) {
   const ViewData& v = *ctx.view;
   const PixelRect r =
@@ -555,8 +581,9 @@ void region_task(const Context& ctx, uint32_t face, uint32_t tile, bool is_depth
   StreamBytes& bytes = is_depth ? out.stats.depth : out.stats.material;
   std::vector<uint8_t> raw;
   const uint32_t k = ctx.options->depth_keyframe_interval;
-  for (uint32_t first = 0; first < v.frames; first += k) {
-    const uint32_t count = std::min(k, v.frames - first);
+  for (uint32_t first = 0, count = 0; first < v.frames; first += count) {
+    count = std::min(k, v.frames - first);
+    if (ctx.options->merge_static_groups) count = static_group_span(ctx, t, first, count);
     out.status = code_region_group(ctx, t, is_depth, coding, first, count, raw, out.stats, bytes,
                                    decoded.empty() ? nullptr : &decoded);
     if (!out.status.ok()) return;

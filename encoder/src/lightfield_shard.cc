@@ -48,7 +48,8 @@ std::string analysis_record(const LightfieldAnalysis& a, const LightfieldEncodeO
     << "\nkeyframe_interval " << o.depth_keyframe_interval << "\nsupercompression "
     << static_cast<int>(o.supercompression) << "\nzstd_level " << o.levels.zstd_level
     << "\nlzma_preset " << o.levels.lzma_preset << "\nsegment_frames " << o.segment_frames
-    << "\nresolved_colour " << static_cast<int>(a.colour) << "\nviews " << a.views.size() << "\n";
+    << "\nmerge_static_groups " << (o.merge_static_groups ? 1 : 0) << "\nresolved_colour "
+    << static_cast<int>(a.colour) << "\nviews " << a.views.size() << "\n";
   for (size_t v = 0; v < a.views.size(); ++v) {
     const LightfieldViewFacts& f = a.views[v];
     s << "view " << v << " " << (f.depth_range ? 1 : 0) << " "
@@ -124,6 +125,8 @@ Status parse_record(const std::string& path, const std::string& text, Lightfield
   o->levels.lzma_preset = static_cast<uint32_t>(x);
   if (!field("segment_frames", UINT32_MAX)) return bad_record(path, "segment_frames");
   o->segment_frames = static_cast<uint32_t>(x);
+  if (!field("merge_static_groups", 1)) return bad_record(path, "merge_static_groups");
+  o->merge_static_groups = x != 0;
   if (!field("resolved_colour", static_cast<uint64_t>(ColourCoding::kRgba16f)))
     return bad_record(path, "resolved_colour");
   *resolved_colour = x;

@@ -288,6 +288,11 @@ int main(int argc, char** argv) {
                  "shards (--frame-range) code apart into the bytes of one encode; a multiple of "
                  "--depth-keyframe-interval; costs bytes (docs/FARM.md) (default 0: no segments)")
       ->default_val(0);
+  bool fixed_groups = false;
+  app.add_flag("--depth-fixed-groups", fixed_groups,
+               "one depth / material chunk per K frames even where a tile does not change (the "
+               "layout of writers before issue 17); default off: a tile unchanged over whole "
+               "groups of K frames keeps one chunk, one keyframe, across them (SPEC 11.1.2)");
   app.add_option("--supercompression", super,
                  "per chunk: zstd (level 19), lzma2 (preset 6), none (default zstd)")
       ->check(CLI::IsMember({"zstd", "lzma2", "none"}))
@@ -553,6 +558,7 @@ int main(int argc, char** argv) {
   o.depth = depth == "bc5"      ? calf::DepthCoding::kBc5
             : depth == "pred16" ? calf::DepthCoding::kRaw16Predicted
                                 : calf::DepthCoding::kRaw16;
+  o.merge_static_groups = !fixed_groups;
   o.supercompression = super == "lzma2"  ? calf::container::Compression::kLzma2
                        : super == "none" ? calf::container::Compression::kNone
                                          : calf::container::Compression::kZstd;
@@ -583,9 +589,9 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (!analysis_path.empty()) {
-    for (const char* opt :
-         {"--cell", "--psnr", "--color-format", "--depth-format", "--depth-window", "--max-aabbs",
-          "--depth-keyframe-interval", "--supercompression", "--segment-frames"}) {
+    for (const char* opt : {"--cell", "--psnr", "--color-format", "--depth-format",
+                            "--depth-window", "--max-aabbs", "--depth-keyframe-interval",
+                            "--supercompression", "--segment-frames", "--depth-fixed-groups"}) {
       if (app.get_option(opt)->count() > 0) {
         return calf::tools::usage_error(
             "calf-encode",

@@ -10,8 +10,16 @@
 // zstd encode gives the raw16 depth bytes beside it; --no-colour-peers skips the colour peers
 // (most of the run's time on noisy colour) when only depth is being measured.
 //
+// The paper's own accounting is printed beside it: raw colour as 24-bit RGB and raw depth as
+// 32-bit float per texel, and calf's stored bytes as ratios to those.
+//
+// --video-peers adds calf-bench's peer set (tests/bench/calf_bench/peers.h, docs/BENCH.md "The
+// peers") on the same capture against the zstd clip: ffmpeg FFV1 and x265 lossless on the log-16
+// depth, x265 on 8-bit sRGB colour at the PSNR calf's decoded colour reaches against the same
+// frames, and xz -9 / zstd -19 of those frames — Table 1's video-coder columns in the same run.
+//
 //   bench-lightfield_table1 --capture DIR [--capture DIR ...] [--threads N]
-//       [--depth-format raw16|pred16] [--no-colour-peers]
+//       [--depth-format raw16|pred16] [--no-colour-peers] [--video-peers [--x265-preset P]]
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -36,6 +44,8 @@
 #include "calf/format/bc.h"
 #include "calf/format/colour.h"
 #include "calf/format/log_depth.h"
+#include "calf_bench/peers.h"
+#include "calf_bench/report.h"
 
 namespace {
 
@@ -51,12 +61,7 @@ uint64_t peak_rss_kib(int who) {
   return static_cast<uint64_t>(u.ru_maxrss);
 }
 std::string bytes(uint64_t b) {
-  std::string s = std::to_string(b), out;
-  for (size_t i = 0; i < s.size(); ++i) {
-    if (i && (s.size() - i) % 3 == 0) out += ',';
-    out += s[i];
-  }
-  return out;
+  return bench::grouped(b);
 }
 std::string ratio(uint64_t raw, std::optional<uint64_t> b) {
   if (!b || *b == 0) return "—";
@@ -152,8 +157,9 @@ struct EncodeRun {
   double seconds = 0;
   uint64_t file_bytes = 0;
 };
+// The clip is removed afterwards unless `keep`.
 Expected<EncodeRun> encode(const fs::path& capture, const fs::path& out, uint32_t threads,
-                           container::Compression sc, DepthCoding depth) {
+                           container::Compression sc, DepthCoding depth, bool keep = false) {
   LightfieldEncodeOptions o;
   o.threads = threads;
   o.depth = depth;
@@ -163,7 +169,7 @@ Expected<EncodeRun> encode(const fs::path& capture, const fs::path& out, uint32_
   CALF_ASSIGN_OR_RETURN(r.stats, encode_lightfield_file(capture, out.string(), o));
   r.seconds = now_s() - t0;
   r.file_bytes = fs::file_size(out);
-  fs::remove(out);
+  if (!keep) fs::remove(out);
   return r;
 }
 
@@ -195,6 +201,8 @@ struct Run {
   uint32_t threads = 0;
   bool have_xz = false, have_zstd = false, colour_peers = true;
   DepthCoding depth = DepthCoding::kRaw16;
+  bool video_peers = false;
+  bench::PeerSettings peers;
 };
 
 int run_one(const fs::path& dir, const Run& run) {
@@ -208,7 +216,9 @@ int run_one(const fs::path& dir, const Run& run) {
   const auto& m = in->manifest();
   const fs::path tmp = fs::temp_directory_path() / fmt::format("calf-table1-{}", ::getpid());
   fs::create_directories(tmp);
-  auto z = encode(dir, tmp / "zstd.calf", threads, container::Compression::kZstd, run.depth);
+  const fs::path zstd_clip = tmp / "zstd.calf";
+  auto z =
+      encode(dir, zstd_clip, threads, container::Compression::kZstd, run.depth, run.video_peers);
   const uint64_t rss_after_zstd = peak_rss_kib(RUSAGE_SELF);
   auto x = z.ok()
                ? encode(dir, tmp / "lzma2.calf", threads, container::Compression::kLzma2, run.depth)
@@ -253,6 +263,28 @@ int run_one(const fs::path& dir, const Run& run) {
       zs_d = run_peer("zstd -19 -q -T1", rd);
     }
   }
+  // calf-bench's peer set on the same capture, against the zstd clip.
+  std::vector<bench::PeerRow> video_peers;
+  std::string video_notes;
+  if (run.video_peers) {
+    bench::CalfReference ref;
+    ref.base_clip = zstd_clip;
+    ref.base.colour_bytes = s.colour.stored;
+    ref.base.depth_bytes = s.depth.stored;
+    ref.base.colour_raw = s.colour.raw;
+    ref.base.depth_raw = s.depth.raw;
+    ref.base.encode_s = z->seconds;
+    ref.base_label =
+        fmt::format("{} + {} + zstd", format_name(s.colour_format), format_name(s.depth_format));
+    const double t0 = now_s();
+    auto rows = bench::measure_peers(dir, ref, run.peers, &video_notes);
+    if (rows.ok()) {
+      video_peers = std::move(*rows);
+      video_notes += fmt::format(" Peer set measured in {:.0f} s.", now_s() - t0);
+    } else {
+      video_notes = "video peers failed: " + rows.status().to_string();
+    }
+  }
   fs::remove_all(tmp);
 
   const std::string scene = m.scene.empty() ? dir.filename().string() : m.scene;
@@ -279,6 +311,18 @@ int run_one(const fs::path& dir, const Run& run) {
   if (!have_xz) fmt::print("- `xz` not installed: peer skipped.\n");
   if (!have_zstd) fmt::print("- `zstd` not installed: peer skipped.\n");
   if (!raw_note.empty()) fmt::print("- {}\n", raw_note);
+  // Paper 002 Table 1's accounting: colour 24-bit RGB, depth 32-bit float per texel.
+  const uint64_t texels =
+      uint64_t{m.face_size} * m.face_size * 6 * m.viewpoints.size() * m.frame_count;
+  auto paper = [](uint64_t raw, uint64_t b) {
+    return b ? fmt::format("{:.1f}×", static_cast<double>(raw) / static_cast<double>(b)) : "—";
+  };
+  fmt::print(
+      "- the paper's accounting (raw colour 24-bit RGB = {} bytes, raw depth 32-bit float = {} "
+      "bytes): calf +zstd colour {}, depth {}; +LZMA2 colour {}, depth {}\n",
+      bytes(texels * 3), bytes(texels * 4), paper(texels * 3, s.colour.stored),
+      paper(texels * 4, s.depth.stored), paper(texels * 3, sx.colour.stored),
+      paper(texels * 4, sx.depth.stored));
   fmt::print(
       "- encode: {:.2f} s (zstd), {:.2f} s (LZMA2); file {} / {} bytes; peak RSS {:.1f} MiB "
       "after the zstd encode, {:.1f} MiB after both (process peak, includes reading the "
@@ -305,6 +349,11 @@ int run_one(const fs::path& dir, const Run& run) {
     fmt::print("- material: none (no view sees a reflective or refractive texel)\n");
   }
   fmt::print("\n");
+  if (run.video_peers) {
+    fmt::print("Video peers (calf-bench's peer set, docs/BENCH.md \"The peers\"): {}\n\n",
+               video_notes);
+    if (!video_peers.empty()) fmt::print("{}\n", bench::peer_table(video_peers));
+  }
   std::fflush(stdout);
   return 0;
 }
@@ -326,6 +375,12 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"raw16", "pred16"}));
   app.add_flag("--no-colour-peers", no_colour_peers,
                "skip xz / zstd on the raw colour stream (default: run them)");
+  app.add_flag("--video-peers", run.video_peers,
+               "also measure calf-bench's peer set on each capture against the zstd clip: ffmpeg "
+               "FFV1 and x265 lossless on the log-16 depth, x265 on 8-bit sRGB colour at the PSNR "
+               "calf's decoded colour reaches, xz -9 / zstd -19 of the same frames (default off)");
+  app.add_option("--x265-preset", run.peers.x265_preset,
+                 "x265 preset of the video peers (default medium)");
   CLI11_PARSE(app, argc, argv);
   run.depth = depth == "pred16" ? DepthCoding::kRaw16Predicted : DepthCoding::kRaw16;
   run.colour_peers = !no_colour_peers;

@@ -16,6 +16,7 @@
 #include "calf/capture/capture_shard.h"
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/encoder/lightfield_shard.h"
+#include "calf/format/container.h"
 #include "calf/samples/render.h"
 #include "calf/samples/scene.h"
 
@@ -125,8 +126,10 @@ std::string test_name(const ::testing::TestParamInfo<std::string>& p) {
 INSTANTIATE_TEST_SUITE_P(EveryBuiltInScene, LightfieldShardScenes,
                          ::testing::ValuesIn(builtin_scene_names()), test_name);
 
-// Frame-range shards with closed segments of 2 frames (depth keyframes every 2 frames) against
-// one encode with the same segments; views x frame ranges in every combination of 2 x 2.
+// Frame-range shards with closed segments of 2 frames against one encode with the same segments;
+// views x frame ranges in every combination of 2 x 2. Depth groups are 1 frame, so static tiles
+// merge two groups inside a segment (SPEC §11.1.2) but never across one: shards that end at a
+// segment boundary would otherwise code them apart.
 TEST(LightfieldShardFrames, FrameRangeShardsEqualSegmentedEncode) {
   const fs::path dir = capture_of("mirror-box", 4, "frames");
   ASSERT_TRUE(fs::exists(dir / capture::kManifestFileName));
@@ -135,10 +138,23 @@ TEST(LightfieldShardFrames, FrameRangeShardsEqualSegmentedEncode) {
   LightfieldEncodeOptions o;
   o.threads = 2;
   o.segment_frames = 2;
-  o.depth_keyframe_interval = 2;
+  o.depth_keyframe_interval = 1;
   const std::string one = (work / "one.calf").string();
   auto stats = encode_lightfield_file(dir, one, o);
   ASSERT_TRUE(stats.ok()) << stats.status().to_string();
+  {
+    auto r = container::Reader::open(one);
+    ASSERT_TRUE(r.ok()) << r.status().to_string();
+    uint32_t merged_groups = 0;
+    for (const auto& e : r->chunks()) {
+      if (e.keys.stream != static_cast<uint16_t>(container::LightfieldStream::kDepth)) continue;
+      EXPECT_TRUE(e.keys.first_frame / 2 == (e.keys.first_frame + e.keys.frame_count - 1) / 2)
+          << "a depth chunk crosses a segment boundary: frames " << e.keys.first_frame << " + "
+          << e.keys.frame_count;
+      merged_groups += e.keys.frame_count > 1;
+    }
+    EXPECT_GT(merged_groups, 0u);
+  }
   // Closed segments: every cell has a keyframe at frames 0 and 2.
   EXPECT_GE(stats->colour_keyframes, 2 * stats->colour_cells);
 

@@ -515,6 +515,123 @@ TEST(ClipDecoder, PredictedDepthDecodesToRaw16Codes) {
   EXPECT_LT(depth_pred, depth_raw);
 }
 
+// A tile that does not change over whole groups of K frames keeps one depth (material) chunk
+// across them (SPEC §11.1.2): the clip decodes to the same faces as with one chunk per K frames,
+// has fewer, smaller depth chunks, never merges across a segment boundary, and a seek still reads
+// one depth chunk per tile.
+TEST(ClipDecoder, StaticTilesKeepOneChunkAcrossGroups) {
+  ClipSpec spec;
+  spec.seed = 47;
+  spec.frames = 9;
+  spec.material = true;
+  spec.options.cell_size = 8;
+  spec.options.depth_keyframe_interval = 2;
+  spec.options.depth_window = 2;
+  const Clip merged = make_clip(spec);
+  spec.options.merge_static_groups = false;
+  const Clip fixed = make_clip(spec);
+  spec.options.merge_static_groups = true;
+  spec.options.segment_frames = 4;
+  const Clip segmented = make_clip(spec);
+
+  auto a = LightfieldReference::open(*fixed.reader, 0);
+  auto b = LightfieldReference::open(*merged.reader, 0);
+  auto c = LightfieldReference::open(*segmented.reader, 0);
+  ASSERT_TRUE(a.ok() && b.ok() && c.ok());
+  for (uint32_t v = 0; v < spec.views; ++v) {
+    for (uint32_t face = 0; face < 6; ++face) {
+      for (uint32_t f = 0; f < spec.frames; ++f) {
+        LightfieldFace fa, fb, fc;
+        ASSERT_TRUE(a->decode_face(v, face, f, &fa).ok());
+        ASSERT_TRUE(b->decode_face(v, face, f, &fb).ok());
+        ASSERT_TRUE(c->decode_face(v, face, f, &fc).ok());
+        const std::string at = "view " + std::to_string(v) + " face " + std::to_string(face) +
+                               " frame " + std::to_string(f);
+        ASSERT_EQ(fa.depth, fb.depth) << at;
+        ASSERT_EQ(fa.material, fb.material) << at;
+        ASSERT_EQ(fa.colour, fb.colour) << at;
+        ASSERT_EQ(fa.depth, fc.depth) << at;
+        ASSERT_EQ(fa.material, fc.material) << at;
+      }
+    }
+  }
+
+  const uint32_t k = spec.options.depth_keyframe_interval;
+  struct Shape {
+    uint32_t chunks = 0, spanning = 0, crossing_segment = 0;
+    uint64_t stored = 0;
+  };
+  auto shape = [&](const Clip& clip, uint16_t stream) {
+    Shape out;
+    for (const auto& e : clip.reader->chunks()) {
+      if (e.keys.stream != stream) continue;
+      out.chunks += 1;
+      out.stored += e.stored_size;
+      EXPECT_EQ(e.keys.first_frame % k, 0u);
+      const uint32_t last = e.keys.first_frame + e.keys.frame_count - 1;
+      EXPECT_TRUE(e.keys.frame_count % k == 0 || last == spec.frames - 1);
+      out.spanning += e.keys.frame_count > k;
+      out.crossing_segment += e.keys.first_frame / 4 != last / 4;
+    }
+    return out;
+  };
+  for (const auto stream :
+       {container::LightfieldStream::kDepth, container::LightfieldStream::kMaterial}) {
+    const uint16_t tag = static_cast<uint16_t>(stream);
+    const Shape f = shape(fixed, tag), m = shape(merged, tag), g = shape(segmented, tag);
+    EXPECT_EQ(f.spanning, 0u);
+    EXPECT_GT(m.spanning, 0u) << "stream " << tag;
+    EXPECT_GT(m.crossing_segment, 0u) << "stream " << tag;
+    EXPECT_EQ(g.crossing_segment, 0u) << "stream " << tag;
+    EXPECT_LT(m.chunks, g.chunks) << "stream " << tag;
+    EXPECT_LT(g.chunks, f.chunks) << "stream " << tag;
+    EXPECT_LT(m.stored, f.stored) << "stream " << tag;
+  }
+  // Some tile changes after its first group, so it has more than one chunk: not everything is
+  // merged. In a merged chunk, P-frames from the second group on are empty but for the first
+  // W - 1 (what changed in the W frames before the group).
+  const uint32_t tiles_per_face =
+      spec.options.depth_tiles_per_side * spec.options.depth_tiles_per_side;
+  uint32_t tiles_with_several = 0;
+  for (uint32_t v = 0; v < spec.views; ++v) {
+    for (uint32_t face = 0; face < 6; ++face) {
+      for (uint32_t tile = 0; tile < tiles_per_face; ++tile) {
+        uint32_t count = 0;
+        for (const auto& e : merged.reader->chunks()) {
+          if (e.keys.stream != static_cast<uint16_t>(container::LightfieldStream::kDepth) ||
+              e.keys.view != v || e.keys.face != face || e.keys.region != tile) {
+            continue;
+          }
+          count += 1;
+          auto counts = b->depth_rect_counts(v, face, tile);
+          ASSERT_TRUE(counts.ok());
+          for (uint32_t i = e.keys.first_frame + k + spec.options.depth_window - 1;
+               i < e.keys.first_frame + e.keys.frame_count; ++i) {
+            EXPECT_EQ((*counts)[i], 0u)
+                << "view " << v << " face " << face << " tile " << tile << " frame " << i;
+          }
+        }
+        tiles_with_several += count > 1;
+      }
+    }
+  }
+  EXPECT_GT(tiles_with_several, 0u);
+  // Random access: a seek to any frame reads one depth and one material chunk per tile.
+  const uint32_t cells =
+      6 * (spec.face / spec.options.cell_size) * (spec.face / spec.options.cell_size);
+  for (uint32_t target = 0; target < spec.frames; ++target) {
+    ClipDecoderOptions o;
+    o.view_dependent = false;
+    ClipDecoder d = open_decoder(merged, o);
+    CpuTextures tex = textures_for(d);
+    const FrameUpdates fu = advance_ok(d, tex, target, {});
+    expect_matches_reference(merged, tex, fu, target, "merged seek " + std::to_string(target));
+    const uint32_t region_chunks = spec.views * 6 * tiles_per_face * 2;
+    EXPECT_GE(fu.stats.chunks_needed, region_chunks + spec.views * 2 * cells) << target;
+    EXPECT_LE(fu.stats.chunks_needed, region_chunks + spec.views * 3 * cells) << target;
+  }
+}
+
 // Nothing visible without viewers; a viewer looking away from a view sees fewer cells.
 TEST(ClipDecoder, VisibilityFollowsTheViewers) {
   ClipSpec spec;

@@ -37,6 +37,7 @@ struct PinCase {
   DepthCoding depth;
   container::Compression compression;
   const char* xxh3;  // of the whole file, hex
+  uint32_t depth_keyframe_interval = 30;
 };
 
 // clang-format off
@@ -52,6 +53,8 @@ const PinCase kCases[] = {
     {"bc1_pred16_zstd",    {.face = 16, .frames = 5, .views = 2},                   ColourCoding::kBc1,     DepthCoding::kRaw16Predicted, container::Compression::kZstd,  "4f52fb389266f4ed"},
     {"bc6h_pred16_lzma2",  {.face = 8, .frames = 3, .views = 2, .hdr = true},       ColourCoding::kBc6h,    DepthCoding::kRaw16Predicted, container::Compression::kLzma2, "3a4515816c9670ef"},
     {"auto_pred16_static", {.face = 16, .frames = 6, .views = 2, .animated = false, .material = true}, ColourCoding::kAuto, DepthCoding::kRaw16Predicted, container::Compression::kZstd, "8792a19d652f5f4f"},
+    // Static depth and material groups merged (SPEC §11.1.2; issue 17): K = 2 over 7 frames.
+    {"bc1_raw16_groups",   {.face = 16, .frames = 7, .views = 2, .material = true},  ColourCoding::kBc1,     DepthCoding::kRaw16, container::Compression::kZstd,  "cefa7985168c295a", 2},
 };
 // clang-format on
 
@@ -87,6 +90,7 @@ TEST_P(EncodePin, OutputBytesAreUnchanged) {
     o.depth = c.depth;
     o.supercompression = c.compression;
     o.cell_size = 8;
+    o.depth_keyframe_interval = c.depth_keyframe_interval;
     o.threads = threads;
     const fs::path out = root / (threads == 1 ? "t1.calf" : "t2.calf");
     auto stats = encode_lightfield_file(capture, out.string(), o);

@@ -60,6 +60,28 @@ std::string grouped(uint64_t n) {
   return out;
 }
 
+std::string peer_table(const std::vector<PeerRow>& peers) {
+  std::string out =
+      "| stream | method | bytes | raw bytes | ratio | × calf | encode s | decode ms/frame | "
+      "marginal ms/frame | quality | note |\n"
+      "|---|---|---:|---:|---:|---:|---:|---:|---:|---|---|\n";
+  for (const PeerRow& r : peers) {
+    if (!r.available) {
+      out += fmt::format("| {} | {} | n/a | | | | | | | | {} |\n", r.stream, r.method, r.note);
+      continue;
+    }
+    out += fmt::format(
+        "| {} | {} | {} | {} | {:.1f}× | {} | {:.2f} | {} | {} | {} | {} |\n", r.stream, r.method,
+        grouped(r.bytes), grouped(r.raw_bytes),
+        r.bytes ? static_cast<double>(r.raw_bytes) / static_cast<double>(r.bytes) : 0.0,
+        r.calf_bytes ? fmt::format("{:.2f}", static_cast<double>(r.bytes) / r.calf_bytes) : "—",
+        r.encode_s, r.decode_ms_per_frame >= 0 ? fmt::format("{:.2f}", r.decode_ms_per_frame) : "—",
+        r.marginal_ms_per_frame >= 0 ? fmt::format("{:.2f}", r.marginal_ms_per_frame) : "—",
+        r.quality, r.note);
+  }
+  return out;
+}
+
 Status write_file_whole(const fs::path& file, const std::string& text) {
   // calf's output rules (regular file or absent, temporary name, cleanup): files::TempFile.
   CALF_ASSIGN_OR_RETURN(files::TempFile temp, files::TempFile::create(file.string()));
@@ -155,28 +177,6 @@ const char* kPointHeader =
     "| {} | clip bytes | colour | depth | material | encode s (CPU s) | decode ms | upload ms | "
     "render ms | frame CPU ms | first frame ms (dec / upl / ren) | PSNR dB | SSIM | front | |\n"
     "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|\n";
-
-std::string peer_table(const SceneResult& s) {
-  std::string out =
-      "| stream | method | bytes | raw bytes | ratio | × calf | encode s | decode ms/frame | "
-      "marginal ms/frame | quality | note |\n"
-      "|---|---|---:|---:|---:|---:|---:|---:|---:|---|---|\n";
-  for (const PeerRow& r : s.peers) {
-    if (!r.available) {
-      out += fmt::format("| {} | {} | n/a | | | | | | | | {} |\n", r.stream, r.method, r.note);
-      continue;
-    }
-    out += fmt::format(
-        "| {} | {} | {} | {} | {:.1f}× | {} | {:.2f} | {} | {} | {} | {} |\n", r.stream, r.method,
-        grouped(r.bytes), grouped(r.raw_bytes),
-        r.bytes ? static_cast<double>(r.raw_bytes) / static_cast<double>(r.bytes) : 0.0,
-        r.calf_bytes ? fmt::format("{:.2f}", static_cast<double>(r.bytes) / r.calf_bytes) : "—",
-        r.encode_s, r.decode_ms_per_frame >= 0 ? fmt::format("{:.2f}", r.decode_ms_per_frame) : "—",
-        r.marginal_ms_per_frame >= 0 ? fmt::format("{:.2f}", r.marginal_ms_per_frame) : "—",
-        r.quality, r.note);
-  }
-  return out;
-}
 
 }  // namespace
 
@@ -282,7 +282,7 @@ Status write_markdown(const fs::path& file, const std::vector<SceneResult>& scen
     }
     out += "### Peers (same run, same capture)\n\n";
     if (!s.peer_notes.empty()) out += s.peer_notes + "\n\n";
-    out += s.peers.empty() ? "Not measured (--no-peers).\n\n" : peer_table(s) + "\n";
+    out += s.peers.empty() ? "Not measured (--no-peers).\n\n" : peer_table(s.peers) + "\n";
     // The plots, when gnuplot made them (write_plots runs first).
     for (const char* axis : {"bytes", "ms"}) {
       const std::string png = fmt::format("{}_psnr_{}.png", s.scene, axis);

@@ -57,4 +57,8 @@ Status write_file_whole(const std::filesystem::path& file, const std::string& te
 // 1234567 -> "1,234,567".
 std::string grouped(uint64_t n);
 
+// The peers of a scene as a markdown table (stream, method, bytes, raw bytes, ratio, x calf,
+// encode s, decode ms/frame, marginal ms/frame, quality, note); unavailable peers say why.
+std::string peer_table(const std::vector<PeerRow>& peers);
+
 }  // namespace calf::bench
