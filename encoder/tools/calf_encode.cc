@@ -667,9 +667,12 @@ int main(int argc, char** argv) {
         b.stored ? static_cast<double>(b.raw) / static_cast<double>(b.stored) : 0.0,
         static_cast<unsigned long long>(b.chunks));
   };
-  std::fprintf(stderr, "calf-encode: wrote %s in %.2f s (colour %s, %s)\n", out.c_str(), seconds,
-               calf::container::pixel_format_name(stats->colour_format),
-               stats->hdr ? "HDR" : "LDR");
+  // Encode speed in capture texels (every view, face and frame) per second: the depth stream's
+  // raw count is 2 bytes a texel.
+  const double mpix = static_cast<double>(stats->depth.raw / 2) / 1e6;
+  std::fprintf(stderr, "calf-encode: wrote %s in %.2f s (colour %s, %s; %.1f Mpix, %.2f Mpix/s)\n",
+               out.c_str(), seconds, calf::container::pixel_format_name(stats->colour_format),
+               stats->hdr ? "HDR" : "LDR", mpix, seconds > 0 ? mpix / seconds : 0.0);
   line("colour", stats->colour);
   line("depth", stats->depth);
   if (stats->material_views) line("material", stats->material);
