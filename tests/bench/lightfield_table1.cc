@@ -6,9 +6,11 @@
 // of the raw log-16 depth stream (per-view z_near / z_far from the data, as the encoder quantises).
 // Also encode seconds and peak RSS (getrusage). Prints markdown.
 //
-// With --depth-format pred16 the depth column is the predicted coding (format r16p) and one more
-// zstd encode gives the raw16 depth bytes beside it; --no-colour-peers skips the colour peers
-// (most of the run's time on noisy colour) when only depth is being measured.
+// With --depth-format pred16 the depth column is the predicted coding (format r16p). Unless the
+// run is the encoder before issue 17 itself (raw16 and --depth-fixed-groups), one more zstd encode
+// with raw16 depth and one chunk per K frames gives those depth bytes beside it, "today's" of the
+// issue. --no-colour-peers skips the colour peers (most of the run's time on noisy colour) when
+// only depth is being measured; --no-lzma2 skips the LZMA2 encode.
 //
 // The paper's own accounting is printed beside it: raw colour as 24-bit RGB and raw depth as
 // 32-bit float per texel, and calf's stored bytes as ratios to those.
@@ -19,7 +21,8 @@
 // frames, and xz -9 / zstd -19 of those frames — Table 1's video-coder columns in the same run.
 //
 //   bench-lightfield_table1 --capture DIR [--capture DIR ...] [--threads N]
-//       [--depth-format raw16|pred16] [--no-colour-peers] [--video-peers [--x265-preset P]]
+//       [--depth-format raw16|pred16] [--depth-fixed-groups] [--no-colour-peers] [--no-lzma2]
+//       [--video-peers [--x265-preset P]]
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -159,10 +162,12 @@ struct EncodeRun {
 };
 // The clip is removed afterwards unless `keep`.
 Expected<EncodeRun> encode(const fs::path& capture, const fs::path& out, uint32_t threads,
-                           container::Compression sc, DepthCoding depth, bool keep = false) {
+                           container::Compression sc, DepthCoding depth, bool merge_static_groups,
+                           bool keep = false) {
   LightfieldEncodeOptions o;
   o.threads = threads;
   o.depth = depth;
+  o.merge_static_groups = merge_static_groups;
   o.supercompression = sc;
   EncodeRun r;
   const double t0 = now_s();
@@ -201,6 +206,7 @@ struct Run {
   uint32_t threads = 0;
   bool have_xz = false, have_zstd = false, colour_peers = true;
   DepthCoding depth = DepthCoding::kRaw16;
+  bool fixed_groups = false, lzma2 = true;
   bool video_peers = false;
   bench::PeerSettings peers;
 };
@@ -217,30 +223,36 @@ int run_one(const fs::path& dir, const Run& run) {
   const fs::path tmp = fs::temp_directory_path() / fmt::format("calf-table1-{}", ::getpid());
   fs::create_directories(tmp);
   const fs::path zstd_clip = tmp / "zstd.calf";
-  auto z =
-      encode(dir, zstd_clip, threads, container::Compression::kZstd, run.depth, run.video_peers);
+  const bool merge = !run.fixed_groups;
+  auto z = encode(dir, zstd_clip, threads, container::Compression::kZstd, run.depth, merge,
+                  run.video_peers);
   const uint64_t rss_after_zstd = peak_rss_kib(RUSAGE_SELF);
-  auto x = z.ok()
-               ? encode(dir, tmp / "lzma2.calf", threads, container::Compression::kLzma2, run.depth)
-               : Expected<EncodeRun>(z.status());
-  // The raw16 depth bytes beside predicted ones (one more zstd encode).
-  std::optional<EncodeRun> z16;
-  if (x.ok() && run.depth != DepthCoding::kRaw16) {
-    auto r = encode(dir, tmp / "zstd16.calf", threads, container::Compression::kZstd,
-                    DepthCoding::kRaw16);
-    if (!r.ok())
-      x = r.status();
-    else
-      z16 = *r;
+  Status failed = z.status();
+  std::optional<EncodeRun> x;
+  if (failed.ok() && run.lzma2) {
+    auto r =
+        encode(dir, tmp / "lzma2.calf", threads, container::Compression::kLzma2, run.depth, merge);
+    failed = r.status();
+    if (r.ok()) x = *r;
+  }
+  // The depth bytes of the encoder before issue 17 (raw16, one chunk per K frames).
+  std::optional<EncodeRun> before;
+  if (failed.ok() && (run.depth != DepthCoding::kRaw16 || merge)) {
+    auto r = encode(dir, tmp / "before.calf", threads, container::Compression::kZstd,
+                    DepthCoding::kRaw16, false);
+    failed = r.status();
+    if (r.ok()) before = *r;
   }
   const uint64_t rss_after_lzma = peak_rss_kib(RUSAGE_SELF);
-  if (!z.ok() || !x.ok()) {
-    fmt::print(stderr, "{}: {}\n", dir.string(), (z.ok() ? x : z).status().to_string());
+  if (!failed.ok()) {
+    fmt::print(stderr, "{}: {}\n", dir.string(), failed.to_string());
     fs::remove_all(tmp);
     return 1;
   }
   const LightfieldEncodeStats& s = z->stats;
-  const LightfieldEncodeStats& sx = x->stats;
+  const LightfieldEncodeStats none;
+  const LightfieldEncodeStats& sx = x ? x->stats : none;
+  auto lz = [&](uint64_t v) { return x ? std::optional<uint64_t>(v) : std::nullopt; };
 
   // Peers on the raw streams.
   Peer xz_c, xz_d, zs_c, zs_d;
@@ -303,8 +315,11 @@ int run_one(const fs::path& dir, const Run& run) {
   row("temporal (keyframes / P-frames)", s.colour.temporal, s.depth.temporal);
   row("+spatial (BCn)", s.colour.spatial, s.depth.spatial);
   row("+zstd (level 19, per chunk)", s.colour.stored, s.depth.stored);
-  row("+LZMA2 (preset 6, per chunk)", sx.colour.stored, sx.depth.stored);
-  if (z16) row("+zstd, depth raw16 (no prediction)", {}, z16->stats.depth.stored);
+  row("+LZMA2 (preset 6, per chunk)", lz(sx.colour.stored), lz(sx.depth.stored));
+  if (before) {
+    row("+zstd, depth raw16, one chunk per K frames (before issue 17)", {},
+        before->stats.depth.stored);
+  }
   row("peer: `zstd -19` of raw", zs_c.size, zs_d.size);
   row("peer: `xz -9` of raw", xz_c.size, xz_d.size);
   fmt::print("\n");
@@ -323,12 +338,22 @@ int run_one(const fs::path& dir, const Run& run) {
       bytes(texels * 3), bytes(texels * 4), paper(texels * 3, s.colour.stored),
       paper(texels * 4, s.depth.stored), paper(texels * 3, sx.colour.stored),
       paper(texels * 4, sx.depth.stored));
+  auto times = [](uint64_t a, std::optional<uint64_t> b) {
+    return b && *b ? fmt::format("{:.2f}×", static_cast<double>(a) / static_cast<double>(*b))
+                   : std::string("—");
+  };
+  fmt::print("- depth +zstd: {} of `xz -9` of raw, {} of the encoder before issue 17\n",
+             times(s.depth.stored, xz_d.size),
+             times(s.depth.stored,
+                   before ? std::optional<uint64_t>(before->stats.depth.stored) : std::nullopt));
   fmt::print(
-      "- encode: {:.2f} s (zstd), {:.2f} s (LZMA2); file {} / {} bytes; peak RSS {:.1f} MiB "
-      "after the zstd encode, {:.1f} MiB after both (process peak, includes reading the "
-      "raw streams later: {:.1f} MiB)\n",
-      z->seconds, x->seconds, bytes(z->file_bytes), bytes(x->file_bytes), rss_after_zstd / 1024.0,
-      rss_after_lzma / 1024.0, peak_rss_kib(RUSAGE_SELF) / 1024.0);
+      "- encode: {:.2f} s ({:.2f} Mpix/s) zstd, {} LZMA2; file {} / {} bytes; peak RSS {:.1f} "
+      "MiB after the zstd encode, {:.1f} MiB after all encodes (process peak, includes reading "
+      "the raw streams later: {:.1f} MiB)\n",
+      z->seconds, z->seconds > 0 ? static_cast<double>(texels) / 1e6 / z->seconds : 0.0,
+      x ? fmt::format("{:.2f} s", x->seconds) : std::string("not run"), bytes(z->file_bytes),
+      x ? bytes(x->file_bytes) : std::string("—"), rss_after_zstd / 1024.0, rss_after_lzma / 1024.0,
+      peak_rss_kib(RUSAGE_SELF) / 1024.0);
   fmt::print(
       "- peers: zstd -19 {:.2f} s + {:.2f} s, xz -9 {:.2f} s + {:.2f} s (colour + depth); "
       "largest child peak RSS {:.1f} MiB\n",
@@ -344,7 +369,7 @@ int run_one(const fs::path& dir, const Run& run) {
     fmt::print("- material ({} views, {}): raw {}, temporal {}, +spatial {}, +zstd {}, +LZMA2 {}\n",
                s.material_views, format_name(s.material_format), bytes(s.material.raw),
                bytes(s.material.temporal), bytes(s.material.spatial), bytes(s.material.stored),
-               bytes(sx.material.stored));
+               x ? bytes(sx.material.stored) : std::string("—"));
   } else {
     fmt::print("- material: none (no view sees a reflective or refractive texel)\n");
   }
@@ -373,6 +398,11 @@ int main(int argc, char** argv) {
                  "depth coding: raw16, or pred16 (then raw16's zstd bytes are printed beside "
                  "it) (default raw16)")
       ->check(CLI::IsMember({"raw16", "pred16"}));
+  app.add_flag("--depth-fixed-groups", run.fixed_groups,
+               "one depth chunk per K frames even where a tile does not change (calf-encode's "
+               "option; default off)");
+  bool no_lzma2 = false;
+  app.add_flag("--no-lzma2", no_lzma2, "skip the LZMA2 encode (default: run it)");
   app.add_flag("--no-colour-peers", no_colour_peers,
                "skip xz / zstd on the raw colour stream (default: run them)");
   app.add_flag("--video-peers", run.video_peers,
@@ -384,6 +414,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   run.depth = depth == "pred16" ? DepthCoding::kRaw16Predicted : DepthCoding::kRaw16;
   run.colour_peers = !no_colour_peers;
+  run.lzma2 = !no_lzma2;
   run.have_xz = have_tool("xz");
   run.have_zstd = have_tool("zstd");
   int rc = 0;
