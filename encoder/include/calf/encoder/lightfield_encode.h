@@ -83,10 +83,10 @@ struct LightfieldEncodeOptions {
   // a segment. Costs bytes (docs/FARM.md).
   uint32_t segment_frames = 0;
   // A depth / material tile that does not change over whole groups of K frames after its group
-  // keeps one chunk across them (its P-frames there are empty) instead of a new keyframe every K
-  // frames: static content costs one keyframe per tile, and a seek still reads one chunk of it
-  // (SPEC §11.1.2). Groups never merge across a segment boundary. false: one chunk per K frames,
-  // as writers before issue 17 did.
+  // keeps one chunk across them (empty P-frames there, but for the first W - 1) instead of a new
+  // keyframe every K frames: static content costs one keyframe per tile, and a seek still reads
+  // one chunk of it (SPEC §11.1.2 "Static groups"). Groups never merge across a segment
+  // boundary. false: one chunk per K frames, as writers before issue 17 did.
   bool merge_static_groups = true;
   container::Compression supercompression = container::Compression::kZstd;
   container::CompressionOptions levels;  // zstd level / LZMA preset (fixed per clip)
