@@ -30,7 +30,7 @@ constexpr const char* kAnalysisKey = "calf.lightfield_analysis";
 constexpr const char* kAnalysisIdKey = "calf.lightfield_analysis_id";
 constexpr const char* kShardViewsKey = "calf.lightfield_shard_views";
 constexpr const char* kShardFramesKey = "calf.lightfield_shard_frames";  // "first-last"
-constexpr const char* kRecordMagic = "calf-lightfield-analysis 1";
+constexpr const char* kRecordMagic = "calf-lightfield-analysis 2";
 
 std::string hex_double(double v) {
   char buf[64];
@@ -48,6 +48,7 @@ std::string analysis_record(const LightfieldAnalysis& a, const LightfieldEncodeO
     << "\nkeyframe_interval " << o.depth_keyframe_interval << "\nsupercompression "
     << static_cast<int>(o.supercompression) << "\nzstd_level " << o.levels.zstd_level
     << "\nlzma_preset " << o.levels.lzma_preset << "\nsegment_frames " << o.segment_frames
+    << "\ncolour_rdo " << hex_double(o.colour_rdo)
     << "\nresolved_colour " << static_cast<int>(a.colour) << "\nviews " << a.views.size() << "\n";
   for (size_t v = 0; v < a.views.size(); ++v) {
     const LightfieldViewFacts& f = a.views[v];
@@ -124,6 +125,9 @@ Status parse_record(const std::string& path, const std::string& text, Lightfield
   o->levels.lzma_preset = static_cast<uint32_t>(x);
   if (!field("segment_frames", UINT32_MAX)) return bad_record(path, "segment_frames");
   o->segment_frames = static_cast<uint32_t>(x);
+  if (!(in >> key) || key != "colour_rdo" || !read_double(in, &o->colour_rdo)) {
+    return bad_record(path, "colour_rdo");
+  }
   if (!field("resolved_colour", static_cast<uint64_t>(ColourCoding::kRgba16f)))
     return bad_record(path, "resolved_colour");
   *resolved_colour = x;

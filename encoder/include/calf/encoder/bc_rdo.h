@@ -1,0 +1,51 @@
+// Rate-distortion optimisation of coded BC6H / BC7 images for an LZ supercompressor (zstd, LZMA).
+//
+// BC6H and BC7 blocks are dense bit fields: two blocks of the same colour rarely share a byte,
+// so a chunk of them barely compresses. This pass rewrites already coded blocks, in order,
+// towards bytes an LZ coder finds again: for each block it tries, from each of the previous
+// `window` blocks of the image (and the three blocks above it), a copy of that block whole, of a
+// prefix of its bytes (mode and endpoints, own indices kept) and of a suffix (indices, own mode
+// and endpoints kept). Each candidate is decoded and measured against the target texels; the one
+// of least cost J = D + lambda · R is kept, with D the block's squared error in the encoder's own
+// metric (BC6H: differences of half-float bit patterns, so one unit is one half ulp, about 2^-10
+// of a stop; BC7: 8-bit RGBA values) and R an estimate of its LZ bits (8 per byte not covered by
+// the longest run it shares, at the same byte offsets, with a block of the window; a run of at
+// least 3 bytes costs 24 bits). The blocks stay standard blocks: any decoder reads them; only the
+// error and the supercompressed size change. lambda 0 leaves the blocks untouched.
+//
+// Deterministic (a sequential pass over the blocks; no threads), no global state. The idea is
+// Geldreich's "entropy reduction transform" (bc7enc_rdo); this implementation and its rate
+// model are calf's own.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "calf/format/bc.h"
+#include "calf/format/status.h"
+
+namespace calf::bc {
+
+struct BcRdoOptions {
+  double lambda = 0;        // error units per estimated bit; 0 = off, >= 0
+  uint32_t window = 8;      // previous blocks in row order tried as sources, 1..256
+};
+
+// What one pass did (for the encoder's statistics).
+struct BcRdoStats {
+  uint64_t blocks = 0, changed = 0;
+  double error_before = 0, error_after = 0;  // sum of D over the blocks, before / after
+};
+
+// Rewrites the BC6H_UF16 blocks of a width x height image (`blocks`, row-major, 16 bytes each,
+// compressed_size() bytes) against `target`: the image's texels as half-float bit patterns,
+// 3 per texel (RGB), rows width * 3 apart. Errors: kBcBufferSize (a buffer too small),
+// kBcOptions (lambda negative or not finite, window out of range).
+Status rdo_bc6h(const uint16_t* target, uint32_t width, uint32_t height, uint8_t* blocks,
+                size_t blocks_size, const BcRdoOptions& options, BcRdoStats* stats = nullptr);
+
+// The same for BC7 blocks against 8-bit RGBA texels (rows width * 4 apart).
+Status rdo_bc7(const uint8_t* target, uint32_t width, uint32_t height, uint8_t* blocks,
+               size_t blocks_size, const BcRdoOptions& options, BcRdoStats* stats = nullptr);
+
+}  // namespace calf::bc
