@@ -48,8 +48,8 @@ std::string analysis_record(const LightfieldAnalysis& a, const LightfieldEncodeO
     << "\nkeyframe_interval " << o.depth_keyframe_interval << "\nsupercompression "
     << static_cast<int>(o.supercompression) << "\nzstd_level " << o.levels.zstd_level
     << "\nlzma_preset " << o.levels.lzma_preset << "\nsegment_frames " << o.segment_frames
-    << "\ncolour_rdo " << hex_double(o.colour_rdo)
-    << "\nresolved_colour " << static_cast<int>(a.colour) << "\nviews " << a.views.size() << "\n";
+    << "\ncolour_rdo " << hex_double(o.colour_rdo) << "\nresolved_colour "
+    << static_cast<int>(a.colour) << "\nviews " << a.views.size() << "\n";
   for (size_t v = 0; v < a.views.size(); ++v) {
     const LightfieldViewFacts& f = a.views[v];
     s << "view " << v << " " << (f.depth_range ? 1 : 0) << " "

@@ -92,9 +92,9 @@ TEST(BcRdo, Bc7SmallerOnceCompressedAndEachBlocksErrorBounded) {
   }
   // Every block still decodes as BC7 (a standard block): the whole image decodes.
   std::vector<uint8_t> out(kW * kH * 4);
-  EXPECT_TRUE(
-      decode_image(Format::kBc7, blocks.data(), blocks.size(), kW, kH, out.data(), out.size(), kW * 4)
-          .ok());
+  EXPECT_TRUE(decode_image(Format::kBc7, blocks.data(), blocks.size(), kW, kH, out.data(),
+                           out.size(), kW * 4)
+                  .ok());
 }
 
 TEST(BcRdo, Bc6hSmallerOnceCompressedAndRepeatable) {
@@ -141,12 +141,10 @@ TEST(BcRdo, RefusesBadOptionsAndBuffers) {
   std::vector<uint8_t> blocks = bc7_of(img);
   BcRdoOptions o;
   o.lambda = -1;
-  EXPECT_EQ(rdo_bc7(img.data(), kW, kH, blocks.data(), blocks.size(), o).id(),
-            ErrorId::kBcOptions);
+  EXPECT_EQ(rdo_bc7(img.data(), kW, kH, blocks.data(), blocks.size(), o).id(), ErrorId::kBcOptions);
   o.lambda = 1;
   o.window = 0;
-  EXPECT_EQ(rdo_bc7(img.data(), kW, kH, blocks.data(), blocks.size(), o).id(),
-            ErrorId::kBcOptions);
+  EXPECT_EQ(rdo_bc7(img.data(), kW, kH, blocks.data(), blocks.size(), o).id(), ErrorId::kBcOptions);
   o.window = 8;
   EXPECT_EQ(rdo_bc7(img.data(), kW, kH, blocks.data(), blocks.size() - 1, o).id(),
             ErrorId::kBcBufferSize);

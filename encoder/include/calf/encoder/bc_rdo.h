@@ -5,13 +5,15 @@
 // towards bytes an LZ coder finds again: for each block it tries, from each of the previous
 // `window` blocks of the image (and the three blocks above it), a copy of that block whole, of a
 // prefix of its bytes (mode and endpoints, own indices kept) and of a suffix (indices, own mode
-// and endpoints kept). Each candidate is decoded and measured against the target texels; the one
-// of least cost J = D + lambda · R is kept, with D the block's squared error in the encoder's own
-// metric (BC6H: differences of half-float bit patterns, so one unit is one half ulp, about 2^-10
-// of a stop; BC7: 8-bit RGBA values) and R an estimate of its LZ bits (8 per byte not covered by
-// the longest run it shares, at the same byte offsets, with a block of the window; a run of at
-// least 3 bytes costs 24 bits). The blocks stay standard blocks: any decoder reads them; only the
-// error and the supercompressed size change. lambda 0 leaves the blocks untouched.
+// and endpoints kept), at the lengths listed in bc_rdo.cc. Each candidate is decoded and measured
+// against the target texels; the one of least cost J = D + lambda · R is kept, with D the block's
+// squared error as a display shows it, in 8-bit sRGB units (BC7: the 8-bit sRGB RGBA values it
+// stores; BC6H: 255 times the sRGB encoding of the linear values, the curve extended past 1
+// as 1.055 v^(1/2.4) - 0.055 so that highlights keep a weight that falls as the eye's) and R an
+// estimate of its LZ bits (8 per byte not covered by the longest run it shares, at the same byte
+// offsets, with a source block; a run of at least 3 bytes costs 24 bits). The blocks stay standard
+// blocks: any decoder reads them; only the error and the supercompressed size change. lambda 0
+// leaves the blocks untouched.
 //
 // Deterministic (a sequential pass over the blocks; no threads), no global state. The idea is
 // Geldreich's "entropy reduction transform" (bc7enc_rdo); this implementation and its rate
@@ -27,8 +29,8 @@
 namespace calf::bc {
 
 struct BcRdoOptions {
-  double lambda = 0;        // error units per estimated bit; 0 = off, >= 0
-  uint32_t window = 8;      // previous blocks in row order tried as sources, 1..256
+  double lambda = 0;    // error units per estimated bit; 0 = off, >= 0
+  uint32_t window = 2;  // previous blocks in row order tried as sources, 1..256
 };
 
 // What one pass did (for the encoder's statistics).
