@@ -11,9 +11,12 @@
 // stores; BC6H: 255 times the sRGB encoding of the linear values, the curve extended past 1
 // as 1.055 v^(1/2.4) - 0.055 so that highlights keep a weight that falls as the eye's) and R an
 // estimate of its LZ bits (8 per byte not covered by the longest run it shares, at the same byte
-// offsets, with a source block; a run of at least 3 bytes costs 24 bits). The blocks stay standard
-// blocks: any decoder reads them; only the error and the supercompressed size change. lambda 0
-// leaves the blocks untouched.
+// offsets, with a source block; a run of at least 3 bytes costs 24 bits). A BC6H candidate that
+// moves a texel further from its target than 1/8 stop (128 half ulps) or than the original block
+// did, whichever is larger, is refused: the display metric alone would let deep shadows become
+// any dark value, and HDR content may be shown brighter. The blocks stay standard blocks: any
+// decoder reads them; only the error and the supercompressed size change. lambda 0 leaves the
+// blocks untouched.
 //
 // Deterministic (a sequential pass over the blocks; no threads), no global state. The idea is
 // Geldreich's "entropy reduction transform" (bc7enc_rdo); this implementation and its rate
@@ -29,7 +32,7 @@
 namespace calf::bc {
 
 struct BcRdoOptions {
-  double lambda = 0;    // error units per estimated bit; 0 = off, >= 0
+  double lambda = 0;    // squared 8-bit sRGB error per estimated bit; 0 = off, >= 0
   uint32_t window = 2;  // previous blocks in row order tried as sources, 1..256
 };
 
