@@ -17,8 +17,9 @@ constexpr int kMinRun = 3;         // zstd's shortest match
 constexpr double kMatchBits = 24;  // an offset and a length, roughly, in zstd's sequences
 
 // The copied lengths tried, as prefixes (side 0; 16 = the whole block) and suffixes (side 1).
-// Measured on BC6H cells of the built-in scenes (all lengths 3..16 from 8 previous blocks): these
-// were the lengths of 93 % of the accepted copies; the others cost a third of the decodes.
+// Measured on mirror-box's BC6H cells at face 64, lambda 0.5 (all lengths 3..16 from 8 previous
+// blocks and the 3 above): these were the lengths of 96.5 % of the accepted copies. With the
+// window cut to 2 this halves the pass's time for 0.5 % more colour bytes.
 constexpr bool kTried[2][17] = {
     {0, 0, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 0, 1, 1, 1},
     {0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1, 0, 0, 1, 0},

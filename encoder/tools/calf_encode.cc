@@ -294,7 +294,7 @@ int main(int argc, char** argv) {
                  "bytes) where the added error (squared, in 8-bit sRGB units; BC6H on the sRGB "
                  "curve extended above 1) is below lambda per estimated bit saved; 0 = off, the "
                  "blocks exactly as the BCn encoder made them; other formats ignore it; 0.5 saves "
-                 "32-69 % of the colour bytes of the built-in scenes for <= 0.02 dB against ground "
+                 "31-69 % of the colour bytes of the built-in scenes for <= 0.02 dB against ground "
                  "truth (docs/ENCODER.md \"Colour RDO\") (default 0.5)")
       ->default_val(0.5);
   app.add_option("--supercompression", super,
