@@ -18,6 +18,7 @@
 #include <tbb/task_arena.h>
 
 #include "calf/encoder/bc_encode.h"
+#include "calf/encoder/bc_rdo.h"
 #include "calf/encoder/color_keyframes.h"
 #include "calf/encoder/depth_aabb.h"
 #include "calf/format/bc.h"
@@ -258,6 +259,34 @@ void append_colour_payload(ColourCoding coding, const std::vector<uint8_t>& byte
   }
 }
 
+// Rewrites keyframe `frame`'s BC6H / BC7 blocks towards cheaper supercompression
+// (calf/encoder/bc_rdo.h), measured against the frame's texels as the BCn encoder saw them.
+Status rdo_keyframe(const Context& ctx, uint32_t face, const PixelRect& r, uint32_t frame,
+                    std::vector<uint8_t>& bytes) {
+  const ViewData& v = *ctx.view;
+  const size_t n = static_cast<size_t>(r.width) * r.height;
+  bc::BcRdoOptions o;
+  o.lambda = ctx.options->colour_rdo;
+  if (ctx.colour == ColourCoding::kBc6h) {
+    std::vector<uint16_t> half(n * 3);
+    for (uint32_t y = 0; y < r.height; ++y) {
+      const uint16_t* src = &v.colour[v.index(frame, face, r.x, r.y + y) * 3];
+      std::copy(src, src + r.width * 3, &half[size_t{y} * r.width * 3]);
+    }
+    return bc::rdo_bc6h(half.data(), r.width, r.height, bytes.data(), bytes.size(), o);
+  }
+  std::vector<uint8_t> rgba(n * 4);
+  for (uint32_t y = 0; y < r.height; ++y) {
+    const uint16_t* src = &v.colour[v.index(frame, face, r.x, r.y + y) * 3];
+    for (uint32_t x = 0; x < r.width; ++x) {
+      uint8_t* d = &rgba[(size_t{y} * r.width + x) * 4];
+      for (int c = 0; c < 3; ++c) d[c] = srgb8_from_linear(bc::half_to_float(src[3 * x + c]));
+      d[3] = 255;
+    }
+  }
+  return bc::rdo_bc7(rgba.data(), r.width, r.height, bytes.data(), bytes.size(), o);
+}
+
 void colour_task(const Context& ctx, uint32_t face, uint32_t cell, TaskOut& out) {
   const ViewData& v = *ctx.view;
   const PixelRect r =
@@ -333,6 +362,11 @@ void colour_task(const Context& ctx, uint32_t face, uint32_t cell, TaskOut& out)
     const uint32_t kf = k->keyframes[i];
     const uint32_t end = i + 1 < k->keyframes.size() ? k->keyframes[i + 1] : frames;
     raw.clear();
+    if (ctx.options->colour_rdo > 0 &&
+        (ctx.colour == ColourCoding::kBc6h || ctx.colour == ColourCoding::kBc7)) {
+      out.status = rdo_keyframe(ctx, face, r, kf, coded[kf].bytes);
+      if (!out.status.ok()) return;
+    }
     append_colour_payload(ctx.colour, coded[kf].bytes, raw);
     keys.stream = static_cast<uint16_t>(LightfieldStream::kColour);
     keys.first_frame = ctx.first_frame + kf;

@@ -36,7 +36,8 @@ struct PinCase {
   ColourCoding colour;
   DepthCoding depth;
   container::Compression compression;
-  const char* xxh3;  // of the whole file, hex
+  const char* xxh3;       // of the whole file, hex
+  double colour_rdo = 0;  // LightfieldEncodeOptions::colour_rdo (0: the clips frozen before it)
   uint32_t depth_keyframe_interval = 30;
 };
 
@@ -54,7 +55,11 @@ const PinCase kCases[] = {
     {"bc6h_pred16_lzma2",  {.face = 8, .frames = 3, .views = 2, .hdr = true},       ColourCoding::kBc6h,    DepthCoding::kRaw16Predicted, container::Compression::kLzma2, "3a4515816c9670ef"},
     {"auto_pred16_static", {.face = 16, .frames = 6, .views = 2, .animated = false, .material = true}, ColourCoding::kAuto, DepthCoding::kRaw16Predicted, container::Compression::kZstd, "8792a19d652f5f4f"},
     // Static depth and material groups merged (SPEC §11.1.2; issue 17): K = 2 over 7 frames.
-    {"bc1_raw16_groups",   {.face = 16, .frames = 7, .views = 2, .material = true},  ColourCoding::kBc1,     DepthCoding::kRaw16, container::Compression::kZstd,  "cefa7985168c295a", 2},
+    {"bc1_raw16_groups",   {.face = 16, .frames = 7, .views = 2, .material = true},  ColourCoding::kBc1,     DepthCoding::kRaw16, container::Compression::kZstd,  "cefa7985168c295a", 0, 2},
+    // Colour RDO (issue 17, docs/ENCODER.md "Colour RDO"): standard BC6H / BC7 blocks, rewritten
+    // towards copies of their neighbours' bytes; same decoder, its own frozen clips.
+    {"bc6h_rdo_zstd",      {.face = 16, .frames = 5, .views = 2, .hdr = true},      ColourCoding::kBc6h,    DepthCoding::kRaw16, container::Compression::kZstd,  "e40d1fb3ffd8ba6f", 4.0},
+    {"bc7_rdo_zstd",       {.face = 16, .frames = 5, .views = 2},                   ColourCoding::kBc7,     DepthCoding::kRaw16, container::Compression::kZstd,  "5b143c1103044687", 4.0},
 };
 // clang-format on
 
@@ -87,6 +92,7 @@ TEST_P(EncodePin, OutputBytesAreUnchanged) {
   for (uint32_t threads : {1u, 2u}) {
     LightfieldEncodeOptions o;
     o.colour = c.colour;
+    o.colour_rdo = c.colour_rdo;
     o.depth = c.depth;
     o.supercompression = c.compression;
     o.cell_size = 8;

@@ -88,6 +88,11 @@ struct LightfieldEncodeOptions {
   // one chunk of it (SPEC §11.1.2 "Static groups"). Groups never merge across a segment
   // boundary. false: one chunk per K frames, as writers before issue 17 did.
   bool merge_static_groups = true;
+  // Colour RDO strength (calf/encoder/bc_rdo.h): lambda, squared 8-bit sRGB error per estimated
+  // bit saved, [0, 1e6]; 0 = off (the blocks as the BCn encoder made them). BC6H and BC7
+  // keyframes only; other colour formats ignore it. Applied to the keyframes after the keyframe
+  // search. The default 0.5 was chosen by measurement (docs/ENCODER.md "Colour RDO").
+  double colour_rdo = 0.5;
   container::Compression supercompression = container::Compression::kZstd;
   container::CompressionOptions levels;  // zstd level / LZMA preset (fixed per clip)
   uint32_t threads = 1;                  // 0 = all cores; never changes the output

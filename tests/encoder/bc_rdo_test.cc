@@ -1,0 +1,156 @@
+// Tests of the colour RDO pass (calf/encoder/bc_rdo.h): off means untouched, on means smaller
+// once zstd-compressed, each block's added error bounded by what the cost rule allows, argument
+// errors.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "calf/encoder/bc_encode.h"
+#include "calf/encoder/bc_rdo.h"
+#include "calf/format/bc.h"
+#include "calf/format/container_codec.h"
+
+namespace calf::bc {
+namespace {
+
+constexpr uint32_t kW = 64, kH = 48;
+
+// A smooth gradient with mild noise and a flat band: content with near-repeating blocks, as a
+// rendered cell has.
+std::vector<uint8_t> ldr_image() {
+  std::vector<uint8_t> img(kW * kH * 4, 255);
+  std::mt19937 rng(7);
+  for (uint32_t y = 0; y < kH; ++y) {
+    for (uint32_t x = 0; x < kW; ++x) {
+      uint8_t* p = &img[(y * kW + x) * 4];
+      const bool band = y >= 16 && y < 28;
+      for (int c = 0; c < 3; ++c) {
+        const int base = band ? 90 + 20 * c : static_cast<int>(x * 2 + y + 30 * c);
+        p[c] = static_cast<uint8_t>(std::clamp(base + static_cast<int>(rng() % 5) - 2, 0, 255));
+      }
+    }
+  }
+  return img;
+}
+
+std::vector<uint8_t> bc7_of(const std::vector<uint8_t>& img) {
+  std::vector<uint8_t> blocks(encode_bound(Format::kBc7, kW, kH));
+  Bc7Options o;
+  o.quality = 0;
+  EXPECT_TRUE(encode_bc7({img.data(), kW, kH, kW * 4, 4}, blocks.data(), blocks.size(), o).ok());
+  return blocks;
+}
+
+size_t zstd_size(const std::vector<uint8_t>& bytes) {
+  auto c = container::compress_chunk(bytes, container::Compression::kZstd);
+  EXPECT_TRUE(c.ok());
+  return c.ok() ? c->bytes.size() : 0;
+}
+
+// Squared 8-bit RGBA error of BC7 block k of the image.
+double bc7_block_error(const uint8_t* block, const std::vector<uint8_t>& img, uint32_t k) {
+  uint8_t out[16 * 4];
+  decode_bc7_block(block, out);
+  const uint32_t bx = k % (kW / 4), by = k / (kW / 4);
+  double e = 0;
+  for (int i = 0; i < 16; ++i) {
+    const uint8_t* p = &img[((by * 4 + i / 4) * kW + bx * 4 + i % 4) * 4];
+    for (int c = 0; c < 4; ++c) e += std::pow(double(out[4 * i + c]) - p[c], 2);
+  }
+  return e;
+}
+
+TEST(BcRdo, LambdaZeroLeavesTheBlocksUntouched) {
+  const std::vector<uint8_t> img = ldr_image();
+  const std::vector<uint8_t> before = bc7_of(img);
+  std::vector<uint8_t> blocks = before;
+  BcRdoStats s;
+  ASSERT_TRUE(rdo_bc7(img.data(), kW, kH, blocks.data(), blocks.size(), {}, &s).ok());
+  EXPECT_EQ(blocks, before);
+  EXPECT_EQ(s.changed, 0u);
+  EXPECT_EQ(s.blocks, uint64_t{kW / 4 * kH / 4});
+}
+
+TEST(BcRdo, Bc7SmallerOnceCompressedAndEachBlocksErrorBounded) {
+  const std::vector<uint8_t> img = ldr_image();
+  const std::vector<uint8_t> before = bc7_of(img);
+  std::vector<uint8_t> blocks = before;
+  BcRdoOptions o;
+  o.lambda = 4;
+  BcRdoStats s;
+  ASSERT_TRUE(rdo_bc7(img.data(), kW, kH, blocks.data(), blocks.size(), o, &s).ok());
+  EXPECT_GT(s.changed, 0u);
+  EXPECT_LT(zstd_size(blocks), zstd_size(before) * 9 / 10);
+  // A block is replaced only when D + lambda R falls; R is at most 128 bits (16 literals) and at
+  // least 24 (one match), so no block may gain more than lambda * 104 of squared error.
+  for (uint32_t k = 0; k < blocks.size() / 16; ++k) {
+    const double d0 = bc7_block_error(&before[k * 16], img, k);
+    const double d1 = bc7_block_error(&blocks[k * 16], img, k);
+    EXPECT_LT(d1 - d0, o.lambda * 104 + 1e-9) << "block " << k;
+  }
+  // Every block still decodes as BC7 (a standard block): the whole image decodes.
+  std::vector<uint8_t> out(kW * kH * 4);
+  EXPECT_TRUE(decode_image(Format::kBc7, blocks.data(), blocks.size(), kW, kH, out.data(),
+                           out.size(), kW * 4)
+                  .ok());
+}
+
+TEST(BcRdo, Bc6hSmallerOnceCompressedAndRepeatable) {
+  std::vector<float> rgb(kW * kH * 3);
+  std::vector<uint16_t> half(rgb.size());
+  std::mt19937 rng(3);
+  for (uint32_t y = 0; y < kH; ++y) {
+    for (uint32_t x = 0; x < kW; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        const size_t i = (y * kW + x) * 3 + c;
+        rgb[i] = (0.2f + 0.01f * x + 0.3f * c) * (1.0f + 0.02f * (rng() % 100) / 100.0f) *
+                 (y > 30 ? 4.0f : 1.0f);
+        half[i] = float_to_half(rgb[i]);
+        rgb[i] = half_to_float(half[i]);  // the encoder's input is half floats
+      }
+    }
+  }
+  std::vector<uint8_t> before(encode_bound(Format::kBc6hUnsigned, kW, kH));
+  Bc6hOptions eo;
+  eo.quality = 0;
+  ASSERT_TRUE(encode_bc6h({rgb.data(), kW, kH, kW * 3, 3}, before.data(), before.size(), eo).ok());
+  BcRdoOptions o;
+  o.lambda = 3;
+  std::vector<uint8_t> a = before, b = before;
+  BcRdoStats s;
+  ASSERT_TRUE(rdo_bc6h(half.data(), kW, kH, a.data(), a.size(), o, &s).ok());
+  ASSERT_TRUE(rdo_bc6h(half.data(), kW, kH, b.data(), b.size(), o).ok());
+  EXPECT_EQ(a, b);  // deterministic
+  EXPECT_GT(s.changed, 0u);
+  EXPECT_GE(s.error_after, s.error_before);
+  EXPECT_LT(zstd_size(a), zstd_size(before));
+  // The decoded image stays close: mean relative error per channel below 3 %.
+  std::vector<uint16_t> out(kW * kH * 3);
+  ASSERT_TRUE(decode_image(Format::kBc6hUnsigned, a.data(), a.size(), kW, kH, out.data(),
+                           out.size() * 2, kW * 6)
+                  .ok());
+  double rel = 0;
+  for (size_t i = 0; i < out.size(); ++i) rel += std::fabs(half_to_float(out[i]) / rgb[i] - 1);
+  EXPECT_LT(rel / out.size(), 0.03);
+}
+
+TEST(BcRdo, RefusesBadOptionsAndBuffers) {
+  const std::vector<uint8_t> img = ldr_image();
+  std::vector<uint8_t> blocks = bc7_of(img);
+  BcRdoOptions o;
+  o.lambda = -1;
+  EXPECT_EQ(rdo_bc7(img.data(), kW, kH, blocks.data(), blocks.size(), o).id(), ErrorId::kBcOptions);
+  o.lambda = 1;
+  o.window = 0;
+  EXPECT_EQ(rdo_bc7(img.data(), kW, kH, blocks.data(), blocks.size(), o).id(), ErrorId::kBcOptions);
+  o.window = 8;
+  EXPECT_EQ(rdo_bc7(img.data(), kW, kH, blocks.data(), blocks.size() - 1, o).id(),
+            ErrorId::kBcBufferSize);
+  EXPECT_EQ(rdo_bc6h(nullptr, kW, kH, blocks.data(), blocks.size(), o).id(),
+            ErrorId::kBcBufferSize);
+}
+
+}  // namespace
+}  // namespace calf::bc
