@@ -168,6 +168,26 @@ struct CodedFrame {
   std::vector<float> shown;
 };
 
+// The cell `r` of one frame of the view as half RGB (the capture's values), rows packed.
+void gather_cell_halves(const ViewData& v, uint32_t face, const PixelRect& r, uint32_t frame,
+                        uint16_t* out) {
+  for (uint32_t y = 0; y < r.height; ++y) {
+    const uint16_t* src = &v.colour[v.index(frame, face, r.x, r.y + y) * 3];
+    std::copy(src, src + r.width * 3, out + size_t{y} * r.width * 3);
+  }
+}
+
+// Linear RGB as 8-bit sRGB RGBA (alpha 255): what the LDR formats code.
+std::vector<uint8_t> srgb8_rgba_of(std::span<const float> rgb) {
+  const size_t n = rgb.size() / 3;
+  std::vector<uint8_t> rgba(n * 4);
+  for (size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) rgba[4 * i + c] = srgb8_from_linear(rgb[3 * i + c]);
+    rgba[4 * i + 3] = 255;
+  }
+  return rgba;
+}
+
 Status code_colour_frame(ColourCoding coding, std::span<const float> rgb, uint32_t w, uint32_t h,
                          CodedFrame* out) {
   const size_t n = static_cast<size_t>(w) * h;
@@ -176,11 +196,7 @@ Status code_colour_frame(ColourCoding coding, std::span<const float> rgb, uint32
     case ColourCoding::kBc1:
     case ColourCoding::kBc7:
     case ColourCoding::kRgba8: {
-      std::vector<uint8_t> rgba(n * 4);
-      for (size_t i = 0; i < n; ++i) {
-        for (int c = 0; c < 3; ++c) rgba[4 * i + c] = srgb8_from_linear(rgb[3 * i + c]);
-        rgba[4 * i + 3] = 255;
-      }
+      std::vector<uint8_t> rgba = srgb8_rgba_of(rgb);
       if (coding == ColourCoding::kRgba8) {
         out->bytes = rgba;
       } else {
@@ -263,27 +279,17 @@ void append_colour_payload(ColourCoding coding, const std::vector<uint8_t>& byte
 // (calf/encoder/bc_rdo.h), measured against the frame's texels as the BCn encoder saw them.
 Status rdo_keyframe(const Context& ctx, uint32_t face, const PixelRect& r, uint32_t frame,
                     std::vector<uint8_t>& bytes) {
-  const ViewData& v = *ctx.view;
   const size_t n = static_cast<size_t>(r.width) * r.height;
   bc::BcRdoOptions o;
   o.lambda = ctx.options->colour_rdo;
+  std::vector<uint16_t> half(n * 3);
+  gather_cell_halves(*ctx.view, face, r, frame, half.data());
   if (ctx.colour == ColourCoding::kBc6h) {
-    std::vector<uint16_t> half(n * 3);
-    for (uint32_t y = 0; y < r.height; ++y) {
-      const uint16_t* src = &v.colour[v.index(frame, face, r.x, r.y + y) * 3];
-      std::copy(src, src + r.width * 3, &half[size_t{y} * r.width * 3]);
-    }
     return bc::rdo_bc6h(half.data(), r.width, r.height, bytes.data(), bytes.size(), o);
   }
-  std::vector<uint8_t> rgba(n * 4);
-  for (uint32_t y = 0; y < r.height; ++y) {
-    const uint16_t* src = &v.colour[v.index(frame, face, r.x, r.y + y) * 3];
-    for (uint32_t x = 0; x < r.width; ++x) {
-      uint8_t* d = &rgba[(size_t{y} * r.width + x) * 4];
-      for (int c = 0; c < 3; ++c) d[c] = srgb8_from_linear(bc::half_to_float(src[3 * x + c]));
-      d[3] = 255;
-    }
-  }
+  std::vector<float> rgb(n * 3);
+  for (size_t i = 0; i < n * 3; ++i) rgb[i] = bc::half_to_float(half[i]);
+  const std::vector<uint8_t> rgba = srgb8_rgba_of(rgb);
   return bc::rdo_bc7(rgba.data(), r.width, r.height, bytes.data(), bytes.size(), o);
 }
 
@@ -298,10 +304,7 @@ void colour_task(const Context& ctx, uint32_t face, uint32_t cell, TaskOut& out)
   std::vector<CodedFrame> coded(frames);
   std::vector<float> shown_all(n * 3 * frames);
   for (uint32_t f = 0; f < frames; ++f) {
-    for (uint32_t y = 0; y < r.height; ++y) {
-      const uint16_t* src = &v.colour[v.index(f, face, r.x, r.y + y) * 3];
-      std::copy(src, src + r.width * 3, &current_half[size_t{y} * r.width * 3]);
-    }
+    gather_cell_halves(v, face, r, f, current_half.data());
     if (f > 0 && current_half == previous_half) {
       coded[f] = coded[f - 1];  // static content: the same bytes, no second encode
     } else {
