@@ -37,11 +37,11 @@ std::vector<uint8_t> split(const std::vector<uint8_t>& blocks, size_t k) {
   return out;
 }
 
+// Byte k of every block, k = 0..15: the layout's own byte planes (SPEC §11.1.5, rgba8).
 std::vector<uint8_t> planes(const std::vector<uint8_t>& blocks) {
   std::vector<uint8_t> out;
   out.reserve(blocks.size());
-  for (size_t k = 0; k < 16; ++k)
-    for (size_t b = k; b < blocks.size(); b += 16) out.push_back(blocks[b]);
+  lf::append_planes(out, blocks, 16);
   return out;
 }
 
