@@ -166,8 +166,12 @@ TEST(LightfieldShardFrames, FrameRangeShardsEqualSegmentedEncode) {
   std::vector<std::string> shards;
   for (uint32_t g = 0; g < 2; ++g) {
     for (uint32_t first : {2u, 0u}) {
-      const std::string path =
-          (work / ("s" + std::to_string(g) + "-" + std::to_string(first) + ".calf")).string();
+      std::string name = "s";  // append, not operator+: GCC 12 -O3 misfires -Wrestrict on it
+      name += std::to_string(g);
+      name += '-';
+      name += std::to_string(first);
+      name += ".calf";
+      const std::string path = (work / name).string();
       auto s = encode_lightfield_shard(dir, *a, groups[g], first, 2, 2, path);
       ASSERT_TRUE(s.ok()) << s.status().to_string();
       shards.push_back(path);
