@@ -20,6 +20,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "../gl_test_context.h"
 #include "calf/capture/capture_set.h"
 #include "calf/decoder/clip_decoder.h"
 #include "calf/decoder/cpu_textures.h"
@@ -207,16 +208,7 @@ inline size_t bad_pixels(const player::RenderedImage& img) {
   return bad;
 }
 
-// One OSMesa GL 4.5 context per test program (contexts are expensive under llvmpipe), or nullptr
-// when the machine cannot make one (the GL half of a test is then skipped).
-inline player::OsMesaContext* gl_context() {
-  static std::unique_ptr<player::OsMesaContext> ctx = [] {
-    auto c = player::OsMesaContext::make();
-    if (!c.ok()) std::printf("no GL: %s\n", c.status().to_string().c_str());
-    return c.ok() ? std::move(*c) : nullptr;
-  }();
-  return ctx.get();
-}
+using ::calf::test::gl_context;
 
 // The value a float takes when stored as a half and read back (the capture set's colour
 // precision), computed independently of calf's converter: round to nearest even with 10

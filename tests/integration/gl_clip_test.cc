@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <string>
 
+#include "../gl_test_context.h"
 #include "../player/synthetic_scene.h"
 #include "calf/capture/capture_set.h"
 #include "calf/decoder/clip_decoder.h"
@@ -30,16 +31,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-OsMesaContext* context() {
-  static std::unique_ptr<OsMesaContext> ctx = [] {
-    Expected<std::unique_ptr<OsMesaContext>> c = OsMesaContext::make();
-    return c.ok() ? std::move(*c) : nullptr;
-  }();
-  return ctx.get();
-}
-
-#define REQUIRE_GL() \
-  if (context() == nullptr) GTEST_SKIP() << "no OSMesa GL 4.5 core context";
+using ::calf::test::gl_context;
 
 constexpr uint32_t kFace = 24, kFrames = 4;
 const Vec3 kViews[] = {{-0.5, 0.1, 0.3}, {0.5, -0.1, 0.3}, {0.0, 0.4, -0.4}};
@@ -170,7 +162,7 @@ void play(const char* name, const LightfieldEncodeOptions& options, bool keep_bc
   decoder::CpuTextures tex(d->header(), infos);
   Expected<GlTextureLayout> layout = layout_for_clip(d->header(), infos, keep_bc5);
   ASSERT_TRUE(layout.ok()) << layout.status().to_string();
-  Expected<std::unique_ptr<GlViews>> gv = GlViews::make(context()->gl(), *layout);
+  Expected<std::unique_ptr<GlViews>> gv = GlViews::make(gl_context()->gl(), *layout);
   ASSERT_TRUE(gv.ok()) << gv.status().to_string();
 
   Camera cam;
@@ -228,7 +220,7 @@ void play(const char* name, const LightfieldEncodeOptions& options, bool keep_bc
 }
 
 TEST(GlClip, DecodedBc7ClipWithRawDepthMatchesTheCpuRenderer) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   LightfieldEncodeOptions o;
   o.cell_size = 8;
   o.min_psnr_db = 40;
@@ -238,7 +230,7 @@ TEST(GlClip, DecodedBc7ClipWithRawDepthMatchesTheCpuRenderer) {
 }
 
 TEST(GlClip, DecodedBc1ClipWithBc5DepthMatchesTheCpuRenderer) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   LightfieldEncodeOptions o;
   o.cell_size = 8;
   o.min_psnr_db = 40;

@@ -10,22 +10,14 @@
 #include <cstring>
 #include <string>
 
+#include "../gl_test_context.h"
 #include "calf/player/gl_renderer.h"
 #include "calf/player/gl_views.h"
 
 namespace calf::player {
 namespace {
 
-OsMesaContext* context() {
-  static std::unique_ptr<OsMesaContext> ctx = [] {
-    Expected<std::unique_ptr<OsMesaContext>> c = OsMesaContext::make();
-    return c.ok() ? std::move(*c) : nullptr;
-  }();
-  return ctx.get();
-}
-
-#define REQUIRE_GL() \
-  if (context() == nullptr) GTEST_SKIP() << "no OSMesa GL 4.5 core context";
+using ::calf::test::gl_context;
 
 GlProc real(const char* name) {
   return OsMesaContext::proc_loader()(name);
@@ -75,8 +67,8 @@ GlTextureLayout one_view(container::PixelFormat colour) {
 }
 
 TEST(GlContext, LoadsEveryEntryPointFromACurrentContext) {
-  REQUIRE_GL();
-  const GlFunctions& gl = context()->gl();
+  CALF_REQUIRE_GL();
+  const GlFunctions& gl = gl_context()->gl();
   EXPECT_GE(gl.major_version * 10 + gl.minor_version, 45);
   EXPECT_FALSE(gl.renderer.empty());
   EXPECT_GE(gl.max_texture_size, 2048);
@@ -90,7 +82,7 @@ TEST(GlContext, LoadsEveryEntryPointFromACurrentContext) {
 }
 
 TEST(GlContext, MissingThingsAreNamed) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   const Status null_loader = load_gl_functions(nullptr).status();
   EXPECT_EQ(null_loader.number(), 404);
 
@@ -113,7 +105,7 @@ TEST(GlContext, MissingThingsAreNamed) {
       << bc1.to_string();
   EXPECT_TRUE(GlViews::make(*bare, one_view(container::PixelFormat::kBc7)).ok());
   // Too many views for the context's array layers.
-  GlFunctions small = context()->gl();
+  GlFunctions small = gl_context()->gl();
   small.max_array_layers = 24;  // two views of 6 faces x 2 keyframe slots
   GlTextureLayout two = one_view(container::PixelFormat::kRgba8);
   two.views.push_back(two.views[0]);
@@ -123,7 +115,7 @@ TEST(GlContext, MissingThingsAreNamed) {
 }
 
 TEST(GlContext, ShaderFailuresAndGlErrorsAreReported) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   const Expected<GlFunctions> gl = load_gl_functions(&failing_compiler);
   ASSERT_TRUE(gl.ok());
   std::unique_ptr<GlViews> views = *GlViews::make(*gl, one_view(container::PixelFormat::kRgba8));
@@ -131,7 +123,7 @@ TEST(GlContext, ShaderFailuresAndGlErrorsAreReported) {
   EXPECT_EQ(compile.number(), 404);
   EXPECT_NE(compile.message().find("does not compile"), std::string::npos) << compile.to_string();
 
-  const GlFunctions& real_gl = context()->gl();
+  const GlFunctions& real_gl = gl_context()->gl();
   EXPECT_TRUE(check_gl_error(real_gl, "nothing").ok());
   real_gl.BindTexture(0x1234, 0);  // not a texture target: GL_INVALID_ENUM
   const Status error = check_gl_error(real_gl, "binding a bad target");
@@ -142,10 +134,10 @@ TEST(GlContext, ShaderFailuresAndGlErrorsAreReported) {
 }
 
 TEST(GlContext, NoCurrentContextIsAnError) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   ASSERT_TRUE(OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0));
   const Status none = load_gl_functions(OsMesaContext::proc_loader()).status();
-  ASSERT_TRUE(context()->make_current().ok());
+  ASSERT_TRUE(gl_context()->make_current().ok());
   EXPECT_EQ(none.number(), 404);
   EXPECT_NE(none.message().find("no OpenGL context"), std::string::npos) << none.to_string();
 }

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "../gl_test_context.h"
 #include "../player/synthetic_scene.h"
 #include "calf/player/cpu_renderer.h"
 #include "calf/player/gl_context.h"
@@ -39,18 +40,7 @@ constexpr double kPi = 3.141592653589793;
 constexpr double kFloatAgreementDb = 65;
 constexpr double kMaxFlipShare = 0.001;
 
-// One OSMesa context for the whole test program (contexts are expensive under llvmpipe).
-OsMesaContext* context() {
-  static std::unique_ptr<OsMesaContext> ctx = [] {
-    Expected<std::unique_ptr<OsMesaContext>> c = OsMesaContext::make();
-    if (!c.ok()) std::printf("no GL: %s\n", c.status().to_string().c_str());
-    return c.ok() ? std::move(*c) : nullptr;
-  }();
-  return ctx.get();
-}
-
-#define REQUIRE_GL() \
-  if (context() == nullptr) GTEST_SKIP() << "no OSMesa GL 4.5 core context";
+using ::calf::test::gl_context;
 
 // PSNR of `test` against `ref` with the reference's largest value as peak (1 for LDR images).
 double psnr_vs(const std::vector<float>& ref, const std::vector<float>& test) {
@@ -84,7 +74,7 @@ Comparison compare(const ViewSet& views, const Camera& cam, RenderOptions o) {
 
   Expected<ViewSetUpload> up = updates_from_view_set(views);
   EXPECT_TRUE(up.ok()) << up.status().to_string();
-  Expected<std::unique_ptr<GlViews>> gv = GlViews::make(context()->gl(), up->layout);
+  Expected<std::unique_ptr<GlViews>> gv = GlViews::make(gl_context()->gl(), up->layout);
   EXPECT_TRUE(gv.ok()) << gv.status().to_string();
   const Status applied = (*gv)->apply(up->frame);
   EXPECT_TRUE(applied.ok()) << applied.to_string();
@@ -144,7 +134,7 @@ Camera between_views_camera(uint32_t size) {
 }
 
 TEST(GlRenderer, MatchesCpuBetweenViewpoints) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   const ViewSet views = make_views(room_with_spheres(), corner_views({0, 0, 0.5}, 1.0), 48);
   const Camera cam = between_views_camera(128);
   const Comparison c = compare(views, cam, {});
@@ -176,7 +166,7 @@ ViewSet tinted_views(uint32_t face) {
 }
 
 TEST(GlRenderer, MatchesCpuForColourAndDepthTestVariants) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   const ViewSet views = tinted_views(32);
   const Camera cam = between_views_camera(80);
   struct Variant {
@@ -239,7 +229,7 @@ TEST(GlRenderer, MatchesCpuForColourAndDepthTestVariants) {
 // nothing), and GL follows the CPU with them, also with several hints, no vetoes and an eye on a
 // viewpoint (the hint view is then the view at the eye).
 TEST(GlRenderer, MatchesCpuWithSurfaceHints) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   const ViewSet views = tinted_views(40);
   Camera cam = between_views_camera(80);
   RenderOptions o;
@@ -271,7 +261,7 @@ TEST(GlRenderer, MatchesCpuWithSurfaceHints) {
 
 // One view, the eye on it: the GL image reproduces the view's own face (mirrored), like the CPU.
 TEST(GlRenderer, MatchesCpuWithOneViewAtItsViewpoint) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   const ViewSet views = make_views(room_with_spheres(), {{0.5, 0.5, 1.0}}, 48);
   Camera cam;
   cam.position = views.views[0].position();
@@ -286,7 +276,7 @@ TEST(GlRenderer, MatchesCpuWithOneViewAtItsViewpoint) {
 
 // A subset of the views in a scrambled order, and a set of views with different face sizes.
 TEST(GlRenderer, MatchesCpuWithActiveSubsetAndMixedFaceSizes) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   const Scene scene = room_with_spheres();
   const std::vector<Vec3> pos = corner_views({0, 0, 0.5}, 1.0);
   ViewSet views = make_views(scene, pos, 32);
@@ -311,7 +301,7 @@ TEST(GlRenderer, MatchesCpuWithActiveSubsetAndMixedFaceSizes) {
 
 // HDR colour (values up to ~10) stays HDR through the half-float textures and the float target.
 TEST(GlRenderer, MatchesCpuWithHdrColour) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   const Scene scene = room_with_spheres();
   const std::vector<Vec3> pos = corner_views({0, 0, 0.5}, 1.0);
   ViewSet views;
@@ -374,7 +364,7 @@ ViewSet views_with_uniform_material(const MirrorFloorRoom& room, uint32_t face, 
 // RR as Alg. 4 writes it (no replacement of the view's own reflection) on the CPU test's mirror
 // floor: reflection rays from the material faces.
 TEST(GlRenderer, MatchesCpuWithRrOnAMirrorFloor) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   const MirrorFloorRoom room = mirror_floor_room(64);
   const ViewSet views = make_views(room.scene, room.positions, 48, /*material=*/true);
   Camera cam = room.camera;
@@ -418,7 +408,7 @@ TEST(GlRenderer, MatchesCpuWithRrOnAMirrorFloor) {
 // pixel clamped at 0. It changes the image, GL follows the CPU, for 1 and 3 bounces, mirror and
 // glass, and with surface hints.
 TEST(GlRenderer, MatchesCpuWithRrViewReflectionReplaced) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   const MirrorFloorRoom room = mirror_floor_room(56);
   const ViewSet views = make_views(room.scene, room.positions, 40, /*material=*/true);
   Camera cam = room.camera;
@@ -449,11 +439,11 @@ TEST(GlRenderer, MatchesCpuWithRrViewReflectionReplaced) {
 }
 
 TEST(GlRenderer, IsDeterministicAndReusable) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   const ViewSet views = make_views(room_with_spheres(), corner_views({0, 0, 0.5}, 1.0), 24);
   Expected<ViewSetUpload> up = updates_from_view_set(views);
   ASSERT_TRUE(up.ok());
-  std::unique_ptr<GlViews> gv = *GlViews::make(context()->gl(), up->layout);
+  std::unique_ptr<GlViews> gv = *GlViews::make(gl_context()->gl(), up->layout);
   ASSERT_TRUE(gv->apply(up->frame).ok());
   Camera cam = between_views_camera(40);
   const RenderOptions o = *march_range_for(up->layout, cam.position, {});
@@ -488,11 +478,11 @@ TEST(GlRenderer, IsDeterministicAndReusable) {
 }
 
 TEST(GlRenderer, RejectsBadOptionsAndCameras) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   const ViewSet views = make_views(room_with_spheres(), {{0, 0, 0}}, 4);
   Expected<ViewSetUpload> up = updates_from_view_set(views);
   ASSERT_TRUE(up.ok());
-  std::unique_ptr<GlViews> gv = *GlViews::make(context()->gl(), up->layout);
+  std::unique_ptr<GlViews> gv = *GlViews::make(gl_context()->gl(), up->layout);
   const auto code = [&](RenderOptions o) { return GlRenderer::make(*gv, o).status().id(); };
   RenderOptions o;
   o.steps = 0;

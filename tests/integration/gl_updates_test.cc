@@ -13,6 +13,7 @@
 #include <list>
 #include <string>
 
+#include "../gl_test_context.h"
 #include "../player/synthetic_scene.h"
 #include "calf/encoder/bc_encode.h"
 #include "calf/format/bc.h"
@@ -32,16 +33,7 @@ using decoder::FrameUpdates;
 using decoder::TextureUpdate;
 using decoder::UpdateTarget;
 
-OsMesaContext* context() {
-  static std::unique_ptr<OsMesaContext> ctx = [] {
-    Expected<std::unique_ptr<OsMesaContext>> c = OsMesaContext::make();
-    return c.ok() ? std::move(*c) : nullptr;
-  }();
-  return ctx.get();
-}
-
-#define REQUIRE_GL() \
-  if (context() == nullptr) GTEST_SKIP() << "no OSMesa GL 4.5 core context";
+using ::calf::test::gl_context;
 
 double psnr_vs(const std::vector<float>& ref, const std::vector<float>& test) {
   double peak = 1, se = 0;
@@ -352,7 +344,7 @@ void fill(HandDecoder& hd, const std::vector<Captured>& views, double scale) {
 }
 
 TEST(GlUpdates, BlockFormatsKeyframeSlotsAndCellsMatchTheCpuRenderer) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   const testing::Scene s = scene();
   const std::vector<Vec3> pos = {{-0.5, 0.2, 0.3}, {0.5, -0.2, 0.3}, {0.1, 0.4, -0.3}};
   const Case cases[] = {
@@ -375,7 +367,7 @@ TEST(GlUpdates, BlockFormatsKeyframeSlotsAndCellsMatchTheCpuRenderer) {
     HandDecoder hd(infos, c.colour, c.depth, c.material);
     if (c.keep_bc5) hd.layout().depth_format = PixelFormat::kBc5;
     fill(hd, views, c.hdr_scale);
-    Expected<std::unique_ptr<GlViews>> gv = GlViews::make(context()->gl(), hd.layout());
+    Expected<std::unique_ptr<GlViews>> gv = GlViews::make(gl_context()->gl(), hd.layout());
     ASSERT_TRUE(gv.ok()) << gv.status().to_string();
     const Status applied = (*gv)->apply(hd.frame());
     ASSERT_TRUE(applied.ok()) << c.name << ": " << applied.to_string();
@@ -416,7 +408,7 @@ TEST(GlUpdates, BlockFormatsKeyframeSlotsAndCellsMatchTheCpuRenderer) {
 
 // Slot and t are honoured: a cell showing slot 1 at t = 0 shows keyframe B, at t = 255 A.
 TEST(GlUpdates, CellParametersSelectAndBlendTheSlots) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   const testing::Scene s = scene();
   std::vector<Captured> views = {capture(s, {0, 0, 0}, 16, 16, false)};
   HandDecoder hd({views[0].info}, PixelFormat::kRgba8, PixelFormat::kR16, PixelFormat::kRgba8);
@@ -427,7 +419,7 @@ TEST(GlUpdates, CellParametersSelectAndBlendTheSlots) {
     hd.colour(0, f, 1, {0, 0, 16, 16}, blue);
     hd.depth(0, f, {0, 0, 16, 16}, views[0].depth[f]);
   }
-  std::unique_ptr<GlViews> gv = *GlViews::make(context()->gl(), hd.layout());
+  std::unique_ptr<GlViews> gv = *GlViews::make(gl_context()->gl(), hd.layout());
   ASSERT_TRUE(gv->apply(hd.frame()).ok());
   Camera cam;
   cam.position = {0.01, 0.02, 0.0};
@@ -453,12 +445,12 @@ TEST(GlUpdates, CellParametersSelectAndBlendTheSlots) {
 }
 
 TEST(GlUpdates, RefusesUpdatesThatDoNotFit) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   GlTextureLayout layout;
   layout.views = {{{0, 0, 0}, *LogDepthRange::make(0.5, 10), 32, 16, false},
                   {{1, 0, 0}, *LogDepthRange::make(0.5, 10), 32, 16, true}};
   layout.colour_format = PixelFormat::kBc7;
-  std::unique_ptr<GlViews> gv = *GlViews::make(context()->gl(), layout);
+  std::unique_ptr<GlViews> gv = *GlViews::make(gl_context()->gl(), layout);
   const std::vector<uint8_t> blocks(64 * 16, 0), codes(32 * 32 * 2, 0), rgba(32 * 32 * 4, 0);
   const auto update = [&](UpdateTarget target, uint32_t view, uint32_t slot, PixelRect r,
                           PixelFormat format, std::span<const uint8_t> bytes) {
@@ -509,8 +501,8 @@ TEST(GlUpdates, RefusesUpdatesThatDoNotFit) {
 }
 
 TEST(GlUpdates, RefusesLayoutsTheGpuCannotHold) {
-  REQUIRE_GL();
-  const GlFunctions& gl = context()->gl();
+  CALF_REQUIRE_GL();
+  const GlFunctions& gl = gl_context()->gl();
   const GlViewInfo v{{0, 0, 0}, *LogDepthRange::make(0.5, 10), 32, 16, false};
   GlTextureLayout layout;
   EXPECT_EQ(GlViews::make(gl, layout).status().number(), 410);  // no views

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "../gl_test_context.h"
 #include "calf/format/colour.h"
 #include "calf/format/mesh_texture.h"
 #include "calf/player/gl_context.h"
@@ -22,16 +23,7 @@ namespace {
 
 using test::rectangle;
 
-OsMesaContext* context() {
-  static std::unique_ptr<OsMesaContext> ctx = [] {
-    Expected<std::unique_ptr<OsMesaContext>> c = OsMesaContext::make();
-    return c.ok() ? std::move(*c) : nullptr;
-  }();
-  return ctx.get();
-}
-
-#define REQUIRE_GL() \
-  if (context() == nullptr) GTEST_SKIP() << "no OSMesa GL 4.5 core context";
+using ::calf::test::gl_context;
 
 // A camera at the origin looking down -z, 90 degrees vertical field of view.
 Camera front_camera(uint32_t w, uint32_t h) {
@@ -216,9 +208,9 @@ TEST(MeshDrawList, InvalidListsAndOptionsAreNamed) {
 // llvmpipe: 0 and 1 pixels); colour PSNR >= 45 dB where both show the same surface (measured
 // 150 dB: the shading is the same formula in float) and >= 35 dB over the whole image.
 TEST(MeshGlRenderer, AgreesWithCpuReference) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   const MeshDrawList list = test::feature_scene();
-  auto gl = GlMeshRenderer::make(context()->gl());
+  auto gl = GlMeshRenderer::make(gl_context()->gl());
   ASSERT_TRUE(gl.ok()) << gl.status().message();
   ASSERT_TRUE((*gl)->upload(list).ok());
   Camera poses[2] = {front_camera(96, 80), front_camera(96, 80)};
@@ -277,8 +269,8 @@ TEST(MeshGlRenderer, AgreesWithCpuReference) {
 }
 
 TEST(MeshGlRenderer, EmptyListAndSubsetsAndStructureChecks) {
-  REQUIRE_GL();
-  auto gl = GlMeshRenderer::make(context()->gl());
+  CALF_REQUIRE_GL();
+  auto gl = GlMeshRenderer::make(gl_context()->gl());
   ASSERT_TRUE(gl.ok());
   MeshDrawList empty;
   ASSERT_TRUE((*gl)->upload(empty).ok());
@@ -309,12 +301,12 @@ TEST(MeshGlRenderer, EmptyListAndSubsetsAndStructureChecks) {
 // Near clipping on both: a floor running from behind the eye, clipped at 0.5, shows the same
 // pixels and depths (GL clips in homogeneous coordinates, the CPU in view space).
 TEST(MeshGlRenderer, NearClippingAgreesWithCpu) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   MeshDrawList list = one_object(rectangle(-3, 3, -3, 3, 0));
   list.objects[0].transform = {1, 0, 0, 0, 0, 0, 1, -0.2f, 0, -1, 0, 0};  // the floor y = -0.2
   MeshRenderOptions o;
   o.near = 0.5;
-  auto gl = GlMeshRenderer::make(context()->gl());
+  auto gl = GlMeshRenderer::make(gl_context()->gl());
   ASSERT_TRUE(gl.ok());
   ASSERT_TRUE((*gl)->upload(list).ok());
   const Camera cam = front_camera(48, 48);
@@ -470,9 +462,9 @@ MeshDrawList textured_scene() {
 // Measured on llvmpipe: 55.2 and 51.2 dB (max difference 0.012 and 0.015), no depth differs;
 // 57.3 dB after the texture swap. GL without mips (GL_LINEAR minification) gives 16-17 dB.
 TEST(MeshGlRenderer, TexturedAgreesWithCpuReference) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   const MeshDrawList list = textured_scene();
-  auto gl = GlMeshRenderer::make(context()->gl());
+  auto gl = GlMeshRenderer::make(gl_context()->gl());
   ASSERT_TRUE(gl.ok()) << gl.status().message();
   const Status up = (*gl)->upload(list);
   ASSERT_TRUE(up.ok()) << up.message();

@@ -9,22 +9,14 @@
 #include <cstdio>
 #include <limits>
 
+#include "../gl_test_context.h"
 #include "calf/player/gl_context.h"
 #include "calf/player/image_compare.h"
 
 namespace calf::player {
 namespace {
 
-OsMesaContext* context() {
-  static std::unique_ptr<OsMesaContext> ctx = [] {
-    Expected<std::unique_ptr<OsMesaContext>> c = OsMesaContext::make();
-    return c.ok() ? std::move(*c) : nullptr;
-  }();
-  return ctx.get();
-}
-
-#define REQUIRE_GL() \
-  if (context() == nullptr) GTEST_SKIP() << "no OSMesa GL 4.5 core context";
+using ::calf::test::gl_context;
 
 // A camera at the origin looking down -z, 90 degrees vertical field of view.
 Camera front_camera(uint32_t w, uint32_t h) {
@@ -249,9 +241,9 @@ SurfelDrawList sphere_scene(uint32_t n) {
 }
 
 TEST(SurfelGlRenderer, AgreesWithCpuReference) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   const SurfelDrawList list = sphere_scene(1500);
-  auto gl = GlSurfelRenderer::make(context()->gl());
+  auto gl = GlSurfelRenderer::make(gl_context()->gl());
   ASSERT_TRUE(gl.ok()) << gl.status().message();
   ASSERT_TRUE((*gl)->upload(list).ok());
   Camera poses[2] = {front_camera(96, 80), front_camera(96, 80)};
@@ -285,9 +277,9 @@ TEST(SurfelGlRenderer, AgreesWithCpuReference) {
 }
 
 TEST(SurfelGlRenderer, StructureChecks) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   SurfelDrawList list = sphere_scene(64);
-  auto gl = GlSurfelRenderer::make(context()->gl());
+  auto gl = GlSurfelRenderer::make(gl_context()->gl());
   ASSERT_TRUE(gl.ok());
   ASSERT_TRUE((*gl)->upload(list).ok());
   RenderedImage out;

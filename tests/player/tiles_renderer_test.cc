@@ -14,6 +14,7 @@
 #include <span>
 #include <vector>
 
+#include "../gl_test_context.h"
 #include "calf/format/colour.h"
 #include "calf/player/gl_context.h"
 #include "calf/player/image_compare.h"
@@ -25,16 +26,7 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-OsMesaContext* context() {
-  static std::unique_ptr<OsMesaContext> ctx = [] {
-    Expected<std::unique_ptr<OsMesaContext>> c = OsMesaContext::make();
-    return c.ok() ? std::move(*c) : nullptr;
-  }();
-  return ctx.get();
-}
-
-#define REQUIRE_GL() \
-  if (context() == nullptr) GTEST_SKIP() << "no OSMesa GL 4.5 core context";
+using ::calf::test::gl_context;
 
 // A camera at the origin looking down -z, 90 degrees vertical field of view.
 Camera front_camera(uint32_t w, uint32_t h) {
@@ -92,7 +84,7 @@ RenderedImage cpu(const TileSet& set, const Camera& cam, TilesRenderOptions o = 
 RenderedImage gl(const TileSet& set, const Camera& cam, TilesRenderOptions o = {},
                  TilesFrameStats* stats = nullptr) {
   RenderedImage out;
-  auto r = GlTilesRenderer::make(context()->gl());
+  auto r = GlTilesRenderer::make(gl_context()->gl());
   EXPECT_TRUE(r.ok()) << r.status().message();
   if (!r.ok()) return out;
   Status s = (*r)->upload(set, tiles_linear_atlas(set));
@@ -106,7 +98,7 @@ RenderedImage gl(const TileSet& set, const Camera& cam, TilesRenderOptions o = {
 template <class F>
 void for_both(const TileSet& set, const Camera& cam, TilesRenderOptions o, F check) {
   check(cpu(set, cam, o), "cpu");
-  if (context() != nullptr) check(gl(set, cam, o), "gl");
+  if (gl_context() != nullptr) check(gl(set, cam, o), "gl");
 }
 
 // The radial distance of pixel (i, j)'s ray to the plane z = -depth (fov 90: tan 45 = 1).
@@ -283,7 +275,7 @@ TEST(TilesRenderer, EmptySetRendersNothing) {
   EXPECT_EQ(stats.fragments, 0u);
   for (float d : c.depth) EXPECT_EQ(d, kInf);
   for (float v : c.color) EXPECT_EQ(v, 0.0f);
-  if (context() == nullptr) return;
+  if (gl_context() == nullptr) return;
   const RenderedImage g = gl(set, cam, {}, &stats);
   ASSERT_EQ(g.depth.size(), 48u);
   EXPECT_EQ(stats.fragments, 0u);
@@ -304,7 +296,7 @@ TEST(TilesRenderer, OverdrawCountsFragmentsPerCoveredPixel) {
   EXPECT_EQ(stats.fragments, 3u * 64 + 16);
   EXPECT_EQ(stats.peak, 4u);
   EXPECT_DOUBLE_EQ(stats.mean_overdraw(), (3.0 * 64 + 16) / 64);
-  if (context() == nullptr) return;
+  if (gl_context() == nullptr) return;
   TilesFrameStats g;
   gl(set, cam, {}, &g);
   EXPECT_TRUE(g.measured);
@@ -387,7 +379,7 @@ TileSet random_set(int n, uint32_t seed, bool opaque) {
 // colour PSNR >= 45 dB where the depths agree and >= 40 dB over the whole image (one 96 x 72
 // pixel showing another tile costs about 43 dB); fragment counts within 1 %.
 TEST(TilesGlRenderer, AgreesWithCpuReference) {
-  REQUIRE_GL();
+  CALF_REQUIRE_GL();
   Camera poses[2] = {front_camera(96, 72), front_camera(96, 72)};
   poses[1].position = {0.4, 0.3, 0.2};
   poses[1].forward = {-0.2, -0.1, -1};
@@ -454,8 +446,8 @@ TEST(TilesRepresentation, PlaysASetWithStatistics) {
   EXPECT_EQ(s.entries[3].value, "64 x 32 (0.0 Mtexels)");
   EXPECT_EQ(TilesRepresentation::make(set, 0, 0, {}, RenderBackend::kCpu, nullptr).status().id(),
             ErrorId::kTilesDraw);
-  if (context() == nullptr) return;
-  auto g = TilesRepresentation::make(set, 2, 30, {}, RenderBackend::kGl, &context()->gl());
+  if (gl_context() == nullptr) return;
+  auto g = TilesRepresentation::make(set, 2, 30, {}, RenderBackend::kGl, &gl_context()->gl());
   ASSERT_TRUE(g.ok()) << g.status().message();
   RenderedImage go;
   ASSERT_TRUE((*g)->render(cam, &go).ok());
