@@ -415,13 +415,17 @@ inline double mean_psnr_db(std::span<const uint8_t> a, std::span<const uint8_t> 
 // gbrp, ...). When even CRF 0 stays below the target (an RGB -> YUV conversion caps the PSNR),
 // the result is unavailable and the note gives the best PSNR reached; when the bisection cannot
 // get within the tolerance (x265's PSNR is not exactly monotonic in CRF) the closest CRF is kept
-// and the note says so.
+// and the note says so. `params` are further x265 parameters ("key=value:key=value", e.g.
+// "keyint=1" for intra-only coding), "" for none.
 inline PeerResult x265_colour_matched_in(std::span<const uint8_t> rgb, uint32_t w, uint32_t h,
                                          uint32_t frames, double target_psnr_db,
                                          double tolerance_db, const std::string& pix_fmt,
-                                         const std::string& preset, int decode_runs) {
+                                         const std::string& preset, int decode_runs,
+                                         const std::string& params = "") {
   PeerResult p;
-  p.method = "ffmpeg x265 (" + pix_fmt + ", " + preset + ") at matched PSNR";
+  p.method = "ffmpeg x265 (" + pix_fmt + ", " + preset + (params.empty() ? "" : ", " + params) +
+             ") at matched PSNR";
+  const std::string x265_params = params.empty() ? "log-level=error" : "log-level=error:" + params;
   p.frames = frames;
   const size_t frame_size = size_t{w} * h * 3;
   if (rgb.size() != frame_size * frames || rgb.empty()) {
@@ -452,18 +456,14 @@ inline PeerResult x265_colour_matched_in(std::span<const uint8_t> rgb, uint32_t 
     char crf_text[32];
     std::snprintf(crf_text, sizeof crf_text, "%.2f", crf);
     const internal::ProcessResult enc =
-        internal::run(internal::ffmpeg_args({"-f",           "rawvideo",
-                                             "-pix_fmt",     "rgb24",
-                                             "-s",           internal::size_arg(w, h),
-                                             "-r",           "24",
-                                             "-i",           in.string(),
-                                             "-c:v",         "libx265",
-                                             "-preset",      preset,
-                                             "-crf",         crf_text,
-                                             "-pix_fmt",     pix_fmt,
-                                             "-x265-params", "log-level=error",
-                                             "-f",           "hevc",
-                                             out.string()}),
+        internal::run(internal::ffmpeg_args({"-f",           "rawvideo",  "-pix_fmt",
+                                             "rgb24",        "-s",        internal::size_arg(w, h),
+                                             "-r",           "24",        "-i",
+                                             in.string(),    "-c:v",      "libx265",
+                                             "-preset",      preset,      "-crf",
+                                             crf_text,       "-pix_fmt",  pix_fmt,
+                                             "-x265-params", x265_params, "-f",
+                                             "hevc",         out.string()}),
                       false, err);
     if (enc.exit_code != 0) return "encode: " + enc.error;
     const internal::ProcessResult dec = internal::run(
@@ -552,16 +552,17 @@ inline PeerResult x265_colour_matched(std::span<const uint8_t> rgb, uint32_t w, 
                                       uint32_t frames, double target_psnr_db,
                                       double tolerance_db = 0.25,
                                       const std::string& pix_fmt = "auto",
-                                      const std::string& preset = "medium", int decode_runs = 3) {
+                                      const std::string& preset = "medium", int decode_runs = 3,
+                                      const std::string& params = "") {
   if (pix_fmt != "auto") {
     return x265_colour_matched_in(rgb, w, h, frames, target_psnr_db, tolerance_db, pix_fmt, preset,
-                                  decode_runs);
+                                  decode_runs, params);
   }
   PeerResult yuv = x265_colour_matched_in(rgb, w, h, frames, target_psnr_db, tolerance_db,
-                                          "yuv444p", preset, decode_runs);
+                                          "yuv444p", preset, decode_runs, params);
   if (yuv.available || yuv.note.rfind("even CRF 0", 0) != 0) return yuv;
   PeerResult gbr = x265_colour_matched_in(rgb, w, h, frames, target_psnr_db, tolerance_db, "gbrp",
-                                          preset, decode_runs);
+                                          preset, decode_runs, params);
   gbr.encodes += yuv.encodes;
   gbr.note = "yuv444p " + yuv.note + (gbr.note.empty() ? "" : "; ") + gbr.note;
   return gbr;

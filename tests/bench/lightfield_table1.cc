@@ -22,7 +22,7 @@
 //
 //   bench-lightfield_table1 --capture DIR [--capture DIR ...] [--threads N]
 //       [--depth-format raw16|pred16] [--depth-fixed-groups] [--no-colour-peers] [--no-lzma2]
-//       [--video-peers [--x265-preset P]]
+//       [--video-peers [--x265-preset P] [--x265-params K=V:...]]
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -411,6 +411,9 @@ int main(int argc, char** argv) {
                "calf's decoded colour reaches, xz -9 / zstd -19 of the same frames (default off)");
   app.add_option("--x265-preset", run.peers.x265_preset,
                  "x265 preset of the video peers (default medium)");
+  app.add_option("--x265-params", run.peers.x265_params,
+                 "further x265 parameters of the colour peer, key=value:key=value (default none); "
+                 "keyint=1 makes it intra-only, each frame decodable alone as each calf frame is");
   CLI11_PARSE(app, argc, argv);
   run.depth = depth == "pred16" ? DepthCoding::kRaw16Predicted : DepthCoding::kRaw16;
   run.colour_peers = !no_colour_peers;

@@ -363,6 +363,9 @@ int main(int argc, char** argv) {
   app.add_option("--x265-preset", o.peers.x265_preset,
                  "x265 preset of the ffmpeg peers (default "
                  "medium)");
+  app.add_option("--x265-params", o.peers.x265_params,
+                 "further x265 parameters of the colour peer, key=value:key=value (default none); "
+                 "keyint=1 makes it intra-only, each frame decodable alone as each calf frame is");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {

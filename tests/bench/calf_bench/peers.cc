@@ -323,11 +323,11 @@ Expected<std::vector<PeerRow>> measure_peers(const fs::path& capture_dir, const 
     rows.push_back(colour.zstd);
   }
   if (settings.ffmpeg) {
-    rows.push_back(
-        ffmpeg_row("colour",
-                   x265_colour_matched(g.rgb, g.width, g.height, g.frames, calf_psnr,
-                                       settings.colour_tolerance_db, "auto", settings.x265_preset),
-                   raw_rgb));
+    rows.push_back(ffmpeg_row("colour",
+                              x265_colour_matched(g.rgb, g.width, g.height, g.frames, calf_psnr,
+                                                  settings.colour_tolerance_db, "auto",
+                                                  settings.x265_preset, 3, settings.x265_params),
+                              raw_rgb));
   } else {
     rows.push_back(skipped("colour", "ffmpeg x265 at matched PSNR", "skipped (--no-ffmpeg)"));
   }

@@ -30,6 +30,7 @@ namespace calf::bench {
 struct PeerSettings {
   bool ffmpeg = true;  // false: the ffmpeg rows say "skipped (--no-ffmpeg)"
   std::string x265_preset = "medium";
+  std::string x265_params;           // further x265 parameters of the colour peer, e.g. "keyint=1"
   double colour_tolerance_db = 0.5;  // how close x265's PSNR must come to calf's (dB)
 };
 
