@@ -20,7 +20,7 @@
 // depth, x265 on 8-bit sRGB colour at the PSNR calf's decoded colour reaches against the same
 // frames, and xz -9 / zstd -19 of those frames — Table 1's video-coder columns in the same run.
 //
-//   bench-lightfield_table1 --capture DIR [--capture DIR ...] [--threads N]
+//   bench-lightfield_table1 --capture DIR [--capture DIR ...] [--threads N] [--psnr Q]
 //       [--depth-format raw16|pred16] [--depth-fixed-groups] [--no-colour-peers] [--no-lzma2]
 //       [--video-peers [--x265-preset P] [--x265-params K=V:...]]
 #include <sys/resource.h>
@@ -161,14 +161,8 @@ struct EncodeRun {
   uint64_t file_bytes = 0;
 };
 // The clip is removed afterwards unless `keep`.
-Expected<EncodeRun> encode(const fs::path& capture, const fs::path& out, uint32_t threads,
-                           container::Compression sc, DepthCoding depth, bool merge_static_groups,
-                           bool keep = false) {
-  LightfieldEncodeOptions o;
-  o.threads = threads;
-  o.depth = depth;
-  o.merge_static_groups = merge_static_groups;
-  o.supercompression = sc;
+Expected<EncodeRun> encode(const fs::path& capture, const fs::path& out,
+                           const LightfieldEncodeOptions& o, bool keep = false) {
   EncodeRun r;
   const double t0 = now_s();
   CALF_ASSIGN_OR_RETURN(r.stats, encode_lightfield_file(capture, out.string(), o));
@@ -204,6 +198,7 @@ const char* format_name(uint16_t f) {
 
 struct Run {
   uint32_t threads = 0;
+  double min_psnr_db = LightfieldEncodeOptions{}.min_psnr_db;  // calf-encode's --psnr
   bool have_xz = false, have_zstd = false, colour_peers = true;
   DepthCoding depth = DepthCoding::kRaw16;
   bool fixed_groups = false, lzma2 = true;
@@ -224,22 +219,32 @@ int run_one(const fs::path& dir, const Run& run) {
   fs::create_directories(tmp);
   const fs::path zstd_clip = tmp / "zstd.calf";
   const bool merge = !run.fixed_groups;
-  auto z = encode(dir, zstd_clip, threads, container::Compression::kZstd, run.depth, merge,
+  // The options of one encode: the run's, with this supercompression and depth layout.
+  auto options = [&](container::Compression sc, DepthCoding depth, bool merge_static_groups) {
+    LightfieldEncodeOptions o;
+    o.threads = threads;
+    o.min_psnr_db = run.min_psnr_db;
+    o.depth = depth;
+    o.merge_static_groups = merge_static_groups;
+    o.supercompression = sc;
+    return o;
+  };
+  auto z = encode(dir, zstd_clip, options(container::Compression::kZstd, run.depth, merge),
                   run.video_peers);
   const uint64_t rss_after_zstd = peak_rss_kib(RUSAGE_SELF);
   Status failed = z.status();
   std::optional<EncodeRun> x;
   if (failed.ok() && run.lzma2) {
     auto r =
-        encode(dir, tmp / "lzma2.calf", threads, container::Compression::kLzma2, run.depth, merge);
+        encode(dir, tmp / "lzma2.calf", options(container::Compression::kLzma2, run.depth, merge));
     failed = r.status();
     if (r.ok()) x = *r;
   }
   // The depth bytes of the encoder before issue 17 (raw16, one chunk per K frames).
   std::optional<EncodeRun> before;
   if (failed.ok() && (run.depth != DepthCoding::kRaw16 || merge)) {
-    auto r = encode(dir, tmp / "before.calf", threads, container::Compression::kZstd,
-                    DepthCoding::kRaw16, false);
+    auto r = encode(dir, tmp / "before.calf",
+                    options(container::Compression::kZstd, DepthCoding::kRaw16, false));
     failed = r.status();
     if (r.ok()) before = *r;
   }
@@ -302,9 +307,10 @@ int run_one(const fs::path& dir, const Run& run) {
   const std::string scene = m.scene.empty() ? dir.filename().string() : m.scene;
   fmt::print("### {} — {} views × {} frames, face {}, cell 64, {} input\n\n", scene,
              m.viewpoints.size(), m.frame_count, m.face_size, s.hdr ? "HDR" : "LDR");
-  fmt::print("Capture `{}`; colour {} (raw = {}), depth {} (raw = log-16 u16); threads {}.\n\n",
-             dir.string(), format_name(s.colour_format), s.hdr ? "RGBA16F" : "RGBA8 sRGB",
-             format_name(s.depth_format), threads);
+  fmt::print(
+      "Capture `{}`; colour {} (raw = {}), Q {} dB, depth {} (raw = log-16 u16); threads {}.\n\n",
+      dir.string(), format_name(s.colour_format), s.hdr ? "RGBA16F" : "RGBA8 sRGB", run.min_psnr_db,
+      format_name(s.depth_format), threads);
   fmt::print("| stage | colour bytes | colour ratio | depth bytes | depth ratio |\n");
   fmt::print("|---|---:|---:|---:|---:|\n");
   auto row = [&](const char* name, std::optional<uint64_t> c, std::optional<uint64_t> d) {
@@ -394,6 +400,10 @@ int main(int argc, char** argv) {
   bool no_colour_peers = false;
   app.add_option("--capture", captures, "capture-set directory (repeatable)")->required();
   app.add_option("--threads", run.threads, "encoder threads, 0 = all cores (default 0)");
+  app.add_option("--psnr", run.min_psnr_db,
+                 "Q: calf-encode's --psnr, the dB every interpolated colour frame keeps (default "
+                 "50)")
+      ->check(CLI::Range(1e-3, 200.0));
   app.add_option("--depth-format", depth,
                  "depth coding: raw16, or pred16 (then raw16's zstd bytes are printed beside "
                  "it) (default raw16)")
