@@ -58,4 +58,41 @@ void reconstruct_depth_rect(const uint8_t* hi, const uint8_t* lo, uint32_t w, ui
   }
 }
 
+void predict_depth_rect_masked(const uint16_t* codes, uint32_t w, uint32_t h, size_t stride,
+                               const uint8_t* mask, std::vector<uint16_t>& residuals) {
+  std::vector<uint16_t> all(size_t{w} * h);
+  predict_depth_rect(codes, w, h, stride, all.data());
+  residuals.clear();
+  for (size_t i = 0; i < all.size(); ++i) {
+    if (mask_bit(mask, i)) residuals.push_back(all[i]);
+  }
+}
+
+void reconstruct_depth_rect_masked(const uint8_t* mask, const uint8_t* hi, const uint8_t* lo,
+                                   uint32_t w, uint32_t h, uint8_t* inout) {
+  auto code_at = [inout](size_t i) {
+    return static_cast<uint16_t>(inout[2 * i] | inout[2 * i + 1] << 8);
+  };
+  size_t k = 0;  // residuals used so far
+  for (uint32_t y = 0; y < h; ++y) {
+    const size_t base = size_t{y} * w;
+    for (uint32_t x = 0; x < w; ++x) {
+      const size_t i = base + x;
+      if (!mask_bit(mask, i)) continue;
+      uint16_t pred;
+      if (y == 0) {
+        pred = x > 0 ? code_at(i - 1) : 0;
+      } else if (x == 0) {
+        pred = code_at(i - w);
+      } else {
+        pred = depth_predict_inner(code_at(i - 1), code_at(i - w), code_at(i - w - 1));
+      }
+      const uint16_t code = unzigzag16(static_cast<uint16_t>(hi[k] << 8 | lo[k]), pred);
+      ++k;
+      inout[2 * i] = static_cast<uint8_t>(code);
+      inout[2 * i + 1] = static_cast<uint8_t>(code >> 8);
+    }
+  }
+}
+
 }  // namespace calf::lf
