@@ -142,6 +142,7 @@ struct MaskedExample {
     EXPECT_TRUE(container::write_fields(head, raw).ok());
     std::vector<uint16_t> e(6);
     predict_depth_rect(key.data(), 3, 2, 3, e.data());
+    EXPECT_EQ(e, (std::vector<uint16_t>{200, 4, 8, 2, 0, 3}));
     std::vector<uint16_t> changed;
     const uint8_t mask = 0x32;
     predict_depth_rect_masked(frame1.data(), 3, 2, 3, &mask, changed);
@@ -172,6 +173,10 @@ TEST(DepthPredictMasked, WorkedExampleDecodes) {
   const MaskedExample ex;
   // Head 4 + 2 x 4 + 2 x 8 = 28 bytes, then 1 mask byte and 2 x (6 + 3) plane bytes.
   ASSERT_EQ(ex.raw.size(), 28u + 1 + 18);
+  // The payload as SPEC §11.1.9 prints it.
+  EXPECT_EQ(std::vector<uint8_t>(ex.raw.begin() + 28, ex.raw.end()),
+            (std::vector<uint8_t>{0x32, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0xC8, 0x04, 0x08, 0x02, 0x00,
+                                  0x03, 0x06, 0xD1, 0xD8}));
   auto depth = depth_coding(static_cast<uint16_t>(container::PixelFormat::kR16PredictedMasked));
   ASSERT_TRUE(depth.ok());
   EXPECT_EQ(*depth, RegionCoding::kR16PredictedMasked);
