@@ -320,13 +320,14 @@ void region_rect_gpu_bytes(const RegionChunk& chunk, size_t index, std::vector<u
       reconstruct_depth_rect(&p[r.first_unit], &p[units + r.first_unit], r.w, r.h, out.data());
       return;
     case RegionCoding::kR16PredictedMasked: {
-      const uint8_t* hi = &p[chunk.mask_bytes + r.first_unit];
-      const uint8_t* lo = &p[chunk.mask_bytes + units + r.first_unit];
+      // Pointer arithmetic, not p[...]: a last rectangle with an empty mask starts at the end.
+      const uint8_t* hi = p.data() + chunk.mask_bytes + r.first_unit;
+      const uint8_t* lo = p.data() + chunk.mask_bytes + units + r.first_unit;
       out.resize(size_t{r.w} * r.h * 2);  // a no-op for a P-frame rectangle, which reads `out`
       if (r.mask_offset == RegionRect::kNoMask) {
         reconstruct_depth_rect(hi, lo, r.w, r.h, out.data());
       } else {
-        reconstruct_depth_rect_masked(&p[r.mask_offset], hi, lo, r.w, r.h, out.data());
+        reconstruct_depth_rect_masked(p.data() + r.mask_offset, hi, lo, r.w, r.h, out.data());
       }
       return;
     }
