@@ -72,6 +72,10 @@ struct ClipDecoder::Impl {
   };
   struct TileState {
     int64_t frame = -1;  // the frame the renderer's texels of the tile hold
+    // r16pm depth only: a copy of the codes the renderer holds (row-major, the tile's size), for
+    // the unchanged texels of P-frame rectangles (SPEC §11.1.9); empty until the tile's first
+    // keyframe and for every other coding.
+    std::vector<uint16_t> codes;
   };
   // Indexed [view][face * count + index].
   std::vector<std::vector<CellState>> cell_state;
@@ -300,11 +304,32 @@ Status ClipDecoder::Impl::update_tile(bool depth, uint32_t view, uint32_t face, 
   }
   const UpdateTarget which = depth ? UpdateTarget::kDepth : UpdateTarget::kMaterial;
   const PixelFormat format = lf::region_gpu_format(coding);
+  const bool shadow = depth && coding == lf::RegionCoding::kR16PredictedMasked;
+  if (shadow) s.codes.resize(size_t{r.width} * r.height);
   std::vector<uint8_t> gpu;
   for (uint32_t step : steps) {
     for (uint32_t k = chunk.first_rect[step]; k < chunk.first_rect[step + 1]; ++k) {
       const lf::RegionRect& rr = chunk.rects[k];
+      if (shadow && lf::region_rect_reads_state(chunk, k)) {
+        gpu.resize(size_t{rr.w} * rr.h * 2);
+        for (uint32_t y = 0; y < rr.h; ++y) {
+          for (uint32_t x = 0; x < rr.w; ++x) {
+            const uint16_t c = s.codes[size_t{rr.y + y} * r.width + rr.x + x];
+            gpu[(size_t{y} * rr.w + x) * 2] = static_cast<uint8_t>(c);
+            gpu[(size_t{y} * rr.w + x) * 2 + 1] = static_cast<uint8_t>(c >> 8);
+          }
+        }
+      }
       lf::region_rect_gpu_bytes(chunk, k, gpu);
+      if (shadow) {
+        for (uint32_t y = 0; y < rr.h; ++y) {
+          for (uint32_t x = 0; x < rr.w; ++x) {
+            const size_t i = (size_t{y} * rr.w + x) * 2;
+            s.codes[size_t{rr.y + y} * r.width + rr.x + x] =
+                static_cast<uint16_t>(gpu[i] | gpu[i + 1] << 8);
+          }
+        }
+      }
       emit(out, which, view, face, 0, PixelRect{r.x + rr.x, r.y + rr.y, rr.w, rr.h}, format, gpu);
     }
   }

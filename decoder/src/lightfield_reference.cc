@@ -214,6 +214,17 @@ Status LightfieldReference::decode_face(uint32_t view, uint32_t face, uint32_t f
       const PixelFormat format = lf::region_gpu_format(coding);
       for (uint32_t rect = 0; rect < chunk.first_rect[frame - keys.first_frame + 1]; ++rect) {
         const lf::RegionRect& rr = chunk.rects[rect];
+        if (lf::region_rect_reads_state(chunk, rect)) {
+          // r16pm: the rectangle's unchanged texels are the tile state, here the frame before.
+          gpu.resize(size_t{rr.w} * rr.h * 2);
+          for (uint32_t y = 0; y < rr.h; ++y) {
+            for (uint32_t x = 0; x < rr.w; ++x) {
+              const uint16_t c = out->depth[(size_t{r.y} + rr.y + y) * n + r.x + rr.x + x];
+              gpu[(size_t{y} * rr.w + x) * 2] = static_cast<uint8_t>(c);
+              gpu[(size_t{y} * rr.w + x) * 2 + 1] = static_cast<uint8_t>(c >> 8);
+            }
+          }
+        }
         lf::region_rect_gpu_bytes(chunk, rect, gpu);
         const size_t texels = size_t{rr.w} * rr.h;
         if (depth) {

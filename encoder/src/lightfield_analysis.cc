@@ -186,9 +186,11 @@ Expected<LightfieldAnalysis> plan_lightfield(const capture::CaptureManifest& m,
       break;
   }
   const bool lossy_depth = options.depth == DepthCoding::kBc5;
-  h.depth_format = pf(lossy_depth                                     ? PixelFormat::kBc5
-                      : options.depth == DepthCoding::kRaw16Predicted ? PixelFormat::kR16Predicted
-                                                                      : PixelFormat::kR16);
+  h.depth_format =
+      pf(lossy_depth                                           ? PixelFormat::kBc5
+         : options.depth == DepthCoding::kRaw16Predicted       ? PixelFormat::kR16Predicted
+         : options.depth == DepthCoding::kRaw16PredictedMasked ? PixelFormat::kR16PredictedMasked
+                                                               : PixelFormat::kR16);
   // Material is coded like depth: raw bytes beside raw depth, BC1 beside BC5.
   const bool material =
       std::any_of(views.begin(), views.end(), [](const auto& v) { return v.has_material; });

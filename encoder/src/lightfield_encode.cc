@@ -411,8 +411,10 @@ ChangeMask material_change_mask(const TileFrames& t, uint32_t first, uint32_t cu
   return mask;
 }
 
-// kRawPredicted: depth only, raw codes replaced by their prediction residuals per rectangle.
-enum class RegionCoding : uint8_t { kRaw, kRawPredicted, kBc5, kBc1 };
+// kRawPredicted: depth only, raw codes replaced by their prediction residuals per rectangle;
+// kRawPredictedMasked: the same, but a P-frame rectangle keeps only its changed texels' residuals
+// behind a change mask (SPEC §11.1.9).
+enum class RegionCoding : uint8_t { kRaw, kRawPredicted, kRawPredictedMasked, kBc5, kBc1 };
 
 // Codes frames [first, first + count) of a tile into one chunk (SPEC §11.1 "Region chunk").
 // `decoded` is the decoder's tile state (bytes_per_texel == 2 only), for the BC5 error report.
@@ -441,9 +443,12 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
   }
   AabbOptions ao;
   ao.max_boxes = o.max_aabbs;
-  const bool raw_texels = coding == RegionCoding::kRaw || coding == RegionCoding::kRawPredicted;
+  const bool masked = coding == RegionCoding::kRawPredictedMasked;
+  const bool raw_texels =
+      coding == RegionCoding::kRaw || coding == RegionCoding::kRawPredicted || masked;
   ao.alignment = raw_texels ? 1 : 4;
   rects[0].push_back({0, 0, t.width, t.height});
+  std::vector<ChangeMask> masks(masked ? count : 0);
   for (uint32_t f = 1; f < count; ++f) {
     ChangeMask mask;
     if (is_depth) {
@@ -454,6 +459,7 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
       mask = material_change_mask(t, first, first + f, o.depth_window);
     }
     CALF_ASSIGN_OR_RETURN(rects[f], fit_change_boxes(mask, ao));
+    if (masked) masks[f] = std::move(mask);
   }
   raw.clear();
   lf::RegionHead head;
@@ -470,7 +476,8 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
   CALF_RETURN_IF_ERROR(container::write_fields(head, raw, "region chunk"));
   const size_t header = raw.size();
   uint64_t covered = 0;
-  std::vector<uint8_t> texels, blocks, rect_bytes, decoded_rect;
+  std::vector<uint8_t> texels, blocks, rect_bytes, decoded_rect, mask_bytes;
+
   std::vector<uint16_t> rect_codes, residuals;
   for (uint32_t f = 0; f < count; ++f) {
     if (f == 0) {
@@ -490,13 +497,31 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
         texels.insert(texels.end(), rect_bytes.begin(), rect_bytes.end());
         continue;
       }
-      if (coding == RegionCoding::kRawPredicted) {
-        const size_t n = size_t{r.width} * r.height;
+      if (coding == RegionCoding::kRawPredicted || masked) {
+        const size_t n = size_t{r.width} * r.height, texels_before = texels.size();
         rect_codes.resize(n);
         residuals.resize(n);
         for (size_t i = 0; i < n; ++i)
           rect_codes[i] = static_cast<uint16_t>(rect_bytes[2 * i] << 8 | rect_bytes[2 * i + 1]);
         lf::predict_depth_rect(rect_codes.data(), r.width, r.height, r.width, residuals.data());
+        if (masked && f > 0) {
+          // §11.1.9: the rectangle's change mask (its own bytes, bit i = texel i, LSB first),
+          // and only the changed texels' residuals. A texel outside the change mask equals its
+          // code in every frame of the window, so any decoder there already holds it.
+          const size_t at = mask_bytes.size();
+          mask_bytes.resize(at + lf::mask_bytes_of(r.width, r.height), 0);
+          size_t i = 0;
+          for (uint32_t y = 0; y < r.height; ++y) {
+            for (uint32_t x = 0; x < r.width; ++x, ++i) {
+              if (!masks[f].at(r.x + x, r.y + y)) continue;
+              mask_bytes[at + i / 8] |= static_cast<uint8_t>(1u << (i % 8));
+              texels.push_back(static_cast<uint8_t>(residuals[i] >> 8));
+              texels.push_back(static_cast<uint8_t>(residuals[i]));
+            }
+          }
+          covered -= n - (texels.size() - texels_before) / 2;
+          continue;
+        }
         for (uint16_t e : residuals) {
           texels.push_back(static_cast<uint8_t>(e >> 8));
           texels.push_back(static_cast<uint8_t>(e));
@@ -546,13 +571,16 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
     }
   }
   if (raw_texels) {
+    // r16pm: every mask of the chunk before the planes (measured: a little smaller under zstd
+    // than after them, or one byte per texel, or one bit string across rectangles).
+    raw.insert(raw.end(), mask_bytes.begin(), mask_bytes.end());
     lf::append_planes(raw, texels, t.bytes_per_texel);
   } else {
     lf::append_block_split(raw, blocks, coding == RegionCoding::kBc5 ? 16 : 8,
                            coding == RegionCoding::kBc5);
   }
   bytes.raw += static_cast<uint64_t>(count) * t.width * t.height * t.bytes_per_texel;
-  bytes.temporal += header + covered * t.bytes_per_texel;
+  bytes.temporal += header + mask_bytes.size() + covered * t.bytes_per_texel;
   (void)bytes;
   return Status::Ok();
 }
@@ -609,10 +637,12 @@ void region_task(const Context& ctx, uint32_t face, uint32_t tile, bool is_depth
   }
   const bool lossy = ctx.options->depth == DepthCoding::kBc5;
   const bool predicted = is_depth && ctx.options->depth == DepthCoding::kRaw16Predicted;
-  const RegionCoding coding = predicted  ? RegionCoding::kRawPredicted
-                              : !lossy   ? RegionCoding::kRaw
-                              : is_depth ? RegionCoding::kBc5
-                                         : RegionCoding::kBc1;
+  const bool masked = is_depth && ctx.options->depth == DepthCoding::kRaw16PredictedMasked;
+  const RegionCoding coding = masked      ? RegionCoding::kRawPredictedMasked
+                              : predicted ? RegionCoding::kRawPredicted
+                              : !lossy    ? RegionCoding::kRaw
+                              : is_depth  ? RegionCoding::kBc5
+                                          : RegionCoding::kBc1;
   std::vector<uint16_t> decoded;
   if (is_depth && lossy) decoded.assign(static_cast<size_t>(r.width) * r.height, 0);
   StreamBytes& bytes = is_depth ? out.stats.depth : out.stats.material;

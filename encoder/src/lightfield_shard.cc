@@ -106,7 +106,7 @@ Status parse_record(const std::string& path, const std::string& text, Lightfield
   if (!field("colour", static_cast<uint64_t>(ColourCoding::kRgba16f)))
     return bad_record(path, "colour");
   o->colour = static_cast<ColourCoding>(x);
-  if (!field("depth", static_cast<uint64_t>(DepthCoding::kRaw16Predicted)))
+  if (!field("depth", static_cast<uint64_t>(DepthCoding::kRaw16PredictedMasked)))
     return bad_record(path, "depth");
   o->depth = static_cast<DepthCoding>(x);
   if (!field("tiles", 64)) return bad_record(path, "tiles");

@@ -269,9 +269,11 @@ int main(int argc, char** argv) {
          "--depth-format", depth,
          "raw16 (exact after log-16 quantisation; material raw), pred16 (the same codes, "
          "lossless, as spatial-prediction residuals: format r16p, smaller; a reader of format "
-         "1.0 without r16p refuses it) or bc5 (hi/lo bytes, lossy; material BC1; the error is "
+         "1.0 without r16p refuses it), pred16m (as pred16, but P-frame rectangles store only "
+         "their changed texels behind a change mask: format r16pm, smaller still; a reader "
+         "without r16pm refuses it) or bc5 (hi/lo bytes, lossy; material BC1; the error is "
          "printed) (default raw16)")
-      ->check(CLI::IsMember({"raw16", "pred16", "bc5"}))
+      ->check(CLI::IsMember({"raw16", "pred16", "pred16m", "bc5"}))
       ->default_val("raw16");
   app.add_option(
          "--depth-window", o.depth_window,
@@ -564,9 +566,10 @@ int main(int argc, char** argv) {
       {"bc7", calf::ColourCoding::kBc7},     {"bc6h", calf::ColourCoding::kBc6h},
       {"rgba8", calf::ColourCoding::kRgba8}, {"rgba16f", calf::ColourCoding::kRgba16f}};
   o.colour = colours.at(colour);
-  o.depth = depth == "bc5"      ? calf::DepthCoding::kBc5
-            : depth == "pred16" ? calf::DepthCoding::kRaw16Predicted
-                                : calf::DepthCoding::kRaw16;
+  o.depth = depth == "bc5"       ? calf::DepthCoding::kBc5
+            : depth == "pred16"  ? calf::DepthCoding::kRaw16Predicted
+            : depth == "pred16m" ? calf::DepthCoding::kRaw16PredictedMasked
+                                 : calf::DepthCoding::kRaw16;
   o.merge_static_groups = !fixed_groups;
   o.supercompression = super == "lzma2"  ? calf::container::Compression::kLzma2
                        : super == "none" ? calf::container::Compression::kNone

@@ -1,6 +1,7 @@
 #include "calf/format/lightfield_layout.h"
 
 #include <algorithm>
+#include <bit>
 
 #include "calf/format/bc.h"
 #include "calf/format/depth_predict.h"
@@ -169,6 +170,7 @@ Expected<CellTimeline> parse_t_chunk(std::span<const uint8_t> raw, uint32_t fram
 Expected<RegionCoding> depth_coding(uint16_t depth_format) {
   if (is(depth_format, PixelFormat::kR16)) return RegionCoding::kR16;
   if (is(depth_format, PixelFormat::kR16Predicted)) return RegionCoding::kR16Predicted;
+  if (is(depth_format, PixelFormat::kR16PredictedMasked)) return RegionCoding::kR16PredictedMasked;
   if (is(depth_format, PixelFormat::kBc5)) return RegionCoding::kBc5;
   return Status(ErrorId::kLightfieldFormat, "depth format " + std::to_string(depth_format) + " (" +
                                                 container::pixel_format_name(depth_format) + ")");
@@ -190,6 +192,7 @@ container::PixelFormat region_gpu_format(RegionCoding coding) {
   switch (coding) {
     case RegionCoding::kR16:
     case RegionCoding::kR16Predicted:
+    case RegionCoding::kR16PredictedMasked:
       return PixelFormat::kR16;
     case RegionCoding::kBc5:
       return PixelFormat::kBc5;
@@ -206,6 +209,7 @@ size_t unit_bytes(RegionCoding coding) {
   switch (coding) {
     case RegionCoding::kR16:
     case RegionCoding::kR16Predicted:
+    case RegionCoding::kR16PredictedMasked:
       return 2;
     case RegionCoding::kBc5:
       return 16;
@@ -263,7 +267,32 @@ Expected<RegionChunk> parse_region_chunk(std::span<const uint8_t> raw, uint32_t 
     return corrupt(what + ": the first frame is not one whole-tile rectangle");
   }
   chunk.payload = reader.rest();
-  const uint64_t expected = chunk.units * unit_bytes(coding);
+  if (coding == RegionCoding::kR16PredictedMasked) {
+    // §11.1.9: the masks of every P-frame rectangle, then the two planes of the keyframe's texels
+    // and every set mask bit's texel.
+    for (size_t k = 1; k < chunk.rects.size(); ++k) {
+      chunk.rects[k].mask_offset = chunk.mask_bytes;
+      chunk.mask_bytes += mask_bytes_of(chunk.rects[k].w, chunk.rects[k].h);
+    }
+    if (chunk.payload.size() < chunk.mask_bytes) {
+      return corrupt(what + ": payload of " + std::to_string(chunk.payload.size()) +
+                     " bytes, shorter than its " + std::to_string(chunk.mask_bytes) +
+                     " bytes of change masks");
+    }
+    chunk.units = uint64_t{tile_width} * tile_height;
+    for (size_t k = 1; k < chunk.rects.size(); ++k) {
+      RegionRect& r = chunk.rects[k];
+      r.first_unit = chunk.units;
+      const uint8_t* m = &chunk.payload[r.mask_offset];
+      const uint64_t bits = uint64_t{r.w} * r.h, bytes = mask_bytes_of(r.w, r.h);
+      for (uint64_t b = 0; b < bytes; ++b) chunk.units += std::popcount(m[b]);
+      if (bits % 8 != 0 && (m[bytes - 1] >> (bits % 8)) != 0) {
+        return corrupt(what + ": change mask of rectangle " + std::to_string(k) +
+                       " has bits set past its " + std::to_string(bits) + " texels");
+      }
+    }
+  }
+  const uint64_t expected = chunk.mask_bytes + chunk.units * unit_bytes(coding);
   if (chunk.payload.size() != expected) {
     return corrupt(what + ": payload of " + std::to_string(chunk.payload.size()) +
                    " bytes, expected " + std::to_string(expected));
@@ -290,6 +319,18 @@ void region_rect_gpu_bytes(const RegionChunk& chunk, size_t index, std::vector<u
       out.resize(size_t{r.w} * r.h * 2);
       reconstruct_depth_rect(&p[r.first_unit], &p[units + r.first_unit], r.w, r.h, out.data());
       return;
+    case RegionCoding::kR16PredictedMasked: {
+      // Pointer arithmetic, not p[...]: a last rectangle with an empty mask starts at the end.
+      const uint8_t* hi = p.data() + chunk.mask_bytes + r.first_unit;
+      const uint8_t* lo = p.data() + chunk.mask_bytes + units + r.first_unit;
+      out.resize(size_t{r.w} * r.h * 2);  // a no-op for a P-frame rectangle, which reads `out`
+      if (r.mask_offset == RegionRect::kNoMask) {
+        reconstruct_depth_rect(hi, lo, r.w, r.h, out.data());
+      } else {
+        reconstruct_depth_rect_masked(p.data() + r.mask_offset, hi, lo, r.w, r.h, out.data());
+      }
+      return;
+    }
     case RegionCoding::kRgb8: {
       const size_t n = size_t{r.w} * r.h;
       out.resize(n * 4);

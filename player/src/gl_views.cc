@@ -119,10 +119,12 @@ Expected<GlTextureLayout> layout_for_clip(const container::LightfieldTrackHeader
   layout.colour_format = static_cast<PixelFormat>(header.colour_format);
   const auto depth = static_cast<PixelFormat>(header.depth_format);
   layout.depth_format = depth == PixelFormat::kBc5 && keep_bc5_depth ? depth : PixelFormat::kR16;
-  // r16p (predicted) decodes to the same r16 codes on the CPU: the textures never see it.
+  // r16p and r16pm (predicted) decode to the same r16 codes on the CPU: the textures never see
+  // them (the ClipDecoder fills an r16pm rectangle's unchanged texels from its own tile state).
   if (depth != PixelFormat::kR16 && depth != PixelFormat::kR16Predicted &&
-      depth != PixelFormat::kBc5) {
-    return Status(kGlLayout, "depth format " + format_name(depth) + " is not r16, r16p or BC5");
+      depth != PixelFormat::kR16PredictedMasked && depth != PixelFormat::kBc5) {
+    return Status(kGlLayout,
+                  "depth format " + format_name(depth) + " is not r16, r16p, r16pm or BC5");
   }
   const auto material = static_cast<PixelFormat>(header.material_format);
   if (material != PixelFormat::kNone) layout.material_format = material;

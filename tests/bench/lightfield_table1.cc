@@ -6,7 +6,8 @@
 // of the raw log-16 depth stream (per-view z_near / z_far from the data, as the encoder quantises).
 // Also encode seconds and peak RSS (getrusage). Prints markdown.
 //
-// With --depth-format pred16 the depth column is the predicted coding (format r16p). Unless the
+// With --depth-format pred16 (pred16m) the depth column is the predicted coding (format r16p,
+// r16pm). Unless the
 // run is the encoder before issue 17 itself (raw16 and --depth-fixed-groups), one more zstd encode
 // with raw16 depth and one chunk per K frames gives those depth bytes beside it, "today's" of the
 // issue. --no-colour-peers skips the colour peers (most of the run's time on noisy colour) when
@@ -21,8 +22,8 @@
 // frames, and xz -9 / zstd -19 of those frames — Table 1's video-coder columns in the same run.
 //
 //   bench-lightfield_table1 --capture DIR [--capture DIR ...] [--threads N] [--psnr Q]
-//       [--depth-format raw16|pred16] [--depth-fixed-groups] [--no-colour-peers] [--no-lzma2]
-//       [--video-peers [--x265-preset P] [--x265-params K=V:...]]
+//       [--depth-format raw16|pred16|pred16m] [--depth-fixed-groups] [--no-colour-peers]
+//       [--no-lzma2] [--video-peers [--x265-preset P] [--x265-params K=V:...]]
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -191,6 +192,8 @@ const char* format_name(uint16_t f) {
       return "raw16";
     case PixelFormat::kR16Predicted:
       return "pred16 (r16p)";
+    case PixelFormat::kR16PredictedMasked:
+      return "pred16m (r16pm)";
     default:
       return "?";
   }
@@ -405,9 +408,9 @@ int main(int argc, char** argv) {
                  "50)")
       ->check(CLI::Range(1e-3, 200.0));
   app.add_option("--depth-format", depth,
-                 "depth coding: raw16, or pred16 (then raw16's zstd bytes are printed beside "
-                 "it) (default raw16)")
-      ->check(CLI::IsMember({"raw16", "pred16"}));
+                 "depth coding: raw16, or pred16 / pred16m (then raw16's zstd bytes are printed "
+                 "beside it) (default raw16)")
+      ->check(CLI::IsMember({"raw16", "pred16", "pred16m"}));
   app.add_flag("--depth-fixed-groups", run.fixed_groups,
                "one depth chunk per K frames even where a tile does not change (calf-encode's "
                "option; default off)");
@@ -425,7 +428,9 @@ int main(int argc, char** argv) {
                  "further x265 parameters of the colour peer, key=value:key=value (default none); "
                  "keyint=1 makes it intra-only, each frame decodable alone as each calf frame is");
   CLI11_PARSE(app, argc, argv);
-  run.depth = depth == "pred16" ? DepthCoding::kRaw16Predicted : DepthCoding::kRaw16;
+  run.depth = depth == "pred16"    ? DepthCoding::kRaw16Predicted
+              : depth == "pred16m" ? DepthCoding::kRaw16PredictedMasked
+                                   : DepthCoding::kRaw16;
   run.colour_peers = !no_colour_peers;
   run.lzma2 = !no_lzma2;
   run.have_xz = have_tool("xz");

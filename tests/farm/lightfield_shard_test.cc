@@ -127,9 +127,9 @@ INSTANTIATE_TEST_SUITE_P(EveryBuiltInScene, LightfieldShardScenes,
                          ::testing::ValuesIn(builtin_scene_names()), test_name);
 
 // Frame-range shards with closed segments of 2 frames against one encode with the same segments;
-// views x frame ranges in every combination of 2 x 2. Depth groups are 1 frame, so static tiles
-// merge two groups inside a segment (SPEC §11.1.2) but never across one: shards that end at a
-// segment boundary would otherwise code them apart.
+// views x frame ranges in every combination of 2 x 2, with depth format r16pm. Depth groups are 1
+// frame, so static tiles merge two groups inside a segment (SPEC §11.1.2) but never across one:
+// shards that end at a segment boundary would otherwise code them apart.
 TEST(LightfieldShardFrames, FrameRangeShardsEqualSegmentedEncode) {
   const fs::path dir = capture_of("mirror-box", 4, "frames");
   ASSERT_TRUE(fs::exists(dir / capture::kManifestFileName));
@@ -139,6 +139,9 @@ TEST(LightfieldShardFrames, FrameRangeShardsEqualSegmentedEncode) {
   o.threads = 2;
   o.segment_frames = 2;
   o.depth_keyframe_interval = 1;
+  // Masked predicted depth (r16pm, the last DepthCoding): the analysis file records it and the
+  // shards code its chunks as one encode does (view shards of raw16 above).
+  o.depth = DepthCoding::kRaw16PredictedMasked;
   const std::string one = (work / "one.calf").string();
   auto stats = encode_lightfield_file(dir, one, o);
   ASSERT_TRUE(stats.ok()) << stats.status().to_string();
@@ -162,6 +165,7 @@ TEST(LightfieldShardFrames, FrameRangeShardsEqualSegmentedEncode) {
   auto a = read_lightfield_analysis((work / "a.calf").string());
   ASSERT_TRUE(a.ok()) << a.status().to_string();
   EXPECT_EQ(a->options.segment_frames, 2u);
+  EXPECT_EQ(a->options.depth, DepthCoding::kRaw16PredictedMasked);
   const auto groups = split(a->analysis.header.view_count, 2);
   std::vector<std::string> shards;
   for (uint32_t g = 0; g < 2; ++g) {

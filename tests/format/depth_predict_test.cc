@@ -1,6 +1,8 @@
 // Depth format r16p (format/SPEC.md §11.1.8): the residuals of hand-computed examples, the
 // region chunk's predicted payload decoded back to codes, and the inverse exact on any codes —
-// random, sky beside finite depth, extremes, every rectangle shape down to one texel.
+// random, sky beside finite depth, extremes, every rectangle shape down to one texel. Depth
+// format r16pm (§11.1.9): its worked example, the masked inverse under any mask and tile state,
+// and malformed masks and payloads (CALF-E202).
 #include "calf/format/depth_predict.h"
 
 #include <gtest/gtest.h>
@@ -120,6 +122,154 @@ TEST(DepthPredict, RegionChunkPayloadDecodesToCodes) {
   // A payload one texel short is E202, as for r16.
   raw.pop_back();
   EXPECT_EQ(parse_region_chunk(raw, 2, 8, 4, *depth, "t").status().id(), ErrorId::kLightfieldChunk);
+}
+
+// Depth format r16pm (SPEC §11.1.9), the specification's worked example: a 3 x 2 tile, frame 0
+// the keyframe 100 102 106 / 101 103 105 (r16p of the whole tile), frame 1 one rectangle, the
+// whole tile, whose texels 1, 4 and 5 changed. Frame 1's codes are 100 103 106 / 101 65535 107; the
+// unchanged texels 0, 2, 3 (100, 106, 101) are the decoder's tile state. Mask: bits 1, 4, 5 = 0x32.
+// Residuals, by hand: texel 1 from its left 100: +3 -> 6; texel 4 the plane 101 + 103 - 100 = 104,
+// 65535 - 104 = -105 -> 209; texel 5 has sky on its left: the median of a = 65535, b = 106, c = 103
+// (c <= min) is max = 65535, and 107 - 65535 = 108 (mod 65536) -> 216.
+struct MaskedExample {
+  std::vector<uint16_t> key = {100, 102, 106, 101, 103, 105};
+  std::vector<uint16_t> frame1 = {100, 103, 106, 101, 65535, 107};
+  std::vector<uint8_t> raw;
+  MaskedExample() {
+    RegionHead head;
+    head.rect_counts = {1, 1};
+    head.rects = {{0, 0, 3, 2, 0}, {0, 0, 3, 2, 0}};
+    EXPECT_TRUE(container::write_fields(head, raw).ok());
+    std::vector<uint16_t> e(6);
+    predict_depth_rect(key.data(), 3, 2, 3, e.data());
+    EXPECT_EQ(e, (std::vector<uint16_t>{200, 4, 8, 2, 0, 3}));
+    std::vector<uint16_t> changed;
+    const uint8_t mask = 0x32;
+    predict_depth_rect_masked(frame1.data(), 3, 2, 3, &mask, changed);
+    EXPECT_EQ(changed, (std::vector<uint16_t>{6, 209, 216}));
+    e.insert(e.end(), changed.begin(), changed.end());
+    raw.push_back(mask);
+    for (uint16_t v : e) raw.push_back(static_cast<uint8_t>(v >> 8));
+    for (uint16_t v : e) raw.push_back(static_cast<uint8_t>(v));
+  }
+};
+
+std::vector<uint16_t> codes_of(const std::vector<uint8_t>& gpu) {
+  std::vector<uint16_t> c(gpu.size() / 2);
+  for (size_t i = 0; i < c.size(); ++i)
+    c[i] = static_cast<uint16_t>(gpu[2 * i] | gpu[2 * i + 1] << 8);
+  return c;
+}
+std::vector<uint8_t> gpu_of(const std::vector<uint16_t>& codes) {
+  std::vector<uint8_t> g;
+  for (uint16_t c : codes) {
+    g.push_back(static_cast<uint8_t>(c));
+    g.push_back(static_cast<uint8_t>(c >> 8));
+  }
+  return g;
+}
+
+TEST(DepthPredictMasked, WorkedExampleDecodes) {
+  const MaskedExample ex;
+  // Head 4 + 2 x 4 + 2 x 8 = 28 bytes, then 1 mask byte and 2 x (6 + 3) plane bytes.
+  ASSERT_EQ(ex.raw.size(), 28u + 1 + 18);
+  // The payload as SPEC §11.1.9 prints it.
+  EXPECT_EQ(std::vector<uint8_t>(ex.raw.begin() + 28, ex.raw.end()),
+            (std::vector<uint8_t>{0x32, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0xC8, 0x04, 0x08, 0x02, 0x00,
+                                  0x03, 0x06, 0xD1, 0xD8}));
+  auto depth = depth_coding(static_cast<uint16_t>(container::PixelFormat::kR16PredictedMasked));
+  ASSERT_TRUE(depth.ok());
+  EXPECT_EQ(*depth, RegionCoding::kR16PredictedMasked);
+  EXPECT_EQ(region_gpu_format(*depth), container::PixelFormat::kR16);
+  auto c = parse_region_chunk(ex.raw, 2, 3, 2, *depth, "tile");
+  ASSERT_TRUE(c.ok()) << c.status().to_string();
+  EXPECT_EQ(c->mask_bytes, 1u);
+  EXPECT_EQ(c->units, 9u);
+  EXPECT_FALSE(region_rect_reads_state(*c, 0));
+  ASSERT_TRUE(region_rect_reads_state(*c, 1));
+  std::vector<uint8_t> out;
+  region_rect_gpu_bytes(*c, 0, out);
+  EXPECT_EQ(codes_of(out), ex.key);
+  // From the keyframe's state (frame 0), and from a state whose changed texels hold anything
+  // (a decoder that came from another frame of the window): the same frame 1, because the
+  // changed texels are predicted from frame-1 values only and the unchanged ones are kept.
+  for (const std::vector<uint16_t>& state :
+       {ex.key, std::vector<uint16_t>{100, 7, 106, 101, 65535, 0}}) {
+    out = gpu_of(state);
+    region_rect_gpu_bytes(*c, 1, out);
+    EXPECT_EQ(codes_of(out), ex.frame1);
+  }
+  // A state whose unchanged texels differ from frame 1 breaks the stream's premise: those
+  // texels stay, and the changed texels predicted from them come out different.
+  std::vector<uint16_t> wrong = ex.key;
+  wrong[0] = 50;  // texel 0: texel 1 is predicted from it
+  out = gpu_of(wrong);
+  region_rect_gpu_bytes(*c, 1, out);
+  EXPECT_NE(codes_of(out), ex.frame1);
+}
+
+TEST(DepthPredictMasked, InverseIsExactUnderAnyMask) {
+  std::mt19937 rng(11);
+  for (uint32_t w : {1u, 3u, 8u, 13u}) {
+    for (uint32_t h : {1u, 2u, 9u}) {
+      const size_t n = size_t{w} * h;
+      std::vector<uint16_t> codes(n), state(n);
+      std::vector<uint8_t> mask(mask_bytes_of(w, h), 0);
+      for (size_t i = 0; i < n; ++i) {
+        codes[i] = rng() % 5 == 0 ? 65535 : static_cast<uint16_t>(30000 + 9 * (i % w) + rng() % 4);
+        const bool changed = rng() % 3 != 0;
+        if (changed) mask[i / 8] |= static_cast<uint8_t>(1u << (i % 8));
+        state[i] = changed ? static_cast<uint16_t>(rng()) : codes[i];
+      }
+      std::vector<uint16_t> e;
+      predict_depth_rect_masked(codes.data(), w, h, w, mask.data(), e);
+      std::vector<uint8_t> hi, lo;
+      for (uint16_t v : e) {
+        hi.push_back(static_cast<uint8_t>(v >> 8));
+        lo.push_back(static_cast<uint8_t>(v));
+      }
+      std::vector<uint8_t> out = gpu_of(state);
+      reconstruct_depth_rect_masked(mask.data(), hi.data(), lo.data(), w, h, out.data());
+      EXPECT_EQ(codes_of(out), codes) << w << "x" << h;
+    }
+  }
+}
+
+TEST(DepthPredictMasked, MalformedPayloadsAreE202) {
+  const MaskedExample ex;
+  auto depth = depth_coding(static_cast<uint16_t>(container::PixelFormat::kR16PredictedMasked));
+  ASSERT_TRUE(depth.ok());
+  auto id = [&](const std::vector<uint8_t>& raw) {
+    return parse_region_chunk(raw, 2, 3, 2, *depth, "t").status().id();
+  };
+  ASSERT_EQ(id(ex.raw), ErrorId::kOk);
+  const size_t mask_at = 28;
+  std::vector<uint8_t> b = ex.raw;
+  b[mask_at] |= 0x40;  // bit 6: past the rectangle's 6 texels
+  EXPECT_EQ(id(b), ErrorId::kLightfieldChunk);
+  b = ex.raw;
+  b[mask_at] |= 0x01;  // one more changed texel, no residual for it
+  EXPECT_EQ(id(b), ErrorId::kLightfieldChunk);
+  b = ex.raw;
+  b[mask_at] = 0x02;  // fewer changed texels than residuals
+  EXPECT_EQ(id(b), ErrorId::kLightfieldChunk);
+  b = ex.raw;
+  b.pop_back();
+  EXPECT_EQ(id(b), ErrorId::kLightfieldChunk);
+  b.assign(ex.raw.begin(), ex.raw.begin() + mask_at);  // no room even for the mask
+  EXPECT_EQ(id(b), ErrorId::kLightfieldChunk);
+  // An empty mask is valid: the rectangle stores nothing and changes nothing.
+  b = ex.raw;
+  b[mask_at] = 0;
+  b.erase(b.begin() + mask_at + 1 + 6, b.begin() + mask_at + 1 + 9);  // hi plane's 3
+  b.resize(b.size() - 3);                                             // lo plane's 3
+  auto c = parse_region_chunk(b, 2, 3, 2, *depth, "t");
+  ASSERT_TRUE(c.ok()) << c.status().to_string();
+  std::vector<uint8_t> out = gpu_of(ex.key);
+  region_rect_gpu_bytes(*c, 1, out);
+  EXPECT_EQ(codes_of(out), ex.key);
+  // The 1.0 pixel formats stay as they were: a depth format past r16pm is E203.
+  EXPECT_EQ(depth_coding(12).status().id(), ErrorId::kLightfieldFormat);
 }
 
 }  // namespace

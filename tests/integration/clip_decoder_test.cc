@@ -37,6 +37,9 @@ namespace fs = std::filesystem;
 struct ClipSpec {
   uint32_t face = 16, frames = 12, views = 2, seed = 1;
   bool material = false, hdr = false;
+  // A second, 2 x 2 square on face 0 moving down its right edge: with one rectangle per P-frame
+  // the rectangle spans both squares and the static texels between them.
+  bool second_square = false;
   LightfieldEncodeOptions options;
 };
 
@@ -65,6 +68,10 @@ capture::ViewFrame make_frame(const ClipSpec& s, uint32_t view, uint32_t frame) 
           r = 0.9f;
           g = 0.1f + 0.05f * (frame % 3);
           z = 1.0f + 0.02f * frame;
+        }
+        if (s.second_square && face == 0 && x + 3 >= s.face && x + 1 < s.face &&
+            (y + s.face - (2 * frame) % s.face) % s.face < 2) {
+          z = 1.5f;
         }
         if (face == 2) {
           r *= 1.0f - 0.04f * static_cast<float>(frame);
@@ -413,9 +420,13 @@ TEST(ClipDecoder, UpdatesDoNotDependOnCullingPathThreadOrCache) {
 // with predicted depth (r16p) too, whose rectangles decode on their own.
 class DepthSeek : public ::testing::TestWithParam<DepthCoding> {};
 INSTANTIATE_TEST_SUITE_P(Codings, DepthSeek,
-                         ::testing::Values(DepthCoding::kRaw16, DepthCoding::kRaw16Predicted),
+                         ::testing::Values(DepthCoding::kRaw16, DepthCoding::kRaw16Predicted,
+                                           DepthCoding::kRaw16PredictedMasked),
                          [](const auto& p) {
-                           return std::string(p.param == DepthCoding::kRaw16 ? "raw16" : "pred16");
+                           return std::string(p.param == DepthCoding::kRaw16 ? "raw16"
+                                              : p.param == DepthCoding::kRaw16Predicted
+                                                  ? "pred16"
+                                                  : "pred16m");
                          });
 TEST_P(DepthSeek, StepsThroughTheWindow) {
   ClipSpec spec;
@@ -513,6 +524,75 @@ TEST(ClipDecoder, PredictedDepthDecodesToRaw16Codes) {
     }
   }
   EXPECT_LT(depth_pred, depth_raw);
+}
+
+// Depth format r16pm (SPEC §11.1.9) is lossless from any frame a decoder may hold: every code of
+// the reference decoder equals raw16's at every frame, and the view-dependent decoder that holds
+// frame j and is asked for frame n (every j < n of a chunk: skipping up to W - 1 frames inside
+// the window, or more through the W steps of a seek) builds exactly raw16's tile state. A mask
+// taken against frame n - 1 alone, or unchanged texels read from anything but the tile state,
+// would fail the jumps over skipped frames. The P-frames really skip texels.
+TEST(ClipDecoder, MaskedDepthDecodesToRaw16CodesFromAnyFrameOfTheWindow) {
+  ClipSpec spec;
+  spec.seed = 53;
+  spec.views = 1;
+  spec.frames = 9;
+  spec.material = true;
+  spec.options.cell_size = 8;
+  spec.options.depth_keyframe_interval = 6;
+  spec.options.depth_window = 3;
+  spec.options.max_aabbs = 1;
+  spec.options.depth_tiles_per_side = 1;
+  spec.options.merge_static_groups = false;
+  spec.second_square = true;
+  const Clip raw = make_clip(spec);
+  spec.options.depth = DepthCoding::kRaw16PredictedMasked;
+  const Clip masked = make_clip(spec);
+  auto a = LightfieldReference::open(*raw.reader, 0);
+  auto b = LightfieldReference::open(*masked.reader, 0);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(b->header().depth_format,
+            static_cast<uint16_t>(container::PixelFormat::kR16PredictedMasked));
+  for (uint32_t face = 0; face < 6; ++face) {
+    for (uint32_t f = 0; f < spec.frames; ++f) {
+      LightfieldFace fa, fb;
+      ASSERT_TRUE(a->decode_face(0, face, f, &fa).ok());
+      ASSERT_TRUE(b->decode_face(0, face, f, &fb).ok());
+      ASSERT_EQ(fa.depth, fb.depth) << "face " << face << " frame " << f;
+      EXPECT_EQ(fa.material, fb.material);
+    }
+  }
+  for (uint32_t j = 0; j < spec.frames; ++j) {
+    for (uint32_t n = j + 1; n < spec.frames; ++n) {
+      ClipDecoderOptions o;
+      o.view_dependent = false;
+      ClipDecoder d = open_decoder(masked, o);
+      CpuTextures tex = textures_for(d);
+      advance_ok(d, tex, j, {});
+      const FrameUpdates fu = advance_ok(d, tex, n, {});
+      // Compared with the raw16 clip's reference decode: colour is coded alike, depth must be.
+      expect_matches_reference(raw, tex, fu, n,
+                               "from frame " + std::to_string(j) + " to " + std::to_string(n));
+    }
+  }
+  // Texels of P-frame rectangles not stored: the area of the rectangles minus the stored texels
+  // beyond the keyframe's (the wrapping square makes one rectangle span unchanged texels).
+  uint64_t skipped = 0;
+  const auto& chunks = masked.reader->chunks();
+  for (uint32_t id = 0; id < chunks.size(); ++id) {
+    if (chunks[id].keys.stream != static_cast<uint16_t>(container::LightfieldStream::kDepth))
+      continue;
+    auto bytes = masked.reader->read_chunk(id);
+    ASSERT_TRUE(bytes.ok());
+    const uint32_t side = spec.face / spec.options.depth_tiles_per_side;
+    auto c = lf::parse_region_chunk(*bytes, chunks[id].keys.frame_count, side, side,
+                                    lf::RegionCoding::kR16PredictedMasked, "depth");
+    ASSERT_TRUE(c.ok()) << c.status().to_string();
+    uint64_t area = 0;
+    for (const lf::RegionRect& r : c->rects) area += uint64_t{r.w} * r.h;
+    skipped += area - c->units;
+  }
+  EXPECT_GT(skipped, 0u);
 }
 
 // A tile that does not change over whole groups of K frames keeps one depth (material) chunk

@@ -39,6 +39,7 @@ struct PinCase {
   const char* xxh3;       // of the whole file, hex
   double colour_rdo = 0;  // LightfieldEncodeOptions::colour_rdo (0: the clips frozen before it)
   uint32_t depth_keyframe_interval = 30;
+  uint32_t max_aabbs = 2;  // LightfieldEncodeOptions::max_aabbs
 };
 
 // clang-format off
@@ -60,6 +61,11 @@ const PinCase kCases[] = {
     // towards copies of their neighbours' bytes; same decoder, its own frozen clips.
     {"bc6h_rdo_zstd",      {.face = 16, .frames = 5, .views = 2, .hdr = true},      ColourCoding::kBc6h,    DepthCoding::kRaw16, container::Compression::kZstd,  "e40d1fb3ffd8ba6f", 4.0},
     {"bc7_rdo_zstd",       {.face = 16, .frames = 5, .views = 2},                   ColourCoding::kBc7,     DepthCoding::kRaw16, container::Compression::kZstd,  "5b143c1103044687", 4.0},
+    // Depth format r16pm (SPEC §11.1.9, issue 17): P-frame rectangles with change masks; the
+    // twins of bc1_raw16_zstd and bc1_raw16_groups, they decode to their hashes. One rectangle
+    // per P-frame, so that it spans the unchanged column inside the moving square (W = 2).
+    {"bc1_pred16m_zstd",   {.face = 16, .frames = 5, .views = 2},                   ColourCoding::kBc1,     DepthCoding::kRaw16PredictedMasked, container::Compression::kZstd,  "a21f65e106f413f6", 0, 30, 1},
+    {"bc1_pred16m_groups", {.face = 16, .frames = 7, .views = 2, .material = true},  ColourCoding::kBc1,     DepthCoding::kRaw16PredictedMasked, container::Compression::kZstd,  "61d24cbe36d26996", 0, 2, 1},
 };
 // clang-format on
 
@@ -97,6 +103,7 @@ TEST_P(EncodePin, OutputBytesAreUnchanged) {
     o.supercompression = c.compression;
     o.cell_size = 8;
     o.depth_keyframe_interval = c.depth_keyframe_interval;
+    o.max_aabbs = c.max_aabbs;
     o.threads = threads;
     const fs::path out = root / (threads == 1 ? "t1.calf" : "t2.calf");
     auto stats = encode_lightfield_file(capture, out.string(), o);

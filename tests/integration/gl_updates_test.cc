@@ -546,6 +546,11 @@ TEST(GlUpdates, RefusesLayoutsTheGpuCannotHold) {
   h.depth_format = static_cast<uint16_t>(PixelFormat::kR16Predicted);
   EXPECT_EQ(layout_for_clip(h, infos)->depth_format, PixelFormat::kR16);
   EXPECT_EQ(layout_for_clip(h, infos, true)->depth_format, PixelFormat::kR16);
+  // So is r16pm: the ClipDecoder sends whole rectangles of r16 codes, their unchanged texels
+  // from its copy of the tile (ClipDecoder.MaskedDepthDecodesToRaw16CodesFromAnyFrameOfTheWindow).
+  h.depth_format = static_cast<uint16_t>(PixelFormat::kR16PredictedMasked);
+  EXPECT_EQ(layout_for_clip(h, infos)->depth_format, PixelFormat::kR16);
+  EXPECT_EQ(layout_for_clip(h, infos, true)->depth_format, PixelFormat::kR16);
   h.depth_format = static_cast<uint16_t>(PixelFormat::kBc1);
   EXPECT_EQ(layout_for_clip(h, infos).status().number(), 410);
 }

@@ -17,10 +17,13 @@
 
 #include "calf/decoder/clip_decoder.h"
 #include "calf/decoder/cpu_textures.h"
+#include "calf/decoder/lightfield_reference.h"
 #include "calf/decoder/lightfield_verify.h"
 #include "calf/format/container.h"
 #include "calf/format/container_codec.h"
 #include "calf/format/cube.h"
+#include "calf/format/grid.h"
+#include "calf/format/lightfield_layout.h"
 
 namespace calf::decoder {
 namespace {
@@ -69,24 +72,70 @@ std::string read_text(const fs::path& p) {
 
 // Depth format r16p is lossless: each predicted clip (same scene and codings as a raw16 clip, depth
 // predicted) decodes to the hashes frozen for its raw16 twin before r16p existed.
+// So do the masked clips (r16pm, §11.1.9, `*_pred16m_*`), frozen after it.
 TEST(LightfieldConformance, PredictedDepthClipsDecodeAsTheirRaw16Twins) {
   size_t twins = 0;
   for (const auto& n : clip_names()) {
-    const size_t at = n.find("_pred16_");
+    size_t at = n.find("_pred16_"), len = 8;
+    if (at == std::string::npos) {
+      at = n.find("_pred16m_");
+      len = 9;
+    }
     if (at == std::string::npos) continue;
-    const std::string twin = n.substr(0, at) + "_raw16_" + n.substr(at + 8);
+    const std::string twin = n.substr(0, at) + "_raw16_" + n.substr(at + len);
     const std::string mine = read_text(suite_dir() / (n + ".hashes"));
     EXPECT_FALSE(mine.empty()) << n;
     EXPECT_EQ(mine, read_text(suite_dir() / (twin + ".hashes"))) << n << " vs " << twin;
     ++twins;
   }
-  EXPECT_GE(twins, 3u);
+  EXPECT_GE(twins, 5u);
 }
 
 container::Reader open_clip(const std::string& name) {
   auto r = container::Reader::open((suite_dir() / (name + ".calf")).string());
   EXPECT_TRUE(r.ok()) << r.status().to_string();
   return std::move(*r);
+}
+
+// The r16pm clips exercise what is new in them: P-frame rectangles whose masks leave texels to
+// the tile state, and rectangles that store every texel.
+TEST(LightfieldConformance, MaskedDepthClipsSkipTexels) {
+  size_t clips = 0;
+  for (const auto& n : clip_names()) {
+    if (n.find("_pred16m_") == std::string::npos) continue;
+    const container::Reader reader = open_clip(n);
+    auto ref = LightfieldReference::open(reader, 0);
+    ASSERT_TRUE(ref.ok()) << n;
+    auto grid = FaceGrid::with_cell_size(ref->header().face_size, ref->header().depth_tile_size);
+    ASSERT_TRUE(grid.ok()) << n;
+    uint64_t skipped = 0, p_rects = 0, skipping_rects = 0;
+    for (uint32_t id = 0; id < reader.chunks().size(); ++id) {
+      const container::ChunkKeys& k = reader.chunks()[id].keys;
+      if (k.stream != static_cast<uint16_t>(container::LightfieldStream::kDepth)) continue;
+      auto raw = reader.read_chunk(id);
+      auto r = grid->cell_rect(k.region);
+      ASSERT_TRUE(raw.ok() && r.ok()) << n;
+      auto c = lf::parse_region_chunk(*raw, k.frame_count, r->width, r->height,
+                                      lf::RegionCoding::kR16PredictedMasked, n);
+      ASSERT_TRUE(c.ok()) << c.status().to_string();
+      uint64_t stored = uint64_t{r->width} * r->height;  // the keyframe's
+      for (size_t i = 1; i < c->rects.size(); ++i) {
+        const lf::RegionRect& rr = c->rects[i];
+        const uint64_t next = i + 1 < c->rects.size() ? c->rects[i + 1].first_unit : c->units;
+        const uint64_t area = uint64_t{rr.w} * rr.h, kept = next - rr.first_unit;
+        stored += kept;
+        ++p_rects;
+        skipping_rects += kept < area;
+        skipped += area - kept;
+      }
+      EXPECT_EQ(stored, c->units) << n;
+    }
+    EXPECT_GT(skipped, 0u) << n;
+    EXPECT_GT(skipping_rects, 0u) << n;
+    EXPECT_LT(skipping_rects, p_rects) << n;
+    ++clips;
+  }
+  EXPECT_GE(clips, 2u);
 }
 
 TEST(LightfieldConformance, ReferenceDecoderReproducesEveryHash) {

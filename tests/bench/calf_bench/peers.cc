@@ -108,8 +108,10 @@ Expected<DecodedClip> decode_clip(const fs::path& clip, const GridFrames& g) {
   }
   DecodedClip out;
   out.rgb.resize(g.rgb.size());
-  const bool raw16 = h.depth_format == static_cast<uint16_t>(container::PixelFormat::kR16) ||
-                     h.depth_format == static_cast<uint16_t>(container::PixelFormat::kR16Predicted);
+  const bool raw16 =
+      h.depth_format == static_cast<uint16_t>(container::PixelFormat::kR16) ||
+      h.depth_format == static_cast<uint16_t>(container::PixelFormat::kR16Predicted) ||
+      h.depth_format == static_cast<uint16_t>(container::PixelFormat::kR16PredictedMasked);
   if (raw16) out.depth_mismatches = 0;
   decoder::LightfieldFace face;
   for (uint32_t f = 0; f < g.frames; ++f) {

@@ -64,8 +64,10 @@ namespace calf {
 enum class ColourCoding : uint8_t { kAuto, kBc1, kBc7, kBc6h, kRgba8, kRgba16f };
 // kRaw16: log-16 codes as 16-bit planes (SPEC §11.1.6); kRaw16Predicted: the same codes as
 // spatial-prediction residuals (depth format r16p, SPEC §11.1.8), lossless like kRaw16 and
-// smaller once supercompressed; kBc5: lossy.
-enum class DepthCoding : uint8_t { kRaw16, kBc5, kRaw16Predicted };
+// smaller once supercompressed; kBc5: lossy; kRaw16PredictedMasked: as kRaw16Predicted, but a
+// P-frame rectangle stores a change mask and the residuals of its changed texels only (depth
+// format r16pm, SPEC §11.1.9). Values are recorded in analysis files: append only.
+enum class DepthCoding : uint8_t { kRaw16, kBc5, kRaw16Predicted, kRaw16PredictedMasked };
 
 struct LightfieldEncodeOptions {
   uint32_t cell_size = 64;  // colour cell side (px), 4..16384 and a multiple of 4

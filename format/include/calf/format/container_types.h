@@ -79,6 +79,7 @@ enum class PixelFormat : uint16_t {
   kBc7 = 8,
   kRg8 = 9,
   kR16Predicted = 10,  // depth only: r16 codes as spatial-prediction residuals (SPEC §11.1.8)
+  kR16PredictedMasked = 11,  // depth only: r16p, P-frames' changed texels only (SPEC §11.1.9)
 };
 const char* pixel_format_name(uint16_t format);
 

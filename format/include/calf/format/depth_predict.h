@@ -28,6 +28,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 namespace calf::lf {
 
@@ -67,5 +68,26 @@ void predict_depth_rect(const uint16_t* codes, uint32_t w, uint32_t h, size_t st
 // (the decoder's GPU-ready bytes, 2 * w * h bytes at `out`).
 void reconstruct_depth_rect(const uint8_t* hi, const uint8_t* lo, uint32_t w, uint32_t h,
                             uint8_t* out);
+
+// Depth format r16pm (SPEC §11.1.9): a P-frame rectangle's change mask, bit i (row-major texel
+// i of the w x h rectangle) = bit (i mod 8) of mask[i / 8], least significant first; ceil(w h / 8)
+// bytes, the unused high bits of the last byte 0.
+inline bool mask_bit(const uint8_t* mask, size_t i) {
+  return (mask[i >> 3] >> (i & 7) & 1) != 0;
+}
+inline size_t mask_bytes_of(uint32_t w, uint32_t h) {
+  return (size_t{w} * h + 7) / 8;
+}
+// Residuals of the texels of a w x h rectangle whose mask bit is set, in row-major order, into
+// `residuals` (resized); the prediction is r16p's over the whole rectangle at this frame (an
+// unchanged neighbour's code is this frame's, which the decoder holds as its tile state).
+void predict_depth_rect_masked(const uint16_t* codes, uint32_t w, uint32_t h, size_t stride,
+                               const uint8_t* mask, std::vector<uint16_t>& residuals);
+// The inverse: `inout` holds the rectangle's codes in the decoder's tile state (little-endian u16,
+// row-major, 2 w h bytes) on entry; every texel whose mask bit is set becomes prediction +
+// residual, taking the residuals from hi[k] / lo[k] in order (k counts set bits). Texels whose bit
+// is clear are left: in a valid stream they already hold this frame's codes.
+void reconstruct_depth_rect_masked(const uint8_t* mask, const uint8_t* hi, const uint8_t* lo,
+                                   uint32_t w, uint32_t h, uint8_t* inout);
 
 }  // namespace calf::lf

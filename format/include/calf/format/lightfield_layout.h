@@ -160,9 +160,12 @@ Expected<CellTimeline> parse_t_chunk(std::span<const uint8_t> raw, uint32_t fram
 enum class RegionCoding : uint8_t {
   kR16,           // depth, two 16-bit planes
   kR16Predicted,  // depth, two 16-bit planes of prediction residuals (depth_predict.h)
-  kBc5,           // depth, BC5 with block split
-  kRgb8,          // material, three byte planes
-  kBc1,           // material, BC1 with block split
+  // depth, r16p whose P-frame rectangles hold a change mask and their changed texels' residuals
+  // only (§11.1.9): their other texels keep the decoder's tile state.
+  kR16PredictedMasked,
+  kBc5,   // depth, BC5 with block split
+  kRgb8,  // material, three byte planes
+  kBc1,   // material, BC1 with block split
 };
 // Errors: CALF-E203 for a format §11.1 does not allow for the stream.
 Expected<RegionCoding> depth_coding(uint16_t depth_format);
@@ -173,7 +176,11 @@ bool region_coding_is_block(RegionCoding coding);
 // derived by the parser, not stored.
 struct RegionRect {
   uint16_t x = 0, y = 0, w = 0, h = 0;  // tile coordinates
-  uint64_t first_unit = 0;  // index of its first texel (raw codings) or block (block codings)
+  uint64_t first_unit = 0;  // index of its first texel (raw codings) or block (block codings);
+                            // kR16PredictedMasked: of its first stored (changed) texel
+  // kR16PredictedMasked P-frame rectangles: the payload offset of its change mask; else kNoMask.
+  static constexpr uint64_t kNoMask = UINT64_MAX;
+  uint64_t mask_offset = kNoMask;
   template <class Self, class V>
   static constexpr void fields(Self& s, V& v) {
     v(s.x, "x");
@@ -206,7 +213,8 @@ struct RegionChunk {
   std::vector<uint32_t>
       first_rect;  // frame_count + 1 entries: frame i owns rects [first_rect[i], first_rect[i + 1])
   std::vector<RegionRect> rects;
-  uint64_t units = 0;  // texels or blocks of all rects
+  uint64_t units = 0;       // texels or blocks of all rects (kR16PredictedMasked: stored texels)
+  uint64_t mask_bytes = 0;  // kR16PredictedMasked: the masks before the planes; else 0
   std::span<const uint8_t> payload;
 };
 // `frame_count` is the chunk's key (ChunkKeys::frame_count); the chunk must agree with it.
@@ -214,9 +222,18 @@ Expected<RegionChunk> parse_region_chunk(std::span<const uint8_t> raw, uint32_t 
                                          uint32_t tile_width, uint32_t tile_height,
                                          RegionCoding coding, const std::string& what);
 
+// True when rect `index` stores only some of its texels (a kR16PredictedMasked P-frame rectangle):
+// its other texels are the decoder's tile state, which region_rect_gpu_bytes then reads from `out`.
+inline bool region_rect_reads_state(const RegionChunk& chunk, size_t index) {
+  return chunk.rects[index].mask_offset != RegionRect::kNoMask;
+}
+
 // The GPU-ready bytes (clip_decoder.h's update formats) of rect `index` of a parsed region chunk:
-// kR16, kR16Predicted -> little-endian u16 codes; kBc5 / kBc1 -> whole blocks, row-major; kRgb8 ->
-// RGBA8 (reflect, refract, ior, 255). Replaces `out`.
+// kR16, kR16Predicted, kR16PredictedMasked -> little-endian u16 codes; kBc5 / kBc1 -> whole
+// blocks, row-major; kRgb8 -> RGBA8 (reflect, refract, ior, 255). Replaces `out`, except when
+// region_rect_reads_state(): then `out` must hold on entry the rectangle's codes in the decoder's
+// tile state (2 w h bytes, little-endian, row-major; the frame before, or any frame of the window
+// §11.1.3 allows), and only its changed texels are rewritten.
 void region_rect_gpu_bytes(const RegionChunk& chunk, size_t index, std::vector<uint8_t>& out);
 // The GPU format of those bytes.
 container::PixelFormat region_gpu_format(RegionCoding coding);
