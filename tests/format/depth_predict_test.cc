@@ -71,7 +71,7 @@ TEST(DepthPredict, InverseIsExactOnAnyCodes) {
   for (uint32_t w : {1u, 2u, 3u, 17u, 32u}) {
     for (uint32_t h : {1u, 2u, 5u, 32u}) {
       const size_t n = size_t{w} * h;
-      std::vector<uint16_t> random(n), sky_edge(n), extremes(n), smooth(n);
+      std::vector<uint16_t> random(n), sky_edge(n), extremes(n), smooth(n), lone_sky(n);
       for (size_t i = 0; i < n; ++i) {
         const uint32_t x = i % w, y = static_cast<uint32_t>(i / w);
         random[i] = static_cast<uint16_t>(rng());
@@ -80,8 +80,14 @@ TEST(DepthPredict, InverseIsExactOnAnyCodes) {
             x + y * 2 < w || rng() % 9 == 0 ? 65535 : static_cast<uint16_t>(20000 + 7 * x + 3 * y);
         extremes[i] = (x + y) % 2 == 0 ? 0 : (rng() % 2 ? 65535 : 65534);
         smooth[i] = static_cast<uint16_t>(65000 + 13 * x + 2 * y);  // wraps past 65535
+        // A plane with one sky texel mid-row under a row without sky (a decoder that sums the
+        // plane's residuals along such a row must notice the sky and use the median there), and
+        // one in the last column (which no texel of its row predicts from).
+        lone_sky[i] = (x == w / 2 && y == h / 2) || (x + 1 == w && y == h - 1)
+                          ? 65535
+                          : static_cast<uint16_t>(30000 + 11 * x - 5 * y);
       }
-      for (const auto* codes : {&random, &sky_edge, &extremes, &smooth}) {
+      for (const auto* codes : {&random, &sky_edge, &extremes, &smooth, &lone_sky}) {
         EXPECT_EQ(round_trip(*codes, w, h), *codes) << w << "x" << h;
       }
     }
