@@ -168,6 +168,7 @@ GridCuller::GridCuller(const FaceGrid& grid) : grid_(grid) {
   }
   for (int f = 0; f < kCubeFaceCount; ++f) {
     const CubeFace face = cube_face_from_index(f);
+    axis_[f] = direction_from_face_coord({face, 0.5, 0.5});
     nodes_[f].resize(count);
     for (uint32_t l = 0; l < levels; ++l) {
       for (uint32_t iy = 0; iy < (1u << l); ++iy) {
@@ -424,7 +425,18 @@ struct GridCuller::Search {
     Projections d;
     const Verdict v = classify(p, e, cert != nullptr ? &d : nullptr);
     if (v == Verdict::kInside || (leaf && v == Verdict::kTouches)) {
-      if (cert != nullptr) certify_corners(p, e, d, v == Verdict::kInside, cert);
+      if (cert != nullptr) {
+        certify_corners(p, e, d, v == Verdict::kInside, cert);
+        // A leaf's corner is where it meets the eye's planes first as the eye turns: the middle
+        // of its centre line's stretch inside the eye, where there is one, usually keeps longer.
+        Vec3 found;
+        Certificate centre;
+        if (leaf && segment_inside((p[0] + p[1] + p[2] + p[3]) * 0.25,
+                                   (p[4] + p[5] + p[6] + p[7]) * 0.25, e, &found)) {
+          certify_point(found, e, &centre);
+          if (centre.slack.usable() && !(centre.slack.angle <= cert->slack.angle)) *cert = centre;
+        }
+      }
       return Outcome::kAccept;
     }
     if (v == Verdict::kOutside) {
@@ -576,6 +588,64 @@ struct GridCuller::Search {
     }
   }
 
+  // The axes of frusta_intersect(eye, node frustum) (calf/format/geometry.h), as the Frustum
+  // class computes them from the corners: axis a < 6 is the eye's face normal a, a < 12 the
+  // node's face normal a - 6, and 12 + 6 i + j the cross product of the eye's edge direction i
+  // and the node's edge direction j.
+  static Vec3 node_edge(int j, const std::array<Vec3, 8>& p) {
+    return j < 4 ? p[4 + j] - p[j] : j == 4 ? p[1] - p[0] : p[3] - p[0];
+  }
+  static Vec3 exact_axis(int a, const Frustum& eye, const std::array<Vec3, 8>& p) {
+    if (a < 6) return eye.face_normals()[a];
+    if (a < 10) {
+      const int i = a - 6, j = (i + 1) % 4;
+      return cross(p[j] - p[i], p[4 + i] - p[i]);
+    }
+    if (a == 10) return cross(p[1] - p[0], p[3] - p[0]);
+    if (a == 11) return cross(p[5] - p[4], p[7] - p[4]);
+    return cross(eye.edge_directions()[(a - 12) / 6], node_edge((a - 12) % 6, p));
+  }
+
+  // The gap between the projections of the eye's corners `q` and the node's `p` on axis `a`, over
+  // |axis|, where it exceeds 100 times frusta_intersect()'s tolerance (so that the exact test,
+  // which tries that axis too, certainly finds them separated); otherwise a negative number. An
+  // edge axis from (nearly) parallel edges, which frusta_intersect() skips, does not count.
+  static double separation(int a, const Frustum& eye, const std::array<Vec3, 8>& p) {
+    const Vec3 axis = exact_axis(a, eye, p);
+    const double len2 = dot(axis, axis);
+    if (a >= 12) {
+      const Vec3 ea = eye.edge_directions()[(a - 12) / 6], eb = node_edge((a - 12) % 6, p);
+      if (!(len2 > 1e-20 * dot(ea, ea) * dot(eb, eb))) return -1;
+    }
+    double q_lo = INFINITY, q_hi = -INFINITY, p_lo = INFINITY, p_hi = -INFINITY;
+    for (int j = 0; j < 8; ++j) {
+      const double dq = dot(axis, eye.corners()[j]), dp = dot(axis, p[j]);
+      q_lo = std::min(q_lo, dq);
+      q_hi = std::max(q_hi, dq);
+      p_lo = std::min(p_lo, dp);
+      p_hi = std::max(p_hi, dp);
+    }
+    const double extent =
+        std::max({std::fabs(q_lo), std::fabs(q_hi), std::fabs(p_lo), std::fabs(p_hi)});
+    const double gap = std::max(p_lo - q_hi, q_lo - p_hi);
+    if (!(gap > 1e-10 * extent && len2 > 0)) return -1;
+    return gap / std::sqrt(len2);
+  }
+
+  // The exact test's axis that separates the eye from a leaf by the widest gap, or -1.
+  static int widest_separation(const Frustum& eye, const std::array<Vec3, 8>& p) {
+    int best = -1;
+    double widest = 0;
+    for (int a = 0; a < 48; ++a) {
+      const double g = separation(a, eye, p);
+      if (g > widest) {
+        widest = g;
+        best = a;
+      }
+    }
+    return best;
+  }
+
   // Whether decision `m` of `node` still holds (see Slack).
   bool holds(const CullMemory::Decision& m, const Node& node) const {
     if (m.kind == Kind::kNone) return false;
@@ -599,6 +669,14 @@ struct GridCuller::Search {
     if (holds(m, node)) {
       if (stats) ++stats->reused;
       kind = m.kind;
+    } else if (leaf && m.axis >= 0 &&
+               separation(m.axis, *eyes[0].frustum,
+                          cell_frustum_corners(node.cell, viewpoint, z_near, z_far)) > 0) {
+      // A leaf the exact test separated on this axis before, separated on it still: the exact
+      // test would reject it, and so would the cheap tests ahead of it (they only ever accept
+      // what meets the eye with room to spare, or reject on the exact test's own axes).
+      if (stats) ++stats->tests;
+      kind = Kind::kReject;
     } else {
       if (stats) ++stats->tests;
       const std::array<Vec3, 8> p = cell_frustum_corners(node.cell, viewpoint, z_near, z_far);
@@ -613,6 +691,10 @@ struct GridCuller::Search {
              : o == Outcome::kReject ? Kind::kReject
                                      : Kind::kDescend;
       m = CullMemory::Decision{};
+      // A leaf rejected without a slack to keep: the axis to try first next time.
+      if (leaf && o == Outcome::kReject && cert.kind == Kind::kNone) {
+        m.axis = static_cast<int8_t>(widest_separation(*eyes[0].frustum, p));
+      }
       if (cert.kind != Kind::kNone && cert.slack.usable()) {
         m.kind = cert.kind;
         m.inv_angle = 1 / cert.slack.angle;
@@ -638,7 +720,7 @@ void GridCuller::visible(const Vec3& viewpoint, CubeFace face, double z_near, do
   const uint32_t total = grid_.quadtree_levels();
   if (levels == 0 || levels > total) levels = total;
   const uint32_t start = total - levels;
-  const Vec3 axis = direction_from_face_coord({face, 0.5, 0.5});
+  const Vec3& axis = axis_[cube_face_index(face)];
   // Eyes in groups of 64 (one bit each); a cell seen by several groups is listed once.
   for (size_t first = 0; first < eyes.size(); first += 64) {
     const std::span<const PreparedEye> group =
@@ -706,7 +788,7 @@ void GridCuller::visible_reusing(const Vec3& viewpoint, CubeFace face, double z_
   const uint32_t total = grid_.quadtree_levels();
   if (levels == 0 || levels > total) levels = total;
   const uint32_t start = total - levels;
-  const Vec3 axis = direction_from_face_coord({face, 0.5, 0.5});
+  const Vec3& axis = axis_[f];
   Search search{
       *this, nodes_[f], viewpoint, z_near,       z_far, std::span<const PreparedEye>(&eye, 1),
       stats, out,       axis,      length(axis), &m,    1e-7 * scale};

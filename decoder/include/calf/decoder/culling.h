@@ -157,7 +157,8 @@ class GridCuller {
   FaceGrid grid_;
   std::vector<uint32_t> level_start_;  // first node of each level in nodes_[face]
   std::array<std::vector<Node>, 6> nodes_;
-  double max_axial_ = 0;  // the longest axial[i] of any node, for how far corners move
+  std::array<Vec3, 6> axis_;  // each face's axis (the caps are perpendicular to it)
+  double max_axial_ = 0;      // the longest axial[i] of any node, for how far corners move
 };
 
 // What GridCuller::visible_reusing() keeps between calls for one (viewpoint, face, eye): each
@@ -177,6 +178,9 @@ class CullMemory {
     // (with room for rounding).
     double inv_angle = 0, inv_distance = 0, turn_at = 0, travel_at = 0;
     double depth = 0;  // an inner node accepted by its cross-section: that section's depth
+    // A leaf the exact test rejected: the axis that separated it by the widest gap, tried
+    // first next time (a fresh test, cheaper than the exact one); -1: none.
+    int8_t axis = -1;
   };
   std::vector<Decision> nodes_;
   const GridCuller* culler_ = nullptr;
