@@ -497,26 +497,28 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
   // Every view's culling first, then every view's decoding: the culler's nodes and memory stay
   // in the processor's caches from one view to the next.
   const auto cull_start = std::chrono::steady_clock::now();
+  bool culled = false;
+  std::vector<double> z_far(eyes.size());
+  std::vector<uint32_t> merged;
+  auto unite = [&](std::vector<uint32_t>& united, const std::vector<uint32_t>& more) {
+    merged.clear();
+    std::set_union(united.begin(), united.end(), more.begin(), more.end(),
+                   std::back_inserter(merged));
+    united.swap(merged);
+  };
   for (uint32_t v : active) {
     const LightfieldViewInfo& info = d.views[v];
     const Vec3 p = info.position;
     Impl::VisibleSets& vs = d.visible_cache[v];
     if (d.options.view_dependent && !vs.valid) {
+      culled = true;
       // Geometry: a cell frustum reaching past each viewer's far plane (seen from this viewpoint)
       // holds every point the viewer can see through it. The far cap depends on the viewer, so
       // each viewer is culled on its own and the visible sets are united: several viewers see
       // exactly the union of each.
-      std::vector<double> z_far(eyes.size());
       for (size_t i = 0; i < eyes.size(); ++i) {
         z_far[i] = std::max<double>(info.z_far, length(eyes[i].position - p) + eyes[i].far);
       }
-      std::vector<uint32_t> merged;
-      auto unite = [&](std::vector<uint32_t>& united, const std::vector<uint32_t>& more) {
-        merged.clear();
-        std::set_union(united.begin(), united.end(), more.begin(), more.end(),
-                       std::back_inserter(merged));
-        united.swap(merged);
-      };
       for (uint32_t f = 0; f < 6; ++f) {
         for (bool tiles : {false, true}) {
           std::vector<uint32_t>& united = tiles ? vs.tiles[f] : vs.cells[f];
@@ -531,9 +533,11 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
       vs.valid = true;
     }
   }
-  stats.culling_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cull_start)
-          .count();
+  if (culled) {
+    stats.culling_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cull_start)
+            .count();
+  }
   for (uint32_t v : active) {
     const bool has_material = d.views[v].has_material && d.material_coding.has_value();
     const Impl::VisibleSets& vs = d.visible_cache[v];

@@ -166,6 +166,18 @@ GridCuller::GridCuller(const FaceGrid& grid) : grid_(grid) {
     level_start_.push_back(count);
     count += (1u << l) * (1u << l);
   }
+  shape_.resize(count);
+  for (uint32_t l = 0; l < levels; ++l) {
+    for (uint32_t iy = 0; iy < (1u << l); ++iy) {
+      for (uint32_t ix = 0; ix < (1u << l); ++ix) {
+        const CellRange r = grid.quadtree_node_cells(l, ix, iy);
+        shape_[level_start_[l] + iy * (1u << l) + ix] = r.empty() ? 1
+                                                        : (r.x1 - r.x0 == 1 && r.y1 - r.y0 == 1)
+                                                            ? 2
+                                                            : 0;
+      }
+    }
+  }
   for (int f = 0; f < kCubeFaceCount; ++f) {
     const CubeFace face = cube_face_from_index(f);
     axis_[f] = direction_from_face_coord({face, 0.5, 0.5});
@@ -448,7 +460,8 @@ struct GridCuller::Search {
       // at most z_near, its far cap at least z_far times its largest cosine).
       double t0 = z_near, t1 = z_far * node.cell.min_cos;
       if (section_inside(node, e, &t0, &t1)) {
-        if (cert != nullptr) certify_section(node, e, 0.5 * (t0 + t1), cert);
+        // The depth as a float, as the memory keeps it.
+        if (cert != nullptr) certify_section(node, e, static_cast<float>(0.5 * (t0 + t1)), cert);
         return Outcome::kAccept;
       }
       if (cert != nullptr) certify_not_rejected(p, e, d, cert);
@@ -646,32 +659,54 @@ struct GridCuller::Search {
     return best;
   }
 
-  // Whether decision `m` of `node` still holds (see Slack).
-  bool holds(const CullMemory::Decision& m, const Node& node) const {
+  // Whether decision `m` of node `index` still holds (see Slack).
+  bool holds(const CullMemory::Decision& m, uint32_t index) const {
     if (m.kind == Kind::kNone) return false;
+    const double lhs = memory->turn_ * double{m.inv_angle} +
+                       (memory->travel_ + keep_margin) * double{m.inv_distance};
+    if (!(lhs < m.budget)) return false;
     // A section must still lie within the depths every cell below spans.
-    if (m.depth > 0 && !(z_near < m.depth && m.depth < z_far * node.cell.min_cos)) return false;
-    const double turned = (memory->turn_ - m.turn_at) * m.inv_angle;
-    const double travelled = (memory->travel_ - m.travel_at + keep_margin) * m.inv_distance;
-    return turned + travelled < 0.999;  // room for the rounding of the sums
+    return m.depth == 0 || (z_near < m.depth && m.depth < z_far * nodes[index].cell.min_cos);
+  }
+
+  // `x` as a float no smaller.
+  static float float_up(double x) {
+    float f = static_cast<float>(x);
+    if (double{f} < x) f = std::nextafter(f, INFINITY);
+    return f;
+  }
+
+  // Keeps `cert` in `m` where it is worth it: a slack of at least 1e-6 radians and 100 margins
+  // (a smaller one would not outlast the smallest motion), which also keeps the products in the
+  // budget small enough for its rounding not to matter.
+  void keep(const Certificate& cert, CullMemory::Decision* m) const {
+    if (cert.kind == Kind::kNone || !cert.slack.usable() || !(cert.slack.angle >= 1e-6) ||
+        !(cert.slack.distance >= 100 * keep_margin)) {
+      return;
+    }
+    m->kind = cert.kind;
+    m->inv_angle = float_up(1 / cert.slack.angle);
+    m->inv_distance = float_up(1 / cert.slack.distance);
+    m->budget =
+        0.999 + memory->turn_ * double{m->inv_angle} + memory->travel_ * double{m->inv_distance};
+    m->depth = static_cast<float>(cert.depth);
   }
 
   // visit() for one eye (eyes[0]) with the memory: a node's kept decision where it holds, else
   // the tests of visit(), whose decision and slack are kept.
   void visit_reusing(uint32_t level, uint32_t ix, uint32_t iy) {
     const uint32_t index = culler.level_start_[level] + iy * (1u << level) + ix;
-    const Node& node = nodes[index];
-    const CellRange& r = node.range;
-    if (r.empty()) return;
-    const bool leaf = r.x1 - r.x0 == 1 && r.y1 - r.y0 == 1;
+    const uint8_t shape = culler.shape_[index];
+    if (shape & 1) return;  // no cells
+    const bool leaf = (shape & 2) != 0;
     CullMemory::Decision& m = memory->nodes_[index];
     Kind kind;
-    if (holds(m, node)) {
+    if (holds(m, index)) {
       if (stats) ++stats->reused;
       kind = m.kind;
     } else if (leaf && m.axis >= 0 &&
                separation(m.axis, *eyes[0].frustum,
-                          cell_frustum_corners(node.cell, viewpoint, z_near, z_far)) > 0) {
+                          cell_frustum_corners(nodes[index].cell, viewpoint, z_near, z_far)) > 0) {
       // A leaf the exact test separated on this axis before, separated on it still: the exact
       // test would reject it, and so would the cheap tests ahead of it (they only ever accept
       // what meets the eye with room to spare, or reject on the exact test's own axes).
@@ -679,6 +714,7 @@ struct GridCuller::Search {
       kind = Kind::kReject;
     } else {
       if (stats) ++stats->tests;
+      const Node& node = nodes[index];
       const std::array<Vec3, 8> p = cell_frustum_corners(node.cell, viewpoint, z_near, z_far);
       Certificate cert;
       Outcome o = test_eye(node, p, leaf, eyes[0], &cert);
@@ -695,17 +731,10 @@ struct GridCuller::Search {
       if (leaf && o == Outcome::kReject && cert.kind == Kind::kNone) {
         m.axis = static_cast<int8_t>(widest_separation(*eyes[0].frustum, p));
       }
-      if (cert.kind != Kind::kNone && cert.slack.usable()) {
-        m.kind = cert.kind;
-        m.inv_angle = 1 / cert.slack.angle;
-        m.inv_distance = 1 / cert.slack.distance;
-        m.turn_at = memory->turn_;
-        m.travel_at = memory->travel_;
-        m.depth = cert.depth;
-      }
+      keep(cert, &m);
     }
     if (kind == Kind::kAccept) {
-      emit_all(r);
+      emit_all(nodes[index].range);
     } else if (kind == Kind::kDescend) {
       for (uint32_t c = 0; c < 4; ++c)
         visit_reusing(level + 1, 2 * ix + (c & 1), 2 * iy + (c >> 1));
@@ -772,7 +801,7 @@ void GridCuller::visible_reusing(const Vec3& viewpoint, CubeFace face, double z_
     m.travel_ = std::nextafter(m.travel_ + travel * (1 + 1e-12), INFINITY);
     // Sums kept small, so that differences of them lose nothing that matters; a NaN or an
     // infinity forgets everything too.
-    if (!(m.turn_ < 1 && m.travel_ < 1e3 * scale)) {
+    if (!(m.turn_ < 1 && m.travel_ < 10 * scale)) {
       std::fill(m.nodes_.begin(), m.nodes_.end(), CullMemory::Decision{});
       m.turn_ = m.travel_ = 0;
     }

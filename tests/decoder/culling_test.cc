@@ -309,7 +309,7 @@ EyeView random_eye_view(std::mt19937& rng) {
 // kept up to the limit of their slack.
 struct Drift {
   Vec3 step, axis{0, 1, 0};
-  double turn = 0, zoom = 0;
+  double turn = 0, zoom = 0, far = 0;
 };
 
 Drift random_drift(std::mt19937& rng) {
@@ -322,6 +322,7 @@ Drift random_drift(std::mt19937& rng) {
   d.axis = normalize(v(sym(rng), sym(rng), sym(rng)));
   d.turn = magnitude(0.02) * (u01(rng) < 0.5 ? -1 : 1);  // 0.02 rad = 1.1 degrees a frame
   d.zoom = u01(rng) < 0.7 ? 0 : magnitude(0.01) * sym(rng);
+  d.far = u01(rng) < 0.6 ? 0 : magnitude(0.03) * sym(rng);
   return d;
 }
 
@@ -336,6 +337,7 @@ EyeView moved(const EyeView& e, const Drift& drift, std::mt19937& rng) {
     n.forward = turned(e.forward, drift.axis, drift.turn);
     n.up = turned(e.up, drift.axis, drift.turn);
     n.fov_y = std::clamp(e.fov_y * (1 + drift.zoom), 0.1, 2.5);
+    n.far = std::clamp(e.far * (1 + drift.far), 1.0, 20.0);
     if (!view_axes_usable(n.forward, n.up)) n = e;
     return n;
   }
@@ -368,8 +370,9 @@ EyeView moved(const EyeView& e, const Drift& drift, std::mt19937& rng) {
 // viewpoint and depth range drifting on their own (short frusta whose far caps cut through the
 // eye), at every level count. Most decisions come from the memory. The sequences keep many
 // decisions near the limit of their slack: a memory that kept one a little too long fails here
-// (checked by halving either part of the bound, by letting 1.2 pass for 1, and by leaving out
-// the viewpoint's or the depth range's motion).
+// (checked: halving the turn's or the travel's part of the bound, letting the budget pass by
+// half, or leaving out the turn of the normals, the travel of the offsets, of the eye's origin,
+// of the viewpoint or of the depth range each fails it).
 TEST(CullingTest, GridCullerReusingEqualsFreshForMovingEyes) {
   std::mt19937 rng(8);
   std::uniform_real_distribution<double> u01(0, 1), sym(-1, 1);
@@ -380,7 +383,7 @@ TEST(CullingTest, GridCullerReusingEqualsFreshForMovingEyes) {
   CullStats fresh_stats, reusing_stats;
   std::vector<uint32_t> fresh, got;
   int partial = 0;
-  for (int sequence = 0; sequence < 48; ++sequence) {
+  for (int sequence = 0; sequence < 72; ++sequence) {
     const GridCuller& culler = cullers[sequence % cullers.size()];
     const int mode = sequence % 3;  // 0: a view, 1: the sky pass, 2: drifting on its own
     Vec3 viewpoint = v(3 * u01(rng) - 1.5, 3 * u01(rng) - 1.5, 3 * u01(rng) - 1.5);

@@ -158,7 +158,10 @@ class GridCuller {
   std::vector<uint32_t> level_start_;  // first node of each level in nodes_[face]
   std::array<std::vector<Node>, 6> nodes_;
   std::array<Vec3, 6> axis_;  // each face's axis (the caps are perpendicular to it)
-  double max_axial_ = 0;      // the longest axial[i] of any node, for how far corners move
+  // Per node (the same on every face): bit 0 no cells, bit 1 one cell (a leaf). A walk through
+  // the memory reads this, not the node.
+  std::vector<uint8_t> shape_;
+  double max_axial_ = 0;  // the longest axial[i] of any node, for how far corners move
 };
 
 // What GridCuller::visible_reusing() keeps between calls for one (viewpoint, face, eye): each
@@ -172,12 +175,15 @@ class CullMemory {
  private:
   friend class GridCuller;
   enum class Kind : uint8_t { kNone, kReject, kAccept, kDescend };
+  // 24 bytes: a walk reads one per node it visits.
   struct Decision {
+    // Kept while turn * inv_angle + (travel + margin) * inv_distance < budget, that is while
+    // (turn - turn then) / angle + (travel - travel then + margin) / distance < 1 with room for
+    // rounding (the inverses rounded up to floats).
+    double budget = 0;
+    float inv_angle = 0, inv_distance = 0;
+    float depth = 0;  // an inner node accepted by its cross-section: that section's depth
     Kind kind = Kind::kNone;
-    // Kept while (turn - turn_at) * inv_angle + (travel - travel_at + margin) * inv_distance < 1
-    // (with room for rounding).
-    double inv_angle = 0, inv_distance = 0, turn_at = 0, travel_at = 0;
-    double depth = 0;  // an inner node accepted by its cross-section: that section's depth
     // A leaf the exact test rejected: the axis that separated it by the widest gap, tried
     // first next time (a fresh test, cheaper than the exact one); -1: none.
     int8_t axis = -1;
