@@ -137,7 +137,9 @@ class GridCuller {
   // node "not rejected by any eye plane", which descends to the children (an inner node the
   // planes accept has only visible cells below it, so descending finds the same cells). All
   // else — leaves settled by their own planes or by the exact test — is tested afresh, with the
-  // very tests of visible(). The result is therefore exactly visible()'s for `eye`, for any
+  // very tests of visible(); a leaf the exact test rejected is first tried on the one axis of
+  // that test which separated it by the widest gap (with 100 times its tolerance, so that the
+  // exact test would reject it too). The result is therefore exactly visible()'s for `eye`, for any
   // sequence of calls (tested on random moving, jumping and zooming eyes). `memory` belongs to
   // one (viewpoint, face, eye) as the caller sees it; one given another culler or face starts
   // afresh, and any other change only makes it test more.
