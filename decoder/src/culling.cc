@@ -460,8 +460,11 @@ struct GridCuller::Search {
       // at most z_near, its far cap at least z_far times its largest cosine).
       double t0 = z_near, t1 = z_far * node.cell.min_cos;
       if (section_inside(node, e, &t0, &t1)) {
-        // The depth as a float, as the memory keeps it.
-        if (cert != nullptr) certify_section(node, e, static_cast<float>(0.5 * (t0 + t1)), cert);
+        // The depth as a float, as the memory keeps it (one beyond a float's range is not kept).
+        const double depth = 0.5 * (t0 + t1);
+        if (cert != nullptr && depth < 1e30) {
+          certify_section(node, e, static_cast<float>(depth), cert);
+        }
         return Outcome::kAccept;
       }
       if (cert != nullptr) certify_not_rejected(p, e, d, cert);
