@@ -93,6 +93,9 @@ struct ClipDecoder::Impl {
     std::array<std::vector<uint32_t>, 6> cells, tiles;
   };
   std::vector<VisibleSets> visible_cache;  // per view
+  // GridCuller's memory of its decisions (a moving eye is culled mostly from them), indexed
+  // [eye][view, then the sky pass][face][cells, tiles].
+  std::vector<CullMemory> cull_memory;
   std::vector<EyeView> cache_eyes;
   ClipDecoderOptions cache_options;
   bool same_viewers(std::span<const EyeView> eyes) const {
@@ -483,14 +486,23 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
   std::vector<PreparedEye> prepared;
   for (const Frustum& f : frusta) prepared.push_back(prepare_eye(f));
   std::vector<uint32_t> by_eye;
-  auto cull_cells = [&](const Vec3& apex, CubeFace face, const GridCuller& culler, double z_near,
+  const size_t memory_per_eye = (size_t{d.header.view_count} + 1) * 12;
+  if (d.cull_memory.size() != eyes.size() * memory_per_eye) {
+    d.cull_memory.resize(eyes.size() * memory_per_eye);
+  }
+  // `view`: view_count for the sky pass.
+  auto cull_cells = [&](const Vec3& apex, uint32_t view, uint32_t f, bool tiles, double z_near,
                         double z_far, size_t eye) {
+    const GridCuller& culler = tiles ? *d.tile_culler : *d.cell_culler;
+    const CubeFace face = static_cast<CubeFace>(f);
     if (d.options.brute_force_culling) {
       by_eye = visible_cells_brute_force(apex, face, culler.grid(), z_near, z_far,
                                          std::span<const Frustum>(&frusta[eye], 1), &cull);
     } else {
-      culler.visible(apex, face, z_near, z_far, std::span<const PreparedEye>(&prepared[eye], 1),
-                     d.options.quadtree_levels, &cull, &by_eye);
+      CullMemory& memory =
+          d.cull_memory[eye * memory_per_eye + (size_t{view} * 6 + f) * 2 + (tiles ? 1 : 0)];
+      culler.visible_reusing(apex, face, z_near, z_far, prepared[eye], d.options.quadtree_levels,
+                             &memory, &cull, &by_eye);
     }
   };
   // Sky: it is at infinity, so the renderer reads every view's sky in the eye ray's own
@@ -502,51 +514,58 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
   auto sky_set = [&](size_t i, uint32_t f, bool tiles) -> const std::vector<uint32_t>& {
     std::optional<std::vector<uint32_t>>& slot = sky[i][f * 2 + (tiles ? 1 : 0)];
     if (!slot) {
-      cull_cells(eyes[i].position, static_cast<CubeFace>(f),
-                 tiles ? *d.tile_culler : *d.cell_culler, eyes[i].near, 2 * eyes[i].far, i);
+      cull_cells(eyes[i].position, d.header.view_count, f, tiles, eyes[i].near, 2 * eyes[i].far, i);
       slot = by_eye;
     }
     return *slot;
   };
+  // Every view's culling first, then every view's decoding: the culler's nodes and memory stay
+  // in the processor's caches from one view to the next.
+  const auto cull_start = std::chrono::steady_clock::now();
+  bool culled = false;
+  std::vector<double> z_far(eyes.size());
+  std::vector<uint32_t> merged;
+  auto unite = [&](std::vector<uint32_t>& united, const std::vector<uint32_t>& more) {
+    merged.clear();
+    std::set_union(united.begin(), united.end(), more.begin(), more.end(),
+                   std::back_inserter(merged));
+    united.swap(merged);
+  };
   for (uint32_t v : active) {
     const LightfieldViewInfo& info = d.views[v];
     const Vec3 p = info.position;
-    const bool has_material = info.has_material && d.material_coding.has_value();
     Impl::VisibleSets& vs = d.visible_cache[v];
     if (d.options.view_dependent && !vs.valid) {
-      const auto cull_start = std::chrono::steady_clock::now();
+      culled = true;
       // Geometry: a cell frustum reaching past each viewer's far plane (seen from this viewpoint)
       // holds every point the viewer can see through it. The far cap depends on the viewer, so
       // each viewer is culled on its own and the visible sets are united: several viewers see
       // exactly the union of each.
-      std::vector<double> z_far(eyes.size());
       for (size_t i = 0; i < eyes.size(); ++i) {
         z_far[i] = std::max<double>(info.z_far, length(eyes[i].position - p) + eyes[i].far);
       }
-      std::vector<uint32_t> merged;
-      auto unite = [&](std::vector<uint32_t>& united, const std::vector<uint32_t>& more) {
-        merged.clear();
-        std::set_union(united.begin(), united.end(), more.begin(), more.end(),
-                       std::back_inserter(merged));
-        united.swap(merged);
-      };
       for (uint32_t f = 0; f < 6; ++f) {
         for (bool tiles : {false, true}) {
           std::vector<uint32_t>& united = tiles ? vs.tiles[f] : vs.cells[f];
           united.clear();
           for (size_t i = 0; i < eyes.size(); ++i) {
-            cull_cells(p, static_cast<CubeFace>(f), tiles ? *d.tile_culler : *d.cell_culler,
-                       info.z_near, z_far[i], i);
+            cull_cells(p, v, f, tiles, info.z_near, z_far[i], i);
             unite(united, by_eye);
             unite(united, sky_set(i, f, tiles));
           }
         }
       }
       vs.valid = true;
-      stats.culling_ms +=
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cull_start)
-              .count();
     }
+  }
+  if (culled) {
+    stats.culling_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cull_start)
+            .count();
+  }
+  for (uint32_t v : active) {
+    const bool has_material = d.views[v].has_material && d.material_coding.has_value();
+    const Impl::VisibleSets& vs = d.visible_cache[v];
     for (uint32_t f = 0; f < 6; ++f) {
       const CubeFace face = static_cast<CubeFace>(f);
       const std::vector<uint32_t>& vis_cells = d.options.view_dependent ? vs.cells[f] : all_cells;
@@ -581,6 +600,7 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
   stats.updates = static_cast<uint32_t>(out->updates.size());
   stats.culling_tests = cull.tests;
   stats.culling_exact_tests = cull.exact_tests;
+  stats.culling_reused = cull.reused;
   // Nearest frames first; a chunk serving several of them once.
   std::unordered_set<uint32_t> queued;
   std::erase_if(d.prefetch_ids, [&](uint32_t id) { return !queued.insert(id).second; });

@@ -284,5 +284,174 @@ TEST(CullingTest, GridCullerTakesMoreThan64Eyes) {
   }
 }
 
+// `a` turned by `angle` radians about the unit axis `k` (Rodrigues).
+Vec3 turned(const Vec3& a, const Vec3& k, double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  return a * c + cross(k, a) * s + k * (dot(k, a) * (1 - c));
+}
+
+EyeView random_eye_view(std::mt19937& rng) {
+  std::uniform_real_distribution<double> pos(-3, 3), u01(0, 1);
+  EyeView e;
+  e.position = v(pos(rng), pos(rng), pos(rng));
+  const double th = u01(rng) * 2 * kPi, ph = std::acos(2 * u01(rng) - 1);
+  e.forward = v(std::sin(ph) * std::cos(th), std::sin(ph) * std::sin(th), std::cos(ph));
+  e.up = std::fabs(e.forward.y) < 0.9 ? v(0, 1, 0) : v(1, 0, 0);
+  e.fov_y = 0.3 + u01(rng) * 1.5;
+  e.aspect = 0.5 + u01(rng) * 1.5;
+  e.near = 0.05;
+  e.far = 1 + u01(rng) * 8;
+  return e;
+}
+
+// A steady motion: a step, a turn about an axis and a zoom every frame (a walking, turning
+// head). Summed over frames, the memory's bound on the motion is tight for it, so decisions are
+// kept up to the limit of their slack.
+struct Drift {
+  Vec3 step, axis{0, 1, 0};
+  double turn = 0, zoom = 0, far = 0;
+};
+
+Drift random_drift(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u01(0, 1), sym(-1, 1);
+  auto magnitude = [&](double most) {
+    return u01(rng) < 0.3 ? 0 : most * std::pow(10.0, -3 * u01(rng));
+  };
+  Drift d;
+  d.step = normalize(v(sym(rng), sym(rng), sym(rng))) * magnitude(0.05);
+  d.axis = normalize(v(sym(rng), sym(rng), sym(rng)));
+  d.turn = magnitude(0.02) * (u01(rng) < 0.5 ? -1 : 1);  // 0.02 rad = 1.1 degrees a frame
+  d.zoom = u01(rng) < 0.7 ? 0 : magnitude(0.01) * sym(rng);
+  d.far = u01(rng) < 0.6 ? 0 : magnitude(0.03) * sym(rng);
+  return d;
+}
+
+// The next pose of a moving eye: the drift, and now and then a jolt — a small turn, step, zoom,
+// change of near, far or aspect — a large turn, a jump, or a frame where nothing moves.
+EyeView moved(const EyeView& e, const Drift& drift, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u01(0, 1), sym(-1, 1);
+  EyeView n = e;
+  const double kind = u01(rng);
+  if (kind < 0.7) {  // the drift
+    n.position = e.position + drift.step;
+    n.forward = turned(e.forward, drift.axis, drift.turn);
+    n.up = turned(e.up, drift.axis, drift.turn);
+    n.fov_y = std::clamp(e.fov_y * (1 + drift.zoom), 0.1, 2.5);
+    n.far = std::clamp(e.far * (1 + drift.far), 1.0, 20.0);
+    if (!view_axes_usable(n.forward, n.up)) n = e;
+    return n;
+  }
+  const double small = std::pow(10.0, -4 + 3 * u01(rng));  // 1e-4 .. 0.1
+  const Vec3 axis = normalize(v(sym(rng), sym(rng), sym(rng)));
+  if (kind < 0.76) {  // turn
+    n.forward = turned(e.forward, axis, small * sym(rng));
+    n.up = turned(e.up, axis, small * sym(rng));
+  } else if (kind < 0.8) {  // step
+    n.position = e.position + axis * small;
+  } else if (kind < 0.84) {  // zoom
+    n.fov_y = std::clamp(e.fov_y * (1 + small * sym(rng)), 0.1, 2.5);
+  } else if (kind < 0.87) {
+    n.aspect = std::clamp(e.aspect * (1 + small * sym(rng)), 0.3, 3.0);
+  } else if (kind < 0.9) {
+    n.near = std::clamp(e.near * (1 + small * sym(rng)), 0.01, 0.5);
+    n.far = std::clamp(e.far * (1 + small * sym(rng)), 1.0, 20.0);
+  } else if (kind < 0.93) {  // a large turn
+    n.forward = turned(e.forward, axis, 0.2 + 3 * u01(rng));
+  } else if (kind < 0.95) {  // a jump
+    n = random_eye_view(rng);
+  }  // else: nothing moves
+  if (!view_axes_usable(n.forward, n.up)) n = e;
+  return n;
+}
+
+// GridCuller's memory (visible_reusing) on random pose sequences of a moving eye: at every frame
+// and face, exactly the set of a fresh visible(), for node frusta at a fixed viewpoint (the
+// decoder's views, their far cap following the eye), at the eye itself (the sky pass), and at a
+// viewpoint and depth range drifting on their own (short frusta whose far caps cut through the
+// eye), at every level count. Most decisions come from the memory. The sequences keep many
+// decisions near the limit of their slack: a memory that kept one a little too long fails here
+// (checked: halving the turn's or the travel's part of the bound, letting the budget pass by
+// half, or leaving out the turn of the normals, the travel of the offsets, of the eye's origin,
+// of the viewpoint or of the depth range each fails it).
+TEST(CullingTest, GridCullerReusingEqualsFreshForMovingEyes) {
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> u01(0, 1), sym(-1, 1);
+  std::vector<GridCuller> cullers;
+  for (int g = 0; g < 4; ++g) {
+    cullers.emplace_back(*FaceGrid::with_cell_size(32 + 32 * g, g == 3 ? 64 : 8 + 4 * (g % 2)));
+  }
+  CullStats fresh_stats, reusing_stats;
+  std::vector<uint32_t> fresh, got;
+  int partial = 0;
+  for (int sequence = 0; sequence < 72; ++sequence) {
+    const GridCuller& culler = cullers[sequence % cullers.size()];
+    const int mode = sequence % 3;  // 0: a view, 1: the sky pass, 2: drifting on its own
+    Vec3 viewpoint = v(3 * u01(rng) - 1.5, 3 * u01(rng) - 1.5, 3 * u01(rng) - 1.5);
+    double z_near = 0.05 + 0.5 * u01(rng), z_far = mode == 2 ? 1 + 3 * u01(rng) : 2 + 10 * u01(rng);
+    const Vec3 viewpoint_step = v(sym(rng), sym(rng), sym(rng)) * (0.02 * u01(rng));
+    const double near_rate = 0.02 * sym(rng) * u01(rng), far_rate = 0.02 * sym(rng) * u01(rng);
+    const uint32_t levels = sequence % 4 == 1 ? 1 + sequence % culler.grid().quadtree_levels() : 0;
+    std::array<CullMemory, 6> memory;
+    const Drift drift = random_drift(rng);
+    EyeView eye = random_eye_view(rng);
+    // Point the eye at the viewpoint's neighbourhood, so that its planes cut through the faces.
+    eye.forward = viewpoint + v(u01(rng), u01(rng), u01(rng)) - eye.position;
+    for (int frame = 0; frame < 80; ++frame) {
+      if (frame > 0) {
+        eye = moved(eye, drift, rng);
+        if (mode == 2) {
+          viewpoint = viewpoint + viewpoint_step;
+          z_near = std::clamp(z_near * (1 + near_rate), 0.02, 0.6);
+          z_far = std::clamp(z_far * (1 + far_rate), 0.8, 8.0);
+        }
+      }
+      const Frustum frustum = eye_frustum(eye);
+      const PreparedEye prepared = prepare_eye(frustum);
+      const Vec3 apex = mode == 1 ? eye.position : viewpoint;
+      const double near = mode == 1 ? eye.near : z_near;
+      const double far = mode == 1   ? 2 * eye.far
+                         : mode == 0 ? std::max(z_far, length(eye.position - viewpoint) + eye.far)
+                                     : z_far;
+      for (int f = 0; f < kCubeFaceCount; ++f) {
+        const CubeFace face = cube_face_from_index(f);
+        culler.visible(apex, face, near, far, std::span(&prepared, 1), levels, &fresh_stats,
+                       &fresh);
+        culler.visible_reusing(apex, face, near, far, prepared, levels, &memory[f], &reusing_stats,
+                               &got);
+        ASSERT_EQ(got, fresh) << "sequence " << sequence << " frame " << frame << " face " << f;
+        partial += !fresh.empty() && fresh.size() < culler.grid().cell_count();
+      }
+    }
+  }
+  EXPECT_GT(partial, 1000);
+  // The memory settles most decisions; fresh tests are the exception.
+  EXPECT_GT(reusing_stats.reused, 2 * reusing_stats.tests);
+  EXPECT_LT(reusing_stats.tests * 3, fresh_stats.tests);
+}
+
+// A memory handed to another face or culler starts afresh, and clear() forgets: still the fresh
+// sets.
+TEST(CullingTest, GridCullerMemoryFollowsItsFaceAndCuller) {
+  std::mt19937 rng(9);
+  const GridCuller a(*FaceGrid::with_cell_size(64, 8)), b(*FaceGrid::with_cell_size(64, 16));
+  CullMemory memory;
+  std::vector<uint32_t> fresh, got;
+  const Drift drift = random_drift(rng);
+  EyeView eye = random_eye_view(rng);
+  eye.forward = v(1, 0.2, 0.1);
+  eye.position = v(0, 0, 0);
+  for (int step = 0; step < 24; ++step) {
+    const GridCuller& culler = step % 3 == 0 ? a : b;
+    const CubeFace face = cube_face_from_index(step % 2 == 0 ? 0 : (step / 2) % 6);
+    if (step == 12) memory.clear();
+    eye = moved(eye, drift, rng);
+    const Frustum frustum = eye_frustum(eye);
+    const PreparedEye prepared = prepare_eye(frustum);
+    culler.visible(v(0.1, 0, 0), face, 0.1, 20, std::span(&prepared, 1), 0, nullptr, &fresh);
+    culler.visible_reusing(v(0.1, 0, 0), face, 0.1, 20, prepared, 0, &memory, nullptr, &got);
+    ASSERT_EQ(got, fresh) << "step " << step;
+  }
+}
+
 }  // namespace
 }  // namespace calf

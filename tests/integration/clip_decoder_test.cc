@@ -785,11 +785,12 @@ TEST(ClipDecoder, VisibleSetsAreKeptOnlyWhileTheViewersStay) {
     const bool same =
         i > 0 && steps[i].size() == steps[i - 1].size() &&
         std::memcmp(steps[i].data(), steps[i - 1].data(), steps[i].size() * sizeof(EyeView)) == 0;
-    // Kept sets cost no culling; changed viewers are culled again.
+    // Kept sets cost no culling; changed viewers are culled again (tests, or decisions kept by
+    // the culler's memory where they provably still hold).
     if (same) {
-      EXPECT_EQ(fu.stats.culling_tests, 0u) << "step " << i;
+      EXPECT_EQ(fu.stats.culling_tests + fu.stats.culling_reused, 0u) << "step " << i;
     } else {
-      EXPECT_GT(fu.stats.culling_tests, 0u) << "step " << i;
+      EXPECT_GT(fu.stats.culling_tests + fu.stats.culling_reused, 0u) << "step " << i;
       changed += sets(fu) != sets(FrameUpdates{}) ? 1 : 0;
     }
   }
@@ -805,7 +806,64 @@ TEST(ClipDecoder, VisibleSetsAreKeptOnlyWhileTheViewersStay) {
   ClipDecoder fresh = open_decoder(clip);
   ASSERT_TRUE(fresh.advance(0, steps[0], {}, &fresh_fu).ok());
   EXPECT_EQ(sets(again), sets(fresh_fu));
-  EXPECT_GT(again.stats.culling_tests, 0u);
+  EXPECT_GT(again.stats.culling_tests + again.stats.culling_reused, 0u);
+}
+
+// A moving pair of eyes (turning, stepping, zooming, now and then jumping): the decoder culls
+// mostly from its culler's memory of earlier frames, and every frame's updates are byte for byte
+// those of a decoder that tests every cell afresh (brute force, no memory) on the same sequence.
+TEST(ClipDecoder, MovingEyesCullFromMemoryWithTheSameUpdates) {
+  ClipSpec spec;
+  spec.seed = 58;
+  spec.views = 3;
+  spec.options.cell_size = 4;
+  const Clip clip = make_clip(spec);
+  ClipDecoderOptions brute;
+  brute.brute_force_culling = true;
+  brute.background_thread = false;
+  ClipDecoderOptions quadtree;
+  quadtree.background_thread = false;
+  ClipDecoder remembering = open_decoder(clip, quadtree), fresh = open_decoder(clip, brute);
+  std::mt19937 rng(58);
+  std::uniform_real_distribution<double> u01(0, 1);
+  std::vector<EyeView> eyes = {random_eye(rng), random_eye(rng)};
+  uint64_t tests = 0, reused = 0;
+  for (uint32_t step = 0; step < 40; ++step) {
+    for (EyeView& e : eyes) {
+      const double a = 0.01 * (1 + step % 3), c = std::cos(a), s = std::sin(a);
+      e.forward = {e.forward.x * c - e.forward.z * s, e.forward.y,
+                   e.forward.x * s + e.forward.z * c};
+      e.position.x += 0.002;
+      if (step % 7 == 3) e.fov_y *= 1.01;
+      if (step % 13 == 12) e = random_eye(rng);
+    }
+    const uint32_t frame = step % spec.frames;
+    FrameUpdates a, b;
+    ASSERT_TRUE(remembering.advance(frame, eyes, {}, &a).ok());
+    ASSERT_TRUE(fresh.advance(frame, eyes, {}, &b).ok());
+    ASSERT_EQ(a.updates.size(), b.updates.size()) << "step " << step;
+    for (size_t i = 0; i < a.updates.size(); ++i) {
+      EXPECT_EQ(a.updates[i].view, b.updates[i].view);
+      EXPECT_EQ(a.updates[i].face, b.updates[i].face);
+      EXPECT_EQ(a.updates[i].target, b.updates[i].target);
+      EXPECT_EQ(a.updates[i].slot, b.updates[i].slot);
+      EXPECT_EQ(a.updates[i].rect, b.updates[i].rect);
+      EXPECT_TRUE(std::equal(a.updates[i].bytes.begin(), a.updates[i].bytes.end(),
+                             b.updates[i].bytes.begin(), b.updates[i].bytes.end()))
+          << "step " << step << " update " << i;
+    }
+    ASSERT_EQ(a.cells.size(), b.cells.size()) << "step " << step;
+    for (size_t i = 0; i < a.cells.size(); ++i) {
+      EXPECT_TRUE(a.cells[i].view == b.cells[i].view && a.cells[i].face == b.cells[i].face &&
+                  a.cells[i].cell == b.cells[i].cell && a.cells[i].t == b.cells[i].t &&
+                  a.cells[i].a_slot == b.cells[i].a_slot)
+          << "step " << step << " cell " << i;
+    }
+    EXPECT_EQ(a.tiles, b.tiles) << "step " << step;
+    tests += a.stats.culling_tests;
+    reused += a.stats.culling_reused;
+  }
+  EXPECT_GT(reused, tests);
 }
 
 // Sky is at infinity: the renderer reads each view's sky in the eye ray's own direction. A view

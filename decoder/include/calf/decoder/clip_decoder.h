@@ -86,6 +86,7 @@ struct FrameStats {
   uint32_t frame = 0;
   uint64_t culling_tests = 0;        // frustum-frustum tests, cells and tiles
   uint64_t culling_exact_tests = 0;  // of those, full separating-axis tests (culling.h GridCuller)
+  uint64_t culling_reused = 0;       // node decisions kept from earlier frames instead of tests
   uint32_t visible_cells = 0;        // colour cells of active views seen by a viewer
   uint32_t total_cells = 0;          // colour cells of active views
   uint32_t visible_tiles = 0;        // depth tiles of active views seen by a viewer

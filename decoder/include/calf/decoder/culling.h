@@ -34,10 +34,13 @@ Frustum cell_frustum(const Vec3& viewpoint, CubeFace face, uint32_t face_size,
 
 // Counts of frustum-frustum tests, for Table 4 of the paper. `exact_tests` counts the full
 // separating-axis tests GridCuller falls back to (the reference searches below count none).
+// GridCuller::visible_reusing() counts in `reused` the node decisions it took from its memory
+// instead of testing (those are not in `tests`).
 struct CullStats {
   uint64_t tests = 0;
   uint64_t visible_cells = 0;
   uint64_t exact_tests = 0;
+  uint64_t reused = 0;
 };
 
 // The cells of `face` (indices in `grid`, increasing) whose frustum meets at least one eye
@@ -72,11 +75,21 @@ std::array<Vec3, 8> cell_frustum_corners(const CellDirections& cell, const Vec3&
 
 // An eye frustum prepared for GridCuller: its face planes (inward normals) with the interval its
 // corners span on each, as the separating-axis test computes them.
+// For GridCuller's memory (visible_reusing) the same planes as 12 half-spaces, each
+// dot(u, x - origin) >= offset with a unit normal u: half-space k < 6 is the eye's side of its
+// interval on normals[k] (u = normals[k] / |normals[k]|, from lo[k]), half-space 6 + k the other
+// end (u = -normals[k] / |normals[k]|, from hi[k]); `origin` is the near cap's centre. How far
+// these move between two eyes bounds how far every decision made against one can change for the
+// other.
 struct PreparedEye {
   const Frustum* frustum = nullptr;
   std::array<Vec3, 6> normals;
   std::array<double, 6> lo{}, hi{}, margin{};
-  double reach = 0;  // the largest coordinate magnitude of a corner
+  double reach = 0;                 // the largest coordinate magnitude of a corner
+  std::array<Vec3, 6> unit;         // normals[k] / |normals[k]|
+  std::array<double, 6> inv_len{};  // 1 / |normals[k]|
+  Vec3 origin;
+  std::array<double, 12> offset{};
 };
 PreparedEye prepare_eye(const Frustum& eye);
 
@@ -99,6 +112,8 @@ PreparedEye prepare_eye(const Frustum& eye);
 // through frusta_intersect(), on the frustum cell_frustum() builds (the same bits), which stays
 // the arbiter. The result is exactly visible_cells_hierarchical()'s and
 // visible_cells_brute_force()'s (tested on random frusta).
+class CullMemory;
+
 class GridCuller {
  public:
   explicit GridCuller(const FaceGrid& grid);
@@ -110,6 +125,27 @@ class GridCuller {
   void visible(const Vec3& viewpoint, CubeFace face, double z_near, double z_far,
                std::span<const PreparedEye> eyes, uint32_t levels, CullStats* stats,
                std::vector<uint32_t>* out) const;
+
+  // The same set for one eye, reusing the decisions `memory` kept from earlier calls where they
+  // provably still hold (a moving eye, issue 17): a node decision is kept with its slack — the
+  // smallest distance by which the node points it rests on lay inside or outside the eye's
+  // planes, and that distance over their distance from the eye — and taken again while the eye's
+  // planes (their unit normals and offsets) and the node frusta (viewpoint, depth range) have
+  // moved less since than the slack allows, with a margin of 1e-7 of the coordinates' scale (far
+  // above the tests' own 1e-9 and rounding). Kept: a rejection by an eye plane, an acceptance by
+  // points inside the eye (corners, a cross-section, a point on a segment), and for an inner
+  // node "not rejected by any eye plane", which descends to the children (an inner node the
+  // planes accept has only visible cells below it, so descending finds the same cells). All
+  // else — leaves settled by their own planes or by the exact test — is tested afresh, with the
+  // very tests of visible(); a leaf the exact test rejected is first tried on the one axis of
+  // that test which separated it by the widest gap (with 100 times its tolerance, so that the
+  // exact test would reject it too). The result is therefore exactly visible()'s for `eye`, for any
+  // sequence of calls (tested on random moving, jumping and zooming eyes). `memory` belongs to
+  // one (viewpoint, face, eye) as the caller sees it; one given another culler or face starts
+  // afresh, and any other change only makes it test more.
+  void visible_reusing(const Vec3& viewpoint, CubeFace face, double z_near, double z_far,
+                       const PreparedEye& eye, uint32_t levels, CullMemory* memory,
+                       CullStats* stats, std::vector<uint32_t>* out) const;
 
  private:
   struct Node {
@@ -123,6 +159,46 @@ class GridCuller {
   FaceGrid grid_;
   std::vector<uint32_t> level_start_;  // first node of each level in nodes_[face]
   std::array<std::vector<Node>, 6> nodes_;
+  std::array<Vec3, 6> axis_;  // each face's axis (the caps are perpendicular to it)
+  // Per node (the same on every face): bit 0 no cells, bit 1 one cell (a leaf). A walk through
+  // the memory reads this, not the node.
+  std::vector<uint8_t> shape_;
+  double max_axial_ = 0;  // the longest axial[i] of any node, for how far corners move
+};
+
+// What GridCuller::visible_reusing() keeps between calls for one (viewpoint, face, eye): each
+// node's last decision with its slack, and the eye and node frusta of the last call with the
+// motion summed since (an upper bound of how far they have moved from any earlier call).
+class CullMemory {
+ public:
+  // Forgets every decision (never needed for correctness: a memory only ever saves tests).
+  void clear();
+
+ private:
+  friend class GridCuller;
+  enum class Kind : uint8_t { kNone, kReject, kAccept, kDescend };
+  // 24 bytes: a walk reads one per node it visits.
+  struct Decision {
+    // Kept while turn * inv_angle + (travel + margin) * inv_distance < budget, that is while
+    // (turn - turn then) / angle + (travel - travel then + margin) / distance < 1 with room for
+    // rounding (the inverses rounded up to floats).
+    double budget = 0;
+    float inv_angle = 0, inv_distance = 0;
+    float depth = 0;  // an inner node accepted by its cross-section: that section's depth
+    Kind kind = Kind::kNone;
+    // A leaf the exact test rejected: the axis that separated it by the widest gap, tried
+    // first next time (a fresh test, cheaper than the exact one); -1: none.
+    int8_t axis = -1;
+  };
+  std::vector<Decision> nodes_;
+  const GridCuller* culler_ = nullptr;
+  int face_ = -1;
+  bool has_last_ = false;
+  std::array<Vec3, 6> unit_;
+  std::array<double, 12> offset_{};
+  Vec3 origin_, apex_;
+  double z_near_ = 0, z_far_ = 0;
+  double turn_ = 0, travel_ = 0;  // summed motion: unit normals' turn, offsets' and points' travel
 };
 
 }  // namespace calf
