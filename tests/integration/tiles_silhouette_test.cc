@@ -1,8 +1,13 @@
-// Experiment: where does a tile set put a straight silhouette, against where it is?
-// A box room with a square panel (x = 1, rotated 0.3 rad about x so its edges cross pixel rows at
-// every sub-pixel phase) in front of the +X wall, captured from 9 viewpoints; the tiles built from
-// it are rendered by the CPU reference at a capture viewpoint looking along +X, and each of the
-// panel's four edges' signed outward displacement (pixels) is measured against the exact edge.
+// Where a tile set puts a straight silhouette, against where it is (issue 18: texel, tile, alpha
+// and atlas conventions end to end). A box room with a square panel (x = 1, rotated 0.3 rad about
+// x so its edges cross pixel rows at every sub-pixel phase) in front of the +X wall, captured from
+// 9 viewpoints (colour box-filtered over the texel, depth of its centre ray, as calf-capture);
+// the tiles built from it are rendered by the CPU reference looking along +X from every capture
+// viewpoint and from 6 novel eyes, and each of the panel's four edges' signed outward
+// displacement in pixels is measured from the green channel against the exact edge. A half-texel
+// error anywhere between the capture's texel centres and the renderer's sampling moves an edge by
+// about 0.5 px (a flat panel: 0.5 px outward on two edges and inward on the others; measured with
+// the conventions right: |offset| <= 0.12 px per view, means within 0.1 px at 64^2).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,7 +18,6 @@
 
 #include "../scratch_dir.h"
 #include "calf/capture/capture_set.h"
-#include "calf/capture/eye_path.h"
 #include "calf/encoder/tiles_build.h"
 #include "calf/format/camera.h"
 #include "calf/format/cube.h"
@@ -37,10 +41,11 @@ void panel_local(double y, double z, double* a, double* b) {
   *b = -s * y + c * z;
 }
 
-// The panel's thickness along x (0: a flat panel); CALF_SIL_DEPTH sets it.
+// The panel's thickness along x (0: a flat panel; a box otherwise, whose side faces the off-centre
+// viewpoints see).
+double g_depth = 0;
 double panel_depth() {
-  static const double d = std::getenv("CALF_SIL_DEPTH") ? std::atof(std::getenv("CALF_SIL_DEPTH")) : 0.0;
-  return d;
+  return g_depth;
 }
 
 // Distance and whether the panel (else a wall) is hit first.
@@ -104,8 +109,8 @@ fs::path write_capture(uint32_t n, uint32_t ss) {
           float c[3] = {0, 0, 0};
           for (uint32_t qy = 0; qy < ss; ++qy) {
             for (uint32_t qx = 0; qx < ss; ++qx) {
-              const Vec3 d = direction_from_texel_coord(
-                  {cf, x + (qx + 0.5) / ss, y + (qy + 0.5) / ss}, n);
+              const Vec3 d =
+                  direction_from_texel_coord({cf, x + (qx + 0.5) / ss, y + (qy + 0.5) / ss}, n);
               const bool panel = trace(vp[v], d).second;
               for (int ch = 0; ch < 3; ++ch) c[ch] += (panel ? kPanel : kWall)[ch];
             }
@@ -176,317 +181,47 @@ EdgeOffsets measure(const std::vector<float>& rgb, const Vec3& eye, uint32_t n) 
   return out;
 }
 
-TEST(TilesSilhouette, EdgeOffsetAtCaptureViewpoints) {
-  const char* env = std::getenv("CALF_SIL_FACES");
-  std::vector<uint32_t> faces = {64};
-  if (env != nullptr) {
-    faces.clear();
-    for (const char* p = env; *p;) {
-      faces.push_back(static_cast<uint32_t>(std::strtoul(p, const_cast<char**>(&p), 10)));
-      if (*p == ',') ++p;
-    }
-  }
-  const uint32_t ss = std::getenv("CALF_SIL_SS") ? std::atoi(std::getenv("CALF_SIL_SS")) : 1;
-  for (uint32_t n : faces) {
-    const fs::path dir = write_capture(n, ss);
+TEST(TilesSilhouette, EdgesStayWithinAFractionOfAPixel) {
+  constexpr uint32_t n = 64;
+  for (double depth : {0.0, 0.3}) {
+    SCOPED_TRACE(depth);
+    g_depth = depth;
+    const fs::path dir = write_capture(n, 4);
     auto reader = capture::CaptureSetReader::open(dir);
     ASSERT_TRUE(reader.ok());
     encoder::TilesBuildOptions o;
     o.threads = 2;
-    if (std::getenv("CALF_SIL_CONSTRAINTS")) {
-      o.alpha_estimate = encoder::TilesAlphaEstimate::kConstraints;
-    }
-    encoder::TilesBuildReport report;
-    auto set = encoder::build_tiles(*reader, 0, o, &report);
+    auto set = encoder::build_tiles(*reader, 0, o, nullptr);
     ASSERT_TRUE(set.ok()) << set.status().to_string();
     const player::TilesLinearAtlas atlas = player::tiles_linear_atlas(*set);
-    const auto vp = viewpoints(0.25);
-    double mean[4] = {0, 0, 0, 0}, cap_mean[4] = {0, 0, 0, 0};
-    capture::ViewFrame view;
-    for (uint32_t v = 0; v < vp.size(); ++v) {
+    std::vector<Vec3> eyes = viewpoints(0.25);
+    const size_t capture_views = eyes.size();
+    for (const Vec3& e :
+         {Vec3{0.12, -0.07, 0.18}, Vec3{-0.15, 0.1, -0.05}, Vec3{0.2, 0.2, -0.2},
+          Vec3{-0.22, -0.18, 0.1}, Vec3{0.05, 0.15, -0.12}, Vec3{-0.1, -0.2, -0.2}}) {
+      eyes.push_back(e);
+    }
+    double mean[4] = {0, 0, 0, 0};
+    for (size_t v = 0; v < eyes.size(); ++v) {
       Camera cam;
-      cam.position = vp[v];
+      cam.position = eyes[v];
       cam.forward = {1, 0, 0};
       cam.up = {0, 1, 0};
       cam.width = cam.height = n;
       player::RenderedImage img;
       ASSERT_TRUE(player::render_tiles_cpu(*set, atlas, cam, {}, &img, nullptr).ok());
-      const EdgeOffsets t = measure(img.color, vp[v], n);
-      // The capture's own +X face as the upright image: pixel (i, j) = texel (n - 1 - i, j).
-      ASSERT_TRUE(reader->read(v, 0, &view).ok());
-      std::vector<float> cap(3 * size_t{n} * n);
-      for (uint32_t j = 0; j < n; ++j) {
-        for (uint32_t i = 0; i < n; ++i) {
-          const size_t tx = view.texel_index(CubeFace::kPosX, n - 1 - i, j);
-          for (int c = 0; c < 3; ++c) cap[3 * (size_t{j} * n + i) + c] = view.color[3 * tx + c];
-        }
-      }
-      const EdgeOffsets c = measure(cap, vp[v], n);
-      std::printf("N %u view %u tiles: %+.3f %+.3f %+.3f %+.3f  capture: %+.3f %+.3f %+.3f %+.3f\n",
-                  n, v, t.edge[0], t.edge[1], t.edge[2], t.edge[3], c.edge[0], c.edge[1],
-                  c.edge[2], c.edge[3]);
+      const EdgeOffsets t = measure(img.color, eyes[v], n);
+      std::printf("panel depth %.1f, %s %zu: edge offsets %+.3f %+.3f %+.3f %+.3f px\n", depth,
+                  v < capture_views ? "capture viewpoint" : "novel eye", v, t.edge[0], t.edge[1],
+                  t.edge[2], t.edge[3]);
       for (int e = 0; e < 4; ++e) {
-        mean[e] += t.edge[e] / vp.size();
-        cap_mean[e] += c.edge[e] / vp.size();
+        EXPECT_LT(std::abs(t.edge[e]), 0.3) << "eye " << v << " edge " << e;
+        mean[e] += t.edge[e] / eyes.size();
       }
     }
-    const Vec3 novel[6] = {{0.12, -0.07, 0.18}, {-0.15, 0.1, -0.05}, {0.2, 0.2, -0.2},
-                           {-0.22, -0.18, 0.1}, {0.05, 0.15, -0.12}, {-0.1, -0.2, -0.2}};
-    double nmean[4] = {0, 0, 0, 0}, nabs = 0;
-    for (const Vec3& eye : novel) {
-      Camera cam;
-      cam.position = eye;
-      cam.forward = {1, 0, 0};
-      cam.up = {0, 1, 0};
-      cam.width = cam.height = n;
-      player::RenderedImage img;
-      ASSERT_TRUE(player::render_tiles_cpu(*set, atlas, cam, {}, &img, nullptr).ok());
-      const EdgeOffsets t = measure(img.color, eye, n);
-      std::printf("N %u novel (%+.2f %+.2f %+.2f) tiles: %+.3f %+.3f %+.3f %+.3f\n", n, eye.x,
-                  eye.y, eye.z, t.edge[0], t.edge[1], t.edge[2], t.edge[3]);
-      for (int e = 0; e < 4; ++e) {
-        nmean[e] += t.edge[e] / 6;
-        nabs += std::abs(t.edge[e]) / 24;
-      }
-    }
-    std::printf("N %u novel mean: %+.3f %+.3f %+.3f %+.3f, mean |offset| %.3f px\n", n, nmean[0],
-                nmean[1], nmean[2], nmean[3], nabs);
-    std::printf("N %u (%zu tiles) mean tiles: %+.3f %+.3f %+.3f %+.3f  capture: %+.3f %+.3f %+.3f %+.3f\n",
-                n, set->tiles.size(), mean[0], mean[1], mean[2], mean[3], cap_mean[0],
-                cap_mean[1], cap_mean[2], cap_mean[3]);
+    for (int e = 0; e < 4; ++e) EXPECT_LT(std::abs(mean[e]), 0.15) << "edge " << e;
   }
 }
 
-}  // namespace
-}  // namespace calf
-
-namespace calf {
-namespace {
-
-// Real data: CALF_SIL_GT (ground-truth dir) against CALF_SIL_RENDER (calf-play --out --format exr
-// frames). Per strong horizontal / vertical depth edge of the ground truth (clean on both sides),
-// the signed outward offset in pixels of the render's edge (its depth crossing the geometric mean
-// of the two sides' depths), as a histogram.
-TEST(TilesSilhouette, RealEdgeOffsets) {
-  const char* gt_dir = std::getenv("CALF_SIL_GT");
-  const char* r_dir = std::getenv("CALF_SIL_RENDER");
-  if (gt_dir == nullptr || r_dir == nullptr) GTEST_SKIP();
-  long hist[2][9] = {};  // [vertical edges, horizontal edges][offset + 3], 7: none, 8: unused
-  double sum[2] = {0, 0};
-  long count[2] = {0, 0};
-  double csum[2] = {0, 0};
-  long ccount[2] = {0, 0};
-  for (uint32_t pose = 0;; ++pose) {
-    char name[64];
-    std::snprintf(name, sizeof name, "gt_%05u.exr", pose);
-    const fs::path g = fs::path(gt_dir) / name;
-    std::snprintf(name, sizeof name, "frame_%05u.exr", pose);
-    const fs::path r = fs::path(r_dir) / name;
-    if (!fs::exists(g) || !fs::exists(r)) break;
-    auto gi = capture::read_perspective_image(g);
-    auto ri = capture::read_perspective_image(r);
-    ASSERT_TRUE(gi.ok() && ri.ok());
-    const uint32_t w = gi->width, h = gi->height;
-    ASSERT_EQ(ri->width, w);
-    long ph[2][9] = {};
-    double pcsum[2] = {0, 0};
-    long pccount[2] = {0, 0};
-    for (int dir = 0; dir < 2; ++dir) {
-      // dir 0: scan rows (vertical silhouettes), 1: scan columns.
-      const uint32_t lines = dir == 0 ? h : w, len = dir == 0 ? w : h;
-      const auto at = [&](const std::vector<float>& d, uint32_t line, int k) {
-        return dir == 0 ? d[size_t{line} * w + k] : d[size_t(k) * w + line];
-      };
-      for (uint32_t line = 0; line < lines; ++line) {
-        for (int i = 3; i + 4 < int(len); ++i) {
-          const float a = at(gi->depth, line, i), b = at(gi->depth, line, i + 1);
-          if (!std::isfinite(a) || !std::isfinite(b)) continue;
-          const bool fg_left = a < b;
-          const float fg = std::min(a, b), bg = std::max(a, b);
-          if (bg < 1.3f * fg) continue;
-          bool clean = true;
-          for (int k = 1; k <= 3; ++k) {
-            const float l = at(gi->depth, line, i + 1 - k), rr = at(gi->depth, line, i + k);
-            const float want_l = fg_left ? fg : bg, want_r = fg_left ? bg : fg;
-            clean &= std::abs(l - want_l) < 0.03f * want_l && std::abs(rr - want_r) < 0.03f * want_r;
-          }
-          if (!clean) continue;
-          {
-            // Colour: the foreground's share of the window's pixels, render minus ground truth.
-            const auto col = [&](const std::vector<float>& c, int k, int ch) {
-              return dir == 0 ? c[3 * (size_t{line} * w + k) + ch] : c[3 * (size_t(k) * w + line) + ch];
-            };
-            const int kf = fg_left ? i - 2 : i + 3, kb = fg_left ? i + 3 : i - 2;
-            double cf[3], cb[3], nn = 0;
-            for (int ch = 0; ch < 3; ++ch) {
-              cf[ch] = col(gi->color, kf, ch);
-              cb[ch] = col(gi->color, kb, ch);
-              nn += (cf[ch] - cb[ch]) * (cf[ch] - cb[ch]);
-            }
-            const double lum = (cf[0] + cf[1] + cf[2] + cb[0] + cb[1] + cb[2]) / 6;
-            if (std::sqrt(nn) > 0.3 * lum) {
-              double shift = 0;
-              for (int k = i - 2; k <= i + 3; ++k) {
-                double fr = 0, fgt = 0;
-                for (int ch = 0; ch < 3; ++ch) {
-                  fr += (col(ri->color, k, ch) - cb[ch]) * (cf[ch] - cb[ch]);
-                  fgt += (col(gi->color, k, ch) - cb[ch]) * (cf[ch] - cb[ch]);
-                }
-                shift += (fr - fgt) / nn;
-              }
-              csum[dir] += shift;
-              ++ccount[dir];
-              pcsum[dir] += shift;
-              ++pccount[dir];
-            }
-          }
-          const float t = std::sqrt(fg * bg);
-          // The render's boundaries k (between k - 1 and k) with the same orientation, nearest
-          // to the ground truth's (i + 1).
-          int best = 99;
-          for (int k = i - 2; k <= i + 4; ++k) {
-            const float l = at(ri->depth, line, k - 1), rr = at(ri->depth, line, k);
-            const bool l_fg = l < t, r_fg = rr < t;
-            if (fg_left ? (l_fg && !r_fg) : (!l_fg && r_fg)) {
-              if (std::abs(k - (i + 1)) < std::abs(best)) best = k - (i + 1);
-            }
-          }
-          const int out = best == 99 ? 99 : (fg_left ? best : -best);
-          if (std::getenv("CALF_SIL_VERBOSE") && std::atoi(std::getenv("CALF_SIL_VERBOSE")) == int(pose)) {
-            std::printf("  dir %d line %u at %d fg %.3f bg %.3f %s out %d\n", dir, line, i, fg, bg,
-                        fg_left ? "fg-left" : "fg-right", out);
-          }
-          const int bin = out == 99 ? 7 : out + 3;
-          ++hist[dir][bin];
-          ++ph[dir][bin];
-          if (out != 99) sum[dir] += out, ++count[dir];
-        }
-      }
-    }
-    std::printf("pose %u rows: ", pose);
-    for (int b = 0; b < 8; ++b) std::printf("%ld ", ph[0][b]);
-    std::printf(" cols: ");
-    for (int b = 0; b < 8; ++b) std::printf("%ld ", ph[1][b]);
-    std::printf(" colour shift rows %+.3f (%ld) cols %+.3f (%ld)\n",
-                pccount[0] ? pcsum[0] / pccount[0] : 0.0, pccount[0],
-                pccount[1] ? pcsum[1] / pccount[1] : 0.0, pccount[1]);
-  }
-  for (int dir = 0; dir < 2; ++dir) {
-    std::printf("%s edges, outward offset -3..+3, none: ", dir == 0 ? "vertical" : "horizontal");
-    for (int b = 0; b < 8; ++b) std::printf("%ld ", hist[dir][b]);
-    std::printf(" mean %+.3f px over %ld; colour shift %+.3f px over %ld\n",
-                count[dir] ? sum[dir] / count[dir] : 0.0, count[dir],
-                ccount[dir] ? csum[dir] / ccount[dir] : 0.0, ccount[dir]);
-  }
-}
-
-}  // namespace
-}  // namespace calf
-
-namespace calf {
-namespace {
-// CALF_SIL_DUMP="gt.exr,render.exr,row,col0,col1": both images' pixels along one row.
-TEST(TilesSilhouette, DumpRow) {
-  const char* spec = std::getenv("CALF_SIL_DUMP");
-  if (spec == nullptr) GTEST_SKIP();
-  std::string s = spec;
-  std::vector<std::string> f;
-  for (size_t p = 0;;) {
-    const size_t q = s.find(',', p);
-    f.push_back(s.substr(p, q - p));
-    if (q == std::string::npos) break;
-    p = q + 1;
-  }
-  auto g = capture::read_perspective_image(f[0]);
-  auto r = capture::read_perspective_image(f[1]);
-  ASSERT_TRUE(g.ok() && r.ok());
-  const int row = std::stoi(f[2]), c0 = std::stoi(f[3]), c1 = std::stoi(f[4]);
-  for (int c = c0; c <= c1; ++c) {
-    const size_t k = size_t(row) * g->width + c;
-    std::printf("col %d  gt %.3f %.3f %.3f z %.3f   render %.3f %.3f %.3f z %.3f\n", c,
-                g->color[3 * k], g->color[3 * k + 1], g->color[3 * k + 2], g->depth[k],
-                r->color[3 * k], r->color[3 * k + 1], r->color[3 * k + 2], r->depth[k]);
-  }
-}
-}  // namespace
-}  // namespace calf
-
-#include "calf/decoder/tiles_track.h"
-#include "calf/format/bc.h"
-#include "calf/format/container.h"
-
-namespace calf {
-namespace {
-// CALF_SIL_FRAG="clip.calf,eye_path.json,pose,i,j": every tile fragment at pixel (i, j) of the
-// pose, back to front, and their composite.
-TEST(TilesSilhouette, DumpFragments) {
-  const char* spec = std::getenv("CALF_SIL_FRAG");
-  if (spec == nullptr) GTEST_SKIP();
-  std::string s = spec;
-  std::vector<std::string> f;
-  for (size_t p = 0;;) {
-    const size_t q = s.find(',', p);
-    f.push_back(s.substr(p, q - p));
-    if (q == std::string::npos) break;
-    p = q + 1;
-  }
-  auto reader = container::Reader::open(f[0]);
-  ASSERT_TRUE(reader.ok());
-  auto set = decoder::decode_tiles_track(*reader, 0);
-  ASSERT_TRUE(set.ok()) << set.status().to_string();
-  auto path = capture::read_eye_path(f[1]);
-  ASSERT_TRUE(path.ok());
-  const Camera cam = capture::camera_from_pose(*path, std::stoi(f[2]));
-  const uint32_t pi = std::stoi(f[3]), pj = std::stoi(f[4]);
-  const Vec3 d = camera_ray(cam, pi, pj);
-  const player::TilesLinearAtlas atlas = player::tiles_linear_atlas(*set);
-  std::vector<uint32_t> order;
-  player::tiles_back_to_front(*set, cam.position, &order);
-  double out[3] = {0, 0, 0};
-  for (uint32_t t : order) {
-    const Tile& tl = set->tiles[t];
-    static constexpr int kTri[2][3] = {{0, 1, 2}, {0, 2, 3}};
-    for (const auto& tri : kTri) {
-      Vec3 p[3], uvw[3];
-      for (int c = 0; c < 3; ++c) {
-        const TileCorner& k = tl.corners[tri[c]];
-        p[c] = Vec3{k.position[0], k.position[1], k.position[2]} - cam.position;
-        uvw[c] = Vec3{k.uvw[0], k.uvw[1], k.uvw[2]};
-      }
-      const Vec3 n = cross(p[1] - p[0], p[2] - p[0]);
-      const double den = dot(n, d);
-      if (den == 0) continue;
-      const double dist = dot(n, p[0]) / den;
-      if (!(dist > 0)) continue;
-      const Vec3 x = d * dist;
-      const double nn = dot(n, n);
-      const double l1 = dot(n, cross(x - p[0], p[2] - p[0])) / nn;
-      const double l2 = dot(n, cross(p[1] - p[0], x - p[0])) / nn;
-      const double l0 = 1 - l1 - l2;
-      if (l0 < 0 || l1 < 0 || l2 < 0) continue;
-      const Vec3 q = uvw[0] * l0 + uvw[1] * l1 + uvw[2] * l2;
-      const double u = q.x / q.z * atlas.width - 0.5, v = q.y / q.z * atlas.height - 0.5;
-      const int x0 = int(std::floor(u)), y0 = int(std::floor(v));
-      const double ax = u - x0, ay = v - y0;
-      double texel[4] = {0, 0, 0, 0};
-      for (int dy = 0; dy < 2; ++dy) {
-        for (int dx = 0; dx < 2; ++dx) {
-          const size_t k = (size_t(y0 + dy) * atlas.width + (x0 + dx)) * 4;
-          const double wgt = (dx ? ax : 1 - ax) * (dy ? ay : 1 - ay);
-          for (int c = 0; c < 4; ++c) texel[c] += wgt * bc::half_to_float(atlas.rgba_half[k + c]);
-        }
-      }
-      for (int c = 0; c < 3; ++c) out[c] = texel[c] + (1 - texel[3]) * out[c];
-      // The tile's centre and normal.
-      Vec3 centre;
-      for (const TileCorner& k : tl.corners) centre += Vec3{k.position[0], k.position[1], k.position[2]} * 0.25;
-      const Vec3 nu = normalize(n);
-      std::printf("tile %u dist %.4f alpha %.3f premult %.3f %.3f %.3f  texel (%.2f, %.2f) centre %.3f %.3f %.3f normal %.2f %.2f %.2f\n",
-                  t, dist, texel[3], texel[0], texel[1], texel[2], u, v, centre.x, centre.y,
-                  centre.z, nu.x, nu.y, nu.z);
-    }
-  }
-  std::printf("composite %.3f %.3f %.3f\n", out[0], out[1], out[2]);
-}
 }  // namespace
 }  // namespace calf
