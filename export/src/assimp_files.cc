@@ -86,7 +86,10 @@ Expected<std::vector<ExportedFile>> write_scene(const aiScene& scene, MeshExport
   std::vector<ExportedFile> files;
   for (const aiExportDataBlob* b = blob; b != nullptr; b = b->next) {
     ExportedFile file;
-    file.suffix = b == blob ? "" : "." + std::string(b->name.C_Str());
+    if (b != blob) {  // appends, not operator+: GCC 12 -O3 misfires -Wrestrict on it
+      file.suffix = ".";
+      file.suffix += b->name.C_Str();
+    }
     const auto* data = static_cast<const uint8_t*>(b->data);
     file.bytes.assign(data, data + b->size);
     files.push_back(std::move(file));

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <string>
 
 #include "../scratch_dir.h"
 #include "calf/capture/capture_set.h"
@@ -86,15 +87,23 @@ std::vector<Vec3> viewpoints(double r) {
 
 // Colour box-filtered over the texel (ss x ss), depth of the centre ray: calf-capture's rule.
 fs::path write_capture(uint32_t n, uint32_t ss) {
-  const fs::path dir = test::scratch_dir("tiles_silhouette_test") /
-                       ("panel" + std::to_string(n) + "_" + std::to_string(ss) + "_" +
-                        std::to_string(panel_depth()));
+  std::string name = "panel";  // appends, not operator+: GCC 12 -O3 misfires -Wrestrict on it
+  for (const std::string& part :
+       {std::to_string(n), std::to_string(ss), std::to_string(panel_depth())}) {
+    name += '_';
+    name += part;
+  }
+  const fs::path dir = test::scratch_dir("tiles_silhouette_test") / name;
   capture::CaptureManifest m;
   m.frame_count = 1;
   m.face_size = n;
   m.view_volume = {{-0.25, -0.25, -0.25}, {0.25, 0.25, 0.25}};
   const auto vp = viewpoints(0.25);
-  for (size_t k = 0; k < vp.size(); ++k) m.viewpoints.push_back({"v" + std::to_string(k), vp[k]});
+  for (size_t k = 0; k < vp.size(); ++k) {
+    std::string id = "v";
+    id += std::to_string(k);
+    m.viewpoints.push_back({id, vp[k]});
+  }
   auto w = capture::CaptureSetWriter::create(dir, m);
   EXPECT_TRUE(w.ok()) << w.status().to_string();
   capture::ViewFrame f;
