@@ -78,22 +78,26 @@ struct RandomScene {
   std::vector<Frustum> eyes;
 };
 
-RandomScene random_scene(std::mt19937& rng, int eye_count) {
+// A random eye: position in [-3, 3]^3, any direction, field of view, aspect and far plane.
+EyeView random_eye_view(std::mt19937& rng) {
   std::uniform_real_distribution<double> pos(-3, 3), u01(0, 1);
+  EyeView e;
+  e.position = v(pos(rng), pos(rng), pos(rng));
+  const double th = u01(rng) * 2 * kPi, ph = std::acos(2 * u01(rng) - 1);
+  e.forward = v(std::sin(ph) * std::cos(th), std::sin(ph) * std::sin(th), std::cos(ph));
+  e.up = std::fabs(e.forward.y) < 0.9 ? v(0, 1, 0) : v(1, 0, 0);
+  e.fov_y = 0.3 + u01(rng) * 1.5;
+  e.aspect = 0.5 + u01(rng) * 1.5;
+  e.near = 0.05;
+  e.far = 1 + u01(rng) * 8;
+  return e;
+}
+
+RandomScene random_scene(std::mt19937& rng, int eye_count) {
+  std::uniform_real_distribution<double> pos(-3, 3);
   RandomScene s;
   s.viewpoint = v(pos(rng), pos(rng), pos(rng));
-  for (int i = 0; i < eye_count; ++i) {
-    EyeView e;
-    e.position = v(pos(rng), pos(rng), pos(rng));
-    const double th = u01(rng) * 2 * kPi, ph = std::acos(2 * u01(rng) - 1);
-    e.forward = v(std::sin(ph) * std::cos(th), std::sin(ph) * std::sin(th), std::cos(ph));
-    e.up = std::fabs(e.forward.y) < 0.9 ? v(0, 1, 0) : v(1, 0, 0);
-    e.fov_y = 0.3 + u01(rng) * 1.5;
-    e.aspect = 0.5 + u01(rng) * 1.5;
-    e.near = 0.05;
-    e.far = 1 + u01(rng) * 8;
-    s.eyes.push_back(eye_frustum(e));
-  }
+  for (int i = 0; i < eye_count; ++i) s.eyes.push_back(eye_frustum(random_eye_view(rng)));
   return s;
 }
 
@@ -288,20 +292,6 @@ TEST(CullingTest, GridCullerTakesMoreThan64Eyes) {
 Vec3 turned(const Vec3& a, const Vec3& k, double angle) {
   const double c = std::cos(angle), s = std::sin(angle);
   return a * c + cross(k, a) * s + k * (dot(k, a) * (1 - c));
-}
-
-EyeView random_eye_view(std::mt19937& rng) {
-  std::uniform_real_distribution<double> pos(-3, 3), u01(0, 1);
-  EyeView e;
-  e.position = v(pos(rng), pos(rng), pos(rng));
-  const double th = u01(rng) * 2 * kPi, ph = std::acos(2 * u01(rng) - 1);
-  e.forward = v(std::sin(ph) * std::cos(th), std::sin(ph) * std::sin(th), std::cos(ph));
-  e.up = std::fabs(e.forward.y) < 0.9 ? v(0, 1, 0) : v(1, 0, 0);
-  e.fov_y = 0.3 + u01(rng) * 1.5;
-  e.aspect = 0.5 + u01(rng) * 1.5;
-  e.near = 0.05;
-  e.far = 1 + u01(rng) * 8;
-  return e;
 }
 
 // A steady motion: a step, a turn about an axis and a zoom every frame (a walking, turning
