@@ -35,9 +35,13 @@ CameraFrame camera_frame(const Camera& c) {
 }
 
 Vec3 camera_ray(const Camera& camera, const CameraFrame& frame, uint32_t i, uint32_t j) {
+  return camera_ray_at(camera, frame, i + 0.5, j + 0.5);
+}
+
+Vec3 camera_ray_at(const Camera& camera, const CameraFrame& frame, double x, double y) {
   const double h = std::tan(camera.fov_y / 2);
-  const double a = 2.0 * (i + 0.5) / camera.width - 1.0;
-  const double b = 1.0 - 2.0 * (j + 0.5) / camera.height;
+  const double a = 2.0 * x / camera.width - 1.0;
+  const double b = 1.0 - 2.0 * y / camera.height;
   const double aspect = static_cast<double>(camera.width) / camera.height;
   return normalize(frame.forward + frame.right * (a * h * aspect) + frame.up * (b * h));
 }

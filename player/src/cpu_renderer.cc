@@ -78,6 +78,7 @@ Status validate_render_options(const RenderOptions& o, size_t view_count) {
   }
   if (!std::isfinite(o.min_view_distance)) return option_error("min_view_distance is not finite");
   if (o.threads < 1 || o.threads > 256) return option_error("threads is outside [1, 256]");
+  if (o.supersample < 1 || o.supersample > 8) return option_error("supersample is outside [1, 8]");
   if (!(o.rr_start > 0) || !std::isfinite(o.rr_start)) {
     return option_error("rr_start (z_e) must be finite and > 0");
   }
@@ -422,10 +423,27 @@ Status CpuRenderer::render(const Camera& camera, RenderedImage* out) const {
   const auto work = [&](uint32_t first) {
     for (uint32_t j = first; j < camera.height; j += options_.threads) {
       for (uint32_t i = 0; i < camera.width; ++i) {
-        const RaySample s = trace(camera.position, camera_ray(camera, frame, i, j));
+        // Sub-pixel rays in row-major order, summed as the GL renderer sums them; with n = 1
+        // the one ray through the centre, camera_ray's own (so the supersampling test has a
+        // reference that does not share the sub-pixel formula).
+        const uint32_t n = options_.supersample;
+        double rgb[3] = {0, 0, 0};
+        double depth = kInf;
+        for (uint32_t sy = 0; sy < n; ++sy) {
+          for (uint32_t sx = 0; sx < n; ++sx) {
+            const Vec3 d =
+                n == 1 ? camera_ray(camera, frame, i, j)
+                       : camera_ray_at(camera, frame, i + (sx + 0.5) / n, j + (sy + 0.5) / n);
+            const RaySample s = trace(camera.position, d);
+            for (int ch = 0; ch < 3; ++ch) rgb[ch] += s.rgb[ch];
+            depth = std::min(depth, s.depth);
+          }
+        }
         const size_t k = size_t{j} * camera.width + i;
-        for (int ch = 0; ch < 3; ++ch) out->color[3 * k + ch] = static_cast<float>(s.rgb[ch]);
-        out->depth[k] = static_cast<float>(s.depth);
+        for (int ch = 0; ch < 3; ++ch) {
+          out->color[3 * k + ch] = static_cast<float>(rgb[ch] / (static_cast<double>(n) * n));
+        }
+        out->depth[k] = static_cast<float>(depth);
       }
     }
   };

@@ -63,6 +63,7 @@ uniform bool rr_replace_view_reflection;
 uniform float rr_start;
 uniform uint rr_max_depth;
 uniform uvec2 image_size;
+uniform uint supersample;        // eye rays per pixel along each axis
 uniform vec3 cam_forward;        // unit forward
 uniform vec3 cam_right;          // unit right * tan(fov_y / 2) * aspect
 uniform vec3 cam_up;             // unit up * tan(fov_y / 2)
@@ -581,12 +582,22 @@ float trace(vec3 o, vec3 d, out vec3 rgb) {
 void main() {
   uint i = uint(gl_FragCoord.x);
   uint j = image_size.y - 1u - uint(gl_FragCoord.y);  // row 0 at the top, like the CPU image
-  float a = 2.0 * (float(i) + 0.5) / float(image_size.x) - 1.0;
-  float b = 1.0 - 2.0 * (float(j) + 0.5) / float(image_size.y);
-  vec3 d = normalize(cam_forward + a * cam_right + b * cam_up);
-  vec3 rgb;
-  float z = trace(vec3(0.0), d, rgb);
-  out_colour = vec4(rgb, z);
+  // CpuRenderer::render: supersample^2 rays through an even grid over the pixel, row-major, the
+  // colour their mean and the depth the nearest hit; 1 = the ray through the centre.
+  float n = float(supersample);
+  vec3 sum = vec3(0.0);
+  float z = INF;
+  for (uint sy = 0u; sy < supersample; ++sy) {
+    for (uint sx = 0u; sx < supersample; ++sx) {
+      float a = 2.0 * (float(i) + (float(sx) + 0.5) / n) / float(image_size.x) - 1.0;
+      float b = 1.0 - 2.0 * (float(j) + (float(sy) + 0.5) / n) / float(image_size.y);
+      vec3 d = normalize(cam_forward + a * cam_right + b * cam_up);
+      vec3 rgb;
+      z = min(z, trace(vec3(0.0), d, rgb));
+      sum += rgb;
+    }
+  }
+  out_colour = vec4(sum / (n * n), z);
 }
 )glsl";
 

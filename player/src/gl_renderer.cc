@@ -186,6 +186,7 @@ Status GlRenderer::draw(const Camera& camera) {
   gl.Uniform1f(loc("rr_start"), f(o.rr_start));
   gl.Uniform1ui(loc("rr_max_depth"), o.rr_max_depth);
   gl.Uniform2ui(loc("image_size"), camera.width, camera.height);
+  gl.Uniform1ui(loc("supersample"), o.supersample);
   gl.Uniform3f(loc("cam_forward"), f(forward.x), f(forward.y), f(forward.z));
   gl.Uniform3f(loc("cam_right"), f(right.x), f(right.y), f(right.z));
   gl.Uniform3f(loc("cam_up"), f(up.x), f(up.y), f(up.z));

@@ -2,7 +2,7 @@
 // views, under OSMesa (llvmpipe): PSNR between the two images of the same frame >= 45 dB and the
 // same hit distances, for plain and RR rendering (Alg. 4 and with the view's reflection replaced),
 // nearest and bilinear colour, one, several and a subset of views, HDR colour, every depth-test
-// variant, surface hints; determinism; option and camera errors.
+// variant, surface hints, supersampling; determinism; option and camera errors.
 // Renders stay at <= 128^2 with few views: llvmpipe is slow. Figures are printed for the report.
 #include "calf/player/gl_renderer.h"
 
@@ -221,6 +221,22 @@ TEST(GlRenderer, MatchesCpuForColourAndDepthTestVariants) {
     // differs in the algorithm itself.
     expect_float_agreement(c, v.name);
     EXPECT_GE(c.depth_agree, 0.99) << v.name;
+  }
+}
+
+// Supersampling: the same sub-pixel grid, mean and nearest depth as the CPU reference (3 x 3, so
+// the centre ray is one of them, and 2 x 2, where none is).
+TEST(GlRenderer, MatchesCpuWithSupersampling) {
+  CALF_REQUIRE_GL();
+  const ViewSet views = tinted_views(32);
+  const Camera cam = between_views_camera(40);
+  for (uint32_t n : {2u, 3u}) {
+    RenderOptions o;
+    o.supersample = n;
+    const Comparison c = compare(views, cam, o);
+    report(n == 2 ? "tinted views, supersample 2" : "tinted views, supersample 3", c);
+    EXPECT_GE(c.psnr, 45.0);
+    expect_float_agreement(c, "supersample " + std::to_string(n));
   }
 }
 
@@ -501,6 +517,9 @@ TEST(GlRenderer, RejectsBadOptionsAndCameras) {
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
   o = {};
   o.surface_hint_substeps = 0;
+  EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
+  o = {};
+  o.supersample = 9;
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
   o = {};
   o.active_views.assign(257, 0);  // more than the shader's view block holds

@@ -57,6 +57,12 @@ CameraFrame camera_frame(const Camera& camera);
 Vec3 camera_ray(const Camera& camera, uint32_t i, uint32_t j);
 Vec3 camera_ray(const Camera& camera, const CameraFrame& frame, uint32_t i, uint32_t j);
 
+// The unit ray direction through the continuous image position (x, y): x in [0, width] from the
+// left edge, y in [0, height] from the top edge, so pixel (i, j)'s centre is (i + 0.5, j + 0.5)
+// and camera_ray(camera, frame, i, j) is exactly camera_ray_at(camera, frame, i + 0.5, j + 0.5).
+// Sub-pixel samples (a renderer's supersampling) use it.
+Vec3 camera_ray_at(const Camera& camera, const CameraFrame& frame, double x, double y);
+
 // The viewing frustum of `camera` between distances `near` and `far` along its forward axis
 // (0 < near < far): aspect = W / H, the same frame and field of view, so the frustum's edges are
 // the image's edges (its corners lie on the rays through the image corners, not pixel centres).

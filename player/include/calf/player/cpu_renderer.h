@@ -144,6 +144,12 @@ struct RenderOptions {
   std::vector<uint32_t> active_views;
   // Worker threads over image rows (1..256). The result does not depend on it.
   uint32_t threads = 1;
+  // Eye rays per pixel along each axis (1..8). The pixel's colour is the mean of n x n rays
+  // through the centres of an n x n grid over the pixel's square (a box filter, as calf-capture
+  // filters its ground truth and capture texels), its depth the nearest of their hits; 1 = one
+  // ray through the pixel centre. Costs n^2 the rays. One ray point-samples every silhouette and
+  // texture edge where an anti-aliased image blends them (docs/RENDERING.md "Supersampling").
+  uint32_t supersample = 1;
   // RR variant (Sec. 6.1): reflection / refraction rays from the material faces. Views without
   // material contribute (0, 0, 1); a view set without any makes it a no-op.
   bool rr = false;
