@@ -34,6 +34,18 @@ RenderedImage render(const ViewSet& views, const Camera& cam, RenderOptions o) {
   return img;
 }
 
+// An eye inside the cube of corner_views({0, 0, 0.5}, 1.0), on none of its viewpoints, looking
+// into the room at 70 degrees.
+Camera between_viewpoints_camera(uint32_t width, uint32_t height) {
+  Camera cam;
+  cam.position = {0.12, 0.07, 0.55};
+  cam.forward = {-0.1, -0.15, -1};
+  cam.fov_y = 70 * kPi / 180;
+  cam.width = width;
+  cam.height = height;
+  return cam;
+}
+
 // An eye at a viewpoint looking down -Z with a 90° square frustum of face_size pixels sees, pixel
 // for pixel, the -Z face mirrored left-right (cube faces are seen from inside): pixel (i, j) is
 // texel (n - 1 - i, j), along exactly the texel's ray.
@@ -71,11 +83,7 @@ TEST(CpuRenderer, ReproducesTheViewImageAtItsViewpoint) {
 TEST(CpuRenderer, ReconstructsBetweenViewpointsAndMoreViewsAreNotWorse) {
   const Scene scene = room_with_spheres();
   const std::vector<Vec3> all = corner_views({0, 0, 0.5}, 1.0);
-  Camera cam;
-  cam.position = {0.12, 0.07, 0.55};  // inside the cube of viewpoints, on none of them
-  cam.forward = {-0.1, -0.15, -1};
-  cam.fov_y = 70 * kPi / 180;
-  cam.width = cam.height = 48;
+  const Camera cam = between_viewpoints_camera(48, 48);
   const RenderedImage gt = ground_truth(scene, cam);
   double previous = 0;
   for (size_t count : {size_t{2}, size_t{4}, size_t{8}}) {
@@ -242,12 +250,7 @@ TEST(CpuRenderer, ImageDoesNotDependOnThreadCount) {
 // pixel, a missing or repeated sub-sample or a wrong divisor changes every pixel (checked).
 TEST(CpuRenderer, SupersamplingIsTheBoxFilterOfItsSubPixelRays) {
   const ViewSet views = make_views(room_with_spheres(), corner_views({0, 0, 0.5}, 1.0), 32);
-  Camera cam;
-  cam.position = {0.12, 0.07, 0.55};
-  cam.forward = {-0.1, -0.15, -1};
-  cam.fov_y = 70 * kPi / 180;
-  cam.width = 20;
-  cam.height = 14;
+  Camera cam = between_viewpoints_camera(20, 14);
   RenderOptions o;
   o.supersample = 2;
   const RenderedImage small = render(views, cam, o);
@@ -291,11 +294,7 @@ TEST(CpuRenderer, SupersamplingIsTheBoxFilterOfItsSubPixelRays) {
 TEST(CpuRenderer, SupersamplingApproachesTheAntiAliasedImage) {
   const Scene scene = room_with_spheres();
   const ViewSet views = make_views(scene, corner_views({0, 0, 0.5}, 1.0), 96);
-  Camera cam;
-  cam.position = {0.12, 0.07, 0.55};
-  cam.forward = {-0.1, -0.15, -1};
-  cam.fov_y = 70 * kPi / 180;
-  cam.width = cam.height = 48;
+  const Camera cam = between_viewpoints_camera(48, 48);
   Camera fine = cam;
   fine.width = fine.height = 4 * cam.width;
   const RenderedImage gt_fine = ground_truth(scene, fine);
