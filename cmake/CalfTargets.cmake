@@ -100,8 +100,9 @@ function(calf_check_layering)
 endfunction()
 
 # calf_add_test(source [TEST_PREFIX prefix] LIBS...): one GoogleTest executable per test file,
-# named after the file; every test case in it becomes its own ctest entry, its name preceded by
-# `prefix` when given (e.g. "extreme." so that `ctest -R extreme` selects one group).
+# named after the file, and one ctest entry of the same name running all of its cases (select
+# cases with `tests/<name> --gtest_filter=...`). With -DCALF_TEST_PER_CASE=ON every case is its
+# own ctest entry instead, its name preceded by `prefix` when given (e.g. "extreme.").
 include(GoogleTest)
 function(calf_add_test source)
   cmake_parse_arguments(T "" "TEST_PREFIX" "" ${ARGN})
@@ -121,18 +122,31 @@ function(calf_add_test source)
     set_source_files_properties(${source} TARGET_DIRECTORY ${name} PROPERTIES
                                 COMPILE_OPTIONS "-fno-sanitize=undefined;-O1;-Wno-stringop-overflow")
   endif()
-  set(prefix "")
-  if(T_TEST_PREFIX)
-    set(prefix TEST_PREFIX ${T_TEST_PREFIX})
-  endif()
   # CALF_TEST_COST_<name> (tests/CMakeLists.txt): ctest starts costlier tests first when it has no
   # timings of its own yet (a fresh CI machine), so the longest ones do not end the run alone.
   set(cost 0)
   if(DEFINED CALF_TEST_COST_${name})
     set(cost ${CALF_TEST_COST_${name}})
   endif()
-  gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST ${prefix}
-                       PROPERTIES ENVIRONMENT "CALF_SOURCE_DIR=${PROJECT_SOURCE_DIR}" COST ${cost})
+  if(CALF_TEST_PER_CASE)
+    set(prefix "")
+    if(T_TEST_PREFIX)
+      set(prefix TEST_PREFIX ${T_TEST_PREFIX})
+    endif()
+    gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST ${prefix}
+                         PROPERTIES ENVIRONMENT "CALF_SOURCE_DIR=${PROJECT_SOURCE_DIR}" COST ${cost})
+  else()
+    # One ctest entry runs the whole file: its cases in one process (the test output names each
+    # case and every failure). A process that links the capture layer loads OpenImageIO and its
+    # ~250 shared libraries, 0.3-0.8 s before main() under the sanitizers (most of it the dynamic
+    # loader's symbol look-ups); one process per case spent more time starting than testing
+    # (sanitized, 2-core VM, -j2: the 754 cases as 754 processes 980 s of test time, the 89
+    # files as 89 processes 297 s). CALF_TEST_PER_CASE=ON restores one entry per case.
+    add_test(NAME ${name} COMMAND ${name} --gtest_also_run_disabled_tests
+             WORKING_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR})
+    set_tests_properties(${name} PROPERTIES
+                         ENVIRONMENT "CALF_SOURCE_DIR=${PROJECT_SOURCE_DIR}" COST ${cost})
+  endif()
 endfunction()
 
 # calf_add_fuzz_target(source LIBS...): a source defining LLVMFuzzerTestOneInput. With

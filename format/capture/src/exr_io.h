@@ -46,6 +46,7 @@ class ExrReader {
   // read back as ~7e-10: a misread, not an error, unless refused here).
   Status require_float(int index) const;
   // Rows [y0, y1) of all channels as float, interleaved (channel_count() floats per pixel).
+  // y0 < y1 <= height().
   Status read_rows(uint32_t y0, uint32_t y1, std::vector<float>* out);
 
  private:
@@ -55,6 +56,7 @@ class ExrReader {
   uint32_t width_ = 0, height_ = 0;
   std::vector<std::string> names_;
   std::vector<OIIO::TypeDesc> formats_;  // per channel
+  std::vector<unsigned char> native_;    // read_rows' file-format rows, reused between calls
 };
 
 }  // namespace calf::capture::detail
