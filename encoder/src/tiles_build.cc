@@ -104,6 +104,10 @@ Status validate_tiles_build_options(const TilesBuildOptions& o) {
     return bad_option(
         sformat("texture_solve_iterations %u is above 1000", o.texture_solve_iterations));
   }
+  if (!(o.secondary_colour_weight >= 0 && o.secondary_colour_weight <= 1)) {
+    return bad_option(
+        sformat("secondary_colour_weight %g is outside [0, 1]", o.secondary_colour_weight));
+  }
   if (!(o.texture_smoothness >= 0 && o.texture_smoothness <= 100)) {
     return bad_option(sformat("texture_smoothness %g is outside [0, 100]", o.texture_smoothness));
   }

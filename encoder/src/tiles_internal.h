@@ -150,7 +150,7 @@ struct TileNormals {
   std::vector<float> coupling;  // side * side * 5, empty without the fit
   void reset(uint32_t side, bool with_coupling);
   // A sample of linear RGB `colour` at texture position (u, w) in texels (corners on centres).
-  void add(double u, double w, const float* colour);
+  void add(double u, double w, const float* colour, double weight = 1.0);
 };
 // Refines `rgba` (side * side * 4, the splat's colour as the start) towards the texel values whose
 // bilinear interpolation best fits the samples, with a membrane term of weight `smoothness` times

@@ -281,9 +281,11 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
       const Vec3 d = q / r;
       const auto [first, cnt] = lookup.find(face_coord_from_direction(d));
       for (uint32_t k = first; k < first + cnt; ++k) {
+        double weight = 1.0;
         if (static_cast<int32_t>(k) != p) {
           const double dist = plane_distance_along(selection.tiles[k].plane, d);
           if (!(dist > 0) || std::abs(dist / r - 1.0) >= thresh) continue;
+          weight = options.secondary_colour_weight;
         }
         const uint32_t side = sides[k];
         const double u = sample_a[t] * (side - 1.0), w = sample_b[t] * (side - 1.0);
@@ -291,7 +293,7 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
         const int sx = std::clamp(static_cast<int>(std::floor((u + 0.5) * ss)), 0, int(g) - 1);
         const int sy = std::clamp(static_cast<int>(std::floor((w + 0.5) * ss)), 0, int(g) - 1);
         if (!votes) work[k].marks[size_t(sy) * g + sx] |= 1;
-        work[k].normals.add(u, w, &view.color[3 * t]);
+        if (weight > 0) work[k].normals.add(u, w, &view.color[3 * t], weight);
       }
     }
     // Free space: each tile's supersamples against this view (per tile in parallel).

@@ -25,7 +25,7 @@ void TileNormals::reset(uint32_t side_in, bool with_coupling) {
   coupling.assign(with_coupling ? size_t{side} * side * 5 : 0, 0.0f);
 }
 
-void TileNormals::add(double u, double w, const float* colour) {
+void TileNormals::add(double u, double w, const float* colour, double weight) {
   const double fu = std::clamp(u, 0.0, side - 1.0), fw = std::clamp(w, 0.0, side - 1.0);
   const uint32_t x0 = std::min<uint32_t>(static_cast<uint32_t>(fu), side - 2);
   const uint32_t y0 = std::min<uint32_t>(static_cast<uint32_t>(fw), side - 2);
@@ -34,18 +34,23 @@ void TileNormals::add(double u, double w, const float* colour) {
   const double b[4] = {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay};
   const size_t i00 = size_t{y0} * side + x0, i10 = i00 + 1, i01 = i00 + side, i11 = i01 + 1;
   const size_t idx[4] = {i00, i10, i01, i11};
+  // The sample's weight scales its row of the least-squares system: weight * b on the
+  // right-hand side, weight * b_i * b_j in the normal matrix.
   for (int k = 0; k < 4; ++k) {
-    for (int c = 0; c < 3; ++c) sums[4 * idx[k] + c] += static_cast<float>(b[k] * colour[c]);
-    sums[4 * idx[k] + 3] += static_cast<float>(b[k]);
+    const double wb = weight * b[k];
+    for (int c = 0; c < 3; ++c) sums[4 * idx[k] + c] += static_cast<float>(wb * colour[c]);
+    sums[4 * idx[k] + 3] += static_cast<float>(wb);
   }
   if (coupling.empty()) return;
-  for (int k = 0; k < 4; ++k) coupling[5 * idx[k] + kDiag] += static_cast<float>(b[k] * b[k]);
-  coupling[5 * i00 + kRight] += static_cast<float>(b[0] * b[1]);
-  coupling[5 * i01 + kRight] += static_cast<float>(b[2] * b[3]);
-  coupling[5 * i00 + kDown] += static_cast<float>(b[0] * b[2]);
-  coupling[5 * i10 + kDown] += static_cast<float>(b[1] * b[3]);
-  coupling[5 * i00 + kDownRight] += static_cast<float>(b[0] * b[3]);
-  coupling[5 * i10 + kDownLeft] += static_cast<float>(b[1] * b[2]);
+  for (int k = 0; k < 4; ++k) {
+    coupling[5 * idx[k] + kDiag] += static_cast<float>(weight * b[k] * b[k]);
+  }
+  coupling[5 * i00 + kRight] += static_cast<float>(weight * b[0] * b[1]);
+  coupling[5 * i01 + kRight] += static_cast<float>(weight * b[2] * b[3]);
+  coupling[5 * i00 + kDown] += static_cast<float>(weight * b[0] * b[2]);
+  coupling[5 * i10 + kDown] += static_cast<float>(weight * b[1] * b[3]);
+  coupling[5 * i00 + kDownRight] += static_cast<float>(weight * b[0] * b[3]);
+  coupling[5 * i10 + kDownLeft] += static_cast<float>(weight * b[1] * b[2]);
 }
 
 void solve_tile_colour(const TileNormals& n, double smoothness, uint32_t iterations, float* rgba) {

@@ -424,6 +424,15 @@ TEST(TilesBuild, Errors) {
   EXPECT_EQ(option.status().id(), ErrorId::kTilesOption);
   EXPECT_NE(option.status().message().find("max_planes"), std::string::npos);
 
+  for (double weight : {-0.5, 1.5, std::nan("")}) {
+    o = small_options();
+    o.secondary_colour_weight = weight;
+    auto secondary = build(o);
+    ASSERT_FALSE(secondary.ok()) << weight;
+    EXPECT_EQ(secondary.status().id(), ErrorId::kTilesOption);
+    EXPECT_NE(secondary.status().message().find("secondary_colour_weight"), std::string::npos);
+  }
+
   o = small_options();
   o.max_atlas_size = 16;
   auto atlas = build(o);

@@ -106,6 +106,52 @@ TEST(TilesTextureSolve, RecoversTexelsTheSamplesWereMadeFrom) {
   EXPECT_LT(solved_rms, splat_rms / 10);
 }
 
+TEST(TilesTextureSolve, WeightedSamplesSolveTheWeightedLeastSquares) {
+  // Two textures sampled at the same 2,000 positions, one set at weight 1 and the other at 0.25
+  // (a tile's own samples and its secondary ones): minimising sum w (Bx - y)^2 over both gives
+  // x = (1 * a + 0.25 * b) / 1.25 texel for texel, because both sets are exact bilinear
+  // magnifications. A weight applied twice in the normal matrix (w^2 b_i b_j) would give
+  // (a + 0.0625 b) / 1.0625 instead: 0.02 away at these values.
+  constexpr uint32_t kSide = 8;
+  constexpr double kWeight = 0.25;
+  std::vector<double> a(kSide * kSide), b(kSide * kSide);
+  for (uint32_t i = 0; i < kSide * kSide; ++i) {
+    a[i] = 0.2 + 0.6 * uniform(100000 + i);
+    b[i] = 0.2 + 0.6 * uniform(200000 + i);
+  }
+  TileNormals normals;
+  normals.reset(kSide, true);
+  std::vector<double> su, sw, value;
+  for (uint64_t s = 0; s < 2000; ++s) {
+    const double u = uniform(2 * s) * (kSide - 1), w = uniform(2 * s + 1) * (kSide - 1);
+    const float ca = float(bilinear(a, kSide, u, w)), cb = float(bilinear(b, kSide, u, w));
+    const float colour_a[3] = {ca, ca, ca}, colour_b[3] = {cb, cb, cb};
+    normals.add(u, w, colour_a);
+    normals.add(u, w, colour_b, kWeight);
+    su.push_back(u);
+    sw.push_back(w);
+    value.push_back((ca + kWeight * cb) / (1 + kWeight));
+  }
+  std::vector<float> rgba = splat(su, sw, value, kSide);
+  solve_tile_colour(normals, 1e-6, 400, rgba.data());
+  double worst = 0, worst_squared_weight = 0;
+  for (uint32_t i = 0; i < kSide * kSide; ++i) {
+    worst = std::max(worst, std::abs(rgba[4 * i] - (a[i] + kWeight * b[i]) / (1 + kWeight)));
+    const double squared = (a[i] + kWeight * kWeight * b[i]) / (1 + kWeight * kWeight);
+    worst_squared_weight = std::max(worst_squared_weight, std::abs(rgba[4 * i] - squared));
+  }
+  EXPECT_LT(worst, 2e-3);
+  EXPECT_GT(worst_squared_weight, 1e-2);
+  // One sample at weight 0.25: weight x b on the right-hand side, weight x b x b on the diagonal.
+  TileNormals one;
+  one.reset(kSide, true);
+  const float grey[3] = {0.5f, 0.5f, 0.5f};
+  one.add(2.25, 3.5, grey, kWeight);
+  EXPECT_FLOAT_EQ(one.sums[4 * (3 * kSide + 2) + 3], float(kWeight * 0.75 * 0.5));
+  EXPECT_FLOAT_EQ(one.coupling[5 * (3 * kSide + 2) + TileNormals::kDiag],
+                  float(kWeight * 0.75 * 0.5 * 0.75 * 0.5));
+}
+
 TEST(TilesTextureSolve, FillsUnsampledTexelsHarmonically) {
   // Samples only on the left (0.2) and right (0.8) edges: the membrane between them is the
   // linear ramp, whatever the start.

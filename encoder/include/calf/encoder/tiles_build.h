@@ -146,6 +146,11 @@ struct TilesBuildOptions {
   // blurs towards the splat's look, smaller follows the samples (and their disagreements) more
   // closely. Texels no sample reaches are filled harmonically either way. [0, 100].
   double texture_smoothness = 0.2;
+  // The weight of a sample's colour on its secondary tiles (those of its cell whose planes lie
+  // within solid_threshold of it, Seurat's crack mitigation) relative to its primary tile's 1.
+  // 1 shares it fully; below 1 a tile's own samples dominate where it has any and secondary
+  // ones only fill where it has none. [0, 1].
+  double secondary_colour_weight = 1.0;
   // How a supersample's alpha is estimated (docs/TILES.md "Alpha"):
   //  - kViewVotes: each view votes solid where it sees this tile's own surface at the supersample
   //    and free where its ray passes the supersample before reaching its surface; alpha is the
