@@ -484,9 +484,9 @@ int main(int argc, char** argv) {
     app.add_option("--tiles-secondary-colour-weight", b.secondary_colour_weight,
                    "tiles: weight of a sample's colour on the other tiles of its cell within "
                    "the solid threshold (Seurat's crack mitigation) against 1 on its own tile, "
-                   "0..1: 1 shares it fully, smaller lets a tile's own samples dominate "
-                   "(default 1)")
-        ->default_val(1.0);
+                   "0..1: 1 shares it fully (Seurat), smaller lets a tile's own samples "
+                   "outweigh a nearby surface's colour, 0 leaves cracks (default 0.5)")
+        ->default_val(0.5);
     app.add_option("--tiles-alpha", tiles_alpha,
                    "tiles: alpha estimate: votes (each view votes solid where it sees the "
                    "tile's surface, free where it sees through it; alpha is the solid share, "

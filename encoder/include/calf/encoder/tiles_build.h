@@ -148,9 +148,11 @@ struct TilesBuildOptions {
   double texture_smoothness = 0.2;
   // The weight of a sample's colour on its secondary tiles (those of its cell whose planes lie
   // within solid_threshold of it, Seurat's crack mitigation) relative to its primary tile's 1.
-  // 1 shares it fully; below 1 a tile's own samples dominate where it has any and secondary
-  // ones only fill where it has none. [0, 1].
-  double secondary_colour_weight = 1.0;
+  // 1 shares it fully (Seurat); below 1 a tile's own samples outweigh the colour of a nearby
+  // surface (a crease's side face) where it has any. [0, 1]. Measured on interior (docs/TILES.md,
+  // capture viewpoints / path, dB, 1 -> 0.5): 64² 36.05 / 33.42 -> 36.12 / 33.42, 256²
+  // 37.03 / 40.12 -> 37.30 / 40.27, 512² 35.29 / 39.98 -> 35.54 / 40.02; 0 leaves cracks.
+  double secondary_colour_weight = 0.5;
   // How a supersample's alpha is estimated (docs/TILES.md "Alpha"):
   //  - kViewVotes: each view votes solid where it sees this tile's own surface at the supersample
   //    and free where its ray passes the supersample before reaching its surface; alpha is the
