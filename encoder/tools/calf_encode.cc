@@ -109,9 +109,10 @@ calf::Expected<calf::encoder::VisibleSet> visible_set_of(const calf::capture::Sc
 // --mode mesh: the scene file at `input` (its folder or scene.json) into a mesh track of the
 // whole scene or, with --visible-set, of the triangles visible from its view region.
 int encode_mesh(const std::string& input, const std::string& out, const std::string& super,
-                uint32_t threads, const VisibleSetFlags& vs) {
+                bool plain_directory, uint32_t threads, const VisibleSetFlags& vs) {
   calf::encoder::MeshEncodeOptions o;
   o.threads = threads;
+  o.levels.compress_directory = !plain_directory;
   o.supercompression = super == "lzma2"  ? calf::container::Compression::kLzma2
                        : super == "none" ? calf::container::Compression::kNone
                                          : calf::container::Compression::kZstd;
@@ -171,11 +172,12 @@ int encode_mesh(const std::string& input, const std::string& out, const std::str
 // --mode surfels: the scene file at `input` and its surfel candidates into a mesh track (track 0)
 // and the surfels track paired with it (track 1; paper 001, encoder/surfels_build.h).
 int encode_surfels(const std::string& input, const std::string& candidates, const std::string& out,
-                   const std::string& super, uint32_t threads,
+                   const std::string& super, bool plain_directory, uint32_t threads,
                    const calf::encoder::SurfelBuildOptions& build) {
   calf::encoder::MeshEncodeOptions mesh;
   calf::encoder::SurfelsEncodeOptions surfels;
   mesh.threads = surfels.threads = threads;
+  mesh.levels.compress_directory = surfels.levels.compress_directory = !plain_directory;
   mesh.supercompression = surfels.supercompression =
       super == "lzma2"  ? calf::container::Compression::kLzma2
       : super == "none" ? calf::container::Compression::kNone
@@ -308,6 +310,12 @@ int main(int argc, char** argv) {
                  "per chunk: zstd (level 19), lzma2 (preset 6), none (default zstd)")
       ->check(CLI::IsMember({"zstd", "lzma2", "none"}))
       ->default_val("zstd");
+  bool plain_directory = false;
+  app.add_flag("--plain-directory", plain_directory,
+               "every mode: write a container 1.0 file (plain 64-byte chunk index entries) that "
+               "calf 1.0 readers open, instead of 1.1's directory compressed as one zstd frame "
+               "(format/SPEC.md 4.1: 2-43 % smaller lightfield clips, docs/ENCODER.md "
+               "\"Compressed directory\"); sharded encodes always write 1.1");
   app.add_flag("-q,--quiet", quiet, "no progress line");
   bool analysis_only = false;
   std::string analysis_path, views_text, frames_text;
@@ -538,6 +546,7 @@ int main(int argc, char** argv) {
     tiles.encode.supercompression = super == "lzma2"  ? calf::container::Compression::kLzma2
                                     : super == "none" ? calf::container::Compression::kNone
                                                       : calf::container::Compression::kZstd;
+    tiles.encode.levels.compress_directory = !plain_directory;
     tiles.quiet = quiet;
     if (calf::Status s = calf::encoder::validate_tiles_build_options(tiles.build); !s.ok()) {
       return calf::tools::print_error("calf-encode", s, calf::tools::kExitUsage);
@@ -556,7 +565,8 @@ int main(int argc, char** argv) {
                                   : sampler == "progressive" ? calf::SurfelOrderMethod::kProgressive
                                                              : calf::SurfelOrderMethod::kGreedyTree;
     surfel_build.sampler.threads = o.threads;
-    return encode_surfels(manifest, candidates, out, super, o.threads, surfel_build);
+    return encode_surfels(manifest, candidates, out, super, plain_directory, o.threads,
+                          surfel_build);
   }
   if (!candidates.empty())
     return calf::tools::usage_error("calf-encode", "--surfel-candidates needs --mode surfels");
@@ -565,7 +575,7 @@ int main(int argc, char** argv) {
     return calf::tools::usage_error("calf-encode", "--visible-set needs --mode mesh");
   vs.options.threads = o.threads;
   vs.quiet = quiet;
-  if (mode == "mesh") return encode_mesh(manifest, out, super, o.threads, vs);
+  if (mode == "mesh") return encode_mesh(manifest, out, super, plain_directory, o.threads, vs);
 
   const std::map<std::string, calf::ColourCoding> colours = {
       {"auto", calf::ColourCoding::kAuto},   {"bc1", calf::ColourCoding::kBc1},
@@ -577,6 +587,7 @@ int main(int argc, char** argv) {
             : depth == "pred16m" ? calf::DepthCoding::kRaw16PredictedMasked
                                  : calf::DepthCoding::kRaw16;
   o.merge_static_groups = !fixed_groups;
+  o.levels.compress_directory = !plain_directory;
   o.supercompression = super == "lzma2"  ? calf::container::Compression::kLzma2
                        : super == "none" ? calf::container::Compression::kNone
                                          : calf::container::Compression::kZstd;
@@ -594,6 +605,10 @@ int main(int argc, char** argv) {
     return calf::tools::usage_error("calf-encode",
                                     "--analysis and --views go together; --frame-range needs them");
   }
+  if (analysis_only && plain_directory) {
+    return calf::tools::usage_error(
+        "calf-encode", "--plain-directory with --analysis-only: sharded encodes write 1.1 files");
+  }
   if (analysis_only) {
     const auto t0 = std::chrono::steady_clock::now();
     auto a = calf::write_lightfield_analysis(dir, out, o);
@@ -610,7 +625,7 @@ int main(int argc, char** argv) {
     for (const char* opt :
          {"--cell", "--psnr", "--color-format", "--depth-format", "--depth-window", "--max-aabbs",
           "--depth-keyframe-interval", "--supercompression", "--segment-frames", "--colour-rdo",
-          "--depth-fixed-groups"}) {
+          "--depth-fixed-groups", "--plain-directory"}) {
       if (app.get_option(opt)->count() > 0) {
         return calf::tools::usage_error(
             "calf-encode",

@@ -87,28 +87,53 @@ Status Reader::load() {
     return Status(
         ErrorId::kContainerFileSize,
         cat("the file has ", real_size, " bytes, its header declares only ", h.file_size));
-  // 5. The directory's place and size, bounded before it is allocated.
-  const uint64_t min_dir =
-      4 + uint64_t{h.track_count} * 8 + uint64_t{h.chunk_count} * fixed_size<ChunkEntry>() + 8;
-  const uint64_t max_dir = min_dir + uint64_t{kMaxMetadataEntries} * 8 + kMaxMetadataBytes +
-                           uint64_t{h.track_count} * kMaxTrackHeaderSize;
+  // 5. The directory's place and size, bounded before it is allocated. A plain directory is
+  // its body and checksum; a compressed one (1.1) the body's size, a zstd frame and checksum.
+  const bool compressed = (h.required_features & kFeatureCompressedDirectory) != 0;
+  const uint64_t min_body =
+      4 + uint64_t{h.track_count} * 8 + uint64_t{h.chunk_count} * fixed_size<ChunkEntry>();
+  const uint64_t max_body = min_body + uint64_t{kMaxMetadataEntries} * 8 + kMaxMetadataBytes +
+                            uint64_t{h.track_count} * kMaxTrackHeaderSize;
+  const uint64_t min_dir = compressed ? 16 : min_body + 8;
+  const uint64_t max_dir =
+      compressed ? 16 + stored_bound(max_body, Compression::kZstd) : max_body + 8;
   if (h.directory_offset < kHeaderSize || h.directory_offset % kAlignment != 0 ||
       h.directory_offset > h.file_size || h.directory_size != h.file_size - h.directory_offset ||
       h.directory_size < min_dir)
     return Status(ErrorId::kContainerDirectoryRange,
                   cat("directory at offset ", h.directory_offset, " with ", h.directory_size,
                       " bytes does not end a ", h.file_size, "-byte file on a 16-byte boundary",
-                      " with room for ", h.track_count, " tracks and ", h.chunk_count, " chunks"));
+                      compressed ? std::string(" with room for its body size and checksum")
+                                 : cat(" with room for ", h.track_count, " tracks and ",
+                                       h.chunk_count, " chunks")));
   if (h.directory_size > max_dir)
     return Status(ErrorId::kContainerLimit,
                   cat("directory of ", h.directory_size, " bytes exceeds its limit ", max_dir));
   std::vector<uint8_t> dir(h.directory_size);
   CALF_RETURN_IF_ERROR(source_->read_at(h.directory_offset, dir));
-  const auto body = std::span<const uint8_t>(dir).first(dir.size() - 8);
-  const uint64_t dir_want = load_le(dir.data() + body.size(), 8);
-  if (hash64(body) != dir_want)
-    return Status(ErrorId::kContainerDirectoryChecksum,
-                  cat("directory checksum is ", hash64(body), ", the directory says ", dir_want));
+  const auto checked = std::span<const uint8_t>(dir).first(dir.size() - 8);
+  const uint64_t dir_want = load_le(dir.data() + checked.size(), 8);
+  if (hash64(checked) != dir_want)
+    return Status(
+        ErrorId::kContainerDirectoryChecksum,
+        cat("directory checksum is ", hash64(checked), ", the directory says ", dir_want));
+  std::span<const uint8_t> body = checked;
+  std::vector<uint8_t> unpacked;
+  if (compressed) {
+    const uint64_t body_size = load_le(dir.data(), 8);
+    if (body_size < min_body)
+      return Status(ErrorId::kContainerDirectoryRange,
+                    cat("compressed directory body of ", body_size, " bytes has no room for ",
+                        h.track_count, " tracks and ", h.chunk_count, " chunks"));
+    if (body_size > max_body)
+      return Status(ErrorId::kContainerLimit, cat("compressed directory body of ", body_size,
+                                                  " bytes exceeds its limit ", max_body));
+    unpacked.resize(body_size);
+    Status st = decompress_chunk(checked.subspan(8), Compression::kZstd, unpacked);
+    if (!st.ok()) return std::move(st).with_context("compressed directory");
+    body = unpacked;
+  }
+  directory_body_size_ = body.size();
   // 6. Directory entries.
   FieldReader dr(body, ErrorId::kContainerDirectoryFormat, ErrorId::kContainerDirectoryFormat,
                  "directory");
@@ -145,7 +170,7 @@ Status Reader::load() {
                         ", unknown to this reader, and is marked must-understand"));
     // An unknown optional track: kept as bytes, skipped by codecs.
   }
-  chunks_.resize(h.chunk_count);  // <= kMaxChunks; min_dir proved the bytes exist
+  chunks_.resize(h.chunk_count);  // <= kMaxChunks; min_body proved the bytes exist
   for (uint32_t i = 0; i < h.chunk_count; ++i) {
     dr.set_context(cat("chunk ", i));
     CALF_RETURN_IF_ERROR(read_fields(chunks_[i], dr));

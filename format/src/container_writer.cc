@@ -138,18 +138,31 @@ Status Writer::finish() {
   if (s_->finished) return misuse("finish called twice");
   s_->finished = true;
   CALF_RETURN_IF_ERROR(s_->failed);
-  // Directory: metadata count + pairs, track records, chunk entries, checksum.
-  std::vector<uint8_t> dir;
+  // Directory body: metadata count + pairs, track records, chunk entries.
+  std::vector<uint8_t> body;
   CALF_RETURN_IF_ERROR(
-      write_fields(MetadataCount{static_cast<uint32_t>(s_->metadata.size())}, dir));
+      write_fields(MetadataCount{static_cast<uint32_t>(s_->metadata.size())}, body));
   for (const auto& [k, v] : s_->metadata)
-    CALF_RETURN_IF_ERROR(write_fields(MetadataEntry{k, v}, dir, "metadata"));
+    CALF_RETURN_IF_ERROR(write_fields(MetadataEntry{k, v}, body, "metadata"));
   for (size_t i = 0; i < s_->tracks.size(); ++i)
-    CALF_RETURN_IF_ERROR(write_fields(s_->tracks[i], dir, cat("track ", i)));
+    CALF_RETURN_IF_ERROR(write_fields(s_->tracks[i], body, cat("track ", i)));
   for (size_t i = 0; i < s_->chunks.size(); ++i)
-    CALF_RETURN_IF_ERROR(write_fields(s_->chunks[i], dir, cat("chunk ", i)));
-  CALF_RETURN_IF_ERROR(write_fields(Checksum{hash64(dir)}, dir));
+    CALF_RETURN_IF_ERROR(write_fields(s_->chunks[i], body, cat("chunk ", i)));
+  // Plain (1.0): the body itself. Compressed (1.1): its size and one zstd frame of it; the
+  // chunk entries are regular (canonical offsets, repeating keys), so 64 bytes shrink to ~10.
   FileHeader h;
+  std::vector<uint8_t> dir;
+  if (s_->options.compress_directory) {
+    CALF_ASSIGN_OR_RETURN(StoredChunk packed,
+                          compress_chunk(body, Compression::kZstd, s_->options));
+    CALF_RETURN_IF_ERROR(write_fields(DirectoryBodySize{body.size()}, dir));
+    dir.insert(dir.end(), packed.bytes.begin(), packed.bytes.end());
+    h.version_minor = kVersionMinor;
+    h.required_features |= kFeatureCompressedDirectory;
+  } else {
+    dir = std::move(body);
+  }
+  CALF_RETURN_IF_ERROR(write_fields(Checksum{hash64(dir)}, dir));
   h.directory_offset = s_->position;
   h.directory_size = dir.size();
   h.file_size = h.directory_offset + h.directory_size;

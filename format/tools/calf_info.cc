@@ -164,6 +164,14 @@ std::optional<TilesFigures> tiles_figures(const Reader& r, const Track& t) {
   return f;
 }
 
+bool compressed_directory(const FileHeader& h) {
+  return (h.required_features & kFeatureCompressedDirectory) != 0;
+}
+// Zero bytes that align chunks to 16 (SPEC §7): the chunk area less the stored bytes.
+uint64_t padding_bytes(const Reader& r, const StreamStats& total) {
+  return r.header().directory_offset - kHeaderSize - total.stored;
+}
+
 void print_text(const std::string& path, const Reader& r, bool list_chunks) {
   const auto& h = r.header();
   StreamStats total;
@@ -172,6 +180,11 @@ void print_text(const std::string& path, const Reader& r, bool list_chunks) {
              h.version_minor, h.file_size, r.tracks().size(), r.chunks().size());
   fmt::print("  payload: {} stored bytes, {} raw bytes, ratio {}\n", total.stored, total.raw,
              ratio(total));
+  fmt::print("  directory: {} bytes ({}), padding: {} bytes\n", h.directory_size,
+             compressed_directory(h)
+                 ? fmt::format("zstd, {} bytes of index and metadata", r.directory_body_size())
+                 : std::string("plain"),
+             padding_bytes(r, total));
   if (!r.metadata().empty()) fmt::print("metadata:\n");
   for (const auto& m : r.metadata())
     fmt::print("  {} = {}\n", printable(m.key), printable(m.value));
@@ -241,6 +254,10 @@ void print_json(const std::string& path, const Reader& r, bool list_chunks) {
                    h.optional_features);
   o += fmt::format("\"chunk_count\":{},\"stored_bytes\":{},\"raw_bytes\":{},\"ratio\":{},",
                    r.chunks().size(), total.stored, total.raw, ratio(total));
+  o += fmt::format(
+      "\"directory_bytes\":{},\"directory_compressed\":{},\"directory_body_bytes\":{},"
+      "\"padding_bytes\":{},",
+      h.directory_size, compressed_directory(h), r.directory_body_size(), padding_bytes(r, total));
   o += "\"metadata\":{";
   for (size_t i = 0; i < r.metadata().size(); ++i)
     o += fmt::format("{}{}:{}", i ? "," : "", json_string(r.metadata()[i].key),

@@ -374,6 +374,19 @@ int run_one(const fs::path& dir, const Run& run) {
       s.colour_cells, s.colour_keyframes, s.colour_cells * m.frame_count, s.min_colour_quality_db,
       s.depth_tiles, s.depth_keyframes, s.depth_pframes, s.depth_empty_pframes,
       bytes(s.index_bytes));
+  // What no stream column counts: the file's header, directory and padding (SPEC §4, §7), per
+  // chunk; container 1.1 compresses the directory (docs/ENCODER.md "Compressed directory").
+  const uint64_t chunks =
+      s.colour.chunks + s.depth.chunks + s.material.chunks + m.viewpoints.size();
+  const uint64_t payload = s.colour.stored + s.depth.stored + s.material.stored + s.index_bytes;
+  if (z->file_bytes >= payload) {
+    fmt::print(
+        "- container: {} bytes of header, directory and padding beside {} chunks ({:.1f} "
+        "bytes per chunk, {:.2f} % of the file)\n",
+        bytes(z->file_bytes - payload), chunks,
+        chunks ? static_cast<double>(z->file_bytes - payload) / chunks : 0.0,
+        100.0 * static_cast<double>(z->file_bytes - payload) / z->file_bytes);
+  }
   if (s.material_views > 0) {
     fmt::print("- material ({} views, {}): raw {}, temporal {}, +spatial {}, +zstd {}, +LZMA2 {}\n",
                s.material_views, format_name(s.material_format), bytes(s.material.raw),

@@ -5,7 +5,10 @@
 // (container_conformance_test.cc, RunnerXxx tests) reads only the committed data and manifest.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -27,10 +30,15 @@ inline constexpr size_t kFrozenSizes[] = {0, 1, 15, 16, 17, 100, 1000, 4000, 333
 
 // The frozen v1 file: every track kind, an unknown optional track (kind 0x7777), UTF-8 metadata,
 // every supercompression, empty and odd-sized chunks (so there is padding). Written by the
-// generator once and committed; it must read back forever.
-inline Expected<Bytes> make_frozen_v1() {
+// generator once and committed; it must read back forever. With `compressed_directory` the same
+// contents in a 1.1 file whose directory is one zstd frame (valid/v1_1_compressed_directory).
+inline Expected<Bytes> make_frozen_v1(bool compressed_directory = false) {
   Bytes file;
-  CALF_ASSIGN_OR_RETURN(Writer w, Writer::create(memory_sink(&file), CompressionOptions{3, 1}));
+  CALF_ASSIGN_OR_RETURN(
+      Writer w, Writer::create(memory_sink(&file),
+                               CompressionOptions{.zstd_level = 3,
+                                                  .lzma_preset = 1,
+                                                  .compress_directory = compressed_directory}));
   LightfieldTrackHeader lf;
   lf.frame_count = 48;
   lf.fps_numerator = 24000;
@@ -82,7 +90,8 @@ inline Expected<Bytes> make_frozen_v1() {
 // directory).
 inline Expected<Bytes> make_empty() {
   Bytes file;
-  CALF_ASSIGN_OR_RETURN(Writer w, Writer::create(memory_sink(&file)));
+  CALF_ASSIGN_OR_RETURN(Writer w, Writer::create(memory_sink(&file),
+                                                 CompressionOptions{.compress_directory = false}));
   CALF_RETURN_IF_ERROR(w.finish());
   return file;
 }
@@ -109,10 +118,33 @@ inline Parts take_apart(const Bytes& file) {
   return p;
 }
 
+// `bytes` as one zstd frame (RFC 8878) of Raw_Blocks, built by hand so that the corpus never
+// depends on a compressor's version: Frame_Header_Descriptor 0xE0 (Single_Segment, an 8-byte
+// Frame_Content_Size, no checksum, no dictionary), `content_size` (normally bytes.size()), then
+// blocks of at most 128 KiB, each with its 3-byte header (Last_Block, Block_Type 0, size).
+inline Bytes raw_zstd_frame(std::span<const uint8_t> bytes, uint64_t content_size) {
+  Bytes f = {0x28, 0xB5, 0x2F, 0xFD, 0xE0};
+  for (int i = 0; i < 8; ++i) f.push_back(static_cast<uint8_t>(content_size >> (8 * i)));
+  size_t at = 0;
+  do {
+    const size_t n = std::min<size_t>(bytes.size() - at, size_t{1} << 17);
+    const bool last = at + n == bytes.size();
+    const uint32_t header = (static_cast<uint32_t>(n) << 3) | (last ? 1u : 0u);
+    for (int i = 0; i < 3; ++i) f.push_back(static_cast<uint8_t>(header >> (8 * i)));
+    f.insert(f.end(), bytes.begin() + static_cast<std::ptrdiff_t>(at),
+             bytes.begin() + static_cast<std::ptrdiff_t>(at + n));
+    at += n;
+  } while (at < bytes.size());
+  return f;
+}
+
 // Serialises parts back into a file. Values outside their ranges are written as given.
 // `reseal` recomputes the directory checksum and the header checksum; `fix_sizes` recomputes
-// directory_size and file_size from what is written.
-inline Bytes assemble(const Parts& p, bool reseal = true, bool fix_sizes = true) {
+// directory_size and file_size from what is written. When the header has the compressed
+// directory bit, the body goes into a raw_zstd_frame after its size (`body_size`, when given,
+// replaces the true size in that field and in the frame; `body_tail` is appended to the body).
+inline Bytes assemble(const Parts& p, bool reseal = true, bool fix_sizes = true,
+                      std::optional<uint64_t> body_size = std::nullopt, Bytes body_tail = {}) {
   auto put = [](Bytes& out, const auto& s) {
     FieldWriter w(out);
     w.allow_out_of_range();
@@ -123,6 +155,15 @@ inline Bytes assemble(const Parts& p, bool reseal = true, bool fix_sizes = true)
   for (const auto& m : p.metadata) put(dir, m);
   for (const auto& t : p.tracks) put(dir, t);
   for (const auto& c : p.chunks) put(dir, c);
+  dir.insert(dir.end(), body_tail.begin(), body_tail.end());
+  if (p.header.required_features & kFeatureCompressedDirectory) {
+    const uint64_t size = body_size.value_or(dir.size());
+    Bytes packed;
+    put(packed, DirectoryBodySize{size});
+    const Bytes frame = raw_zstd_frame(dir, size);
+    packed.insert(packed.end(), frame.begin(), frame.end());
+    dir = std::move(packed);
+  }
   put(dir, Checksum{reseal ? hash64(dir) : 0});
   FileHeader h = p.header;
   if (fix_sizes) {
@@ -144,6 +185,13 @@ inline Bytes assemble(const Parts& p, bool reseal = true, bool fix_sizes = true)
 inline void reseal_header(Bytes& file) {
   store_le(file.data() + kHeaderChecksumOffset,
            hash64(std::span<const uint8_t>(file).first(kHeaderChecksumOffset)), 8);
+}
+
+// Recomputes the directory checksum of a file in place (after editing directory bytes directly).
+inline void reseal_directory(Bytes& file) {
+  const uint64_t at = load_le(file.data() + 32, 8);
+  store_le(file.data() + file.size() - 8,
+           hash64(std::span<const uint8_t>(file).subspan(at, file.size() - at - 8)), 8);
 }
 
 struct Malformed {
@@ -230,7 +278,7 @@ inline std::vector<Malformed> make_malformed(const Bytes& valid) {
   reseal_header(v2);
   add("version_2", v2, ErrorId::kContainerVersion);
   Bytes feat = valid;
-  feat[16] = 1;
+  feat[19] = 0x80;  // bit 31: bit 0 is the compressed directory since 1.1
   reseal_header(feat);
   add("required_feature_unknown", feat, ErrorId::kContainerRequiredFeature);
   Bytes bigger = valid;
@@ -325,6 +373,66 @@ inline std::vector<Malformed> make_malformed(const Bytes& valid) {
       ErrorId::kContainerMetadata);
   add("metadata_key_empty", edited([](Parts& p) { p.metadata[0].key.clear(); }),
       ErrorId::kContainerDirectoryFormat);
+  return out;
+}
+
+// The compressed-directory cases (1.1, SPEC §4.1), derived from the committed
+// valid/v1_1_compressed_directory.calf by byte edits and hand-built Raw_Block frames only.
+inline std::vector<Malformed> make_malformed_compressed_directory(const Bytes& valid) {
+  std::vector<Malformed> out;
+  const Parts base = take_apart(valid);
+  const uint64_t dir_at = base.header.directory_offset;
+  auto add = [&out](std::string name, Bytes b, ErrorId id) {
+    out.push_back({"zdir_" + std::move(name), std::move(b), id});
+  };
+  // The body's bounds from the header's counts (SPEC §9 step 7).
+  const uint64_t min_body = 4 + 8 * uint64_t{base.header.track_count} +
+                            uint64_t{fixed_size<ChunkEntry>()} * base.header.chunk_count;
+  const uint64_t max_body = min_body + uint64_t{kMaxMetadataEntries} * 8 + kMaxMetadataBytes +
+                            uint64_t{base.header.track_count} * kMaxTrackHeaderSize;
+  Bytes flip = valid;
+  flip[dir_at + 20] ^= 0x10;  // inside the zstd frame, checksum left as it was
+  add("checksum", flip, ErrorId::kContainerDirectoryChecksum);
+  Bytes shortdir(valid.begin(), valid.begin() + static_cast<std::ptrdiff_t>(dir_at));
+  shortdir.insert(shortdir.end(), 15, 0);  // 7 bytes and a checksum: no room for the size
+  store_le(shortdir.data() + 24, shortdir.size(), 8);
+  store_le(shortdir.data() + 40, 15, 8);
+  reseal_header(shortdir);
+  reseal_directory(shortdir);
+  add("too_short", shortdir, ErrorId::kContainerDirectoryRange);
+  Bytes below = valid;
+  store_le(below.data() + dir_at, min_body - 1, 8);
+  reseal_directory(below);
+  add("body_below_counts", below, ErrorId::kContainerDirectoryRange);
+  Bytes above = valid;
+  store_le(above.data() + dir_at, max_body + 1, 8);
+  reseal_directory(above);
+  add("body_above_limit", above, ErrorId::kContainerLimit);
+  Bytes magic = valid;
+  magic[dir_at + 8] ^= 0x01;  // the frame's first magic byte
+  reseal_directory(magic);
+  add("frame_magic", magic, ErrorId::kContainerDecompress);
+  Bytes longer_size = valid;  // the size field one more than the frame holds
+  store_le(longer_size.data() + dir_at, load_le(valid.data() + dir_at, 8) + 1, 8);
+  reseal_directory(longer_size);
+  add("body_size_mismatch", longer_size, ErrorId::kContainerDecompress);
+  Bytes cut = valid;  // the frame's last byte removed
+  cut.erase(cut.end() - 9);
+  store_le(cut.data() + 24, cut.size(), 8);
+  store_le(cut.data() + 40, cut.size() - dir_at, 8);
+  reseal_header(cut);
+  reseal_directory(cut);
+  add("frame_truncated", cut, ErrorId::kContainerDecompress);
+  add("raw_blocks_leftover_body_bytes", assemble(base, true, true, std::nullopt, Bytes{0, 0, 0}),
+      ErrorId::kContainerDirectoryFormat);
+  add(
+      "raw_blocks_chunk_track_missing",
+      [&] {
+        Parts p = base;
+        p.chunks[0].keys.track = 200;
+        return assemble(p);
+      }(),
+      ErrorId::kContainerChunkTrack);
   return out;
 }
 

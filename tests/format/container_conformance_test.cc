@@ -108,7 +108,8 @@ std::string manifest_text(const std::vector<std::string>& valid_names,
   return os.str();
 }
 
-const std::vector<std::string> kValidNames = {"valid/v1_frozen.calf", "valid/empty.calf"};
+const std::vector<std::string> kValidNames = {"valid/v1_frozen.calf", "valid/empty.calf",
+                                              "valid/v1_1_compressed_directory.calf"};
 
 TEST(ContainerConformanceTest, GeneratorReproducesTheCommittedCorpus) {
   const bool write = std::getenv("CALF_CONFORMANCE_WRITE") != nullptr;
@@ -120,11 +121,17 @@ TEST(ContainerConformanceTest, GeneratorReproducesTheCommittedCorpus) {
       write_file(suite_dir() / kValidNames[0], *corpus::make_frozen_v1());
     if (!fs::exists(suite_dir() / kValidNames[1]))
       write_file(suite_dir() / kValidNames[1], *corpus::make_empty());
+    if (!fs::exists(suite_dir() / kValidNames[2]))
+      write_file(suite_dir() / kValidNames[2], *corpus::make_frozen_v1(true));
   }
   const Bytes frozen = read_file(suite_dir() / kValidNames[0]);
+  const Bytes frozen_1_1 = read_file(suite_dir() / kValidNames[2]);
   ASSERT_FALSE(frozen.empty()) << "run once with CALF_CONFORMANCE_WRITE=1 to create the suite";
-  const auto malformed = corpus::make_malformed(frozen);
+  ASSERT_FALSE(frozen_1_1.empty()) << "run once with CALF_CONFORMANCE_WRITE=1 to add the 1.1 file";
+  auto malformed = corpus::make_malformed(frozen);
   ASSERT_GT(malformed.size(), 40u);
+  for (auto& m : corpus::make_malformed_compressed_directory(frozen_1_1))
+    malformed.push_back(std::move(m));
   if (write) {
     for (const auto& e : fs::directory_iterator(suite_dir() / "malformed")) fs::remove(e.path());
     for (const auto& m : malformed)
@@ -146,12 +153,17 @@ TEST(ContainerConformanceTest, GeneratorReproducesTheCommittedCorpus) {
   EXPECT_EQ(text.str(), manifest_text(kValidNames, malformed));
   // Today's writer still produces a file with the frozen file's contents (bytes may differ
   // with another zstd / liblzma version, so the comparison is of decoded contents).
-  const Bytes fresh = *corpus::make_frozen_v1();
-  auto a = Reader::open(memory_source(std::span<const uint8_t>(frozen)));
-  auto b = Reader::open(memory_source(std::span<const uint8_t>(fresh)));
-  ASSERT_TRUE(a.ok() && b.ok());
-  ASSERT_EQ(a->chunks().size(), b->chunks().size());
-  for (uint32_t i = 0; i < a->chunks().size(); ++i) EXPECT_EQ(*a->read_chunk(i), *b->read_chunk(i));
+  for (const bool compressed : {false, true}) {
+    const Bytes fresh = *corpus::make_frozen_v1(compressed);
+    const Bytes& frozen_file = compressed ? frozen_1_1 : frozen;
+    auto a = Reader::open(memory_source(std::span<const uint8_t>(frozen_file)));
+    auto b = Reader::open(memory_source(std::span<const uint8_t>(fresh)));
+    ASSERT_TRUE(a.ok() && b.ok());
+    EXPECT_EQ(a->metadata().size(), b->metadata().size());
+    ASSERT_EQ(a->chunks().size(), b->chunks().size());
+    for (uint32_t i = 0; i < a->chunks().size(); ++i)
+      EXPECT_EQ(*a->read_chunk(i), *b->read_chunk(i));
+  }
 }
 
 TEST(ContainerConformanceTest, RunnerValidFilesVerifyAndDecodeToManifestHashes) {
@@ -216,6 +228,34 @@ TEST(ContainerConformanceTest, FrozenV1ReadsItsKnownContents) {
     EXPECT_EQ(*r->read_chunk(i), corpus::pattern(i, corpus::kFrozenSizes[i])) << i;
     EXPECT_EQ(r->chunks()[i].compression, i % 3);
     EXPECT_EQ(r->chunks()[i].keys.region, i * 7);
+  }
+}
+
+// The 1.1 file holds the frozen 1.0 file's directory, compressed: the same header fields but the
+// version and feature bit, the same metadata, tracks and chunk entries up to the offsets.
+TEST(ContainerConformanceTest, CompressedDirectoryFileHoldsTheFrozenV1Directory) {
+  auto a = Reader::open(suite_dir() / "valid" / "v1_frozen.calf");
+  auto b = Reader::open(suite_dir() / "valid" / "v1_1_compressed_directory.calf");
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(a->header().version_minor, 0);
+  EXPECT_EQ(a->header().required_features, 0u);
+  EXPECT_EQ(b->header().version_minor, 1);
+  EXPECT_EQ(b->header().required_features, kFeatureCompressedDirectory);
+  EXPECT_EQ(b->directory_body_size(), a->directory_body_size());
+  EXPECT_LT(b->header().directory_size, a->header().directory_size);
+  ASSERT_EQ(a->metadata().size(), b->metadata().size());
+  for (size_t i = 0; i < a->metadata().size(); ++i) {
+    EXPECT_EQ(a->metadata()[i].key, b->metadata()[i].key);
+    EXPECT_EQ(a->metadata()[i].value, b->metadata()[i].value);
+  }
+  ASSERT_EQ(a->tracks().size(), b->tracks().size());
+  for (size_t i = 0; i < a->tracks().size(); ++i)
+    EXPECT_EQ(a->tracks()[i].record.header, b->tracks()[i].record.header);
+  ASSERT_EQ(a->chunks().size(), b->chunks().size());
+  for (size_t i = 0; i < a->chunks().size(); ++i) {
+    EXPECT_EQ(a->chunks()[i].keys, b->chunks()[i].keys) << i;
+    EXPECT_EQ(a->chunks()[i].raw_size, b->chunks()[i].raw_size) << i;
+    EXPECT_EQ(a->chunks()[i].compression, b->chunks()[i].compression) << i;
   }
 }
 

@@ -84,6 +84,49 @@ TEST(ContainerRobustnessTest, LeftoverDirectoryBytesAreCorrupt) {
   EXPECT_NE(s.message().find("3 bytes left over"), std::string::npos) << s.to_string();
 }
 
+// A compressed directory (1.1) is any conforming zstd frame: the reader takes one built by hand
+// from Raw_Blocks (several of them once the body passes 128 KiB) as it takes the writer's.
+TEST(ContainerRobustnessTest, CompressedDirectoryReadsFromAnyConformingFrame) {
+  const Bytes written = *corpus::make_frozen_v1(true);
+  corpus::Parts p = corpus::take_apart(written);
+  ASSERT_EQ(p.header.required_features, kFeatureCompressedDirectory);
+  ASSERT_EQ(p.chunks.size(), std::size(corpus::kFrozenSizes));
+  const Bytes raw_blocks = corpus::assemble(p);
+  EXPECT_NE(raw_blocks, written);
+  EXPECT_TRUE(corpus::first_error(raw_blocks).ok()) << corpus::first_error(raw_blocks).to_string();
+  p.metadata.push_back({"z.large", std::string(300000, 'q')});  // body of three Raw_Blocks
+  const Bytes large = corpus::assemble(p);
+  auto r = Reader::open(memory_source(std::span<const uint8_t>(large)));
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  EXPECT_GT(r->directory_body_size(), 2u << 17);
+  ASSERT_NE(r->find_metadata("z.large"), nullptr);
+  EXPECT_EQ(r->find_metadata("z.large")->size(), 300000u);
+  for (uint32_t i = 0; i < r->chunks().size(); ++i)
+    EXPECT_EQ(*r->read_chunk(i), corpus::pattern(i, corpus::kFrozenSizes[i])) << i;
+  EXPECT_TRUE(r->verify().empty());
+}
+
+// The writer's two directory forms: the same contents; the plain one is a 1.0 file (minor 0,
+// no feature bit), the compressed one a 1.1 file whose directory is smaller than its body.
+TEST(ContainerRobustnessTest, WriterDirectoryFormsHoldTheSameContents) {
+  const Bytes plain = *corpus::make_frozen_v1(false);
+  const Bytes packed = *corpus::make_frozen_v1(true);
+  auto a = Reader::open(memory_source(std::span<const uint8_t>(plain)));
+  auto b = Reader::open(memory_source(std::span<const uint8_t>(packed)));
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(a->header().version_minor, 0);
+  EXPECT_EQ(a->header().required_features, 0u);
+  EXPECT_EQ(a->header().directory_size, a->directory_body_size() + 8);
+  EXPECT_EQ(b->header().version_minor, 1);
+  EXPECT_EQ(b->header().required_features, kFeatureCompressedDirectory);
+  EXPECT_EQ(b->directory_body_size(), a->directory_body_size());
+  EXPECT_LT(b->header().directory_size, b->directory_body_size());
+  EXPECT_EQ(a->header().directory_offset, b->header().directory_offset);  // chunks unchanged
+  EXPECT_TRUE(std::equal(plain.begin() + 64,
+                         plain.begin() + static_cast<std::ptrdiff_t>(a->header().directory_offset),
+                         packed.begin() + 64));
+}
+
 TEST(ContainerRobustnessTest, LongerTrackHeadersFromLaterMinorVersionsAreAccepted) {
   corpus::Parts p = corpus::take_apart(*corpus::make_frozen_v1());
   p.tracks[0].header.insert(p.tracks[0].header.end(), {9, 9, 9, 9});

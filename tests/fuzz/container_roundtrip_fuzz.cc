@@ -1,7 +1,7 @@
 // Fuzz target: writer -> reader round trip driven by the input bytes. The input is cut into
-// chunks whose keys and supercompression come from its bytes; the clip is written twice (must
-// give identical bytes: determinism) and read back (every chunk must decode to its input, and
-// verify must find nothing).
+// chunks whose keys and supercompression come from its bytes (the directory form from its size);
+// the clip is written twice (must give identical bytes: determinism) and read back (every chunk
+// must decode to its input, and verify must find nothing).
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -19,7 +19,10 @@ std::vector<uint8_t> write_clip(const uint8_t* data, size_t size,
                                 std::vector<std::vector<uint8_t>>* raws) {
   using namespace calf::container;
   std::vector<uint8_t> file;
-  auto w = Writer::create(memory_sink(&file), CompressionOptions{1, 0});
+  // Both directory forms: plain (1.0) for odd sizes, compressed (1.1) for even ones.
+  auto w = Writer::create(
+      memory_sink(&file),
+      CompressionOptions{.zstd_level = 1, .lzma_preset = 0, .compress_directory = size % 2 == 0});
   check(w.ok());
   check(w->add_track(LightfieldTrackHeader{}).ok());
   check(w->add_track(0x1234, 0, std::vector<uint8_t>(data, data + std::min<size_t>(size, 8))).ok());

@@ -40,6 +40,9 @@ struct PinCase {
   double colour_rdo = 0;  // LightfieldEncodeOptions::colour_rdo (0: the clips frozen before it)
   uint32_t depth_keyframe_interval = 30;
   uint32_t max_aabbs = 2;  // LightfieldEncodeOptions::max_aabbs
+  // CompressionOptions::compress_directory: the clips frozen before container 1.1 are 1.0 files
+  // with a plain directory (their pins unchanged since); `*_zdir` clips are their 1.1 twins.
+  bool compress_directory = false;
 };
 
 // clang-format off
@@ -66,6 +69,10 @@ const PinCase kCases[] = {
     // per P-frame, so that it spans the unchanged column inside the moving square (W = 2).
     {"bc1_pred16m_zstd",   {.face = 16, .frames = 5, .views = 2},                   ColourCoding::kBc1,     DepthCoding::kRaw16PredictedMasked, container::Compression::kZstd,  "a21f65e106f413f6", 0, 30, 1},
     {"bc1_pred16m_groups", {.face = 16, .frames = 7, .views = 2, .material = true},  ColourCoding::kBc1,     DepthCoding::kRaw16PredictedMasked, container::Compression::kZstd,  "61d24cbe36d26996", 0, 2, 1},
+    // Container 1.1 (SPEC §4.1, issue 17): the directory as one zstd frame, the encoders'
+    // default since; twins of the 1.0 clips, they decode to their hashes.
+    {"bc1_raw16_zstd_zdir",   {.face = 16, .frames = 5, .views = 2},                ColourCoding::kBc1,     DepthCoding::kRaw16, container::Compression::kZstd,  "fba3ff8193f27a11", 0, 30, 2, true},
+    {"bc1_pred16m_groups_zdir", {.face = 16, .frames = 7, .views = 2, .material = true}, ColourCoding::kBc1, DepthCoding::kRaw16PredictedMasked, container::Compression::kZstd, "03502347f39cf975", 0, 2, 1, true},
 };
 // clang-format on
 
@@ -104,6 +111,7 @@ TEST_P(EncodePin, OutputBytesAreUnchanged) {
     o.cell_size = 8;
     o.depth_keyframe_interval = c.depth_keyframe_interval;
     o.max_aabbs = c.max_aabbs;
+    o.levels.compress_directory = c.compress_directory;
     o.threads = threads;
     const fs::path out = root / (threads == 1 ? "t1.calf" : "t2.calf");
     auto stats = encode_lightfield_file(capture, out.string(), o);

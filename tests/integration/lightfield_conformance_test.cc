@@ -76,6 +76,7 @@ std::string read_text(const fs::path& p) {
 TEST(LightfieldConformance, PredictedDepthClipsDecodeAsTheirRaw16Twins) {
   size_t twins = 0;
   for (const auto& n : clip_names()) {
+    if (n.ends_with("_zdir")) continue;  // 1.1 twins: CompressedDirectoryClipsDecodeAs...
     size_t at = n.find("_pred16_"), len = 8;
     if (at == std::string::npos) {
       at = n.find("_pred16m_");
@@ -89,6 +90,27 @@ TEST(LightfieldConformance, PredictedDepthClipsDecodeAsTheirRaw16Twins) {
     ++twins;
   }
   EXPECT_GE(twins, 5u);
+}
+
+// Container 1.1 (SPEC §4.1): each `*_zdir` clip is a plain-directory clip's twin with its
+// directory compressed, and decodes to the twin's hashes.
+TEST(LightfieldConformance, CompressedDirectoryClipsDecodeAsTheirPlainTwins) {
+  size_t twins = 0;
+  for (const auto& n : clip_names()) {
+    if (!n.ends_with("_zdir")) continue;
+    const std::string twin = n.substr(0, n.size() - 5);
+    const std::string mine = read_text(suite_dir() / (n + ".hashes"));
+    EXPECT_FALSE(mine.empty()) << n;
+    EXPECT_EQ(mine, read_text(suite_dir() / (twin + ".hashes"))) << n << " vs " << twin;
+    auto a = container::Reader::open((suite_dir() / (n + ".calf")).string());
+    auto b = container::Reader::open((suite_dir() / (twin + ".calf")).string());
+    ASSERT_TRUE(a.ok() && b.ok()) << n;
+    EXPECT_EQ(a->header().required_features, container::kFeatureCompressedDirectory) << n;
+    EXPECT_EQ(b->header().required_features, 0u) << twin;
+    EXPECT_LT(a->header().file_size, b->header().file_size) << n;
+    ++twins;
+  }
+  EXPECT_GE(twins, 2u);
 }
 
 container::Reader open_clip(const std::string& name) {

@@ -39,7 +39,7 @@ std::vector<uint8_t> encode(const capture::SceneFile& scene,
                             encoder::MeshEncodeOptions options = {},
                             encoder::MeshEncodeStats* stats = nullptr) {
   std::vector<uint8_t> file;
-  auto w = container::Writer::create(container::memory_sink(&file));
+  auto w = container::Writer::create(container::memory_sink(&file), options.levels);
   EXPECT_TRUE(w.ok());
   const Status st = encoder::encode_mesh_track(scene, visible, options, &*w, stats);
   EXPECT_TRUE(st.ok()) << st.to_string();
@@ -551,16 +551,19 @@ constexpr Clip kClips[] = {{"full_none", false, Compression::kNone},
                            {"full_lzma2", false, Compression::kLzma2},
                            {"textured_zstd", false, Compression::kZstd, true}};
 
+// The frozen clips are container 1.0 files: a plain directory (SPEC §4.1 is 1.1).
 std::vector<uint8_t> make_clip(const Clip& c) {
   if (c.textured) {
     encoder::MeshEncodeOptions o;
     o.supercompression = c.compression;
+    o.levels.compress_directory = false;
     return encode(test::make_textured_mesh_test_scene(), nullptr, o);
   }
   const capture::SceneFile scene = test::make_mesh_test_scene(3, false);
   const auto visible = test_subset(false);
   encoder::MeshEncodeOptions o;
   o.supercompression = c.compression;
+  o.levels.compress_directory = false;
   o.segment_count = c.subset ? 8 : 0;
   return encode(scene, c.subset ? &visible : nullptr, o);
 }

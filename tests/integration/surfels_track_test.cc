@@ -91,10 +91,11 @@ std::vector<uint8_t> encode(const SurfelsTrackInput& input,
                             encoder::SurfelsEncodeOptions options = {},
                             encoder::SurfelsEncodeStats* stats = nullptr, bool spheres = false) {
   std::vector<uint8_t> file;
-  auto w = container::Writer::create(container::memory_sink(&file));
+  auto w = container::Writer::create(container::memory_sink(&file), options.levels);
   EXPECT_TRUE(w.ok());
   encoder::MeshEncodeOptions mesh_options;
   mesh_options.supercompression = options.supercompression;
+  mesh_options.levels = options.levels;
   Status st = encoder::encode_mesh_track(test::make_mesh_test_scene(3, spheres), nullptr,
                                          mesh_options, &*w);
   EXPECT_TRUE(st.ok()) << st.to_string();
@@ -549,8 +550,11 @@ constexpr Clip kClips[] = {{"levels_none", Compression::kNone},
                            {"levels_zstd", Compression::kZstd},
                            {"levels_lzma2", Compression::kLzma2}};
 
+// The frozen clips are container 1.0 files: a plain directory (SPEC §4.1 is 1.1).
 std::vector<uint8_t> make_clip(const Clip& c) {
-  return encode(test_input(mesh_prototypes(), false), opts(c.compression));
+  encoder::SurfelsEncodeOptions o = opts(c.compression);
+  o.levels.compress_directory = false;
+  return encode(test_input(mesh_prototypes(), false), o);
 }
 
 // The generator (tests/conformance/README.md): with CALF_CONFORMANCE_OUT=DIR it writes the clips

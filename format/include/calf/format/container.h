@@ -60,10 +60,12 @@ class Reader {
   // kFileOpen, kContainerIdentifier, kContainerTruncated (shorter than the header or than
   // file_size), kContainerHeaderChecksum, kContainerVersion, kContainerRequiredFeature,
   // kContainerFileSize, kContainerLimit (counts), kContainerDirectoryRange,
-  // kContainerDirectoryChecksum, then per directory entry kContainerDirectoryFormat,
-  // kContainerMetadata, kContainerTrackKind, kContainerTrackHeader, kContainerLimit and per
-  // chunk kContainerChunkTrack, kContainerCompression, kContainerRequiredFeature,
-  // kContainerChunkSize, kContainerChunkRange, kContainerChunkLayout. Every error of the path
+  // kContainerDirectoryChecksum, a compressed directory's body size and frame
+  // (kContainerDirectoryRange, kContainerLimit, kContainerDecompress), then per directory entry
+  // kContainerDirectoryFormat, kContainerMetadata, kContainerTrackKind, kContainerTrackHeader,
+  // kContainerLimit and per chunk kContainerChunkTrack, kContainerCompression,
+  // kContainerRequiredFeature, kContainerChunkSize, kContainerChunkRange, kContainerChunkLayout.
+  // Every error of the path
   // overload names the path exactly once ("clip.calf: ..."), so a command prints it as it is.
   static Expected<Reader> open(const std::string& path);
   static Expected<Reader> open(std::unique_ptr<ByteSource> source);
@@ -76,6 +78,9 @@ class Reader {
   const std::vector<Track>& tracks() const { return tracks_; }
   const std::vector<MetadataEntry>& metadata() const { return metadata_; }
   const std::vector<ChunkEntry>& chunks() const { return chunks_; }
+  // Bytes of the directory's body (metadata, track records, chunk index) as parsed: equal to
+  // directory_size - 8 for a plain directory, the decompressed size for a compressed one.
+  uint64_t directory_body_size() const { return directory_body_size_; }
   // The value for `key`, or nullptr.
   const std::string* find_metadata(std::string_view key) const;
   // Ids of the chunks matching `q`, in index order.
@@ -110,6 +115,7 @@ class Reader {
   std::vector<Track> tracks_;
   std::vector<MetadataEntry> metadata_;
   std::vector<ChunkEntry> chunks_;
+  uint64_t directory_body_size_ = 0;
 };
 
 class Writer {

@@ -30,6 +30,10 @@ uint64_t hash64(std::span<const uint8_t> bytes);
 struct CompressionOptions {
   int zstd_level = 19;       // 1..22 (ZSTD_maxCLevel)
   uint32_t lzma_preset = 6;  // 0..9
+  // The Writer stores the directory as one zstd frame at zstd_level (container 1.1, required
+  // feature bit 0; SPEC.md §4.1 "Compressed directory"): 9-14 bytes per chunk instead of 64. False
+  // writes a plain 1.0 directory, which 1.0 readers open.
+  bool compress_directory = true;
 };
 
 // A chunk ready for Writer::add_stored_chunk(): stored bytes, their scheme and raw length.

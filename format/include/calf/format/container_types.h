@@ -32,12 +32,17 @@ namespace calf::container {
 inline constexpr std::array<uint8_t, 12> kIdentifier = {0xAB, 'C',  'A',  'L',  'F',  ' ',
                                                         '1',  0xBB, 0x0D, 0x0A, 0x1A, 0x0A};
 inline constexpr uint16_t kVersionMajor = 1;  // a reader refuses any other major version
-inline constexpr uint16_t kVersionMinor = 0;  // minor versions only add what 1.0 may ignore
+// Minor versions add what a 1.0 reader may ignore, or announce a must-understand addition with a
+// required_features bit. 1.1 defines bit 0 (a compressed directory); a writer writes minor 1 only
+// when it sets that bit, so a file with a plain directory is byte for byte a 1.0 file.
+inline constexpr uint16_t kVersionMinor = 1;
 inline constexpr uint64_t kHeaderSize = 64;
 inline constexpr uint64_t kAlignment = 16;  // chunk offsets and the directory offset
-// Must-understand feature bits this reader knows (none in 1.0): any other set bit in
+// Must-understand feature bits (SPEC.md "Header"). Bit 0 (1.1): the directory is its body's size
+// and one zstd frame of the body (SPEC.md §4.1 "Compressed directory"). Any other set bit in
 // FileHeader::required_features is refused with kContainerRequiredFeature.
-inline constexpr uint32_t kKnownRequiredFeatures = 0;
+inline constexpr uint32_t kFeatureCompressedDirectory = 1u << 0;
+inline constexpr uint32_t kKnownRequiredFeatures = kFeatureCompressedDirectory;
 // Chunk flags: bits 0-7 are must-understand (none known in 1.0), bits 8-15 optional.
 inline constexpr uint16_t kChunkRequiredFlagsMask = 0x00FF;
 inline constexpr uint16_t kKnownChunkRequiredFlags = 0;
@@ -87,7 +92,7 @@ const char* pixel_format_name(uint16_t format);
 struct FileHeader {
   std::array<uint8_t, 12> identifier = kIdentifier;
   uint16_t version_major = kVersionMajor;
-  uint16_t version_minor = kVersionMinor;
+  uint16_t version_minor = 0;      // the writer sets kVersionMinor with a compressed directory
   uint32_t required_features = 0;  // must-understand bits
   uint32_t optional_features = 0;  // bits a reader may ignore
   uint64_t file_size = 0;          // the whole file, bytes
@@ -123,6 +128,16 @@ struct MetadataCount {
   template <class Self, class V>
   static constexpr void fields(Self& s, V& v) {
     v(s.count, "metadata_count", Range{0, kMaxMetadataEntries});
+  }
+};
+
+// A compressed directory (required feature bit 0) starts with the size of its body: the
+// metadata, track records and chunk entries of a plain directory, without its checksum.
+struct DirectoryBodySize {
+  uint64_t size = 0;
+  template <class Self, class V>
+  static constexpr void fields(Self& s, V& v) {
+    v(s.size, "directory_body_size");
   }
 };
 
