@@ -31,8 +31,8 @@ double now_ms() {
 Expected<std::vector<uint8_t>> rewrite(const Reader& r, bool compressed) {
   std::vector<uint8_t> file;
   CALF_ASSIGN_OR_RETURN(
-      Writer w, Writer::create(memory_sink(&file), CompressionOptions{.compress_directory =
-                                                                          compressed}));
+      Writer w,
+      Writer::create(memory_sink(&file), CompressionOptions{.compress_directory = compressed}));
   for (const Track& t : r.tracks())
     CALF_RETURN_IF_ERROR(w.add_track(t.record.kind, t.record.flags, t.record.header).status());
   for (const MetadataEntry& m : r.metadata()) CALF_RETURN_IF_ERROR(w.set_metadata(m.key, m.value));
