@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -141,10 +140,10 @@ inline Bytes raw_zstd_frame(std::span<const uint8_t> bytes, uint64_t content_siz
 // Serialises parts back into a file. Values outside their ranges are written as given.
 // `reseal` recomputes the directory checksum and the header checksum; `fix_sizes` recomputes
 // directory_size and file_size from what is written. When the header has the compressed
-// directory bit, the body goes into a raw_zstd_frame after its size (`body_size`, when given,
-// replaces the true size in that field and in the frame; `body_tail` is appended to the body).
+// directory bit, the body goes into a raw_zstd_frame after its size (`body_tail`, bytes a
+// writer would never leave, is appended to the body first).
 inline Bytes assemble(const Parts& p, bool reseal = true, bool fix_sizes = true,
-                      std::optional<uint64_t> body_size = std::nullopt, Bytes body_tail = {}) {
+                      Bytes body_tail = {}) {
   auto put = [](Bytes& out, const auto& s) {
     FieldWriter w(out);
     w.allow_out_of_range();
@@ -157,7 +156,7 @@ inline Bytes assemble(const Parts& p, bool reseal = true, bool fix_sizes = true,
   for (const auto& c : p.chunks) put(dir, c);
   dir.insert(dir.end(), body_tail.begin(), body_tail.end());
   if (p.header.required_features & kFeatureCompressedDirectory) {
-    const uint64_t size = body_size.value_or(dir.size());
+    const uint64_t size = dir.size();
     Bytes packed;
     put(packed, DirectoryBodySize{size});
     const Bytes frame = raw_zstd_frame(dir, size);
@@ -423,7 +422,7 @@ inline std::vector<Malformed> make_malformed_compressed_directory(const Bytes& v
   reseal_header(cut);
   reseal_directory(cut);
   add("frame_truncated", cut, ErrorId::kContainerDecompress);
-  add("raw_blocks_leftover_body_bytes", assemble(base, true, true, std::nullopt, Bytes{0, 0, 0}),
+  add("raw_blocks_leftover_body_bytes", assemble(base, true, true, Bytes{0, 0, 0}),
       ErrorId::kContainerDirectoryFormat);
   add(
       "raw_blocks_chunk_track_missing",
