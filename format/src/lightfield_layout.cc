@@ -204,6 +204,9 @@ container::PixelFormat region_gpu_format(RegionCoding coding) {
   return PixelFormat::kNone;
 }
 
+// region_rect_gpu_bytes() stores 16-bit codes as the host writes them.
+static_assert(std::endian::native == std::endian::little, "GPU bytes are little-endian");
+
 namespace {
 size_t unit_bytes(RegionCoding coding) {
   switch (coding) {
@@ -308,10 +311,16 @@ void region_rect_gpu_bytes(const RegionChunk& chunk, size_t index, std::vector<u
     case RegionCoding::kR16: {
       const size_t n = size_t{r.w} * r.h;
       out.resize(n * 2);
+      // Planes hold the high byte, then the low byte; GPU bytes are little-endian. Through local
+      // pointers and 16-bit stores (a little-endian host: asserted above), so that the compiler can
+      // vectorise the interleave (byte stores through the vector could alias the payload, which
+      // kept it a byte loop: a quarter of a moving eye's decode time on raw16 depth).
+      const uint8_t* hi = p.data() + r.first_unit;
+      const uint8_t* lo = p.data() + units + r.first_unit;
+      uint8_t* dst = out.data();
       for (size_t i = 0; i < n; ++i) {
-        // Planes hold the high byte, then the low byte; GPU bytes are little-endian.
-        out[2 * i] = p[units + r.first_unit + i];
-        out[2 * i + 1] = p[r.first_unit + i];
+        const uint16_t code = static_cast<uint16_t>(hi[i] << 8 | lo[i]);
+        std::memcpy(dst + 2 * i, &code, 2);
       }
       return;
     }

@@ -9,7 +9,10 @@
 //   `--directions` horizontal directions in turn; for each it plays the whole clip `--repeats`
 //   times (the wrap back to frame 0 is a seek). The first frame of each direction is left out
 //   of the means (it uploads everything visible from nothing). Active views: the nearest to the
-//   eye (ties by index).
+//   eye (ties by index). The three ways (no VD; VD, eye held; VD, eye turning) play each
+//   direction in turn, each with its own decoder, so that load on a shared machine falls on all
+//   three alike; besides the wall clock, advance()'s thread CPU time is printed ("CPU ms/frame"),
+//   with the VD / no VD ratio of each.
 // Table 4 — quadtree leaf levels 1-4 (2x2 ... 16x16 cells per face): per frame, the share of cells
 //   visible and the frustum tests of the regular method (every cell) and of the hierarchical one,
 //   9 active views (or all, if fewer), one eye, same poses.
@@ -29,10 +32,12 @@
 //       [--no-table4] [--background-thread] [--synthetic 1024 [--synthetic-frames 4]
 //       [--synthetic-out FILE]]
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <numbers>
 #include <string>
@@ -59,6 +64,15 @@ double now_ms() {
   return std::chrono::duration<double, std::milli>(
              std::chrono::steady_clock::now().time_since_epoch())
       .count();
+}
+
+// CPU time of the calling thread: the "decode CPU ms", steadier than the wall clock on a
+// shared machine (another process taking the core does not count). Without the background thread
+// every chunk is read and decompressed on this thread, so this is all of advance()'s work.
+double thread_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
 }
 
 struct Poses {
@@ -108,99 +122,129 @@ struct Table3Row {
   uint32_t views = 0;
   double colour_mbps = 0, depth_mbps = 0, decode_ms = 0, memcpy_ms = 0, visible_pct = 0;
   double culling_ms = 0, decompress_ms = 0;  // limit = decompress_ms + memcpy_ms
+  double cpu_ms = 0;                         // advance()'s thread CPU time
   double tests = 0, exact_tests = 0;         // culling tests per frame
   double kept = 0;  // culling decisions kept from earlier frames per frame (GridCuller's memory)
   uint32_t errors = 0;
   uint64_t frames = 0;
 };
 
-// `moving`: the eye turns by 0.1° about the vertical every frame (a head never holds still), so
-// the decoder's visible sets are recomputed every frame (mostly from the culler's memory of the
-// decisions that still hold); otherwise it holds each direction.
-Table3Row run_table3(const container::Reader& reader, const Poses& poses, bool vd,
-                     const std::vector<uint32_t>& active, uint32_t repeats, bool background,
-                     bool moving) {
-  Table3Row row;
-  row.vd = vd;
-  row.views = static_cast<uint32_t>(active.size());
-  ClipDecoderOptions o;
-  o.view_dependent = vd;
-  o.background_thread = background;
-  auto d = ClipDecoder::open(reader, 0, o);
-  if (!d.ok()) {
-    std::fprintf(stderr, "%s\n", d.status().to_string().c_str());
-    std::exit(1);
+// The three ways of Table 3, in this order: everything (no VD), VD with the eye held on each
+// direction, VD with the eye turning by 0.1° about the vertical every frame (a head never holds
+// still: the decoder's visible sets are recomputed every frame, mostly from the culler's memory
+// of the decisions that still hold).
+struct Table3Mode {
+  bool vd, moving;
+};
+constexpr std::array<Table3Mode, 3> kTable3Modes = {{{false, false}, {true, false}, {true, true}}};
+
+// Plays every direction with each mode in turn (direction by direction, so that a burst of load
+// on the shared machine falls on all three alike and their ratios stay fair), each mode with its
+// own decoder.
+std::array<Table3Row, 3> run_table3(const container::Reader& reader, const Poses& poses,
+                                    const std::vector<uint32_t>& active, uint32_t repeats,
+                                    bool background) {
+  std::array<Table3Row, 3> rows;
+  std::array<ClipDecoderOptions, 3> options;
+  for (size_t m = 0; m < 3; ++m) {
+    rows[m].vd = kTable3Modes[m].vd;
+    rows[m].views = static_cast<uint32_t>(active.size());
+    options[m].view_dependent = kTable3Modes[m].vd;
+    options[m].background_thread = background;
   }
-  const uint32_t frames = d->header().frame_count;
+  auto d0 = ClipDecoder::open(reader, 0, options[0]);
+  auto d1 = ClipDecoder::open(reader, 0, options[1]);
+  auto d2 = ClipDecoder::open(reader, 0, options[2]);
+  for (const auto* d : {&d0, &d1, &d2}) {
+    if (!d->ok()) {
+      std::fprintf(stderr, "%s\n", d->status().to_string().c_str());
+      std::exit(1);
+    }
+  }
+  const std::array<ClipDecoder*, 3> decoders = {&*d0, &*d1, &*d2};
+  const uint32_t frames = decoders[0]->header().frame_count;
   std::vector<uint8_t> sink, chunk, scratch;
   FrameUpdates fu;
-  double colour = 0, depth = 0, visible = 0;
+  std::array<double, 3> colour{}, depth{}, visible{};
   for (const EyeView& held : poses.eyes) {
-    d->reset();
-    bool first = true;
-    uint32_t step = 0;
-    for (uint32_t r = 0; r < repeats; ++r) {
-      for (uint32_t f = 0; f < frames; ++f, ++step) {
-        EyeView eye = held;
-        if (moving) {
-          const double a = step * (std::numbers::pi / 1800), c = std::cos(a), sn = std::sin(a);
-          eye.forward = {held.forward.x * c - held.forward.z * sn, held.forward.y,
-                         held.forward.x * sn + held.forward.z * c};
+    for (size_t m = 0; m < 3; ++m) {
+      ClipDecoder& d = *decoders[m];
+      Table3Row& row = rows[m];
+      const bool moving = kTable3Modes[m].moving;
+      d.reset();
+      bool first = true;
+      uint32_t step = 0;
+      for (uint32_t r = 0; r < repeats; ++r) {
+        for (uint32_t f = 0; f < frames; ++f, ++step) {
+          EyeView eye = held;
+          if (moving) {
+            const double a = step * (std::numbers::pi / 1800), c = std::cos(a), sn = std::sin(a);
+            eye.forward = {held.forward.x * c - held.forward.z * sn, held.forward.y,
+                           held.forward.x * sn + held.forward.z * c};
+          }
+          const double cpu0 = thread_cpu_ms();
+          const Status s = d.advance(f, std::span<const EyeView>(&eye, 1), active, &fu);
+          const double cpu_ms = thread_cpu_ms() - cpu0;
+          if (!s.ok()) {
+            std::fprintf(stderr, "%s\n", s.to_string().c_str());
+            std::exit(1);
+          }
+          // The same bytes copied once, as a GPU upload from mapped memory would at best.
+          const uint64_t bytes = fu.stats.update_bytes();
+          if (sink.size() < bytes) sink.resize(bytes);
+          const double t0 = now_ms();
+          size_t at = 0;
+          for (const TextureUpdate& u : fu.updates) {
+            std::memcpy(sink.data() + at, u.bytes.data(), u.bytes.size());
+            at += u.bytes.size();
+          }
+          const double copy_ms = now_ms() - t0;
+          // The limit's other half: reading and decompressing just the chunks the frame used
+          // (each time it used one, as if nothing were cached), into one reused buffer.
+          const double t1 = now_ms();
+          for (uint32_t id : fu.chunks) {
+            chunk.resize(reader.chunks()[id].raw_size);
+            if (!reader.read_chunk_into(id, chunk, scratch).ok()) row.errors += 1;
+          }
+          const double decompress_ms = now_ms() - t1;
+          row.errors += fu.stats.errors;
+          if (first) {
+            first = false;
+            continue;
+          }
+          row.frames += 1;
+          colour[m] += fu.stats.colour_bytes;
+          depth[m] += fu.stats.depth_bytes + fu.stats.material_bytes;
+          row.decode_ms += fu.stats.decode_ms;
+          row.cpu_ms += cpu_ms;
+          row.culling_ms += fu.stats.culling_ms;
+          row.tests += fu.stats.culling_tests;
+          row.exact_tests += fu.stats.culling_exact_tests;
+          row.kept += fu.stats.culling_reused;
+          row.memcpy_ms += copy_ms;
+          row.decompress_ms += decompress_ms;
+          visible[m] +=
+              fu.stats.total_cells ? double(fu.stats.visible_cells) / fu.stats.total_cells : 0;
         }
-        const Status s = d->advance(f, std::span<const EyeView>(&eye, 1), active, &fu);
-        if (!s.ok()) {
-          std::fprintf(stderr, "%s\n", s.to_string().c_str());
-          std::exit(1);
-        }
-        // The same bytes copied once, as a GPU upload from mapped memory would at best.
-        const uint64_t bytes = fu.stats.update_bytes();
-        if (sink.size() < bytes) sink.resize(bytes);
-        const double t0 = now_ms();
-        size_t at = 0;
-        for (const TextureUpdate& u : fu.updates) {
-          std::memcpy(sink.data() + at, u.bytes.data(), u.bytes.size());
-          at += u.bytes.size();
-        }
-        const double copy_ms = now_ms() - t0;
-        // The limit's other half: reading and decompressing just the chunks the frame used (each
-        // time it used one, as if nothing were cached), into one reused buffer.
-        const double t1 = now_ms();
-        for (uint32_t id : fu.chunks) {
-          chunk.resize(reader.chunks()[id].raw_size);
-          if (!reader.read_chunk_into(id, chunk, scratch).ok()) row.errors += 1;
-        }
-        const double decompress_ms = now_ms() - t1;
-        row.errors += fu.stats.errors;
-        if (first) {
-          first = false;
-          continue;
-        }
-        row.frames += 1;
-        colour += fu.stats.colour_bytes;
-        depth += fu.stats.depth_bytes + fu.stats.material_bytes;
-        row.decode_ms += fu.stats.decode_ms;
-        row.culling_ms += fu.stats.culling_ms;
-        row.tests += fu.stats.culling_tests;
-        row.exact_tests += fu.stats.culling_exact_tests;
-        row.kept += fu.stats.culling_reused;
-        row.memcpy_ms += copy_ms;
-        row.decompress_ms += decompress_ms;
-        visible += fu.stats.total_cells ? double(fu.stats.visible_cells) / fu.stats.total_cells : 0;
       }
     }
   }
-  const double n = std::max<double>(1, row.frames);
-  row.colour_mbps = colour / n * 8 * 24 / 1e6;
-  row.depth_mbps = depth / n * 8 * 24 / 1e6;
-  row.decode_ms /= n;
-  row.culling_ms /= n;
-  row.tests /= n;
-  row.exact_tests /= n;
-  row.kept /= n;
-  row.memcpy_ms /= n;
-  row.decompress_ms /= n;
-  row.visible_pct = 100 * visible / n;
-  return row;
+  for (size_t m = 0; m < 3; ++m) {
+    Table3Row& row = rows[m];
+    const double n = std::max<double>(1, row.frames);
+    row.colour_mbps = colour[m] / n * 8 * 24 / 1e6;
+    row.depth_mbps = depth[m] / n * 8 * 24 / 1e6;
+    row.decode_ms /= n;
+    row.cpu_ms /= n;
+    row.culling_ms /= n;
+    row.tests /= n;
+    row.exact_tests /= n;
+    row.kept /= n;
+    row.memcpy_ms /= n;
+    row.decompress_ms /= n;
+    row.visible_pct = 100 * visible[m] / n;
+  }
+  return rows;
 }
 
 struct Table4Row {
@@ -382,9 +426,9 @@ int main(int argc, char** argv) {
         "memcpy of its update bytes; eye held: one direction for all its frames, moving: turning "
         "0.1° a frame)\n\n| VD | eye | active views | colour Mbps @24fps | "
         "depth+material Mbps | cells visible %% | decode ms/frame | of it culling | limit "
-        "ms/frame | decode / limit | VD / no VD | memcpy ms/frame | decode / memcpy | tests "
-        "(exact) + kept per frame "
-        "|\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "ms/frame | decode / limit | VD / no VD | CPU ms/frame | VD / no VD (CPU) | memcpy "
+        "ms/frame | decode / memcpy | tests (exact) + kept per frame "
+        "|\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         background ? "with its background thread" : "on one thread");
     std::vector<uint32_t> counts;
     for (uint32_t c : {5u, 9u, h.view_count}) {
@@ -394,20 +438,23 @@ int main(int argc, char** argv) {
     double nine_no_vd_ms = 0;
     for (uint32_t k : counts) {
       const std::vector<uint32_t> active = nearest_views(*probe, poses.centre, k);
-      double no_vd_ms = 0;
-      for (int mode = 0; mode < 3; ++mode) {
-        const bool vd = mode > 0, moving = mode == 2;
-        const Table3Row r = run_table3(*reader, poses, vd, active, repeats, background, moving);
+      double no_vd_ms = 0, no_vd_cpu_ms = 0;
+      const std::array<Table3Row, 3> rows = run_table3(*reader, poses, active, repeats, background);
+      for (size_t mode = 0; mode < 3; ++mode) {
+        const bool vd = kTable3Modes[mode].vd, moving = kTable3Modes[mode].moving;
+        const Table3Row& r = rows[mode];
         if (!vd && k == std::min(9u, h.view_count)) nine_no_vd_ms = r.decode_ms;
         if (!vd) no_vd_ms = r.decode_ms;
+        if (!vd) no_vd_cpu_ms = r.cpu_ms;
         const double limit = r.decompress_ms + r.memcpy_ms;
         std::printf(
-            "| %s | %s | %u | %.2f | %.2f | %.1f | %.3f | %.3f | %.3f | %.2f | %s | %.4f | %.0f× | "
-            "%.0f "
-            "(%.0f) + %.0f |%s\n",
+            "| %s | %s | %u | %.2f | %.2f | %.1f | %.3f | %.3f | %.3f | %.2f | %s | %.3f | %s | "
+            "%.4f | %.0f× | %.0f (%.0f) + %.0f |%s\n",
             vd ? "yes" : "no", moving ? "moving" : "held", k, r.colour_mbps, r.depth_mbps,
             r.visible_pct, r.decode_ms, r.culling_ms, limit, r.decode_ms / std::max(1e-9, limit),
             vd ? fmt::format("{:.2f}", r.decode_ms / std::max(1e-9, no_vd_ms)).c_str() : "—",
+            r.cpu_ms,
+            vd ? fmt::format("{:.2f}", r.cpu_ms / std::max(1e-9, no_vd_cpu_ms)).c_str() : "—",
             r.memcpy_ms, r.decode_ms / std::max(1e-9, r.memcpy_ms), r.tests, r.exact_tests, r.kept,
             r.errors ? fmt::format(" {} chunk errors", r.errors).c_str() : "");
       }
