@@ -30,7 +30,7 @@
 //
 //   bench-decoder_tables --clip FILE.calf [--clip ...] [--directions 8] [--repeats 2] [--no-peers]
 //       [--no-table4] [--background-thread] [--synthetic 1024 [--synthetic-frames 4]
-//       [--synthetic-out FILE]]
+//       [--synthetic-depth-format raw16|pred16|pred16m] [--synthetic-out FILE]]
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -334,9 +334,11 @@ void run_peers(const container::Reader& reader, const std::vector<uint32_t>& act
 // A 9-view clip of face x face texels per cube face made here (no ray tracing): the synthetic
 // scene of the integration tests (tests/integration/synthetic_capture.h: smooth colour, a small
 // moving square on face 0, a fade on face 2, sky on half of face 3), viewpoints 0.1 apart on a
-// line, encoded with the default options (cell 64, 2 x 2 depth tiles, raw16 depth, BC1 colour).
-// The capture set is written to a temporary directory and removed after encoding.
-bool make_synthetic_clip(uint32_t face, uint32_t frames, const std::string& out) {
+// line, encoded with the default options (cell 64, 2 x 2 depth tiles, raw16 depth, BC1 colour)
+// but for the depth coding `depth`. The capture set is written to a temporary directory and
+// removed after encoding.
+bool make_synthetic_clip(uint32_t face, uint32_t frames, DepthCoding depth,
+                         const std::string& out) {
   namespace fs = std::filesystem;
   const fs::path dir =
       fs::path(out).parent_path() / (fs::path(out).filename().string() + ".capture");
@@ -352,6 +354,7 @@ bool make_synthetic_clip(uint32_t face, uint32_t frames, const std::string& out)
   if (s.ok()) {
     LightfieldEncodeOptions o;
     o.threads = 0;
+    o.depth = depth;
     auto stats = encode_lightfield_file(dir, out, o);
     if (!stats.ok()) s = stats.status();
   }
@@ -372,6 +375,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> clips;
   uint32_t directions = 8, repeats = 2, synthetic = 0, synthetic_frames = 4;
   std::string synthetic_out = "/tmp/calf-bench-synthetic.calf";
+  std::string synthetic_depth = "raw16";
   bool no_peers = false, no_table4 = false, background = false;
   app.add_option("--clip", clips, "encoded .calf clip (repeatable)");
   app.add_option("--directions", directions, "horizontal look directions (default 8)")
@@ -389,13 +393,20 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 4096));
   app.add_option("--synthetic-frames", synthetic_frames, "frames of the synthetic clip (default 4)")
       ->check(CLI::Range(2, 600));
+  app.add_option("--synthetic-depth-format", synthetic_depth,
+                 "depth coding of the synthetic clip: raw16 (calf-encode's default), pred16 or "
+                 "pred16m (default raw16)")
+      ->check(CLI::IsMember({"raw16", "pred16", "pred16m"}));
   app.add_option("--synthetic-out", synthetic_out,
                  "where the synthetic clip is written and kept (default "
                  "/tmp/calf-bench-synthetic.calf); measure it again with --clip")
       ->check(CLI::NonexistentPath);
   CLI11_PARSE(app, argc, argv);
   if (synthetic != 0) {
-    if (!make_synthetic_clip(synthetic, synthetic_frames, synthetic_out)) return 1;
+    const DepthCoding depth = synthetic_depth == "pred16"    ? DepthCoding::kRaw16Predicted
+                              : synthetic_depth == "pred16m" ? DepthCoding::kRaw16PredictedMasked
+                                                             : DepthCoding::kRaw16;
+    if (!make_synthetic_clip(synthetic, synthetic_frames, depth, synthetic_out)) return 1;
     clips.push_back(synthetic_out);
   }
   if (clips.empty()) {
