@@ -7,13 +7,13 @@
 //
 //   bench-container_directory --clip A.calf [--clip B.calf ...] [--repeat 30]
 #include <algorithm>
-#include <chrono>
 #include <string>
 #include <vector>
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "bench_clock.h"
 #include "calf/format/container.h"
 
 namespace {
@@ -21,12 +21,7 @@ namespace {
 using namespace calf;
 using namespace calf::container;
 
-double now_ms() {
-  return std::chrono::duration<double, std::milli>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
-
+using bench::now_ms;
 // `r`'s tracks, metadata and stored chunks written again with the given directory form.
 Expected<std::vector<uint8_t>> rewrite(const Reader& r, bool compressed) {
   std::vector<uint8_t> file;

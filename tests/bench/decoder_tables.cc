@@ -33,11 +33,9 @@
 //       [--synthetic-depth-format raw16|pred16|pred16m] [--synthetic-out FILE]]
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <ctime>
 #include <filesystem>
 #include <numbers>
 #include <string>
@@ -47,6 +45,7 @@
 #include <CLI/CLI.hpp>
 
 #include "../integration/synthetic_capture.h"
+#include "bench_clock.h"
 #include "calf/decoder/clip_decoder.h"
 #include "calf/decoder/culling.h"
 #include "calf/decoder/lightfield_reference.h"
@@ -60,20 +59,10 @@ namespace {
 using namespace calf;
 using namespace calf::decoder;
 
-double now_ms() {
-  return std::chrono::duration<double, std::milli>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
-
-// CPU time of the calling thread: the "decode CPU ms", steadier than the wall clock on a
-// shared machine (another process taking the core does not count). Without the background thread
-// every chunk is read and decompressed on this thread, so this is all of advance()'s work.
-double thread_cpu_ms() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
-}
+using bench::now_ms;
+// advance()'s CPU time: without the background thread every chunk is read and decompressed on
+// the calling thread, so its thread CPU time is all of advance()'s work.
+using bench::thread_cpu_ms;
 
 struct Poses {
   Vec3 centre;

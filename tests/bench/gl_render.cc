@@ -16,12 +16,12 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <chrono>
 #include <ctime>
 #include <string>
 #include <vector>
 
 #include "../player/synthetic_scene.h"
+#include "bench_clock.h"
 #include "calf/player/cpu_renderer.h"
 #include "calf/player/gl_context.h"
 #include "calf/player/gl_renderer.h"
@@ -32,12 +32,7 @@ namespace {
 using namespace calf;
 using namespace calf::player;
 
-double now_ms() {
-  return std::chrono::duration<double, std::milli>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
-
+using bench::now_ms;
 // CPU time of the whole process (every llvmpipe thread): unlike wall time, it hardly depends on
 // what else runs on the machine.
 double process_cpu_ms() {
