@@ -1,8 +1,10 @@
 #include "calf/decoder/clip_decoder.h"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <iterator>
 #include <numbers>
 #include <optional>
@@ -13,6 +15,10 @@
 #include "chunk_cache.h"
 
 namespace calf::decoder {
+
+// r16pm tile state is kept as host u16 and copied to and from little-endian GPU bytes by memcpy.
+static_assert(std::endian::native == std::endian::little);
+
 namespace {
 
 using container::LightfieldStream;
@@ -314,23 +320,19 @@ Status ClipDecoder::Impl::update_tile(bool depth, uint32_t view, uint32_t face, 
     for (uint32_t k = chunk.first_rect[step]; k < chunk.first_rect[step + 1]; ++k) {
       const lf::RegionRect& rr = chunk.rects[k];
       if (shadow && lf::region_rect_reads_state(chunk, k)) {
+        // Whole rows by memcpy: the GPU bytes are little-endian u16, the host's order (asserted
+        // at the top of the file).
         gpu.resize(size_t{rr.w} * rr.h * 2);
         for (uint32_t y = 0; y < rr.h; ++y) {
-          for (uint32_t x = 0; x < rr.w; ++x) {
-            const uint16_t c = s.codes[size_t{rr.y + y} * r.width + rr.x + x];
-            gpu[(size_t{y} * rr.w + x) * 2] = static_cast<uint8_t>(c);
-            gpu[(size_t{y} * rr.w + x) * 2 + 1] = static_cast<uint8_t>(c >> 8);
-          }
+          std::memcpy(gpu.data() + size_t{y} * rr.w * 2,
+                      s.codes.data() + size_t{rr.y + y} * r.width + rr.x, size_t{rr.w} * 2);
         }
       }
       lf::region_rect_gpu_bytes(chunk, k, gpu);
       if (shadow) {
         for (uint32_t y = 0; y < rr.h; ++y) {
-          for (uint32_t x = 0; x < rr.w; ++x) {
-            const size_t i = (size_t{y} * rr.w + x) * 2;
-            s.codes[size_t{rr.y + y} * r.width + rr.x + x] =
-                static_cast<uint16_t>(gpu[i] | gpu[i + 1] << 8);
-          }
+          std::memcpy(s.codes.data() + size_t{rr.y + y} * r.width + rr.x,
+                      gpu.data() + size_t{y} * rr.w * 2, size_t{rr.w} * 2);
         }
       }
       emit(out, which, view, face, 0, PixelRect{r.x + rr.x, r.y + rr.y, rr.w, rr.h}, format, gpu);

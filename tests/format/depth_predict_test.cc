@@ -68,7 +68,8 @@ TEST(DepthPredict, HandComputedResiduals) {
 
 TEST(DepthPredict, InverseIsExactOnAnyCodes) {
   std::mt19937 rng(7);
-  for (uint32_t w : {1u, 2u, 3u, 17u, 32u}) {
+  // Widths around the decoder's 8-texel prefix sums (a whole number of them, one more, one less).
+  for (uint32_t w : {1u, 2u, 3u, 7u, 8u, 9u, 17u, 32u, 100u}) {
     for (uint32_t h : {1u, 2u, 5u, 32u}) {
       const size_t n = size_t{w} * h;
       std::vector<uint16_t> random(n), sky_edge(n), extremes(n), smooth(n), lone_sky(n);
@@ -216,27 +217,57 @@ TEST(DepthPredictMasked, WorkedExampleDecodes) {
 
 TEST(DepthPredictMasked, InverseIsExactUnderAnyMask) {
   std::mt19937 rng(11);
-  for (uint32_t w : {1u, 3u, 8u, 13u}) {
+  // Masks: random texels, runs of 1-40 texels (the decoder sums each run of set bits on its own,
+  // from the code on its left), every texel, none. Codes: sky in one texel of 5, sky rarely (most
+  // runs are the plane's; a few must notice a sky code), no sky (every run is the plane's).
+  enum class Mask { kRandom, kRuns, kAll, kNone };
+  for (uint32_t w : {1u, 3u, 8u, 13u, 16u, 41u, 100u}) {
     for (uint32_t h : {1u, 2u, 9u}) {
-      const size_t n = size_t{w} * h;
-      std::vector<uint16_t> codes(n), state(n);
-      std::vector<uint8_t> mask(mask_bytes_of(w, h), 0);
-      for (size_t i = 0; i < n; ++i) {
-        codes[i] = rng() % 5 == 0 ? 65535 : static_cast<uint16_t>(30000 + 9 * (i % w) + rng() % 4);
-        const bool changed = rng() % 3 != 0;
-        if (changed) mask[i / 8] |= static_cast<uint8_t>(1u << (i % 8));
-        state[i] = changed ? static_cast<uint16_t>(rng()) : codes[i];
+      for (Mask kind : {Mask::kRandom, Mask::kRuns, Mask::kAll, Mask::kNone}) {
+        for (uint32_t sky_one_in : {5u, 150u, 0u}) {
+          const size_t n = size_t{w} * h;
+          std::vector<uint16_t> codes(n), state(n);
+          std::vector<uint8_t> mask(mask_bytes_of(w, h), 0);
+          bool changed = false;
+          size_t run_left = 0;
+          for (size_t i = 0; i < n; ++i) {
+            const bool sky = sky_one_in != 0 && rng() % sky_one_in == 0;
+            codes[i] =
+                sky ? 65535 : static_cast<uint16_t>(30000 + 9 * (i % w) - 4 * (i / w) + rng() % 4);
+            switch (kind) {
+              case Mask::kRandom:
+                changed = rng() % 3 != 0;
+                break;
+              case Mask::kRuns:
+                if (run_left == 0) {
+                  changed = !changed;
+                  run_left = 1 + rng() % 40;
+                }
+                --run_left;
+                break;
+              case Mask::kAll:
+                changed = true;
+                break;
+              case Mask::kNone:
+                changed = false;
+                break;
+            }
+            if (changed) mask[i / 8] |= static_cast<uint8_t>(1u << (i % 8));
+            state[i] = changed ? static_cast<uint16_t>(rng()) : codes[i];
+          }
+          std::vector<uint16_t> e;
+          predict_depth_rect_masked(codes.data(), w, h, w, mask.data(), e);
+          std::vector<uint8_t> hi, lo;
+          for (uint16_t v : e) {
+            hi.push_back(static_cast<uint8_t>(v >> 8));
+            lo.push_back(static_cast<uint8_t>(v));
+          }
+          std::vector<uint8_t> out = gpu_of(state);
+          reconstruct_depth_rect_masked(mask.data(), hi.data(), lo.data(), w, h, out.data());
+          EXPECT_EQ(codes_of(out), codes)
+              << w << "x" << h << " mask " << static_cast<int>(kind) << " sky 1/" << sky_one_in;
+        }
       }
-      std::vector<uint16_t> e;
-      predict_depth_rect_masked(codes.data(), w, h, w, mask.data(), e);
-      std::vector<uint8_t> hi, lo;
-      for (uint16_t v : e) {
-        hi.push_back(static_cast<uint8_t>(v >> 8));
-        lo.push_back(static_cast<uint8_t>(v));
-      }
-      std::vector<uint8_t> out = gpu_of(state);
-      reconstruct_depth_rect_masked(mask.data(), hi.data(), lo.data(), w, h, out.data());
-      EXPECT_EQ(codes_of(out), codes) << w << "x" << h;
     }
   }
 }
