@@ -236,7 +236,7 @@ int main(int argc, char** argv) {
       std::string(calf::tools::kExitStatusHelp)};
   calf::LightfieldEncodeOptions o;
   std::string manifest, out;
-  std::string colour = "auto", depth = "raw16", super = "zstd", mode = "lightfield";
+  std::string colour = "auto", depth = "pred16m", super = "zstd", mode = "lightfield";
   bool quiet = false;
   app.add_option("MANIFEST", manifest,
                  "lightfield: the capture set (its manifest.json or the directory holding it); "
@@ -269,14 +269,14 @@ int main(int argc, char** argv) {
       ->default_val("auto");
   app.add_option(
          "--depth-format", depth,
-         "raw16 (exact after log-16 quantisation; material raw), pred16 (the same codes, "
-         "lossless, as spatial-prediction residuals: format r16p, smaller; a reader of format "
-         "1.0 without r16p refuses it), pred16m (as pred16, but P-frame rectangles store only "
-         "their changed texels behind a change mask: format r16pm, smaller still; a reader "
-         "without r16pm refuses it) or bc5 (hi/lo bytes, lossy; material BC1; the error is "
-         "printed) (default raw16)")
+         "pred16m (log-16 codes, exact after quantisation, as spatial-prediction residuals; "
+         "P-frame rectangles store only their changed texels behind a change mask: format "
+         "r16pm, the smallest lossless depth; material raw), pred16 (the same without masks: "
+         "format r16p), raw16 (the codes as plain 16-bit planes: the largest, the cheapest to "
+         "decode; format r16, which 1.0 readers know) or bc5 (hi/lo bytes, lossy; material BC1; "
+         "the error is printed) (default pred16m)")
       ->check(CLI::IsMember({"raw16", "pred16", "pred16m", "bc5"}))
-      ->default_val("raw16");
+      ->default_val("pred16m");
   app.add_option(
          "--depth-window", o.depth_window,
          "W: a P-frame holds texels differing from any of the previous W frames (default 2)")

@@ -19,72 +19,62 @@ constexpr uint16_t kSkyCode = 65535;
 
 uint16_t load_code(const uint8_t* p) {
   uint16_t v;
-  std::memcpy(&v, p, 2);  // little-endian host: asserted at the top of the file
+  std::memcpy(&v, p, 2);  // little-endian host: asserted above
   return v;
 }
 void store_code(uint8_t* p, uint16_t v) {
   std::memcpy(p, &v, 2);
 }
 
-// Whether any of the n codes at `codes` (little-endian u16) is sky.
-bool any_sky(const uint8_t* codes, size_t n) {
-  unsigned all = 0xFFFF;
-  for (size_t i = 0; i < n; ++i) all &= load_code(codes + 2 * i) == kSkyCode ? 0u : 0xFFFFu;
-  return all != 0xFFFF;
-}
-
-// The plane predictor's closed form along a run. Where every prediction of a run of texels
-// x0 .. x0 + n - 1 is the plane a + b - c, code(x) - up(x) = code(x - 1) - up(x - 1) + d(x), so
-//   code(x0 + i) = up(x0 + i) + carry + d(x0) + ... + d(x0 + i),
-// carry = code(x0 - 1) - up(x0 - 1) (0 at the row's start, where the prediction is up(x0)); on the
-// first row, where the prediction is the left code, the same with up = 0 and carry = code(x0 - 1).
-// A prefix sum has no serial chain through the predictor's branches: SSE2 sums eight residuals in
-// three shifted additions. Writes n codes to `out` (little-endian u16) and returns the index of the
-// first sky code among them (n if none); the run is the plane's only if none of the codes it
-// predicts from is sky, which the caller checks with this index and the codes above.
-size_t prefix_run(const uint8_t* hi, const uint8_t* lo, const uint8_t* up, uint16_t carry, size_t n,
-                  uint8_t* out) {
-  size_t i = 0;
-  bool sky = false;
+// Inversion by prefix sums. Where every prediction of texels x .. x + n - 1 of a row is the plane
+// a + b - c, code(x) - up(x) = code(x - 1) - up(x - 1) + d(x) (d: the unzigzagged residual), so
+//   code(x + i) = up(x + i) + carry + d(x) + ... + d(x + i),  carry = code(x - 1) - up(x - 1)
+// (0 at the row's start, where the prediction is up(x)); on the first row, which predicts from
+// the left code whatever it is, the same with up = 0 and carry = code(x - 1). A prefix sum has no
+// serial chain through the predictor's branches: SSE2 sums eight residuals in three shifted
+// additions. Where sky (65535) takes the median into the prediction, texels go one at a time,
+// except a block under sky with sky on its left (or at the row's start) and zero residuals, which
+// is sky: with a = b = sky the median is sky whatever c is, and at x = 0 the prediction is b. So
+// the sky around a model costs a compare per eight texels too.
 #if defined(__SSE2__)
-  const __m128i zero = _mm_setzero_si128(), one = _mm_set1_epi16(1), ones = _mm_set1_epi16(-1);
+// The residuals of texels i .. i + 7, unzigzagged: e >> 1, inverted where e is odd.
+__m128i residuals8(const uint8_t* hi, const uint8_t* lo) {
+  const __m128i e = _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(lo)),
+                                      _mm_loadl_epi64(reinterpret_cast<const __m128i*>(hi)));
+  return _mm_xor_si128(_mm_srli_epi16(e, 1),
+                       _mm_sub_epi16(_mm_setzero_si128(), _mm_and_si128(e, _mm_set1_epi16(1))));
+}
+// Lane j: d(0) + ... + d(j).
+__m128i prefix8(__m128i d) {
+  d = _mm_add_epi16(d, _mm_slli_si128(d, 2));
+  d = _mm_add_epi16(d, _mm_slli_si128(d, 4));
+  return _mm_add_epi16(d, _mm_slli_si128(d, 8));
+}
+#endif
+
+// The first row of a rectangle's run x0 .. x0 + n - 1: code(x) = code(x - 1) + d(x), code(-1) = 0.
+void first_row_run(const uint8_t* hi, const uint8_t* lo, size_t x0, size_t n, uint8_t* row) {
+  uint16_t carry = x0 > 0 ? load_code(row + 2 * (x0 - 1)) : 0;
+  uint8_t* out = row + 2 * x0;
+  size_t i = 0;
+#if defined(__SSE2__)
   __m128i run = _mm_set1_epi16(static_cast<int16_t>(carry));
-  __m128i sky_lanes = zero;
   for (; i + 8 <= n; i += 8) {
-    const __m128i e = _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(lo + i)),
-                                        _mm_loadl_epi64(reinterpret_cast<const __m128i*>(hi + i)));
-    // unzigzag: e >> 1, inverted where e is odd.
-    __m128i d = _mm_xor_si128(_mm_srli_epi16(e, 1), _mm_sub_epi16(zero, _mm_and_si128(e, one)));
-    d = _mm_add_epi16(d, _mm_slli_si128(d, 2));
-    d = _mm_add_epi16(d, _mm_slli_si128(d, 4));
-    d = _mm_add_epi16(d, _mm_slli_si128(d, 8));
-    d = _mm_add_epi16(d, run);
-    const __m128i last = _mm_shufflehi_epi16(d, _MM_SHUFFLE(3, 3, 3, 3));
+    const __m128i codes = _mm_add_epi16(prefix8(residuals8(hi + i, lo + i)), run);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 2 * i), codes);
+    const __m128i last = _mm_shufflehi_epi16(codes, _MM_SHUFFLE(3, 3, 3, 3));
     run = _mm_unpackhi_epi64(last, last);  // lane 7 in every lane
-    if (up != nullptr)
-      d = _mm_add_epi16(d, _mm_loadu_si128(reinterpret_cast<const __m128i*>(up + 2 * i)));
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 2 * i), d);
-    sky_lanes = _mm_or_si128(sky_lanes, _mm_cmpeq_epi16(d, ones));
   }
-  sky = _mm_movemask_epi8(sky_lanes) != 0;
   carry = static_cast<uint16_t>(_mm_cvtsi128_si32(run));
 #endif
   for (; i < n; ++i) {
     carry = unzigzag16(static_cast<uint16_t>(hi[i] << 8 | lo[i]), carry);
-    const uint16_t code =
-        up != nullptr ? static_cast<uint16_t>(load_code(up + 2 * i) + carry) : carry;
-    store_code(out + 2 * i, code);
-    sky |= code == kSkyCode;
+    store_code(out + 2 * i, carry);
   }
-  if (!sky) return n;
-  for (size_t k = 0; k < n; ++k) {
-    if (load_code(out + 2 * k) == kSkyCode) return k;
-  }
-  return n;  // not reached
 }
 
-// Texels x0 .. x0 + n - 1 of row y (> 0) one at a time, with the full predictor: where a sky code
-// takes the median into a run. `row` and `up` point at the row's and the upper row's first code.
+// Texels x0 .. x0 + n - 1 of a later row, one at a time with the full predictor. `row` and `up`
+// point at the row's and the upper row's first code.
 void general_run(const uint8_t* hi, const uint8_t* lo, const uint8_t* up, size_t x0, size_t n,
                  uint8_t* row) {
   for (size_t i = 0; i < n; ++i) {
@@ -97,25 +87,43 @@ void general_run(const uint8_t* hi, const uint8_t* lo, const uint8_t* up, size_t
   }
 }
 
-// Texels x0 .. x0 + n - 1 of row y of a rectangle whose row y - 1 (`up`, or null on the first row)
-// is final: the prefix sum where the plane holds, else the texel-by-texel predictor.
+// Texels x0 .. x0 + n - 1 of row y of a rectangle whose row y - 1 (`up`, null on the first row)
+// and the texels left of x0 are final, eight at a time where the block is the plane's or sky.
 void reconstruct_run(const uint8_t* hi, const uint8_t* lo, const uint8_t* up, size_t x0, size_t n,
                      uint8_t* row) {
-  if (up == nullptr) {  // the first row predicts from the left whatever the codes: always a sum
-    const uint16_t carry = x0 > 0 ? load_code(row + 2 * (x0 - 1)) : 0;
-    (void)prefix_run(hi, lo, nullptr, carry, n, row + 2 * x0);
+  if (up == nullptr) {
+    first_row_run(hi, lo, x0, n, row);
     return;
   }
-  // The run's predictions read up(x0 - 1 .. x0 + n - 1), code(x0 - 1) and its own first n - 1.
-  const size_t from = x0 > 0 ? x0 - 1 : 0;
-  const bool left_sky = x0 > 0 && load_code(row + 2 * (x0 - 1)) == kSkyCode;
-  if (!left_sky && !any_sky(up + 2 * from, x0 + n - from)) {
-    const uint16_t carry =
-        x0 > 0 ? static_cast<uint16_t>(load_code(row + 2 * (x0 - 1)) - load_code(up + 2 * (x0 - 1)))
-               : 0;
-    if (prefix_run(hi, lo, up + 2 * x0, carry, n, row + 2 * x0) + 1 >= n) return;
+  size_t i = 0;
+#if defined(__SSE2__)
+  const __m128i sky = _mm_set1_epi16(-1);
+  for (; i + 8 <= n; i += 8) {
+    const size_t x = x0 + i;
+    const __m128i above = _mm_loadu_si128(reinterpret_cast<const __m128i*>(up + 2 * x));
+    const int above_sky = _mm_movemask_epi8(_mm_cmpeq_epi16(above, sky));  // 2 bits a texel
+    // The predictions of x .. x + 7 read up(x - 1 .. x + 7), code(x - 1) and codes x .. x + 6.
+    const bool left_sky = x > 0 && load_code(row + 2 * (x - 1)) == kSkyCode;
+    const bool up_left_sky = x > 0 && load_code(up + 2 * (x - 1)) == kSkyCode;
+    const __m128i d = residuals8(hi + i, lo + i);
+    if (above_sky == 0 && !left_sky && !up_left_sky) {
+      const uint16_t carry =
+          x > 0 ? static_cast<uint16_t>(load_code(row + 2 * (x - 1)) - load_code(up + 2 * (x - 1)))
+                : 0;
+      const __m128i codes = _mm_add_epi16(
+          _mm_add_epi16(prefix8(d), _mm_set1_epi16(static_cast<int16_t>(carry))), above);
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(row + 2 * x), codes);
+      // A sky code in lanes 0..6 takes the median into the next lane: redo the block below.
+      if ((_mm_movemask_epi8(_mm_cmpeq_epi16(codes, sky)) & 0x3FFF) == 0) continue;
+    } else if (above_sky == 0xFFFF && (x == 0 || left_sky) &&
+               _mm_movemask_epi8(_mm_cmpeq_epi16(d, _mm_setzero_si128())) == 0xFFFF) {
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(row + 2 * x), sky);
+      continue;
+    }
+    general_run(hi + i, lo + i, up, x, 8, row);
   }
-  general_run(hi, lo, up, x0, n, row);
+#endif
+  general_run(hi + i, lo + i, up, x0 + i, n - i, row);
 }
 
 // The first index in [i, end) whose mask bit is `set`, or end.

@@ -364,7 +364,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> clips;
   uint32_t directions = 8, repeats = 2, synthetic = 0, synthetic_frames = 4;
   std::string synthetic_out = "/tmp/calf-bench-synthetic.calf";
-  std::string synthetic_depth = "raw16";
+  std::string synthetic_depth = "pred16m";
   bool no_peers = false, no_table4 = false, background = false;
   app.add_option("--clip", clips, "encoded .calf clip (repeatable)");
   app.add_option("--directions", directions, "horizontal look directions (default 8)")
@@ -383,8 +383,8 @@ int main(int argc, char** argv) {
   app.add_option("--synthetic-frames", synthetic_frames, "frames of the synthetic clip (default 4)")
       ->check(CLI::Range(2, 600));
   app.add_option("--synthetic-depth-format", synthetic_depth,
-                 "depth coding of the synthetic clip: raw16 (calf-encode's default), pred16 or "
-                 "pred16m (default raw16)")
+                 "depth coding of the synthetic clip: pred16m (calf-encode's default), pred16 or "
+                 "raw16 (default pred16m)")
       ->check(CLI::IsMember({"raw16", "pred16", "pred16m"}));
   app.add_option("--synthetic-out", synthetic_out,
                  "where the synthetic clip is written and kept (default "

@@ -412,7 +412,7 @@ int main(int argc, char** argv) {
       "Paper 002 Table 1 for the lightfield track of each capture set, with xz / zstd peers"};
   std::vector<std::string> captures;
   Run run;
-  std::string depth = "raw16";
+  std::string depth = "pred16m";
   bool no_colour_peers = false;
   app.add_option("--capture", captures, "capture-set directory (repeatable)")->required();
   app.add_option("--threads", run.threads, "encoder threads, 0 = all cores (default 0)");
@@ -421,8 +421,8 @@ int main(int argc, char** argv) {
                  "50)")
       ->check(CLI::Range(1e-3, 200.0));
   app.add_option("--depth-format", depth,
-                 "depth coding: raw16, or pred16 / pred16m (then raw16's zstd bytes are printed "
-                 "beside it) (default raw16)")
+                 "depth coding: pred16m (calf-encode's default), pred16 or raw16; with either "
+                 "predicted coding raw16's zstd bytes are printed beside it (default pred16m)")
       ->check(CLI::IsMember({"raw16", "pred16", "pred16m"}));
   app.add_flag("--depth-fixed-groups", run.fixed_groups,
                "one depth chunk per K frames even where a tile does not change (calf-encode's "

@@ -114,7 +114,9 @@ TEST_F(LightfieldTwoPass, AnalysisDecidesTheWholeHeader) {
   EXPECT_EQ(a->colour, ColourCoding::kBc6h);
   EXPECT_EQ(a->header.colour_format, static_cast<uint16_t>(container::PixelFormat::kBc6h));
   EXPECT_EQ(a->header.flags, 1);
-  EXPECT_EQ(a->header.depth_format, static_cast<uint16_t>(container::PixelFormat::kR16));
+  // The default depth coding (LightfieldEncodeOptions::depth): r16pm.
+  EXPECT_EQ(a->header.depth_format,
+            static_cast<uint16_t>(container::PixelFormat::kR16PredictedMasked));
   EXPECT_EQ(a->header.material_format, static_cast<uint16_t>(container::PixelFormat::kRgba8));
   EXPECT_EQ(a->header.view_count, kViews);
   EXPECT_EQ(a->header.frame_count, kFrames);

@@ -95,6 +95,31 @@ TEST(DepthPredict, InverseIsExactOnAnyCodes) {
   }
 }
 
+TEST(DepthPredict, SkyAtEveryColumnOfAPlaneRow) {
+  // The decoder sums a row's residuals eight at a time where the row above has no sky; a sky code
+  // it produces in any lane must send the lanes after it to the median. One sky texel per case,
+  // at every column of the second row of a plane, and a run of sky ending at every column.
+  for (uint32_t w : {16u, 24u}) {
+    for (uint32_t k = 0; k < w; ++k) {
+      std::vector<uint16_t> lone(size_t{w} * 3), run(size_t{w} * 3);
+      for (uint32_t i = 0; i < lone.size(); ++i) {
+        const uint32_t x = i % w, y = i / w;
+        const auto plane = static_cast<uint16_t>(20000 + 37 * x + 11 * y);
+        lone[i] = y == 1 && x == k ? 65535 : plane;
+        run[i] = y >= 1 && x <= k ? 65535 : plane;
+      }
+      EXPECT_EQ(round_trip(lone, w, 3), lone) << w << " sky at " << k;
+      EXPECT_EQ(round_trip(run, w, 3), run) << w << " sky to " << k;
+    }
+    // Under a row of sky, a surface that starts at column 0 and stays constant: its residuals
+    // are 0 after the first (the median of a finite left code and sky above is the left code),
+    // which is no sky block however long the row.
+    std::vector<uint16_t> under(size_t{w} * 2, 65535);
+    for (uint32_t x = 0; x < w; ++x) under[w + x] = 30000;
+    EXPECT_EQ(round_trip(under, w, 2), under) << w << " surface under sky";
+  }
+}
+
 TEST(DepthPredict, RegionChunkPayloadDecodesToCodes) {
   // An 8 x 4 tile, 2 frames: the keyframe (0, 0, 8, 4), then (3, 2, 2, 1); the payload is the
   // residuals of both rectangles, each predicted on its own, as two planes.

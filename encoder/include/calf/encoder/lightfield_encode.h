@@ -73,7 +73,8 @@ struct LightfieldEncodeOptions {
   uint32_t cell_size = 64;  // colour cell side (px), 4..16384 and a multiple of 4
   double min_psnr_db = 50;  // Q, (0, 200]
   ColourCoding colour = ColourCoding::kAuto;
-  DepthCoding depth = DepthCoding::kRaw16;
+  // The smallest lossless depth; its decode cost against raw16: docs/DECODER.md.
+  DepthCoding depth = DepthCoding::kRaw16PredictedMasked;
   uint32_t depth_tiles_per_side = 2;      // 1..64
   uint32_t depth_window = 2;              // W, >= 1
   uint32_t max_aabbs = 2;                 // A, 1..64
