@@ -1,4 +1,4 @@
-// Rate-distortion pass over coded BC6H / BC7 blocks (calf/encoder/bc_rdo.h).
+// Rate-distortion pass over coded BC1 / BC6H / BC7 blocks (calf/encoder/bc_rdo.h).
 #include "calf/encoder/bc_rdo.h"
 
 #include <algorithm>
@@ -226,7 +226,174 @@ Status rdo_image(const T* target, uint32_t width, uint32_t height, uint8_t* bloc
   return Status::Ok();
 }
 
+// ---- BC1 ----
+//
+// calf stores BC1 block-split (SPEC §7): a chunk's 4-byte endpoint halves, then its 4-byte index
+// halves. So each half of a block is its own LZ symbol: it repeats the half of the block before
+// it (offset 4 in its plane; where that block did the same, zstd is extending one match and the
+// half costs almost nothing), repeats the half of another source block (a new match), or is
+// literal. Candidates per source: the whole block, the source's endpoints with indices re-chosen
+// for them (the nearest of their four colours, texel by texel), and the source's indices with the
+// block's own endpoints.
+constexpr double kBc1LiteralBits = 32;  // 4 literal bytes
+constexpr double kBc1MatchBits = 20;    // a new match: offset and length
+constexpr double kBc1RunBits = 2;       // the same match, four bytes longer
+
+// Estimated LZ bits of the half at byte `side` (0: endpoints, 4: indices) of candidate `c` for
+// block i, given the final blocks before it and the sources.
+double bc1_half_bits(const uint8_t* c, int side, const uint8_t* blocks, size_t i,
+                     const uint8_t* const* sources, int count) {
+  const uint8_t* half = c + side;
+  if (i >= 1 && std::memcmp(half, blocks + (i - 1) * 8 + side, 4) == 0) {
+    const bool run =
+        i >= 2 && std::memcmp(blocks + (i - 1) * 8 + side, blocks + (i - 2) * 8 + side, 4) == 0;
+    return run ? kBc1RunBits : kBc1MatchBits;
+  }
+  for (int s = 0; s < count; ++s) {
+    if (std::memcmp(half, sources[s] + side, 4) == 0) return kBc1MatchBits;
+  }
+  return kBc1LiteralBits;
+}
+
+// Squared 8-bit RGBA error of a BC1 block against the target texels.
+double bc1_error(const uint8_t* block, const Bc7Target& t) {
+  uint8_t out[16][4];
+  decode_bc1_block(block, &out[0][0]);
+  double e = 0;
+  for (int i = 0; i < 16; ++i) {
+    if (!t.valid[i]) continue;
+    for (int c = 0; c < 4; ++c) {
+      const double d = static_cast<double>(out[i][c]) - t.v[i][c];
+      e += d * d;
+    }
+  }
+  return e;
+}
+
+// The indices (bytes 4..7 of `block`) that pick, for every texel, the nearest of the four colours
+// of the endpoints in bytes 0..3 (ties: the lower index). The palette is read by decoding the
+// endpoints with the indices 0, 1, 2, 3 in texels 0..3, so it is the decoder's own.
+void bc1_choose_indices(uint8_t* block, const Bc7Target& t) {
+  uint8_t probe[8];
+  std::memcpy(probe, block, 4);
+  const uint32_t ramp = 0xE4E4E4E4u;  // texel k: index k mod 4
+  for (int k = 0; k < 4; ++k) probe[4 + k] = static_cast<uint8_t>(ramp >> (8 * k));
+  uint8_t palette[16][4];
+  decode_bc1_block(probe, &palette[0][0]);
+  uint32_t idx = 0;
+  for (int i = 0; i < 16; ++i) {
+    int best = 0;
+    int best_d = -1;
+    for (int p = 0; p < 4; ++p) {
+      int d = 0;
+      for (int c = 0; c < 4; ++c) {
+        const int x = static_cast<int>(palette[p][c]) - t.v[i][c];
+        d += x * x;
+      }
+      if (best_d < 0 || d < best_d) {
+        best_d = d;
+        best = p;
+      }
+    }
+    idx |= static_cast<uint32_t>(best) << (2 * i);
+  }
+  for (int k = 0; k < 4; ++k) block[4 + k] = static_cast<uint8_t>(idx >> (8 * k));
+}
+
 }  // namespace
+
+Status rdo_bc1(const uint8_t* target, uint32_t width, uint32_t height, uint8_t* blocks,
+               size_t blocks_size, const BcRdoOptions& options, BcRdoStats* stats) {
+  if (!(options.lambda >= 0 && std::isfinite(options.lambda)) || options.window < 1 ||
+      options.window > 256) {
+    return Status(ErrorId::kBcOptions, "BC1 RDO: lambda must be finite and >= 0, window 1..256");
+  }
+  CALF_ASSIGN_OR_RETURN(const size_t needed, compressed_size(Format::kBc1, width, height));
+  if (target == nullptr || blocks == nullptr || blocks_size < needed) {
+    return Status(ErrorId::kBcBufferSize, "BC1 RDO: " + std::to_string(width) + " x " +
+                                              std::to_string(height) + " image needs " +
+                                              std::to_string(needed) + " block bytes");
+  }
+  BcRdoStats local;
+  const uint32_t bw = blocks_along(width), bh = blocks_along(height);
+  const size_t count = size_t{bw} * bh;
+  const double lambda = options.lambda;
+  for (size_t i = 0; i < count; ++i) {
+    const uint32_t bx = static_cast<uint32_t>(i % bw), by = static_cast<uint32_t>(i / bw);
+    Bc7Target t;
+    for (int k = 0; k < 16; ++k) {
+      const uint32_t x = bx * 4 + k % 4, y = by * 4 + k / 4;
+      t.valid[k] = x < width && y < height;
+      const size_t at = (size_t{std::min(y, height - 1)} * width + std::min(x, width - 1)) * 4;
+      for (int c = 0; c < 4; ++c) t.v[k][c] = target[at + c];
+    }
+    uint8_t* block = blocks + i * 8;
+    std::array<const uint8_t*, 256 + 3> sources;
+    int n = 0;
+    auto add_source = [&](const uint8_t* b) {
+      for (int s = 0; s < n; ++s)
+        if (std::memcmp(sources[s], b, 8) == 0) return;
+      sources[n++] = b;
+    };
+    for (size_t j = 1; j <= options.window && j <= i; ++j) add_source(blocks + (i - j) * 8);
+    if (by > 0) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int64_t x = static_cast<int64_t>(bx) + dx;
+        if (x < 0 || x >= bw) continue;
+        const size_t j = size_t{by - 1} * bw + static_cast<size_t>(x);
+        if (i - j > options.window) add_source(blocks + j * 8);
+      }
+    }
+    const double d0 = bc1_error(block, t);
+    local.blocks += 1;
+    local.error_before += d0;
+    if (lambda == 0 || n == 0) {
+      local.error_after += d0;
+      continue;
+    }
+    auto rate = [&](const uint8_t* c) {
+      return bc1_half_bits(c, 0, blocks, i, sources.data(), n) +
+             bc1_half_bits(c, 4, blocks, i, sources.data(), n);
+    };
+    uint8_t best[8];
+    std::memcpy(best, block, 8);
+    double best_d = d0, best_j = d0 + lambda * rate(block);
+    auto consider = [&](const uint8_t* cand) {
+      if (std::memcmp(cand, best, 8) == 0) return;
+      const double r = rate(cand);
+      if (lambda * r >= best_j) return;
+      const double d = bc1_error(cand, t);
+      if (d + lambda * r < best_j) {
+        best_j = d + lambda * r;
+        best_d = d;
+        std::memcpy(best, cand, 8);
+      }
+    };
+    for (int s = 0; s < n; ++s) {
+      uint8_t cand[8];
+      consider(sources[s]);  // the whole block
+      std::memcpy(cand, sources[s], 4);
+      std::memcpy(cand + 4, block + 4, 4);
+      bc1_choose_indices(cand, t);
+      consider(cand);  // its endpoints, indices re-chosen
+      std::memcpy(cand, block, 4);
+      std::memcpy(cand + 4, sources[s] + 4, 4);
+      consider(cand);  // its indices, own endpoints
+    }
+    if (std::memcmp(best, block, 8) != 0) {
+      std::memcpy(block, best, 8);
+      local.changed += 1;
+    }
+    local.error_after += best_d;
+  }
+  if (stats != nullptr) {
+    stats->blocks += local.blocks;
+    stats->changed += local.changed;
+    stats->error_before += local.error_before;
+    stats->error_after += local.error_after;
+  }
+  return Status::Ok();
+}
 
 Status rdo_bc6h(const uint16_t* target, uint32_t width, uint32_t height, uint8_t* blocks,
                 size_t blocks_size, const BcRdoOptions& options, BcRdoStats* stats) {

@@ -275,7 +275,7 @@ void append_colour_payload(ColourCoding coding, const std::vector<uint8_t>& byte
   }
 }
 
-// Rewrites keyframe `frame`'s BC6H / BC7 blocks towards cheaper supercompression
+// Rewrites keyframe `frame`'s BC1 / BC6H / BC7 blocks towards cheaper supercompression
 // (calf/encoder/bc_rdo.h), measured against the frame's texels as the BCn encoder saw them.
 Status rdo_keyframe(const Context& ctx, uint32_t face, const PixelRect& r, uint32_t frame,
                     std::vector<uint8_t>& bytes) {
@@ -290,6 +290,9 @@ Status rdo_keyframe(const Context& ctx, uint32_t face, const PixelRect& r, uint3
   std::vector<float> rgb(n * 3);
   for (size_t i = 0; i < n * 3; ++i) rgb[i] = bc::half_to_float(half[i]);
   const std::vector<uint8_t> rgba = srgb8_rgba_of(rgb);
+  if (ctx.colour == ColourCoding::kBc1) {
+    return bc::rdo_bc1(rgba.data(), r.width, r.height, bytes.data(), bytes.size(), o);
+  }
   return bc::rdo_bc7(rgba.data(), r.width, r.height, bytes.data(), bytes.size(), o);
 }
 
@@ -366,7 +369,8 @@ void colour_task(const Context& ctx, uint32_t face, uint32_t cell, TaskOut& out)
     const uint32_t end = i + 1 < k->keyframes.size() ? k->keyframes[i + 1] : frames;
     raw.clear();
     if (ctx.options->colour_rdo > 0 &&
-        (ctx.colour == ColourCoding::kBc6h || ctx.colour == ColourCoding::kBc7)) {
+        (ctx.colour == ColourCoding::kBc6h || ctx.colour == ColourCoding::kBc7 ||
+         ctx.colour == ColourCoding::kBc1)) {
       out.status = rdo_keyframe(ctx, face, r, kf, coded[kf].bytes);
       if (!out.status.ok()) return;
     }

@@ -1,6 +1,6 @@
-// Tests of the colour RDO pass (calf/encoder/bc_rdo.h): off means untouched, on means smaller
-// once zstd-compressed, each block's added error bounded by what the cost rule allows, argument
-// errors.
+// Tests of the colour RDO pass (calf/encoder/bc_rdo.h), BC1 / BC6H / BC7: off means untouched, on
+// means smaller once zstd-compressed, each block's added error bounded by what the cost rule
+// allows, argument errors.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -95,6 +95,78 @@ TEST(BcRdo, Bc7SmallerOnceCompressedAndEachBlocksErrorBounded) {
   EXPECT_TRUE(decode_image(Format::kBc7, blocks.data(), blocks.size(), kW, kH, out.data(),
                            out.size(), kW * 4)
                   .ok());
+}
+
+std::vector<uint8_t> bc1_of(const std::vector<uint8_t>& img) {
+  std::vector<uint8_t> blocks(encode_bound(Format::kBc1, kW, kH));
+  EXPECT_TRUE(encode_bc1({img.data(), kW, kH, kW * 4, 4}, blocks.data(), blocks.size(), {}).ok());
+  return blocks;
+}
+
+// BC1 as calf stores it: endpoint halves, then index halves (SPEC §7).
+std::vector<uint8_t> block_split(const std::vector<uint8_t>& bc1) {
+  std::vector<uint8_t> out;
+  for (int side : {0, 4})
+    for (size_t b = 0; b < bc1.size() / 8; ++b)
+      out.insert(out.end(), bc1.begin() + b * 8 + side, bc1.begin() + b * 8 + side + 4);
+  return out;
+}
+
+// Squared 8-bit RGBA error of BC1 block k of the image, decoded here block by block.
+double bc1_block_error(const uint8_t* block, const std::vector<uint8_t>& img, uint32_t k) {
+  uint8_t out[16 * 4];
+  decode_bc1_block(block, out);
+  const uint32_t bx = k % (kW / 4), by = k / (kW / 4);
+  double e = 0;
+  for (int i = 0; i < 16; ++i) {
+    const uint8_t* p = &img[((by * 4 + i / 4) * kW + bx * 4 + i % 4) * 4];
+    for (int c = 0; c < 4; ++c) e += std::pow(double(out[4 * i + c]) - p[c], 2);
+  }
+  return e;
+}
+
+TEST(BcRdo, Bc1SmallerOnceSplitAndCompressedEachBlocksErrorBoundedRepeatable) {
+  const std::vector<uint8_t> img = ldr_image();
+  const std::vector<uint8_t> before = bc1_of(img);
+  std::vector<uint8_t> blocks = before;
+  BcRdoStats s;
+  ASSERT_TRUE(rdo_bc1(img.data(), kW, kH, blocks.data(), blocks.size(), {}, &s).ok());
+  EXPECT_EQ(blocks, before);  // lambda 0: untouched
+  EXPECT_EQ(s.changed, 0u);
+  BcRdoOptions o;
+  o.lambda = 4;
+  std::vector<uint8_t> again = before;
+  s = {};
+  ASSERT_TRUE(rdo_bc1(img.data(), kW, kH, blocks.data(), blocks.size(), o, &s).ok());
+  ASSERT_TRUE(rdo_bc1(img.data(), kW, kH, again.data(), again.size(), o).ok());
+  EXPECT_EQ(blocks, again);  // deterministic
+  EXPECT_GT(s.changed, 0u);
+  EXPECT_EQ(s.blocks, uint64_t{kW / 4 * kH / 4});
+  EXPECT_LT(zstd_size(block_split(blocks)), zstd_size(block_split(before)) * 9 / 10);
+  // Replaced only when D + lambda R falls, R in [4, 64] bits: no block gains more than
+  // lambda * 60 of squared error, by the decoder's own reckoning.
+  double d0 = 0, d1 = 0;
+  for (uint32_t k = 0; k < blocks.size() / 8; ++k) {
+    const double a = bc1_block_error(&before[k * 8], img, k);
+    const double b = bc1_block_error(&blocks[k * 8], img, k);
+    EXPECT_LT(b - a, o.lambda * 60 + 1e-9) << "block " << k;
+    d0 += a;
+    d1 += b;
+  }
+  EXPECT_DOUBLE_EQ(s.error_before, d0);
+  EXPECT_DOUBLE_EQ(s.error_after, d1);
+  // An image that is not a multiple of 4 (edge blocks' outside texels do not count), and errors.
+  std::vector<uint8_t> edge(encode_bound(Format::kBc1, kW - 1, kH - 3));
+  ASSERT_TRUE(
+      encode_bc1({img.data(), kW - 1, kH - 3, kW * 4, 4}, edge.data(), edge.size(), {}).ok());
+  std::vector<uint8_t> packed;  // the same texels, rows (kW - 1) * 4 apart
+  for (uint32_t y = 0; y < kH - 3; ++y)
+    packed.insert(packed.end(), img.begin() + y * kW * 4, img.begin() + (y * kW + kW - 1) * 4);
+  EXPECT_TRUE(rdo_bc1(packed.data(), kW - 1, kH - 3, edge.data(), edge.size(), o).ok());
+  EXPECT_EQ(rdo_bc1(img.data(), kW, kH, blocks.data(), blocks.size() - 1, o).id(),
+            ErrorId::kBcBufferSize);
+  o.lambda = std::nan("");
+  EXPECT_EQ(rdo_bc1(img.data(), kW, kH, blocks.data(), blocks.size(), o).id(), ErrorId::kBcOptions);
 }
 
 TEST(BcRdo, Bc6hSmallerOnceCompressedAndRepeatable) {

@@ -64,6 +64,9 @@ const PinCase kCases[] = {
     // towards copies of their neighbours' bytes; same decoder, its own frozen clips.
     {"bc6h_rdo_zstd",      {.face = 16, .frames = 5, .views = 2, .hdr = true},      ColourCoding::kBc6h,    DepthCoding::kRaw16, container::Compression::kZstd,  "e40d1fb3ffd8ba6f", 4.0},
     {"bc7_rdo_zstd",       {.face = 16, .frames = 5, .views = 2},                   ColourCoding::kBc7,     DepthCoding::kRaw16, container::Compression::kZstd,  "5b143c1103044687", 4.0},
+    // BC1 RDO (stop 37): standard BC1 blocks with endpoints or indices of a neighbour, indices
+    // re-chosen for borrowed endpoints; stored block-split as every BC1 chunk.
+    {"bc1_rdo_zstd",       {.face = 16, .frames = 5, .views = 2},                   ColourCoding::kBc1,     DepthCoding::kRaw16, container::Compression::kZstd,  "43deb744d350afa1", 4.0},
     // Depth format r16pm (SPEC §11.1.9, issue 17): P-frame rectangles with change masks; the
     // twins of bc1_raw16_zstd and bc1_raw16_groups, they decode to their hashes. One rectangle
     // per P-frame, so that it spans the unchanged column inside the moving square (W = 2).

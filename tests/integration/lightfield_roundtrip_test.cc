@@ -142,9 +142,14 @@ class LightfieldRoundTrip : public ::testing::Test {
 
 TEST_F(LightfieldRoundTrip, Bc1ColourMeetsQAndRaw16DepthIsExact) {
   const fs::path cap = make_capture({}, "ldr");
+  const fs::path cap32 = make_capture({.face = 32}, "ldr32");
   LightfieldEncodeOptions o;
   o.cell_size = 8;
   o.threads = 2;
+  // Q bounds the temporal loss against the frames as the BC1 encoder alone makes them; the colour
+  // RDO's error comes on top (docs/ENCODER.md "Colour RDO"), so Q is checked without it here and
+  // the RDO below.
+  o.colour_rdo = 0;
   const auto stats = encode(cap, root_ / "ldr.calf", o);
   EXPECT_EQ(stats.colour_format, static_cast<uint16_t>(container::PixelFormat::kBc1));
   EXPECT_FALSE(stats.hdr);
@@ -155,6 +160,18 @@ TEST_F(LightfieldRoundTrip, Bc1ColourMeetsQAndRaw16DepthIsExact) {
   EXPECT_LT(stats.colour_keyframes, stats.colour_cells * 5);
   EXPECT_GT(stats.depth_empty_pframes, 0u);
   check_file(cap, root_ / "ldr.calf", ColourCoding::kBc1, 50.0, true);
+  // The default RDO (lambda 0.5) makes the colour smaller; its error per block is at most
+  // lambda * 60 squared 8-bit units (bc_rdo.h), 0.625 per RGB sample, on top of Q's 0.65 (50 dB):
+  // a cell's MSE is then at most 2 (0.65 + 0.625) (the two errors in the same direction), 44.1 dB.
+  // Cells of 32 (64 blocks a chunk): in 8² cells a chunk is 4 blocks, too few for zstd to find
+  // the copies.
+  LightfieldEncodeOptions off = o, rdo = o;
+  off.cell_size = rdo.cell_size = 32;
+  rdo.colour_rdo = 0.5;
+  const auto without = encode(cap32, root_ / "ldr32.calf", off);
+  const auto with_rdo = encode(cap32, root_ / "ldr32-rdo.calf", rdo);
+  EXPECT_LT(with_rdo.colour.stored, without.colour.stored);
+  check_file(cap32, root_ / "ldr32-rdo.calf", ColourCoding::kBc1, 44.0, true);
 }
 
 TEST_F(LightfieldRoundTrip, EveryColourFormatAndSchemeRoundTrips) {
@@ -217,6 +234,7 @@ TEST_F(LightfieldRoundTrip, StaticSceneIsOneKeyframePerCellAndEmptyPFrames) {
   const fs::path cap = make_capture({.frames = 6, .animated = false}, "static");
   LightfieldEncodeOptions o;
   o.cell_size = 8;
+  o.colour_rdo = 0;  // Q is checked: see Bc1ColourMeetsQAndRaw16DepthIsExact
   const auto stats = encode(cap, root_ / "static.calf", o);
   EXPECT_EQ(stats.colour_keyframes, stats.colour_cells);
   EXPECT_EQ(stats.depth_pframes, stats.depth_empty_pframes);
@@ -247,6 +265,7 @@ TEST_F(LightfieldRoundTrip, Bc5DepthReportsItsErrorAndDecodesWithinIt) {
   const fs::path cap = make_capture({.material = true}, "bc5");
   LightfieldEncodeOptions o;
   o.cell_size = 8;
+  o.colour_rdo = 0;  // Q is checked: see Bc1ColourMeetsQAndRaw16DepthIsExact
   o.depth = DepthCoding::kBc5;
   const auto stats = encode(cap, root_ / "bc5.calf", o);
   EXPECT_EQ(stats.depth_format, static_cast<uint16_t>(container::PixelFormat::kBc5));
@@ -263,6 +282,7 @@ TEST_F(LightfieldRoundTrip, MaterialOnlyWhereAViewSeesIt) {
   const fs::path cap = make_capture({.material = true}, "material");
   LightfieldEncodeOptions o;
   o.cell_size = 8;
+  o.colour_rdo = 0;  // Q is checked: see Bc1ColourMeetsQAndRaw16DepthIsExact
   const auto stats = encode(cap, root_ / "m.calf", o);
   EXPECT_EQ(stats.material_views, 2u);
   EXPECT_EQ(stats.material_format, static_cast<uint16_t>(container::PixelFormat::kRgba8));

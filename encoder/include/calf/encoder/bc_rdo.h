@@ -1,4 +1,5 @@
-// Rate-distortion optimisation of coded BC6H / BC7 images for an LZ supercompressor (zstd, LZMA).
+// Rate-distortion optimisation of coded BC1 / BC6H / BC7 images for an LZ supercompressor (zstd,
+// LZMA).
 //
 // BC6H and BC7 blocks are dense bit fields: two blocks of the same colour rarely share a byte,
 // so a chunk of them barely compresses. This pass rewrites already coded blocks, in order,
@@ -51,6 +52,17 @@ Status rdo_bc6h(const uint16_t* target, uint32_t width, uint32_t height, uint8_t
 
 // The same for BC7 blocks against 8-bit RGBA texels (rows width * 4 apart).
 Status rdo_bc7(const uint8_t* target, uint32_t width, uint32_t height, uint8_t* blocks,
+               size_t blocks_size, const BcRdoOptions& options, BcRdoStats* stats = nullptr);
+
+// The same for BC1 blocks (8 bytes each) against 8-bit RGBA texels (rows width * 4 apart), with a
+// rate model for calf's block-split BC1 chunks (SPEC §7: all endpoint halves, then all index
+// halves): each 4-byte half costs 32 bits as literals, 20 when it repeats the same half of a
+// source block (the previous `window` blocks and the three above), 2 when it repeats the previous
+// block's half as that block repeated the one before it (zstd extending one match). Candidates per
+// source: the whole block; its endpoints with indices re-chosen for them (nearest colour per
+// texel, as the decoder's palette gives it); its indices with the block's own endpoints. D is the
+// squared 8-bit RGBA error, so no block gains more than lambda * 60 (64 - 4 bits saved).
+Status rdo_bc1(const uint8_t* target, uint32_t width, uint32_t height, uint8_t* blocks,
                size_t blocks_size, const BcRdoOptions& options, BcRdoStats* stats = nullptr);
 
 }  // namespace calf::bc

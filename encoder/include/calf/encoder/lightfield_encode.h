@@ -92,9 +92,9 @@ struct LightfieldEncodeOptions {
   // boundary. false: one chunk per K frames, as writers before issue 17 did.
   bool merge_static_groups = true;
   // Colour RDO strength (calf/encoder/bc_rdo.h): lambda, squared 8-bit sRGB error per estimated
-  // bit saved, [0, 1e6]; 0 = off (the blocks as the BCn encoder made them). BC6H and BC7
-  // keyframes only; other colour formats ignore it. Applied to the keyframes after the keyframe
-  // search. The default 0.5 was chosen by measurement (docs/ENCODER.md "Colour RDO").
+  // bit saved, [0, 1e6]; 0 = off (the blocks as the BCn encoder made them). BC1, BC6H and BC7
+  // keyframes (BC1 since stop 37); rgba8 / rgba16f ignore it. Applied to the keyframes after the
+  // keyframe search. The default 0.5 was chosen by measurement (docs/ENCODER.md "Colour RDO").
   double colour_rdo = 0.5;
   container::Compression supercompression = container::Compression::kZstd;
   container::CompressionOptions levels;  // zstd level / LZMA preset (fixed per clip)
