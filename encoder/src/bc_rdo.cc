@@ -88,22 +88,27 @@ struct Bc6hCodec {
   static int guard(int deviation) { return std::max(deviation, kBc6hGuardUlps); }
 };
 
+// Squared error of decoded 8-bit RGBA texels against the target's valid ones (BC7, BC1).
+double rgba8_error(const uint8_t (&out)[16][4], const Bc7Target& t) {
+  double e = 0;
+  for (int i = 0; i < 16; ++i) {
+    if (!t.valid[i]) continue;
+    for (int c = 0; c < 4; ++c) {
+      const double d = static_cast<double>(out[i][c]) - t.v[i][c];
+      e += d * d;
+    }
+  }
+  return e;
+}
+
 struct Bc7Codec {
   using Target = Bc7Target;
   static void set(Target& t, int k, int c, uint8_t v) { t.v[k][c] = v; }
   static double error(const uint8_t* block, const Target& t, int* deviation) {
     uint8_t out[16][4];
     decode_bc7_block(block, &out[0][0]);
-    double e = 0;
-    for (int i = 0; i < 16; ++i) {
-      if (!t.valid[i]) continue;
-      for (int c = 0; c < 4; ++c) {
-        const double d = static_cast<double>(out[i][c]) - t.v[i][c];
-        e += d * d;
-      }
-    }
     *deviation = 0;
-    return e;
+    return rgba8_error(out, t);
   }
   static int guard(int) { return 0; }  // 8-bit display values: the squared error says it all
 };
@@ -124,10 +129,10 @@ double rate_bits(const uint8_t* c, const uint8_t* const* sources, int count) {
   return 8.0 * (16 - best) + kMatchBits;
 }
 
-template <typename Codec, typename T, int C>
-Status rdo_image(const T* target, uint32_t width, uint32_t height, uint8_t* blocks,
-                 size_t blocks_size, const BcRdoOptions& options, BcRdoStats* stats,
-                 Format format) {
+// The checks every pass makes before touching a block.
+Status check_rdo_arguments(const void* target, uint32_t width, uint32_t height,
+                           const uint8_t* blocks, size_t blocks_size, const BcRdoOptions& options,
+                           Format format) {
   if (!(options.lambda >= 0 && std::isfinite(options.lambda)) || options.window < 1 ||
       options.window > 256) {
     return Status(ErrorId::kBcOptions, std::string(format_name(format)) +
@@ -140,6 +145,60 @@ Status rdo_image(const T* target, uint32_t width, uint32_t height, uint8_t* bloc
                                               std::to_string(height) + " image needs " +
                                               std::to_string(needed) + " block bytes");
   }
+  return Status::Ok();
+}
+
+// Block (bx, by)'s C-channel target texels through `set(k, c, value)`; `valid[k]` marks those
+// inside the image (an edge block's others repeat the edge and do not count).
+template <int C, typename T, typename Set>
+void gather_target(const T* target, uint32_t width, uint32_t height, uint32_t bx, uint32_t by,
+                   bool* valid, Set set) {
+  for (int k = 0; k < 16; ++k) {
+    const uint32_t x = bx * 4 + k % 4, y = by * 4 + k / 4;
+    valid[k] = x < width && y < height;
+    const size_t at = (size_t{std::min(y, height - 1)} * width + std::min(x, width - 1)) * C;
+    for (int c = 0; c < C; ++c) set(k, c, target[at + c]);
+  }
+}
+
+// The sources of block i (at bx, by of a row of bw blocks of `block_bytes` each): the previous
+// `window` blocks, then the three above that are not among them. A source equal to an earlier one
+// offers the same candidates (common once blocks have been copied): it is listed once. Returns
+// the count.
+int gather_sources(const uint8_t* blocks, size_t block_bytes, size_t i, uint32_t bx, uint32_t by,
+                   uint32_t bw, uint32_t window, std::array<const uint8_t*, 256 + 3>& sources) {
+  int n = 0;
+  auto add_source = [&](const uint8_t* b) {
+    for (int s = 0; s < n; ++s)
+      if (std::memcmp(sources[s], b, block_bytes) == 0) return;
+    sources[n++] = b;
+  };
+  for (size_t j = 1; j <= window && j <= i; ++j) add_source(blocks + (i - j) * block_bytes);
+  if (by > 0) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int64_t x = static_cast<int64_t>(bx) + dx;
+      if (x < 0 || x >= bw) continue;
+      const size_t j = size_t{by - 1} * bw + static_cast<size_t>(x);
+      if (i - j > window) add_source(blocks + j * block_bytes);
+    }
+  }
+  return n;
+}
+
+void add_stats(const BcRdoStats& local, BcRdoStats* stats) {
+  if (stats == nullptr) return;
+  stats->blocks += local.blocks;
+  stats->changed += local.changed;
+  stats->error_before += local.error_before;
+  stats->error_after += local.error_after;
+}
+
+template <typename Codec, typename T, int C>
+Status rdo_image(const T* target, uint32_t width, uint32_t height, uint8_t* blocks,
+                 size_t blocks_size, const BcRdoOptions& options, BcRdoStats* stats,
+                 Format format) {
+  CALF_RETURN_IF_ERROR(
+      check_rdo_arguments(target, width, height, blocks, blocks_size, options, format));
   BcRdoStats local;
   const uint32_t bw = blocks_along(width), bh = blocks_along(height);
   const size_t count = size_t{bw} * bh;
@@ -147,32 +206,11 @@ Status rdo_image(const T* target, uint32_t width, uint32_t height, uint8_t* bloc
   for (size_t i = 0; i < count; ++i) {
     const uint32_t bx = static_cast<uint32_t>(i % bw), by = static_cast<uint32_t>(i / bw);
     typename Codec::Target t;
-    for (int k = 0; k < 16; ++k) {
-      const uint32_t x = bx * 4 + k % 4, y = by * 4 + k / 4;
-      t.valid[k] = x < width && y < height;
-      const size_t at = (size_t{std::min(y, height - 1)} * width + std::min(x, width - 1)) * C;
-      for (int c = 0; c < C; ++c) Codec::set(t, k, c, target[at + c]);
-    }
+    gather_target<C>(target, width, height, bx, by, t.valid,
+                     [&t](int k, int c, T v) { Codec::set(t, k, c, v); });
     uint8_t* block = blocks + i * 16;
-    // Sources: the previous `window` blocks, then the three above that are not among them.
     std::array<const uint8_t*, 256 + 3> sources;
-    int n = 0;
-    // A source equal to an earlier one offers the same candidates (common once blocks have been
-    // copied): it is tried once.
-    auto add_source = [&](const uint8_t* b) {
-      for (int s = 0; s < n; ++s)
-        if (std::memcmp(sources[s], b, 16) == 0) return;
-      sources[n++] = b;
-    };
-    for (size_t j = 1; j <= options.window && j <= i; ++j) add_source(blocks + (i - j) * 16);
-    if (by > 0) {
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int64_t x = static_cast<int64_t>(bx) + dx;
-        if (x < 0 || x >= bw) continue;
-        const size_t j = size_t{by - 1} * bw + static_cast<size_t>(x);
-        if (i - j > options.window) add_source(blocks + j * 16);
-      }
-    }
+    const int n = gather_sources(blocks, 16, i, bx, by, bw, options.window, sources);
     int deviation = 0;
     const double d0 = Codec::error(block, t, &deviation);
     const int limit = Codec::guard(deviation);
@@ -217,12 +255,7 @@ Status rdo_image(const T* target, uint32_t width, uint32_t height, uint8_t* bloc
     }
     local.error_after += best_d;
   }
-  if (stats != nullptr) {
-    stats->blocks += local.blocks;
-    stats->changed += local.changed;
-    stats->error_before += local.error_before;
-    stats->error_after += local.error_after;
-  }
+  add_stats(local, stats);
   return Status::Ok();
 }
 
@@ -259,15 +292,7 @@ double bc1_half_bits(const uint8_t* c, int side, const uint8_t* blocks, size_t i
 double bc1_error(const uint8_t* block, const Bc7Target& t) {
   uint8_t out[16][4];
   decode_bc1_block(block, &out[0][0]);
-  double e = 0;
-  for (int i = 0; i < 16; ++i) {
-    if (!t.valid[i]) continue;
-    for (int c = 0; c < 4; ++c) {
-      const double d = static_cast<double>(out[i][c]) - t.v[i][c];
-      e += d * d;
-    }
-  }
-  return e;
+  return rgba8_error(out, t);
 }
 
 // The indices (bytes 4..7 of `block`) that pick, for every texel, the nearest of the four colours
@@ -304,16 +329,8 @@ void bc1_choose_indices(uint8_t* block, const Bc7Target& t) {
 
 Status rdo_bc1(const uint8_t* target, uint32_t width, uint32_t height, uint8_t* blocks,
                size_t blocks_size, const BcRdoOptions& options, BcRdoStats* stats) {
-  if (!(options.lambda >= 0 && std::isfinite(options.lambda)) || options.window < 1 ||
-      options.window > 256) {
-    return Status(ErrorId::kBcOptions, "BC1 RDO: lambda must be finite and >= 0, window 1..256");
-  }
-  CALF_ASSIGN_OR_RETURN(const size_t needed, compressed_size(Format::kBc1, width, height));
-  if (target == nullptr || blocks == nullptr || blocks_size < needed) {
-    return Status(ErrorId::kBcBufferSize, "BC1 RDO: " + std::to_string(width) + " x " +
-                                              std::to_string(height) + " image needs " +
-                                              std::to_string(needed) + " block bytes");
-  }
+  CALF_RETURN_IF_ERROR(
+      check_rdo_arguments(target, width, height, blocks, blocks_size, options, Format::kBc1));
   BcRdoStats local;
   const uint32_t bw = blocks_along(width), bh = blocks_along(height);
   const size_t count = size_t{bw} * bh;
@@ -321,29 +338,11 @@ Status rdo_bc1(const uint8_t* target, uint32_t width, uint32_t height, uint8_t* 
   for (size_t i = 0; i < count; ++i) {
     const uint32_t bx = static_cast<uint32_t>(i % bw), by = static_cast<uint32_t>(i / bw);
     Bc7Target t;
-    for (int k = 0; k < 16; ++k) {
-      const uint32_t x = bx * 4 + k % 4, y = by * 4 + k / 4;
-      t.valid[k] = x < width && y < height;
-      const size_t at = (size_t{std::min(y, height - 1)} * width + std::min(x, width - 1)) * 4;
-      for (int c = 0; c < 4; ++c) t.v[k][c] = target[at + c];
-    }
+    gather_target<4>(target, width, height, bx, by, t.valid,
+                     [&t](int k, int c, uint8_t v) { t.v[k][c] = v; });
     uint8_t* block = blocks + i * 8;
     std::array<const uint8_t*, 256 + 3> sources;
-    int n = 0;
-    auto add_source = [&](const uint8_t* b) {
-      for (int s = 0; s < n; ++s)
-        if (std::memcmp(sources[s], b, 8) == 0) return;
-      sources[n++] = b;
-    };
-    for (size_t j = 1; j <= options.window && j <= i; ++j) add_source(blocks + (i - j) * 8);
-    if (by > 0) {
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int64_t x = static_cast<int64_t>(bx) + dx;
-        if (x < 0 || x >= bw) continue;
-        const size_t j = size_t{by - 1} * bw + static_cast<size_t>(x);
-        if (i - j > options.window) add_source(blocks + j * 8);
-      }
-    }
+    const int n = gather_sources(blocks, 8, i, bx, by, bw, options.window, sources);
     const double d0 = bc1_error(block, t);
     local.blocks += 1;
     local.error_before += d0;
@@ -386,12 +385,7 @@ Status rdo_bc1(const uint8_t* target, uint32_t width, uint32_t height, uint8_t* 
     }
     local.error_after += best_d;
   }
-  if (stats != nullptr) {
-    stats->blocks += local.blocks;
-    stats->changed += local.changed;
-    stats->error_before += local.error_before;
-    stats->error_after += local.error_after;
-  }
+  add_stats(local, stats);
   return Status::Ok();
 }
 

@@ -49,10 +49,11 @@ size_t zstd_size(const std::vector<uint8_t>& bytes) {
   return c.ok() ? c->bytes.size() : 0;
 }
 
-// Squared 8-bit RGBA error of BC7 block k of the image.
-double bc7_block_error(const uint8_t* block, const std::vector<uint8_t>& img, uint32_t k) {
+// Squared 8-bit RGBA error of block k of the image, decoded by `decode` (BC7 or BC1).
+double block_error(void (*decode)(const uint8_t*, uint8_t*), const uint8_t* block,
+                   const std::vector<uint8_t>& img, uint32_t k) {
   uint8_t out[16 * 4];
-  decode_bc7_block(block, out);
+  decode(block, out);
   const uint32_t bx = k % (kW / 4), by = k / (kW / 4);
   double e = 0;
   for (int i = 0; i < 16; ++i) {
@@ -86,8 +87,8 @@ TEST(BcRdo, Bc7SmallerOnceCompressedAndEachBlocksErrorBounded) {
   // A block is replaced only when D + lambda R falls; R is at most 128 bits (16 literals) and at
   // least 24 (one match), so no block may gain more than lambda * 104 of squared error.
   for (uint32_t k = 0; k < blocks.size() / 16; ++k) {
-    const double d0 = bc7_block_error(&before[k * 16], img, k);
-    const double d1 = bc7_block_error(&blocks[k * 16], img, k);
+    const double d0 = block_error(decode_bc7_block, &before[k * 16], img, k);
+    const double d1 = block_error(decode_bc7_block, &blocks[k * 16], img, k);
     EXPECT_LT(d1 - d0, o.lambda * 104 + 1e-9) << "block " << k;
   }
   // Every block still decodes as BC7 (a standard block): the whole image decodes.
@@ -112,19 +113,6 @@ std::vector<uint8_t> block_split(const std::vector<uint8_t>& bc1) {
   return out;
 }
 
-// Squared 8-bit RGBA error of BC1 block k of the image, decoded here block by block.
-double bc1_block_error(const uint8_t* block, const std::vector<uint8_t>& img, uint32_t k) {
-  uint8_t out[16 * 4];
-  decode_bc1_block(block, out);
-  const uint32_t bx = k % (kW / 4), by = k / (kW / 4);
-  double e = 0;
-  for (int i = 0; i < 16; ++i) {
-    const uint8_t* p = &img[((by * 4 + i / 4) * kW + bx * 4 + i % 4) * 4];
-    for (int c = 0; c < 4; ++c) e += std::pow(double(out[4 * i + c]) - p[c], 2);
-  }
-  return e;
-}
-
 TEST(BcRdo, Bc1SmallerOnceSplitAndCompressedEachBlocksErrorBoundedRepeatable) {
   const std::vector<uint8_t> img = ldr_image();
   const std::vector<uint8_t> before = bc1_of(img);
@@ -147,8 +135,8 @@ TEST(BcRdo, Bc1SmallerOnceSplitAndCompressedEachBlocksErrorBoundedRepeatable) {
   // lambda * 60 of squared error, by the decoder's own reckoning.
   double d0 = 0, d1 = 0;
   for (uint32_t k = 0; k < blocks.size() / 8; ++k) {
-    const double a = bc1_block_error(&before[k * 8], img, k);
-    const double b = bc1_block_error(&blocks[k * 8], img, k);
+    const double a = block_error(decode_bc1_block, &before[k * 8], img, k);
+    const double b = block_error(decode_bc1_block, &blocks[k * 8], img, k);
     EXPECT_LT(b - a, o.lambda * 60 + 1e-9) << "block " << k;
     d0 += a;
     d1 += b;
