@@ -50,6 +50,15 @@ void for_each_block(uint32_t width, uint32_t height, int threads, uint8_t* out, 
       &ctx);
 }
 
+// BC1 (encoder/src/bc1_refine.cc). The indices (bytes 4..7 of `block`) that pick, for every
+// texel of `rgba` (16 RGBA8 texels), the nearest of the four colours of the endpoints in bytes
+// 0..3 by squared RGBA distance (ties: the lower index); the palette is the decoder's own.
+void bc1_choose_indices(uint8_t* block, const uint8_t* rgba);
+// Rewrites `block` with least-squares endpoints for its indices and indices chosen again for
+// them, while that lowers the squared RGBA error as calf's decoder shows the block; the block is
+// kept where nothing does. Opaque blocks only (the fit assumes four-colour mode).
+void bc1_refine(const uint8_t* rgba, uint8_t* block);
+
 // Writes fields LSB-first into a 16-byte block (the inverse of format/src/bc_bits.h).
 class BitWriter {
  public:

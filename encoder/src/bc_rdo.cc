@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "bc_encode_internal.h"
 #include "calf/format/colour.h"
 
 namespace calf::bc {
@@ -295,36 +296,6 @@ double bc1_error(const uint8_t* block, const Bc7Target& t) {
   return rgba8_error(out, t);
 }
 
-// The indices (bytes 4..7 of `block`) that pick, for every texel, the nearest of the four colours
-// of the endpoints in bytes 0..3 (ties: the lower index). The palette is read by decoding the
-// endpoints with the indices 0, 1, 2, 3 in texels 0..3, so it is the decoder's own.
-void bc1_choose_indices(uint8_t* block, const Bc7Target& t) {
-  uint8_t probe[8];
-  std::memcpy(probe, block, 4);
-  const uint32_t ramp = 0xE4E4E4E4u;  // texel k: index k mod 4
-  for (int k = 0; k < 4; ++k) probe[4 + k] = static_cast<uint8_t>(ramp >> (8 * k));
-  uint8_t palette[16][4];
-  decode_bc1_block(probe, &palette[0][0]);
-  uint32_t idx = 0;
-  for (int i = 0; i < 16; ++i) {
-    int best = 0;
-    int best_d = -1;
-    for (int p = 0; p < 4; ++p) {
-      int d = 0;
-      for (int c = 0; c < 4; ++c) {
-        const int x = static_cast<int>(palette[p][c]) - t.v[i][c];
-        d += x * x;
-      }
-      if (best_d < 0 || d < best_d) {
-        best_d = d;
-        best = p;
-      }
-    }
-    idx |= static_cast<uint32_t>(best) << (2 * i);
-  }
-  for (int k = 0; k < 4; ++k) block[4 + k] = static_cast<uint8_t>(idx >> (8 * k));
-}
-
 }  // namespace
 
 Status rdo_bc1(const uint8_t* target, uint32_t width, uint32_t height, uint8_t* blocks,
@@ -373,7 +344,7 @@ Status rdo_bc1(const uint8_t* target, uint32_t width, uint32_t height, uint8_t* 
       consider(sources[s]);  // the whole block
       std::memcpy(cand, sources[s], 4);
       std::memcpy(cand + 4, block + 4, 4);
-      bc1_choose_indices(cand, t);
+      internal::bc1_choose_indices(cand, &t.v[0][0]);
       consider(cand);  // its endpoints, indices re-chosen
       std::memcpy(cand, block, 4);
       std::memcpy(cand + 4, sources[s] + 4, 4);

@@ -1,6 +1,6 @@
 // BC1, BC4 and BC5 encoders: libsquish does the fitting; calf adds argument checks, edge
-// clamping, threads, and (BC4/BC5 quality 1) an endpoint refinement measured with calf's own
-// decoder rounding.
+// clamping, threads, and endpoint refinements measured with calf's own decoder rounding (BC4/BC5
+// quality 1 here; BC1's `refine` in bc1_refine.cc).
 //
 // libsquish 1.15 facts used here (DESIGN.md): kBc4 compresses the R byte of RGBA input, kBc5 the
 // R and G bytes (two DXT5-alpha blocks); its Decompress decodes BC4/BC5 wrongly, so nothing here
@@ -95,6 +95,7 @@ void encode_bc1_block(const uint8_t* rgba, uint8_t* out8, const Bc1Options& opti
     for (int i = 0; i < 16; ++i) px[4 * i + 3] = 255;
   }
   squish::Compress(px, out8, bc1_flags(std::clamp(options.quality, 0, 2)));
+  if (options.refine && !options.punch_through_alpha) internal::bc1_refine(px, out8);
 }
 
 void encode_bc4_block(const uint8_t* r, uint8_t* out8, const Bc4Options& options) {

@@ -48,8 +48,11 @@ Status validate_options(const LightfieldEncodeOptions& o) {
                ": expected a multiple of --depth-keyframe-interval " +
                std::to_string(o.depth_keyframe_interval) + " (or 0, no segments)");
   }
-  if (!(o.colour_rdo >= 0 && o.colour_rdo <= 1e6)) {
-    return bad("--colour-rdo " + std::to_string(o.colour_rdo) + ": expected [0, 1e6]");
+  if (o.colour_rdo != kColourRdoAuto && !(o.colour_rdo >= 0 && o.colour_rdo <= 1e6)) {
+    return bad("--colour-rdo " + std::to_string(o.colour_rdo) + ": expected [0, 1e6] or auto");
+  }
+  if (static_cast<uint8_t>(o.bc1_fit) > static_cast<uint8_t>(Bc1Fit::kCluster)) {
+    return bad("unknown BC1 fit");
   }
   // 256 as calf-capture's: beyond it oneTBB prints warnings of its own (a library never prints).
   if (o.threads > 256) return bad("--threads " + std::to_string(o.threads) + ": expected [0, 256]");

@@ -188,8 +188,15 @@ std::vector<uint8_t> srgb8_rgba_of(std::span<const float> rgb) {
   return rgba;
 }
 
-Status code_colour_frame(ColourCoding coding, std::span<const float> rgb, uint32_t w, uint32_t h,
-                         CodedFrame* out) {
+bc::Bc1Options bc1_options(Bc1Fit fit) {
+  bc::Bc1Options o;
+  o.quality = fit == Bc1Fit::kCluster ? 1 : 0;
+  o.refine = fit == Bc1Fit::kRefined;
+  return o;
+}
+
+Status code_colour_frame(ColourCoding coding, Bc1Fit bc1_fit, std::span<const float> rgb,
+                         uint32_t w, uint32_t h, CodedFrame* out) {
   const size_t n = static_cast<size_t>(w) * h;
   out->shown.resize(n * 3);
   switch (coding) {
@@ -204,7 +211,8 @@ Status code_colour_frame(ColourCoding coding, std::span<const float> rgb, uint32
         const bc::Image8 img{rgba.data(), w, h, size_t{w} * 4, 4};
         out->bytes.assign(bc::encode_bound(f, w, h), 0);
         if (coding == ColourCoding::kBc1) {
-          CALF_RETURN_IF_ERROR(bc::encode_bc1(img, out->bytes.data(), out->bytes.size(), {}));
+          CALF_RETURN_IF_ERROR(
+              bc::encode_bc1(img, out->bytes.data(), out->bytes.size(), bc1_options(bc1_fit)));
         } else {
           bc::Bc7Options o;
           o.quality = 0;
@@ -281,7 +289,7 @@ Status rdo_keyframe(const Context& ctx, uint32_t face, const PixelRect& r, uint3
                     std::vector<uint8_t>& bytes) {
   const size_t n = static_cast<size_t>(r.width) * r.height;
   bc::BcRdoOptions o;
-  o.lambda = ctx.options->colour_rdo;
+  o.lambda = colour_rdo_lambda(*ctx.options, ctx.colour);
   std::vector<uint16_t> half(n * 3);
   gather_cell_halves(*ctx.view, face, r, frame, half.data());
   if (ctx.colour == ColourCoding::kBc6h) {
@@ -312,7 +320,8 @@ void colour_task(const Context& ctx, uint32_t face, uint32_t cell, TaskOut& out)
       coded[f] = coded[f - 1];  // static content: the same bytes, no second encode
     } else {
       for (size_t i = 0; i < n * 3; ++i) original[i] = bc::half_to_float(current_half[i]);
-      out.status = code_colour_frame(ctx.colour, original, r.width, r.height, &coded[f]);
+      out.status = code_colour_frame(ctx.colour, ctx.options->bc1_fit, original, r.width, r.height,
+                                     &coded[f]);
       if (!out.status.ok()) return;
     }
     std::copy(coded[f].shown.begin(), coded[f].shown.end(), &shown_all[f * n * 3]);
@@ -368,9 +377,9 @@ void colour_task(const Context& ctx, uint32_t face, uint32_t cell, TaskOut& out)
     const uint32_t kf = k->keyframes[i];
     const uint32_t end = i + 1 < k->keyframes.size() ? k->keyframes[i + 1] : frames;
     raw.clear();
-    if (ctx.options->colour_rdo > 0 &&
-        (ctx.colour == ColourCoding::kBc6h || ctx.colour == ColourCoding::kBc7 ||
-         ctx.colour == ColourCoding::kBc1)) {
+    if ((ctx.colour == ColourCoding::kBc6h || ctx.colour == ColourCoding::kBc7 ||
+         ctx.colour == ColourCoding::kBc1) &&
+        colour_rdo_lambda(*ctx.options, ctx.colour) > 0) {
       out.status = rdo_keyframe(ctx, face, r, kf, coded[kf].bytes);
       if (!out.status.ok()) return;
     }
@@ -734,10 +743,15 @@ double psnr_log2(std::span<const float> reference, std::span<const float> test) 
   return 10.0 * std::log10(64.0 * static_cast<double>(reference.size()) / sum);
 }
 
-Status spatial_colour_reference(ColourCoding coding, std::span<const float> rgb, uint32_t w,
-                                uint32_t h, std::vector<float>* shown) {
+double colour_rdo_lambda(const LightfieldEncodeOptions& options, ColourCoding coding) {
+  if (options.colour_rdo != kColourRdoAuto) return options.colour_rdo;
+  return coding == ColourCoding::kBc1 ? 12.0 : 0.5;
+}
+
+Status spatial_colour_reference(ColourCoding coding, Bc1Fit bc1_fit, std::span<const float> rgb,
+                                uint32_t w, uint32_t h, std::vector<float>* shown) {
   CodedFrame coded;
-  CALF_RETURN_IF_ERROR(code_colour_frame(coding, rgb, w, h, &coded));
+  CALF_RETURN_IF_ERROR(code_colour_frame(coding, bc1_fit, rgb, w, h, &coded));
   *shown = std::move(coded.shown);
   return Status::Ok();
 }

@@ -30,7 +30,7 @@ constexpr const char* kAnalysisKey = "calf.lightfield_analysis";
 constexpr const char* kAnalysisIdKey = "calf.lightfield_analysis_id";
 constexpr const char* kShardViewsKey = "calf.lightfield_shard_views";
 constexpr const char* kShardFramesKey = "calf.lightfield_shard_frames";  // "first-last"
-constexpr const char* kRecordMagic = "calf-lightfield-analysis 2";
+constexpr const char* kRecordMagic = "calf-lightfield-analysis 3";
 
 std::string hex_double(double v) {
   char buf[64];
@@ -49,8 +49,8 @@ std::string analysis_record(const LightfieldAnalysis& a, const LightfieldEncodeO
     << static_cast<int>(o.supercompression) << "\nzstd_level " << o.levels.zstd_level
     << "\nlzma_preset " << o.levels.lzma_preset << "\nsegment_frames " << o.segment_frames
     << "\nmerge_static_groups " << (o.merge_static_groups ? 1 : 0) << "\ncolour_rdo "
-    << hex_double(o.colour_rdo) << "\nresolved_colour " << static_cast<int>(a.colour) << "\nviews "
-    << a.views.size() << "\n";
+    << hex_double(o.colour_rdo) << "\nbc1_fit " << static_cast<int>(o.bc1_fit)
+    << "\nresolved_colour " << static_cast<int>(a.colour) << "\nviews " << a.views.size() << "\n";
   for (size_t v = 0; v < a.views.size(); ++v) {
     const LightfieldViewFacts& f = a.views[v];
     s << "view " << v << " " << (f.depth_range ? 1 : 0) << " "
@@ -131,6 +131,9 @@ Status parse_record(const std::string& path, const std::string& text, Lightfield
   if (!(in >> key) || key != "colour_rdo" || !read_double(in, &o->colour_rdo)) {
     return bad_record(path, "colour_rdo");
   }
+  if (!field("bc1_fit", static_cast<uint64_t>(Bc1Fit::kCluster)))
+    return bad_record(path, "bc1_fit");
+  o->bc1_fit = static_cast<Bc1Fit>(x);
   if (!field("resolved_colour", static_cast<uint64_t>(ColourCoding::kRgba16f)))
     return bad_record(path, "resolved_colour");
   *resolved_colour = x;

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <map>
 #include <optional>
@@ -297,16 +298,28 @@ int main(int argc, char** argv) {
                "one depth / material chunk per K frames even where a tile does not change (the "
                "layout of writers before issue 17); default off: a tile unchanged over whole "
                "groups of K frames keeps one chunk, one keyframe, across them (SPEC 11.1.2)");
-  app.add_option("--colour-rdo", o.colour_rdo,
-                 "colour rate-distortion strength lambda, 0..1e6: BC1 / BC6H / BC7 keyframe blocks "
-                 "are rewritten towards bytes zstd / LZMA find again (copies of a neighbour "
-                 "block's bytes; BC1: its endpoints or indices) where the added error (squared, "
-                 "in 8-bit sRGB units; BC6H on the sRGB curve extended above 1) is below lambda "
-                 "per estimated bit saved; 0 = off, the blocks exactly as the BCn encoder made "
-                 "them; rgba8 / rgba16f ignore it; 0.5 saves 31-69 % of the BC6H colour bytes of "
-                 "the built-in scenes for <= 0.02 dB against ground truth, 10-27 % of their BC1 "
-                 "bytes (4: 23-42 %) (docs/ENCODER.md \"Colour RDO\") (default 0.5)")
-      ->default_val(0.5);
+  std::string colour_rdo = "auto";
+  app.add_option(
+         "--colour-rdo", colour_rdo,
+         "colour rate-distortion strength lambda, 0..1e6, or auto: BC1 / BC6H / BC7 "
+         "keyframe blocks are rewritten towards bytes zstd / LZMA find again (copies of a "
+         "neighbour block's bytes; BC1: its endpoints or indices) where the added error "
+         "(squared, in 8-bit sRGB units; BC6H on the sRGB curve extended above 1) is below "
+         "lambda per estimated bit saved; 0 = off, the blocks exactly as the BCn encoder "
+         "made them; rgba8 / rgba16f ignore it; auto = 0.5 for BC6H / BC7 (31-69 % fewer "
+         "BC6H colour bytes on the built-in scenes for <= 0.02 dB against ground truth) and "
+         "12 for BC1 (32-46 % with the default --bc1-fit, within 0.02 dB) "
+         "(docs/ENCODER.md \"Colour RDO\", \"BC1 fit\") (default auto)")
+      ->default_val("auto");
+  std::string bc1_fit = "cluster";
+  app.add_option("--bc1-fit", bc1_fit,
+                 "how BC1 colour blocks are fitted: range (libsquish's range fit, the fastest; "
+                 "the encoder before stop 38), refined (range fit, then least-squares endpoints "
+                 "for its indices: +0.1 dB for ~1.3x the BC1 encode time) or cluster (libsquish's "
+                 "cluster fit: +0.2-0.3 dB for 1.5-3x the encode time) (docs/ENCODER.md \"BC1 "
+                 "fit\") (default cluster)")
+      ->check(CLI::IsMember({"range", "refined", "cluster"}))
+      ->default_val("cluster");
   app.add_option("--supercompression", super,
                  "per chunk: zstd (level 19), lzma2 (preset 6), none (default zstd)")
       ->check(CLI::IsMember({"zstd", "lzma2", "none"}))
@@ -583,6 +596,19 @@ int main(int argc, char** argv) {
       {"bc7", calf::ColourCoding::kBc7},     {"bc6h", calf::ColourCoding::kBc6h},
       {"rgba8", calf::ColourCoding::kRgba8}, {"rgba16f", calf::ColourCoding::kRgba16f}};
   o.colour = colours.at(colour);
+  if (colour_rdo == "auto") {
+    o.colour_rdo = calf::kColourRdoAuto;
+  } else {
+    char* end = nullptr;
+    o.colour_rdo = std::strtod(colour_rdo.c_str(), &end);
+    if (colour_rdo.empty() || *end != '\0' || !(o.colour_rdo >= 0 && o.colour_rdo <= 1e6)) {
+      return calf::tools::usage_error(
+          "calf-encode", "--colour-rdo " + colour_rdo + ": expected a number in [0, 1e6] or auto");
+    }
+  }
+  o.bc1_fit = bc1_fit == "range"     ? calf::Bc1Fit::kRange
+              : bc1_fit == "refined" ? calf::Bc1Fit::kRefined
+                                     : calf::Bc1Fit::kCluster;
   o.depth = depth == "bc5"       ? calf::DepthCoding::kBc5
             : depth == "pred16"  ? calf::DepthCoding::kRaw16Predicted
             : depth == "pred16m" ? calf::DepthCoding::kRaw16PredictedMasked
@@ -626,7 +652,7 @@ int main(int argc, char** argv) {
     for (const char* opt :
          {"--cell", "--psnr", "--color-format", "--depth-format", "--depth-window", "--max-aabbs",
           "--depth-keyframe-interval", "--supercompression", "--segment-frames", "--colour-rdo",
-          "--depth-fixed-groups", "--plain-directory"}) {
+          "--bc1-fit", "--depth-fixed-groups", "--plain-directory"}) {
       if (app.get_option(opt)->count() > 0) {
         return calf::tools::usage_error(
             "calf-encode",

@@ -43,6 +43,8 @@ struct PinCase {
   // CompressionOptions::compress_directory: the clips frozen before container 1.1 are 1.0 files
   // with a plain directory (their pins unchanged since); `*_zdir` clips are their 1.1 twins.
   bool compress_directory = false;
+  // LightfieldEncodeOptions::bc1_fit: the clips frozen before stop 38 used the range fit.
+  Bc1Fit bc1_fit = Bc1Fit::kRange;
 };
 
 // clang-format off
@@ -76,6 +78,9 @@ const PinCase kCases[] = {
     // default since; twins of the 1.0 clips, they decode to their hashes.
     {"bc1_raw16_zstd_zdir",   {.face = 16, .frames = 5, .views = 2},                ColourCoding::kBc1,     DepthCoding::kRaw16, container::Compression::kZstd,  "fba3ff8193f27a11", 0, 30, 2, true},
     {"bc1_pred16m_groups_zdir", {.face = 16, .frames = 7, .views = 2, .material = true}, ColourCoding::kBc1, DepthCoding::kRaw16PredictedMasked, container::Compression::kZstd, "03502347f39cf975", 0, 2, 1, true},
+    // BC1 at stop 38's defaults: cluster fit and BC1's own RDO lambda (auto = 12), the 1.1
+    // directory, r16pm depth (docs/ENCODER.md "BC1 fit").
+    {"bc1_cluster_rdo_pred16m", {.face = 16, .frames = 5, .views = 2},                 ColourCoding::kBc1,     DepthCoding::kRaw16PredictedMasked, container::Compression::kZstd, "b62d0d9de42e2a98", kColourRdoAuto, 30, 2, true, Bc1Fit::kCluster},
 };
 // clang-format on
 
@@ -109,6 +114,7 @@ TEST_P(EncodePin, OutputBytesAreUnchanged) {
     LightfieldEncodeOptions o;
     o.colour = c.colour;
     o.colour_rdo = c.colour_rdo;
+    o.bc1_fit = c.bc1_fit;
     o.depth = c.depth;
     o.supercompression = c.compression;
     o.cell_size = 8;

@@ -60,9 +60,10 @@ class LightfieldRoundTrip : public ::testing::Test {
 
   // Decodes every view, face and frame of `file` and checks colour against Q (on the spatial
   // reference), depth against the quantised input (exactly, or within `max_rel` for BC5), and
-  // material codes exactly (raw).
+  // material codes exactly (raw). BC1 is fitted with `bc1_fit`, as the file was encoded.
   void check_file(const fs::path& capture_dir, const fs::path& file, ColourCoding coding, double q,
-                  bool exact_depth, double max_rel = 0, bool exact_material = true) {
+                  bool exact_depth, double max_rel = 0, bool exact_material = true,
+                  Bc1Fit bc1_fit = LightfieldEncodeOptions{}.bc1_fit) {
     auto reader = container::Reader::open(file.string());
     ASSERT_TRUE(reader.ok()) << reader.status().to_string();
     EXPECT_TRUE(reader->verify().empty());
@@ -102,7 +103,9 @@ class LightfieldRoundTrip : public ::testing::Test {
               }
             }
             std::vector<float> reference;
-            ASSERT_TRUE(spatial_colour_reference(coding, orig, r.width, r.height, &reference).ok());
+            ASSERT_TRUE(
+                spatial_colour_reference(coding, bc1_fit, orig, r.width, r.height, &reference)
+                    .ok());
             const double quality = hdr ? psnr_log2(reference, got) : psnr_srgb(reference, got);
             worst = std::min(worst, quality);
             EXPECT_GE(quality, q) << "view " << v << " face " << face << " frame " << f << " cell "
@@ -172,6 +175,63 @@ TEST_F(LightfieldRoundTrip, Bc1ColourMeetsQAndRaw16DepthIsExact) {
   const auto with_rdo = encode(cap32, root_ / "ldr32-rdo.calf", rdo);
   EXPECT_LT(with_rdo.colour.stored, without.colour.stored);
   check_file(cap32, root_ / "ldr32-rdo.calf", ColourCoding::kBc1, 44.0, true);
+}
+
+// Every BC1 fit meets Q against its own spatial coding; the refined and cluster fits show the
+// source closer than the range fit (the mean over every decoded frame and face), and auto picks
+// BC1's own RDO lambda.
+TEST_F(LightfieldRoundTrip, EveryBc1FitMeetsQAndTheBetterFitsShowTheSourceCloser) {
+  const fs::path cap = make_capture({.face = 16, .frames = 3}, "fits");
+  double source_psnr[3] = {};
+  for (Bc1Fit fit : {Bc1Fit::kRange, Bc1Fit::kRefined, Bc1Fit::kCluster}) {
+    LightfieldEncodeOptions o;
+    o.cell_size = 8;
+    o.colour_rdo = 0;  // Q is checked: see Bc1ColourMeetsQAndRaw16DepthIsExact
+    o.bc1_fit = fit;
+    const fs::path file = root_ / ("fit" + std::to_string(static_cast<int>(fit)) + ".calf");
+    encode(cap, file, o);
+    check_file(cap, file, ColourCoding::kBc1, 50.0, true, 0, true, fit);
+    // Against the source: sRGB PSNR over every face of every frame.
+    auto reader = container::Reader::open(file.string());
+    ASSERT_TRUE(reader.ok());
+    auto dec = decoder::LightfieldReference::open(*reader, 0);
+    ASSERT_TRUE(dec.ok());
+    auto input = capture::CaptureSetReader::open(cap);
+    ASSERT_TRUE(input.ok());
+    std::vector<float> src, got;
+    capture::ViewFrame vf;
+    decoder::LightfieldFace out;
+    const uint32_t n = input->manifest().face_size;
+    for (uint32_t v = 0; v < dec->header().view_count; ++v) {
+      for (uint32_t f = 0; f < dec->header().frame_count; ++f) {
+        ASSERT_TRUE(input->read(v, f, &vf).ok());
+        for (uint32_t face = 0; face < 6; ++face) {
+          ASSERT_TRUE(dec->decode_face(v, face, f, &out).ok());
+          for (uint32_t y = 0; y < n; ++y) {
+            for (uint32_t x = 0; x < n; ++x) {
+              const size_t i = vf.texel_index(static_cast<CubeFace>(face), x, y);
+              for (int k = 0; k < 3; ++k) {
+                src.push_back(vf.color[3 * i + k]);
+                got.push_back(out.colour[(size_t{y} * n + x) * 3 + k]);
+              }
+            }
+          }
+        }
+      }
+    }
+    source_psnr[static_cast<int>(fit)] = psnr_srgb(src, got);
+  }
+  RecordProperty("range_db", std::to_string(source_psnr[0]));
+  RecordProperty("refined_db", std::to_string(source_psnr[1]));
+  RecordProperty("cluster_db", std::to_string(source_psnr[2]));
+  EXPECT_GT(source_psnr[1], source_psnr[0]);
+  EXPECT_GT(source_psnr[2], source_psnr[0]);
+  LightfieldEncodeOptions o;
+  EXPECT_EQ(colour_rdo_lambda(o, ColourCoding::kBc1), 12.0);
+  EXPECT_EQ(colour_rdo_lambda(o, ColourCoding::kBc6h), 0.5);
+  EXPECT_EQ(colour_rdo_lambda(o, ColourCoding::kBc7), 0.5);
+  o.colour_rdo = 3;
+  EXPECT_EQ(colour_rdo_lambda(o, ColourCoding::kBc1), 3.0);
 }
 
 TEST_F(LightfieldRoundTrip, EveryColourFormatAndSchemeRoundTrips) {

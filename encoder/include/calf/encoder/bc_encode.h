@@ -10,7 +10,8 @@
 //    block column/row are copies of the nearest edge texel (so the block fits only real colours).
 //
 // What each encoder searches (docs/BLOCK_CODECS.md has the reasons and measured numbers):
-//  - BC1: libsquish. quality 0 = range fit (fast), 1 = cluster fit, 2 = iterative cluster fit.
+//  - BC1: libsquish. quality 0 = range fit (fast), 1 = cluster fit, 2 = iterative cluster fit;
+//    `refine` adds an in-house least-squares endpoint refinement measured with calf's decoder.
 //  - BC4/BC5: libsquish's DXT5-alpha fitter per channel (it tries the 8- and 6-level modes);
 //    quality 1 adds an in-house refinement that searches endpoint pairs near squish's.
 //  - BC7 (quality 0 / 1 / 2):
@@ -74,6 +75,10 @@ struct Bc1Options {
   // become transparent black through BC1's 3-colour mode.
   bool punch_through_alpha = false;
   int threads = 1;
+  // After the fit: least-squares endpoints for the block's indices, indices chosen again, kept
+  // only where calf's decoder shows a smaller RGB error (docs/BLOCK_CODECS.md "BC1"). Blocks with
+  // punched-through alpha are left as fitted.
+  bool refine = false;
 };
 
 struct Bc4Options {

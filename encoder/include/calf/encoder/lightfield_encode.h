@@ -68,6 +68,14 @@ enum class ColourCoding : uint8_t { kAuto, kBc1, kBc7, kBc6h, kRgba8, kRgba16f }
 // P-frame rectangle stores a change mask and the residuals of its changed texels only (depth
 // format r16pm, SPEC §11.1.9). Values are recorded in analysis files: append only.
 enum class DepthCoding : uint8_t { kRaw16, kBc5, kRaw16Predicted, kRaw16PredictedMasked };
+// How BC1 colour blocks are fitted (calf/encoder/bc_encode.h): kRange = libsquish's range fit
+// (the encoder before stop 38), kRefined = range fit plus least-squares endpoint refinement
+// (Bc1Options::refine), kCluster = libsquish's cluster fit. Costs and gains: docs/ENCODER.md
+// "BC1 fit". Values are recorded in analysis files: append only.
+enum class Bc1Fit : uint8_t { kRange, kRefined, kCluster };
+// LightfieldEncodeOptions::colour_rdo's "auto": the measured default of each colour format
+// (colour_rdo_lambda).
+inline constexpr double kColourRdoAuto = -1;
 
 struct LightfieldEncodeOptions {
   uint32_t cell_size = 64;  // colour cell side (px), 4..16384 and a multiple of 4
@@ -94,8 +102,13 @@ struct LightfieldEncodeOptions {
   // Colour RDO strength (calf/encoder/bc_rdo.h): lambda, squared 8-bit sRGB error per estimated
   // bit saved, [0, 1e6]; 0 = off (the blocks as the BCn encoder made them). BC1, BC6H and BC7
   // keyframes (BC1 since stop 37); rgba8 / rgba16f ignore it. Applied to the keyframes after the
-  // keyframe search. The default 0.5 was chosen by measurement (docs/ENCODER.md "Colour RDO").
-  double colour_rdo = 0.5;
+  // keyframe search. kColourRdoAuto (the default): 0.5 for BC6H / BC7, 12 for BC1, each chosen
+  // by measurement (docs/ENCODER.md "Colour RDO", "BC1 fit"); see colour_rdo_lambda.
+  double colour_rdo = kColourRdoAuto;
+  // BC1 colour only: the block fit (above). Cluster fit by default since stop 38: with the BC1
+  // RDO at its default it is what keeps LDR content within 0.05 dB of the encoder before issue 17
+  // while saving 30 % of its colour bytes.
+  Bc1Fit bc1_fit = Bc1Fit::kCluster;
   container::Compression supercompression = container::Compression::kZstd;
   container::CompressionOptions levels;  // zstd level / LZMA preset (fixed per clip)
   uint32_t threads = 1;                  // 0 = all cores; never changes the output
@@ -269,11 +282,17 @@ Expected<LightfieldEncodeStats> encode_lightfield_file(const std::filesystem::pa
                                                        const std::string& out_path,
                                                        const LightfieldEncodeOptions& options);
 
+// The RDO lambda an encode uses for colour coded as `coding` (kBc1 / kBc6h / kBc7; the resolved
+// format, not kAuto): options.colour_rdo, or, when that is kColourRdoAuto, the format's default
+// (BC1 12, BC6H and BC7 0.5). BC1's differs because a BC1 candidate saves at most 30 estimated
+// bits where a BC6H / BC7 one saves 104, so the same lambda buys a third of the bytes.
+double colour_rdo_lambda(const LightfieldEncodeOptions& options, ColourCoding coding);
+
 // A cell of linear RGB (w * h * 3 floats) as the spatial codec alone would show it: coded in
-// `coding` (not kAuto) exactly as a keyframe is, then decoded to linear RGB. This is the reference
-// Q is measured against; tests use it to check decoded files.
-Status spatial_colour_reference(ColourCoding coding, std::span<const float> rgb, uint32_t w,
-                                uint32_t h, std::vector<float>* shown);
+// `coding` (not kAuto) exactly as a keyframe is (BC1 with `bc1_fit`), then decoded to linear
+// RGB. This is the reference Q is measured against; tests use it to check decoded files.
+Status spatial_colour_reference(ColourCoding coding, Bc1Fit bc1_fit, std::span<const float> rgb,
+                                uint32_t w, uint32_t h, std::vector<float>* shown);
 
 // HDR metric: 10 log10(8^2 / MSE) over log2(max(v, 2^-14)) of every channel, i.e. PSNR in stops
 // with an 8-stop peak (+inf when identical). 50 dB is an RMS error of 0.025 stops (~1.8 %).
