@@ -185,6 +185,14 @@ uint64_t stored_bound(uint64_t raw_size, Compression c) {
 
 Expected<StoredChunk> compress_chunk(std::span<const uint8_t> raw, Compression c,
                                      const CompressionOptions& options) {
+  // The raw bytes themselves where the compressed frame is no smaller (and the options allow).
+  auto keep_smaller = [&](Expected<StoredChunk> packed) -> Expected<StoredChunk> {
+    if (!packed.ok() || !options.store_when_larger || packed->bytes.size() < raw.size()) {
+      return packed;
+    }
+    return StoredChunk{Compression::kNone, raw.size(),
+                       std::vector<uint8_t>(raw.begin(), raw.end())};
+  };
   if (raw.size() > kMaxRawChunkSize)
     return Status(ErrorId::kContainerWriterMisuse,
                   cat("raw chunk of ", raw.size(), " bytes exceeds the limit ", kMaxRawChunkSize));
@@ -196,9 +204,9 @@ Expected<StoredChunk> compress_chunk(std::span<const uint8_t> raw, Compression c
         return Status(
             ErrorId::kContainerWriterMisuse,
             cat("zstd level ", options.zstd_level, " is outside [1, ", ZSTD_maxCLevel(), "]"));
-      return compress_zstd(raw, options.zstd_level);
+      return keep_smaller(compress_zstd(raw, options.zstd_level));
     case Compression::kLzma2:
-      return compress_lzma2(raw, options.lzma_preset);
+      return keep_smaller(compress_lzma2(raw, options.lzma_preset));
   }
   return Status(ErrorId::kContainerWriterMisuse,
                 cat("supercompression ", static_cast<unsigned>(c), " is unknown"));

@@ -153,8 +153,10 @@ Status Writer::finish() {
   FileHeader h;
   std::vector<uint8_t> dir;
   if (s_->options.compress_directory) {
-    CALF_ASSIGN_OR_RETURN(StoredChunk packed,
-                          compress_chunk(body, Compression::kZstd, s_->options));
+    // Always one zstd frame (SPEC §4.1), even where it is no smaller than the body.
+    CompressionOptions zstd_frame = s_->options;
+    zstd_frame.store_when_larger = false;
+    CALF_ASSIGN_OR_RETURN(StoredChunk packed, compress_chunk(body, Compression::kZstd, zstd_frame));
     CALF_RETURN_IF_ERROR(write_fields(DirectoryBodySize{body.size()}, dir));
     dir.insert(dir.end(), packed.bytes.begin(), packed.bytes.end());
     h.version_minor = kVersionMinor;

@@ -142,7 +142,7 @@ TEST(ContainerCodecTest, StoredBoundHoldsAndStreamsMustBeExact) {
     for (auto& b : raw) b = static_cast<uint8_t>(rng());  // incompressible: worst case
     for (uint16_t c = 0; c < kCompressionCount; ++c) {
       const auto scheme = static_cast<Compression>(c);
-      auto stored = compress_chunk(raw, scheme, {1, 0});
+      auto stored = compress_chunk(raw, scheme, {1, 0, true, false});  // the scheme asked for
       ASSERT_TRUE(stored.ok()) << stored.status().to_string();
       EXPECT_LE(stored->bytes.size(), stored_bound(size, scheme));
       Bytes out(size);

@@ -33,8 +33,9 @@ struct Clip {
   std::vector<Compression> compressions;
 };
 
-// A clip with one lightfield track, one unknown optional track and `n` random chunks.
-Clip make_clip(uint64_t seed, int n, const CompressionOptions& opt = {1, 0}) {
+// A clip with one lightfield track, one unknown optional track and `n` random chunks, each stored
+// with the scheme asked for (random bytes do not compress: store_when_larger would store them raw).
+Clip make_clip(uint64_t seed, int n, const CompressionOptions& opt = {1, 0, true, false}) {
   std::mt19937_64 rng(seed);
   Clip clip;
   auto w = Writer::create(memory_sink(&clip.file), opt);
@@ -70,6 +71,48 @@ Clip make_clip(uint64_t seed, int n, const CompressionOptions& opt = {1, 0}) {
   }
   EXPECT_TRUE(w->finish().ok());
   return clip;
+}
+
+// CompressionOptions::store_when_larger (the default): a chunk zstd or LZMA2 would not shrink is
+// stored raw, one they shrink keeps its scheme; false keeps the scheme asked for. Either way the
+// chunk reads back as written, and the 1.1 directory stays one zstd frame however small.
+TEST(ContainerTest, ChunksThatCompressionWouldEnlargeAreStoredRaw) {
+  std::mt19937_64 rng(5);
+  Bytes noise(3000);
+  for (auto& b : noise) b = static_cast<uint8_t>(rng());  // white noise: no scheme shrinks it
+  const Bytes zeros(3000, 0), tiny{7};
+  for (bool store_raw : {true, false}) {
+    for (Compression c : {Compression::kZstd, Compression::kLzma2}) {
+      CompressionOptions opt;
+      opt.store_when_larger = store_raw;
+      Bytes file;
+      auto w = Writer::create(memory_sink(&file), opt);
+      ASSERT_TRUE(w.ok());
+      ASSERT_TRUE(w->add_track(999, 0, Bytes{1}).ok());
+      ChunkKeys k;
+      for (const Bytes* raw : {static_cast<const Bytes*>(&noise), &zeros, &tiny}) {
+        ASSERT_TRUE(w->add_chunk(k, *raw, c).ok());
+        ++k.region;
+      }
+      ASSERT_TRUE(w->finish().ok());
+      auto r = Reader::open(memory_source(std::span<const uint8_t>(file)));
+      ASSERT_TRUE(r.ok()) << r.status().to_string();
+      const uint16_t asked = static_cast<uint16_t>(c), none = 0;
+      EXPECT_EQ(r->chunks()[0].compression, store_raw ? none : asked);
+      if (store_raw) {
+        EXPECT_EQ(r->chunks()[0].stored_size, noise.size());
+      } else {
+        EXPECT_GT(r->chunks()[0].stored_size, noise.size());  // what store_when_larger avoids
+      }
+      EXPECT_EQ(r->chunks()[1].compression, asked);
+      EXPECT_LT(r->chunks()[1].stored_size, zeros.size());
+      EXPECT_EQ(r->chunks()[2].compression, store_raw ? none : asked);
+      EXPECT_EQ(*r->read_chunk(0), noise);
+      EXPECT_EQ(*r->read_chunk(1), zeros);
+      EXPECT_EQ(*r->read_chunk(2), tiny);
+      EXPECT_TRUE(r->verify().empty());
+    }
+  }
 }
 
 TEST(ContainerTest, RoundTripsRandomContentsAndCompressions) {

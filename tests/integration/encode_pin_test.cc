@@ -45,6 +45,9 @@ struct PinCase {
   bool compress_directory = false;
   // LightfieldEncodeOptions::bc1_fit: the clips frozen before stop 38 used the range fit.
   Bc1Fit bc1_fit = Bc1Fit::kRange;
+  // CompressionOptions::store_when_larger: the clips frozen before stop 38 keep zstd / LZMA2
+  // chunks that are larger than their raw bytes.
+  bool store_when_larger = false;
 };
 
 // clang-format off
@@ -78,9 +81,10 @@ const PinCase kCases[] = {
     // default since; twins of the 1.0 clips, they decode to their hashes.
     {"bc1_raw16_zstd_zdir",   {.face = 16, .frames = 5, .views = 2},                ColourCoding::kBc1,     DepthCoding::kRaw16, container::Compression::kZstd,  "fba3ff8193f27a11", 0, 30, 2, true},
     {"bc1_pred16m_groups_zdir", {.face = 16, .frames = 7, .views = 2, .material = true}, ColourCoding::kBc1, DepthCoding::kRaw16PredictedMasked, container::Compression::kZstd, "03502347f39cf975", 0, 2, 1, true},
-    // BC1 at stop 38's defaults: cluster fit and BC1's own RDO lambda (auto = 12), the 1.1
-    // directory, r16pm depth (docs/ENCODER.md "BC1 fit").
-    {"bc1_cluster_rdo_pred16m", {.face = 16, .frames = 5, .views = 2},                 ColourCoding::kBc1,     DepthCoding::kRaw16PredictedMasked, container::Compression::kZstd, "b62d0d9de42e2a98", kColourRdoAuto, 30, 2, true, Bc1Fit::kCluster},
+    // Stop 38's defaults: BC1 by cluster fit with BC1's own RDO lambda (auto = 12; docs/ENCODER.md
+    // "BC1 fit"), r16pm depth, the 1.1 directory, and chunks that zstd would enlarge (the 16-byte
+    // t chunks here) stored as they are.
+    {"bc1_cluster_rdo_pred16m", {.face = 16, .frames = 5, .views = 2},                 ColourCoding::kBc1,     DepthCoding::kRaw16PredictedMasked, container::Compression::kZstd, "f1c992d88578e467", kColourRdoAuto, 30, 2, true, Bc1Fit::kCluster, true},
 };
 // clang-format on
 
@@ -121,6 +125,7 @@ TEST_P(EncodePin, OutputBytesAreUnchanged) {
     o.depth_keyframe_interval = c.depth_keyframe_interval;
     o.max_aabbs = c.max_aabbs;
     o.levels.compress_directory = c.compress_directory;
+    o.levels.store_when_larger = c.store_when_larger;
     o.threads = threads;
     const fs::path out = root / (threads == 1 ? "t1.calf" : "t2.calf");
     auto stats = encode_lightfield_file(capture, out.string(), o);

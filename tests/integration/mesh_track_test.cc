@@ -551,12 +551,14 @@ constexpr Clip kClips[] = {{"full_none", false, Compression::kNone},
                            {"full_lzma2", false, Compression::kLzma2},
                            {"textured_zstd", false, Compression::kZstd, true}};
 
-// The frozen clips are container 1.0 files: a plain directory (SPEC §4.1 is 1.1).
+// The frozen clips are container 1.0 files: a plain directory (SPEC §4.1 is 1.1), every chunk in
+// the clip's scheme even where it is larger than raw (as writers before stop 38 stored them).
 std::vector<uint8_t> make_clip(const Clip& c) {
   if (c.textured) {
     encoder::MeshEncodeOptions o;
     o.supercompression = c.compression;
     o.levels.compress_directory = false;
+    o.levels.store_when_larger = false;
     return encode(test::make_textured_mesh_test_scene(), nullptr, o);
   }
   const capture::SceneFile scene = test::make_mesh_test_scene(3, false);
@@ -564,6 +566,7 @@ std::vector<uint8_t> make_clip(const Clip& c) {
   encoder::MeshEncodeOptions o;
   o.supercompression = c.compression;
   o.levels.compress_directory = false;
+  o.levels.store_when_larger = false;  // as the writers of 1.0 did
   o.segment_count = c.subset ? 8 : 0;
   return encode(scene, c.subset ? &visible : nullptr, o);
 }

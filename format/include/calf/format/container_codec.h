@@ -34,6 +34,11 @@ struct CompressionOptions {
   // feature bit 0; SPEC.md §4.1 "Compressed directory"): 9-14 bytes per chunk instead of 64. False
   // writes a plain 1.0 directory, which 1.0 readers open.
   bool compress_directory = true;
+  // compress_chunk stores a chunk as kNone when zstd / LZMA2 would make it no smaller (a short
+  // chunk, or bytes that do not compress: SPEC §6.3 lets every chunk name its own scheme, and
+  // every reader, 1.0 included, reads kNone). False keeps the requested scheme whatever it costs,
+  // as writers before stop 38 did (the pinned 1.0 clips).
+  bool store_when_larger = true;
 };
 
 // A chunk ready for Writer::add_stored_chunk(): stored bytes, their scheme and raw length.
