@@ -104,6 +104,12 @@ Status validate_tiles_build_options(const TilesBuildOptions& o) {
     return bad_option(
         sformat("texture_solve_iterations %u is above 1000", o.texture_solve_iterations));
   }
+  if (!(o.edge_colour_weight >= 0 && o.edge_colour_weight <= 1)) {
+    return bad_option(sformat("edge_colour_weight %g is outside [0, 1]", o.edge_colour_weight));
+  }
+  if (!(o.edge_depth_ratio > 0 && o.edge_depth_ratio <= 100)) {
+    return bad_option(sformat("edge_depth_ratio %g is outside (0, 100]", o.edge_depth_ratio));
+  }
   if (!(o.secondary_colour_weight >= 0 && o.secondary_colour_weight <= 1)) {
     return bad_option(
         sformat("secondary_colour_weight %g is outside [0, 1]", o.secondary_colour_weight));

@@ -179,6 +179,26 @@ std::vector<float> coverage_from_votes(const std::vector<uint8_t>& votes, uint32
   return cover;
 }
 
+// options.edge_colour_weight where texel (x, y) of `face` lies on a depth edge of the view (a
+// 4-neighbour on the same face more than edge_depth_ratio nearer or farther, or sky beside a
+// surface), else 1.
+double edge_weight(const capture::ViewFrame& view, CubeFace face, uint32_t x, uint32_t y,
+                   uint32_t n, const TilesBuildOptions& options) {
+  if (options.edge_colour_weight >= 1) return 1.0;
+  const float d = view.depth[view.texel_index(face, x, y)];
+  const double hi = 1 + options.edge_depth_ratio;
+  auto differs = [&](uint32_t xx, uint32_t yy) {
+    const float e = view.depth[view.texel_index(face, xx, yy)];
+    if (!std::isfinite(e)) return true;
+    return e > d * hi || d > e * hi;
+  };
+  if ((x > 0 && differs(x - 1, y)) || (x + 1 < n && differs(x + 1, y)) ||
+      (y > 0 && differs(x, y - 1)) || (y + 1 < n && differs(x, y + 1))) {
+    return options.edge_colour_weight;
+  }
+  return 1.0;
+}
+
 }  // namespace
 
 Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader& reader,
@@ -276,6 +296,7 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
       }
       if (p < 0) continue;
       const double depth = view.depth[t];
+      const double edge = edge_weight(view, face, x, y, n, options);
       const Vec3 q = eye + direction_from_texel(face, x, y, n) * depth - f.origin;
       const double r = length(q);
       const Vec3 d = q / r;
@@ -293,6 +314,7 @@ Expected<std::vector<TileTexture>> texture_tiles(const capture::CaptureSetReader
         const int sx = std::clamp(static_cast<int>(std::floor((u + 0.5) * ss)), 0, int(g) - 1);
         const int sy = std::clamp(static_cast<int>(std::floor((w + 0.5) * ss)), 0, int(g) - 1);
         if (!votes) work[k].marks[size_t(sy) * g + sx] |= 1;
+        weight *= edge;
         if (weight > 0) work[k].normals.add(u, w, &view.color[3 * t], weight);
       }
     }

@@ -509,6 +509,15 @@ int main(int argc, char** argv) {
                    "0..1: 1 shares it fully (Seurat), smaller lets a tile's own samples "
                    "outweigh a nearby surface's colour, 0 leaves cracks (default 0.5)")
         ->default_val(0.5);
+    app.add_option("--tiles-edge-colour-weight", b.edge_colour_weight,
+                   "tiles: weight of a colour sample at a view's depth edge (box-filtered "
+                   "texels that blend foreground and background) against 1 elsewhere, 0..1; 1 "
+                   "takes every sample alike (default 0.3)")
+        ->default_val(0.3);
+    app.add_option("--tiles-edge-depth-ratio", b.edge_depth_ratio,
+                   "tiles: the relative depth step to a neighbouring texel that makes a texel an "
+                   "edge texel for --tiles-edge-colour-weight, (0, 100] (default 0.05)")
+        ->default_val(0.05);
     app.add_option("--tiles-alpha", tiles_alpha,
                    "tiles: alpha estimate: votes (each view votes solid where it sees the "
                    "tile's surface, free where it sees through it; alpha is the solid share, "

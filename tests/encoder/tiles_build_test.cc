@@ -58,8 +58,10 @@ std::pair<double, int> trace(const Vec3& e, const Vec3& d) {
 }
 
 // Writes the room's capture set (`sky`: every depth +inf instead; `open_top`: the +Y wall is sky,
-// still in its colour) and returns its directory.
-fs::path write_room(const std::string& name, bool sky = false, bool open_top = false) {
+// still in its colour; `blend_edges`: a texel beside one of another surface holds the mean of
+// both colours, as a box-filtered capture's silhouette texels do) and returns its directory.
+fs::path write_room(const std::string& name, bool sky = false, bool open_top = false,
+                    bool blend_edges = false) {
   const fs::path dir = test::scratch_dir("tiles_build_test") / name;
   capture::CaptureManifest m;
   m.frame_count = 1;
@@ -81,6 +83,20 @@ fs::path write_room(const std::string& name, bool sky = false, bool open_top = f
           f.depth[t] = sky || (open_top && hit == 2) ? std::numeric_limits<float>::infinity()
                                                      : static_cast<float>(depth);
           for (int c = 0; c < 3; ++c) f.color[3 * t + c] = kColour[hit][c];
+          if (!blend_edges) continue;
+          const int dx[4] = {-1, 1, 0, 0}, dy[4] = {0, 0, -1, 1};
+          for (int k = 0; k < 4; ++k) {
+            const int nx = static_cast<int>(x) + dx[k], ny = static_cast<int>(y) + dy[k];
+            if (nx < 0 || ny < 0 || nx >= int(kFace) || ny >= int(kFace)) continue;
+            const int other = trace(m.viewpoints[v].position,
+                                    direction_from_texel(cf, uint32_t(nx), uint32_t(ny), kFace))
+                                  .second;
+            if (other == hit) continue;
+            for (int c = 0; c < 3; ++c) {
+              f.color[3 * t + c] = 0.5f * (kColour[hit][c] + kColour[other][c]);
+            }
+            break;
+          }
         }
       }
     }
@@ -316,6 +332,63 @@ TEST(TilesBuild, PanelSilhouetteIsCarved) {
   }
 }
 
+// Box-filtered silhouette texels (the panel's edge texels half panel, half wall) weigh less in
+// the colour fit with edge_colour_weight < 1, so the panel's tiles near its edge keep the
+// panel's colour: the mean error there against the panel's colour falls.
+TEST(TilesBuild, EdgeTexelsWeighLessInTheColour) {
+  static const fs::path blended = write_room("blended", false, false, true);
+  const auto panel_edge_error = [](double weight) {
+    TilesBuildOptions o = small_options();
+    o.edge_colour_weight = weight;
+    auto set = build(o, nullptr, 0, blended);
+    EXPECT_TRUE(set.ok()) << set.status().to_string();
+    double sum = 0;
+    size_t n = 0;
+    for (const Tile& t : set->tiles) {
+      bool on_panel = true;
+      for (const TileCorner& c : t.corners) on_panel &= std::abs(c.position[0] - kPanelX) < 0.01;
+      if (!on_panel) continue;
+      for (int j = 0; j < 8; ++j) {
+        for (int i = 0; i < 8; ++i) {
+          const double a = (i + 0.5) / 8, b = (j + 0.5) / 8;
+          double p[3] = {0, 0, 0}, uvw[3] = {0, 0, 0};
+          const double wgt[4] = {(1 - a) * (1 - b), a * (1 - b), a * b, (1 - a) * b};
+          for (int k = 0; k < 4; ++k) {
+            for (int c = 0; c < 3; ++c) {
+              p[c] += wgt[k] * t.corners[k].position[c];
+              uvw[c] += wgt[k] * t.corners[k].uvw[c];
+            }
+          }
+          // Inside the panel, within 0.1 of its edge (about two capture texels there).
+          const double m = std::max(std::abs(p[1]), std::abs(p[2]));
+          if (m > kPanelHalf - 0.02 || m < kPanelHalf - 0.1) continue;
+          const uint32_t x = std::min<uint32_t>(
+              static_cast<uint32_t>(uvw[0] / uvw[2] * set->atlas_width), set->atlas_width - 1);
+          const uint32_t y = std::min<uint32_t>(
+              static_cast<uint32_t>(uvw[1] / uvw[2] * set->atlas_height), set->atlas_height - 1);
+          const uint8_t* px = &set->atlas_rgba[(size_t{y} * set->atlas_width + x) * 4];
+          for (int c = 0; c < 3; ++c)
+            sum += std::abs(int(px[c]) - int(srgb8_from_linear(kColour[6][c])));
+          n += 3;
+        }
+      }
+    }
+    EXPECT_GT(n, 0u);
+    return n ? sum / n : 0.0;
+  };
+  // Here every view sees the same edge texels blended (the viewpoints are 0.1 apart, the panel
+  // 1 away), so only the clean texels beside them can outweigh them: weight 0 drops the blended
+  // samples and the edge takes the clean colour beside it (measured 6.5 against 28.5 of 255);
+  // the default 0.3 moves a little towards it (27.4).
+  const double full = panel_edge_error(1.0), light = panel_edge_error(0.3),
+               none = panel_edge_error(0.0);
+  RecordProperty("edge_error_weight_1", std::to_string(full));
+  RecordProperty("edge_error_weight_0_3", std::to_string(light));
+  RecordProperty("edge_error_weight_0", std::to_string(none));
+  EXPECT_LT(none, full * 0.5) << "weight 1: " << full << ", 0: " << none;
+  EXPECT_LT(light, full) << "weight 1: " << full << ", 0.3: " << light;
+}
+
 TEST(TilesBuild, SkyLayerHoldsTheSkyWithinTheBudgets) {
   // The room without its +Y wall: the views see sky there. The sky layer puts one far, opaque
   // tile in the sky's colour on each root cell of +Y (the whole face is sky) and on the side
@@ -431,6 +504,20 @@ TEST(TilesBuild, Errors) {
     ASSERT_FALSE(secondary.ok()) << weight;
     EXPECT_EQ(secondary.status().id(), ErrorId::kTilesOption);
     EXPECT_NE(secondary.status().message().find("secondary_colour_weight"), std::string::npos);
+    o = small_options();
+    o.edge_colour_weight = weight;
+    auto edge = build(o);
+    ASSERT_FALSE(edge.ok()) << weight;
+    EXPECT_EQ(edge.status().id(), ErrorId::kTilesOption);
+    EXPECT_NE(edge.status().message().find("edge_colour_weight"), std::string::npos);
+  }
+  for (double ratio : {0.0, -1.0, 101.0, std::nan("")}) {
+    o = small_options();
+    o.edge_depth_ratio = ratio;
+    auto edge = build(o);
+    ASSERT_FALSE(edge.ok()) << ratio;
+    EXPECT_EQ(edge.status().id(), ErrorId::kTilesOption);
+    EXPECT_NE(edge.status().message().find("edge_depth_ratio"), std::string::npos);
   }
 
   o = small_options();
