@@ -3,12 +3,14 @@
 //
 // Why a refinement after libsquish: its range fit (Bc1Options quality 0) puts the endpoints at
 // the extremes of the block's principal axis, which over-spreads them for most blocks; cluster
-// fit searches index partitions instead and costs ~10x more (docs/ENCODER.md "BC1 endpoint
-// refinement" has the figures). Given indices, the best endpoints are a 2 x 2 linear least-squares
-// problem per channel; solving it, quantising to 5:6:5 and choosing the indices again gets most of
-// cluster fit's gain at a fraction of its time.
+// fit searches index partitions instead and costs several times more. Given indices, the best
+// endpoints are a 2 x 2 linear least-squares problem per channel; solving it, quantising to 5:6:5
+// and choosing the indices again gains most of cluster fit's quality on the synthetic LDR set
+// (31.69 dB against 31.84, range fit 30.76) and a third of it on interior's captures (+0.09 dB
+// against +0.28), at a fraction of its time (docs/ENCODER.md "BC1 fit").
 #include <cmath>
 #include <cstring>
+#include <utility>
 
 #include "bc_encode_internal.h"
 #include "calf/format/bc.h"

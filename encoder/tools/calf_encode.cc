@@ -316,7 +316,7 @@ int main(int argc, char** argv) {
                  "how BC1 colour blocks are fitted: range (libsquish's range fit, the fastest; "
                  "the encoder before stop 38), refined (range fit, then least-squares endpoints "
                  "for its indices: +0.1 dB for ~1.3x the BC1 encode time) or cluster (libsquish's "
-                 "cluster fit: +0.2-0.3 dB for 1.5-3x the encode time) (docs/ENCODER.md \"BC1 "
+                 "cluster fit: +0.2-0.3 dB for 1.1-2.6x the encode time) (docs/ENCODER.md \"BC1 "
                  "fit\") (default cluster)")
       ->check(CLI::IsMember({"range", "refined", "cluster"}))
       ->default_val("cluster");

@@ -76,7 +76,7 @@ struct Bc1Options {
   bool punch_through_alpha = false;
   int threads = 1;
   // After the fit: least-squares endpoints for the block's indices, indices chosen again, kept
-  // only where calf's decoder shows a smaller RGB error (docs/BLOCK_CODECS.md "BC1"). Blocks with
+  // only where calf's decoder shows a smaller RGB error (docs/ENCODER.md "BC1 fit"). Blocks with
   // punched-through alpha are left as fitted.
   bool refine = false;
 };
