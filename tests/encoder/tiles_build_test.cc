@@ -282,6 +282,38 @@ TEST(TilesBuild, AtlasReproducesCapturedColourAtTileCentres) {
   }
 }
 
+// Samples the texture of every tile on the panel's plane on a g x g grid of its own (bilinear in
+// uvw: the tile is planar and its w is constant along the panel's axis, x) and calls fn(m, px):
+// m = max(|y|, |z|) of the sample's position (the panel's edge is at m = kPanelHalf), px the
+// atlas texel's RGBA8.
+template <class Fn>
+void for_each_panel_texel(const TileSet& set, int g, const Fn& fn) {
+  for (const Tile& t : set.tiles) {
+    bool on_panel = true;
+    for (const TileCorner& c : t.corners) on_panel &= std::abs(c.position[0] - kPanelX) < 0.01;
+    if (!on_panel) continue;
+    for (int j = 0; j < g; ++j) {
+      for (int i = 0; i < g; ++i) {
+        const double a = (i + 0.5) / g, b = (j + 0.5) / g;
+        double p[3] = {0, 0, 0}, uvw[3] = {0, 0, 0};
+        const double wgt[4] = {(1 - a) * (1 - b), a * (1 - b), a * b, (1 - a) * b};
+        for (int k = 0; k < 4; ++k) {
+          for (int c = 0; c < 3; ++c) {
+            p[c] += wgt[k] * t.corners[k].position[c];
+            uvw[c] += wgt[k] * t.corners[k].uvw[c];
+          }
+        }
+        const uint32_t x = std::min<uint32_t>(
+            static_cast<uint32_t>(uvw[0] / uvw[2] * set.atlas_width), set.atlas_width - 1);
+        const uint32_t y = std::min<uint32_t>(
+            static_cast<uint32_t>(uvw[1] / uvw[2] * set.atlas_height), set.atlas_height - 1);
+        fn(std::max(std::abs(p[1]), std::abs(p[2])),
+           &set.atlas_rgba[(size_t{y} * set.atlas_width + x) * 4]);
+      }
+    }
+  }
+}
+
 TEST(TilesBuild, PanelSilhouetteIsCarved) {
   // A tile on the panel's plane reaching past its edge is transparent outside the panel.
   for (const TilesBuildOptions& variant : texturing_variants()) {
@@ -289,41 +321,16 @@ TEST(TilesBuild, PanelSilhouetteIsCarved) {
     auto set = build(variant);
     ASSERT_TRUE(set.ok()) << set.status().to_string();
     size_t solid_inside = 0, clear_outside = 0, inside = 0, outside = 0;
-    for (const Tile& t : set->tiles) {
-      bool on_panel = true;
-      for (const TileCorner& c : t.corners) on_panel &= std::abs(c.position[0] - kPanelX) < 0.01;
-      if (!on_panel) continue;
-      // Sample the tile's texture on a 5 x 5 grid of its own (bilinear in uvw: the tile is planar
-      // and its w is constant along the panel's axis, x).
-      for (int j = 0; j < 5; ++j) {
-        for (int i = 0; i < 5; ++i) {
-          const double a = (i + 0.5) / 5, b = (j + 0.5) / 5;
-          double p[3] = {0, 0, 0}, uvw[3] = {0, 0, 0};
-          const double wgt[4] = {(1 - a) * (1 - b), a * (1 - b), a * b, (1 - a) * b};
-          for (int k = 0; k < 4; ++k) {
-            for (int c = 0; c < 3; ++c) {
-              p[c] += wgt[k] * t.corners[k].position[c];
-              uvw[c] += wgt[k] * t.corners[k].uvw[c];
-            }
-          }
-          const double margin = 0.08;
-          const double m = std::max(std::abs(p[1]), std::abs(p[2]));
-          if (std::abs(m - kPanelHalf) < margin) continue;
-          const uint32_t x = std::min<uint32_t>(
-              static_cast<uint32_t>(uvw[0] / uvw[2] * set->atlas_width), set->atlas_width - 1);
-          const uint32_t y = std::min<uint32_t>(
-              static_cast<uint32_t>(uvw[1] / uvw[2] * set->atlas_height), set->atlas_height - 1);
-          const uint8_t alpha = set->atlas_rgba[(size_t{y} * set->atlas_width + x) * 4 + 3];
-          if (m < kPanelHalf) {
-            ++inside;
-            solid_inside += alpha >= 200;
-          } else {
-            ++outside;
-            clear_outside += alpha <= 55;
-          }
-        }
+    for_each_panel_texel(*set, 5, [&](double m, const uint8_t* px) {
+      if (std::abs(m - kPanelHalf) < 0.08) return;  // the edge itself may be either
+      if (m < kPanelHalf) {
+        ++inside;
+        solid_inside += px[3] >= 200;
+      } else {
+        ++outside;
+        clear_outside += px[3] <= 55;
       }
-    }
+    });
     EXPECT_GT(inside, 0u);
     EXPECT_GE(solid_inside, inside * 9 / 10) << solid_inside << " of " << inside;
     if (outside > 0) {
@@ -344,35 +351,14 @@ TEST(TilesBuild, EdgeTexelsWeighLessInTheColour) {
     EXPECT_TRUE(set.ok()) << set.status().to_string();
     double sum = 0;
     size_t n = 0;
-    for (const Tile& t : set->tiles) {
-      bool on_panel = true;
-      for (const TileCorner& c : t.corners) on_panel &= std::abs(c.position[0] - kPanelX) < 0.01;
-      if (!on_panel) continue;
-      for (int j = 0; j < 8; ++j) {
-        for (int i = 0; i < 8; ++i) {
-          const double a = (i + 0.5) / 8, b = (j + 0.5) / 8;
-          double p[3] = {0, 0, 0}, uvw[3] = {0, 0, 0};
-          const double wgt[4] = {(1 - a) * (1 - b), a * (1 - b), a * b, (1 - a) * b};
-          for (int k = 0; k < 4; ++k) {
-            for (int c = 0; c < 3; ++c) {
-              p[c] += wgt[k] * t.corners[k].position[c];
-              uvw[c] += wgt[k] * t.corners[k].uvw[c];
-            }
-          }
-          // Inside the panel, within 0.1 of its edge (about two capture texels there).
-          const double m = std::max(std::abs(p[1]), std::abs(p[2]));
-          if (m > kPanelHalf - 0.02 || m < kPanelHalf - 0.1) continue;
-          const uint32_t x = std::min<uint32_t>(
-              static_cast<uint32_t>(uvw[0] / uvw[2] * set->atlas_width), set->atlas_width - 1);
-          const uint32_t y = std::min<uint32_t>(
-              static_cast<uint32_t>(uvw[1] / uvw[2] * set->atlas_height), set->atlas_height - 1);
-          const uint8_t* px = &set->atlas_rgba[(size_t{y} * set->atlas_width + x) * 4];
-          for (int c = 0; c < 3; ++c)
-            sum += std::abs(int(px[c]) - int(srgb8_from_linear(kColour[6][c])));
-          n += 3;
-        }
+    for_each_panel_texel(*set, 8, [&](double m, const uint8_t* px) {
+      // Inside the panel, within 0.1 of its edge (about two capture texels there).
+      if (m > kPanelHalf - 0.02 || m < kPanelHalf - 0.1) return;
+      for (int c = 0; c < 3; ++c) {
+        sum += std::abs(int(px[c]) - int(srgb8_from_linear(kColour[6][c])));
       }
-    }
+      n += 3;
+    });
     EXPECT_GT(n, 0u);
     return n ? sum / n : 0.0;
   };
