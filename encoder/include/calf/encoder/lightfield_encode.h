@@ -285,7 +285,8 @@ Expected<LightfieldEncodeStats> encode_lightfield_file(const std::filesystem::pa
 // The RDO lambda an encode uses for colour coded as `coding` (kBc1 / kBc6h / kBc7; the resolved
 // format, not kAuto): options.colour_rdo, or, when that is kColourRdoAuto, the format's default
 // (BC1 12, BC6H and BC7 0.5). BC1's differs because a BC1 candidate saves at most 30 estimated
-// bits where a BC6H / BC7 one saves 104, so the same lambda buys a third of the bytes.
+// bits where a BC6H / BC7 one saves 104, so the same lambda buys far fewer bytes (at 0.5: BC1
+// 10-27 % of its colour bytes, BC6H 31-69 %, docs/ENCODER.md).
 double colour_rdo_lambda(const LightfieldEncodeOptions& options, ColourCoding coding);
 
 // A cell of linear RGB (w * h * 3 floats) as the spatial codec alone would show it: coded in
