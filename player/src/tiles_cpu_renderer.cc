@@ -96,10 +96,18 @@ Status render_tiles_cpu(const TileSet& set, const TilesLinearAtlas& atlas, const
     for (size_t t = 0; t < order.size(); ++t) order[t] = static_cast<uint32_t>(t);
   }
 
+  // kSorted's occlusion pre-pass: the nearest distance per pixel of a fragment at least
+  // occlusion_alpha opaque (tiles_renderer.h); pass 0 fills it, pass 1 draws.
+  const bool occlusion = sorted && options.occlusion_alpha > 0;
+  std::vector<float> occluder(occlusion ? pixels : 0, std::numeric_limits<float>::infinity());
+  const float occlusion_alpha = static_cast<float>(options.occlusion_alpha);
+  const double behind = 1 + options.occlusion_epsilon;
+  int pass = occlusion ? 0 : 1;
+
   TriangleTexture s;
   const auto shade = [&](uint32_t i, uint32_t j) {
     const size_t k = size_t{j} * width + i;
-    ++counts[k];
+    if (pass == 1) ++counts[k];
     const Vec3& d = rays[k];
     const double den = dot(s.face, d);
     if (den == 0) return;
@@ -114,6 +122,11 @@ Status render_tiles_cpu(const TileSet& set, const TilesLinearAtlas& atlas, const
     const Vec3 uvw = s.uvw[0] * l0 + s.uvw[1] * l1 + s.uvw[2] * l2;
     const std::array<float, 4> t = sampler.sample(uvw.x / uvw.z, uvw.y / uvw.z);
     const float depth = static_cast<float>(dist);
+    if (pass == 0) {
+      if (t[3] >= occlusion_alpha) occluder[k] = std::min(occluder[k], depth);
+      return;
+    }
+    if (occlusion && double{depth} > double{occluder[k]} * behind) return;
     float* c = &out->color[3 * k];
     if (sorted) {
       const float keep = 1.0f - t[3];
@@ -126,19 +139,21 @@ Status render_tiles_cpu(const TileSet& set, const TilesLinearAtlas& atlas, const
   };
 
   static constexpr int kTriangles[2][3] = {{0, 1, 2}, {0, 2, 3}};
-  for (uint32_t tile : order) {
-    const Tile& tl = set.tiles[tile];
-    for (const auto& tri : kTriangles) {
-      std::array<ViewVertex, 3> view;
-      for (int c = 0; c < 3; ++c) {
-        const TileCorner& k = tl.corners[tri[c]];
-        s.p[c] = Vec3{k.position[0], k.position[1], k.position[2]} - camera.position;
-        s.uvw[c] = Vec3{k.uvw[0], k.uvw[1], k.uvw[2]};
-        view[c] = {dot(s.p[c], frame.right), dot(s.p[c], frame.up), dot(s.p[c], frame.forward)};
+  for (; pass < 2; ++pass) {
+    for (uint32_t tile : order) {
+      const Tile& tl = set.tiles[tile];
+      for (const auto& tri : kTriangles) {
+        std::array<ViewVertex, 3> view;
+        for (int c = 0; c < 3; ++c) {
+          const TileCorner& k = tl.corners[tri[c]];
+          s.p[c] = Vec3{k.position[0], k.position[1], k.position[2]} - camera.position;
+          s.uvw[c] = Vec3{k.uvw[0], k.uvw[1], k.uvw[2]};
+          view[c] = {dot(s.p[c], frame.right), dot(s.p[c], frame.up), dot(s.p[c], frame.forward)};
+        }
+        s.face = cross(s.p[1] - s.p[0], s.p[2] - s.p[0]);
+        if (!(length(s.face) > 0)) continue;  // degenerate: covers nothing
+        internal::rasterise_clipped(view, options.near, project, width, height, shade);
       }
-      s.face = cross(s.p[1] - s.p[0], s.p[2] - s.p[0]);
-      if (!(length(s.face) > 0)) continue;  // degenerate: covers nothing
-      internal::rasterise_clipped(view, options.near, project, width, height, shade);
     }
   }
 

@@ -72,6 +72,17 @@ Status validate_tiles_render_options(const TilesRenderOptions& options) {
                   "tiles blend mode " + std::to_string(static_cast<int>(options.blend)) +
                       " is not one of sort, alpha-test");
   }
+  if (!(options.occlusion_alpha == 0 ||
+        (options.occlusion_alpha >= 0.5 && options.occlusion_alpha <= 1))) {
+    return Status(ErrorId::kTilesRenderOptions, "tiles occlusion alpha " +
+                                                    std::to_string(options.occlusion_alpha) +
+                                                    " is neither 0 (off) nor in [0.5, 1]");
+  }
+  if (!(options.occlusion_epsilon > 0 && options.occlusion_epsilon <= 1)) {
+    return Status(ErrorId::kTilesRenderOptions, "tiles occlusion epsilon " +
+                                                    std::to_string(options.occlusion_epsilon) +
+                                                    " is outside (0, 1]");
+  }
   return Status::Ok();
 }
 

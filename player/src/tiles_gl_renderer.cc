@@ -42,18 +42,28 @@ in vec3 v_uvw;  // perspective-correct (smooth) interpolation of (U, V, W)
 // Premultiplied linear RGBA16F (layer 0 of an array texture), LINEAR, CLAMP_TO_EDGE, one level.
 uniform sampler2DArray atlas;
 uniform bool alpha_test, count_fragments;
+// The occlusion pre-pass (tiles_renderer.h): occlusion_prepass keeps, per pixel, the smallest
+// distance of a fragment with alpha >= occlusion_alpha (float bits: non-negative floats order as
+// their bit patterns); occlusion_test then drops fragments farther than it times occlusion_behind.
+uniform bool occlusion_prepass, occlusion_test;
+uniform float occlusion_alpha, occlusion_behind;
 uniform uint image_width;
 layout(std430, binding = 0) buffer Counts { uint counts[]; };
+layout(std430, binding = 1) buffer Occluders { uint occluders[]; };
 // Dual-source blending: colour (rgb) and radial depth (a) in index 0, the blend weight src.a in
 // index 1, so the depth channel can take a MIN blend while the colour takes the over operator.
 layout(location = 0, index = 0) out vec4 out_colour;
 layout(location = 0, index = 1) out vec4 out_weight;
 void main() {
-  if (count_fragments) {
-    atomicAdd(counts[uint(gl_FragCoord.y) * image_width + uint(gl_FragCoord.x)], 1u);
-  }
+  uint pixel = uint(gl_FragCoord.y) * image_width + uint(gl_FragCoord.x);
   vec4 t = texture(atlas, vec3(v_uvw.xy / v_uvw.z, 0.0));
   float d = length(v_rel);
+  if (occlusion_prepass) {
+    if (t.a >= occlusion_alpha) atomicMin(occluders[pixel], floatBitsToUint(d));
+    discard;
+  }
+  if (count_fragments) atomicAdd(counts[pixel], 1u);
+  if (occlusion_test && d > uintBitsToFloat(occluders[pixel]) * occlusion_behind) discard;
   if (alpha_test) {
     if (t.a < 0.5) discard;
     out_colour = vec4(t.rgb / t.a, d);
@@ -81,14 +91,14 @@ GlTilesRenderer::~GlTilesRenderer() {
 
 void GlTilesRenderer::release() {
   const GlFunctions& gl = *gl_;
-  for (GLuint* b : {&vertices_, &indices_, &counts_}) {
+  for (GLuint* b : {&vertices_, &indices_, &counts_, &occluders_}) {
     if (*b != 0) gl.DeleteBuffers(1, b);
     *b = 0;
   }
   if (vao_ != 0) gl.DeleteVertexArrays(1, &vao_);
   if (atlas_ != 0) gl.DeleteTextures(1, &atlas_);
   vao_ = atlas_ = 0;
-  tile_count_ = counts_size_ = 0;
+  tile_count_ = counts_size_ = occluders_size_ = 0;
 }
 
 Expected<std::unique_ptr<GlTilesRenderer>> GlTilesRenderer::make(const GlFunctions& gl) {
@@ -196,6 +206,22 @@ Status GlTilesRenderer::render(const TileSet& set, const Camera& camera,
     }
     gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, counts_);
   }
+  const bool occlusion = sorted && options.occlusion_alpha > 0;
+  if (occlusion) {
+    // One occluder distance per pixel, +inf (as float bits) for this render.
+    const std::vector<uint32_t> far(pixels, 0x7f800000u);
+    if (occluders_ == 0) gl.GenBuffers(1, &occluders_);
+    gl.BindBuffer(GL_SHADER_STORAGE_BUFFER, occluders_);
+    if (occluders_size_ != pixels) {
+      gl.BufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(pixels * sizeof(uint32_t)),
+                    far.data(), GL_DYNAMIC_DRAW);
+      occluders_size_ = pixels;
+    } else {
+      gl.BufferSubData(GL_SHADER_STORAGE_BUFFER, 0,
+                       static_cast<GLsizeiptr>(pixels * sizeof(uint32_t)), far.data());
+    }
+    gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, occluders_);
+  }
   for (GLenum cap : {GL_SCISSOR_TEST, GL_CULL_FACE, GL_STENCIL_TEST}) gl.Disable(cap);
   if (sorted) {
     gl.Disable(GL_DEPTH_TEST);
@@ -226,6 +252,9 @@ Status GlTilesRenderer::render(const TileSet& set, const Camera& camera,
   gl.Uniform1f(loc("near_distance"), f(options.near));
   gl.Uniform1i(loc("alpha_test"), sorted ? 0 : 1);
   gl.Uniform1i(loc("count_fragments"), count ? 1 : 0);
+  gl.Uniform1f(loc("occlusion_alpha"), f(options.occlusion_alpha));
+  gl.Uniform1f(loc("occlusion_behind"), f(1 + options.occlusion_epsilon));
+  gl.Uniform1i(loc("occlusion_test"), 0);
   gl.Uniform1ui(loc("image_width"), camera.width);
   gl.Uniform1i(loc("atlas"), 0);
   gl.ActiveTexture(GL_TEXTURE0);
@@ -249,8 +278,19 @@ Status GlTilesRenderer::render(const TileSet& set, const Camera& camera,
     gl.BufferData(GL_ELEMENT_ARRAY_BUFFER,
                   static_cast<GLsizeiptr>(index_data_.size() * sizeof(uint32_t)),
                   index_data_.data(), GL_STREAM_DRAW);
-    gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(index_data_.size()), GL_UNSIGNED_INT,
-                    nullptr);
+    const auto draw = [&] {
+      gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(index_data_.size()), GL_UNSIGNED_INT,
+                      nullptr);
+    };
+    if (occlusion) {
+      // Every pre-pass fragment is discarded after its atomicMin: nothing reaches the target.
+      gl.Uniform1i(loc("occlusion_prepass"), 1);
+      draw();
+      gl.MemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+      gl.Uniform1i(loc("occlusion_test"), 1);
+    }
+    gl.Uniform1i(loc("occlusion_prepass"), 0);
+    draw();
     gl.BindVertexArray(0);
   }
 

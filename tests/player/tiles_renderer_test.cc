@@ -206,6 +206,40 @@ TEST(TilesRenderer, BackToFrontOrderIsByDistanceThenIndex) {
   EXPECT_EQ(order, (std::vector<uint32_t>{0, 2, 1, 3}));
 }
 
+// The occlusion pre-pass: an opaque front tile (z = -5, x in [-2, 20]) whose centre lies 10.3 from
+// the eye, and a small tile behind it (z = -6, x and y in [-1, 1]) whose centre lies 6 away. The
+// sort draws the hidden tile last, over the front; the pre-pass drops its fragments (pixels 7 and 8
+// of both axes, inside the front's i >= 5), and without it they show.
+TEST(TilesRenderer, OcclusionPassHidesWhatTheSortDrawsLastFromBehind) {
+  TileSet set = base_set();
+  set_atlas(&set, 4, 1,
+            {{200, 100, 50, 255}, {200, 100, 50, 255}, {0, 0, 255, 255}, {0, 0, 255, 255}});
+  set.tiles.push_back(quad(-2, 20, -10, 10, -5, 0.125, 0.375, 0, 1));  // front, opaque
+  set.tiles.push_back(quad(-1, 1, -1, 1, -6, 0.625, 0.875, 0, 1));     // behind it
+  std::vector<uint32_t> order;
+  tiles_back_to_front(set, {0, 0, 0}, &order);
+  ASSERT_EQ(order, (std::vector<uint32_t>{0, 1}));  // the sort gets it wrong
+  const Camera cam = front_camera(16, 16);
+  const double front_r = decode(200 / 255.0);
+  for (const double occlusion : {0.9, 0.0}) {
+    TilesRenderOptions o;
+    o.occlusion_alpha = occlusion;
+    for_both(set, cam, o, [&](const RenderedImage& im, const char* backend) {
+      for (uint32_t j = 0; j < 16; ++j) {
+        for (uint32_t i = 5; i < 16; ++i) {
+          const size_t k = j * 16 + i;
+          const bool hidden = (i == 7 || i == 8) && (j == 7 || j == 8);
+          const bool shows_back = hidden && occlusion == 0;
+          EXPECT_NEAR(im.color[3 * k + 0], shows_back ? 0.0 : front_r, 1e-3)
+              << backend << " occlusion " << occlusion << " pixel " << i << "," << j;
+          EXPECT_NEAR(im.color[3 * k + 2], shows_back ? 1.0 : decode(50 / 255.0), 1e-3)
+              << backend << " occlusion " << occlusion << " pixel " << i << "," << j;
+        }
+      }
+    });
+  }
+}
+
 // Projective texture coordinates: a full-screen tile whose right corners carry w = 3 (uvw = (3 u,
 // 3 v, 3)) over an atlas of two texels, black and white. Along the tile at fraction s from the
 // left, U = 3 s and W = 1 + 2 s, so u = 3 s / (1 + 2 s) (affine interpolation would give s); the
@@ -326,6 +360,20 @@ TEST(TilesRenderer, InvalidSetsAndOptionsAreRejected) {
   TilesRenderOptions o;
   o.near = 0;
   EXPECT_EQ(validate_tiles_render_options(o).id(), ErrorId::kTilesRenderOptions);
+  o = {};
+  for (double a : {0.3, 0.49, 1.01, -1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    o.occlusion_alpha = a;
+    EXPECT_EQ(validate_tiles_render_options(o).id(), ErrorId::kTilesRenderOptions) << a;
+  }
+  for (double a : {0.0, 0.5, 0.9, 1.0}) {
+    o.occlusion_alpha = a;
+    EXPECT_TRUE(validate_tiles_render_options(o).ok()) << a;
+  }
+  o = {};
+  for (double e : {0.0, -1e-3, 1.5, std::numeric_limits<double>::infinity()}) {
+    o.occlusion_epsilon = e;
+    EXPECT_EQ(validate_tiles_render_options(o).id(), ErrorId::kTilesRenderOptions) << e;
+  }
   EXPECT_EQ(tiles_blend_from_name("additive").status().id(), ErrorId::kTilesRenderOptions);
   EXPECT_EQ(*tiles_blend_from_name("alpha-test"), TilesBlend::kAlphaTest);
   RenderedImage out;
@@ -385,9 +433,12 @@ TEST(TilesGlRenderer, AgreesWithCpuReference) {
   poses[1].forward = {-0.2, -0.1, -1};
   for (bool opaque : {true, false}) {
     const TileSet set = random_set(60, opaque ? 7 : 11, opaque);
-    for (TilesBlend blend : {TilesBlend::kSorted, TilesBlend::kAlphaTest}) {
+    // The sort with and without the occlusion pre-pass, and the alpha test.
+    for (int mode = 0; mode < 3; ++mode) {
+      const TilesBlend blend = mode == 2 ? TilesBlend::kAlphaTest : TilesBlend::kSorted;
       TilesRenderOptions o;
       o.blend = blend;
+      if (mode == 1) o.occlusion_alpha = 0;
       for (const Camera& cam : poses) {
         TilesFrameStats sg, sc;
         const RenderedImage g = gl(set, cam, o, &sg);
@@ -407,10 +458,11 @@ TEST(TilesGlRenderer, AgreesWithCpuReference) {
         }
         const double p_same = *psnr(rgb_ref(same_surface), rgb_ref(c));
         std::printf(
-            "tiles GL vs CPU (%s, %s): PSNR %.1f dB (%.1f dB where the depth agrees), depth "
+            "tiles GL vs CPU (%s, %s%s): PSNR %.1f dB (%.1f dB where the depth agrees), depth "
             "differs at %zu of %zu, overdraw %.3f / %.3f, peak %u / %u\n",
-            opaque ? "opaque" : "transparent", tiles_blend_name(blend).data(), p, p_same, differing,
-            g.depth.size(), sg.mean_overdraw(), sc.mean_overdraw(), sg.peak, sc.peak);
+            opaque ? "opaque" : "transparent", tiles_blend_name(blend).data(),
+            mode == 1 ? ", no occlusion pass" : "", p, p_same, differing, g.depth.size(),
+            sg.mean_overdraw(), sc.mean_overdraw(), sg.peak, sc.peak);
         EXPECT_GE(p_same, 45.0);
         EXPECT_GE(p, 40.0);  // one pixel showing another tile costs ~43 dB at this size
         EXPECT_LE(differing, g.depth.size() / 200);
