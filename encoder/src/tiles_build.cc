@@ -97,8 +97,8 @@ Status validate_tiles_build_options(const TilesBuildOptions& o) {
   if (o.max_atlas_size < 16 || o.max_atlas_size > 16384) {
     return bad_option(sformat("max_atlas_size %u is outside [16, 16384]", o.max_atlas_size));
   }
-  if (!(o.solid_threshold > 0 && o.solid_threshold < 1)) {
-    return bad_option(sformat("solid_threshold %g is outside (0, 1)", o.solid_threshold));
+  if (!(o.solid_threshold >= 0 && o.solid_threshold < 1)) {
+    return bad_option(sformat("solid_threshold %g is outside [0, 1)", o.solid_threshold));
   }
   if (o.texture_solve_iterations > 1000) {
     return bad_option(
@@ -294,9 +294,16 @@ Expected<TileSet> build_tiles(const capture::CaptureSetReader& reader, uint32_t 
     scale *= std::min(0.9, std::sqrt(fill) * 0.95);
   }
   r.texture_scale = scale;
+  // 0: the plane fit's tolerance plus the depth change across one texel at 45 degrees.
+  TilesBuildOptions texture_options = options;
+  if (texture_options.solid_threshold == 0) {
+    texture_options.solid_threshold =
+        std::min(0.5, options.ransac_threshold + 1.25 * 1.5707963267948966 / m.face_size);
+  }
+  r.solid_threshold = texture_options.solid_threshold;
   for (uint32_t s : sides) r.tile_texels += uint64_t{s} * s;
   CALF_ASSIGN_OR_RETURN(const std::vector<TileTexture> textures,
-                        texture_tiles(reader, frame, f, selection, sides, options));
+                        texture_tiles(reader, frame, f, selection, sides, texture_options));
   r.seconds_texture = seconds_since(t0);
 
   // 5. Atlas.
@@ -350,9 +357,9 @@ std::string format_tiles_report(const TilesBuildReport& r) {
       r.max_peak_overdraw, r.measured_max_layers);
   s += sformat(
       "texture    %llu tile texels at %.2f texels/degree (scale %.3f), atlas %u x %u, "
-      "occupancy %.1f %%\n",
+      "occupancy %.1f %%, solid threshold %.4f\n",
       (unsigned long long)r.tile_texels, r.texels_per_degree, r.texture_scale, r.atlas_width,
-      r.atlas_height, r.atlas_occupancy);
+      r.atlas_height, r.atlas_occupancy, r.solid_threshold);
   s += sformat(
       "seconds    merge %.2f, candidates %.2f, select %.2f, texture %.2f, atlas %.2f, "
       "measure %.2f, total %.2f\n",

@@ -452,6 +452,22 @@ TEST(TilesBuild, DeterministicForAnyThreadCount) {
   EXPECT_TRUE(same(*a, *c));
 }
 
+// solid_threshold 0 resolves from the capture's face size (32² here): the RANSAC threshold plus
+// 1.25 texel angles, written out; a given threshold is used as it is.
+TEST(TilesBuild, SolidThresholdFollowsTheCaptureResolution) {
+  TilesBuildOptions o = small_options();
+  TilesBuildReport r;
+  ASSERT_TRUE(build(o, &r).ok());
+  EXPECT_NEAR(r.solid_threshold, 0.01 + 1.25 * (std::acos(-1.0) / 2) / 32, 1e-12);
+  o.ransac_threshold = 0.02;
+  ASSERT_TRUE(build(o, &r).ok());
+  EXPECT_NEAR(r.solid_threshold, 0.02 + 1.25 * (std::acos(-1.0) / 2) / 32, 1e-12);
+  o.solid_threshold = 0.05;
+  ASSERT_TRUE(build(o, &r).ok());
+  EXPECT_EQ(r.solid_threshold, 0.05);
+  EXPECT_NE(encoder::format_tiles_report(r).find("solid threshold 0.0500"), std::string::npos);
+}
+
 TEST(TilesBuild, Errors) {
   TilesBuildOptions o = small_options();
   auto frame = build(o, nullptr, 1);
@@ -496,6 +512,14 @@ TEST(TilesBuild, Errors) {
     ASSERT_FALSE(edge.ok()) << weight;
     EXPECT_EQ(edge.status().id(), ErrorId::kTilesOption);
     EXPECT_NE(edge.status().message().find("edge_colour_weight"), std::string::npos);
+  }
+  for (double threshold : {-0.01, 1.0, std::nan("")}) {
+    o = small_options();
+    o.solid_threshold = threshold;
+    auto solid = build(o);
+    ASSERT_FALSE(solid.ok()) << threshold;
+    EXPECT_EQ(solid.status().id(), ErrorId::kTilesOption);
+    EXPECT_NE(solid.status().message().find("solid_threshold"), std::string::npos);
   }
   for (double ratio : {0.0, -1.0, 101.0, std::nan("")}) {
     o = small_options();

@@ -133,11 +133,18 @@ struct TilesBuildOptions {
   uint32_t max_atlas_size = 8192;
   // Seurat's thresh_solid: a sample makes secondary solid constraints on other layers with
   // |t_hit - 1| below it, and a view marks free space only where its ray passes a tile more than
-  // this relative distance before its surface. (0, 1). Seurat's 0.01 suits its fine tilings;
-  // with the plane fits here (RANSAC threshold 0.01, cells of a 64-512² capture) a surface lies
-  // up to a few percent off its tile and 0.01 carves holes into it: measured on interior (64²
-  // faces, docs/TILES.md) 23.9 dB at 0.01, 29.1 at 0.03, 29.3 at 0.05 - 0.08, 28.0 at 0.2.
-  double solid_threshold = 0.05;
+  // this relative distance before its surface. [0, 1); 0 = from the capture's resolution:
+  // ransac_threshold + 1.25 x a face texel's angle in radians (pi / 2 / face size), i.e. 0.041,
+  // 0.018 and 0.014 for 64², 256² and 512² faces: a surface lies up to the plane fit's tolerance
+  // off its tile, plus the depth change across one texel at 45 degrees, where a view's centre-ray
+  // depth stands for its whole texel. Seurat's 0.01 suits its fine tilings and carves holes into
+  // coarse tiles (interior 64², docs/TILES.md: 23.9 dB at 0.01, 29.3 at 0.05). Measured with the
+  // player's occlusion pass (docs/TILES.md "Occlusion pass and the solid threshold"; capture
+  // viewpoints / novel views, dB, 0.05 -> auto): interior 64² 36.90 / 33.87 -> 37.01 / 33.88,
+  // 256² 39.23 / 41.76 -> 40.75 / 42.84, 512² 38.17 / 42.40 -> 40.44 / 43.65; off the project's
+  // content it costs on novel views (CesiumMilkTruck -0.16 dB, turntable -0.59, box rigs outside
+  // them).
+  double solid_threshold = 0;
   // Colour by least squares (tiles_texture_solve.cc): conjugate-gradient steps towards the texel
   // values whose bilinear interpolation (the renderer's magnification) best fits the samples,
   // starting from Seurat's filtered splat; 0 keeps the splat. 0 .. 1000.
@@ -215,6 +222,7 @@ struct TilesBuildReport {
   uint32_t atlas_width = 0, atlas_height = 0;
   double atlas_occupancy = 0;                       // tile_texels / atlas area, percent
   double texels_per_degree = 0, texture_scale = 1;  // the density used and the fit-down factor
+  double solid_threshold = 0;                       // the threshold used (options' 0 resolved)
   // Wall seconds per stage (informative).
   double seconds_merge = 0, seconds_candidates = 0, seconds_select = 0, seconds_texture = 0,
          seconds_atlas = 0, seconds_measure = 0, seconds_total = 0;
