@@ -102,7 +102,7 @@ struct TilesRenderOptions {
   // kSorted's occlusion pre-pass (above): the filtered alpha at which a fragment hides what lies
   // behind it, in [0.5, 1], or 0 for none (Seurat's plain sort). Measured on interior, 9 views,
   // capture viewpoints / novel views, dB: 256² 37.65 / 40.39 without, 39.23 / 41.76 at 0.9;
-  // 512² 35.63 / 40.18 without, 38.17 / 42.39 at 0.9 (docs/TILES.md "Occlusion pass").
+  // 512² 35.63 / 40.18 without, 38.17 / 42.40 at 0.9 (docs/TILES.md "Occlusion pass").
   double occlusion_alpha = 0.9;
   // How much farther than the occluder (relative) a fragment must be to be dropped, so that tiles
   // of one surface (overlapping by the builder's dilation) never hide each other. (0, 1].
