@@ -79,6 +79,23 @@ Status set_error(const std::string& what) {
   return Status(ErrorId::kTilesDraw, what);
 }
 
+// Sets the storage buffer `*buffer` (created, or re-sized from `*size` entries, as needed) to
+// `pixels` copies of `value` and binds it at `binding`: the per-pixel counters and occluders.
+void fill_pixel_buffer(const GlFunctions& gl, size_t pixels, uint32_t value, GLuint binding,
+                       GLuint* buffer, size_t* size) {
+  const std::vector<uint32_t> data(pixels, value);
+  const auto bytes = static_cast<GLsizeiptr>(pixels * sizeof(uint32_t));
+  if (*buffer == 0) gl.GenBuffers(1, buffer);
+  gl.BindBuffer(GL_SHADER_STORAGE_BUFFER, *buffer);
+  if (*size != pixels) {
+    gl.BufferData(GL_SHADER_STORAGE_BUFFER, bytes, data.data(), GL_DYNAMIC_READ);
+    *size = pixels;
+  } else {
+    gl.BufferSubData(GL_SHADER_STORAGE_BUFFER, 0, bytes, data.data());
+  }
+  gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, *buffer);
+}
+
 }  // namespace
 
 GlTilesRenderer::GlTilesRenderer(const GlFunctions& gl)
@@ -191,37 +208,11 @@ Status GlTilesRenderer::render(const TileSet& set, const Camera& camera,
   const size_t pixels = size_t{camera.width} * camera.height;
   CALF_RETURN_IF_ERROR(
       target_->bind_and_clear(camera.width, camera.height, "the tiles render target"));
-  if (count) {
-    // One counter per pixel, zeroed for this render.
-    const std::vector<uint32_t> zeros(pixels, 0);
-    if (counts_ == 0) gl.GenBuffers(1, &counts_);
-    gl.BindBuffer(GL_SHADER_STORAGE_BUFFER, counts_);
-    if (counts_size_ != pixels) {
-      gl.BufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(pixels * sizeof(uint32_t)),
-                    zeros.data(), GL_DYNAMIC_READ);
-      counts_size_ = pixels;
-    } else {
-      gl.BufferSubData(GL_SHADER_STORAGE_BUFFER, 0,
-                       static_cast<GLsizeiptr>(pixels * sizeof(uint32_t)), zeros.data());
-    }
-    gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, counts_);
-  }
+  // One counter per pixel, zeroed for this render.
+  if (count) fill_pixel_buffer(gl, pixels, 0, 0, &counts_, &counts_size_);
+  // One occluder distance per pixel, +inf (as float bits) for this render.
   const bool occlusion = sorted && options.occlusion_alpha > 0;
-  if (occlusion) {
-    // One occluder distance per pixel, +inf (as float bits) for this render.
-    const std::vector<uint32_t> far(pixels, 0x7f800000u);
-    if (occluders_ == 0) gl.GenBuffers(1, &occluders_);
-    gl.BindBuffer(GL_SHADER_STORAGE_BUFFER, occluders_);
-    if (occluders_size_ != pixels) {
-      gl.BufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(pixels * sizeof(uint32_t)),
-                    far.data(), GL_DYNAMIC_DRAW);
-      occluders_size_ = pixels;
-    } else {
-      gl.BufferSubData(GL_SHADER_STORAGE_BUFFER, 0,
-                       static_cast<GLsizeiptr>(pixels * sizeof(uint32_t)), far.data());
-    }
-    gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, occluders_);
-  }
+  if (occlusion) fill_pixel_buffer(gl, pixels, 0x7f800000u, 1, &occluders_, &occluders_size_);
   for (GLenum cap : {GL_SCISSOR_TEST, GL_CULL_FACE, GL_STENCIL_TEST}) gl.Disable(cap);
   if (sorted) {
     gl.Disable(GL_DEPTH_TEST);
