@@ -81,18 +81,17 @@ Status set_error(const std::string& what) {
 
 // Sets the storage buffer `*buffer` (created, or re-sized from `*size` entries, as needed) to
 // `pixels` copies of `value` and binds it at `binding`: the per-pixel counters and occluders.
+// The GL fills it (glClearBufferData), so no frame builds or uploads a copy.
 void fill_pixel_buffer(const GlFunctions& gl, size_t pixels, uint32_t value, GLuint binding,
                        GLuint* buffer, size_t* size) {
-  const std::vector<uint32_t> data(pixels, value);
-  const auto bytes = static_cast<GLsizeiptr>(pixels * sizeof(uint32_t));
   if (*buffer == 0) gl.GenBuffers(1, buffer);
   gl.BindBuffer(GL_SHADER_STORAGE_BUFFER, *buffer);
   if (*size != pixels) {
-    gl.BufferData(GL_SHADER_STORAGE_BUFFER, bytes, data.data(), GL_DYNAMIC_READ);
+    gl.BufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(pixels * sizeof(uint32_t)),
+                  nullptr, GL_DYNAMIC_READ);
     *size = pixels;
-  } else {
-    gl.BufferSubData(GL_SHADER_STORAGE_BUFFER, 0, bytes, data.data());
   }
+  gl.ClearBufferData(GL_SHADER_STORAGE_BUFFER, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &value);
   gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, *buffer);
 }
 

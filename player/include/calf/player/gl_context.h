@@ -105,6 +105,7 @@ using GlGetProc = GlProc (*)(const char* name);
   X(PFNGLDISABLEVERTEXATTRIBARRAYPROC, DisableVertexAttribArray)    \
   X(PFNGLVERTEXATTRIB3FPROC, VertexAttrib3f)                        \
   X(PFNGLBUFFERSUBDATAPROC, BufferSubData)                          \
+  X(PFNGLCLEARBUFFERDATAPROC, ClearBufferData)                      \
   X(PFNGLBLENDFUNCSEPARATEPROC, BlendFuncSeparate)                  \
   X(PFNGLBLENDEQUATIONSEPARATEPROC, BlendEquationSeparate)
 // clang-format on
