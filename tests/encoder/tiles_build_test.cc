@@ -499,35 +499,29 @@ TEST(TilesBuild, Errors) {
   EXPECT_EQ(option.status().id(), ErrorId::kTilesOption);
   EXPECT_NE(option.status().message().find("max_planes"), std::string::npos);
 
-  for (double weight : {-0.5, 1.5, std::nan("")}) {
-    o = small_options();
-    o.secondary_colour_weight = weight;
-    auto secondary = build(o);
-    ASSERT_FALSE(secondary.ok()) << weight;
-    EXPECT_EQ(secondary.status().id(), ErrorId::kTilesOption);
-    EXPECT_NE(secondary.status().message().find("secondary_colour_weight"), std::string::npos);
-    o = small_options();
-    o.edge_colour_weight = weight;
-    auto edge = build(o);
-    ASSERT_FALSE(edge.ok()) << weight;
-    EXPECT_EQ(edge.status().id(), ErrorId::kTilesOption);
-    EXPECT_NE(edge.status().message().find("edge_colour_weight"), std::string::npos);
-  }
-  for (double threshold : {-0.01, 1.0, std::nan("")}) {
-    o = small_options();
-    o.solid_threshold = threshold;
-    auto solid = build(o);
-    ASSERT_FALSE(solid.ok()) << threshold;
-    EXPECT_EQ(solid.status().id(), ErrorId::kTilesOption);
-    EXPECT_NE(solid.status().message().find("solid_threshold"), std::string::npos);
-  }
-  for (double ratio : {0.0, -1.0, 101.0, std::nan("")}) {
-    o = small_options();
-    o.edge_depth_ratio = ratio;
-    auto edge = build(o);
-    ASSERT_FALSE(edge.ok()) << ratio;
-    EXPECT_EQ(edge.status().id(), ErrorId::kTilesOption);
-    EXPECT_NE(edge.status().message().find("edge_depth_ratio"), std::string::npos);
+  // Each double option outside its range: CALF-E250 naming it.
+  struct BadDouble {
+    double TilesBuildOptions::*field;
+    const char* name;
+    std::vector<double> values;
+  };
+  const BadDouble bad_doubles[] = {
+      {&TilesBuildOptions::secondary_colour_weight,
+       "secondary_colour_weight",
+       {-0.5, 1.5, std::nan("")}},
+      {&TilesBuildOptions::edge_colour_weight, "edge_colour_weight", {-0.5, 1.5, std::nan("")}},
+      {&TilesBuildOptions::solid_threshold, "solid_threshold", {-0.01, 1.0, std::nan("")}},
+      {&TilesBuildOptions::edge_depth_ratio, "edge_depth_ratio", {0.0, -1.0, 101.0, std::nan("")}},
+  };
+  for (const BadDouble& bad : bad_doubles) {
+    for (double value : bad.values) {
+      o = small_options();
+      o.*bad.field = value;
+      auto result = build(o);
+      ASSERT_FALSE(result.ok()) << bad.name << " " << value;
+      EXPECT_EQ(result.status().id(), ErrorId::kTilesOption) << bad.name;
+      EXPECT_NE(result.status().message().find(bad.name), std::string::npos) << bad.name;
+    }
   }
 
   o = small_options();
