@@ -378,9 +378,12 @@ struct FrameTracer::Impl {
 
   // The colour of a pixel as the mean of its samples (RenderOptions: rounds doubling the count
   // until the sRGB-encoded standard error is at most `tolerance` or spp samples are taken).
-  // `dir_at(x, y)` is the ray through position (x, y) in [0, 1)^2 of the pixel's square. Every
-  // sample filters textures over the whole pixel's footprint `spread` (pixel_spread): the count
-  // of samples varies per pixel, and the same footprint keeps each sample's texel the pixel's.
+  // `dir_at(x, y)` is the ray through position (x, y) in [0, 1)^2 of the pixel's square. The
+  // samples themselves box-filter the pixel, so each filters textures only over its share of the
+  // pixel: the footprint of the first round's stratum, `spread` (the pixel's angular width,
+  // pixel_spread) / sqrt(first-round count), the same for every sample of every pixel whatever
+  // count the pixel ends at. (A whole pixel's footprint per sample blurs textures twice: the box
+  // of the samples over the pixel, then a mip filter as wide again.)
   template <typename DirFn>
   glm::vec3 converged_color(const glm::vec3& o, const DirFn& dir_at, float spread, uint64_t key,
                             uint64_t* rays, uint64_t* samples) const {
@@ -390,6 +393,7 @@ struct FrameTracer::Impl {
     const double tol2 = static_cast<double>(options.tolerance) * options.tolerance;
     glm::dvec3 sum(0), mean_y(0), m2_y(0);  // Welford over the sRGB-encoded samples
     uint32_t n = 0, target = std::min(std::max(options.min_spp, 1u), max_n);
+    const float sample_spread = spread / std::sqrt(static_cast<float>(target));
     for (;;) {
       for (; n < target; ++n) {
         const SamplePoint p = scrambled_sequence_point(n, sx, sy);
@@ -398,7 +402,7 @@ struct FrameTracer::Impl {
         rng.net_key = key;
         rng.net_index = n * options.ao_samples;
         const glm::vec3 c =
-            trace(o, dir_at(p.x, p.y), Cone{0, spread}, 0, &rng, rays, nullptr, nullptr);
+            trace(o, dir_at(p.x, p.y), Cone{0, sample_spread}, 0, &rng, rays, nullptr, nullptr);
         for (int i = 0; i < 3; ++i) {
           const float v = std::clamp(std::isfinite(c[i]) ? c[i] : 0.0f, 0.0f, kMaxRadiance);
           sum[i] += v;

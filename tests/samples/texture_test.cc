@@ -253,6 +253,35 @@ TEST(Texture, FarCheckerConvergesToItsMeanNearOneKeepsItsContrast) {
   EXPECT_NEAR(pixel(n, 6, 2).x, 50.0f / 64, 1e-4);
 }
 
+TEST(Texture, ConvergedPixelsFilterATextureEdgeOnlyOverThePixel) {
+  // A 256 x 256 texture, black left of u = 0.5 and white right of it, over the quad seen at 32 x
+  // 32: 8 texels per pixel, the edge exactly on the boundary of pixels 15 and 16. A box filter of
+  // the texture over each pixel gives 0 and 1 on either side. The samples are that box filter, so
+  // each sample's own texture filter must be narrower than the pixel: a whole pixel's footprint
+  // per sample (mip level 3, 1-pixel texels, read bilinearly) spreads the edge half a pixel into
+  // pixel 15, 0.125 of the step by the tent's area; the first round's stratum (1 / sqrt(8) of a
+  // pixel) spreads it about a quarter pixel.
+  const capture::SceneTexture edge =
+      image(256, 256, [](uint32_t x, uint32_t) { return glm::u8vec3(x < 128 ? 0 : 255); });
+  const Scene s = quad_scene(edge, 1, 0);
+  RenderOptions o{1, 1, 0, 2, 0};
+  o.spp = 64;
+  o.min_spp = 8;
+  o.tolerance = 0;
+  auto tracer = FrameTracer::create(s, 0, o);
+  ASSERT_TRUE(tracer.ok()) << tracer.status().to_string();
+  capture::PerspectiveImage img;
+  const glm::dvec3 eye(0, 0, 1);
+  (*tracer)->render_perspective(look_at_pose(0, eye, eye - glm::dvec3(0, 0, 1), 90), 32, 32, 0,
+                                &img);
+  for (uint32_t j : {8u, 16u, 24u}) {
+    EXPECT_LT(pixel(img, 14, j).x, 0.01f) << "row " << j;
+    EXPECT_LT(pixel(img, 15, j).x, 0.08f) << "row " << j;
+    EXPECT_GT(pixel(img, 16, j).x, 0.92f) << "row " << j;
+    EXPECT_GT(pixel(img, 17, j).x, 0.99f) << "row " << j;
+  }
+}
+
 // ---- models through assimp ----
 
 // 2 x 2: top row red, green; bottom row blue, white.
