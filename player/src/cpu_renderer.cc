@@ -70,8 +70,8 @@ Status validate_render_options(const RenderOptions& o, size_t view_count) {
   if (o.surface_hint_substeps < 1 || o.surface_hint_substeps > 64) {
     return option_error("surface_hint_substeps is outside [1, 64]");
   }
-  if (!(o.surface_hint_margin >= 0) || !std::isfinite(o.surface_hint_margin)) {
-    return option_error("surface_hint_margin must be finite and >= 0");
+  if (!(o.surface_hint_margin_texels >= 0) || !std::isfinite(o.surface_hint_margin_texels)) {
+    return option_error("surface_hint_margin_texels must be finite and >= 0");
   }
   if (!(o.color_depth_tolerance >= 0) || !std::isfinite(o.color_depth_tolerance)) {
     return option_error("color_depth_tolerance must be finite and >= 0");
@@ -149,13 +149,14 @@ double code_margin(const View& v, const Vec3& x, double r, double footprint,
 }  // namespace
 
 // BetweenViewpointAndGeometry (footnote 2) over the active views: true as soon as one view that
-// is not too near sees p in front of its stored surface (or sees sky there) by more than the
-// relative depth `margin` (0 for the plain test).
+// is not too near sees p in front of its stored surface (or sees sky there) by more than
+// `margin_texels` of its own texels, as relative depth margin_texels x 2 / face size (0 for the
+// plain test).
 bool CpuRenderer::empty_at(const Vec3& p) const {
   return empty_beyond(p, 0, 0);
 }
 
-bool CpuRenderer::empty_beyond(const Vec3& p, double margin, uint32_t vetoes_ignored) const {
+bool CpuRenderer::empty_beyond(const Vec3& p, double margin_texels, uint32_t vetoes_ignored) const {
   bool consulted = false;
   uint32_t vetoes = 0;
   for (const View* v : active_) {
@@ -164,7 +165,7 @@ bool CpuRenderer::empty_beyond(const Vec3& p, double margin, uint32_t vetoes_ign
     if (r <= min_view_distance_) continue;
     consulted = true;
     if (code_margin(*v, x, r, options_.depth_footprint, smooth_log_ratio_) >
-            margin / v->range().relative_step() &&
+            margin_texels * 2 / v->face_size() / v->range().relative_step() &&
         ++vetoes > vetoes_ignored) {
       return true;
     }
@@ -260,7 +261,7 @@ bool CpuRenderer::intersect(const Vec3& o, const Vec3& d, double start, Hit* hit
             (side(hint[h], mid) == 1 ? lo : hi) = mid;
           }
           const double xc = 0.5 * (lo + hi);
-          if (xc < found && !empty_beyond(o + d * lin(xc), options_.surface_hint_margin,
+          if (xc < found && !empty_beyond(o + d * lin(xc), options_.surface_hint_margin_texels,
                                           options_.surface_hint_vetoes)) {
             found = xc;
           }

@@ -55,7 +55,7 @@ uniform float color_depth_tolerance;
 uniform bool tight_march_start;
 uniform bool bilinear_color;
 uniform bool depth_aware_color;
-uniform float surface_hint_margin;  // relative depth a vetoing view must see beyond
+uniform float surface_hint_margin_texels;  // of its own texels a vetoing view must see beyond
 uniform uint surface_hint_vetoes;   // vetoes a hint crossing survives
 uniform uint surface_hint_substeps; // hint tests per step
 uniform bool rr;
@@ -189,9 +189,9 @@ float code_margin(CalfView v, vec3 x, float r) {
 }
 
 // ---- CpuRenderer::empty_at / empty_beyond: BetweenViewpointAndGeometry over the active views,
-// true as soon as one view that is not too near sees p in front of its surface by more than the
-// relative depth `margin` ----
-bool empty_beyond(vec3 p, float margin, uint vetoes_ignored) {
+// true as soon as one view that is not too near sees p in front of its surface by more than
+// `margin_texels` of its own texels (relative depth margin_texels x 2 / face size) ----
+bool empty_beyond(vec3 p, float margin_texels, uint vetoes_ignored) {
   bool consulted = false;
   uint vetoes = 0u;
   for (uint k = 0u; k < view_count; ++k) {
@@ -200,7 +200,10 @@ bool empty_beyond(vec3 p, float margin, uint vetoes_ignored) {
     float r = length(x);
     if (r <= min_view_distance) continue;
     consulted = true;
-    if (code_margin(v, x, r) > margin * v.inv_step && ++vetoes > vetoes_ignored) return true;
+    if (code_margin(v, x, r) > margin_texels * 2.0 / float(v.face_size) * v.inv_step &&
+        ++vetoes > vetoes_ignored) {
+      return true;
+    }
   }
   return !consulted;
 }
@@ -292,7 +295,7 @@ bool intersect(vec3 o, vec3 d, float start, out float z_hit) {
         continue;
       }
       x = crossing[h_next];
-      margin = surface_hint_margin;
+      margin = surface_hint_margin_texels;
       vetoes_ignored = surface_hint_vetoes;
     } else
 #endif

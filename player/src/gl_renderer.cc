@@ -178,7 +178,7 @@ Status GlRenderer::draw(const Camera& camera) {
   gl.Uniform1i(loc("tight_march_start"), o.tight_march_start ? 1 : 0);
   gl.Uniform1i(loc("bilinear_color"), o.bilinear_color ? 1 : 0);
   gl.Uniform1i(loc("depth_aware_color"), o.depth_aware_color ? 1 : 0);
-  gl.Uniform1f(loc("surface_hint_margin"), f(o.surface_hint_margin));
+  gl.Uniform1f(loc("surface_hint_margin_texels"), f(o.surface_hint_margin_texels));
   gl.Uniform1ui(loc("surface_hint_vetoes"), o.surface_hint_vetoes);
   gl.Uniform1ui(loc("surface_hint_substeps"), o.surface_hint_substeps);
   gl.Uniform1i(loc("rr"), o.rr ? 1 : 0);

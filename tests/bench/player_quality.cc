@@ -462,7 +462,8 @@ int main(int argc, char** argv) {
   app.add_option("--tight-start", base.tight_march_start, "tight_march_start (0/1)")
       ->capture_default_str();
   app.add_option("--hints", base.surface_hints, "surface_hints")->capture_default_str();
-  app.add_option("--hint-margin", base.surface_hint_margin, "surface_hint_margin")
+  app.add_option("--hint-margin", base.surface_hint_margin_texels,
+                 "surface_hint_margin_texels (of the vetoing view)")
       ->capture_default_str();
   app.add_option("--hint-vetoes", base.surface_hint_vetoes, "surface_hint_vetoes")
       ->capture_default_str();
@@ -539,13 +540,13 @@ int main(int argc, char** argv) {
   std::printf(
       "## %s: %zu views, face %u, %u frames; steps %u, refine %u, footprint %.2f, smooth "
       "%.2f, depth_decay %.0f, cam_decay %.0f, colour tolerance %.2f, tight start %d, "
-      "hints %u (margin %.3f, vetoes %u, substeps %u), rr_start %.3f, rr replace %d, "
+      "hints %u (margin %.3f texels, vetoes %u, substeps %u), rr_start %.3f, rr replace %d, "
       "supersample %u, threads %u\n",
       m.scene.c_str(), m.viewpoints.size(), m.face_size, m.frame_count, base.steps,
       base.refine_steps, base.depth_footprint, base.smooth_depth_ratio, base.depth_decay,
       base.cam_decay, base.color_depth_tolerance, base.tight_march_start, base.surface_hints,
-      base.surface_hint_margin, base.surface_hint_vetoes, base.surface_hint_substeps, base.rr_start,
-      base.rr_replace_view_reflection, g_supersample, base.threads);
+      base.surface_hint_margin_texels, base.surface_hint_vetoes, base.surface_hint_substeps,
+      base.rr_start, base.rr_replace_view_reflection, g_supersample, base.threads);
   FrameCache frames(reader);
   if (!between.empty()) measure("between", between, frames, m, variants, out_dir, false);
   if (!vp_gt_file.empty()) {

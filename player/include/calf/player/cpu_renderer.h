@@ -121,15 +121,19 @@ struct RenderOptions {
   // the ray crossed the hint's surface in between: the crossing is located by `refine_steps`
   // bisections on that view alone (within that substep) and placed
   // at the middle of the final interval, and it is the hit unless more than
-  // `surface_hint_vetoes` active views see it as empty by more than the relative depth
-  // `surface_hint_margin` (in code units: margin / relative_step of that view).
+  // `surface_hint_vetoes` active views see it as empty by more than
+  // `surface_hint_margin_texels` of their own texels: the relative depth margin x 2 / face size
+  // (a texel's angular width at the face centre), in code units that / relative_step of the
+  // view. A fixed relative depth (0.5 %, the default before stop 40) was three texels of a 1024²
+  // face: near a silhouette the hint view's shadow edge of the object lies that close to the
+  // object's surface in the other views, so no view vetoed it and silhouettes grew by a pixel.
   // Of several hints crossing in one interval the nearest confirmed crossing wins. This finds
   // parts thinner than a step (wings, chains, leaves) that the plain march steps over, and at a
   // viewpoint puts the hit exactly on that view's surface. 0: the paper's march alone.
   // Default 1, the tuned value (docs/RENDERING.md "Quality": +7 dB at turntable's viewpoints).
   // The GL renderer compiles the count into its shader (changing it relinks the program).
   uint32_t surface_hints = 1;
-  double surface_hint_margin = 0.005;
+  double surface_hint_margin_texels = 0.2;
   // How many views may see a hint crossing as empty space beyond the margin without refuting
   // it (0..65536). Thin parts are often carved away by one view whose texels straddle them; a
   // crossing that is really empty space (the shadow edge, seen from the hint view, of an object
@@ -217,7 +221,7 @@ class CpuRenderer {
     double z = 0;  // its distance from the ray origin
   };
   bool empty_at(const Vec3& p) const;
-  bool empty_beyond(const Vec3& p, double margin, uint32_t vetoes_ignored) const;
+  bool empty_beyond(const Vec3& p, double margin_texels, uint32_t vetoes_ignored) const;
   bool intersect(const Vec3& origin, const Vec3& dir, double start, Hit* hit) const;
   void shade_surface(const Vec3& origin, const Vec3& p, double* rgb, int* best_view,
                      double* best_rgb = nullptr) const;
