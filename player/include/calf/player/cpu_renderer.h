@@ -124,7 +124,7 @@ struct RenderOptions {
   // `surface_hint_vetoes` active views see it as empty by more than
   // `surface_hint_margin_texels` of their own texels: the relative depth margin x 2 / face size
   // (a texel's angular width at the face centre), in code units that / relative_step of the
-  // view. A fixed relative depth (0.5 %, the default before stop 40) was three texels of a 1024²
+  // view. A fixed relative depth (0.5 %, the default before stop 40) was 2.56 texels of a 1024²
   // face: near a silhouette the hint view's shadow edge of the object lies that close to the
   // object's surface in the other views, so no view vetoed it and silhouettes grew by a pixel.
   // Of several hints crossing in one interval the nearest confirmed crossing wins. This finds
