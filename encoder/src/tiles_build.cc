@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include <cstdarg>
@@ -298,7 +299,7 @@ Expected<TileSet> build_tiles(const capture::CaptureSetReader& reader, uint32_t 
   TilesBuildOptions texture_options = options;
   if (texture_options.solid_threshold == 0) {
     texture_options.solid_threshold =
-        std::min(0.5, options.ransac_threshold + 1.25 * 1.5707963267948966 / m.face_size);
+        std::min(0.5, options.ransac_threshold + 1.25 * (std::numbers::pi / 2) / m.face_size);
   }
   r.solid_threshold = texture_options.solid_threshold;
   for (uint32_t s : sides) r.tile_texels += uint64_t{s} * s;
