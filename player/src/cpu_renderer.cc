@@ -76,6 +76,12 @@ Status validate_render_options(const RenderOptions& o, size_t view_count) {
   if (!(o.color_depth_tolerance >= 0) || !std::isfinite(o.color_depth_tolerance)) {
     return option_error("color_depth_tolerance must be finite and >= 0");
   }
+  if (!(o.mixed_texel_penalty >= 0 && o.mixed_texel_penalty <= 50)) {
+    return option_error("mixed_texel_penalty must be in [0, 50]");
+  }
+  if (!(o.mixed_texel_bend_texels >= 0) || !std::isfinite(o.mixed_texel_bend_texels)) {
+    return option_error("mixed_texel_bend_texels must be finite and >= 0");
+  }
   if (!std::isfinite(o.min_view_distance)) return option_error("min_view_distance is not finite");
   if (o.threads < 1 || o.threads > 256) return option_error("threads is outside [1, 256]");
   if (o.supersample < 1 || o.supersample > 8) return option_error("supersample is outside [1, 8]");
@@ -105,6 +111,7 @@ Expected<CpuRenderer> CpuRenderer::make(const ViewSet& views, const RenderOption
   }
   r.smooth_log_ratio_ = std::log1p(std::max(o.smooth_depth_ratio, 0.0));
   r.min_view_distance_ = o.min_view_distance < 0 ? o.near : o.min_view_distance;
+  r.mixed_penalty_factor_ = std::exp(-o.mixed_texel_penalty);
   return r;
 }
 
@@ -146,7 +153,33 @@ double code_margin(const View& v, const Vec3& x, double r, double footprint,
   return code == kLog16Sky ? kInf : code - rcode;
 }
 
+// Whether texel t of v lies on a depth edge of its view (see RenderOptions::mixed_texel_penalty):
+// one of its four neighbours, across face seams, is sky where t is not (or the reverse), or the
+// log depth bends at t by more than `bend_codes` log-16 codes along either axis (the second
+// difference; RenderOptions::mixed_texel_bend_texels says what bends how much).
+bool mixed_texel(const View& v, const Texel& t, double bend_codes) {
+  const uint16_t code = v.depth_code_at(t.face, t.x, t.y);
+  constexpr int kDx[4] = {-1, 1, 0, 0}, kDy[4] = {0, 0, -1, 1};
+  int bend[2] = {0, 0};  // along x, along y: the neighbours' sum less twice t's code
+  for (int k = 0; k < 4; ++k) {
+    const Texel u = internal::texel_beyond_face(t.face, int64_t{t.x} + kDx[k],
+                                                int64_t{t.y} + kDy[k], v.face_size());
+    const uint16_t other = v.depth_code_at(u.face, u.x, u.y);
+    if ((other == kLog16Sky) != (code == kLog16Sky)) return true;
+    bend[k / 2] += int{other} - int{code};
+  }
+  return code != kLog16Sky && (std::abs(bend[0]) > bend_codes || std::abs(bend[1]) > bend_codes);
+}
+
 }  // namespace
+
+// The factor a colour tap of v keeps: exp(-mixed_texel_penalty) on a depth edge, else 1.
+double CpuRenderer::tap_purity(const View& v, const Texel& t) const {
+  if (mixed_penalty_factor_ == 1) return 1;
+  const double bend_codes =
+      options_.mixed_texel_bend_texels * 2 / v.face_size() / v.range().relative_step();
+  return mixed_texel(v, t, bend_codes) ? mixed_penalty_factor_ : 1;
+}
 
 // BetweenViewpointAndGeometry (footnote 2) over the active views: true as soon as one view that
 // is not too near sees p in front of its stored surface (or sees sky there) by more than
@@ -315,7 +348,7 @@ void CpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* rgb, int* 
       }
       double a[4], asum = 0;
       for (int t = 0; t < 4; ++t) {
-        a[t] = taps.weight[t];
+        a[t] = taps.weight[t] > 0 ? taps.weight[t] * tap_purity(v, taps.texel[t]) : 0.0;
         if (options_.depth_aware_color) {
           a[t] *= diff[t] == kInf
                       ? 0.0
@@ -348,36 +381,41 @@ void CpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* rgb, int* 
 }
 
 // Sky has no parallax: every view sees it in the ray's own direction. Views whose depth there is
-// sky count equally; if none is (the march ended before far geometry), all views do.
+// sky count (if none is, the march ended before far geometry, all views do), each with the share
+// of its taps' bilinear weight that mixed texels leave (1 where none is mixed).
 void CpuRenderer::shade_sky(const Vec3& /*origin*/, const Vec3& d, double* rgb) const {
   for (int pass = 0; pass < 2; ++pass) {
     double sum[3] = {0, 0, 0};
-    int n = 0;
+    double n = 0;
     for (const View* v : active_) {
       const Texel nearest = texel_from_direction(d, v->face_size());
       const bool sky = v->depth_code_at(nearest.face, nearest.x, nearest.y) == kLog16Sky;
       if (pass == 0 && !sky) continue;
       double c[3] = {0, 0, 0};
+      double w = 1;  // the view's weight
       if (!options_.bilinear_color) {
         const float* col = v->color_at(nearest.face, nearest.x, nearest.y);
         for (int ch = 0; ch < 3; ++ch) c[ch] = col[ch];
       } else {
         const internal::BilinearTaps taps =
             internal::bilinear_taps(texel_coord_from_direction(d, v->face_size()), v->face_size());
-        double a[4], asum = 0;
+        double a[4], asum = 0, unweighed = 0;
         for (int t = 0; t < 4; ++t) {
           const bool tap_sky =
               v->depth_code_at(taps.texel[t].face, taps.texel[t].x, taps.texel[t].y) == kLog16Sky;
           a[t] = taps.weight[t] * (pass == 0 && options_.depth_aware_color && !tap_sky ? 0 : 1);
+          unweighed += a[t];
+          if (a[t] > 0) a[t] *= tap_purity(*v, taps.texel[t]);
           asum += a[t];
         }
         for (int t = 0; t < 4; ++t) {
           const float* col = v->color_at(taps.texel[t].face, taps.texel[t].x, taps.texel[t].y);
           for (int ch = 0; ch < 3; ++ch) c[ch] += a[t] / asum * col[ch];
         }
+        w = asum / unweighed;
       }
-      for (int ch = 0; ch < 3; ++ch) sum[ch] += c[ch];
-      ++n;
+      for (int ch = 0; ch < 3; ++ch) sum[ch] += w * c[ch];
+      n += w;
     }
     if (n > 0) {
       for (int ch = 0; ch < 3; ++ch) rgb[ch] = sum[ch] / n;

@@ -52,6 +52,8 @@ uniform float smooth_log_ratio;  // ln(1 + smooth_depth_ratio)
 uniform float depth_decay;
 uniform float cam_decay;
 uniform float color_depth_tolerance;
+uniform float mixed_penalty_factor;  // exp(-mixed_texel_penalty); 1 = off
+uniform float mixed_texel_bend_texels;  // in texel angles, 2 / face size radians
 uniform bool tight_march_start;
 uniform bool bilinear_color;
 uniform bool depth_aware_color;
@@ -360,6 +362,26 @@ bool intersect(vec3 o, vec3 d, float start, out float z_hit) {
   return true;
 }
 
+// ---- mixed_texel / CpuRenderer::tap_purity ----
+bool mixed_texel(CalfView v, ivec3 t) {
+  uint code = depth_code(v, t);
+  const ivec2 kStep[4] = ivec2[4](ivec2(-1, 0), ivec2(1, 0), ivec2(0, -1), ivec2(0, 1));
+  float bend[2] = float[2](0.0, 0.0);
+  for (int k = 0; k < 4; ++k) {
+    uint other = depth_code(v, texel_beyond_face(t.z, t.x + kStep[k].x, t.y + kStep[k].y,
+                                                 v.face_size));
+    if ((other == CALF_LOG16_SKY) != (code == CALF_LOG16_SKY)) return true;
+    bend[k / 2] += float(other) - float(code);
+  }
+  float bend_codes = mixed_texel_bend_texels * 2.0 / float(v.face_size) * v.inv_step;
+  return code != CALF_LOG16_SKY && (abs(bend[0]) > bend_codes || abs(bend[1]) > bend_codes);
+}
+
+float tap_purity(CalfView v, ivec3 t) {
+  if (mixed_penalty_factor == 1.0) return 1.0;
+  return mixed_texel(v, t) ? mixed_penalty_factor : 1.0;
+}
+
 // ---- CpuRenderer::shade_surface: SampleColor + CalculateColor ----
 // The weighted mean is accumulated online, rescaled whenever a larger log weight arrives: the
 // same exp(log_w - best) normalisation as the CPU's two passes, without an array of views.
@@ -397,7 +419,7 @@ vec3 shade_surface(vec3 o, vec3 p, out int best_view, out vec3 best_colour) {
       float a[4];
       float asum = 0.0;
       for (int t = 0; t < 4; ++t) {
-        a[t] = taps.weight[t];
+        a[t] = taps.weight[t] > 0.0 ? taps.weight[t] * tap_purity(v, taps.texel[t]) : 0.0;
         if (depth_aware_color) {
           a[t] *= diff[t] == INF
                       ? 0.0
@@ -428,7 +450,7 @@ vec3 shade_surface(vec3 o, vec3 p, out int best_view, out vec3 best_colour) {
 vec3 shade_sky(vec3 d) {
   for (int pass = 0; pass < 2; ++pass) {
     vec3 sum = vec3(0.0);
-    int n = 0;
+    float n = 0.0;
     for (uint k = 0u; k < view_count; ++k) {
       CalfView v = views[k];
       int face = face_of(d);
@@ -437,23 +459,27 @@ vec3 shade_sky(vec3 d) {
       bool sky = depth_code(v, nearest) == CALF_LOG16_SKY;
       if (pass == 0 && !sky) continue;
       vec3 c = vec3(0.0);
+      float w = 1.0;  // the view's weight
       if (!bilinear_color) {
         c = colour_at(v, nearest);
       } else {
         Taps taps = bilinear_taps(face, uv, v.face_size);
         float a[4];
-        float asum = 0.0;
+        float asum = 0.0, unweighed = 0.0;
         for (int t = 0; t < 4; ++t) {
           bool tap_sky = depth_code(v, taps.texel[t]) == CALF_LOG16_SKY;
           a[t] = taps.weight[t] * (pass == 0 && depth_aware_color && !tap_sky ? 0.0 : 1.0);
+          unweighed += a[t];
+          if (a[t] > 0.0) a[t] *= tap_purity(v, taps.texel[t]);
           asum += a[t];
         }
         for (int t = 0; t < 4; ++t) c += a[t] / asum * colour_at(v, taps.texel[t]);
+        w = asum / unweighed;
       }
-      sum += c;
-      ++n;
+      sum += w * c;
+      n += w;
     }
-    if (n > 0) return sum / float(n);
+    if (n > 0.0) return sum / n;
   }
   return vec3(0.0);
 }

@@ -175,6 +175,8 @@ Status GlRenderer::draw(const Camera& camera) {
   gl.Uniform1f(loc("depth_decay"), f(o.depth_decay));
   gl.Uniform1f(loc("cam_decay"), f(o.cam_decay));
   gl.Uniform1f(loc("color_depth_tolerance"), f(o.color_depth_tolerance));
+  gl.Uniform1f(loc("mixed_penalty_factor"), f(std::exp(-o.mixed_texel_penalty)));
+  gl.Uniform1f(loc("mixed_texel_bend_texels"), f(o.mixed_texel_bend_texels));
   gl.Uniform1i(loc("tight_march_start"), o.tight_march_start ? 1 : 0);
   gl.Uniform1i(loc("bilinear_color"), o.bilinear_color ? 1 : 0);
   gl.Uniform1i(loc("depth_aware_color"), o.depth_aware_color ? 1 : 0);

@@ -561,6 +561,12 @@ int main(int argc, char** argv) {
   app.add_option("--hint-substeps", o.render.surface_hint_substeps,
                  "hint tests per march step (default 4)")
       ->check(CLI::Range(1, 64));
+  app.add_option("--mixed-texel-penalty", o.render.mixed_texel_penalty,
+                 "light field: colour taps on a depth edge of their view (an anti-aliased "
+                 "capture mixes both sides' colours there) keep e^-P of their weight, so colour "
+                 "comes from texels wholly on one surface; 0..50, 0 = off (default 3; "
+                 "docs/RENDERING.md \"Mixed texels\")")
+      ->check(CLI::Range(0.0, 50.0));
   app.add_option("--supersample", o.render.supersample,
                  "light field: N x N eye rays per pixel on an even grid, colour their mean (a box "
                  "filter, as the ground truth's), depth the nearest; anti-aliases silhouettes and "

@@ -462,6 +462,10 @@ int main(int argc, char** argv) {
   app.add_option("--tight-start", base.tight_march_start, "tight_march_start (0/1)")
       ->capture_default_str();
   app.add_option("--hints", base.surface_hints, "surface_hints")->capture_default_str();
+  app.add_option("--mixed-penalty", base.mixed_texel_penalty, "mixed_texel_penalty (0 = off)")
+      ->capture_default_str();
+  app.add_option("--mixed-bend", base.mixed_texel_bend_texels, "mixed_texel_bend_texels")
+      ->capture_default_str();
   app.add_option("--hint-margin", base.surface_hint_margin_texels,
                  "surface_hint_margin_texels (of the vetoing view)")
       ->capture_default_str();
@@ -481,6 +485,10 @@ int main(int argc, char** argv) {
   app.add_option("--supersample", g_supersample,
                  "compare k x k box-filtered images: ground truth rendered k times the size, "
                  "reconstructions rendered at that size (1..8)")
+      ->capture_default_str();
+  app.add_option("--render-supersample", base.supersample,
+                 "RenderOptions::supersample: the renderer's own n x n eye rays per pixel, box-"
+                 "filtered, against the ground truth at its size (calf-play --supersample; 1..8)")
       ->capture_default_str();
   app.add_flag("--no-reproject", no_reproject, "skip the vp-reproj measurement");
   app.add_flag("--breakdown", g_breakdown,
@@ -539,14 +547,17 @@ int main(int argc, char** argv) {
 
   std::printf(
       "## %s: %zu views, face %u, %u frames; steps %u, refine %u, footprint %.2f, smooth "
-      "%.2f, depth_decay %.0f, cam_decay %.0f, colour tolerance %.2f, tight start %d, "
+      "%.2f, depth_decay %.0f, cam_decay %.0f, colour tolerance %.2f, mixed texels %.1f (bend %.2f "
+      "texels), tight start %d, "
       "hints %u (margin %.3f texels, vetoes %u, substeps %u), rr_start %.3f, rr replace %d, "
-      "supersample %u, threads %u\n",
+      "supersample %u (renderer %u), threads %u\n",
       m.scene.c_str(), m.viewpoints.size(), m.face_size, m.frame_count, base.steps,
       base.refine_steps, base.depth_footprint, base.smooth_depth_ratio, base.depth_decay,
-      base.cam_decay, base.color_depth_tolerance, base.tight_march_start, base.surface_hints,
+      base.cam_decay, base.color_depth_tolerance, base.mixed_texel_penalty,
+      base.mixed_texel_bend_texels, base.tight_march_start, base.surface_hints,
       base.surface_hint_margin_texels, base.surface_hint_vetoes, base.surface_hint_substeps,
-      base.rr_start, base.rr_replace_view_reflection, g_supersample, base.threads);
+      base.rr_start, base.rr_replace_view_reflection, g_supersample, base.supersample,
+      base.threads);
   FrameCache frames(reader);
   if (!between.empty()) measure("between", between, frames, m, variants, out_dir, false);
   if (!vp_gt_file.empty()) {

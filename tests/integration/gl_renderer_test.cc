@@ -220,6 +220,13 @@ TEST(GlRenderer, MatchesCpuForColourAndDepthTestVariants) {
   o.surface_hint_margin_texels = 2;
   o.steps = 12;  // coarse steps: many thin parts are found by the hints alone
   variants.push_back({"surface hints 3, 0 vetoes, margin 2 texels, 12 steps", o});
+  o = {};
+  o.mixed_texel_penalty = 0;
+  variants.push_back({"no mixed-texel penalty", o});
+  o = {};
+  o.mixed_texel_penalty = 50;
+  o.mixed_texel_bend_texels = 0.5;  // most texels of the room's slanted walls count as mixed
+  variants.push_back({"mixed-texel penalty 50, bend 0.5 texels", o});
   variants.push_back({"defaults", {}});
   for (const Variant& v : variants) {
     const Comparison c = compare(views, cam, v.o);

@@ -132,8 +132,12 @@ inline void shade(const Scene& s, const Vec3& o, const Vec3& d, double rgb[3], d
   albedo(h, rgb);
 }
 
-// A view at `position` with faces of `n` texels, its depth range measured from the data.
-inline View make_view(const Scene& s, const Vec3& position, uint32_t n, bool material = false) {
+// A view at `position` with faces of `n` texels, its depth range measured from the data. With
+// `colour_samples` k > 1 a texel's colour is the mean of k x k rays through the centres of a
+// k x k grid over the texel (anti-aliased, as calf-capture's), its depth and material the
+// centre ray's.
+inline View make_view(const Scene& s, const Vec3& position, uint32_t n, bool material = false,
+                      uint32_t colour_samples = 1) {
   std::vector<float> color[6], depth[6], mat[6];
   double lo = std::numeric_limits<double>::infinity(), hi = 0;
   for (int f = 0; f < 6; ++f) {
@@ -143,6 +147,20 @@ inline View make_view(const Scene& s, const Vec3& position, uint32_t n, bool mat
         double rgb[3], z;
         Material m;
         shade(s, position, {dd.x, dd.y, dd.z}, rgb, &z, &m);
+        if (colour_samples > 1) {
+          const uint32_t k = colour_samples;
+          double sum[3] = {0, 0, 0};
+          for (uint32_t sy = 0; sy < k; ++sy) {
+            for (uint32_t sx = 0; sx < k; ++sx) {
+              const Vec3 ds = direction_from_texel_coord(
+                  {cube_face_from_index(f), x + (sx + 0.5) / k, y + (sy + 0.5) / k}, n);
+              double c[3], zs;
+              shade(s, position, unit(ds), c, &zs);
+              for (int ch = 0; ch < 3; ++ch) sum[ch] += c[ch] / (k * k);
+            }
+          }
+          std::copy(sum, sum + 3, rgb);
+        }
         for (double c : rgb) color[f].push_back(static_cast<float>(c));
         depth[f].push_back(static_cast<float>(z));
         mat[f].insert(mat[f].end(), {m.reflect, m.refract, m.ior});
@@ -169,21 +187,39 @@ inline View make_view(const Scene& s, const Vec3& position, uint32_t n, bool mat
 }
 
 inline ViewSet make_views(const Scene& s, const std::vector<Vec3>& positions, uint32_t n,
-                          bool material = false) {
+                          bool material = false, uint32_t colour_samples = 1) {
   ViewSet set;
-  for (const Vec3& p : positions) set.views.push_back(make_view(s, p, n, material));
+  for (const Vec3& p : positions) {
+    set.views.push_back(make_view(s, p, n, material, colour_samples));
+  }
   return set;
 }
 
-// Ground truth of `camera`: colour and radial depth per pixel.
-inline RenderedImage ground_truth(const Scene& s, const Camera& camera) {
+// Ground truth of `camera`: colour and radial depth per pixel. With `colour_samples` k > 1 the
+// colour is the mean of k x k rays over the pixel (anti-aliased), the depth the centre ray's.
+inline RenderedImage ground_truth(const Scene& s, const Camera& camera,
+                                  uint32_t colour_samples = 1) {
   RenderedImage img;
   img.width = camera.width;
   img.height = camera.height;
+  const CameraFrame frame = camera_frame(camera);
   for (uint32_t j = 0; j < camera.height; ++j) {
     for (uint32_t i = 0; i < camera.width; ++i) {
       double rgb[3], z;
       shade(s, camera.position, camera_ray(camera, i, j), rgb, &z);
+      if (colour_samples > 1) {
+        const uint32_t k = colour_samples;
+        double sum[3] = {0, 0, 0};
+        for (uint32_t sy = 0; sy < k; ++sy) {
+          for (uint32_t sx = 0; sx < k; ++sx) {
+            double c[3], zs;
+            shade(s, camera.position,
+                  camera_ray_at(camera, frame, i + (sx + 0.5) / k, j + (sy + 0.5) / k), c, &zs);
+            for (int ch = 0; ch < 3; ++ch) sum[ch] += c[ch] / (k * k);
+          }
+        }
+        std::copy(sum, sum + 3, rgb);
+      }
       for (double c : rgb) img.color.push_back(static_cast<float>(c));
       img.depth.push_back(static_cast<float>(z));
     }

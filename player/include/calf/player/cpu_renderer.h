@@ -32,9 +32,12 @@
 // Colour texels are sampled bilinearly (optionally depth-aware: each of the four taps is weighted
 // by its own depth agreement beyond `color_depth_tolerance`, so silhouettes do not bleed
 // foreground into background); taps that fall off a face are fetched from the neighbouring face
-// through the cube conventions.
+// through the cube conventions. Taps on a depth edge of their view ("mixed" texels: an
+// anti-aliased capture gives them the mean colour of both sides) keep only
+// exp(-mixed_texel_penalty) of their weight, so colour comes from texels wholly on one surface.
 // Sky: the colour of the views whose depth is sky in the ray direction (sky is at infinity, so
-// every viewpoint sees it in the same direction), bilinear over sky taps.
+// every viewpoint sees it in the same direction), bilinear over sky taps, mixed taps weighed down
+// as above (a view's weight is the share of its sky taps' bilinear weight that is left).
 //
 // RR variant (Alg. 4 *_RR, Sec. 6.1), when `rr` is set and views carry material: at a hit the
 // material (reflect, refract, IOR) is the best-weighted view's nearest texel, the normal comes
@@ -109,6 +112,28 @@ struct RenderOptions {
   // slanted surfaces (neighbouring texels at different depths) skews bilinear weights towards the
   // nearest texel and shifts colour edges. >= 0.
   double color_depth_tolerance = 0.1;
+  // Mixed texels. An anti-aliased capture (calf-capture's default, any offline renderer's) gives
+  // a texel on a depth edge the mean colour of the surfaces on both sides, while its depth (the
+  // centre ray's) names one of them: re-projected, it paints background colour into a surface
+  // (grey specks along a model's thin legs, where most texels are edge texels) and foreground
+  // colour into the background beside it. A colour tap is mixed when one of its four neighbours
+  // in its view (across face seams) is sky where it is not (or the reverse), or its log depth
+  // bends there along either axis by more than `mixed_texel_bend_texels` texel angles (2 / face
+  // size radians, as for the hint margin): |ln z(x-1) + ln z(x+1) - 2 ln z(x)| > bend x 2 / n.
+  // A step or a part one texel thin bends by its own depth ratio; a slanted plane's steady slope
+  // bends by about (2 / n)^2 / cos^2(incidence), and a crease between planes at incidences a
+  // and b by (2 / n)(tan a + tan b), so in texel angles neither depends on the face size, and
+  // the default 5 counts a plane as mixed only beyond 88° at 512² faces (83° at 24²), a crease
+  // only where its walls are seen at 69° or more. With bilinear colour a mixed tap keeps
+  // exp(-mixed_texel_penalty) of its weight, in surface and sky lookups: colour comes from the
+  // texels wholly on one surface, in the same view or, since a depth-aware view's w_depth is the
+  // sum of its taps' weights, in another view, where there are any; where every texel is mixed
+  // (a part a texel thin in every view) nothing changes. 0 = off. Defaults from a sweep on six
+  // captures (docs/RENDERING.md "Mixed texels"). The penalty is in [0, 50] (e^-50 already drops
+  // a mixed tap wherever an unmixed one is near; a larger one would underflow the GPU's float
+  // weights), the bend >= 0 and finite.
+  double mixed_texel_penalty = 3;
+  double mixed_texel_bend_texels = 5;
   // Start each march where the first surface can be: no point nearer to view j's centre than
   // z_near_j can be behind its surface, so the march starts at max_j (z_near_j - |o - P_j|)
   // (over the active views, at least the ray's own start) and spends its steps beyond.
@@ -220,6 +245,7 @@ class CpuRenderer {
     Vec3 p;        // the surface point
     double z = 0;  // its distance from the ray origin
   };
+  double tap_purity(const View& v, const Texel& t) const;
   bool empty_at(const Vec3& p) const;
   bool empty_beyond(const Vec3& p, double margin_texels, uint32_t vetoes_ignored) const;
   bool intersect(const Vec3& origin, const Vec3& dir, double start, Hit* hit) const;
@@ -236,6 +262,7 @@ class CpuRenderer {
   std::vector<const View*> active_;
   double min_view_distance_ = 0;
   double smooth_log_ratio_ = 0;
+  double mixed_penalty_factor_ = 1;  // exp(-mixed_texel_penalty)
 };
 
 }  // namespace calf::player
