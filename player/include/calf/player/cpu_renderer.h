@@ -124,12 +124,12 @@ struct RenderOptions {
   // bends by about (2 / n)^2 / cos^2(incidence), and a crease between planes at incidences a
   // and b by (2 / n)(tan a + tan b), so in texel angles neither depends on the face size, and
   // the default 5 counts a plane as mixed only beyond 88° at 512² faces (83° at 24²), a crease
-  // only where its walls are seen at 69° or more. With bilinear colour a mixed tap keeps
+  // only where its walls are seen at 68° or more. With bilinear colour a mixed tap keeps
   // exp(-mixed_texel_penalty) of its weight, in surface and sky lookups: colour comes from the
   // texels wholly on one surface, in the same view or, since a depth-aware view's w_depth is the
   // sum of its taps' weights, in another view, where there are any; where every texel is mixed
   // (a part a texel thin in every view) nothing changes. 0 = off. Defaults from a sweep on six
-  // captures (docs/RENDERING.md "Mixed texels"). The penalty is in [0, 50] (e^-50 already drops
+  // captures (docs/RENDERING.md "Fourth round"). The penalty is in [0, 50] (e^-50 already drops
   // a mixed tap wherever an unmixed one is near; a larger one would underflow the GPU's float
   // weights), the bend >= 0 and finite.
   double mixed_texel_penalty = 3;
