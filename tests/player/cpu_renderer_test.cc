@@ -272,12 +272,12 @@ TEST(CpuRenderer, HintMarginInTexelsKeepsSilhouettesFromGrowingAtFineCaptures) {
 
 // Mixed texels: views anti-aliased as calf-capture's are (4 x 4 rays per texel), so every texel
 // on a silhouette of the spheres (7 texels across at 128² faces) holds the mean of sphere and
-// sky, at the depth of whichever its centre ray meets. The eye, between the views and nearer the spheres, sees the
-// points on a view's silhouette inside the sphere's disc, where the mixed colour paints sky into
-// the sphere. Counted: pixels inside a disc (their ground truth, 4 x 4 rays, is the sphere alone),
-// rendered with supersample 2. Measured: RMS colour error 0.0131 with no penalty, 0.0035 with
-// the default; the whole image, whose error is the spheres' silhouettes against the sky, 26.87
-// against 26.80 dB (real captures gain, docs/RENDERING.md "Fourth round").
+// sky, at the depth of whichever its centre ray meets. The eye, between the views and nearer the
+// spheres, sees the points on a view's silhouette inside the sphere's disc, where the mixed colour
+// paints sky into the sphere. Counted: pixels inside a disc (their ground truth, 4 x 4 rays, is the
+// sphere alone), rendered with supersample 2. Measured: RMS colour error 0.0131 with no penalty,
+// 0.0035 with the default; the whole image, whose error is the spheres' silhouettes against the
+// sky, 26.87 against 26.80 dB (real captures gain, docs/RENDERING.md "Fourth round").
 TEST(CpuRenderer, MixedTexelsOfAntiAliasedViewsGiveTheirColourWeightAway) {
   Scene scene;
   scene.room = false;
