@@ -153,6 +153,13 @@ double code_margin(const View& v, const Vec3& x, double r, double footprint,
   return code == kLog16Sky ? kInf : code - rcode;
 }
 
+// `texels` texel angles of v (2 / face size radians each, a texel's width at the face centre) as
+// a relative depth, in v's log-16 code units: the scale of the hint margin and the mixed-texel
+// bend.
+double texel_angles_in_codes(const View& v, double texels) {
+  return texels * 2 / v.face_size() / v.range().relative_step();
+}
+
 // Whether texel t of v lies on a depth edge of its view (see RenderOptions::mixed_texel_penalty):
 // one of its four neighbours, across face seams, is sky where t is not (or the reverse), or the
 // log depth bends at t by more than `bend_codes` log-16 codes along either axis (the second
@@ -176,9 +183,9 @@ bool mixed_texel(const View& v, const Texel& t, double bend_codes) {
 // The factor a colour tap of v keeps: exp(-mixed_texel_penalty) on a depth edge, else 1.
 double CpuRenderer::tap_purity(const View& v, const Texel& t) const {
   if (mixed_penalty_factor_ == 1) return 1;
-  const double bend_codes =
-      options_.mixed_texel_bend_texels * 2 / v.face_size() / v.range().relative_step();
-  return mixed_texel(v, t, bend_codes) ? mixed_penalty_factor_ : 1;
+  return mixed_texel(v, t, texel_angles_in_codes(v, options_.mixed_texel_bend_texels))
+             ? mixed_penalty_factor_
+             : 1;
 }
 
 // BetweenViewpointAndGeometry (footnote 2) over the active views: true as soon as one view that
@@ -198,7 +205,7 @@ bool CpuRenderer::empty_beyond(const Vec3& p, double margin_texels, uint32_t vet
     if (r <= min_view_distance_) continue;
     consulted = true;
     if (code_margin(*v, x, r, options_.depth_footprint, smooth_log_ratio_) >
-            margin_texels * 2 / v->face_size() / v->range().relative_step() &&
+            texel_angles_in_codes(*v, margin_texels) &&
         ++vetoes > vetoes_ignored) {
       return true;
     }
@@ -399,12 +406,12 @@ void CpuRenderer::shade_sky(const Vec3& /*origin*/, const Vec3& d, double* rgb) 
       } else {
         const internal::BilinearTaps taps =
             internal::bilinear_taps(texel_coord_from_direction(d, v->face_size()), v->face_size());
-        double a[4], asum = 0, unweighed = 0;
+        double a[4], asum = 0, unpenalised = 0;
         for (int t = 0; t < 4; ++t) {
           const bool tap_sky =
               v->depth_code_at(taps.texel[t].face, taps.texel[t].x, taps.texel[t].y) == kLog16Sky;
           a[t] = taps.weight[t] * (pass == 0 && options_.depth_aware_color && !tap_sky ? 0 : 1);
-          unweighed += a[t];
+          unpenalised += a[t];
           if (a[t] > 0) a[t] *= tap_purity(*v, taps.texel[t]);
           asum += a[t];
         }
@@ -412,7 +419,7 @@ void CpuRenderer::shade_sky(const Vec3& /*origin*/, const Vec3& d, double* rgb) 
           const float* col = v->color_at(taps.texel[t].face, taps.texel[t].x, taps.texel[t].y);
           for (int ch = 0; ch < 3; ++ch) c[ch] += a[t] / asum * col[ch];
         }
-        w = asum / unweighed;
+        w = asum / unpenalised;
       }
       for (int ch = 0; ch < 3; ++ch) sum[ch] += w * c[ch];
       n += w;

@@ -144,6 +144,12 @@ CalfLogRange log_range(CalfView v) {
   return CalfLogRange(v.z_near, v.z_far, v.log_near, v.step, v.inv_step);
 }
 
+// texel_angles_in_codes: `texels` texel angles of v (2 / face size radians each) as a relative
+// depth in v's code units.
+float texel_angles_in_codes(CalfView v, float texels) {
+  return texels * 2.0 / float(v.face_size) * v.inv_step;
+}
+
 // |ln(decode(code) / r)| given ln r.
 float log_disagreement(CalfView v, uint code, float log_r) {
   return abs(calf_log_depth_from_code(code, log_range(v)) - log_r);
@@ -202,7 +208,7 @@ bool empty_beyond(vec3 p, float margin_texels, uint vetoes_ignored) {
     float r = length(x);
     if (r <= min_view_distance) continue;
     consulted = true;
-    if (code_margin(v, x, r) > margin_texels * 2.0 / float(v.face_size) * v.inv_step &&
+    if (code_margin(v, x, r) > texel_angles_in_codes(v, margin_texels) &&
         ++vetoes > vetoes_ignored) {
       return true;
     }
@@ -373,7 +379,7 @@ bool mixed_texel(CalfView v, ivec3 t) {
     if ((other == CALF_LOG16_SKY) != (code == CALF_LOG16_SKY)) return true;
     bend[k / 2] += float(other) - float(code);
   }
-  float bend_codes = mixed_texel_bend_texels * 2.0 / float(v.face_size) * v.inv_step;
+  float bend_codes = texel_angles_in_codes(v, mixed_texel_bend_texels);
   return code != CALF_LOG16_SKY && (abs(bend[0]) > bend_codes || abs(bend[1]) > bend_codes);
 }
 
@@ -465,16 +471,16 @@ vec3 shade_sky(vec3 d) {
       } else {
         Taps taps = bilinear_taps(face, uv, v.face_size);
         float a[4];
-        float asum = 0.0, unweighed = 0.0;
+        float asum = 0.0, unpenalised = 0.0;
         for (int t = 0; t < 4; ++t) {
           bool tap_sky = depth_code(v, taps.texel[t]) == CALF_LOG16_SKY;
           a[t] = taps.weight[t] * (pass == 0 && depth_aware_color && !tap_sky ? 0.0 : 1.0);
-          unweighed += a[t];
+          unpenalised += a[t];
           if (a[t] > 0.0) a[t] *= tap_purity(v, taps.texel[t]);
           asum += a[t];
         }
         for (int t = 0; t < 4; ++t) c += a[t] / asum * colour_at(v, taps.texel[t]);
-        w = asum / unweighed;
+        w = asum / unpenalised;
       }
       sum += w * c;
       n += w;

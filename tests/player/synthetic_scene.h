@@ -132,6 +132,21 @@ inline void shade(const Scene& s, const Vec3& o, const Vec3& d, double rgb[3], d
   albedo(h, rgb);
 }
 
+// The mean colour of k x k rays from `o` through the centres of a k x k grid over a pixel or
+// texel: ray_at(u, v) gives the unit direction at offsets u, v in (0, 1) of its square.
+template <class RayAt>
+void mean_colour(const Scene& s, const Vec3& o, uint32_t k, RayAt ray_at, double rgb[3]) {
+  double sum[3] = {0, 0, 0};
+  for (uint32_t sy = 0; sy < k; ++sy) {
+    for (uint32_t sx = 0; sx < k; ++sx) {
+      double c[3], z;
+      shade(s, o, ray_at((sx + 0.5) / k, (sy + 0.5) / k), c, &z);
+      for (int ch = 0; ch < 3; ++ch) sum[ch] += c[ch] / (k * k);
+    }
+  }
+  std::copy(sum, sum + 3, rgb);
+}
+
 // A view at `position` with faces of `n` texels, its depth range measured from the data. With
 // `colour_samples` k > 1 a texel's colour is the mean of k x k rays through the centres of a
 // k x k grid over the texel (anti-aliased, as calf-capture's), its depth and material the
@@ -148,18 +163,10 @@ inline View make_view(const Scene& s, const Vec3& position, uint32_t n, bool mat
         Material m;
         shade(s, position, {dd.x, dd.y, dd.z}, rgb, &z, &m);
         if (colour_samples > 1) {
-          const uint32_t k = colour_samples;
-          double sum[3] = {0, 0, 0};
-          for (uint32_t sy = 0; sy < k; ++sy) {
-            for (uint32_t sx = 0; sx < k; ++sx) {
-              const Vec3 ds = direction_from_texel_coord(
-                  {cube_face_from_index(f), x + (sx + 0.5) / k, y + (sy + 0.5) / k}, n);
-              double c[3], zs;
-              shade(s, position, unit(ds), c, &zs);
-              for (int ch = 0; ch < 3; ++ch) sum[ch] += c[ch] / (k * k);
-            }
-          }
-          std::copy(sum, sum + 3, rgb);
+          const auto ray_at = [&](double u, double v) {
+            return unit(direction_from_texel_coord({cube_face_from_index(f), x + u, y + v}, n));
+          };
+          mean_colour(s, position, colour_samples, ray_at, rgb);
         }
         for (double c : rgb) color[f].push_back(static_cast<float>(c));
         depth[f].push_back(static_cast<float>(z));
@@ -208,17 +215,10 @@ inline RenderedImage ground_truth(const Scene& s, const Camera& camera,
       double rgb[3], z;
       shade(s, camera.position, camera_ray(camera, i, j), rgb, &z);
       if (colour_samples > 1) {
-        const uint32_t k = colour_samples;
-        double sum[3] = {0, 0, 0};
-        for (uint32_t sy = 0; sy < k; ++sy) {
-          for (uint32_t sx = 0; sx < k; ++sx) {
-            double c[3], zs;
-            shade(s, camera.position,
-                  camera_ray_at(camera, frame, i + (sx + 0.5) / k, j + (sy + 0.5) / k), c, &zs);
-            for (int ch = 0; ch < 3; ++ch) sum[ch] += c[ch] / (k * k);
-          }
-        }
-        std::copy(sum, sum + 3, rgb);
+        const auto ray_at = [&](double u, double v) {
+          return camera_ray_at(camera, frame, i + u, j + v);
+        };
+        mean_colour(s, camera.position, colour_samples, ray_at, rgb);
       }
       for (double c : rgb) img.color.push_back(static_cast<float>(c));
       img.depth.push_back(static_cast<float>(z));
