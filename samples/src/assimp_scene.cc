@@ -22,6 +22,7 @@
 
 #include "calf/format/coordinates.h"
 #include "calf/samples/scene.h"
+#include "glm_vec.h"
 #include "model_prescan.h"
 #include "model_textures.h"
 
@@ -437,6 +438,10 @@ Expected<Scene> load_scene_file(const std::filesystem::path& path) {
   scene.ambient = glm::vec3(0.25f);
   scene.ao_distance = static_cast<float>(0.3 * radius);
   scene.default_rig = ring_rig(8, 2.0 * radius, center + glm::dvec3(0, 0.25 * radius, 0));
+  // The viewer walks around the model, not through it; placement is in units of its size.
+  scene.default_rig.keep_out_center = to_vec3(center);
+  scene.default_rig.keep_out_radius = radius;
+  scene.length_scale = radius;
   // Midway between ring cameras (which sit at multiples of 45 degrees), inside the ring.
   scene.validation_path = [center, radius](uint32_t frames, double fps, uint32_t w, uint32_t h) {
     capture::EyePath p;

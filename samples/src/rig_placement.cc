@@ -25,7 +25,8 @@ const char* const kPlacementSyntaxHelp =
     "                                  volume; keys (defaults): max=16 (most cameras, 1..256),\n"
     "                                  stop=0.01 (stop when a camera's gain is below this share\n"
     "                                  of the best reachable coverage), k=1 (proximity decay per\n"
-    "                                  scene unit), candidates=512, samples=16384 (surface "
+    "                                  scene length: 1 unit for built-in scenes, a model file's\n"
+    "                                  bounding radius), candidates=512, samples=16384 (surface "
     "points),\n"
     "                                  frames=1 (frames of Eq. 7), specular (Eq. 6), theta=50\n"
     "                                  (degrees; implies specular), seed=1,\n"
@@ -83,6 +84,22 @@ double distance_to_box(const glm::dvec3& p, const Box3& b) {
   const glm::dvec3 lo = to_dvec3(b.min), hi = to_dvec3(b.max);
   return glm::length(glm::max(glm::max(lo - p, p - hi), glm::dvec3(0)));
 }
+
+// Where viewers may be: the view volume less the rig's keep-out ball.
+struct ViewerRegion {
+  Box3 box;
+  glm::dvec3 keep_out_center{0};
+  double keep_out_radius = 0;
+
+  bool kept_out(const glm::dvec3& p) const {
+    return glm::length(p - keep_out_center) < keep_out_radius;
+  }
+  // Z(x), the minimum viewer distance: no viewer is nearer to x than the box, nor (from inside
+  // the ball) than the ball's surface. A lower bound where the ball pokes out of the box.
+  double min_viewer_distance(const glm::dvec3& x) const {
+    return std::max(distance_to_box(x, box), keep_out_radius - glm::length(x - keep_out_center));
+  }
+};
 
 // About `n` points on a regular grid spanning `volume`, ends included (so that its corners,
 // where hand-made rigs put cameras, are candidates too); an axis of zero extent gets one point.
@@ -292,6 +309,10 @@ Expected<PlacementResult> place_cameras(const Scene& scene, const PlacementOptio
                                         uint32_t capture_frames) {
   const auto start = std::chrono::steady_clock::now();
   const Box3 volume = options.has_volume ? options.volume : scene.default_rig.view_volume;
+  const ViewerRegion region{volume, to_dvec3(scene.default_rig.keep_out_center),
+                            scene.default_rig.keep_out_radius};
+  // k is per the scene's length scale, so a model's rig does not depend on its file's unit.
+  const double k = options.k / scene.length_scale;
   const uint32_t frames = std::max(1u, capture_frames);
   RenderOptions render;
   render.threads = options.threads;
@@ -326,7 +347,11 @@ Expected<PlacementResult> place_cameras(const Scene& scene, const PlacementOptio
       }
     }
   }
+  // Outside geometry (and outside the keep-out ball: no viewer there either).
   std::vector<char> outside(probe.size(), 1);
+  for (size_t i = 0; i < probe.size(); ++i) {
+    if (region.kept_out(to_dvec3(probe[i]))) outside[i] = 0;
+  }
   std::vector<std::unique_ptr<FrameTracer>> tracers(eq7_frames.size());
   for (uint32_t f = 0; f < frames; ++f) {
     CALF_ASSIGN_OR_RETURN(std::unique_ptr<FrameTracer> t,
@@ -350,7 +375,8 @@ Expected<PlacementResult> place_cameras(const Scene& scene, const PlacementOptio
   if (candidates.empty()) {
     return Status(ErrorId::kPlacementVolume,
                   "--rig '" + options.text + "': all " + std::to_string(grid.size()) +
-                      " candidate points of the view volume lie inside geometry");
+                      " candidate points of the view volume lie inside geometry" +
+                      (region.keep_out_radius > 0 ? " or the rig's keep-out ball" : ""));
   }
   // hammersley[n - 1]: the point indices of the n-point set.
   std::vector<std::vector<size_t>> hammersley(m);
@@ -371,7 +397,8 @@ Expected<PlacementResult> place_cameras(const Scene& scene, const PlacementOptio
       return Status(ErrorId::kPlacementVolume,
                     "--rig '" + options.text + "': fewer than " + std::to_string(n) + " of " +
                         std::to_string(grown(n, kGrow)) +
-                        " Hammersley points of the view volume lie outside geometry");
+                        " Hammersley points of the view volume lie outside geometry" +
+                        (region.keep_out_radius > 0 ? " and the rig's keep-out ball" : ""));
     }
   }
   std::vector<size_t> hand_points;
@@ -394,7 +421,7 @@ Expected<PlacementResult> place_cameras(const Scene& scene, const PlacementOptio
   frame_begin.push_back(field.samples.size());
   const size_t ns = field.samples.size(), np = field.points.size();
   std::vector<double> z(ns);
-  for (size_t s = 0; s < ns; ++s) z[s] = distance_to_box(glm::dvec3(field.samples[s]), volume);
+  for (size_t s = 0; s < ns; ++s) z[s] = region.min_viewer_distance(glm::dvec3(field.samples[s]));
   field.suit.assign(np * ns, 0.0f);
   for (size_t i = 0; i < eq7_frames.size(); ++i) {
     const FrameTracer* t = tracers[i].get();
@@ -406,7 +433,7 @@ Expected<PlacementResult> place_cameras(const Scene& scene, const PlacementOptio
           const glm::dvec3 x(field.samples[s]);
           if (!t->segment_clear(o, to_vec3(x))) continue;
           const double excess = std::max(glm::length(x - field.points[p]) - z[s], 0.0);
-          row[s] = static_cast<float>(std::exp(-options.k * excess));
+          row[s] = static_cast<float>(std::exp(-k * excess));
         }
       });
     });
@@ -426,6 +453,7 @@ Expected<PlacementResult> place_cameras(const Scene& scene, const PlacementOptio
   const double cos_theta = std::cos(options.theta_degrees * M_PI / 180);
   PlacementResult result;
   result.candidates = static_cast<uint32_t>(candidates.size());
+  result.length_scale = scene.length_scale;
   result.surface_samples = static_cast<uint32_t>(ns);
   result.rays = static_cast<uint64_t>(np) * ns;
   Accumulator greedy(field, spec, cos_theta);
@@ -472,6 +500,8 @@ Expected<PlacementResult> place_cameras(const Scene& scene, const PlacementOptio
 
   Rig& rig = result.rig;
   rig.view_volume = volume;
+  rig.keep_out_center = to_vec3(region.keep_out_center);
+  rig.keep_out_radius = region.keep_out_radius;
   rig.description = options.text;
   if (options.kind == PlacementOptions::Kind::kAuto) {
     for (const CoverageRow& row : result.curve) {

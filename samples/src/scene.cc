@@ -124,6 +124,14 @@ Status validate_scene(const Scene& scene) {
                         "make_texture");
     }
   }
+  if (!(std::isfinite(scene.length_scale) && scene.length_scale > 0) ||
+      !(std::isfinite(scene.default_rig.keep_out_radius) &&
+        scene.default_rig.keep_out_radius >= 0)) {
+    return Status(ErrorId::kSceneGeometry,
+                  where +
+                      ": the length scale must be finite and > 0, the rig's keep-out radius "
+                      "finite and >= 0");
+  }
   for (size_t m = 0; m < scene.materials.size(); ++m) {
     const Material& mat = scene.materials[m];
     bool ok = finite(mat.albedo) && finite(mat.emission) && mat.reflect >= 0 && mat.refract >= 0 &&

@@ -88,10 +88,14 @@ int report_placement(const samples::PlacementResult& r, const samples::Placement
                      const std::string& out_dir) {
   const std::string table = samples::placement_table(r);
   std::printf(
-      "calf-capture: placement %s on %s: %u candidates outside geometry, %u surface points, "
-      "%.1f M visibility rays, %.2f s; Alg. 1 stopped: %s\n%s",
-      o.text.c_str(), scene.c_str(), r.candidates, r.surface_samples,
-      static_cast<double>(r.rays) * 1e-6, r.seconds, r.stop_reason.c_str(), table.c_str());
+      "calf-capture: placement %s on %s: %u candidates outside geometry%s, %u surface points, "
+      "length scale %g (k is per it), %.1f M visibility rays, %.2f s; Alg. 1 stopped: %s\n%s",
+      o.text.c_str(), scene.c_str(), r.candidates,
+      r.rig.keep_out_radius > 0
+          ? fmt::format(" and the keep-out ball (radius {:g})", r.rig.keep_out_radius).c_str()
+          : "",
+      r.surface_samples, r.length_scale, static_cast<double>(r.rays) * 1e-6, r.seconds,
+      r.stop_reason.c_str(), table.c_str());
   std::printf("hand-made rig %s: %u views, coverage %.6f\n", hand_made.c_str(), r.hand_made_count,
               r.hand_made_coverage);
   std::string list;

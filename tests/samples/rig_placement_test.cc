@@ -1,9 +1,12 @@
 // Camera placement (calf/samples/rig_placement.h, paper 002 Alg. 1): known answers on a scene
 // whose pillar hides part of the floor from one side of the view volume, the specular and dynamic
 // variants, the curve's monotonicity, the stopping rule, determinism, the Hammersley comparison
-// rig, and the errors.
+// rig, a model file's rig whatever its unit, and the errors.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+#include <filesystem>
+#include <fstream>
 #include <set>
 #include <string>
 #include <tuple>
@@ -279,6 +282,82 @@ TEST(RigPlacement, VolumeInsideGeometryIsAnError) {
   auto r = place_cameras(s, o, 1);
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().id(), ErrorId::kPlacementVolume);
+}
+
+// A model file as a user brings one: a 4 x 4 floor with a 1 x 1 x 1 box on it, as OBJ text in
+// units where the floor is 4 * scale wide (scale 100: the same model in centimetres). Every
+// coordinate is exact in float at both scales.
+std::string floor_and_box_obj(double scale) {
+  std::string text;
+  auto v = [&](double x, double y, double z) {
+    text += "v " + std::to_string(x * scale) + " " + std::to_string(y * scale) + " " +
+            std::to_string(z * scale) + "\n";
+  };
+  v(-2, 0, -2), v(2, 0, -2), v(2, 0, 2), v(-2, 0, 2);  // floor: 1-4
+  for (int i = 0; i < 8; ++i) v(i & 1 ? 0.5 : -0.5, i & 2 ? 1 : 0, i & 4 ? 0.5 : -0.5);  // 5-12
+  text += "f 1 4 3\nf 1 3 2\n";
+  // The box's six faces (vertex 5 + bits: x = 1, y = 2, z = 4), wound outwards.
+  const int quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+  for (const auto& q : quads) {
+    text += "f " + std::to_string(5 + q[0]) + " " + std::to_string(5 + q[1]) + " " +
+            std::to_string(5 + q[2]) + " " + std::to_string(5 + q[3]) + "\n";
+  }
+  return text;
+}
+
+Expected<PlacementResult> place_on_model(double scale) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("calf_rig_placement_model_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path file =
+      dir / ("floor_and_box_x" + std::to_string(int(scale)) + ".obj");
+  std::ofstream(file) << floor_and_box_obj(scale);
+  Expected<Scene> scene = load_scene_file(file);
+  std::filesystem::remove_all(dir);
+  if (!scene.ok()) return scene.status();
+  PlacementOptions o;
+  o.text = "auto (test)";
+  o.candidates = 128;
+  o.samples = 2048;
+  o.max_cameras = 4;
+  o.stop = 0;
+  o.threads = 2;
+  return place_cameras(*scene, o, 1);
+}
+
+// Until stop 42 k was per scene unit and a model's view volume held the model: in centimetres
+// every camera's suitability underflowed but the nearest ones', the ring the model file comes
+// with scored coverage 0.000000 and Alg. 1 put cameras between the spider's legs (7.94 dB on
+// issue 16's protocol). Now k is per the model's bounding radius and no camera goes inside its
+// bounding sphere: the same model in any unit gets the same rig, scaled.
+TEST(RigPlacement, ModelFileGetsTheSameRigInAnyUnit) {
+  auto metres = place_on_model(1);
+  auto centimetres = place_on_model(100);
+  ASSERT_TRUE(metres.ok()) << metres.status().to_string();
+  ASSERT_TRUE(centimetres.ok()) << centimetres.status().to_string();
+  const Rig& rig = metres->rig;
+  ASSERT_GT(rig.keep_out_radius, 0);
+  EXPECT_NEAR(metres->length_scale, rig.keep_out_radius, 1e-12);  // the bounding radius
+  EXPECT_NEAR(centimetres->rig.keep_out_radius, 100 * rig.keep_out_radius,
+              1e-9 * centimetres->rig.keep_out_radius);
+  ASSERT_EQ(metres->curve.size(), 4u) << metres->stop_reason;
+  ASSERT_EQ(centimetres->curve.size(), metres->curve.size());
+  for (size_t i = 0; i < metres->curve.size(); ++i) {
+    const CoverageRow& m = metres->curve[i];
+    const CoverageRow& c = centimetres->curve[i];
+    EXPECT_NEAR(c.position.x, 100 * m.position.x, 1e-6 * rig.keep_out_radius * 100) << i;
+    EXPECT_NEAR(c.position.y, 100 * m.position.y, 1e-6 * rig.keep_out_radius * 100) << i;
+    EXPECT_NEAR(c.position.z, 100 * m.position.z, 1e-6 * rig.keep_out_radius * 100) << i;
+    EXPECT_NEAR(c.coverage, m.coverage, 1e-4) << i;
+    EXPECT_NEAR(c.hand_made, m.hand_made, 1e-4) << i;
+    // Outside the model's bounding sphere, where a viewer walking around it can be.
+    EXPECT_GE(length(m.position - rig.keep_out_center), rig.keep_out_radius) << i;
+  }
+  // The model's own ring (8 views at twice the radius) covers a real share, in both units.
+  EXPECT_GT(metres->hand_made_coverage, 0.1);
+  EXPECT_NEAR(centimetres->hand_made_coverage, metres->hand_made_coverage, 1e-4);
+  EXPECT_GT(metres->curve.back().coverage, metres->hand_made_coverage * 0.5);
 }
 
 TEST(RigPlacement, ReportFiles) {

@@ -8,7 +8,10 @@
 // mean over those frames). For a viewpoint O and a surface point x,
 //   I_suit(O, x) = V(O, x) exp(-k max(|x - O| - Z(x), 0))                              (Eq. 2)
 // with V the visibility (an occlusion ray from O stopping just short of x) and Z(x) the distance
-// from x to the view volume (the paper's minimum viewer distance: no viewer gets closer). The
+// from x to the view volume (the paper's minimum viewer distance: no viewer gets closer), or,
+// where the rig keeps viewers out of a ball around an object (Rig::keep_out_radius), the larger
+// of that and x's distance to the ball's surface; k is per Scene::length_scale (1 for the
+// built-in scenes; a model file's bounding radius, so that its file's unit does not matter). The
 // gain of adding O to the chosen set C is
 //   f(O, C) = integral over S of max(I_suit(O, x) - max_{i in C'} I_suit(C_i, x), 0)  (Eqs. 3-4)
 // where C' is every chosen camera in the diffuse variant, and in the specular variant (Eq. 6)
@@ -24,10 +27,10 @@
 // at most 1; in the specular variant a point seen from several directions counts once per
 // direction, so it may exceed 1.
 //
-// Candidates inside geometry at any of the capture's frames (FrameTracer::inside_geometry) are
-// never chosen, and Hammersley points inside geometry are skipped (the set grows, up to 2N, until N
-// are outside). Deterministic: every candidate's gain is a sum in a fixed order, whatever
-// `threads`.
+// Candidates inside geometry at any of the capture's frames (FrameTracer::inside_geometry) or
+// inside the keep-out ball are never chosen, and Hammersley points there are skipped (the set
+// grows, up to 2N, until N are outside). Deterministic: every candidate's gain is a sum in a fixed
+// order, whatever `threads`.
 #pragma once
 
 #include <cstdint>
@@ -48,7 +51,7 @@ struct PlacementOptions {
   uint32_t candidates = 512;  // about this many grid points span the volume, 1..65536
   uint32_t samples = 16384;   // surface points over all frames, 16..4194304
   uint32_t frames = 1;        // frames of Eq. 7 (evenly spread over the capture), 1..256
-  double k = 1;               // proximity decay per scene unit, >= 0 (0: visibility alone)
+  double k = 1;               // proximity decay per Scene::length_scale, >= 0 (0: visibility)
   double stop = 0.01;         // stop when a gain is below stop x R, [0, 1]; 0: only at gain 0
   bool specular = false;      // Eq. 6
   double theta_degrees = 50;  // the specular variant's minimum view angle, (0, 180]
@@ -83,7 +86,8 @@ struct PlacementResult {
   double hammersley_coverage = 0;  // coverage of a Hammersley rig (kHammersley: the one returned)
   double hand_made_coverage = 0;   // the scene's default rig's, all of it
   uint32_t hand_made_count = 0;
-  uint32_t candidates = 0;  // grid points outside geometry
+  uint32_t candidates = 0;  // grid points outside geometry and the rig's keep-out ball
+  double length_scale = 1;  // the scene's: k was applied per this many scene units
   uint32_t surface_samples = 0;
   uint64_t rays = 0;
   double seconds = 0;

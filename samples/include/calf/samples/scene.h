@@ -118,6 +118,11 @@ struct Sky {
 struct Rig {
   std::vector<capture::Viewpoint> viewpoints;
   Box3 view_volume;
+  // A ball inside the view volume where no viewer goes: the object a viewer walks around (a
+  // model file's bounding sphere; camera placement puts no camera in it and measures each surface
+  // point's minimum viewer distance to its boundary). Radius 0: none (the whole box is open).
+  Vec3 keep_out_center;
+  double keep_out_radius = 0;
   std::string description;  // the --rig text that makes it, e.g. "box:0,1.6,0,0.5,0.3,0.5"
 };
 
@@ -143,6 +148,11 @@ struct Scene {
   uint32_t frame_count = 30;
   Rig default_rig;
   EyePathAt validation_path;
+  // A length typical of the scene, in scene units, for the knobs that would otherwise depend on
+  // the unit a file happens to use (camera placement's proximity decay k is per this length):
+  // 1 for the built-in scenes (metres), a model file's bounding radius (a model in centimetres
+  // and the same model in metres then get the same rig, scaled).
+  double length_scale = 1;
 
   // Whether any material reflects or refracts: only then does a capture carry material channels.
   bool has_mirror_or_glass() const;
