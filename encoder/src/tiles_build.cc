@@ -39,6 +39,17 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// The share of the merged points' weight (captured samples) inside the view volume.
+double share_inside_view_volume(const tiles::MergedPoints& points, const Vec3& origin,
+                                const Box3& volume) {
+  double inside = 0, total = 0;
+  for (size_t i = 0; i < points.position.size(); ++i) {
+    total += points.weight[i];
+    if (volume.contains(points.position[i] + origin)) inside += points.weight[i];
+  }
+  return total > 0 ? inside / total : 0;
+}
+
 }  // namespace
 
 Status validate_tiles_build_options(const TilesBuildOptions& o) {
@@ -242,7 +253,26 @@ Expected<TileSet> build_tiles(const capture::CaptureSetReader& reader, uint32_t 
 
   // 3. Selection.
   t0 = std::chrono::steady_clock::now();
-  CALF_ASSIGN_OR_RETURN(Selection selection, select_tiles(candidates, f, selection_options));
+  Expected<Selection> selected = select_tiles(candidates, f, selection_options);
+  if (!selected.ok() && selected.status().id() == ErrorId::kTilesBudget) {
+    // A capture around a model (a model file's default ring, turntable's sphere) puts the model
+    // inside the view region, where Seurat's model is not defined: say so rather than leave the
+    // user to raise budgets that no setting meets.
+    const double inside = share_inside_view_volume(points, f.origin, m.view_volume);
+    if (inside >= 0.01) {
+      return Status(
+          ErrorId::kTilesBudget,
+          selected.status().message() +
+              sformat("; %.0f %% of the captured surface lies inside the view region (%g,%g,%g "
+                      ".. %g,%g,%g), where layered tiles are not defined: capture from a rig "
+                      "beside the model, e.g. --rig box:..., not around it (docs/TILES.md, "
+                      "\"Content from outside the project\")",
+                      100 * inside, m.view_volume.min.x, m.view_volume.min.y, m.view_volume.min.z,
+                      m.view_volume.max.x, m.view_volume.max.y, m.view_volume.max.z));
+    }
+  }
+  if (!selected.ok()) return selected.status();
+  Selection selection = std::move(*selected);
   selection.tiles.insert(selection.tiles.end(), sky.begin(), sky.end());
   if (!sky.empty()) {
     selection.average_overdraw += sky_area;

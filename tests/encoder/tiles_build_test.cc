@@ -59,14 +59,15 @@ std::pair<double, int> trace(const Vec3& e, const Vec3& d) {
 
 // Writes the room's capture set (`sky`: every depth +inf instead; `open_top`: the +Y wall is sky,
 // still in its colour; `blend_edges`: a texel beside one of another surface holds the mean of
-// both colours, as a box-filtered capture's silhouette texels do) and returns its directory.
+// both colours, as a box-filtered capture's silhouette texels do; `view_half`: the view volume's
+// half size around the centre) and returns its directory.
 fs::path write_room(const std::string& name, bool sky = false, bool open_top = false,
-                    bool blend_edges = false) {
+                    bool blend_edges = false, double view_half = 0.1) {
   const fs::path dir = test::scratch_dir("tiles_build_test") / name;
   capture::CaptureManifest m;
   m.frame_count = 1;
   m.face_size = kFace;
-  m.view_volume = {{-0.1, -0.1, -0.1}, {0.1, 0.1, 0.1}};
+  m.view_volume = {{-view_half, -view_half, -view_half}, {view_half, view_half, view_half}};
   m.viewpoints = {{"centre", {0, 0, 0}}, {"a", {0.1, 0.1, 0.1}}, {"b", {-0.1, -0.05, 0.1}}};
   auto w = capture::CaptureSetWriter::create(dir, m);
   EXPECT_TRUE(w.ok()) << w.status().to_string();
@@ -485,6 +486,18 @@ TEST(TilesBuild, Errors) {
   EXPECT_EQ(budget.status().id(), ErrorId::kTilesBudget) << budget.status().to_string();
   EXPECT_NE(budget.status().message().find("192"), std::string::npos)
       << budget.status().to_string();
+  EXPECT_EQ(budget.status().message().find("inside the view region"), std::string::npos)
+      << budget.status().to_string();
+  // A capture around its content (the view volume, 2.4 on each side, holds the panel and the
+  // x and y walls): the same budget error says that most of the surface lies inside the region,
+  // which no budget cures, and stays one line.
+  auto around = build(o, nullptr, 0, write_room("around", false, false, false, 2.4));
+  ASSERT_FALSE(around.ok());
+  EXPECT_EQ(around.status().id(), ErrorId::kTilesBudget) << around.status().to_string();
+  EXPECT_NE(around.status().message().find("of the captured surface lies inside the view region"),
+            std::string::npos)
+      << around.status().to_string();
+  EXPECT_EQ(around.status().message().find('\n'), std::string::npos);
 
   o = small_options();
   o.max_average_overdraw = 0.5;  // a closed room needs at least 1
