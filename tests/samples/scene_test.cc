@@ -158,6 +158,20 @@ TEST(Scenes, ValidationCatchesBadScenes) {
   s.materials[0].reflect = 0.7f;
   s.materials[0].refract = 0.7f;
   EXPECT_EQ(validate_scene(s).id(), ErrorId::kSceneGeometry);
+  s.materials[0] = Material{};
+  ASSERT_TRUE(validate_scene(s).ok());
+  // Camera placement divides by the length scale and measures from the keep-out ball.
+  for (double bad : {0.0, -1.0, std::nan(""), double{INFINITY}}) {
+    s.length_scale = bad;
+    EXPECT_EQ(validate_scene(s).id(), ErrorId::kSceneGeometry) << bad;
+  }
+  s.length_scale = 1;
+  for (double bad : {-1.0, std::nan(""), double{INFINITY}}) {
+    s.default_rig.keep_out_radius = bad;
+    EXPECT_EQ(validate_scene(s).id(), ErrorId::kSceneGeometry) << bad;
+  }
+  s.default_rig.keep_out_radius = 0;
+  EXPECT_TRUE(validate_scene(s).ok());
 }
 
 class AssimpTest : public ::testing::Test {
