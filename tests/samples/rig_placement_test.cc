@@ -4,13 +4,14 @@
 // rig, a model file's rig whatever its unit, and the errors.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
 #include <string>
 #include <tuple>
 
+#include "../scratch_dir.h"
 #include "calf/samples/rig_placement.h"
 
 namespace calf::samples {
@@ -307,14 +308,10 @@ std::string floor_and_box_obj(double scale) {
 }
 
 Expected<PlacementResult> place_on_model(double scale) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
-                                    ("calf_rig_placement_model_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  const std::filesystem::path file =
-      dir / ("floor_and_box_x" + std::to_string(int(scale)) + ".obj");
+  const std::filesystem::path file = test::scratch_dir("calf_rig_placement_test") /
+                                     ("floor_and_box_x" + std::to_string(int(scale)) + ".obj");
   std::ofstream(file) << floor_and_box_obj(scale);
   Expected<Scene> scene = load_scene_file(file);
-  std::filesystem::remove_all(dir);
   if (!scene.ok()) return scene.status();
   PlacementOptions o;
   o.text = "auto (test)";
@@ -337,10 +334,12 @@ TEST(RigPlacement, ModelFileGetsTheSameRigInAnyUnit) {
   ASSERT_TRUE(metres.ok()) << metres.status().to_string();
   ASSERT_TRUE(centimetres.ok()) << centimetres.status().to_string();
   const Rig& rig = metres->rig;
-  ASSERT_GT(rig.keep_out_radius, 0);
-  EXPECT_NEAR(metres->length_scale, rig.keep_out_radius, 1e-12);  // the bounding radius
-  EXPECT_NEAR(centimetres->rig.keep_out_radius, 100 * rig.keep_out_radius,
-              1e-9 * centimetres->rig.keep_out_radius);
+  // The bounding box (-2, 0, -2) .. (2, 1, 2): half its diagonal, sqrt(33) / 2.
+  const double radius = std::sqrt(33.0) / 2;
+  ASSERT_NEAR(rig.keep_out_radius, radius, 1e-6 * radius);
+  EXPECT_NEAR(metres->length_scale, radius, 1e-6 * radius);
+  EXPECT_NEAR(centimetres->rig.keep_out_radius, 100 * radius, 1e-4 * radius);
+  EXPECT_NEAR(centimetres->length_scale, 100 * radius, 1e-4 * radius);
   ASSERT_EQ(metres->curve.size(), 4u) << metres->stop_reason;
   ASSERT_EQ(centimetres->curve.size(), metres->curve.size());
   for (size_t i = 0; i < metres->curve.size(); ++i) {
