@@ -432,17 +432,29 @@ void CpuRenderer::shade_sky(const Vec3& /*origin*/, const Vec3& d, double* rgb) 
 }
 
 RaySample CpuRenderer::trace(const Vec3& origin, const Vec3& direction) const {
-  RaySample s;
   Hit hit;
-  if (!intersect(origin, direction, options_.near, &hit)) {
+  return shade_hit(origin, direction,
+                   intersect(origin, direction, options_.near, &hit) ? &hit : nullptr);
+}
+
+RaySample CpuRenderer::shade_at(const Vec3& origin, const Vec3& direction, double depth) const {
+  if (!std::isfinite(depth)) return shade_hit(origin, direction, nullptr);
+  const Hit hit{origin + direction * depth, depth};
+  return shade_hit(origin, direction, &hit);
+}
+
+// The colour and depth of a ray whose march ended at `hit` (nullptr: no surface).
+RaySample CpuRenderer::shade_hit(const Vec3& origin, const Vec3& direction, const Hit* hit) const {
+  RaySample s;
+  if (!hit) {
     shade_sky(origin, direction, s.rgb);
     s.depth = kInf;
     return s;
   }
   s.hit = true;
-  s.depth = hit.z;
+  s.depth = hit->z;
   if (options_.rr) {
-    shade_rr(origin, direction, hit, 0, s.rgb);
+    shade_rr(origin, direction, *hit, 0, s.rgb);
     // With replacement a ray's colour is c_view + sum of w (c_eye - c_view): negative where a
     // view saw a brighter reflection than the eye does. Intermediate bounces stay linear (the
     // GL renderer sums the ray tree in any order); the pixel is clamped.
@@ -451,7 +463,7 @@ RaySample CpuRenderer::trace(const Vec3& origin, const Vec3& direction) const {
     }
   } else {
     int best;
-    shade_surface(origin, hit.p, s.rgb, &best);
+    shade_surface(origin, hit->p, s.rgb, &best);
   }
   return s;
 }

@@ -43,6 +43,7 @@
 
 #include "calf/capture/capture_set.h"
 #include "calf/capture/eye_path.h"
+#include "calf/format/camera.h"
 #include "calf/format/colour.h"
 #include "calf/player/capture_views.h"
 #include "calf/player/cpu_renderer.h"
@@ -217,6 +218,27 @@ RenderedImage box_down(const RenderedImage& in, uint32_t k) {
 
 uint32_t g_supersample = 1;
 bool g_breakdown = false;
+// --gt-depth: which eye rays are shaded at the reference's depth instead of where the march ends.
+enum class GtDepth { kNone, kAll, kSky };
+GtDepth g_gt_depth = GtDepth::kNone;
+
+// Re-shades the rays of `img` (rendered by `renderer` from `cam`, one ray per pixel) that
+// g_gt_depth names at `reference`'s depth: all of them, or those the reference sends to the sky
+// while the renderer hit something. What is left is the error of the shading alone.
+void shade_at_reference_depth(const CpuRenderer& renderer, const Camera& cam,
+                              const RenderedImage& reference, RenderedImage* img) {
+  const CameraFrame frame = camera_frame(cam);
+  for (uint32_t j = 0; j < cam.height; ++j) {
+    for (uint32_t i = 0; i < cam.width; ++i) {
+      const size_t k = size_t{j} * cam.width + i;
+      const double z = reference.depth[k];
+      if (g_gt_depth == GtDepth::kSky && !(std::isinf(z) && std::isfinite(img->depth[k]))) continue;
+      const RaySample s = renderer.shade_at(cam.position, camera_ray(cam, frame, i, j), z);
+      for (int ch = 0; ch < 3; ++ch) img->color[3 * k + ch] = static_cast<float>(s.rgb[ch]);
+      img->depth[k] = static_cast<float>(s.depth);
+    }
+  }
+}
 
 // Where the squared error of a reconstruction sits, by what the ground truth shows at each pixel
 // (--breakdown; docs/RENDERING.md "Quality"):
@@ -361,6 +383,7 @@ std::vector<Score> measure(const char* section, std::vector<Pose>& poses, FrameC
       RenderedImage img;
       const double t0 = now_s();
       if (Status s = renderer.render(cam, &img); !s.ok()) die(s);
+      if (g_gt_depth != GtDepth::kNone) shade_at_reference_depth(renderer, cam, p.reference, &img);
       img = box_down(img, g_supersample);
       Score s;
       s.ms = 1e3 * (now_s() - t0);
@@ -495,7 +518,22 @@ int main(int argc, char** argv) {
                "print where the squared error sits: sky, grown, hole, edge, wrong depth, surface, "
                "mirror, glass pixels (not with --supersample)");
   app.add_option("--out", out_dir, "write renders, references and heat maps (PNG) here");
+  std::string gt_depth_arg = "none";
+  app.add_option("--gt-depth", gt_depth_arg,
+                 "none; all: shade every eye ray at the reference's depth instead of where the "
+                 "march ends (the error the shading leaves when the geometry is exact); sky: only "
+                 "the rays that the reference sends to the sky and the march ends on a surface "
+                 "(with --render-supersample 1; use --supersample K for anti-aliased figures)")
+      ->check(CLI::IsMember({"none", "all", "sky"}))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  g_gt_depth = gt_depth_arg == "all"   ? GtDepth::kAll
+               : gt_depth_arg == "sky" ? GtDepth::kSky
+                                       : GtDepth::kNone;
+  if (g_gt_depth != GtDepth::kNone && base.supersample != 1) {
+    die(Status(ErrorId::kInvalidArgument,
+               "--gt-depth needs --render-supersample 1: the reference has one depth per pixel"));
+  }
 
   if (g_supersample < 1 || g_supersample > 8) {
     die(Status(ErrorId::kInvalidArgument, "--supersample must be in 1..8"));

@@ -237,6 +237,12 @@ class CpuRenderer {
   // One ray from `origin` along unit `direction`: Alg. 4 Main (or Main_RR with options.rr).
   RaySample trace(const Vec3& origin, const Vec3& direction) const;
 
+  // What trace() returns for the same ray if its march had ended at radial distance `depth`
+  // (+inf or NaN: it found no surface and shows the sky): the same shading, plain or RR, without
+  // the march. A diagnostic: given a ground truth's depth it measures the error the shading alone
+  // leaves when the geometry is exact (bench-player_quality --gt-depth).
+  RaySample shade_at(const Vec3& origin, const Vec3& direction, double depth) const;
+
   const RenderOptions& options() const { return options_; }
 
  private:
@@ -245,6 +251,7 @@ class CpuRenderer {
     Vec3 p;        // the surface point
     double z = 0;  // its distance from the ray origin
   };
+  RaySample shade_hit(const Vec3& origin, const Vec3& direction, const Hit* hit) const;
   double tap_purity(const View& v, const Texel& t) const;
   bool empty_at(const Vec3& p) const;
   bool empty_beyond(const Vec3& p, double margin_texels, uint32_t vetoes_ignored) const;
