@@ -163,11 +163,12 @@ TEST(CpuRenderer, ShadeAtTheMarchDepthIsTheTraceAndExactDepthIsBetter) {
       CpuRenderer::make(views, *march_range_for(views, cam.position, {}));
   ASSERT_TRUE(r.ok());
   RenderedImage exact = marched;
+  const CameraFrame exact_frame = camera_frame(cam);
   for (uint32_t j = 0; j < cam.height; ++j) {
     for (uint32_t i = 0; i < cam.width; ++i) {
       const size_t k = size_t{j} * cam.width + i;
       const RaySample s =
-          r->shade_at(cam.position, camera_ray(cam, camera_frame(cam), i, j), gt.depth[k]);
+          r->shade_at(cam.position, camera_ray(cam, exact_frame, i, j), gt.depth[k]);
       for (int ch = 0; ch < 3; ++ch) exact.color[3 * k + ch] = static_cast<float>(s.rgb[ch]);
     }
   }

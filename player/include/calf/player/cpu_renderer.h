@@ -237,7 +237,7 @@ class CpuRenderer {
   // One ray from `origin` along unit `direction`: Alg. 4 Main (or Main_RR with options.rr).
   RaySample trace(const Vec3& origin, const Vec3& direction) const;
 
-  // What trace() returns for the same ray if its march had ended at radial distance `depth`
+  // What trace() returns for the same ray if its march had ended at radial distance `depth` >= 0
   // (+inf or NaN: it found no surface and shows the sky): the same shading, plain or RR, without
   // the march. A diagnostic: given a ground truth's depth it measures the error the shading alone
   // leaves when the geometry is exact (bench-player_quality --gt-depth).
