@@ -523,7 +523,8 @@ int main(int argc, char** argv) {
                  "none; all: shade every eye ray at the reference's depth instead of where the "
                  "march ends (the error the shading leaves when the geometry is exact); sky: only "
                  "the rays that the reference sends to the sky and the march ends on a surface "
-                 "(with --render-supersample 1; use --supersample K for anti-aliased figures)")
+                 "(with --render-supersample 1; use --supersample K for anti-aliased figures; "
+                 "the ms column then includes the re-shading)")
       ->check(CLI::IsMember({"none", "all", "sky"}))
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
