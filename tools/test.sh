@@ -20,7 +20,8 @@ ctest --test-dir "$BUILD" --output-on-failure -j"$(nproc)" "$@"
 # (format/SPEC.md §11.1.4: binary32, no fused multiply-add; CMakeLists.txt builds the format and
 # decoder layers with -ffp-contract=off): calf-verify built by clang at -O3 -march=native must
 # print every lightfield, tiles, mesh and surfels clip's committed lines. Only calf-verify and the
-# two layers it links are built.
+# two layers it links are built: measured 532 s to build and 21 s to run the 32 entries on the
+# 2-core VM while other builds loaded it (load average ≈ 14), so less on an idle one.
 if [ $# -eq 0 ]; then
   CONF=build/clang-conformance
   cmake -S . -B "$CONF" -G Ninja -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
