@@ -8,7 +8,8 @@
 //     writes an eye path of 5 poses inside the capture set's view volume: its centre and four
 //     points at 40 % of the way to corners, each looking in another direction
 //   node three_compare.js compare NPM_DIR CHROMIUM MODEL.glb EYE_PATH.json FRAMES_DIR MIN_DB
-//     prints "pose P: PSNR X dB" per pose and "three.js <version>: min PSNR X dB over N poses in
+//     prints "pose P: PSNR X dB (blending in linear colour: Y dB)" per pose (X: three.js's
+//     default rendering into the canvas, the figure MIN_DB applies to) and "three.js <version>: min PSNR X dB over N poses in
 //     T s"; exits 1 when a pose is below MIN_DB or its canvas is blank (one colour)
 'use strict';
 const fs = require('fs');
@@ -117,7 +118,8 @@ async function compare([npmDir, chromium, model, eyePath, framesDir, minDb]) {
   }
   let worst = Infinity, ok = true;
   result.poses.forEach((p, i) => {
-    console.log(`pose ${i}: PSNR ${p.psnr.toFixed(2)} dB${p.blank ? ' (blank canvas)' : ''}`);
+    console.log(`pose ${i}: PSNR ${p.psnr.toFixed(2)} dB${p.blank ? ' (blank canvas)' : ''} ` +
+                `(blending in linear colour: ${p.psnrLinear.toFixed(2)} dB)`);
     worst = Math.min(worst, p.psnr);
     if (p.blank || !(p.psnr >= Number(minDb))) ok = false;
   });
