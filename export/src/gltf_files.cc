@@ -13,8 +13,8 @@
 
 #include <assimp/GltfMaterial.h>
 #include <assimp/material.h>
-#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
+#include <nlohmann/json.hpp>
 
 namespace calf::exporter {
 namespace {
@@ -107,7 +107,8 @@ tinygltf::Primitive make_primitive(const aiMesh& mesh, int material, BufferBuild
   if (mesh.mColors[0] != nullptr) {
     values.clear();
     for (unsigned i = 0; i < n; ++i) {
-      values.insert(values.end(), {mesh.mColors[0][i].r, mesh.mColors[0][i].g, mesh.mColors[0][i].b});
+      values.insert(values.end(),
+                    {mesh.mColors[0][i].r, mesh.mColors[0][i].g, mesh.mColors[0][i].b});
     }
     primitive.attributes["COLOR_0"] = buffer->add_floats(values, 3, false);
   }
@@ -115,7 +116,8 @@ tinygltf::Primitive make_primitive(const aiMesh& mesh, int material, BufferBuild
     values.clear();
     for (unsigned i = 0; i < n; ++i) {
       // assimp's v runs up, glTF's down.
-      values.insert(values.end(), {mesh.mTextureCoords[0][i].x, 1.0f - mesh.mTextureCoords[0][i].y});
+      values.insert(values.end(),
+                    {mesh.mTextureCoords[0][i].x, 1.0f - mesh.mTextureCoords[0][i].y});
     }
     primitive.attributes["TEXCOORD_0"] = buffer->add_floats(values, 2, false);
   }
@@ -153,19 +155,21 @@ Expected<tinygltf::Material> make_material(const aiScene& scene, const aiMateria
   float cutoff = 0.5f;
   if (source.Get(AI_MATKEY_GLTF_ALPHACUTOFF, cutoff) == AI_SUCCESS) material.alphaCutoff = cutoff;
   int two_sided = 0;
-  if (source.Get(AI_MATKEY_TWOSIDED, two_sided) == AI_SUCCESS) material.doubleSided = two_sided != 0;
+  if (source.Get(AI_MATKEY_TWOSIDED, two_sided) == AI_SUCCESS)
+    material.doubleSided = two_sided != 0;
   int shading = 0;
-  if (source.Get(AI_MATKEY_SHADING_MODEL, shading) == AI_SUCCESS && shading == aiShadingMode_Unlit) {
+  if (source.Get(AI_MATKEY_SHADING_MODEL, shading) == AI_SUCCESS &&
+      shading == aiShadingMode_Unlit) {
     material.extensions[kUnlit] = tinygltf::Value(tinygltf::Value::Object());
   }
   aiString path;
   if (source.Get(AI_MATKEY_TEXTURE(aiTextureType_DIFFUSE, 0), path) == AI_SUCCESS) {
     const std::string p = path.C_Str();
     unsigned index = 0;
-    if (p.size() < 2 || p[0] != '*' || (index = static_cast<unsigned>(std::stoul(p.substr(1)))) >=
-                                           scene.mNumTextures) {
-      return Status(ErrorId::kExportWrite, "material '" + material.name +
-                                               "': texture '" + p + "' is not embedded");
+    if (p.size() < 2 || p[0] != '*' ||
+        (index = static_cast<unsigned>(std::stoul(p.substr(1)))) >= scene.mNumTextures) {
+      return Status(ErrorId::kExportWrite,
+                    "material '" + material.name + "': texture '" + p + "' is not embedded");
     }
     // The sampler: glTF's defaults (repeat, the engine's filtering) unless the material sets
     // the wrap modes or filters.
@@ -181,9 +185,11 @@ Expected<tinygltf::Material> make_material(const aiScene& scene, const aiMateria
       sampler.wrapT = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
     }
     int filter = 0;
-    if (source.Get(AI_MATKEY_GLTF_MAPPINGFILTER_MAG(aiTextureType_DIFFUSE, 0), filter) == AI_SUCCESS)
+    if (source.Get(AI_MATKEY_GLTF_MAPPINGFILTER_MAG(aiTextureType_DIFFUSE, 0), filter) ==
+        AI_SUCCESS)
       sampler.magFilter = filter;
-    if (source.Get(AI_MATKEY_GLTF_MAPPINGFILTER_MIN(aiTextureType_DIFFUSE, 0), filter) == AI_SUCCESS)
+    if (source.Get(AI_MATKEY_GLTF_MAPPINGFILTER_MIN(aiTextureType_DIFFUSE, 0), filter) ==
+        AI_SUCCESS)
       sampler.minFilter = filter;
     int sampler_index = -1;
     for (size_t i = 0; i < model->samplers.size(); ++i) {
@@ -230,7 +236,7 @@ Expected<std::vector<ExportedFile>> write_gltf(const aiScene& scene, MeshExportF
   model.asset.version = "2.0";
   model.asset.generator = "calf-export";
   BufferBuilder buffer(&model);
-  std::map<unsigned, int> material_of;  // assimp material -> glTF material
+  std::map<unsigned, int> material_of;                 // assimp material -> glTF material
   std::map<std::pair<unsigned, int>, int> texture_of;  // (embedded texture, sampler) -> texture
   std::map<std::vector<unsigned>, int> mesh_of;
   const auto add_node = [&](const aiNode& source) -> Expected<int> {
@@ -250,11 +256,12 @@ Expected<std::vector<ExportedFile>> write_gltf(const aiScene& scene, MeshExportF
         for (unsigned m : meshes) {
           const aiMesh& source_mesh = *scene.mMeshes[m];
           const unsigned mi = source_mesh.mMaterialIndex;
-          auto [mat, new_material] = material_of.try_emplace(mi, static_cast<int>(model.materials.size()));
+          auto [mat, new_material] =
+              material_of.try_emplace(mi, static_cast<int>(model.materials.size()));
           if (new_material) {
-            CALF_ASSIGN_OR_RETURN(tinygltf::Material material,
-                                  make_material(scene, *scene.mMaterials[mi], &model, &buffer,
-                                                &texture_of));
+            CALF_ASSIGN_OR_RETURN(
+                tinygltf::Material material,
+                make_material(scene, *scene.mMaterials[mi], &model, &buffer, &texture_of));
             model.materials.push_back(std::move(material));
           }
           mesh.primitives.push_back(make_primitive(source_mesh, mat->second, &buffer));
