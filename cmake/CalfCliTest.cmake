@@ -6,6 +6,7 @@
 #   FORBID         paths that must not exist afterwards (';'-list): nothing half-written
 #   CLEAN          a directory removed before the run, so FORBID checks this run only
 #   STATUS         the exact exit status expected (e.g. 2 for a usage error), when set
+#   STDERR         with "ok": a regular expression stderr must match (a warning), when set
 if(CLEAN)
   file(REMOVE_RECURSE "${CLEAN}")
 endif()
@@ -34,6 +35,9 @@ else()
     message(FATAL_ERROR "expected exit 0 from: ${shown} (got ${rc})\nstderr: ${err}")
   endif()
   set(checked "${out}")
+endif()
+if(EXPECT STREQUAL "ok" AND NOT "${STDERR}" STREQUAL "" AND NOT err MATCHES "${STDERR}")
+  message(FATAL_ERROR "stderr of ${shown} does not match '${STDERR}':\n${err}")
 endif()
 if(REGEX AND NOT checked MATCHES "${REGEX}")
   message(FATAL_ERROR "output of ${shown} does not match '${REGEX}':\n${checked}")

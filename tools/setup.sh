@@ -19,6 +19,8 @@ PACKAGES=(
   libsquish-dev
   # capture ray tracer and scene loading
   libembree-dev libassimp-dev
+  # export: glTF writer (header-only); headless Chromium, the browser of the three.js export test
+  libtinygltf-dev chromium
   # textured models the texture tests load when present (BoxTextured, CesiumMilkTruck)
   assimp-testmodels
   # player: GL, window, headless, maths, HUD
@@ -43,25 +45,33 @@ for p in "${PACKAGES[@]}"; do
   fi
 done
 
-# Khronos' glTF-Validator (npm), the second glTF reader of the export tests
-# (tests/export/gltf_validate.js), pinned, into build/npm; node and npm from Debian when the
-# machine has none.
-GLTF_VALIDATOR_VERSION=2.0.0-dev.3.10
-install_gltf_validator() {
-  local dir
+# The npm packages of the export tests, pinned, into build/npm: Khronos' glTF-Validator (the
+# second glTF reader, tests/export/gltf_validate.js), three.js and playwright-core (the browser
+# test, tests/export/three_compare.js, which drives Debian's chromium). node and npm from Debian
+# when the machine has none.
+NPM_PACKAGES=(gltf-validator@2.0.0-dev.3.10 three@0.187.0 playwright-core@1.64.1)
+install_npm_packages() {
+  local dir p name version
   dir="$(cd "$(dirname "$0")/.." && pwd)/build/npm"
-  if [ -f "$dir/node_modules/gltf-validator/package.json" ] &&
-     grep -q "\"version\": \"$GLTF_VALIDATOR_VERSION\"" "$dir/node_modules/gltf-validator/package.json"; then
-    return
-  fi
+  local wanted=()
+  for p in "${NPM_PACKAGES[@]}"; do
+    name="${p%@*}"
+    version="${p##*@}"
+    if ! [ -f "$dir/node_modules/$name/package.json" ] ||
+       ! grep -q "\"version\": \"$version\"" "$dir/node_modules/$name/package.json"; then
+      wanted+=("$p")
+    fi
+  done
+  if [ ${#wanted[@]} -eq 0 ]; then return; fi
   mkdir -p "$dir"
+  # All pinned packages at once: npm install --no-save removes what the command does not name.
   npm install --no-save --no-audit --no-fund --loglevel=error --prefix "$dir" \
-    "gltf-validator@$GLTF_VALIDATOR_VERSION" >/dev/null
-  echo "calf setup: glTF-Validator $GLTF_VALIDATOR_VERSION installed in $dir"
+    "${NPM_PACKAGES[@]}" >/dev/null
+  echo "calf setup: ${NPM_PACKAGES[*]} installed in $dir"
 }
 if [ ${#missing[@]} -eq 0 ]; then
   echo "calf setup: all ${#PACKAGES[@]} packages already installed"
-  install_gltf_validator
+  install_npm_packages
   exit 0
 fi
 
@@ -72,4 +82,4 @@ export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 echo "calf setup: done"
-install_gltf_validator
+install_npm_packages

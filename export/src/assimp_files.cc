@@ -11,20 +11,10 @@
 #include <assimp/texture.h>
 #include <assimp/Exporter.hpp>
 
+#include "gltf_files.h"
+
 namespace calf::exporter {
 namespace {
-
-const char* assimp_format_id(MeshExportFormat format) {
-  switch (format) {
-    case MeshExportFormat::kGlb:
-      return "glb2";
-    case MeshExportFormat::kGltf:
-      return "gltf2";
-    case MeshExportFormat::kObj:
-      return "obj";
-  }
-  return "glb2";
-}
 
 // assimp's exporters name the side files of a blob export after "$blobfile" (OBJ's
 // "mtllib $blobfile.mtl", glTF's buffer uri "$blobfile.bin"); the files are written as
@@ -77,8 +67,9 @@ std::string embed_png(aiScene* scene, const std::vector<uint8_t>& png) {
 
 Expected<std::vector<ExportedFile>> write_scene(const aiScene& scene, MeshExportFormat format,
                                                 const std::string& stem) {
+  if (format != MeshExportFormat::kObj) return write_gltf(scene, format, stem);
   Assimp::Exporter exporter;
-  const aiExportDataBlob* blob = exporter.ExportToBlob(&scene, assimp_format_id(format), 0);
+  const aiExportDataBlob* blob = exporter.ExportToBlob(&scene, "obj", 0);
   if (blob == nullptr) {
     return Status(ErrorId::kExportWrite,
                   std::string("assimp's exporter failed: ") + exporter.GetErrorString());

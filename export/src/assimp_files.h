@@ -1,6 +1,6 @@
 // What every calf exporter shares (private to export/): an RGBA8 image as PNG bytes, and an
-// assimp scene written by assimp's own glTF 2.0 / OBJ exporters (DESIGN.md: no hand-written glTF)
-// into the files of an export, the side files renamed after the output's stem.
+// assimp scene written into the files of an export (DESIGN.md: no hand-written glTF): glTF 2.0 by
+// tinygltf (gltf_files.h), OBJ by assimp's exporter, the side files named after the output's stem.
 #pragma once
 
 #include <cstdint>
@@ -23,9 +23,9 @@ Expected<std::vector<uint8_t>> png_bytes(const uint8_t* rgba, uint32_t width, ui
 // that path.
 std::string embed_png(aiScene* scene, const std::vector<uint8_t>& png);
 
-// Writes `scene` with assimp's exporter for `format`: the main file first (suffix ""), then its
-// side files (".bin", ".mtl"), each named after `stem` in the main file. CALF-E481 when assimp
-// fails (its message quoted).
+// Writes `scene` in `format` (glTF: write_gltf; OBJ: assimp's exporter): the main file first
+// (suffix ""), then its side files (".bin", ".mtl"), each named after `stem` in the main file.
+// CALF-E481 when the writer fails (assimp's message quoted).
 Expected<std::vector<ExportedFile>> write_scene(const aiScene& scene, MeshExportFormat format,
                                                 const std::string& stem);
 

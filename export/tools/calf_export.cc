@@ -1,8 +1,9 @@
 // calf-export: a mesh track of a .calf clip (a full scene or its visible set) or a tiles track
-// (layered quad tiles and their atlas) to glTF 2.0 (.glb / .gltf) or OBJ (+ .mtl) through
-// assimp's exporters (calf/export/mesh_export.h, calf/export/tiles_export.h, docs/EXPORT.md).
-// Errors are one line with a stable id and exit status 1; usage errors exit 2; every file is
-// written whole or not at all.
+// (layered quad tiles and their atlas) to glTF 2.0 (.glb / .gltf, written by tinygltf) or OBJ
+// (+ .mtl, written by assimp's exporter) (calf/export/mesh_export.h, calf/export/tiles_export.h,
+// docs/EXPORT.md). Errors are one line with a stable id and exit status 1; usage errors exit 2;
+// every file is written whole or not at all.
+#include <charconv>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -45,10 +46,14 @@ int main(int argc, char** argv) {
       "to 1) are kept, and base-colour textures as PNG (embedded in a .glb / .gltf's buffer; "
       "OUT_texture<n>.png beside an .obj).\n"
       "A tiles track (layered quad tiles, SPEC §11.2) becomes one mesh of two triangles per tile "
-      "(2 x N^2 with --subdivide N) with one unlit material: the atlas as PNG with straight "
+      "(2 x N^2 for a tile split N x N: --subdivide, by default each tile's own N), written back "
+      "to front from the view region's centre, with one unlit material (KHR_materials_unlit): the "
+      "atlas as PNG with straight "
       "alpha, alphaMode BLEND, single-sided (embedded in a .glb / .gltf; OUT_atlas.png beside an "
-      ".obj). Texture coordinates are the tiles' projective ones divided out per vertex (affine "
-      "inside a triangle: --subdivide bounds the difference; the largest is printed in texels)."
+      ".obj, as map_Kd and map_d). Texture coordinates are the tiles' projective ones divided out "
+      "per vertex (affine "
+      "inside a triangle: --subdivide bounds the difference; the largest is printed in texels, "
+      "and a warning when a fixed --subdivide leaves more than 2)."
       " Each file is written whole or not at all (a temporary file renamed into "
       "place).\n" +
       std::string(calf::tools::kExitStatusHelp)};
@@ -56,7 +61,7 @@ int main(int argc, char** argv) {
   uint32_t frame = 0;
   int track_option = -1;
   bool quiet = false;
-  uint32_t subdivide = 1;
+  std::string subdivide = "auto";
   app.add_option("CLIP", clip, "input .calf holding a mesh or tiles track")->required();
   app.add_option("-o,--output", out, "output .glb, .gltf or .obj")->required();
   app.add_option("--frame", frame,
@@ -67,8 +72,9 @@ int main(int argc, char** argv) {
                  "track)");
   app.add_option("--subdivide", subdivide,
                  "tiles track: split each of a tile's two triangles into N x N, 1..16, to bound "
-                 "the affine texture approximation (default 1)")
-      ->default_val(1);
+                 "the affine texture approximation, or auto: each tile the smallest N that keeps "
+                 "its error within 1 atlas texel (default auto)")
+      ->default_val("auto");
   app.add_flag("-q,--quiet", quiet, "print nothing on success");
   if (const int exit = calf::tools::parse_command_line(app, kCommand, argc, argv); exit >= 0) {
     return exit;
@@ -109,7 +115,7 @@ int main(int argc, char** argv) {
   const std::string base = out.substr(0, out.find_last_of('.'));
   calf::Expected<std::vector<calf::exporter::ExportedFile>> files =
       std::vector<calf::exporter::ExportedFile>{};
-  std::string summary;
+  std::string summary, warning;
   if (kind_of(track) == calf::container::TrackKind::kTiles) {
     if (frame != 0) {
       return fail(
@@ -119,7 +125,19 @@ int main(int argc, char** argv) {
     auto set = calf::decoder::decode_tiles_track(reader.value(), static_cast<uint16_t>(track));
     if (!set.ok()) return fail(set.status().with_context(clip));
     calf::exporter::TilesExportOptions options;
-    options.subdivide = subdivide;
+    if (subdivide != "auto") {
+      uint32_t n = 0;
+      const auto [end, ec] =
+          std::from_chars(subdivide.data(), subdivide.data() + subdivide.size(), n);
+      if (ec != std::errc() || end != subdivide.data() + subdivide.size() || n == 0) {
+        return calf::tools::print_error(
+            kCommand,
+            calf::Status(calf::ErrorId::kExportTilesOption,
+                         "subdivide " + subdivide + " is not auto or 1 .. 16"),
+            2);
+      }
+      options.subdivide = n;
+    }
     calf::exporter::TilesExportStats stats;
     files = calf::exporter::export_tile_set(set.value(), format.value(), file_name(base), options,
                                             &stats);
@@ -128,10 +146,18 @@ int main(int argc, char** argv) {
       return calf::tools::print_error(kCommand, files.status().with_context(clip), usage ? 2 : 1);
     }
     summary = fmt::format(
-        "{}: {} tiles, {} vertices, {} triangles, atlas {} x {}, largest affine texture error "
-        "{:.3f} texels",
-        out, stats.tiles, stats.vertices, stats.triangles, stats.atlas_width, stats.atlas_height,
-        stats.max_texel_error);
+        "{}: {} tiles, {} vertices, {} triangles ({:.2f} x the {} of whole tiles, subdivision {} "
+        "to {}), atlas {} x {}, largest affine texture error {:.3f} texels",
+        out, stats.tiles, stats.vertices, stats.triangles,
+        static_cast<double>(stats.triangles) / static_cast<double>(2 * stats.tiles),
+        2 * stats.tiles, stats.min_subdivide, stats.max_subdivide, stats.atlas_width,
+        stats.atlas_height, stats.max_texel_error);
+    if (options.subdivide != 0 && stats.max_texel_error > calf::exporter::kTilesTexelErrorWarning) {
+      warning = fmt::format(
+          "{}: warning: --subdivide {} leaves an affine texture error of {:.3f} texels (above "
+          "{:.0f}); --subdivide auto keeps every tile within 1",
+          kCommand, subdivide, stats.max_texel_error, calf::exporter::kTilesTexelErrorWarning);
+    }
   } else {
     auto mesh = calf::decoder::MeshTrack::open(reader.value(), static_cast<uint16_t>(track));
     if (!mesh.ok()) return fail(mesh.status().with_context(clip));
@@ -158,5 +184,6 @@ int main(int argc, char** argv) {
     if (calf::Status s = temp.commit(); !s.ok()) return fail(s);
   }
   if (!quiet) std::printf("%s\n", summary.c_str());
+  if (!warning.empty()) std::fprintf(stderr, "%s\n", warning.c_str());
   return calf::tools::kExitOk;
 }

@@ -1,12 +1,16 @@
 // calf/export/tiles_export.h: a tile set exported to glTF / OBJ and read back by assimp's
-// importer: two triangles per tile (2 n^2 with subdivision), one embedded PNG of the atlas's size
-// with straight alpha, the material's alpha mode BLEND and single-sided, texture coordinates
-// (U / W, V / W) at the corners. Expected values come from the synthetic tile set itself
-// (tests/integration/synthetic_tiles.h), not from the exporter. The second, independent glTF
-// reader (Khronos' glTF-Validator) runs in the CLI tests (cli.calf_export_tiles_*).
+// importer (and the .glb's JSON by nlohmann-json): two triangles per tile (2 n^2 with
+// subdivision), one embedded PNG of the atlas's size with straight alpha, the material's alpha
+// mode BLEND, single-sided and unlit, texture coordinates (U / W, V / W) at the corners, tiles
+// back to front from the view region's centre, the default per-tile subdivision, OBJ's map_d.
+// Expected values come from the synthetic tile set itself (tests/integration/synthetic_tiles.h),
+// not from the exporter. The second, independent glTF reader (Khronos' glTF-Validator) runs in the
+// CLI tests (cli.calf_export_tiles_*).
 #include "calf/export/tiles_export.h"
 
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -19,6 +23,7 @@
 #include <assimp/scene.h>
 #include <gtest/gtest.h>
 #include <assimp/Importer.hpp>
+#include <nlohmann/json.hpp>
 
 #include "../integration/synthetic_tiles.h"
 
@@ -53,10 +58,25 @@ TileSet small_set() {
   return test::make_synthetic_tile_set(2, 10, 62, 21);  // 24 tiles, 62 x 40
 }
 
+exporter::TilesExportOptions fixed(uint32_t n) {
+  exporter::TilesExportOptions o;
+  o.subdivide = n;
+  return o;
+}
+
+// The JSON chunk of a .glb (its 12-byte header, then the chunk's length and type).
+std::string glb_json(const std::vector<uint8_t>& glb) {
+  if (glb.size() < 20) return {};
+  uint32_t length = 0;
+  std::memcpy(&length, glb.data() + 12, 4);
+  if (glb.size() < 20 + size_t{length}) return {};
+  return std::string(glb.begin() + 20, glb.begin() + 20 + length);
+}
+
 TEST(TilesExport, GlbHasTwoTrianglesPerTileAndTheAtlas) {
   const TileSet set = small_set();
   exporter::TilesExportStats stats;
-  auto glb = exporter::export_tile_set(set, MeshExportFormat::kGlb, "tiles", {}, &stats);
+  auto glb = exporter::export_tile_set(set, MeshExportFormat::kGlb, "tiles", fixed(1), &stats);
   ASSERT_TRUE(glb.ok()) << glb.status().to_string();
   ASSERT_EQ(glb->size(), 1u);
   EXPECT_EQ(stats.tiles, 24u);
@@ -96,8 +116,21 @@ TEST(TilesExport, GlbHasTwoTrianglesPerTileAndTheAtlas) {
   int two_sided = 1;
   material->Get(AI_MATKEY_TWOSIDED, two_sided);
   EXPECT_EQ(two_sided, 0);
-  const std::string json(glb->front().bytes.begin(), glb->front().bytes.end());
-  EXPECT_NE(json.find("\"alphaMode\":\"BLEND\""), std::string::npos);
+  const nlohmann::json json = nlohmann::json::parse(glb_json(glb->front().bytes), nullptr, false);
+  ASSERT_FALSE(json.is_discarded());
+  EXPECT_EQ(json["materials"][0]["alphaMode"], "BLEND");
+  // Baked radiance: unlit, and that is the only extension the file declares.
+  EXPECT_TRUE(json["materials"][0]["extensions"].contains("KHR_materials_unlit")) << json.dump();
+  EXPECT_EQ(json["extensionsUsed"], nlohmann::json::array({"KHR_materials_unlit"}));
+  EXPECT_FALSE(json.contains("extensionsRequired"));
+  EXPECT_EQ(json["materials"].size(), 1u);
+  EXPECT_FALSE(json["materials"][0].contains("emissiveFactor"));
+  // Sampled as calf-play samples the atlas: bilinear, no mipmaps, clamped.
+  const nlohmann::json& sampler = json["samplers"][json["textures"][0]["sampler"].get<int>()];
+  EXPECT_EQ(sampler["magFilter"], 9729);
+  EXPECT_EQ(sampler["minFilter"], 9729);
+  EXPECT_EQ(sampler["wrapS"], 33071);
+  EXPECT_EQ(sampler["wrapT"], 33071);
   // Corner texture coordinates: (U / W, V / W) of the set, at some vertex of the import.
   const aiMesh* mesh = got->mMeshes[0];
   ASSERT_NE(mesh->mTextureCoords[0], nullptr);
@@ -123,10 +156,8 @@ TEST(TilesExport, SubdivisionBoundsTheAffineError) {
   const TileSet set = small_set();
   double last = INFINITY;
   for (uint32_t n : {1u, 2u, 4u}) {
-    exporter::TilesExportOptions o;
-    o.subdivide = n;
     exporter::TilesExportStats stats;
-    auto glb = exporter::export_tile_set(set, MeshExportFormat::kGlb, "t", o, &stats);
+    auto glb = exporter::export_tile_set(set, MeshExportFormat::kGlb, "t", fixed(n), &stats);
     ASSERT_TRUE(glb.ok()) << glb.status().to_string();
     EXPECT_EQ(stats.triangles, 2ull * n * n * set.tiles.size());
     std::printf("subdivide %u: %llu triangles, largest affine texture error %.4f texels\n", n,
@@ -143,15 +174,110 @@ TEST(TilesExport, SubdivisionBoundsTheAffineError) {
   EXPECT_GT(last, 0.0);
 }
 
+// The triangles of a tile are written together, tiles farthest first from the view region's
+// centre (distance to the mean of the tile's four corners, computed here from the file's own
+// vertices), so an engine drawing the mesh in index order composites back to front there.
+TEST(TilesExport, TilesAreWrittenBackToFrontFromTheViewRegionCentre) {
+  const TileSet set = small_set();
+  const Box3& r = set.view_region;
+  const aiVector3D centre((r.min.x + r.max.x) / 2, (r.min.y + r.max.y) / 2,
+                          (r.min.z + r.max.z) / 2);
+  const auto distance_of = [&](const std::array<aiVector3D, 4>& corners) {
+    aiVector3D mean(0, 0, 0);
+    for (const aiVector3D& c : corners) mean += c;
+    return (mean * 0.25f - centre).Length();
+  };
+  // The set's own order is not already sorted, or the test would prove nothing.
+  bool sorted = true;
+  for (size_t t = 1; t < set.tiles.size(); ++t) {
+    std::array<aiVector3D, 4> a, b;
+    for (int k = 0; k < 4; ++k) {
+      const auto& p = set.tiles[t - 1].corners[k].position;
+      const auto& q = set.tiles[t].corners[k].position;
+      a[k] = aiVector3D(p[0], p[1], p[2]);
+      b[k] = aiVector3D(q[0], q[1], q[2]);
+    }
+    sorted = sorted && distance_of(a) >= distance_of(b);
+  }
+  ASSERT_FALSE(sorted);
+  auto glb = exporter::export_tile_set(set, MeshExportFormat::kGlb, "t", fixed(1));
+  ASSERT_TRUE(glb.ok()) << glb.status().to_string();
+  Assimp::Importer importer;
+  const aiScene* got =
+      importer.ReadFileFromMemory(glb->front().bytes.data(), glb->front().bytes.size(), 0, "glb");
+  ASSERT_NE(got, nullptr);
+  const aiMesh* mesh = got->mMeshes[0];
+  ASSERT_EQ(mesh->mNumFaces, 2 * set.tiles.size());
+  double last = INFINITY;
+  for (unsigned f = 0; f < mesh->mNumFaces; f += 2) {
+    // Triangles (0, 1, 2) and (0, 2, 3) of one tile: its corners are the first's three and the
+    // second's last.
+    const aiFace& a = mesh->mFaces[f];
+    const aiFace& b = mesh->mFaces[f + 1];
+    ASSERT_EQ(a.mIndices[0], b.mIndices[0]);
+    ASSERT_EQ(a.mIndices[2], b.mIndices[1]);
+    const double d = distance_of({mesh->mVertices[a.mIndices[0]], mesh->mVertices[a.mIndices[1]],
+                                  mesh->mVertices[a.mIndices[2]], mesh->mVertices[b.mIndices[2]]});
+    EXPECT_LE(d, last + 1e-6) << "tile " << f / 2;
+    last = d;
+  }
+}
+
+// The default subdivision: each tile the smallest n that keeps its own error within the target,
+// so the whole file is within it, with fewer triangles than one n for all would need.
+TEST(TilesExport, DefaultSubdivisionKeepsEveryTileWithinTheTarget) {
+  // A set with more tilt (more cells of a larger cube face) than small_set: its error at n = 1
+  // is several texels.
+  const TileSet set = test::make_synthetic_tile_set(3, 32, 512, 21);
+  exporter::TilesExportStats one, automatic, coarse;
+  ASSERT_TRUE(exporter::export_tile_set(set, MeshExportFormat::kGlb, "t", fixed(1), &one).ok());
+  ASSERT_TRUE(exporter::export_tile_set(set, MeshExportFormat::kGlb, "t", {}, &automatic).ok());
+  exporter::TilesExportOptions loose;
+  loose.target_texel_error = 2.0;
+  ASSERT_TRUE(exporter::export_tile_set(set, MeshExportFormat::kGlb, "t", loose, &coarse).ok());
+  std::printf(
+      "subdivide 1: %.3f texels, %llu triangles; auto: %.3f texels, %llu triangles "
+      "(n %u .. %u); auto within 2: %.3f texels, %llu triangles\n",
+      one.max_texel_error, static_cast<unsigned long long>(one.triangles),
+      automatic.max_texel_error, static_cast<unsigned long long>(automatic.triangles),
+      automatic.min_subdivide, automatic.max_subdivide, coarse.max_texel_error,
+      static_cast<unsigned long long>(coarse.triangles));
+  ASSERT_GT(one.max_texel_error, 2.0) << "the set must need subdivision";
+  EXPECT_LE(automatic.max_texel_error, 1.0);
+  EXPECT_LE(coarse.max_texel_error, 2.0);
+  EXPECT_LT(coarse.triangles, automatic.triangles);
+  EXPECT_EQ(automatic.min_subdivide, 1u) << "tiles facing the centre need no split";
+  EXPECT_GT(automatic.max_subdivide, 1u);
+  // Fewer triangles than the one n that bounds every tile.
+  const uint64_t n = automatic.max_subdivide;
+  EXPECT_LT(automatic.triangles, 2 * n * n * set.tiles.size());
+}
+
+TEST(TilesExport, GltfWritesItsBufferBeside) {
+  const TileSet set = small_set();
+  auto gltf = exporter::export_tile_set(set, MeshExportFormat::kGltf, "t2", fixed(1));
+  ASSERT_TRUE(gltf.ok()) << gltf.status().to_string();
+  ASSERT_EQ(gltf->size(), 2u);
+  EXPECT_EQ((*gltf)[1].suffix, ".bin");
+  const nlohmann::json json = nlohmann::json::parse(
+      std::string((*gltf)[0].bytes.begin(), (*gltf)[0].bytes.end()), nullptr, false);
+  ASSERT_FALSE(json.is_discarded());
+  EXPECT_EQ(json["buffers"][0]["uri"], "t2.bin");
+  EXPECT_EQ(json["buffers"][0]["byteLength"], (*gltf)[1].bytes.size());
+}
+
 TEST(TilesExport, ObjWritesMtlAndAtlasPng) {
   const TileSet set = small_set();
-  auto obj = exporter::export_tile_set(set, MeshExportFormat::kObj, "scene_tiles");
+  auto obj = exporter::export_tile_set(set, MeshExportFormat::kObj, "scene_tiles", fixed(1));
   ASSERT_TRUE(obj.ok()) << obj.status().to_string();
   ASSERT_EQ(obj->size(), 3u);
   EXPECT_EQ((*obj)[1].suffix, ".mtl");
   EXPECT_EQ((*obj)[2].suffix, "_atlas.png");
   const std::string mtl((*obj)[1].bytes.begin(), (*obj)[1].bytes.end());
   EXPECT_NE(mtl.find("map_Kd scene_tiles_atlas.png"), std::string::npos) << mtl;
+  // The atlas's alpha: the dissolve map, the material itself opaque.
+  EXPECT_NE(mtl.find("map_d scene_tiles_atlas.png"), std::string::npos) << mtl;
+  EXPECT_NE(mtl.find("\nd 1"), std::string::npos) << mtl;
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("calf_tiles_obj_" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
@@ -176,7 +302,7 @@ TEST(TilesExport, ObjWritesMtlAndAtlasPng) {
 TEST(TilesExport, BadRequestsAreRefused) {
   const TileSet set = small_set();
   exporter::TilesExportOptions o;
-  o.subdivide = 0;
+  o.target_texel_error = 0;
   EXPECT_EQ(exporter::export_tile_set(set, MeshExportFormat::kGlb, "t", o).status().id(),
             ErrorId::kExportTilesOption);
   o.subdivide = 17;

@@ -1,7 +1,8 @@
 // Exporting a mesh track (format/SPEC.md §11.4) to the formats engines import: glTF 2.0 binary
-// (.glb), glTF 2.0 with its buffer embedded (.gltf) and Wavefront OBJ (+ .mtl). The scene is
-// built as an assimp scene and written by assimp's own exporters (DESIGN.md: no hand-written
-// glTF), so a visible set computed by calf drops into Unity, Unreal, Blender or three.js.
+// (.glb), glTF 2.0 with its buffer beside it (.gltf + .bin) and Wavefront OBJ (+ .mtl). The scene
+// is built as an assimp scene and written by a library (DESIGN.md: no hand-written glTF): glTF by
+// tinygltf, OBJ by assimp's exporter, so a visible set computed by calf drops into Unity, Unreal,
+// Blender or three.js.
 //
 // What is exported, at one frame of the track:
 //   - one node per object, named "object <i>" (or "object <i>: <prototype i>"), carrying the
@@ -11,15 +12,15 @@
 //     triangles use; positions at the frame's time when the prototype has vertex states;
 //   - normals (the prototype's, or none: the importer computes flat ones), vertex colours
 //     (linear, as COLOR_0), UVs (TEXCOORD_0 / vt) and materials (base colour, emission and the
-//     base-colour texture as PNG: embedded in a .glb's binary buffer / a .gltf's data URI as glTF's
-//     baseColorTexture, a side file <stem>_texture<n>.png named by map_Kd beside an .obj;
-//     textures no material uses are left out; a prototype without UVs placed with a textured
-//     material gets an untextured copy of it, "material <i> untextured", as the renderers draw
-//     it untextured and glTF needs TEXCOORD_0 for a texture); triangles with a
-//     per-triangle material are split into one mesh per material, as glTF primitives carry one
-//     material each.
+//     base-colour texture as PNG: embedded in the glTF's binary buffer as its baseColorTexture, a
+//     side file <stem>_texture<n>.png named by map_Kd beside an .obj; textures no material uses are
+//     left out; a prototype without UVs placed with a textured material gets an untextured copy of
+//     it, "material <i> untextured", as the renderers draw it untextured and glTF needs TEXCOORD_0
+//     for a texture); triangles with a per-triangle material are split into one mesh per material,
+//     as glTF primitives carry one material each. Only materials a mesh uses are written, and only
+//     the extensions the file uses are declared.
 // Triangle counts are preserved exactly: the export of a track whose objects draw T triangles in
-// all holds T triangles.
+// all holds T triangles; vertices are written as counted (MeshExportStats), never welded.
 #pragma once
 
 #include <cstdint>
@@ -32,8 +33,8 @@
 namespace calf::exporter {
 
 enum class MeshExportFormat : uint8_t {
-  kGlb,   // glTF 2.0 binary, one file (assimp "glb2")
-  kGltf,  // glTF 2.0 JSON plus its binary buffer <stem>.bin (assimp "gltf2"): two files
+  kGlb,   // glTF 2.0 binary, one file (tinygltf)
+  kGltf,  // glTF 2.0 JSON plus its binary buffer <stem>.bin (tinygltf): two files
   kObj,   // Wavefront OBJ plus its .mtl (assimp "obj"): two files
 };
 
@@ -61,7 +62,7 @@ struct MeshExportStats {
 // without its extension), and the main file refers to them by those names. Errors: the track's
 // decoding errors (naming the object or prototype), CALF-E480 for a frame out of range, an empty
 // track or a stem of other characters than A-Z a-z 0-9 _ - . (for .gltf / .obj), CALF-E481 when
-// assimp's exporter fails (its message quoted).
+// the glTF or OBJ writer fails (assimp's message quoted).
 Expected<std::vector<ExportedFile>> export_mesh_track(const decoder::MeshTrack& track,
                                                       uint32_t frame, MeshExportFormat format,
                                                       const std::string& stem,
