@@ -429,8 +429,12 @@ Expected<LightfieldEncodeStats> encode_lightfield_shard(const std::filesystem::p
   // The images must be the ones analysed, byte for byte: a capture of the same manifest with
   // other pixels would otherwise merge into a mixed clip.
   const uint32_t segment = pixel_segment(analysis.options, h.frame_count);
+  // (A range that is not whole segments is refused by the view coder below, E201.)
+  const bool whole_segments =
+      first_frame % segment == 0 &&
+      (frame_count % segment == 0 || first_frame + frame_count == h.frame_count);
   for (const uint32_t v : views) {
-    if (v >= analysis.pixels.size()) break;  // an analysis held only in memory has none
+    if (v >= analysis.pixels.size() || !whole_segments) break;  // in memory only: none
     for (uint32_t first = first_frame; first < first_frame + frame_count; first += segment) {
       const uint32_t count = std::min(segment, h.frame_count - first);
       CALF_ASSIGN_OR_RETURN(const uint64_t p, pixels_of(input, v, first, count));
