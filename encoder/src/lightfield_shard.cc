@@ -2,11 +2,14 @@
 // (lightfield_shard.h, docs/FARM.md).
 #include "calf/encoder/lightfield_shard.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cinttypes>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -17,6 +20,8 @@
 
 #include "calf/capture/capture_shard.h"
 #include "calf/format/container.h"
+#include "calf/format/container_codec.h"
+#include "calf/format/container_fields.h"
 #include "calf/format/files.h"
 #include "calf/format/version.h"
 #include "lightfield_internal.h"
@@ -30,7 +35,8 @@ constexpr const char* kAnalysisKey = "calf.lightfield_analysis";
 constexpr const char* kAnalysisIdKey = "calf.lightfield_analysis_id";
 constexpr const char* kShardViewsKey = "calf.lightfield_shard_views";
 constexpr const char* kShardFramesKey = "calf.lightfield_shard_frames";  // "first-last"
-constexpr const char* kRecordMagic = "calf-lightfield-analysis 3";
+constexpr const char* kRecordMagic = "calf-lightfield-analysis 4";
+constexpr const char* kRecordMagicPrefix = "calf-lightfield-analysis ";
 
 std::string hex_double(double v) {
   char buf[64];
@@ -38,8 +44,10 @@ std::string hex_double(double v) {
   return buf;
 }
 
-// The record: options that change the bytes, the resolved colour format and every view's facts.
-std::string analysis_record(const LightfieldAnalysis& a, const LightfieldEncodeOptions& o) {
+// The record: options that change the bytes, the resolved colour format, every view's facts and
+// the fingerprints of its images' bytes (one per segment of frames).
+std::string analysis_record(const LightfieldAnalysis& a, const LightfieldEncodeOptions& o,
+                            const std::vector<std::vector<uint64_t>>& pixels) {
   std::ostringstream s;
   s << kRecordMagic << "\n";
   s << "cell " << o.cell_size << "\npsnr " << hex_double(o.min_psnr_db) << "\ncolour "
@@ -57,6 +65,15 @@ std::string analysis_record(const LightfieldAnalysis& a, const LightfieldEncodeO
       << hex_double(f.depth_range ? f.depth_range->z_near() : 0.0) << " "
       << hex_double(f.depth_range ? f.depth_range->z_far() : 0.0) << " " << (f.has_material ? 1 : 0)
       << " " << (f.hdr ? 1 : 0) << "\n";
+  }
+  for (size_t v = 0; v < pixels.size(); ++v) {
+    s << "pixels " << v << " " << pixels[v].size();
+    for (const uint64_t h : pixels[v]) {
+      char buf[24];
+      std::snprintf(buf, sizeof buf, " %016" PRIx64, h);
+      s << buf;
+    }
+    s << "\n";
   }
   return s.str();
 }
@@ -88,10 +105,21 @@ bool read_double(std::istringstream& in, double* out) {
 // The record back into options and facts; the analysis itself is planned again from them, so a
 // record that does not fit its own header is refused.
 Status parse_record(const std::string& path, const std::string& text, LightfieldEncodeOptions* o,
-                    uint64_t* resolved_colour, std::vector<LightfieldViewFacts>* facts) {
+                    uint64_t* resolved_colour, std::vector<LightfieldViewFacts>* facts,
+                    std::vector<std::vector<uint64_t>>* pixels) {
   std::istringstream in(text);
   std::string line;
-  if (!std::getline(in, line) || line != kRecordMagic) return bad_record(path, "unknown record");
+  if (!std::getline(in, line)) return bad_record(path, "unknown record");
+  if (line != kRecordMagic) {
+    if (line.rfind(kRecordMagicPrefix, 0) == 0 && line.size() < 40) {
+      return bad_record(path, "record version '" + line.substr(std::strlen(kRecordMagicPrefix)) +
+                                  "' is not this calf's " +
+                                  std::string(kRecordMagic + std::strlen(kRecordMagicPrefix)) +
+                                  " (an analysis file of another calf version: write it again "
+                                  "with calf-encode --analysis-only)");
+    }
+    return bad_record(path, "unknown record");
+  }
   uint64_t x = 0;
   auto field = [&](const char* key, uint64_t max) -> bool {
     if (!read_uint(in, key, max, &x)) return false;
@@ -164,6 +192,27 @@ Status parse_record(const std::string& path, const std::string& text, Lightfield
       f.depth_range = *r;
     }
   }
+  pixels->assign(n, {});
+  for (uint64_t v = 0; v < n; ++v) {
+    const std::string what = "pixels of view " + std::to_string(v);
+    uint64_t index = 0, count = 0;
+    if (!read_uint(in, "pixels", UINT32_MAX, &index) || index != v || !(in >> count) ||
+        count == 0 || count > container::kMaxFrames || count > text.size() / 17) {
+      return bad_record(path, what);
+    }
+    auto& hashes = (*pixels)[v];
+    hashes.resize(count);
+    for (uint64_t& h : hashes) {
+      std::string hex;
+      if (!(in >> hex) || hex.size() != 16) return bad_record(path, what);
+      char* end = nullptr;
+      errno = 0;
+      h = std::strtoull(hex.c_str(), &end, 16);
+      if (errno != 0 || *end != '\0' || hex[0] == '-' || hex[0] == '+') {
+        return bad_record(path, what);
+      }
+    }
+  }
   std::string rest;
   if (in >> rest) return bad_record(path, "trailing text");
   return Status::Ok();
@@ -193,15 +242,73 @@ std::vector<std::pair<std::string, std::string>> clip_metadata(const capture::Ca
 
 constexpr const char* kClipMetadataPrefix = "calf.clip.";
 
-// Every image of the set plus its directory and manifest: what an output must not be.
-std::vector<std::string> capture_inputs(const capture::CaptureSetReader& input) {
+// Every image of the set plus its directory and manifest, and the analysis file a shard is coded
+// with: what an output must not be.
+std::vector<std::string> capture_inputs(const capture::CaptureSetReader& input,
+                                        const std::string& analysis_path = {}) {
   std::vector<std::string> inputs = {input.directory().string(),
                                      (input.directory() / capture::kManifestFileName).string()};
   for (uint32_t v = 0; v < input.manifest().viewpoints.size(); ++v) {
     for (uint32_t f = 0; f < input.manifest().frame_count; ++f)
       inputs.push_back(input.image_path(v, f).string());
   }
+  if (!analysis_path.empty()) inputs.push_back(analysis_path);
   return inputs;
+}
+
+// Frames per fingerprint: a segment of --segment-frames, or the whole clip.
+uint32_t pixel_segment(const LightfieldEncodeOptions& o, uint32_t frame_count) {
+  return o.segment_frames ? o.segment_frames : frame_count;
+}
+
+// XXH3-64 of a whole image file's bytes.
+Expected<uint64_t> file_hash(const std::string& path) {
+  CALF_ASSIGN_OR_RETURN(const int fd, files::open_regular_file(path));
+  std::vector<uint8_t> bytes;
+  uint8_t buf[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const int e = errno;
+      ::close(fd);
+      return Status(ErrorId::kFileRead, path + ": " + std::strerror(e));
+    }
+    if (n == 0) break;
+    bytes.insert(bytes.end(), buf, buf + n);
+  }
+  ::close(fd);
+  return container::hash64(bytes);
+}
+
+// The fingerprint of view `v`'s frames [first, first + count): XXH3-64 of their files' hashes,
+// 8 bytes each, little-endian, in frame order.
+Expected<uint64_t> pixels_of(const capture::CaptureSetReader& input, uint32_t v, uint32_t first,
+                             uint32_t count) {
+  std::vector<uint8_t> hashes;
+  for (uint32_t f = first; f < first + count; ++f) {
+    CALF_ASSIGN_OR_RETURN(const uint64_t h, file_hash(input.image_path(v, f).string()));
+    const size_t at = hashes.size();
+    hashes.resize(at + 8);
+    container::store_le(hashes.data() + at, h, 8);
+  }
+  return container::hash64(hashes);
+}
+
+// Every view's fingerprints, one per segment of frames.
+Expected<std::vector<std::vector<uint64_t>>> capture_pixels(const capture::CaptureSetReader& input,
+                                                            const LightfieldEncodeOptions& o) {
+  const uint32_t frames = input.manifest().frame_count;
+  const uint32_t segment = pixel_segment(o, frames);
+  std::vector<std::vector<uint64_t>> out(input.manifest().viewpoints.size());
+  for (uint32_t v = 0; v < out.size(); ++v) {
+    for (uint32_t first = 0; first < frames; first += segment) {
+      CALF_ASSIGN_OR_RETURN(const uint64_t h,
+                            pixels_of(input, v, first, std::min(segment, frames - first)));
+      out[v].push_back(h);
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -214,10 +321,12 @@ Expected<LightfieldAnalysisFile> write_lightfield_analysis(const std::filesystem
                         capture::CaptureSetReader::open(capture_dir));
   CALF_RETURN_IF_ERROR(files::check_output_not_input(out_path, capture_inputs(input)));
   LightfieldAnalysisFile file;
+  file.path = out_path;
   CALF_ASSIGN_OR_RETURN(file.analysis, analyse_lightfield(input, options));
   file.options = options;
   file.clip_metadata = clip_metadata(input.manifest());
-  const std::string record = analysis_record(file.analysis, options);
+  CALF_ASSIGN_OR_RETURN(file.pixels, capture_pixels(input, options));
+  const std::string record = analysis_record(file.analysis, options, file.pixels);
   CALF_ASSIGN_OR_RETURN(const std::vector<uint8_t> header,
                         container::encode_track_header(file.analysis.header));
   file.id = id_of(record, header);
@@ -243,9 +352,10 @@ Expected<LightfieldAnalysisFile> read_lightfield_analysis(const std::string& pat
   const auto* header = std::get_if<container::LightfieldTrackHeader>(&reader.tracks()[0].header);
   if (!header) return bad_record(path, "its track is not a lightfield track");
   LightfieldAnalysisFile file;
+  file.path = path;
   uint64_t resolved = 0;
   std::vector<LightfieldViewFacts> facts;
-  CALF_RETURN_IF_ERROR(parse_record(path, *record, &file.options, &resolved, &facts));
+  CALF_RETURN_IF_ERROR(parse_record(path, *record, &file.options, &resolved, &facts, &file.pixels));
   if (Status s = lightfield_internal::validate_options(file.options); !s.ok()) {
     return bad_record(path, s.message());
   }
@@ -258,6 +368,13 @@ Expected<LightfieldAnalysisFile> read_lightfield_analysis(const std::string& pat
   if (a.views.size() != header->view_count || a.colour == ColourCoding::kAuto ||
       (header->flags & 1) != (a.hdr ? 1 : 0)) {
     return bad_record(path, "the record contradicts the track header");
+  }
+  const uint32_t segment = pixel_segment(file.options, header->frame_count);
+  const uint64_t segments = segment ? (uint64_t{header->frame_count} + segment - 1) / segment : 0;
+  for (const auto& hashes : file.pixels) {
+    if (hashes.size() != segments) {
+      return bad_record(path, "its pixel fingerprints do not cover the clip's segments");
+    }
   }
   CALF_ASSIGN_OR_RETURN(const std::vector<uint8_t> header_bytes,
                         container::encode_track_header(a.header));
@@ -307,7 +424,31 @@ Expected<LightfieldEncodeStats> encode_lightfield_shard(const std::filesystem::p
                                             " are outside the set's " +
                                             std::to_string(h.frame_count) + " frames");
   }
-  CALF_RETURN_IF_ERROR(files::check_output_not_input(out_path, capture_inputs(input)));
+  CALF_RETURN_IF_ERROR(
+      files::check_output_not_input(out_path, capture_inputs(input, analysis.path)));
+  // The images must be the ones analysed, byte for byte: a capture of the same manifest with
+  // other pixels would otherwise merge into a mixed clip.
+  const uint32_t segment = pixel_segment(analysis.options, h.frame_count);
+  // (A range that is not whole segments is refused by the view coder below, E201.)
+  const bool whole_segments =
+      first_frame % segment == 0 &&
+      (frame_count % segment == 0 || first_frame + frame_count == h.frame_count);
+  for (const uint32_t v : views) {
+    if (v >= analysis.pixels.size() || !whole_segments) break;  // in memory only: none
+    for (uint32_t first = first_frame; first < first_frame + frame_count; first += segment) {
+      const uint32_t count = std::min(segment, h.frame_count - first);
+      CALF_ASSIGN_OR_RETURN(const uint64_t p, pixels_of(input, v, first, count));
+      if (p != analysis.pixels[v][first / segment]) {
+        return Status(ErrorId::kShardMismatch,
+                      capture_dir.string() + ": view " + std::to_string(v) + " frames " +
+                          std::to_string(first) + "-" + std::to_string(first + count - 1) +
+                          " are not the images analysed (their bytes differ from the ones " +
+                          (analysis.path.empty() ? std::string("analysed")
+                                                 : "the analysis file " + analysis.path) +
+                          " fingerprints)");
+      }
+    }
+  }
   LightfieldEncodeOptions options = analysis.options;
   options.threads = threads;
   CALF_ASSIGN_OR_RETURN(container::Writer writer,
@@ -346,8 +487,9 @@ Status merge_lightfield_shards(const LightfieldAnalysisFile& analysis,
                                std::span<const std::string> shard_paths,
                                const std::string& out_path) {
   const container::LightfieldTrackHeader& h = analysis.analysis.header;
-  CALF_RETURN_IF_ERROR(files::check_output_not_input(
-      out_path, std::vector<std::string>(shard_paths.begin(), shard_paths.end())));
+  std::vector<std::string> inputs(shard_paths.begin(), shard_paths.end());
+  if (!analysis.path.empty()) inputs.push_back(analysis.path);
+  CALF_RETURN_IF_ERROR(files::check_output_not_input(out_path, inputs));
   // Open every shard and check it before anything is written.
   struct Piece {
     uint32_t first, last;  // frames, inclusive

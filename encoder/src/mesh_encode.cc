@@ -316,6 +316,27 @@ Expected<MeshPrototypeArrays> prototype_arrays(const capture::SceneMesh& m) {
   return out;
 }
 
+Status check_mesh_scene(const capture::SceneFile& scene) {
+  std::vector<bool> used(scene.meshes.size(), false);
+  for (const capture::SceneObject& o : scene.objects) {
+    if (o.mesh < used.size()) used[o.mesh] = true;
+  }
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    if (!used[m]) continue;
+    const std::string what = cat("scene mesh ", m);
+    Expected<MeshPrototypeArrays> a = prototype_arrays(scene.meshes[m]);
+    if (!a.ok()) return std::move(a).status().with_context(what);
+    // The layout's own checks, as compress_into() reports them.
+    Expected<std::vector<uint8_t>> raw = mesh::encode_vertices(a->record, a->vertices);
+    if (!raw.ok()) {
+      return raw.status().id() == ErrorId::kContainerWriterMisuse
+                 ? input_error(what + ": " + raw.status().message())
+                 : raw.status();
+    }
+  }
+  return Status::Ok();
+}
+
 Status encode_mesh_track(const capture::SceneFile& scene,
                          const std::vector<std::vector<uint32_t>>* visible,
                          const MeshEncodeOptions& options, container::Writer* writer,

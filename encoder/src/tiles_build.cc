@@ -31,6 +31,17 @@ std::string sformat(const char* format, ...) {
   return out;
 }
 
+// Upper bounds of the iteration and trial counts (docs/TILES.md; CALF-E250 above them): each is
+// tens to hundreds of times its default, far past where the result stops changing, and keeps a
+// build's time bounded.
+constexpr uint32_t kTilesMaxRansacTrials = 4096;
+constexpr uint32_t kTilesMaxRefineIterations = 256;
+constexpr uint32_t kTilesMaxSelectionIterations = 20000;
+// The farthest a captured surface (or the view region's corner) may lie from the view region's
+// centre, in scene units (CALF-E201 beyond): tiles reach a few times that far and the sky layer
+// 100 times, which keeps every corner within the tiles track's +-1e12.
+constexpr double kTilesMaxDistance = 1e9;
+
 Status bad_option(const std::string& what) {
   return Status(ErrorId::kTilesOption, what);
 }
@@ -80,13 +91,19 @@ Status validate_tiles_build_options(const TilesBuildOptions& o) {
   if (o.max_planes < 1 || o.max_planes > 16) {
     return bad_option(sformat("max_planes %u is outside [1, 16]", o.max_planes));
   }
-  if (o.ransac_trials < 1) return bad_option("ransac_trials must be >= 1");
+  if (o.ransac_trials < 1 || o.ransac_trials > kTilesMaxRansacTrials) {
+    return bad_option(
+        sformat("ransac_trials %u is outside [1, %u]", o.ransac_trials, kTilesMaxRansacTrials));
+  }
   if (!(o.ransac_threshold > 0) || !std::isfinite(o.ransac_threshold)) {
     return bad_option(
         sformat("ransac_threshold %g is not a finite number > 0", o.ransac_threshold));
   }
   if (o.min_cell_points < 1) return bad_option("min_cell_points must be >= 1");
-  if (o.refine_iterations < 1) return bad_option("refine_iterations must be >= 1");
+  if (o.refine_iterations < 1 || o.refine_iterations > kTilesMaxRefineIterations) {
+    return bad_option(sformat("refine_iterations %u is outside [1, %u]", o.refine_iterations,
+                              kTilesMaxRefineIterations));
+  }
   if (o.refine_sample_limit < 16) {
     return bad_option(sformat("refine_sample_limit %u is below 16", o.refine_sample_limit));
   }
@@ -97,7 +114,10 @@ Status validate_tiles_build_options(const TilesBuildOptions& o) {
   if (!(o.tile_dilation >= 0 && o.tile_dilation <= 0.25)) {
     return bad_option(sformat("tile_dilation %g is outside [0, 0.25]", o.tile_dilation));
   }
-  if (o.selection_iterations < 1) return bad_option("selection_iterations must be >= 1");
+  if (o.selection_iterations < 1 || o.selection_iterations > kTilesMaxSelectionIterations) {
+    return bad_option(sformat("selection_iterations %u is outside [1, %u]", o.selection_iterations,
+                              kTilesMaxSelectionIterations));
+  }
   if (!(o.texels_per_degree >= 0) || !std::isfinite(o.texels_per_degree) ||
       o.texels_per_degree > 1000) {
     return bad_option(sformat("texels_per_degree %g is outside [0, 1000]", o.texels_per_degree));
@@ -193,6 +213,18 @@ Expected<TileSet> build_tiles(const capture::CaptureSetReader& reader, uint32_t 
                   sformat("%s: frame %u has no finite depth outside the view region's core in "
                           "any of its %zu views",
                           reader.directory().string().c_str(), frame, m.viewpoints.size()));
+  }
+
+  if (!(std::max(points.max_radius, f.region_radius) <= kTilesMaxDistance)) {
+    return Status(ErrorId::kEncoderInput,
+                  sformat("%s: frame %u: %s lies %g scene units from the view region's centre, "
+                          "beyond the %g a tiles track can hold (its tiles and sky layer would "
+                          "leave the track's +-1e12 coordinates); give such far surfaces as sky "
+                          "(infinite depth)",
+                          reader.directory().string().c_str(), frame,
+                          points.max_radius >= f.region_radius ? "a captured surface"
+                                                               : "the view region's corner",
+                          std::max(points.max_radius, f.region_radius), kTilesMaxDistance));
   }
 
   // 2. Candidates.

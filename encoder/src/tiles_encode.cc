@@ -81,8 +81,7 @@ Status validate_tile_set(const TileSet& t) {
   return Status::Ok();
 }
 
-Status encode_tiles_track(const TileSet& input, const TilesEncodeOptions& options,
-                          container::Writer* writer, TilesEncodeStats* stats) {
+Status validate_tiles_encode_options(const TilesEncodeOptions& options) {
   if (options.threads > 256)
     return Status(ErrorId::kEncoderOption, cat("threads ", options.threads, " is above 256"));
   if (static_cast<uint16_t>(options.supercompression) >= container::kCompressionCount)
@@ -94,6 +93,12 @@ Status encode_tiles_track(const TileSet& input, const TilesEncodeOptions& option
       options.band_rows % 4 != 0)
     return Status(ErrorId::kEncoderOption, cat("atlas band rows ", options.band_rows,
                                                " is not a multiple of 4 in [4, 16384]"));
+  return Status::Ok();
+}
+
+Status encode_tiles_track(const TileSet& input, const TilesEncodeOptions& options,
+                          container::Writer* writer, TilesEncodeStats* stats) {
+  CALF_RETURN_IF_ERROR(validate_tiles_encode_options(options));
   CALF_RETURN_IF_ERROR(validate_tile_set(input));
 
   const uint32_t width = input.atlas_width, height = input.atlas_height;

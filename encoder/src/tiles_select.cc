@@ -11,6 +11,7 @@
 // feasible (as Seurat does once at the end, which is still done when nothing feasible was seen).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "tiles_internal.h"
@@ -109,7 +110,10 @@ class Selector {
         const TilingWeights& w = tilings_[t];
         const double cost = c_.tilings[t].distortion + m_tri * 2.0 * w.tiles +
                             m_area * cells_[k].area * w.tiles + fill_price * w.bound;
-        if (cost < best) {
+        // The first tiling is taken whatever its cost: prices against a bound near 0 (an
+        // overdraw bound of 1e-300) overflow to infinity or NaN, and a cell left with no choice
+        // would drop out of the selection, uncovered.
+        if (choice < 0 || cost < best) {
           best = cost;
           choice = static_cast<int32_t>(t);
         }
@@ -184,6 +188,13 @@ class Selector {
   std::vector<int32_t> choice_;
   uint32_t evaluations_ = 0;
 };
+
+// A bound as the user gave it (%g: 1e-300 stays readable, not 0.000000).
+std::string number_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
 
 }  // namespace
 
@@ -315,11 +326,11 @@ Expected<Selection> select_tiles(const Candidates& candidates, const Frame& f,
     const Totals by_area = least(1, 2), by_fill = least(2, dims);
     std::string what;
     if (by_area.area > options.max_average_overdraw) {
-      what = "the average overdraw bound " + std::to_string(options.max_average_overdraw) +
-             " is below the " + std::to_string(by_area.area) + " the covered directions need";
+      what = "the average overdraw bound " + number_text(options.max_average_overdraw) +
+             " is below the " + number_text(by_area.area) + " the covered directions need";
     } else if (Selector::peak(by_fill) > options.max_peak_overdraw) {
-      what = "the peak overdraw bound " + std::to_string(options.max_peak_overdraw) +
-             " is below the " + std::to_string(Selector::peak(by_fill)) +
+      what = "the peak overdraw bound " + number_text(options.max_peak_overdraw) +
+             " is below the " + number_text(Selector::peak(by_fill)) +
              " the covered directions need";
     } else {
       what = "no selection meets the triangle, average and peak overdraw bounds together";

@@ -54,11 +54,13 @@ struct VisibleSetFlags {
 };
 
 // Computes the visible set of `scene` from its view region's perimeter (calf/encoder/
-// visible_set.h), printing what it solves and a summary; the set's errors (E110-E115) pass
-// through.
+// visible_set.h), showing what it solves on a terminal; `summary` receives the summary line (the
+// caller prints it once the clip is written, so that an error stays the only line). The set's
+// errors (E110-E115) pass through.
 calf::Expected<calf::encoder::VisibleSet> visible_set_of(const calf::capture::SceneFile& scene,
                                                          const VisibleSetFlags& flags,
-                                                         uint32_t* segment_count) {
+                                                         uint32_t* segment_count,
+                                                         std::string* summary) {
   const calf::Box3 region{
       {scene.view_region_min[0], scene.view_region_min[1], scene.view_region_min[2]},
       {scene.view_region_max[0], scene.view_region_max[1], scene.view_region_max[2]}};
@@ -87,8 +89,9 @@ calf::Expected<calf::encoder::VisibleSet> visible_set_of(const calf::capture::Sc
   if (!flags.quiet) {
     const bool coupled = flags.options.motion == calf::encoder::VisibilityMotion::kCoupled;
     const auto& st = set->stats;
-    std::fprintf(
-        stderr,
+    char line[1024];
+    std::snprintf(
+        line, sizeof line,
         "calf-encode: visible set: %zu segments (%.3f of perimeter at eye height %.3f), 6 faces "
         "of %u px, %s granularity%s: %llu of %llu triangles (%.3f %%) in %.2f s; %llu of %u %s "
         "solved, %llu (triangle, pixel) pairs, %.3g pairs/s\n",
@@ -103,6 +106,7 @@ calf::Expected<calf::encoder::VisibleSet> visible_set_of(const calf::capture::Sc
         coupled ? "frames: motion steps" : "frames",
         static_cast<unsigned long long>(st.triangle_pixel_pairs),
         st.seconds > 0 ? static_cast<double>(st.triangle_pixel_pairs) / st.seconds : 0.0);
+    *summary = line;
   }
   return set;
 }
@@ -124,9 +128,12 @@ int encode_mesh(const std::string& input, const std::string& out, const std::str
   auto scene = calf::capture::read_scene_file(dir);
   if (!scene.ok()) return fail(scene.status());
   std::optional<calf::encoder::VisibleSet> set;
+  std::string vs_summary;
   std::vector<std::pair<std::string, std::string>> metadata;
   if (vs.enabled) {
-    auto computed = visible_set_of(*scene, vs, &o.segment_count);
+    // The scene the mesh track refuses is refused before the set is solved (and its line printed).
+    if (calf::Status s = calf::encoder::check_mesh_scene(*scene); !s.ok()) return fail(s);
+    auto computed = visible_set_of(*scene, vs, &o.segment_count, &vs_summary);
     if (!computed.ok()) return fail(computed.status());
     set = std::move(*computed);
     // How the set was made (no time: the bytes depend on the scene and the options only).
@@ -141,6 +148,7 @@ int encode_mesh(const std::string& input, const std::string& out, const std::str
   auto stats = calf::encoder::encode_mesh_file(*scene, dir, out, set ? &set->triangles : nullptr, o,
                                                metadata);
   if (!stats.ok()) return fail(stats.status());
+  std::fputs(vs_summary.c_str(), stderr);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const uint64_t stored = stats->index.stored + stats->vertices_stream.stored +
@@ -221,8 +229,10 @@ int main(int argc, char** argv) {
       "with spheres tessellated, objects with their transforms), or with --visible-set only the "
       "triangles visible from the scene's view region (paper 004; its errors: CALF-E110..E115, "
       "docs/ERRORS.md); only --supercompression, "
-      "--threads, --quiet and the visible-set options apply, the lightfield options are "
-      "ignored.\n"
+      "--threads, --quiet and the visible-set options apply.\n"
+      "An option of another mode (a lightfield option such as --cell or --analysis with --mode "
+      "mesh, surfels or tiles; --surfels without --mode surfels; --tiles-* without --mode tiles; "
+      "--visible-set without --mode mesh) is a usage error (exit 2).\n"
       "--mode surfels: INPUT is a scene file and --surfel-candidates its candidate file "
       "(format/SURFEL_CANDIDATES.md, from calf-capture --surfel-candidates); the output holds the "
       "mesh track of the whole scene and a surfels track (format/SPEC.md 11.3): per prototype up "
@@ -444,7 +454,7 @@ int main(int argc, char** argv) {
                    "tiles: K, most planes (tiles) per cell, 1..16 (default 8)")
         ->default_val(8);
     app.add_option("--tiles-ransac-trials", b.ransac_trials,
-                   "tiles: RANSAC trials of each cell's first plane, >= 1 (default 32)")
+                   "tiles: RANSAC trials of each cell's first plane, 1..4096 (default 32)")
         ->default_val(32);
     app.add_option("--tiles-ransac-threshold", b.ransac_threshold,
                    "tiles: RANSAC inlier bound on the relative radial error, > 0 (default 0.01)")
@@ -454,7 +464,7 @@ int main(int argc, char** argv) {
                    "(default 16)")
         ->default_val(16);
     app.add_option("--tiles-refine-iterations", b.refine_iterations,
-                   "tiles: assign-and-refit iterations after each plane split, >= 1 (default 4)")
+                   "tiles: assign-and-refit iterations after each plane split, 1..256 (default 4)")
         ->default_val(4);
     app.add_option("--tiles-refine-samples", b.refine_sample_limit,
                    "tiles: most points per plane refit, >= 16 (default 2048)")
@@ -467,8 +477,9 @@ int main(int argc, char** argv) {
                    "tiles: each tile's cell grows by this fraction of its width per side, so "
                    "neighbours overlap instead of cracking, 0..0.25 (default 0.02)")
         ->default_val(0.02);
-    app.add_option("--tiles-selection-iterations", b.selection_iterations,
-                   "tiles: subgradient iterations of the Lagrangian selection, >= 1 (default 150)")
+    app.add_option(
+           "--tiles-selection-iterations", b.selection_iterations,
+           "tiles: subgradient iterations of the Lagrangian selection, 1..20000 (default 150)")
         ->default_val(150);
     app.add_option("--tiles-texels-per-degree", b.texels_per_degree,
                    "tiles: texture density per degree of a tile's angular width, 0 = twice "
@@ -546,6 +557,26 @@ int main(int argc, char** argv) {
         ->default_val(1);
   }
   if (int rc = calf::tools::parse_command_line(app, "calf-encode", argc, argv); rc >= 0) return rc;
+  // An option of another mode is a usage error, never silently ignored.
+  const auto given = [&](const char* name) { return app.get_option(name)->count() > 0; };
+  if (mode != "lightfield") {
+    for (const char* opt :
+         {"--cell", "--psnr", "--color-format", "--depth-format", "--depth-window", "--max-aabbs",
+          "--depth-keyframe-interval", "--segment-frames", "--colour-rdo", "--bc1-fit",
+          "--depth-fixed-groups", "--analysis-only", "--analysis", "--views", "--frame-range"}) {
+      if (given(opt)) {
+        return calf::tools::usage_error("calf-encode",
+                                        std::string(opt) + " needs --mode lightfield");
+      }
+    }
+  }
+  if (mode != "surfels") {
+    for (const char* opt : {"--surfels", "--surfel-sampler"}) {
+      if (given(opt)) {
+        return calf::tools::usage_error("calf-encode", std::string(opt) + " needs --mode surfels");
+      }
+    }
+  }
   bool tiles_option_given = false;
   for (const CLI::Option* opt : app.get_options()) {
     if (opt->get_name().rfind("--tiles-", 0) == 0 && opt->count() > 0) tiles_option_given = true;
@@ -573,6 +604,9 @@ int main(int argc, char** argv) {
     tiles.encode.levels.compress_directory = !plain_directory;
     tiles.quiet = quiet;
     if (calf::Status s = calf::encoder::validate_tiles_build_options(tiles.build); !s.ok()) {
+      return calf::tools::print_error("calf-encode", s, calf::tools::kExitUsage);
+    }
+    if (calf::Status s = calf::encoder::validate_tiles_encode_options(tiles.encode); !s.ok()) {
       return calf::tools::print_error("calf-encode", s, calf::tools::kExitUsage);
     }
     return calf::tools::encode_tiles(manifest, out, tiles);

@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
       "inside a triangle: --subdivide bounds the difference; the largest is printed in texels, "
       "and a warning when a fixed --subdivide leaves more than 2)."
       " Each file is written whole or not at all (a temporary file renamed into "
-      "place).\n" +
+      "place); an output or side file that is the input clip is refused (CALF-E007).\n" +
       std::string(calf::tools::kExitStatusHelp)};
   std::string clip, out;
   uint32_t frame = 0;
@@ -68,8 +68,9 @@ int main(int argc, char** argv) {
                  "the frame whose transforms and vertex states are exported (default 0)")
       ->default_val(0);
   app.add_option("--track", track_option,
-                 "index of the mesh or tiles track in the clip (default: the first mesh or tiles "
-                 "track)");
+                 "index of the mesh or tiles track in the clip, 0..65535 (default: the first "
+                 "mesh or tiles track)")
+      ->check(CLI::Range(0, 65535));
   app.add_option("--subdivide", subdivide,
                  "tiles track: split each of a tile's two triangles into N x N, 1..16, to bound "
                  "the affine texture approximation, or auto: each tile the smallest N that keeps "
@@ -159,6 +160,11 @@ int main(int argc, char** argv) {
           kCommand, subdivide, stats.max_texel_error, calf::exporter::kTilesTexelErrorWarning);
     }
   } else {
+    if (app.get_option("--subdivide")->count() > 0) {
+      return calf::tools::usage_error(
+          kCommand,
+          fmt::format("--subdivide applies to a tiles track; track {} is a mesh track", track));
+    }
     auto mesh = calf::decoder::MeshTrack::open(reader.value(), static_cast<uint16_t>(track));
     if (!mesh.ok()) return fail(mesh.status().with_context(clip));
     calf::exporter::MeshExportStats stats;
@@ -170,11 +176,20 @@ int main(int argc, char** argv) {
         stats.objects, stats.meshes, stats.vertices, stats.triangles, stats.textures);
   }
 
+  // No output may replace the clip: neither OUT nor a side file beside it (CALF-E007), checked
+  // for every file before any is written.
+  std::vector<std::string> paths;
+  for (const auto& file : files.value())
+    paths.push_back(file.suffix.empty() ? out : base + file.suffix);
+  const std::vector<std::string> inputs = {clip};
+  for (const std::string& path : paths) {
+    if (calf::Status s = calf::files::check_output_not_input(path, inputs); !s.ok()) return fail(s);
+  }
   // Every file is written to its temporary name first and renamed only when all were written.
   std::vector<calf::files::TempFile> temps;
-  for (const auto& file : files.value()) {
-    std::string path = out;
-    if (!file.suffix.empty()) path = base + file.suffix;
+  for (size_t i = 0; i < paths.size(); ++i) {
+    const auto& file = files.value()[i];
+    const std::string& path = paths[i];
     auto temp = calf::files::TempFile::create(path);
     if (!temp.ok()) return fail(temp.status());
     if (calf::Status s = temp.value().write(file.bytes); !s.ok()) return fail(s);

@@ -21,6 +21,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "calf/format/coordinates.h"
+#include "calf/format/files.h"
 #include "calf/samples/scene.h"
 #include "glm_vec.h"
 #include "model_prescan.h"
@@ -298,10 +299,8 @@ Status check_imported(const aiScene* ai, const std::string& file) {
 
 Expected<Scene> load_scene_file(const std::filesystem::path& path) {
   const std::string file = path.string();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    return Status(ErrorId::kFileOpen, file + ": no such file");
-  }
+  // "no such file", or what the path is instead ("not a regular file (a directory)").
+  CALF_RETURN_IF_ERROR(files::check_regular_file(file));
   Assimp::Importer importer;
   std::string ext = path.extension().string();
   if (ext.empty() || !importer.IsExtensionSupported(ext)) {

@@ -298,11 +298,13 @@ int main(int argc, char** argv) {
   std::error_code ec;
   const std::filesystem::path scene_json =
       std::filesystem::path(scene_arg) / calf::capture::kSceneManifestFileName;
-  if (!surfel_path.empty() && std::filesystem::is_directory(scene_arg, ec) &&
-      std::filesystem::exists(scene_json, ec)) {
-    if (!out_dir.empty() || !export_dir.empty()) {
+  if (std::filesystem::is_directory(scene_arg, ec) && std::filesystem::exists(scene_json, ec)) {
+    if (surfel_path.empty() || !out_dir.empty() || !export_dir.empty()) {
       return calf::tools::usage_error(
-          "calf-capture", "a scene-file folder as --scene goes with --surfel-candidates alone");
+          "calf-capture", "--scene " + scene_arg +
+                              " is a scene-file folder, which goes with --surfel-candidates "
+                              "alone (--out and --export-scene take a built-in scene or a model "
+                              "file; calf-encode --mode mesh encodes a scene file)");
     }
     auto file = calf::capture::read_scene_file(scene_arg);
     if (!file.ok()) return fail(file.status());

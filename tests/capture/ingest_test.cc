@@ -476,6 +476,8 @@ std::string error_of(const fs::path& manifest, const IngestOptions& options = {}
   const Status s = ingest_seurat(manifest, manifest.parent_path() / "out", options);
   EXPECT_FALSE(s.ok());
   EXPECT_FALSE(fs::exists(manifest.parent_path() / "out" / "manifest.json"));
+  // Nor the folder the ingest would have created.
+  EXPECT_FALSE(fs::exists(manifest.parent_path() / "out")) << s.to_string();
   const std::string text = s.to_string();
   EXPECT_EQ(text.find('\n'), std::string::npos) << text;
   return text;
@@ -528,6 +530,25 @@ TEST(SeuratIngest, ColourAndDepthOfDifferentSizes) {
   const std::string e = error_of(manifest);
   EXPECT_NE(e.find("CALF-E147"), std::string::npos) << e;
   EXPECT_NE(e.find("is 4 x 4 but depth"), std::string::npos) << e;
+}
+
+// An image path that is a symbolic link out of the manifest's folder is refused, as a scene
+// file's is (E153); a link to a file inside the folder is read.
+TEST(SeuratIngest, ImageLinkLeavingTheFolder) {
+  const fs::path dir = scratch("link_out");
+  const fs::path manifest = write_seurat(dir, kCentres, 4, {});
+  const fs::path outside = dir.parent_path() / "link_out_elsewhere.exr";
+  fs::remove(outside);
+  fs::rename(dir / "Cube_top_1_Depth.exr", outside);
+  fs::create_symlink(outside, dir / "Cube_top_1_Depth.exr");
+  const std::string e = error_of(manifest);
+  EXPECT_NE(e.find("CALF-E143"), std::string::npos) << e;
+  EXPECT_NE(e.find("'Cube_top_1_Depth.exr' resolves (through a link) outside"), std::string::npos)
+      << e;
+  fs::remove(dir / "Cube_top_1_Depth.exr");
+  fs::rename(outside, dir / "Cube_top_1_Depth.exr.real");
+  fs::create_symlink("Cube_top_1_Depth.exr.real", dir / "Cube_top_1_Depth.exr");
+  EXPECT_TRUE(ingest_seurat(manifest, dir / "ok", {}).ok()) << "a link inside the folder";
 }
 
 TEST(SeuratIngest, ManifestErrors) {

@@ -353,6 +353,37 @@ TEST(SceneFile, NonFiniteValues) {
                "objects[0]: transform 0 is not finite");
 }
 
+// Transforms are rigid or uniformly scaled: a singular, zero or absurdly scaled one, or one that
+// translates beyond the coordinate bound, is refused naming the object.
+TEST(SceneFile, DegenerateTransforms) {
+  struct Case {
+    SceneTransform t;
+    const char* what;
+  };
+  const Case cases[] = {
+      {{0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0}, "zero"},
+      {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0}, "singular"},
+      {{1e30f, 0, 0, 0, 0, 1e30f, 0, 0, 0, 0, 1e30f, 0}, "1e30"},
+      {{1e-8f, 0, 0, 0, 0, 1e-8f, 0, 0, 0, 0, 1e-8f, 0}, "1e-8"},
+      {{1, 0, 0, 2e12f, 0, 1, 0, 0, 0, 0, 1, 0}, "far"},
+  };
+  for (const Case& c : cases) {
+    SceneFile s = sample_scene();
+    s.objects[0].transforms.assign(1, c.t);
+    const Status st = validate_scene_file(s);
+    EXPECT_EQ(st.id(), ErrorId::kSceneFileValue) << c.what << ": " << st.to_string();
+    EXPECT_NE(st.message().find("objects[0]: transform 0"), std::string::npos) << st.to_string();
+  }
+  // Rigid, mirrored and uniformly scaled ones stay valid.
+  for (const SceneTransform& t : {SceneTransform{0, -1, 0, 5, 1, 0, 0, 0, 0, 0, 1, -3},
+                                  SceneTransform{-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0},
+                                  SceneTransform{1e3f, 0, 0, 0, 0, 1e3f, 0, 0, 0, 0, 1e3f, 0}}) {
+    SceneFile s = sample_scene();
+    s.objects[0].transforms.assign(1, t);
+    EXPECT_TRUE(validate_scene_file(s).ok()) << validate_scene_file(s).to_string();
+  }
+}
+
 TEST(SceneFile, Views) {
   expect_json_error("\"offset\": 36, \"count\": 1", "\"offset\": 36, \"count\": 6",
                     ErrorId::kSceneFileView, "meshes[0].triangles");

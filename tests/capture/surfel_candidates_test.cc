@@ -149,6 +149,8 @@ TEST(SurfelCandidates, RoundTripOnDiskRecordByRecord) {
   EXPECT_EQ(reader->entries()[0].mesh_hash, 0x0123456789abcdefull);
   EXPECT_EQ(reader->entries()[0].candidate_count, 3u);
   EXPECT_EQ(reader->entries()[0].colour_set_count, 2u);
+  EXPECT_EQ(reader->entries()[0].last_material, 2u);  // the second set's, as laid out above
+  EXPECT_EQ(reader->entries()[1].last_material, 0u);  // no colour sets
   EXPECT_EQ(reader->entries()[1].offset, kHeader + kRecord0);
   auto one = reader->read(1);
   ASSERT_TRUE(one.ok());
@@ -337,6 +339,7 @@ TEST(SurfelCandidates, MatchTheSceneTheyWereMadeFrom) {
   m.indices = {0, 1, 2};
   scene.meshes = {m, m};
   scene.meshes[1].positions[0] = 0.5f;
+  scene.materials.resize(3);  // the sample's colour sets are of materials 0 and 2
   SurfelCandidateFile f = sample_file();
   f.prototypes[0].mesh_hash = surfel_mesh_hash(scene.meshes[0]);
   f.prototypes[1].mesh_hash = surfel_mesh_hash(scene.meshes[1]);
@@ -353,8 +356,45 @@ TEST(SurfelCandidates, MatchTheSceneTheyWereMadeFrom) {
   coloured.meshes[0].colors = {1, 1, 1, 1, 1, 1, 0, 0, 0};
   EXPECT_EQ(check_surfel_candidates_match(entries, coloured, "c").id(),
             ErrorId::kSurfelSceneMismatch);
+  // A colour set of a material the scene lacks (a builder would index past its materials).
+  SceneFile fewer = scene;
+  fewer.materials.resize(2);
+  s = check_surfel_candidates_match(entries, fewer, "c");
+  EXPECT_EQ(s.id(), ErrorId::kSurfelSceneMismatch);
+  EXPECT_NE(s.message().find("record 0 has a colour set of material 2"), std::string::npos)
+      << s.to_string();
   scene.meshes.pop_back();
   EXPECT_EQ(check_surfel_candidates_match(entries, scene, "c").id(), ErrorId::kSurfelSceneMismatch);
+}
+
+// The same refusal on a file read from disk: the reader's entries carry each record's last
+// material, whatever it is (60000000 would have crashed the surfel builder, 5 read past the
+// scene's materials without a word).
+TEST(SurfelCandidates, MaterialsPastTheSceneAreRefusedFromDisk) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("calf_surfel_cand_mat_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  SceneFile scene;
+  SceneMesh m;
+  m.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  m.indices = {0, 1, 2};
+  scene.meshes = {m, m};
+  scene.materials.resize(3);
+  for (const uint32_t material : {3u, 5u, 60000000u, 0xfffffffeu}) {
+    SurfelCandidateFile f = sample_file();
+    f.prototypes[0].mesh_hash = surfel_mesh_hash(scene.meshes[0]);
+    f.prototypes[1].mesh_hash = surfel_mesh_hash(scene.meshes[1]);
+    f.prototypes[0].colour_sets[1].material = material;
+    const std::string path = (dir / "c.cand").string();
+    ASSERT_TRUE(write_surfel_candidates(path, f).ok());
+    auto reader = SurfelCandidateReader::open(path);
+    ASSERT_TRUE(reader.ok()) << reader.status().to_string();
+    const Status s = check_surfel_candidates_match(reader->entries(), scene, path);
+    EXPECT_EQ(s.id(), ErrorId::kSurfelSceneMismatch) << material;
+    EXPECT_NE(s.message().find("material " + std::to_string(material)), std::string::npos)
+        << s.to_string();
+  }
+  fs::remove_all(dir);
 }
 
 }  // namespace

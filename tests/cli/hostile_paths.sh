@@ -131,6 +131,64 @@ encode-onto-manifest | encode-onto-image | encode-onto-set)
   done
   no_temp_files "$work/set"
   ;;
+# The analysis file is an input of every shard and of the merge.
+shard-onto-analysis | merge-onto-analysis)
+  "$bin/calf-encode" "$set_dir" --analysis-only -o "$work/a.calf" --quiet || broken "analysis failed"
+  cp "$work/a.calf" "$work/a.orig"
+  if [ $name = shard-onto-analysis ]; then
+    timeout 60 "$bin/calf-encode" "$set_dir" --analysis "$work/a.calf" --views 0 -o "$work/a.calf" \
+      --quiet
+    rc=$?
+  else
+    # One shard of every view, so that nothing but the output check can stop the merge.
+    views=$(ls "$set_dir" | grep -c '_frame00000\.')
+    "$bin/calf-encode" "$set_dir" --analysis "$work/a.calf" --views "0-$((views - 1))" \
+      -o "$work/s0.calf" --quiet || broken "shard failed"
+    timeout 60 "$bin/calf-merge" --analysis "$work/a.calf" "$work/s0.calf" -o "$work/a.calf" -q
+    rc=$?
+  fi
+  cmp -s "$work/a.calf" "$work/a.orig" || broken "the analysis file was changed"
+  no_temp_files "$work"
+  ;;
+# calf-export's side files (OUT.bin, OUT.mtl, OUT_atlas.png, OUT_texture<n>.png) are outputs too.
+export-onto-bin | export-onto-mtl | export-onto-atlas | export-onto-texture)
+  case $name in
+  export-onto-bin) clip=c.bin out=c.gltf from=mesh/textured_zstd.calf ;;
+  export-onto-mtl) clip=d.mtl out=d.obj from=mesh/textured_zstd.calf ;;
+  export-onto-atlas) clip=e_atlas.png out=e.obj from=tiles/bc7_zstd.calf ;;
+  *) clip=f_texture0.png out=f.obj from=mesh/textured_zstd.calf ;;
+  esac
+  cp "$src/tests/conformance/$from" "$work/$clip"
+  timeout 60 "$bin/calf-export" "$work/$clip" -o "$work/$out" -q
+  rc=$?
+  cmp -s "$work/$clip" "$src/tests/conformance/$from" || broken "the input clip was changed"
+  [ -e "$work/$out" ] && broken "an output was written"
+  no_temp_files "$work"
+  ;;
+# ---- a scene the mesh track refuses is refused by --visible-set too, in one line ----
+visible-set-far-vertex)
+  mkdir -p "$work/scene"
+  z='\000\000\000\000'
+  one='\000\000\200\077'
+  big='\346\261\141\177'  # 3e38
+  printf "$z$z$z$big$z$z$z$one$z"'\000\000\000\000\001\000\000\000\002\000\000\000' \
+    >"$work/scene/scene.bin"
+  printf "$one$z$z$z$z$one$z$z$z$z$one"'\000\000\100\300' >>"$work/scene/scene.bin"
+  cat >"$work/scene/scene.json" <<'JSON'
+{"format": "calf-scene", "version": 1, "name": "far", "fps": 24, "frame_count": 1,
+ "view_region": {"min": [0, 1, 0], "max": [1, 2, 1]},
+ "buffers": [{"uri": "scene.bin", "byte_length": 96}],
+ "materials": [{"base_color": [0.5, 0.25, 1]}],
+ "meshes": [{"positions": {"buffer": 0, "offset": 0, "count": 3},
+             "triangles": {"buffer": 0, "offset": 36, "count": 1}}],
+ "objects": [{"mesh": 0, "material": 0, "transforms": {"buffer": 0, "offset": 48, "count": 1}}]}
+JSON
+  timeout 60 "$bin/calf-encode" --mode mesh --visible-set --visibility-face-size 16 \
+    "$work/scene" -o "$work/v.calf"
+  rc=$?
+  [ -e "$work/v.calf" ] && broken "an output was written"
+  no_temp_files "$work"
+  ;;
 # ---- temporary files ----
 stale-temp)
   # Left by dead processes of this host (a pid above any pid_max): removed by the next writer.

@@ -62,7 +62,7 @@ std::pair<double, int> trace(const Vec3& e, const Vec3& d) {
 // both colours, as a box-filtered capture's silhouette texels do; `view_half`: the view volume's
 // half size around the centre) and returns its directory.
 fs::path write_room(const std::string& name, bool sky = false, bool open_top = false,
-                    bool blend_edges = false, double view_half = 0.1) {
+                    bool blend_edges = false, double view_half = 0.1, float top_depth = 0) {
   const fs::path dir = test::scratch_dir("tiles_build_test") / name;
   capture::CaptureManifest m;
   m.frame_count = 1;
@@ -83,6 +83,7 @@ fs::path write_room(const std::string& name, bool sky = false, bool open_top = f
               trace(m.viewpoints[v].position, direction_from_texel(cf, x, y, kFace));
           f.depth[t] = sky || (open_top && hit == 2) ? std::numeric_limits<float>::infinity()
                                                      : static_cast<float>(depth);
+          if (top_depth > 0 && hit == 2) f.depth[t] = top_depth;
           for (int c = 0; c < 3; ++c) f.color[3 * t + c] = kColour[hit][c];
           if (!blend_edges) continue;
           const int dx[4] = {-1, 1, 0, 0}, dy[4] = {0, 0, -1, 1};
@@ -535,6 +536,54 @@ TEST(TilesBuild, Errors) {
       EXPECT_EQ(result.status().id(), ErrorId::kTilesOption) << bad.name;
       EXPECT_NE(result.status().message().find(bad.name), std::string::npos) << bad.name;
     }
+  }
+
+  // A valid but far depth (CAPTURE.md allows any finite one): an input error, not the track
+  // encoder's internal-consistency E214.
+  auto far = build(small_options(), nullptr, 0, write_room("far", false, false, false, 0.1, 1e30f));
+  ASSERT_FALSE(far.ok());
+  EXPECT_EQ(far.status().id(), ErrorId::kEncoderInput) << far.status().to_string();
+  auto near_enough =
+      build(small_options(), nullptr, 0, write_room("far-1e6", false, false, false, 0.1, 1e6f));
+  EXPECT_TRUE(near_enough.ok()) << near_enough.status().to_string();
+
+  // Bounds so near 0 that the selection's prices overflow: still E253, never a tile set that
+  // covers nothing.
+  for (const double bound : {1e-300, 1e-30}) {
+    for (const bool peak : {false, true}) {
+      o = small_options();
+      (peak ? o.max_peak_overdraw : o.max_average_overdraw) = bound;
+      auto tiny = build(o);
+      ASSERT_FALSE(tiny.ok()) << bound << " peak " << peak << ": " << tiny->tiles.size()
+                              << " tiles";
+      EXPECT_EQ(tiny.status().id(), ErrorId::kTilesBudget) << tiny.status().to_string();
+      EXPECT_NE(tiny.status().message().find(peak ? "peak" : "average"), std::string::npos)
+          << tiny.status().to_string();
+    }
+  }
+
+  // The iteration and trial counts have upper bounds.
+  struct BadCount {
+    uint32_t TilesBuildOptions::*field;
+    const char* name;
+    uint32_t above;
+  };
+  const BadCount bad_counts[] = {
+      {&TilesBuildOptions::ransac_trials, "ransac_trials", 4097},
+      {&TilesBuildOptions::refine_iterations, "refine_iterations", 257},
+      {&TilesBuildOptions::selection_iterations, "selection_iterations", 20001},
+  };
+  for (const BadCount& bad : bad_counts) {
+    for (const uint32_t value : {0u, bad.above, 1000000000u}) {
+      o = small_options();
+      o.*bad.field = value;
+      const Status s = encoder::validate_tiles_build_options(o);
+      EXPECT_EQ(s.id(), ErrorId::kTilesOption) << bad.name << " " << value;
+      EXPECT_NE(s.message().find(bad.name), std::string::npos) << s.to_string();
+    }
+    o = small_options();
+    o.*bad.field = bad.above - 1;
+    EXPECT_TRUE(encoder::validate_tiles_build_options(o).ok()) << bad.name;
   }
 
   o = small_options();

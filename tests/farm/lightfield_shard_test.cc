@@ -242,6 +242,14 @@ TEST(LightfieldShardErrors, MergeRefusesMissingForeignAndOverlappingShards) {
       ErrorId::kShardFile);
   expect_one_line(read_lightfield_analysis(s0).status(), ErrorId::kShardFile);
   EXPECT_FALSE(fs::exists(out));
+  // The analysis file is an input of a shard and of a merge: neither may write over it.
+  const std::string a_path = (work / "a.calf").string();
+  const std::string a_bytes = bytes_of(a_path);
+  expect_one_line(encode_lightfield_shard(dir, *a, groups[0], 0, frames, 1, a_path).status(),
+                  ErrorId::kOutputIsInput);
+  expect_one_line(merge_lightfield_shards(*a, std::vector<std::string>{s0, s1}, a_path),
+                  ErrorId::kOutputIsInput);
+  EXPECT_EQ(bytes_of(a_path), a_bytes);
   // The shard list and view lists.
   expect_one_line(capture::parse_index_list("0-2,2", 9, "views").status(), ErrorId::kShardRange);
   expect_one_line(capture::parse_index_list("3-1", 9, "views").status(), ErrorId::kShardRange);
@@ -251,6 +259,71 @@ TEST(LightfieldShardErrors, MergeRefusesMissingForeignAndOverlappingShards) {
   EXPECT_EQ(*list, (std::vector<uint32_t>{0, 1, 2, 5, 7, 8}));
   EXPECT_EQ(capture::index_list_text(*list), "0-2,5,7-8");
   ASSERT_TRUE(merge_lightfield_shards(*a, std::vector<std::string>{s1, s0}, out).ok());
+}
+
+// Two captures of one manifest whose pixels differ (one colour texel of view 0, frame 0: the
+// views' facts stay the same) give analyses with other ids: their shards do not merge, and a
+// shard of the other capture coded with the first analysis is refused where it reads the changed
+// image.
+TEST(LightfieldShardErrors, AnalysisIdentifiesThePixels) {
+  const fs::path dir = capture_of("turntable", 2, "views");
+  ASSERT_TRUE(fs::exists(dir / capture::kManifestFileName));
+  const fs::path work = scratch() / "pixels";
+  fs::remove_all(work);
+  fs::create_directories(work);
+  const fs::path other = work / "other-capture";
+  {
+    auto reader = capture::CaptureSetReader::open(dir);
+    ASSERT_TRUE(reader.ok());
+    auto writer = capture::CaptureSetWriter::create(other, reader->manifest());
+    ASSERT_TRUE(writer.ok());
+    for (uint32_t v = 0; v < reader->manifest().viewpoints.size(); ++v) {
+      for (uint32_t f = 0; f < reader->manifest().frame_count; ++f) {
+        capture::ViewFrame frame;
+        ASSERT_TRUE(reader->read(v, f, &frame).ok());
+        if (v == 0 && f == 0) frame.color[0] = frame.color[0] > 0.5f ? 0.25f : 0.75f;
+        ASSERT_TRUE(writer->write(v, f, frame).ok());
+      }
+    }
+    ASSERT_TRUE(writer->finish().ok());
+  }
+  EXPECT_EQ(bytes_of(other / capture::kManifestFileName),
+            bytes_of(dir / capture::kManifestFileName));
+  LightfieldEncodeOptions o;
+  o.threads = 2;
+  const std::string a_path = (work / "a.calf").string(), b_path = (work / "b.calf").string();
+  ASSERT_TRUE(write_lightfield_analysis(dir, a_path, o).ok());
+  ASSERT_TRUE(write_lightfield_analysis(other, b_path, o).ok());
+  auto a = read_lightfield_analysis(a_path);
+  auto b = read_lightfield_analysis(b_path);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_NE(a->id, b->id);
+  const uint32_t n = a->analysis.header.view_count, frames = a->analysis.header.frame_count;
+  const auto groups = split(n, 2);
+  const std::string s0 = (work / "s0.calf").string(), s1 = (work / "s1-other.calf").string();
+  ASSERT_TRUE(encode_lightfield_shard(dir, *a, groups[0], 0, frames, 1, s0).ok());
+  ASSERT_TRUE(encode_lightfield_shard(other, *b, groups[1], 0, frames, 1, s1).ok());
+  const std::string out = (work / "mixed.calf").string();
+  expect_one_line(merge_lightfield_shards(*a, std::vector<std::string>{s0, s1}, out),
+                  ErrorId::kShardMismatch);
+  EXPECT_FALSE(fs::exists(out));
+  // View 0 of the other capture, coded with the first analysis.
+  const Status s =
+      encode_lightfield_shard(other, *a, groups[0], 0, frames, 1, (work / "s0-other.calf").string())
+          .status();
+  expect_one_line(s, ErrorId::kShardMismatch);
+  EXPECT_NE(s.message().find("view 0 frames 0-1 are not the images analysed"), std::string::npos)
+      << s.to_string();
+  // Views whose files the change did not touch still code (their files are rewritten from the
+  // same pixels, byte-identical when the EXR writer is deterministic).
+  auto reader = capture::CaptureSetReader::open(dir);
+  ASSERT_TRUE(reader.ok());
+  const std::string last = reader->image_path(n - 1, 0).filename().string();
+  if (bytes_of(dir / last) == bytes_of(other / last)) {
+    EXPECT_TRUE(encode_lightfield_shard(other, *a, groups[1], 0, frames, 1,
+                                        (work / "s1-same.calf").string())
+                    .ok());
+  }
 }
 
 // Capture shards (2 view groups x 2 frame ranges) rendered into one folder and joined hold the

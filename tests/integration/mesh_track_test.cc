@@ -291,6 +291,26 @@ TEST(MeshTrack, BadVisibleSetsAreRefused) {
   EXPECT_EQ(encoder::encode_mesh_track(far, nullptr, {}, &*w).id(), ErrorId::kEncoderInput);
 }
 
+// check_mesh_scene refuses, without encoding, what encode_mesh_track refuses in the placed
+// meshes (calf-encode --visible-set calls it before solving the set): a vertex or a sphere far
+// beyond the coordinate bound. A mesh no object places is not checked.
+TEST(MeshTrack, SceneCheckRefusesWhatTheTrackRefuses) {
+  const capture::SceneFile scene = test::make_mesh_test_scene(2);
+  EXPECT_TRUE(encoder::check_mesh_scene(scene).ok());
+  capture::SceneFile far = scene;
+  far.meshes[0].positions[0] = 3e38f;
+  Status s = encoder::check_mesh_scene(far);
+  EXPECT_EQ(s.id(), ErrorId::kEncoderInput) << s.to_string();
+  EXPECT_NE(s.message().find("scene mesh 0"), std::string::npos) << s.to_string();
+  std::vector<uint8_t> file;
+  auto w = container::Writer::create(container::memory_sink(&file));
+  ASSERT_TRUE(w.ok());
+  EXPECT_EQ(encoder::encode_mesh_track(far, nullptr, {}, &*w).id(), s.id());
+  capture::SceneFile ball = scene;
+  ball.meshes[0].spheres.push_back({{0, 0, 0}, 3e38f});
+  EXPECT_EQ(encoder::check_mesh_scene(ball).id(), ErrorId::kEncoderInput);
+}
+
 // ---- Damaged chunks: the file is rebuilt with valid hashes, so the track's parser sees them ----
 
 struct Edit {

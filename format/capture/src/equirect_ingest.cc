@@ -12,6 +12,7 @@
 #include "calf/capture/capture_set.h"
 #include "calf/capture/ingest.h"
 #include "calf/format/cube.h"
+#include "ingest_folder.h"
 #include "ingest_image.h"
 #include "json_fields.h"
 
@@ -265,7 +266,14 @@ Status ingest_equirect(const std::filesystem::path& manifest_path,
       options.face_size
           ? options.face_size
           : std::max<uint32_t>(1, static_cast<uint32_t>(std::lround(image.w / std::numbers::pi)));
-  CALF_ASSIGN_OR_RETURN(CaptureSetWriter writer, CaptureSetWriter::create(out_dir, m));
+  // A failed ingest removes the folders it created (remove_empty_folders after abandon()).
+  const std::vector<std::filesystem::path> created = detail::missing_folders(out_dir);
+  Expected<CaptureSetWriter> created_writer = CaptureSetWriter::create(out_dir, m);
+  if (!created_writer.ok()) {
+    detail::remove_empty_folders(created);
+    return created_writer.status();
+  }
+  CaptureSetWriter writer = std::move(*created_writer);
   ViewFrame frame;
   frame.resize(m.face_size, false);
   for (uint32_t v = 0; v < m.viewpoints.size(); ++v) {
@@ -278,12 +286,14 @@ Status ingest_equirect(const std::filesystem::path& manifest_path,
       }
       if (!s.ok()) {
         writer.abandon();
+        detail::remove_empty_folders(created);
         return s;
       }
     }
   }
   if (Status s = writer.finish(); !s.ok()) {
     writer.abandon();
+    detail::remove_empty_folders(created);
     return s;
   }
   if (report) {

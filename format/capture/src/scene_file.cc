@@ -21,6 +21,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "calf/capture/capture_set.h"
+#include "calf/format/coordinates.h"
 #include "calf/format/files.h"
 #include "calf/format/vertex_states.h"
 #include "json_fields.h"
@@ -30,6 +31,11 @@ namespace calf::capture {
 // Buffers are little-endian and are copied byte for byte into the arrays.
 static_assert(std::endian::native == std::endian::little,
               "scene buffers assume a little-endian host");
+
+// An object transform's scale (the cube root of |det| of its 3 x 3 part) lies within
+// [kMinScale, kMaxScale] (CALF-E157 outside: singular, zero or absurdly scaled; SCENE.md).
+constexpr double kMinScale = 1e-6;
+constexpr double kMaxScale = 1e6;
 
 namespace {
 
@@ -295,10 +301,32 @@ Status validate_impl(const SceneFile& s, ErrorId size_id) {
                                  std::to_string(s.frame_count) + ")");
     }
     for (size_t f = 0; f < n; ++f) {
-      for (float x : o.transforms[f]) {
+      const SceneTransform& t = o.transforms[f];
+      for (float x : t) {
         if (!std::isfinite(x)) {
           return Status(ErrorId::kSceneFileValue,
                         at + ": transform " + std::to_string(f) + " is not finite");
+        }
+      }
+      // Rigid or uniformly scaled (SCENE.md): at least not singular, and a scale and a
+      // translation a renderer can hold.
+      const auto m = [&](int r, int c) { return static_cast<double>(t[4 * r + c]); };
+      const double det = m(0, 0) * (m(1, 1) * m(2, 2) - m(1, 2) * m(2, 1)) -
+                         m(0, 1) * (m(1, 0) * m(2, 2) - m(1, 2) * m(2, 0)) +
+                         m(0, 2) * (m(1, 0) * m(2, 1) - m(1, 1) * m(2, 0));
+      const double scale = std::cbrt(std::fabs(det));
+      if (!(scale >= kMinScale && scale <= kMaxScale)) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf,
+                      ": transform %zu has scale %g (cube root of |det|), not in "
+                      "[%g, %g]: singular, zero or too large",
+                      f, scale, kMinScale, kMaxScale);
+        return Status(ErrorId::kSceneFileValue, at + buf);
+      }
+      for (int r = 0; r < 3; ++r) {
+        if (!coordinate_ok(m(r, 3))) {
+          return Status(ErrorId::kSceneFileValue, at + ": transform " + std::to_string(f) +
+                                                      " translates beyond the coordinate bound");
         }
       }
     }

@@ -11,6 +11,7 @@
 #include "calf/capture/capture_set.h"
 #include "calf/capture/ingest.h"
 #include "calf/format/cube.h"
+#include "ingest_folder.h"
 #include "ingest_image.h"
 
 namespace calf::capture {
@@ -84,9 +85,29 @@ PreparedView prepare_geometry(const SeuratView& v) {
   return p;
 }
 
+// True when `path`, its symbolic links resolved, lies inside the folder `root` (as a scene file's
+// paths must, E153); false too when either cannot be resolved.
+bool resolves_inside(const std::filesystem::path& root, const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::filesystem::path base = std::filesystem::weakly_canonical(root, ec);
+  if (ec) return false;
+  const std::filesystem::path full = std::filesystem::weakly_canonical(path, ec);
+  if (ec) return false;
+  return std::mismatch(base.begin(), base.end(), full.begin(), full.end()).first == base.end();
+}
+
 // Loads a view's images and turns every pixel into colour + radial depth from `centre`.
 Status load_pixels(const SeuratView& v, const std::filesystem::path& dir, const Vec3& centre,
                    const std::string& where, PreparedView* p) {
+  // As a scene file's (E153): a path stays in the manifest's folder, through links too.
+  for (const std::string* rel : {&v.color.path, &v.depth.path}) {
+    const std::filesystem::path root = dir.empty() ? std::filesystem::path(".") : dir;
+    if (!resolves_inside(root, root / *rel)) {
+      return Status(ErrorId::kSeuratField, where + ": image '" + *rel +
+                                               "' resolves (through a link) outside the "
+                                               "manifest's folder");
+    }
+  }
   NamedPlanes colour, depth;
   CALF_RETURN_IF_ERROR(detail::read_named_planes(dir / v.color.path, v.color.channels,
                                                  {PngSamples::kSrgbColour, PngSamples::kSrgbColour,
@@ -287,7 +308,14 @@ Status ingest_seurat(const std::filesystem::path& manifest_path,
     m.view_volume = box;
   }
   m.face_size = options.face_size ? options.face_size : density;
-  CALF_ASSIGN_OR_RETURN(CaptureSetWriter writer, CaptureSetWriter::create(out_dir, m));
+  // A failed ingest removes the folders it created (remove_empty_folders after abandon()).
+  const std::vector<std::filesystem::path> created = detail::missing_folders(out_dir);
+  Expected<CaptureSetWriter> created_writer = CaptureSetWriter::create(out_dir, m);
+  if (!created_writer.ok()) {
+    detail::remove_empty_folders(created);
+    return created_writer.status();
+  }
+  CaptureSetWriter writer = std::move(*created_writer);
 
   ViewFrame frame;
   frame.resize(m.face_size, false);
@@ -307,12 +335,14 @@ Status ingest_seurat(const std::filesystem::path& manifest_path,
     if (s.ok()) s = writer.write(static_cast<uint32_t>(g), 0, frame);
     if (!s.ok()) {
       writer.abandon();
+      detail::remove_empty_folders(created);
       return s;
     }
     exact_groups += exact ? 1 : 0;
   }
   if (Status s = writer.finish(); !s.ok()) {
     writer.abandon();
+    detail::remove_empty_folders(created);
     return s;
   }
   if (report) {

@@ -305,6 +305,15 @@ Expected<Walk> walk(const container::ByteSource& src, std::string_view source) {
                     cat(where, ": record_size ", record_size, " runs past the file's end (",
                         size - offset, " bytes left)"));
     }
+    // The last material, for check_surfel_candidates_match; a record too short to hold its
+    // materials is read() 's E183.
+    const uint64_t materials_end =
+        kRecordHeadBytes + kViewBytes * f.direction_count + 4 * uint64_t{e.colour_set_count};
+    if (e.colour_set_count > 0 && materials_end + kHashBytes <= record_size) {
+      uint8_t last[4];
+      CALF_RETURN_IF_ERROR(src.read_at(offset + materials_end - 4, last));
+      e.last_material = static_cast<uint32_t>(container::load_le(last, 4));
+    }
     w.entries.push_back(e);
     offset += record_size;
   }
@@ -455,6 +464,12 @@ Status check_surfel_candidates_match(std::span<const SurfelCandidateEntry> entri
           cat(source, ": record ", i, " was made from another mesh than the scene's mesh ", i, " '",
               scene.meshes[i].name, "' (mesh hash differs)"));
     }
+    if (entries[i].colour_set_count > 0 && entries[i].last_material >= scene.materials.size()) {
+      return Status(
+          ErrorId::kSurfelSceneMismatch,
+          cat(source, ": record ", i, " has a colour set of material ", entries[i].last_material,
+              "; the scene has ", scene.materials.size(), " materials"));
+    }
   }
   return Status::Ok();
 }
@@ -468,6 +483,7 @@ std::vector<SurfelCandidateEntry> surfel_candidate_entries(const SurfelCandidate
     e.mesh_hash = p.mesh_hash;
     e.candidate_count = static_cast<uint32_t>(p.candidate_count());
     e.colour_set_count = static_cast<uint32_t>(p.colour_sets.size());
+    if (!p.colour_sets.empty()) e.last_material = p.colour_sets.back().material;
     e.offset = offset;
     e.size = record_bytes(file.header.direction_count, e.candidate_count, e.colour_set_count);
     offset += e.size;

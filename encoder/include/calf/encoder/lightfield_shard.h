@@ -36,6 +36,15 @@ struct LightfieldAnalysisFile {
   std::string id;
   // Metadata of the final clip ("encoder", "source_scene", "view_volume"), key-sorted.
   std::vector<std::pair<std::string, std::string>> clip_metadata;
+  // Fingerprints of the capture set's images, per view one per segment of segment_frames frames
+  // (one for the whole clip without segments): XXH3-64 of the image files' XXH3-64s in frame
+  // order. A shard codes only images that match them (kShardMismatch otherwise), and they are in
+  // the record the id hashes: captures of one manifest with other pixels have other ids.
+  std::vector<std::vector<uint64_t>> pixels;
+  // The file it was read from or written to: an input of every shard and merge made with it, so
+  // that their output may not replace it (kOutputIsInput). Empty for an analysis held only in
+  // memory.
+  std::string path;
 };
 
 // Pass 1 as a job: analyses every view of the capture set at `capture_dir` (options.threads at a
@@ -53,8 +62,10 @@ Expected<LightfieldAnalysisFile> read_lightfield_analysis(const std::string& pat
 // at `capture_dir` with the analysis file's options (`threads` worker threads) and writes the
 // shard file `out_path` whole. A frame range short of the clip must be whole segments of the
 // analysis's segment_frames (encode_lightfield_view_frames()). Errors: kShardRange;
-// kShardMismatch (the capture set is not the one analysed: other view count, frames or face size);
-// encode_lightfield_view()'s (kEncoderInput when an image changed since the analysis).
+// kShardMismatch (the capture set is not the one analysed: other view count, frames or face size,
+// or an image whose bytes differ from the analysis's fingerprint of its segment);
+// encode_lightfield_view()'s (kEncoderInput when an image changed since the analysis);
+// kOutputIsInput (`out_path` is the analysis file, the manifest or an image of the set).
 Expected<LightfieldEncodeStats> encode_lightfield_shard(const std::filesystem::path& capture_dir,
                                                         const LightfieldAnalysisFile& analysis,
                                                         std::span<const uint32_t> views,
@@ -66,7 +77,8 @@ Expected<LightfieldEncodeStats> encode_lightfield_shard(const std::filesystem::p
 // the partial t chunks of frame-range shards are joined and compressed as one encode does. Errors:
 // the container reader's; kShardFile (not a shard file); kShardMismatch (a shard of another
 // analysis, naming both files); kShardOverlap (a view-frame in two shards, naming both);
-// kShardMissing (a view-frame in no shard); kOutputIsInput.
+// kShardMissing (a view-frame in no shard); kOutputIsInput (`out_path` is a shard or the analysis
+// file).
 Status merge_lightfield_shards(const LightfieldAnalysisFile& analysis,
                                std::span<const std::string> shard_paths,
                                const std::string& out_path);

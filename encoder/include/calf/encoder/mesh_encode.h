@@ -82,6 +82,12 @@ struct MeshPrototypeArrays {
 };
 Expected<MeshPrototypeArrays> prototype_arrays(const capture::SceneMesh& mesh);
 
+// The values encode_mesh_track refuses in the meshes objects place (a position or sphere beyond
+// the coordinate bound, counts too large), checked without encoding anything: a caller that
+// computes something from the scene first (calf-encode --visible-set) refuses the scene the mesh
+// track would, before that work. Errors: kEncoderInput and kMeshLimit naming the scene mesh.
+Status check_mesh_scene(const capture::SceneFile& scene);
+
 // Encodes `scene` into a new mesh track of `writer` (does not finish the writer). `visible`:
 // nullptr for every triangle of every object, else one sorted list of mesh-triangle indices per
 // scene object (compute_visible_set's VisibleSet::triangles; sphere triangles numbered as

@@ -69,6 +69,11 @@ struct TilesEncodeStats {
 // (more than 2^22 tiles).
 Status validate_tile_set(const TileSet& tiles);
 
+// Checks the options alone (what encode_tiles_track checks first), so that a command can refuse
+// them before building anything. Errors: kEncoderOption (threads above 256, an unknown
+// supercompression, bc7_quality outside 0..2, band_rows not a multiple of 4 in [4, 16384]).
+Status validate_tiles_encode_options(const TilesEncodeOptions& options);
+
 // Encodes `tiles` into a new tiles track of `writer` (does not finish the writer), marked
 // must-understand as options.required says. `stats` (optional) receives
 // the figures. Errors: validate_tile_set's; kEncoderOption (threads above 256, an unknown

@@ -102,6 +102,9 @@ struct SurfelCandidateEntry {
   uint64_t mesh_hash = 0;
   uint32_t candidate_count = 0;
   uint32_t colour_set_count = 0;
+  // The last (largest, materials being strictly increasing) colour set's material; 0 without
+  // colour sets or when the record is too short to hold its materials (read() refuses it then).
+  uint32_t last_material = 0;
   uint64_t offset = 0, size = 0;  // the record's bytes in the file
 };
 
@@ -119,8 +122,10 @@ Status validate_surfel_candidates(const SurfelCandidateHeader& header, uint32_t 
                                   const SurfelCandidates& prototype);
 
 // Ok when `entries` (a file's records) belong to `scene`: one record per mesh, each with that
-// mesh's surfel_mesh_hash, every colour set's material in range. Else CALF-E189 naming the
-// first record at fault. `source` names the candidate file in messages.
+// mesh's surfel_mesh_hash, every colour set's material below the scene's material count (the
+// last one checked: materials strictly increase, which read() enforces). Else CALF-E189 naming
+// the first record at fault. `source` names the candidate file in messages. A builder calls it
+// before reading any record against the scene.
 Status check_surfel_candidates_match(std::span<const SurfelCandidateEntry> entries,
                                      const SceneFile& scene, std::string_view source);
 // The entries of an in-memory file (offsets and sizes as encode_surfel_candidates lays it out).
