@@ -296,7 +296,7 @@ Status check_imported(const aiScene* ai, const std::string& file) {
 
 }  // namespace
 
-Expected<Scene> load_scene_file(const std::filesystem::path& path) {
+Expected<Scene> load_scene_file(const std::filesystem::path& path, uint64_t max_image_pixels) {
   const std::string file = path.string();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
@@ -339,7 +339,8 @@ Expected<Scene> load_scene_file(const std::filesystem::path& path) {
   for (unsigned i = 0; i < ai->mNumMaterials; ++i) {
     scene.materials.push_back(convert_material(ai->mMaterials[i]));
   }
-  CALF_RETURN_IF_ERROR(detail::load_model_textures(*ai, path, lower_ext == ".fbx", &scene));
+  CALF_RETURN_IF_ERROR(
+      detail::load_model_textures(*ai, path, lower_ext == ".fbx", max_image_pixels, &scene));
   if (scene.materials.empty()) scene.materials.push_back(Material{});
 
   // The first animation drives the nodes it names.
