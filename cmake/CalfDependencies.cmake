@@ -31,6 +31,8 @@ calf_find_pkgconfig(LZMA liblzma liblzma-dev)
 calf_find_pkgconfig(XXHASH libxxhash libxxhash-dev)
 # capture sets: OpenImageIO through pkg-config, because its CMake config wants OpenCV headers
 calf_find_pkgconfig(OIIO OpenImageIO libopenimageio-dev)
+# PNG is decoded by libpng directly: its errors become Status values, its header is checked first
+calf_find_pkgconfig(PNG libpng libpng-dev)
 calf_find_config(OpenEXR libopenexr-dev)
 calf_find_config(nlohmann_json nlohmann-json3-dev)
 # commands

@@ -10,7 +10,7 @@ PACKAGES=(
   # format: compression and hashing
   libzstd-dev liblzma-dev libxxhash-dev
   # capture sets: images and manifests
-  libopenimageio-dev libopenexr-dev nlohmann-json3-dev
+  libopenimageio-dev libopenexr-dev libpng-dev nlohmann-json3-dev
   # command lines and text
   libcli11-dev libfmt-dev
   # threads

@@ -429,7 +429,8 @@ Status encode_mesh_track(const capture::SceneFile& scene,
 Expected<MeshEncodeStats> encode_mesh_file(const std::filesystem::path& scene_dir,
                                            const std::string& out_path,
                                            const MeshEncodeOptions& options) {
-  CALF_ASSIGN_OR_RETURN(const capture::SceneFile scene, capture::read_scene_file(scene_dir));
+  CALF_ASSIGN_OR_RETURN(const capture::SceneFile scene,
+                        capture::read_scene_file(scene_dir, options.max_image_pixels));
   return encode_mesh_file(scene, scene_dir, out_path, nullptr, options);
 }
 

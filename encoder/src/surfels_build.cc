@@ -80,7 +80,8 @@ Expected<SurfelBuildStats> encode_surfel_file(const std::filesystem::path& scene
                                               const MeshEncodeOptions& mesh_options,
                                               const SurfelsEncodeOptions& surfels_options,
                                               SurfelsEncodeStats* surfels_stats) {
-  CALF_ASSIGN_OR_RETURN(const capture::SceneFile scene, capture::read_scene_file(scene_dir));
+  CALF_ASSIGN_OR_RETURN(const capture::SceneFile scene,
+                        capture::read_scene_file(scene_dir, mesh_options.max_image_pixels));
   CALF_ASSIGN_OR_RETURN(const capture::SurfelCandidateReader candidates,
                         capture::SurfelCandidateReader::open(candidates_path));
   SurfelBuildStats stats;

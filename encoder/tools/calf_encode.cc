@@ -114,7 +114,8 @@ calf::Expected<calf::encoder::VisibleSet> visible_set_of(const calf::capture::Sc
 // --mode mesh: the scene file at `input` (its folder or scene.json) into a mesh track of the
 // whole scene or, with --visible-set, of the triangles visible from its view region.
 int encode_mesh(const std::string& input, const std::string& out, const std::string& super,
-                bool plain_directory, uint32_t threads, const VisibleSetFlags& vs) {
+                bool plain_directory, uint32_t threads, const VisibleSetFlags& vs,
+                uint64_t max_image_pixels) {
   calf::encoder::MeshEncodeOptions o;
   o.threads = threads;
   o.levels.compress_directory = !plain_directory;
@@ -125,7 +126,7 @@ int encode_mesh(const std::string& input, const std::string& out, const std::str
   if (dir.filename() == calf::capture::kSceneManifestFileName) dir = dir.parent_path();
   if (dir.empty()) dir = ".";
   const auto start = std::chrono::steady_clock::now();
-  auto scene = calf::capture::read_scene_file(dir);
+  auto scene = calf::capture::read_scene_file(dir, max_image_pixels);
   if (!scene.ok()) return fail(scene.status());
   std::optional<calf::encoder::VisibleSet> set;
   std::string vs_summary;
@@ -182,8 +183,9 @@ int encode_mesh(const std::string& input, const std::string& out, const std::str
 // and the surfels track paired with it (track 1; paper 001, encoder/surfels_build.h).
 int encode_surfels(const std::string& input, const std::string& candidates, const std::string& out,
                    const std::string& super, bool plain_directory, uint32_t threads,
-                   const calf::encoder::SurfelBuildOptions& build) {
+                   const calf::encoder::SurfelBuildOptions& build, uint64_t max_image_pixels) {
   calf::encoder::MeshEncodeOptions mesh;
+  mesh.max_image_pixels = max_image_pixels;
   calf::encoder::SurfelsEncodeOptions surfels;
   mesh.threads = surfels.threads = threads;
   mesh.levels.compress_directory = surfels.levels.compress_directory = !plain_directory;
@@ -215,7 +217,7 @@ int encode_surfels(const std::string& input, const std::string& candidates, cons
   return 0;
 }
 
-int main(int argc, char** argv) {
+static int command_main(int argc, char** argv) {
   CLI::App app{
       "calf-encode: encode a capture set (format/CAPTURE.md) into a .calf lightfield track "
       "(format/SPEC.md 11.1).\nColour: per-cell keyframes + 8-bit t (Alg. 2); depth: log-16 "
@@ -266,6 +268,10 @@ int main(int argc, char** argv) {
                  "(default 0)")
       ->check(CLI::Range(0u, calf::tools::kMaxThreads))
       ->default_val(0);
+  uint64_t max_image_pixels = calf::capture::kDefaultMaxImagePixels;
+  app.add_option("--max-image-pixels", max_image_pixels,
+                 std::string("mesh, surfels: ") + calf::capture::kMaxImagePixelsHelp)
+      ->check(CLI::Range(uint64_t{1}, calf::capture::kMaxImagePixelsLimit));
   app.add_option("--cell", o.cell_size, "colour cell side in px, multiple of 4 (default 64)")
       ->default_val(64);
   app.add_option(
@@ -624,7 +630,7 @@ int main(int argc, char** argv) {
                                                              : calf::SurfelOrderMethod::kGreedyTree;
     surfel_build.sampler.threads = o.threads;
     return encode_surfels(manifest, candidates, out, super, plain_directory, o.threads,
-                          surfel_build);
+                          surfel_build, max_image_pixels);
   }
   if (!candidates.empty())
     return calf::tools::usage_error("calf-encode", "--surfel-candidates needs --mode surfels");
@@ -633,7 +639,9 @@ int main(int argc, char** argv) {
     return calf::tools::usage_error("calf-encode", "--visible-set needs --mode mesh");
   vs.options.threads = o.threads;
   vs.quiet = quiet;
-  if (mode == "mesh") return encode_mesh(manifest, out, super, plain_directory, o.threads, vs);
+  if (mode == "mesh") {
+    return encode_mesh(manifest, out, super, plain_directory, o.threads, vs, max_image_pixels);
+  }
 
   const std::map<std::string, calf::ColourCoding> colours = {
       {"auto", calf::ColourCoding::kAuto},   {"bc1", calf::ColourCoding::kBc1},
@@ -796,4 +804,8 @@ int main(int argc, char** argv) {
   }
   std::fprintf(stderr, "calf-encode: peak RSS %.1f MiB\n", peak_rss_mib());
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return calf::tools::run_command("calf-encode", [&] { return command_main(argc, argv); });
 }

@@ -12,7 +12,7 @@
 #include "calf/encoder/lightfield_shard.h"
 #include "command_line.h"
 
-int main(int argc, char** argv) {
+static int command_main(int argc, char** argv) {
   CLI::App app{
       "calf-merge: join the shard files of a sharded light-field encode into one .calf clip "
       "(docs/FARM.md).\n"
@@ -53,4 +53,8 @@ int main(int argc, char** argv) {
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return calf::tools::run_command("calf-merge", [&] { return command_main(argc, argv); });
 }

@@ -34,7 +34,7 @@ std::string file_name(const std::string& path) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int command_main(int argc, char** argv) {
   CLI::App app{
       "calf-export: write a mesh track of a .calf clip (the full scene or its visible set, "
       "calf-encode --mode mesh) as glTF 2.0 or OBJ for engines (docs/EXPORT.md).\n"
@@ -201,4 +201,8 @@ int main(int argc, char** argv) {
   if (!quiet) std::printf("%s\n", summary.c_str());
   if (!warning.empty()) std::fprintf(stderr, "%s\n", warning.c_str());
   return calf::tools::kExitOk;
+}
+
+int main(int argc, char** argv) {
+  return calf::tools::run_command("calf-export", [&] { return command_main(argc, argv); });
 }

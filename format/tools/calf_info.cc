@@ -325,7 +325,7 @@ void print_json(const std::string& path, const Reader& r, bool list_chunks) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int command_main(int argc, char** argv) {
   CLI::App app{
       std::string("calf-info: summarise a .calf clip (version, tracks, frames, views, face size, "
                   "formats, bytes per stream and ratio to raw). Reads only the header and "
@@ -347,4 +347,8 @@ int main(int argc, char** argv) {
   else
     print_text(path, *reader, chunks);
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return calf::tools::run_command("calf-info", [&] { return command_main(argc, argv); });
 }

@@ -18,7 +18,7 @@
 #include "calf/format/version.h"
 #include "command_line.h"
 
-int main(int argc, char** argv) {
+static int command_main(int argc, char** argv) {
   CLI::App app{std::string(
       "calf-verify: check .calf files completely: header, directory, every chunk "
       "hash and decompression, padding, then every lightfield, mesh, surfels and tiles track's "
@@ -127,4 +127,8 @@ int main(int argc, char** argv) {
     }
   }
   return rc;
+}
+
+int main(int argc, char** argv) {
+  return calf::tools::run_command("calf-verify", [&] { return command_main(argc, argv); });
 }

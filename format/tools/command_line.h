@@ -7,10 +7,14 @@
 //           range or contradiction a command checks after parsing keeps its own id (calf-capture
 //           E177, calf-play E461) with exit 2.
 // parse_command_line() also installs the signal handlers that remove the command's temporary
-// files on SIGINT / SIGTERM / SIGHUP (calf/format/files.h).
+// files on SIGINT / SIGTERM / SIGHUP (calf/format/files.h). Every main runs its body through
+// run_command(), so that an allocation that fails is one line too (CALF-E013, exit 1).
 #pragma once
 
+#include <cstdint>
 #include <cstdio>
+#include <new>
+#include <stdexcept>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -63,6 +67,26 @@ inline int parse_command_line(CLI::App& app, const char* command, int argc, char
     return usage_error(command, message);
   }
   return -1;
+}
+
+// Runs a command's body and returns its exit status. Sizes are checked before anything is
+// allocated (the image budget, calf/capture/image_budget.h; every length in a file), so memory
+// runs out only when the machine has less than the inputs need: the std::bad_alloc (or a
+// container's std::length_error) that then escapes the body becomes the command's one line,
+// CALF-E013, and exit 1 instead of an abort. Temporary files are removed by their owners as the
+// exception unwinds.
+template <typename Body>
+int run_command(const char* command, Body&& body) {
+  try {
+    return body();
+  } catch (const std::bad_alloc&) {
+    return print_error(command, Status(ErrorId::kOutOfMemory,
+                                       "out of memory: the inputs need more memory than this "
+                                       "machine could give (see docs/ERRORS.md)"));
+  } catch (const std::length_error& e) {
+    return print_error(command,
+                       Status(ErrorId::kOutOfMemory, std::string("out of memory: ") + e.what()));
+  }
 }
 
 }  // namespace calf::tools

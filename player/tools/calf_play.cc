@@ -422,7 +422,7 @@ int run_headless(Playback& play, Playback* full, Playback* lossless, const Headl
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int command_main(int argc, char** argv) {
   CLI::App app{
       "calf-play: play a .calf clip: lightfield tracks (paper 002 Sec. 6) by ray-march "
       "reconstruction from the nearest viewpoints' colour + depth cube maps, decoded "
@@ -674,4 +674,8 @@ int main(int argc, char** argv) {
   }
   if (Status s = run_window(clip, play_options, w); !s.ok()) return fail(s);
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return calf::tools::run_command("calf-play", [&] { return command_main(argc, argv); });
 }

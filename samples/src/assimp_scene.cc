@@ -297,7 +297,7 @@ Status check_imported(const aiScene* ai, const std::string& file) {
 
 }  // namespace
 
-Expected<Scene> load_scene_file(const std::filesystem::path& path) {
+Expected<Scene> load_scene_file(const std::filesystem::path& path, uint64_t max_image_pixels) {
   const std::string file = path.string();
   // "no such file", or what the path is instead ("not a regular file (a directory)").
   CALF_RETURN_IF_ERROR(files::check_regular_file(file));
@@ -338,7 +338,8 @@ Expected<Scene> load_scene_file(const std::filesystem::path& path) {
   for (unsigned i = 0; i < ai->mNumMaterials; ++i) {
     scene.materials.push_back(convert_material(ai->mMaterials[i]));
   }
-  CALF_RETURN_IF_ERROR(detail::load_model_textures(*ai, path, lower_ext == ".fbx", &scene));
+  CALF_RETURN_IF_ERROR(
+      detail::load_model_textures(*ai, path, lower_ext == ".fbx", max_image_pixels, &scene));
   if (scene.materials.empty()) scene.materials.push_back(Material{});
 
   // The first animation drives the nodes it names.

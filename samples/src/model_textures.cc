@@ -12,6 +12,7 @@
 #include <assimp/scene.h>
 #include <assimp/texture.h>
 
+#include "calf/capture/image_budget.h"
 #include "calf/capture/scene_file.h"
 #include "model_prescan.h"
 
@@ -54,7 +55,8 @@ std::filesystem::path resolve(const std::filesystem::path& folder, std::string n
 
 // An embedded image: compressed bytes (mHeight 0: mWidth bytes in a format such as PNG or JPEG)
 // or raw BGRA texels (mWidth x mHeight, row 0 at the top).
-Status decode_embedded(const aiTexture& t, const std::string& name, capture::SceneTexture* out) {
+Status decode_embedded(const aiTexture& t, const std::string& name, uint64_t max_image_pixels,
+                       capture::SceneTexture* out) {
   if (!t.pcData || t.mWidth == 0) {
     return Status(ErrorId::kModelTexture, name + ": the embedded image holds no data");
   }
@@ -62,13 +64,14 @@ Status decode_embedded(const aiTexture& t, const std::string& name, capture::Sce
     const std::span<const uint8_t> bytes(reinterpret_cast<const uint8_t*>(t.pcData), t.mWidth);
     // achFormatHint is a NUL-terminated extension of at most 8 characters.
     std::string hint(t.achFormatHint, strnlen(t.achFormatHint, sizeof t.achFormatHint));
-    return capture::decode_texture_image(bytes, hint, name, out);
+    return capture::decode_texture_image(bytes, hint, name, out, max_image_pixels);
   }
   if (t.mWidth > capture::kSceneMaxTextureSize || t.mHeight > capture::kSceneMaxTextureSize) {
     return Status(ErrorId::kModelTexture, name + ": " + std::to_string(t.mWidth) + " x " +
                                               std::to_string(t.mHeight) +
                                               " is larger than 16384 x 16384");
   }
+  CALF_RETURN_IF_ERROR(capture::check_image_budget(name, t.mWidth, t.mHeight, max_image_pixels));
   out->width = t.mWidth;
   out->height = t.mHeight;
   out->rgba.resize(size_t{t.mWidth} * t.mHeight * 4);
@@ -83,7 +86,7 @@ Status decode_embedded(const aiTexture& t, const std::string& name, capture::Sce
 }  // namespace
 
 Status load_model_textures(const aiScene& ai, const std::filesystem::path& model,
-                           bool replaces_colour, Scene* scene) {
+                           bool replaces_colour, uint64_t max_image_pixels, Scene* scene) {
   const std::filesystem::path folder = model.parent_path();
   // One decoded texture per file or embedded image, however many materials name it.
   std::map<std::string, uint32_t> index_of;
@@ -116,8 +119,11 @@ Status load_model_textures(const aiScene& ai, const std::filesystem::path& model
     auto found = index_of.find(key);
     if (found == index_of.end()) {
       capture::SceneTexture image;
-      Status s = embedded ? decode_embedded(*embedded, where, &image)
-                          : capture::read_texture_image(file, &image);
+      Status s = embedded ? decode_embedded(*embedded, where, max_image_pixels, &image)
+                          : capture::read_texture_image(file, &image, max_image_pixels);
+      if (s.id() == ErrorId::kImageBudget) {
+        return Status(s.id(), (embedded ? "" : where + ": ") + s.message());
+      }
       if (!s.ok()) {
         return Status(ErrorId::kModelTexture, (embedded ? "" : where + ": ") + s.message());
       }

@@ -21,7 +21,9 @@ namespace calf::samples::detail {
 // (FBX) a textured material's albedo becomes 1: the texture replaces the colour rather than
 // multiplying it. E190 for a file found nowhere, E191 for an image that cannot be decoded, is too
 // large or is an embedded index the model does not hold; both name the texture and the material.
+// E012 for an image with more pixels than `max_image_pixels`, found from its header (an embedded
+// one's too) before it is decoded (calf/capture/image_budget.h).
 Status load_model_textures(const aiScene& ai, const std::filesystem::path& model,
-                           bool replaces_colour, Scene* scene);
+                           bool replaces_colour, uint64_t max_image_pixels, Scene* scene);
 
 }  // namespace calf::samples::detail

@@ -180,14 +180,14 @@ Status validate_scene(const Scene& scene) {
   return Status::Ok();
 }
 
-Expected<Scene> load_scene(std::string_view name_or_path) {
+Expected<Scene> load_scene(std::string_view name_or_path, uint64_t max_image_pixels) {
   for (const SceneInfo& info : builtin_scenes()) {
     if (name_or_path == info.name) return make_builtin_scene(name_or_path);
   }
   std::error_code ec;
   std::filesystem::path path(name_or_path);
   if (name_or_path.find('.') != std::string_view::npos || std::filesystem::exists(path, ec)) {
-    return load_scene_file(path);
+    return load_scene_file(path, max_image_pixels);
   }
   std::string names;
   for (const SceneInfo& info : builtin_scenes()) {

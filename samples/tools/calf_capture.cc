@@ -129,7 +129,7 @@ int report_placement(const samples::PlacementResult& r, const samples::Placement
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int command_main(int argc, char** argv) {
   CLI::App app{
       "calf-capture: ray-trace capture sets (format/CAPTURE.md) and ground truth of sample "
       "scenes.\n"
@@ -171,6 +171,12 @@ int main(int argc, char** argv) {
                  "count")
       ->check(CLI::Range(0u, calf::tools::kMaxThreads))
       ->capture_default_str();
+  uint64_t max_image_pixels = calf::capture::kDefaultMaxImagePixels;
+  app.add_option("--max-image-pixels", max_image_pixels,
+                 std::string("model and scene-file textures: ") +
+                     calf::capture::kMaxImagePixelsHelp +
+                     "; the ray tracer keeps about 16 bytes per texel")
+      ->check(CLI::Range(uint64_t{1}, calf::capture::kMaxImagePixelsLimit));
   app.add_option("--seed", render.seed, "seed of sample positions, AO directions and noise")
       ->capture_default_str();
   app.add_option("--spp", render.spp,
@@ -306,11 +312,11 @@ int main(int argc, char** argv) {
                               "alone (--out and --export-scene take a built-in scene or a model "
                               "file; calf-encode --mode mesh encodes a scene file)");
     }
-    auto file = calf::capture::read_scene_file(scene_arg);
+    auto file = calf::capture::read_scene_file(scene_arg, max_image_pixels);
     if (!file.ok()) return fail(file.status());
     return write_candidates(*file, surfel, surfel_path, quiet);
   }
-  auto scene = samples::load_scene(scene_arg);
+  auto scene = samples::load_scene(scene_arg, max_image_pixels);
   if (!scene.ok()) return fail(scene.status());
   const uint32_t frame_count = frames ? frames : scene->frame_count;
   if (!surfel_path.empty()) {
@@ -430,4 +436,8 @@ int main(int argc, char** argv) {
                  images > 0 ? stats.seconds / images : 0.0, gt ? "pose" : "view-frame");
   }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return calf::tools::run_command("calf-capture", [&] { return command_main(argc, argv); });
 }

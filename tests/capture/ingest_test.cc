@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -24,6 +25,7 @@
 #include "calf/format/camera.h"
 #include "calf/format/colour.h"
 #include "calf/format/cube.h"
+#include "hostile_images.h"
 
 namespace calf::capture {
 namespace {
@@ -529,7 +531,51 @@ TEST(SeuratIngest, ColourAndDepthOfDifferentSizes) {
   write_image(dir / "Cube_top_1_Depth.exr", 5, 4, {"R"}, {std::vector<float>(20, 1.0f)});
   const std::string e = error_of(manifest);
   EXPECT_NE(e.find("CALF-E147"), std::string::npos) << e;
-  EXPECT_NE(e.find("is 4 x 4 but depth"), std::string::npos) << e;
+  EXPECT_NE(e.find("is 5 x 4 but the camera says 4 x 4"), std::string::npos) << e;
+}
+
+// Images whose headers disagree with their camera are refused from the header, before a pixel
+// is decoded: a 100-byte PNG and a 16 KB EXR header declaring 16384 x 16384 for 16 x 16 cameras
+// (they took 5 GB and 59 s, and 6.8 GB then an uncaught bad_alloc).
+TEST(SeuratIngest, ImageHeaderAgainstTheCameraBeforeDecoding) {
+  const fs::path dir = scratch("hostile_header");
+  fs::create_directories(dir);
+  std::ofstream(dir / "big.png", std::ios::binary) << calf::test::png_declaring(16384, 16384);
+  std::ofstream(dir / "big.exr", std::ios::binary)
+      << calf::test::exr_header_only(16384, 16384, {"R"});
+  std::vector<std::string> many;
+  for (int c = 0; c < 64; ++c) many.push_back("C" + std::to_string(c));
+  std::ofstream(dir / "wide.exr", std::ios::binary)
+      << calf::test::exr_header_only(4096, 4096, many);
+  const auto start = std::chrono::steady_clock::now();
+  for (const char* colour : {"big.png", "big.exr", "wide.exr"}) {
+    std::ofstream(dir / "manifest.json") << calf::test::seurat_manifest(16, colour, "big.exr");
+    const std::string e = error_of(dir / "manifest.json");
+    EXPECT_NE(e.find("CALF-E147"), std::string::npos) << e;
+    EXPECT_NE(e.find(std::string(colour) + ": the image is "), std::string::npos) << e;
+    EXPECT_NE(e.find(" but the camera says 16 x 16"), std::string::npos) << e;
+  }
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0);
+}
+
+// Face sizes whose six faces exceed the image budget: E012 before anything is read or written
+// (16384 asked for ~25 GB and aborted on bad_alloc or swapped for minutes).
+TEST(SeuratIngest, FaceSizeOverTheBudget) {
+  const fs::path dir = scratch("face_budget");
+  fs::create_directories(dir);
+  std::ofstream(dir / "manifest.json") << calf::test::seurat_manifest(16, "c.png", "d.exr");
+  IngestOptions options;
+  options.face_size = 16384;
+  std::string e = error_of(dir / "manifest.json", options);
+  EXPECT_NE(e.find("CALF-E012 face size 16384: 6 x 16384 x 16384"), std::string::npos) << e;
+  options.face_size = 3345;  // 6 x 3345^2 > 2^26
+  EXPECT_NE(error_of(dir / "manifest.json", options).find("CALF-E012"), std::string::npos);
+  // A focal term of 1e6 implies a face size of 16384 (the density at the view's centre).
+  std::ofstream(dir / "manifest.json") << calf::test::seurat_manifest(16, "c.png", "d.exr", 1e6);
+  e = error_of(dir / "manifest.json");
+  EXPECT_NE(e.find("CALF-E012"), std::string::npos) << e;
+  EXPECT_NE(e.find("the face size the cameras imply, 16384"), std::string::npos) << e;
+  EXPECT_FALSE(fs::exists(dir / "out"));
 }
 
 // An image path that is a symbolic link out of the manifest's folder is refused, as a scene

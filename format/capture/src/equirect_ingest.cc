@@ -62,11 +62,18 @@ struct Equirect {
   std::vector<float> rgb, depth;
 };
 
-Status load(const std::filesystem::path& path, Equirect* e) {
+Status load(const std::filesystem::path& path, uint64_t max_pixels, Equirect* e) {
   detail::NamedPlanes planes;
+  // Every image after the first has the first one's size, checked from its header.
+  detail::ImageExpect expect;
+  expect.width = e->w;
+  expect.height = e->h;
+  expect.wrong_size = ErrorId::kEquirectInput;
+  expect.expected_by = "the first image is";
+  expect.max_pixels = max_pixels;
   CALF_RETURN_IF_ERROR(detail::read_named_planes(
       path, {"R", "G", "B", "Z"}, std::vector<detail::PngSamples>(4, detail::PngSamples::kLinear),
-      ErrorId::kEquirectInput, &planes));
+      ErrorId::kEquirectInput, expect, &planes));
   const std::string p = path.string();
   if (planes.width != 2 * planes.height) {
     return Status(ErrorId::kEquirectInput, p + ": is " + std::to_string(planes.width) + " x " +
@@ -253,12 +260,17 @@ Status ingest_equirect(const std::filesystem::path& manifest_path,
     return Status(ErrorId::kInvalidArgument,
                   "sharpen " + std::to_string(options.equirect_sharpen) + " is outside 0..0.25");
   }
+  const auto check_faces = [&](const std::string& what, uint32_t n) {
+    return check_image_budget(what + std::to_string(n), n, n, options.max_image_pixels, 6);
+  };
+  if (options.face_size) CALF_RETURN_IF_ERROR(check_faces("face size ", options.face_size));
   CALF_ASSIGN_OR_RETURN(std::string text, read_small_file(manifest_path));
   CALF_ASSIGN_OR_RETURN(CaptureManifest input, parse_equirect_manifest(text, source));
   const std::filesystem::path dir = manifest_path.parent_path();
   // The first image decides the face size (and every other image must match it).
   Equirect image;
-  CALF_RETURN_IF_ERROR(load(dir / capture_file_name(input, 0, 0), &image));
+  CALF_RETURN_IF_ERROR(
+      load(dir / capture_file_name(input, 0, 0), options.max_image_pixels, &image));
   CaptureManifest m = input;
   m.generator = "calf-ingest";
   m.file_pattern = kDefaultFilePattern;
@@ -266,6 +278,10 @@ Status ingest_equirect(const std::filesystem::path& manifest_path,
       options.face_size
           ? options.face_size
           : std::max<uint32_t>(1, static_cast<uint32_t>(std::lround(image.w / std::numbers::pi)));
+  if (!options.face_size) {
+    CALF_RETURN_IF_ERROR(
+        check_faces(source + ": the face size the first image implies, ", m.face_size));
+  }
   // A failed ingest removes the folders it created (remove_empty_folders after abandon()).
   const std::vector<std::filesystem::path> created = detail::missing_folders(out_dir);
   Expected<CaptureSetWriter> created_writer = CaptureSetWriter::create(out_dir, m);
@@ -279,7 +295,9 @@ Status ingest_equirect(const std::filesystem::path& manifest_path,
   for (uint32_t v = 0; v < m.viewpoints.size(); ++v) {
     for (uint32_t f = 0; f < m.frame_count; ++f) {
       Status s;
-      if (v != 0 || f != 0) s = load(dir / capture_file_name(input, v, f), &image);
+      if (v != 0 || f != 0) {
+        s = load(dir / capture_file_name(input, v, f), options.max_image_pixels, &image);
+      }
       if (s.ok()) {
         resample(image, m.face_size, options, &frame);
         s = writer.write(v, f, frame);

@@ -8,6 +8,7 @@
 #include "calf/format/coordinates.h"
 
 #include "exr_io.h"
+#include "image_input.h"
 #include "json_fields.h"
 
 namespace calf::capture {
@@ -250,6 +251,9 @@ Status write_perspective_image(const std::filesystem::path& file, const Perspect
 
 Expected<PerspectiveImage> read_perspective_image(const std::filesystem::path& file) {
   CALF_ASSIGN_OR_RETURN(detail::ExrReader exr, detail::ExrReader::open(file));
+  // The image rule (its size from the header, within the default budget) before any row is read.
+  CALF_RETURN_IF_ERROR(
+      detail::check_image_size(file.string(), exr.width(), exr.height(), detail::ImageExpect{}));
   int idx[4];
   const char* const names[4] = {"R", "G", "B", "Z"};
   for (int c = 0; c < 4; ++c) {

@@ -1,6 +1,6 @@
 // Reading the images of foreign captures by channel name (internal to ingest): OpenEXR through
-// exr_io.h, 8-bit PNG through OpenImageIO's PNG reader (its signature checked first, so that no
-// other format plugin ever sees the bytes).
+// exr_io.h, 8-bit PNG through image_input.h (its signature checked first, so that no other
+// reader ever sees the bytes).
 #pragma once
 
 #include <cstdint>
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "calf/format/status.h"
+#include "image_input.h"
 
 namespace calf::capture::detail {
 
@@ -25,10 +26,13 @@ struct NamedPlanes {
 };
 
 // Reads `names` from the image at `path`. `png[i]` says how a PNG's channel i is decoded (ignored
-// for EXR, whose channels must be HALF or FLOAT). Errors: E135 missing file, E136 undecodable or
-// unsupported image, `missing_channel` (naming the channel and listing those the image has).
+// for EXR, whose channels must be HALF or FLOAT). The header is checked against `expect` (size,
+// budget) before any pixel is decoded; EXR rows are read in strips, so that memory is the planes
+// asked for plus one strip. Errors: E135 missing file, E136 undecodable or unsupported image,
+// `expect.wrong_size`, E012 over the budget, `missing_channel` (naming the channel and listing
+// those the image has).
 Status read_named_planes(const std::filesystem::path& path, const std::vector<std::string>& names,
                          const std::vector<PngSamples>& png, ErrorId missing_channel,
-                         NamedPlanes* out);
+                         const ImageExpect& expect, NamedPlanes* out);
 
 }  // namespace calf::capture::detail

@@ -24,6 +24,7 @@
 #include "calf/format/coordinates.h"
 #include "calf/format/files.h"
 #include "calf/format/vertex_states.h"
+#include "image_input.h"
 #include "json_fields.h"
 
 namespace calf::capture {
@@ -835,8 +836,51 @@ std::string oiio_error(const std::string& fallback) {
   return e.empty() ? fallback : e;
 }
 
-// Decodes the image `name` (read through `proxy` when given, else from the file of that name).
-Status decode_image(const std::string& name, OIIO::Filesystem::IOProxy* proxy, SceneTexture* t) {
+// Spreads `nch` 8-bit channels into RGBA by SCENE.md "Texture" (grey spreads to RGB, alpha is
+// opaque when the image has none); `rgba` may be `raw` itself when nch is 4.
+void spread_to_rgba(const uint8_t* raw, int nch, size_t pixels, uint8_t* rgba) {
+  if (nch == 4) {
+    if (raw != rgba) std::memcpy(rgba, raw, pixels * 4);
+    return;
+  }
+  for (size_t i = 0; i < pixels; ++i) {
+    const uint8_t* p = &raw[i * static_cast<size_t>(nch)];
+    uint8_t* q = &rgba[i * 4];
+    q[0] = p[0];
+    q[1] = nch >= 3 ? p[1] : p[0];
+    q[2] = nch >= 3 ? p[2] : p[0];
+    q[3] = nch >= 4 ? p[3] : nch == 2 ? p[1] : 255;
+  }
+}
+
+// The texture rule of every image: its header's size (at most 16384 x 16384, within the budget)
+// before any pixel is decoded.
+detail::ImageExpect texture_expect(uint64_t max_pixels) {
+  detail::ImageExpect expect;
+  expect.wrong_size = ErrorId::kSceneFileTexture;
+  expect.undecodable = ErrorId::kSceneFileTexture;
+  expect.max_pixels = max_pixels;
+  expect.allow_16_bit = true;
+  return expect;
+}
+
+// A decoded PNG as a texture: RGBA images keep their buffer, others spread into a new one.
+void texture_from_png(detail::Png8&& image, SceneTexture* t) {
+  t->width = image.width;
+  t->height = image.height;
+  const size_t pixels = size_t{image.width} * image.height;
+  if (image.channels == 4) {
+    t->rgba = std::move(image.pixels);
+    return;
+  }
+  t->rgba.resize(pixels * 4);
+  spread_to_rgba(image.pixels.data(), static_cast<int>(image.channels), pixels, t->rgba.data());
+}
+
+// Decodes the image `name` (read through `proxy` when given, else from the file of that name)
+// with OpenImageIO: formats other than PNG.
+Status decode_image(const std::string& name, OIIO::Filesystem::IOProxy* proxy, uint64_t max_pixels,
+                    SceneTexture* t) {
   try {
     // Unassociated alpha: the bytes of the file, not colour premultiplied by alpha.
     OIIO::ImageSpec config;
@@ -846,30 +890,24 @@ Status decode_image(const std::string& name, OIIO::Filesystem::IOProxy* proxy, S
     std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(name, &config, proxy);
     if (!in) return Status(ErrorId::kSceneFileTexture, name + ": " + oiio_error("cannot decode"));
     const OIIO::ImageSpec& spec = in->spec();
-    if (spec.width < 1 || spec.height < 1 || spec.width > static_cast<int>(kSceneMaxTextureSize) ||
-        spec.height > static_cast<int>(kSceneMaxTextureSize) || spec.nchannels < 1) {
-      return Status(ErrorId::kSceneFileTexture, name + ": " + std::to_string(spec.width) + " x " +
-                                                    std::to_string(spec.height) +
-                                                    " is empty or larger than 16384 x 16384");
+    CALF_RETURN_IF_ERROR(
+        detail::check_image_size(name, spec.width, spec.height, texture_expect(max_pixels)));
+    if (spec.nchannels < 1) {
+      return Status(ErrorId::kSceneFileTexture, name + ": an image without channels");
     }
-    const int nch = spec.nchannels;
+    const int nch = std::min(spec.nchannels, 4);  // channels past RGBA are never read
     const size_t pixels = static_cast<size_t>(spec.width) * static_cast<size_t>(spec.height);
-    std::vector<uint8_t> raw(pixels * static_cast<size_t>(nch));
-    if (!in->read_image(0, 0, 0, nch, OIIO::TypeDesc::UINT8, raw.data())) {
+    t->rgba.resize(pixels * 4);
+    std::vector<uint8_t> raw;
+    if (nch != 4) raw.resize(pixels * static_cast<size_t>(nch));
+    uint8_t* target = nch == 4 ? t->rgba.data() : raw.data();
+    if (!in->read_image(0, 0, 0, nch, OIIO::TypeDesc::UINT8, target)) {
+      t->rgba.clear();
       return Status(ErrorId::kSceneFileTexture, name + ": " + oiio_error("cannot decode"));
     }
     t->width = static_cast<uint32_t>(spec.width);
     t->height = static_cast<uint32_t>(spec.height);
-    t->rgba.resize(pixels * 4);
-    for (size_t i = 0; i < pixels; ++i) {
-      const uint8_t* p = &raw[i * static_cast<size_t>(nch)];
-      uint8_t* q = &t->rgba[i * 4];
-      // Grey (+ alpha) spreads to RGB; alpha is opaque when the image has none.
-      q[0] = p[0];
-      q[1] = nch >= 3 ? p[1] : p[0];
-      q[2] = nch >= 3 ? p[2] : p[0];
-      q[3] = nch >= 4 ? p[3] : nch == 2 ? p[1] : 255;
-    }
+    spread_to_rgba(target, nch, pixels, t->rgba.data());
   } catch (const std::exception& e) {
     return Status(ErrorId::kSceneFileTexture, name + ": " + e.what());
   }
@@ -1047,7 +1085,8 @@ Expected<SceneFile> parse_scene_file(std::string_view manifest,
   return decoder.decode(manifest, read, check, nullptr);
 }
 
-Expected<SceneFile> read_scene_file(const std::filesystem::path& directory) {
+Expected<SceneFile> read_scene_file(const std::filesystem::path& directory,
+                                    uint64_t max_image_pixels) {
   const std::filesystem::path manifest_path = directory / kSceneManifestFileName;
   const std::string source = manifest_path.string();
   CALF_ASSIGN_OR_RETURN(
@@ -1093,17 +1132,32 @@ Expected<SceneFile> read_scene_file(const std::filesystem::path& directory) {
     const std::string field = "textures[" + std::to_string(i) + "].uri";
     CALF_ASSIGN_OR_RETURN(std::filesystem::path path, confined(directory, t.path, field));
     CALF_RETURN_IF_ERROR(regular_file_size(path, "texture").status());
-    CALF_RETURN_IF_ERROR(read_texture_image(path, &t));
+    CALF_RETURN_IF_ERROR(read_texture_image(path, &t, max_image_pixels));
   }
   return scene;
 }
 
-Status read_texture_image(const std::filesystem::path& path, SceneTexture* texture) {
-  return decode_image(path.string(), nullptr, texture);
+Status read_texture_image(const std::filesystem::path& path, SceneTexture* texture,
+                          uint64_t max_image_pixels) {
+  if (detail::has_png_signature(path)) {
+    detail::Png8 image;
+    CALF_RETURN_IF_ERROR(detail::read_png8(path, texture_expect(max_image_pixels), &image));
+    texture_from_png(std::move(image), texture);
+    return Status::Ok();
+  }
+  return decode_image(path.string(), nullptr, max_image_pixels, texture);
 }
 
 Status decode_texture_image(std::span<const uint8_t> bytes, std::string_view format_hint,
-                            std::string_view name, SceneTexture* texture) {
+                            std::string_view name, SceneTexture* texture,
+                            uint64_t max_image_pixels) {
+  if (detail::has_png_signature(bytes)) {
+    detail::Png8 image;
+    CALF_RETURN_IF_ERROR(detail::decode_png8(bytes, std::string(name) + " (png)",
+                                             texture_expect(max_image_pixels), &image));
+    texture_from_png(std::move(image), texture);
+    return Status::Ok();
+  }
   // OpenImageIO picks its reader by the name's extension; the magic numbers of the formats
   // models embed win over a hint that may be wrong or empty.
   std::string ext(format_hint);
@@ -1117,7 +1171,7 @@ Status decode_texture_image(std::span<const uint8_t> bytes, std::string_view for
                   std::string(name) + ": an image of unknown format (not PNG or JPEG, no hint)");
   }
   OIIO::Filesystem::IOMemReader reader(bytes.data(), bytes.size());
-  Status s = decode_image("embedded." + ext, &reader, texture);
+  Status s = decode_image("embedded." + ext, &reader, max_image_pixels, texture);
   if (s.ok()) return s;
   return Status(s.id(), std::string(name) + " (" + ext + "): " + s.message());
 }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "calf/capture/capture_set.h"
+#include "calf/capture/image_budget.h"
 #include "calf/capture/ingest.h"
 #include "calf/format/cube.h"
 #include "ingest_folder.h"
@@ -98,7 +99,7 @@ bool resolves_inside(const std::filesystem::path& root, const std::filesystem::p
 
 // Loads a view's images and turns every pixel into colour + radial depth from `centre`.
 Status load_pixels(const SeuratView& v, const std::filesystem::path& dir, const Vec3& centre,
-                   const std::string& where, PreparedView* p) {
+                   const std::string& where, uint64_t max_pixels, PreparedView* p) {
   // As a scene file's (E153): a path stays in the manifest's folder, through links too.
   for (const std::string* rel : {&v.color.path, &v.depth.path}) {
     const std::filesystem::path root = dir.empty() ? std::filesystem::path(".") : dir;
@@ -109,13 +110,20 @@ Status load_pixels(const SeuratView& v, const std::filesystem::path& dir, const 
     }
   }
   NamedPlanes colour, depth;
+  // Each image's header is compared with its camera before a pixel of it is decoded.
+  detail::ImageExpect expect;
+  expect.width = v.image_width;
+  expect.height = v.image_height;
+  expect.wrong_size = ErrorId::kSeuratImageSize;
+  expect.expected_by = "the camera says";
+  expect.max_pixels = max_pixels;
   CALF_RETURN_IF_ERROR(detail::read_named_planes(dir / v.color.path, v.color.channels,
                                                  {PngSamples::kSrgbColour, PngSamples::kSrgbColour,
                                                   PngSamples::kSrgbColour, PngSamples::kLinear},
-                                                 ErrorId::kSeuratChannel, &colour));
+                                                 ErrorId::kSeuratChannel, expect, &colour));
   CALF_RETURN_IF_ERROR(detail::read_named_planes(dir / v.depth.path, v.depth.channels,
                                                  {PngSamples::kLinear}, ErrorId::kSeuratChannel,
-                                                 &depth));
+                                                 expect, &depth));
   const std::string cpath = (dir / v.color.path).string(), dpath = (dir / v.depth.path).string();
   if (colour.width != depth.width || colour.height != depth.height) {
     return Status(ErrorId::kSeuratImageSize,
@@ -254,6 +262,11 @@ Status ingest_seurat(const std::filesystem::path& manifest_path,
                      const std::filesystem::path& out_dir, const IngestOptions& options,
                      IngestReport* report) {
   const std::string source = manifest_path.string();
+  if (options.face_size) {
+    CALF_RETURN_IF_ERROR(check_image_budget("face size " + std::to_string(options.face_size),
+                                            options.face_size, options.face_size,
+                                            options.max_image_pixels, 6));
+  }
   CALF_ASSIGN_OR_RETURN(std::string text, read_small_file(manifest_path));
   CALF_ASSIGN_OR_RETURN(SeuratCapture capture, parse_seurat_manifest(text, source));
   const std::filesystem::path dir = manifest_path.parent_path();
@@ -308,6 +321,12 @@ Status ingest_seurat(const std::filesystem::path& manifest_path,
     m.view_volume = box;
   }
   m.face_size = options.face_size ? options.face_size : density;
+  if (!options.face_size) {
+    // The cameras' pixel density (a matrix term of 1e300 implies the largest face size).
+    CALF_RETURN_IF_ERROR(check_image_budget(
+        source + ": the face size the cameras imply, " + std::to_string(m.face_size), m.face_size,
+        m.face_size, options.max_image_pixels, 6));
+  }
   // A failed ingest removes the folders it created (remove_empty_folders after abandon()).
   const std::vector<std::filesystem::path> created = detail::missing_folders(out_dir);
   Expected<CaptureSetWriter> created_writer = CaptureSetWriter::create(out_dir, m);
@@ -325,7 +344,8 @@ Status ingest_seurat(const std::filesystem::path& manifest_path,
     Status s;
     for (size_t k = 0; k < groups[g].size() && s.ok(); ++k) {
       s = load_pixels(capture.view_groups[g][k], dir, m.viewpoints[g].position,
-                      where + ".views[" + std::to_string(k) + "]", &groups[g][k]);
+                      where + ".views[" + std::to_string(k) + "]", options.max_image_pixels,
+                      &groups[g][k]);
     }
     bool exact = false;
     if (s.ok()) {

@@ -10,7 +10,7 @@
 #include "calf/format/version.h"
 #include "command_line.h"
 
-int main(int argc, char** argv) {
+static int command_main(int argc, char** argv) {
   CLI::App app{std::string("calf-ingest: convert a capture made by another renderer into a calf "
                            "capture set (format/CAPTURE.md, \"Ingest\") that calf-encode reads.\n"
                            "  calf-ingest seurat MANIFEST OUT_DIR     a Seurat capture manifest "
@@ -38,8 +38,9 @@ int main(int argc, char** argv) {
       ->required();
   seurat
       ->add_option("--face-size", options.face_size,
-                   "texels per face side; default 0 = the largest pixel density of any view "
-                   "(an exact cube map keeps its size)")
+                   "texels per face side, 0..16384; default 0 = the largest pixel density of "
+                   "any view (an exact cube map keeps its size); the six faces must fit "
+                   "--max-image-pixels (by default a face size of at most 3344)")
       ->check(CLI::Range(0, 16384));
   seurat
       ->add_option("--headbox-size", options.headbox_size,
@@ -49,6 +50,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1e12));
   seurat->add_option("--fps", options.fps, "frames per second written to the manifest; default 30")
       ->check(CLI::Range(1e-3, 1000.0));
+  seurat
+      ->add_option("--max-image-pixels", options.max_image_pixels,
+                   calf::capture::kMaxImagePixelsHelp)
+      ->check(CLI::Range(uint64_t{1}, calf::capture::kMaxImagePixelsLimit));
 
   CLI::App* equirect =
       app.add_subcommand("equirect",
@@ -62,8 +67,9 @@ int main(int argc, char** argv) {
       ->required();
   equirect
       ->add_option("--face-size", options.face_size,
-                   "texels per face side; default 0 = round(width / pi), the input's "
-                   "equatorial density at each face centre")
+                   "texels per face side, 0..16384; default 0 = round(width / pi), the "
+                   "input's equatorial density at each face centre; the six faces must fit "
+                   "--max-image-pixels (by default a face size of at most 3344)")
       ->check(CLI::Range(0, 16384));
   equirect
       ->add_option("--supersample", options.supersample,
@@ -86,6 +92,10 @@ int main(int argc, char** argv) {
                    "depth between two surfaces) or edge-aware (bilinear where the 2 x 2 nearest "
                    "pixels agree within 2 %, else nearest)")
       ->check(CLI::IsMember({"nearest", "edge-aware"}));
+  equirect
+      ->add_option("--max-image-pixels", options.max_image_pixels,
+                   calf::capture::kMaxImagePixelsHelp)
+      ->check(CLI::Range(uint64_t{1}, calf::capture::kMaxImagePixelsLimit));
 
   if (int rc = calf::tools::parse_command_line(app, "calf-ingest", argc, argv); rc >= 0) return rc;
   options.equirect_filter = filter == "bilinear" ? calf::capture::EquirectFilter::kBilinear
@@ -105,4 +115,8 @@ int main(int argc, char** argv) {
                out);
   }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return calf::tools::run_command("calf-ingest", [&] { return command_main(argc, argv); });
 }

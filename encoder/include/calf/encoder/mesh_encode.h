@@ -51,6 +51,9 @@ struct MeshEncodeOptions {
   // Written to the header (informative): the view-region perimeter segments the visible set was
   // computed from; 0 for a full-scene track.
   uint32_t segment_count = 0;
+  // The image budget of the scene file's textures (calf/capture/image_budget.h): the files
+  // read by encode_mesh_file / encode_surfel_file from a folder are refused with E012 above it.
+  uint64_t max_image_pixels = capture::kDefaultMaxImagePixels;
 };
 
 // Bytes of one stream of the track.

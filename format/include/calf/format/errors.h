@@ -40,6 +40,8 @@ enum class ErrorKind : uint8_t {
   X(kInternal, 5, kInternal, "an internal invariant failed")                                    \
   X(kUsage, 6, kInvalidArgument, "a command-line option or argument is invalid")                \
   X(kOutputIsInput, 7, kInvalidArgument, "an output path names one of the command's inputs")    \
+  X(kImageBudget, 12, kLimit, "an image or a viewpoint's faces exceed the image budget")        \
+  X(kOutOfMemory, 13, kLimit, "the command ran out of memory")                                  \
   /* conventions */                                                                             \
   X(kDepthRange, 20, kInvalidArgument, "z_near / z_far do not form a valid log-depth range")    \
   X(kDepthValue, 21, kCorrupt, "a depth value is NaN, negative, zero or -inf")                  \

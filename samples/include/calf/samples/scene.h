@@ -21,6 +21,7 @@
 
 #include "calf/capture/capture_set.h"
 #include "calf/capture/eye_path.h"
+#include "calf/capture/image_budget.h"
 #include "calf/format/status.h"
 #include "calf/samples/texture.h"
 
@@ -197,11 +198,14 @@ Expected<Scene> make_builtin_scene(std::string_view name);
 // count: the animation's duration at 30 fps (at least 1 frame), capped at 300. Errors: E002 missing
 // file, E172 unsupported extension, E171 import failure, E173 no triangles, E174 bad geometry
 // (non-finite UVs too), E190 a referenced texture file is missing, E191 a texture cannot be
-// decoded or is larger than 16384 x 16384 (each naming the texture and the material).
-Expected<Scene> load_scene_file(const std::filesystem::path& path);
+// decoded or is larger than 16384 x 16384 (each naming the texture and the material), E012 a
+// texture with more pixels than `max_image_pixels` (calf/capture/image_budget.h).
+Expected<Scene> load_scene_file(const std::filesystem::path& path,
+                                uint64_t max_image_pixels = capture::kDefaultMaxImagePixels);
 
 // A built-in name, else a file path. E170 when it is neither.
-Expected<Scene> load_scene(std::string_view name_or_path);
+Expected<Scene> load_scene(std::string_view name_or_path,
+                           uint64_t max_image_pixels = capture::kDefaultMaxImagePixels);
 
 // ---- rigs --------------------------------------------------------------------------------------
 

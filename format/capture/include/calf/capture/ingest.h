@@ -29,6 +29,7 @@
 #include <string_view>
 #include <vector>
 
+#include "calf/capture/image_budget.h"
 #include "calf/format/geometry.h"
 #include "calf/format/status.h"
 
@@ -86,7 +87,11 @@ struct IngestOptions {
   // Texels per cube face side; 0 chooses it from the input: Seurat, the largest pixel density at
   // any view's centre (an exact cube map keeps its size); equirectangular, round(width / pi),
   // the equirectangular image's density at the equator (pixels per radian) at each face centre.
+  // Either way the six faces (6 x face_size^2 pixels) must fit `max_image_pixels` (E012).
   uint32_t face_size = 0;
+  // The image budget (image_budget.h): the most pixels of one input image, checked from its
+  // header before it is decoded, and of one viewpoint's six faces.
+  uint64_t max_image_pixels = kDefaultMaxImagePixels;
   // Seurat: the side of the view volume (the headbox), centred on `headbox_center` (else on the
   // box of the view groups). 0: the box of the view-group positions, which must not be a point.
   double headbox_size = 0;
@@ -113,8 +118,9 @@ struct IngestReport {
 };
 
 // Converts the Seurat manifest at `manifest_path` into a capture set in `out_dir`.
-// Errors: E130/E143 manifest, E144 headbox, E145 group, E146 channel, E147 sizes, E148 depth,
-// E135/E136 images, E137/E138 converted pixels, E004 writing.
+// Errors: E130/E143 manifest, E144 headbox, E145 group, E146 channel, E147 sizes (an image's
+// header against its camera, before it is decoded), E148 depth, E135/E136 images, E012 budget,
+// E137/E138 converted pixels, E004 writing.
 Status ingest_seurat(const std::filesystem::path& manifest_path,
                      const std::filesystem::path& out_dir, const IngestOptions& options,
                      IngestReport* report = nullptr);
@@ -125,7 +131,8 @@ Status ingest_seurat(const std::filesystem::path& manifest_path,
 // depth, +inf sky). Pixel (i, j) looks along longitude phi = 2 pi (i + 0.5) / W - pi and latitude
 // theta = pi / 2 - pi (j + 0.5) / H: direction (cos theta sin phi, sin theta, -cos theta cos phi),
 // so the image centre looks down -Z with +Y up and +X on the right (upright, unmirrored).
-// Errors: E130-E134 and E149 manifest, E135/E136/E149 images, E137/E138 pixels, E004 writing.
+// Errors: E130-E134 and E149 manifest, E135/E136/E149 images, E012 budget, E137/E138 pixels,
+// E004 writing.
 Status ingest_equirect(const std::filesystem::path& manifest_path,
                        const std::filesystem::path& out_dir, const IngestOptions& options,
                        IngestReport* report = nullptr);

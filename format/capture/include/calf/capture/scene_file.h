@@ -31,6 +31,7 @@
 #include <string_view>
 #include <vector>
 
+#include "calf/capture/image_budget.h"
 #include "calf/format/status.h"
 
 namespace calf::capture {
@@ -112,13 +113,19 @@ struct SceneTexture {
 
 // Decodes an image file into `texture`'s width, height and 8-bit RGBA by SCENE.md "Texture"'s
 // rules (grey spreads to RGB, missing alpha is opaque, at most 16384 x 16384); `path` is left
-// alone. E159 when it cannot be decoded or is too large. read_scene_file reads textures with it.
-Status read_texture_image(const std::filesystem::path& path, SceneTexture* texture);
+// alone. The header's size is checked before any pixel is decoded: E159 when it cannot be
+// decoded or is too large, E012 when it has more pixels than `max_image_pixels`
+// (image_budget.h). PNG is read by libpng (a PNG whose image data cannot hold the rows it
+// declares is refused before its buffer exists), other formats by OpenImageIO. read_scene_file
+// reads textures with it.
+Status read_texture_image(const std::filesystem::path& path, SceneTexture* texture,
+                          uint64_t max_image_pixels = kDefaultMaxImagePixels);
 // The same for an image in memory (one embedded in a model file): PNG and JPEG are recognised by
 // their first bytes, anything else OpenImageIO reads from memory by `format_hint` (an extension
-// such as "png", without the dot). `name` names the image in messages. E159 as above.
+// such as "png", without the dot). `name` names the image in messages. E159 / E012 as above.
 Status decode_texture_image(std::span<const uint8_t> bytes, std::string_view format_hint,
-                            std::string_view name, SceneTexture* texture);
+                            std::string_view name, SceneTexture* texture,
+                            uint64_t max_image_pixels = kDefaultMaxImagePixels);
 
 // A surface (samples::Material plus a texture). Weights as CAPTURE.md "Conventions".
 struct SceneMaterial {
@@ -216,9 +223,10 @@ Expected<SceneFile> parse_scene_file(std::string_view manifest,
 
 // Reads DIR/scene.json, its buffers (each file's size must equal its byte_length: E155; reads go
 // straight from the file into the arrays, after every view was checked against the sizes) and
-// decodes every texture (E154 missing, E159 undecodable or too large). A path that resolves
-// (through links) outside DIR is E153.
-Expected<SceneFile> read_scene_file(const std::filesystem::path& directory);
+// decodes every texture (E154 missing, E159 undecodable or too large, E012 over
+// `max_image_pixels`). A path that resolves (through links) outside DIR is E153.
+Expected<SceneFile> read_scene_file(const std::filesystem::path& directory,
+                                    uint64_t max_image_pixels = kDefaultMaxImagePixels);
 
 // Writes the scene into DIR (created if missing): removes an old DIR/scene.json first, then
 // writes each texture as PNG, DIR/scene.bin and DIR/scene.json last, each whole (temporary file

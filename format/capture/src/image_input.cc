@@ -1,0 +1,290 @@
+#include "image_input.h"
+
+#include <png.h>
+
+#include <csetjmp>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <memory>
+
+#include <OpenImageIO/fmath.h>
+
+namespace calf::capture {
+
+Status check_image_budget(std::string_view what, uint64_t width, uint64_t height,
+                          uint64_t max_pixels, uint64_t count) {
+  // width, height <= 2^32 and count <= 6 in every caller: no overflow in 64 bits.
+  const uint64_t pixels = width * height * count;
+  if (pixels <= max_pixels) return Status::Ok();
+  std::string need = std::to_string(width) + " x " + std::to_string(height);
+  if (count > 1) need = std::to_string(count) + " x " + need;
+  return Status(ErrorId::kImageBudget,
+                std::string(what) + ": " + need + " = " + std::to_string(pixels) +
+                    " pixels, more than the image budget of " + std::to_string(max_pixels) +
+                    " (raise it with --max-image-pixels)");
+}
+
+namespace detail {
+
+Status check_image_size(const std::string& name, int64_t width, int64_t height,
+                        const ImageExpect& expect) {
+  if (width < 1 || height < 1 || width > kMaxImageSide || height > kMaxImageSide) {
+    return Status(expect.undecodable, name + ": " + std::to_string(width) + " x " +
+                                          std::to_string(height) + " is empty or larger than " +
+                                          std::to_string(kMaxImageSide) + " x " +
+                                          std::to_string(kMaxImageSide));
+  }
+  if ((expect.width != 0 || expect.height != 0) &&
+      (width != expect.width || height != expect.height)) {
+    return Status(expect.wrong_size, name + ": the image is " + std::to_string(width) + " x " +
+                                         std::to_string(height) + " but " + expect.expected_by +
+                                         " " + std::to_string(expect.width) + " x " +
+                                         std::to_string(expect.height));
+  }
+  return check_image_budget(name, static_cast<uint64_t>(width), static_cast<uint64_t>(height),
+                            expect.max_pixels);
+}
+
+std::vector<std::string> png_channel_names(uint32_t channels) {
+  switch (channels) {
+    case 1:
+      return {"Y"};
+    case 2:
+      return {"Y", "A"};
+    case 3:
+      return {"R", "G", "B"};
+    default:
+      return {"R", "G", "B", "A"};
+  }
+}
+
+namespace {
+
+constexpr unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+
+// Deflate's largest expansion: a 258-byte match coded in 2 bits is 1032:1.
+constexpr uint64_t kMaxInflateRatio = 1032;
+
+// The bytes of a PNG, from memory or from a file, read at any offset.
+class PngBytes {
+ public:
+  explicit PngBytes(std::span<const uint8_t> bytes) : bytes_(bytes), size_(bytes.size()) {}
+  PngBytes(std::FILE* file, uint64_t size) : file_(file), size_(size) {}
+  uint64_t size() const { return size_; }
+  // Copies [offset, offset + n) into `out`; false when the bytes end first.
+  bool read_at(uint64_t offset, void* out, size_t n) {
+    if (offset > size_ || n > size_ - offset) return false;
+    if (!file_) {
+      std::memcpy(out, bytes_.data() + offset, n);
+      return true;
+    }
+    return std::fseek(file_, static_cast<long>(offset), SEEK_SET) == 0 &&
+           std::fread(out, 1, n, file_) == n;
+  }
+  // libpng's sequential reads, from `position_`.
+  bool read_next(void* out, size_t n) {
+    if (!read_at(position_, out, n)) return false;
+    position_ += n;
+    return true;
+  }
+
+ private:
+  std::span<const uint8_t> bytes_;
+  std::FILE* file_ = nullptr;
+  uint64_t size_ = 0;
+  uint64_t position_ = 0;
+};
+
+uint32_t be32(const uint8_t* p) {
+  return uint32_t{p[0]} << 24 | uint32_t{p[1]} << 16 | uint32_t{p[2]} << 8 | p[3];
+}
+
+// The chunk walk before decoding: IHDR's size and format, and the bytes of image data present.
+Status check_png_chunks(PngBytes& bytes, const std::string& name, const ImageExpect& expect) {
+  const auto bad = [&](const std::string& why) {
+    return Status(expect.undecodable, name + ": " + why);
+  };
+  uint8_t head[8 + 8 + 13];
+  if (!bytes.read_at(0, head, sizeof head) || std::memcmp(head, kSignature, 8) != 0 ||
+      be32(head + 8) != 13 || std::memcmp(head + 12, "IHDR", 4) != 0) {
+    return bad("not a PNG file (no PNG signature and IHDR chunk)");
+  }
+  const uint32_t width = be32(head + 16), height = be32(head + 20);
+  const uint8_t depth = head[24], colour = head[25];
+  int samples = 0;
+  switch (colour) {
+    case 0:
+      samples = 1;
+      break;  // grey
+    case 2:
+      samples = 3;
+      break;  // RGB
+    case 3:
+      samples = 1;
+      break;  // palette index
+    case 4:
+      samples = 2;
+      break;  // grey + alpha
+    case 6:
+      samples = 4;
+      break;  // RGBA
+    default:
+      return bad("PNG colour type " + std::to_string(colour) + " does not exist");
+  }
+  if (depth != 1 && depth != 2 && depth != 4 && depth != 8 && depth != 16) {
+    return bad("PNG bit depth " + std::to_string(depth) + " does not exist");
+  }
+  CALF_RETURN_IF_ERROR(check_image_size(name, width, height, expect));
+  if (depth == 16 && !expect.allow_16_bit) {
+    return bad("a 16-bit PNG; calf reads 8-bit PNG (write 16-bit or float data as OpenEXR)");
+  }
+  // The image data present: the IDAT chunks' lengths (every chunk is 12 bytes plus its data).
+  uint64_t idat = 0;
+  for (uint64_t at = 8; at + 12 <= bytes.size();) {
+    uint8_t chunk[8];
+    if (!bytes.read_at(at, chunk, 8)) break;
+    const uint64_t length = be32(chunk);
+    if (std::memcmp(chunk + 4, "IDAT", 4) == 0) idat += length;
+    if (std::memcmp(chunk + 4, "IEND", 4) == 0) break;
+    at += 12 + length;
+  }
+  const uint64_t row_bytes = (uint64_t{width} * samples * depth + 7) / 8;
+  const uint64_t pixel_bytes = row_bytes * height;
+  if (pixel_bytes > idat * kMaxInflateRatio + 1024) {
+    return bad(std::to_string(width) + " x " + std::to_string(height) + " needs " +
+               std::to_string(pixel_bytes) + " bytes of pixels, more than its " +
+               std::to_string(idat) + " bytes of image data can hold (truncated)");
+  }
+  return Status::Ok();
+}
+
+struct PngError {
+  char message[200] = {};
+};
+
+void on_png_error(png_structp png, png_const_charp message) {
+  auto* e = static_cast<PngError*>(png_get_error_ptr(png));
+  std::snprintf(e->message, sizeof e->message, "%s", message ? message : "error");
+  png_longjmp(png, 1);
+}
+
+void on_png_warning(png_structp, png_const_charp) {}  // warnings are not errors: ignored
+
+void on_png_read(png_structp png, png_bytep out, size_t n) {
+  if (!static_cast<PngBytes*>(png_get_io_ptr(png))->read_next(out, n)) {
+    png_error(png, "the file ends before its image data");
+  }
+}
+
+// What the decode keeps across libpng's longjmp: everything it changes lives here, outside the
+// frame that calls setjmp.
+struct PngDecode {
+  std::vector<uint8_t> wide;    // 16-bit rows before their reduction to 8 bits
+  std::vector<png_bytep> rows;  // the row pointers of an interlaced image
+  Png8* out = nullptr;
+};
+
+// The libpng calls, in a frame that holds no C++ object: a longjmp out of libpng lands in
+// setjmp here and returns false with `error` set.
+bool decode_with_libpng(PngBytes* bytes, PngDecode* d, PngError* error) {
+  png_structp png =
+      png_create_read_struct(PNG_LIBPNG_VER_STRING, error, on_png_error, on_png_warning);
+  if (!png) return false;
+  png_infop info = png_create_info_struct(png);
+  if (!info) {
+    png_destroy_read_struct(&png, nullptr, nullptr);
+    return false;
+  }
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    return false;
+  }
+  png_set_read_fn(png, bytes, on_png_read);
+  png_set_user_limits(png, kMaxImageSide, kMaxImageSide);
+  png_read_info(png, info);
+  png_set_expand(png);  // palette -> RGB, grey < 8 bits -> 8, tRNS -> alpha
+  const bool sixteen = png_get_bit_depth(png, info) == 16;
+  if (sixteen) png_set_swap(png);  // native byte order for the reduction below
+  const int passes = png_set_interlace_handling(png);
+  png_read_update_info(png, info);
+  Png8& out = *d->out;
+  out.width = png_get_image_width(png, info);
+  out.height = png_get_image_height(png, info);
+  out.channels = png_get_channels(png, info);
+  const size_t samples = size_t{out.width} * out.channels;
+  out.pixels.resize(samples * out.height);
+  if (passes > 1 || !sixteen) {
+    // Interlaced images need all their rows at once; 8-bit rows go straight to the output.
+    const size_t row_bytes = samples * (sixteen ? 2 : 1);
+    uint8_t* base = out.pixels.data();
+    if (sixteen) {
+      d->wide.resize(row_bytes * out.height);
+      base = d->wide.data();
+    }
+    d->rows.resize(out.height);
+    for (uint32_t y = 0; y < out.height; ++y) d->rows[y] = base + size_t{y} * row_bytes;
+    png_read_image(png, d->rows.data());
+    if (sixteen) {
+      OIIO::convert_type(reinterpret_cast<const uint16_t*>(d->wide.data()), out.pixels.data(),
+                         samples * out.height);
+    }
+  } else {
+    // 16-bit, not interlaced: one row at a time, reduced as OpenImageIO reduces it.
+    d->wide.resize(samples * 2);
+    for (uint32_t y = 0; y < out.height; ++y) {
+      png_read_row(png, d->wide.data(), nullptr);
+      OIIO::convert_type(reinterpret_cast<const uint16_t*>(d->wide.data()),
+                         out.pixels.data() + size_t{y} * samples, samples);
+    }
+  }
+  png_destroy_read_struct(&png, &info, nullptr);
+  return true;
+}
+
+Status decode(PngBytes& bytes, const std::string& name, const ImageExpect& expect, Png8* out) {
+  CALF_RETURN_IF_ERROR(check_png_chunks(bytes, name, expect));
+  PngDecode d;
+  d.out = out;
+  PngError error;
+  if (!decode_with_libpng(&bytes, &d, &error)) {
+    *out = Png8{};
+    return Status(expect.undecodable,
+                  name + ": cannot be decoded: " +
+                      (error.message[0] ? std::string(error.message) : "out of memory in libpng"));
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+bool has_png_signature(std::span<const uint8_t> head) {
+  return head.size() >= 8 && std::memcmp(head.data(), kSignature, 8) == 0;
+}
+
+bool has_png_signature(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  uint8_t head[8] = {};
+  in.read(reinterpret_cast<char*>(head), 8);
+  return in.gcount() == 8 && has_png_signature(head);
+}
+
+Status read_png8(const std::filesystem::path& path, const ImageExpect& expect, Png8* out) {
+  const std::string name = path.string();
+  std::error_code ec;
+  const uint64_t size = std::filesystem::file_size(path, ec);
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(name.c_str(), "rb"),
+                                                       &std::fclose);
+  if (ec || !file) return Status(ErrorId::kFileOpen, name + ": cannot be opened");
+  PngBytes bytes(file.get(), size);
+  return decode(bytes, name, expect, out);
+}
+
+Status decode_png8(std::span<const uint8_t> bytes, const std::string& name,
+                   const ImageExpect& expect, Png8* out) {
+  PngBytes source(bytes);
+  return decode(source, name, expect, out);
+}
+
+}  // namespace detail
+}  // namespace calf::capture
