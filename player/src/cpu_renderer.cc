@@ -82,7 +82,7 @@ Status validate_render_options(const RenderOptions& o, size_t view_count) {
   if (!(o.mixed_texel_bend_texels >= 0) || !std::isfinite(o.mixed_texel_bend_texels)) {
     return option_error("mixed_texel_bend_texels must be finite and >= 0");
   }
-  if (o.coverage > 2) return option_error("coverage is not 0, 1 or 2");
+  if (o.coverage > 3) return option_error("coverage is not 0, 1, 2 or 3");
   if (!(o.coverage_threshold >= 0 && o.coverage_threshold <= 1)) {
     return option_error("coverage_threshold must be in [0, 1]");
   }
@@ -198,9 +198,18 @@ double coverage_margin(const View& v, const Vec3& x, double r, double margin, ui
     };
     // The nearest tap is the texel containing the direction; on a face's last row or column
     // bilinear_taps may name it by its clamped coordinates, which the cell ignores.
-    const int bit = 4 * cell(fc.v) + cell(fc.u);
-    const bool own = (cov[nearest].mask >> bit) & 1u;
-    covered = front[nearest] ? own : !own;
+    const int cx = cell(fc.u), cy = cell(fc.v);
+    const uint32_t mask = front[nearest] ? cov[nearest].mask : ~uint32_t{cov[nearest].mask};
+    covered = false;
+    // Mode 3 grows the front surface by one cell (a quarter texel) within the texel: one view's
+    // empty vote suffices, so each view's errors erode thin parts unless the test leans to
+    // occupied, as the footprint rule does by up to 0.9 texels.
+    const int grow = mode == 3 ? 1 : 0;
+    for (int j = std::max(cy - grow, 0); j <= std::min(cy + grow, 3); ++j) {
+      for (int i = std::max(cx - grow, 0); i <= std::min(cx + grow, 3); ++i) {
+        covered = covered || ((mask >> (4 * j + i)) & 1u);
+      }
+    }
   }
   if (covered) return margin;
   if (back < 0) return margin;  // no surface behind among the taps: keep the front's answer

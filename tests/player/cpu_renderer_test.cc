@@ -469,9 +469,10 @@ TEST(CpuRenderer, CoveragePlacesSilhouettesInsideTexels) {
 TEST(CpuRenderer, ViewsWithoutCoverageRenderAsBefore) {
   const ViewSet views = make_views(room_with_spheres(), corner_views({0, 0, 0.5}, 1.0), 24);
   const Camera cam = between_viewpoints_camera(48, 40);
-  RenderOptions off;
+  RenderOptions off, on;
   off.coverage = 0;
-  const RenderedImage a = render(views, cam, off), b = render(views, cam, RenderOptions{});
+  on.coverage = 2;
+  const RenderedImage a = render(views, cam, off), b = render(views, cam, on);
   EXPECT_EQ(a.color, b.color);
   EXPECT_EQ(a.depth, b.depth);
 }
