@@ -116,16 +116,20 @@ TEST(Antialias, AnEdgeTexelIsTheMeanOfItsCoverage) {
   EXPECT_EQ(render_edge(0.6, 1).color, 1.0f);
 }
 
-// Coverage of texel (0, 0) of render_edge's face: the 4 x 4 cells' centres lie at u = 0.125,
-// 0.375, 0.625, 0.875 of the texel, so the edge's position decides each column.
+// Coverage of texel (32, 32) of face +X (64 texels; near the face centre, where the plane x = 1
+// is one surface within the tolerance across a texel), covered on the side u < 32 + edge by an
+// emitter: the 4 x 4 cells' centres lie at 0.125, 0.375, 0.625, 0.875 of the texel, so the
+// edge's position decides each column.
 struct EdgeCoverage {
   float near = -1, far = -1, mask = -1;
 };
 EdgeCoverage render_edge_coverage(double edge, uint32_t spp) {
   Scene s = dark_scene();
-  const uint32_t n = 2;
-  s.objects.push_back(emitter(on_pos_x(-9, -9, n), on_pos_x(-9, 9, n), on_pos_x(edge, -9, n)));
-  s.objects.push_back(emitter(on_pos_x(edge, -9, n), on_pos_x(-9, 9, n), on_pos_x(edge, 9, n)));
+  const uint32_t n = 64;
+  const double e = 32 + edge;
+  s.objects.push_back(
+      emitter(on_pos_x(-100, -100, n), on_pos_x(-100, 200, n), on_pos_x(e, -100, n)));
+  s.objects.push_back(emitter(on_pos_x(e, -100, n), on_pos_x(-100, 200, n), on_pos_x(e, 200, n)));
   auto tracer = FrameTracer::create(s, 0, fixed_spp(spp));
   EXPECT_TRUE(tracer.ok()) << tracer.status().to_string();
   if (!tracer.ok()) return {};
@@ -133,7 +137,7 @@ EdgeCoverage render_edge_coverage(double edge, uint32_t spp) {
   (*tracer)->render_cube({0, 0, 0}, 0, 0, n, false, &f, /*with_coverage=*/true);
   EXPECT_TRUE(f.has_coverage);
   if (f.coverage.size() != 3 * f.texel_count()) return {};
-  const size_t i = static_cast<size_t>(cube_face_index(CubeFace::kPosX)) * n * n;  // (0, 0)
+  const size_t i = f.texel_index(CubeFace::kPosX, 32, 32);
   return {f.coverage[3 * i], f.coverage[3 * i + 1], f.coverage[3 * i + 2]};
 }
 
