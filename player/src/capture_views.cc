@@ -24,7 +24,8 @@ Expected<View> view_from_capture_frame(const capture::ViewFrame& frame, const Ve
   const uint32_t n = frame.face_size;
   const size_t texels = frame.texel_count();
   if (n == 0 || frame.color.size() != 3 * texels || frame.depth.size() != texels ||
-      frame.material.size() != (frame.has_material ? 3 * texels : 0)) {
+      frame.material.size() != (frame.has_material ? 3 * texels : 0) ||
+      frame.coverage.size() != (frame.has_coverage ? 3 * texels : 0)) {
     return views_error(context, "view-frame buffers do not match face size " + std::to_string(n));
   }
   // The range covers exactly this view-frame's finite depths; invalid depths are rejected here
@@ -70,6 +71,11 @@ Expected<View> view_from_capture_frame(const capture::ViewFrame& frame, const Ve
     if (s.ok() && frame.has_material) {
       s = view.write_material_rect(
           face, whole, std::span<const float>(frame.material).subspan(3 * first, 3 * face_texels));
+    }
+    if (s.ok() && frame.has_coverage) {
+      view.add_coverage();
+      s = view.write_coverage_rect(
+          face, whole, std::span<const float>(frame.coverage).subspan(3 * first, 3 * face_texels));
     }
     if (!s.ok()) return std::move(s).with_context(context);
   }

@@ -82,6 +82,13 @@ Status validate_render_options(const RenderOptions& o, size_t view_count) {
   if (!(o.mixed_texel_bend_texels >= 0) || !std::isfinite(o.mixed_texel_bend_texels)) {
     return option_error("mixed_texel_bend_texels must be finite and >= 0");
   }
+  if (o.coverage > 3) return option_error("coverage is not 0, 1, 2 or 3");
+  if (!(o.coverage_threshold >= 0 && o.coverage_threshold <= 1)) {
+    return option_error("coverage_threshold must be in [0, 1]");
+  }
+  if (!(o.coverage_cluster >= 0) || !std::isfinite(o.coverage_cluster)) {
+    return option_error("coverage_cluster must be finite and >= 0");
+  }
   if (!std::isfinite(o.min_view_distance)) return option_error("min_view_distance is not finite");
   if (o.threads < 1 || o.threads > 256) return option_error("threads is outside [1, 256]");
   if (o.supersample < 1 || o.supersample > 8) return option_error("supersample is outside [1, 8]");
@@ -153,6 +160,62 @@ double code_margin(const View& v, const Vec3& x, double r, double footprint,
   return code == kLog16Sky ? kInf : code - rcode;
 }
 
+// Coverage (RenderOptions::coverage): `margin` is code_margin's answer for the same point; where
+// it says the point lies at or behind the footprint's surface, the view's coverage decides
+// whether that surface covers the direction at sub-texel precision, and where it does not, the
+// answer is measured against the surface behind it instead.
+double coverage_margin(const View& v, const Vec3& x, double r, double margin, uint32_t mode,
+                       double threshold, double cluster) {
+  if (margin > 0 || mode == 0 || !v.has_coverage()) return margin;
+  const FaceTexelCoord fc = texel_coord_from_direction(x, v.face_size());
+  const internal::BilinearTaps taps = internal::bilinear_taps(fc, v.face_size());
+  const double rcode = v.range().normalized_from_depth(r) * kLog16MaxFinite;
+  const double front_code = rcode + margin;  // the footprint's surface
+  const double cluster_codes = cluster / v.range().relative_step();
+  bool front[4], edge = false;
+  Coverage cov[4];
+  int nearest = 0;
+  double back = -1;  // the farthest tap outside the front cluster (kLog16Sky: sky)
+  for (int k = 0; k < 4; ++k) {
+    const uint16_t c = v.depth_code_at(taps.texel[k].face, taps.texel[k].x, taps.texel[k].y);
+    cov[k] = v.coverage_at(taps.texel[k].face, taps.texel[k].x, taps.texel[k].y);
+    front[k] = c != kLog16Sky && c - front_code <= cluster_codes;
+    if (!front[k]) back = std::max(back, static_cast<double>(c));
+    if (cov[k].mask != 0xFFFF || cov[k].near > 0 || cov[k].far > 0 || !front[k]) edge = true;
+    if (taps.weight[k] > taps.weight[nearest]) nearest = k;
+  }
+  if (!edge) return margin;
+  bool covered;
+  if (mode == 1) {
+    double o = 0;
+    for (int k = 0; k < 4; ++k) {
+      o += taps.weight[k] * (front[k] ? 1.0 - cov[k].far : cov[k].near);
+    }
+    covered = o >= threshold;
+  } else {
+    const auto cell = [](double u) {
+      return std::clamp(static_cast<int>(std::floor((u - std::floor(u)) * 4)), 0, 3);
+    };
+    // The nearest tap is the texel containing the direction; on a face's last row or column
+    // bilinear_taps may name it by its clamped coordinates, which the cell ignores.
+    const int cx = cell(fc.u), cy = cell(fc.v);
+    const uint32_t mask = front[nearest] ? cov[nearest].mask : ~uint32_t{cov[nearest].mask};
+    covered = false;
+    // Mode 3 grows the front surface by one cell (a quarter texel) within the texel: one view's
+    // empty vote suffices, so each view's errors erode thin parts unless the test leans to
+    // occupied, as the footprint rule does by up to 0.9 texels.
+    const int grow = mode == 3 ? 1 : 0;
+    for (int j = std::max(cy - grow, 0); j <= std::min(cy + grow, 3); ++j) {
+      for (int i = std::max(cx - grow, 0); i <= std::min(cx + grow, 3); ++i) {
+        covered = covered || ((mask >> (4 * j + i)) & 1u);
+      }
+    }
+  }
+  if (covered) return margin;
+  if (back < 0) return margin;  // no surface behind among the taps: keep the front's answer
+  return back == kLog16Sky ? kInf : back - rcode;
+}
+
 // `texels` texel angles of v (2 / face size radians each, a texel's width at the face centre) as
 // a relative depth, in v's log-16 code units: the scale of the hint margin and the mixed-texel
 // bend.
@@ -204,9 +267,10 @@ bool CpuRenderer::empty_beyond(const Vec3& p, double margin_texels, uint32_t vet
     const double r = length(x);
     if (r <= min_view_distance_) continue;
     consulted = true;
-    if (code_margin(*v, x, r, options_.depth_footprint, smooth_log_ratio_) >
-            texel_angles_in_codes(*v, margin_texels) &&
-        ++vetoes > vetoes_ignored) {
+    const double m = coverage_margin(
+        *v, x, r, code_margin(*v, x, r, options_.depth_footprint, smooth_log_ratio_),
+        options_.coverage, options_.coverage_threshold, options_.coverage_cluster);
+    if (m > texel_angles_in_codes(*v, margin_texels) && ++vetoes > vetoes_ignored) {
       return true;
     }
   }

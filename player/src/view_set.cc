@@ -121,6 +121,27 @@ Status View::write_material_rect(CubeFace face, const PixelRect& rect, std::span
   return Status::Ok();
 }
 
+void View::add_coverage() {
+  if (has_coverage()) return;
+  for (auto& face : coverage_) face.assign(size_t{face_size_} * face_size_, Coverage{});
+}
+
+Status View::write_coverage_rect(CubeFace face, const PixelRect& rect, std::span<const float> src,
+                                 size_t src_stride) {
+  CALF_RETURN_IF_ERROR(check_rect(face, rect, src.size(), 3, &src_stride));
+  add_coverage();
+  for (uint32_t j = 0; j < rect.height; ++j) {
+    for (uint32_t i = 0; i < rect.width; ++i) {
+      const float* c = &src[j * src_stride + 3 * size_t{i}];
+      Coverage& t = coverage_[cube_face_index(face)][texel_index(rect.x + i, rect.y + j)];
+      t.near = c[0];
+      t.far = c[1];
+      t.mask = static_cast<uint16_t>(std::clamp(c[2], 0.0f, 65535.0f));
+    }
+  }
+  return Status::Ok();
+}
+
 bool ViewSet::has_material() const {
   return std::any_of(views.begin(), views.end(), [](const View& v) { return v.has_material(); });
 }

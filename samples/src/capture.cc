@@ -66,6 +66,10 @@ Expected<RenderStats> render_capture_set(const Scene& scene, const CaptureReques
   manifest.view_volume = request.rig.view_volume;
   manifest.viewpoints = request.rig.viewpoints;
   manifest.material = scene.has_mirror_or_glass();
+  if (request.coverage) {
+    manifest.version = capture::kCaptureCoverageVersion;
+    manifest.coverage = true;
+  }
   manifest.scene = scene.name;
   manifest.generator = request.generator;
   CALF_RETURN_IF_ERROR(capture::validate_manifest(manifest));
@@ -119,8 +123,9 @@ Expected<RenderStats> render_capture_set(const Scene& scene, const CaptureReques
       return tracer.status();
     }
     for (const uint32_t v : views) {
-      RenderStats s = (*tracer)->render_cube(manifest.viewpoints[v].position, v, f,
-                                             request.face_size, manifest.material, &image);
+      RenderStats s =
+          (*tracer)->render_cube(manifest.viewpoints[v].position, v, f, request.face_size,
+                                 manifest.material, &image, manifest.coverage);
       stats.rays += s.rays;
       stats.images += s.images;
       stats.pixels += s.pixels;

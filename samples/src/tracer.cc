@@ -480,6 +480,10 @@ struct FrameTracer::Impl {
   }
 };
 
+float coverage_tolerance(uint32_t face_size) {
+  return std::min(0.05f, 4.0f / static_cast<float>(std::max(face_size, 1u)));
+}
+
 Status validate_render_options(const RenderOptions& o) {
   auto bad = [](const std::string& what) { return Status(ErrorId::kCaptureOption, what); };
   if (o.threads > 256) return bad("threads " + std::to_string(o.threads) + " is outside 0..256");
@@ -632,8 +636,9 @@ Expected<std::unique_ptr<FrameTracer>> FrameTracer::create(const Scene& scene, d
 
 RenderStats FrameTracer::render_cube(const Vec3& center, uint32_t view, uint32_t frame,
                                      uint32_t face_size, bool with_material,
-                                     capture::ViewFrame* out) const {
-  out->resize(face_size, with_material);
+                                     capture::ViewFrame* out, bool with_coverage) const {
+  out->resize(face_size, with_material, with_coverage);
+  const float coverage_tol = coverage_tolerance(face_size);
   const Impl& im = *impl_;
   const glm::vec3 o = to_fvec3(center);
   const uint32_t n = face_size;
@@ -656,6 +661,35 @@ RenderStats FrameTracer::render_cube(const Vec3& center, uint32_t view, uint32_t
                      pixel_key(im.options.seed ^ 0xA5A5A5A5ull, view, face * n + y, x, frame),
                      &out->color[3 * i], &out->depth[i],
                      with_material ? &out->material[3 * i] : nullptr, &c->rays, &c->samples);
+      if (with_coverage) {
+        // The first hits of the centre rays of the texel's 4 x 4 cells against the centre
+        // ray's depth (format/CAPTURE.md "Coverage").
+        const float centre = out->depth[i];
+        uint32_t near = 0, far = 0, mask = 0;
+        for (uint32_t cell = 0; cell < kCoverageCells * kCoverageCells; ++cell) {
+          const float cx = (static_cast<float>(cell % kCoverageCells) + 0.5f) / kCoverageCells;
+          const float cy = (static_cast<float>(cell / kCoverageCells) + 0.5f) / kCoverageCells;
+          Hit h;
+          const bool hit = im.intersect(o, dir_at(cx, cy), 0, INFINITY, &h, &c->rays);
+          const float t = hit ? h.t : INFINITY;
+          if (!std::isfinite(centre)) {
+            if (hit)
+              ++near;
+            else
+              mask |= 1u << cell;
+          } else if (!hit) {
+            ++far;
+          } else if (std::fabs(std::log(t / centre)) > coverage_tol) {
+            ++(t < centre ? near : far);
+          } else {
+            mask |= 1u << cell;
+          }
+        }
+        constexpr float kCells = kCoverageCells * kCoverageCells;
+        out->coverage[3 * i] = static_cast<float>(near) / kCells;
+        out->coverage[3 * i + 1] = static_cast<float>(far) / kCells;
+        out->coverage[3 * i + 2] = static_cast<float>(mask);
+      }
     }
   });
   stats.rays = counts.rays;

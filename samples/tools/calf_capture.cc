@@ -185,6 +185,12 @@ static int command_main(int argc, char** argv) {
                  "calf's rendering before anti-aliasing, bit for bit. Depth and material are "
                  "always the centre ray's (docs/RENDERING.md, \"Converged capture\")")
       ->capture_default_str();
+  bool coverage = false;
+  app.add_flag("--coverage", coverage,
+               "also write each texel's coverage: the shares of its square whose first surface "
+               "lies nearer and farther than its depth, from the colour samples (capture set "
+               "version 2, format/CAPTURE.md \"Coverage\"). Default off: calf-encode does not "
+               "carry it yet; the CPU reference reads it from the set");
   app.add_option("--min-spp", render.min_spp,
                  "samples of the first round, 1..4096; rounds double the count until the "
                  "pixel's standard error is within --tolerance or --spp samples are taken")
@@ -368,6 +374,7 @@ static int command_main(int argc, char** argv) {
   } else {
     samples::CaptureRequest request;
     request.face_size = face_size;
+    request.coverage = coverage;
     request.frames = frame_count;
     request.render = render;
     request.generator = "calf-capture";

@@ -489,6 +489,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--mixed-bend", base.mixed_texel_bend_texels, "mixed_texel_bend_texels")
       ->capture_default_str();
+  app.add_option("--coverage", base.coverage,
+                 "coverage: 0 off, 1 bilinear front shares, 2 cell mask (views with coverage)")
+      ->capture_default_str();
+  app.add_option("--coverage-threshold", base.coverage_threshold, "coverage_threshold")
+      ->capture_default_str();
+  app.add_option("--coverage-cluster", base.coverage_cluster, "coverage_cluster")
+      ->capture_default_str();
   app.add_option("--hint-margin", base.surface_hint_margin_texels,
                  "surface_hint_margin_texels (of the vetoing view)")
       ->capture_default_str();
@@ -589,14 +596,14 @@ int main(int argc, char** argv) {
       "%.2f, depth_decay %.0f, cam_decay %.0f, colour tolerance %.2f, mixed texels %.1f (bend %.2f "
       "texels), tight start %d, "
       "hints %u (margin %.3f texels, vetoes %u, substeps %u), rr_start %.3f, rr replace %d, "
-      "supersample %u (renderer %u), threads %u\n",
+      "supersample %u (renderer %u), threads %u; coverage %u (threshold %.2f, cluster %.3f)\n",
       m.scene.c_str(), m.viewpoints.size(), m.face_size, m.frame_count, base.steps,
       base.refine_steps, base.depth_footprint, base.smooth_depth_ratio, base.depth_decay,
       base.cam_decay, base.color_depth_tolerance, base.mixed_texel_penalty,
       base.mixed_texel_bend_texels, base.tight_march_start, base.surface_hints,
       base.surface_hint_margin_texels, base.surface_hint_vetoes, base.surface_hint_substeps,
-      base.rr_start, base.rr_replace_view_reflection, g_supersample, base.supersample,
-      base.threads);
+      base.rr_start, base.rr_replace_view_reflection, g_supersample, base.supersample, base.threads,
+      base.coverage, base.coverage_threshold, base.coverage_cluster);
   FrameCache frames(reader);
   if (!between.empty()) measure("between", between, frames, m, variants, out_dir, false);
   if (!vp_gt_file.empty()) {

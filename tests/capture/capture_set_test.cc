@@ -380,6 +380,81 @@ TEST_F(CaptureSetTest, BadMaterialPixels) {
   }
 }
 
+// Coverage (format/CAPTURE.md "Coverage"): a version-2 set round-trips its coverage channels; a
+// version-1 set reads with none; shares out of range, a mask that is not an integer 0..65535, a
+// missing or unannounced channel, and a coverage key in a version-1 manifest are refused.
+TEST_F(CaptureSetTest, CoverageRoundTripAndRefusals) {
+  CaptureManifest m = manifest(false);
+  m.version = kCaptureCoverageVersion;
+  m.coverage = true;
+  const auto with_coverage = [](uint32_t view, uint32_t frame) {
+    ViewFrame f = frame_data(view, frame, false);
+    const ViewFrame base = f;
+    f.resize(4, false, true);
+    f.color = base.color;
+    f.depth = base.depth;
+    for (size_t i = 0; i < f.texel_count(); ++i) {
+      f.coverage[3 * i] = static_cast<float>(i % 5) / 16;
+      f.coverage[3 * i + 1] = static_cast<float>(i % 3) / 16;
+      f.coverage[3 * i + 2] = static_cast<float>((i * 4099) % 65536);
+    }
+    return f;
+  };
+  {
+    auto w = CaptureSetWriter::create(dir_, m);
+    ASSERT_TRUE(w.ok()) << w.status().to_string();
+    EXPECT_EQ(w->write(0, 0, frame_data(0, 0, false)).id(), ErrorId::kCaptureWriterMisuse);
+    ViewFrame bad = with_coverage(0, 0);
+    bad.coverage[3 * 7] = 0.75f;
+    bad.coverage[3 * 7 + 1] = 0.5f;  // near + far > 1
+    Status s = w->write(0, 0, bad);
+    EXPECT_EQ(s.id(), ErrorId::kCaptureImageFormat) << s.to_string();
+    EXPECT_NE(s.message().find("face +X texel (3, 1): coverage"), std::string::npos)
+        << s.to_string();
+    bad = with_coverage(0, 0);
+    bad.coverage[3 * 7 + 2] = 2.5f;  // not an integer mask
+    EXPECT_EQ(w->write(0, 0, bad).id(), ErrorId::kCaptureImageFormat);
+    for (uint32_t v = 0; v < 2; ++v) {
+      for (uint32_t f = 0; f < 2; ++f) ASSERT_TRUE(w->write(v, f, with_coverage(v, f)).ok());
+    }
+    ASSERT_TRUE(w->finish().ok());
+  }
+  auto r = CaptureSetReader::open(dir_);
+  ASSERT_TRUE(r.ok()) << r.status().to_string();
+  EXPECT_EQ(r->manifest(), m);
+  ViewFrame got;
+  ASSERT_TRUE(r->read(1, 1, &got).ok());
+  EXPECT_TRUE(got.has_coverage);
+  EXPECT_EQ(got.coverage, with_coverage(1, 1).coverage);
+  EXPECT_EQ(got.color, with_coverage(1, 1).color);
+  // A mask that is not an integer (0.25 everywhere), in a file written past the writer.
+  const std::vector<std::string> channels = {
+      "R", "G", "B", "Z", "coverage.near", "coverage.far", "coverage.mask"};
+  write_raw(image(1, 0), 4, 24, channels, 0.25f);
+  expect_read_error(ErrorId::kCaptureImageFormat, "face +X texel (0, 0): coverage");
+  write_raw(image(1, 0), 4, 24, {"R", "G", "B", "Z", "coverage.near", "coverage.far"}, 0.0f);
+  expect_read_error(ErrorId::kCaptureImageFormat, "coverage.mask' is missing");
+  // A version-1 set: no coverage key, and a coverage channel is refused.
+  fs::remove_all(dir_);
+  write_set(false);
+  ASSERT_TRUE(CaptureSetReader::open(dir_)->read(1, 0, &got).ok());
+  EXPECT_FALSE(got.has_coverage);
+  EXPECT_TRUE(got.coverage.empty());
+  write_raw(image(1, 0), 4, 24, channels, 0.5f);
+  expect_read_error(ErrorId::kCaptureImageFormat, "does not say \"coverage\": true");
+  CaptureManifest v1 = manifest(false);
+  v1.coverage = true;
+  EXPECT_EQ(validate_manifest(v1).id(), ErrorId::kManifestVersion);
+  std::string json = serialize_manifest(manifest(false));
+  json.replace(json.find("\"material\""), 0, "\"coverage\": true, ");
+  EXPECT_EQ(parse_manifest(json, "m").status().id(), ErrorId::kManifestField);
+  m.coverage = false;  // version 2 without coverage: valid, and says so
+  EXPECT_NE(serialize_manifest(m).find("\"coverage\": false"), std::string::npos);
+  EXPECT_EQ(*parse_manifest(serialize_manifest(m), "m"), m);
+  // Version 1 manifests serialize as before: no coverage key.
+  EXPECT_EQ(serialize_manifest(manifest(false)).find("coverage"), std::string::npos);
+}
+
 TEST_F(CaptureSetTest, MissingOrBrokenManifest) {
   EXPECT_EQ(CaptureSetReader::open(dir_).status().id(), ErrorId::kFileOpen);
   fs::create_directories(dir_);

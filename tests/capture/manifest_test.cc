@@ -82,8 +82,8 @@ TEST(CaptureManifest, SyntaxError) {
 TEST(CaptureManifest, FormatAndVersion) {
   expect_error(manifest_json("\"calf-capture-set\"", "\"seurat\""), ErrorId::kManifestVersion,
                "seurat");
-  expect_error(manifest_json("\"version\": 1", "\"version\": 2"), ErrorId::kManifestVersion,
-               "version 2");
+  expect_error(manifest_json("\"version\": 1", "\"version\": 3"), ErrorId::kManifestVersion,
+               "version 3");
 }
 
 TEST(CaptureManifest, FieldErrorsNameTheField) {

@@ -193,6 +193,46 @@ inline View make_view(const Scene& s, const Vec3& position, uint32_t n, bool mat
   return v;
 }
 
+// Coverage of every texel of `v` (format/CAPTURE.md "Coverage"), cast here from the scene: the
+// centre rays of the texel's 4 x 4 cells against the texel's centre-ray depth, a cell showing the
+// texel's own surface when both are sky or their depths agree within min(4 / n, 5 %) relative.
+inline void add_coverage(const Scene& s, View* v) {
+  const uint32_t n = v->face_size();
+  const double tol = std::min(0.05, 4.0 / n);
+  v->add_coverage();
+  for (int f = 0; f < 6; ++f) {
+    const CubeFace face = cube_face_from_index(f);
+    std::vector<float> cov;
+    for (uint32_t y = 0; y < n; ++y) {
+      for (uint32_t x = 0; x < n; ++x) {
+        double rgb[3], centre;
+        shade(s, v->position(), direction_from_texel(face, x, y, n), rgb, &centre);
+        int near = 0, far = 0, mask = 0;
+        for (int cell = 0; cell < 16; ++cell) {
+          const Vec3 d = unit(direction_from_texel_coord(
+              {face, x + (cell % 4 + 0.5) / 4, y + (cell / 4 + 0.5) / 4}, n));
+          double z;
+          shade(s, v->position(), d, rgb, &z);
+          if (!std::isfinite(centre)) {
+            if (std::isfinite(z))
+              ++near;
+            else
+              mask |= 1 << cell;
+          } else if (!std::isfinite(z)) {
+            ++far;
+          } else if (std::fabs(std::log(z / centre)) > tol) {
+            ++(z < centre ? near : far);
+          } else {
+            mask |= 1 << cell;
+          }
+        }
+        cov.insert(cov.end(), {near / 16.0f, far / 16.0f, static_cast<float>(mask)});
+      }
+    }
+    if (!v->write_coverage_rect(face, {0, 0, n, n}, cov).ok()) std::abort();
+  }
+}
+
 inline ViewSet make_views(const Scene& s, const std::vector<Vec3>& positions, uint32_t n,
                           bool material = false, uint32_t colour_samples = 1) {
   ViewSet set;

@@ -116,6 +116,56 @@ TEST(Antialias, AnEdgeTexelIsTheMeanOfItsCoverage) {
   EXPECT_EQ(render_edge(0.6, 1).color, 1.0f);
 }
 
+// Coverage of texel (32, 32) of face +X (64 texels; near the face centre, where the plane x = 1
+// is one surface within the tolerance across a texel), covered on the side u < 32 + edge by an
+// emitter: the 4 x 4 cells' centres lie at 0.125, 0.375, 0.625, 0.875 of the texel, so the
+// edge's position decides each column.
+struct EdgeCoverage {
+  float near = -1, far = -1, mask = -1;
+};
+EdgeCoverage render_edge_coverage(double edge, uint32_t spp) {
+  Scene s = dark_scene();
+  const uint32_t n = 64;
+  const double e = 32 + edge;
+  s.objects.push_back(
+      emitter(on_pos_x(-100, -100, n), on_pos_x(-100, 200, n), on_pos_x(e, -100, n)));
+  s.objects.push_back(emitter(on_pos_x(e, -100, n), on_pos_x(-100, 200, n), on_pos_x(e, 200, n)));
+  auto tracer = FrameTracer::create(s, 0, fixed_spp(spp));
+  EXPECT_TRUE(tracer.ok()) << tracer.status().to_string();
+  if (!tracer.ok()) return {};
+  capture::ViewFrame f;
+  (*tracer)->render_cube({0, 0, 0}, 0, 0, n, false, &f, /*with_coverage=*/true);
+  EXPECT_TRUE(f.has_coverage);
+  if (f.coverage.size() != 3 * f.texel_count()) return {};
+  const size_t i = f.texel_index(CubeFace::kPosX, 32, 32);
+  return {f.coverage[3 * i], f.coverage[3 * i + 1], f.coverage[3 * i + 2]};
+}
+
+TEST(Coverage, TheCellsOfAnEdgeTexel) {
+  // Centre covered (edge at 0.6 and 0.7 of the texel): the cells beyond the edge see sky, farther
+  // than the texel's depth. Columns 0-1 (0.6) or 0-2 (0.7) are the texel's own surface.
+  for (uint32_t spp : {1u, 16u}) {  // coverage does not depend on the colour's samples
+    EdgeCoverage c = render_edge_coverage(0.6, spp);
+    EXPECT_EQ(c.near, 0.0f);
+    EXPECT_EQ(c.far, 0.5f);
+    EXPECT_EQ(c.mask, float{0x3333});
+    c = render_edge_coverage(0.7, spp);
+    EXPECT_EQ(c.near, 0.0f);
+    EXPECT_EQ(c.far, 0.25f);
+    EXPECT_EQ(c.mask, float{0x7777});
+  }
+  // Centre uncovered (edge at 0.4): the texel is sky; the emitter in columns 0-1 is nearer.
+  EdgeCoverage c = render_edge_coverage(0.4, 16);
+  EXPECT_EQ(c.near, 0.5f);
+  EXPECT_EQ(c.far, 0.0f);
+  EXPECT_EQ(c.mask, float{0xCCCC});
+  // A texel the emitter covers wholly: its own surface in every cell.
+  c = render_edge_coverage(1.9, 16);
+  EXPECT_EQ(c.near, 0.0f);
+  EXPECT_EQ(c.far, 0.0f);
+  EXPECT_EQ(c.mask, float{0xFFFF});
+}
+
 TEST(Antialias, DepthIsTheCentreRaysAtAnEdge) {
   // Centre (0.5, 0.5) uncovered: sky (+inf) though 40 % of the texel shows the emitter.
   EXPECT_TRUE(std::isinf(render_edge(0.4, 64).depth));

@@ -20,6 +20,7 @@ constexpr float kHalfMax = 65504.0f;
 constexpr float kWeightSlack = 2e-3f;
 
 const char* const kMaterialChannels[3] = {"material.reflect", "material.refract", "material.ior"};
+const char* const kCoverageChannels[3] = {"coverage.near", "coverage.far", "coverage.mask"};
 
 std::string texel_text(const ViewFrame& f, size_t index) {
   size_t n = f.face_size;
@@ -38,19 +39,22 @@ std::string value_text(float v) {
 
 }  // namespace
 
-void ViewFrame::resize(uint32_t size, bool with_material) {
+void ViewFrame::resize(uint32_t size, bool with_material, bool with_coverage) {
   face_size = size;
   has_material = with_material;
+  has_coverage = with_coverage;
   color.resize(texel_count() * 3);
   depth.resize(texel_count());
   material.resize(with_material ? texel_count() * 3 : 0);
+  coverage.resize(with_coverage ? texel_count() * 3 : 0);
 }
 
 Status validate_view_frame(const ViewFrame& f, std::string_view context) {
   std::string ctx(context);
   const size_t n = f.texel_count();
   if (f.color.size() != 3 * n || f.depth.size() != n ||
-      f.material.size() != (f.has_material ? 3 * n : 0)) {
+      f.material.size() != (f.has_material ? 3 * n : 0) ||
+      f.coverage.size() != (f.has_coverage ? 3 * n : 0)) {
     return Status(ErrorId::kCaptureWriterMisuse,
                   ctx + ": buffer sizes do not match face size " + std::to_string(f.face_size));
   }
@@ -78,6 +82,16 @@ Status validate_view_frame(const ViewFrame& f, std::string_view context) {
                       ctx + ": " + texel_text(f, i) + ": material (" + value_text(rfl) + ", " +
                           value_text(rfr) + ", " + value_text(ior) +
                           ") (expected weights in [0, 1] summing to <= 1 and IOR > 0)");
+      }
+    }
+    if (f.has_coverage) {
+      float near = f.coverage[3 * i], far = f.coverage[3 * i + 1], mask = f.coverage[3 * i + 2];
+      if (!(near >= 0 && near <= 1 && far >= 0 && far <= 1 && near + far <= 1 + kWeightSlack) ||
+          !(mask >= 0 && mask <= 65535 && mask == std::floor(mask))) {
+        return Status(ErrorId::kCaptureImageFormat,
+                      ctx + ": " + texel_text(f, i) + ": coverage (near " + value_text(near) +
+                          ", far " + value_text(far) + ", mask " + value_text(mask) +
+                          ") (expected shares in [0, 1] summing to <= 1, a mask 0..65535)");
       }
     }
   }
@@ -174,7 +188,7 @@ Status CaptureSetReader::read(uint32_t view, uint32_t frame, ViewFrame* out) con
                       std::to_string(6 * n) + " (six faces of face_size " + std::to_string(n) +
                       " stacked vertically)");
   }
-  int idx[7];
+  int idx[10];
   const char* const required[4] = {"R", "G", "B", "Z"};
   for (int c = 0; c < 4; ++c) {
     idx[c] = exr.channel(required[c]);
@@ -195,10 +209,25 @@ Status CaptureSetReader::read(uint32_t view, uint32_t frame, ViewFrame* out) con
                         "' but the manifest says \"material\": false");
     }
   }
+  for (int c = 0; c < 3; ++c) {
+    idx[7 + c] = exr.channel(kCoverageChannels[c]);
+    if (m.coverage && idx[7 + c] < 0) {
+      return Status(ErrorId::kCaptureImageFormat, name + ": channel '" + kCoverageChannels[c] +
+                                                      "' is missing (the manifest says coverage)");
+    }
+    if (!m.coverage && idx[7 + c] >= 0) {
+      return Status(ErrorId::kCaptureImageFormat,
+                    name + ": has channel '" + kCoverageChannels[c] +
+                        "' but the manifest does not say \"coverage\": true");
+    }
+  }
   for (int c = 0; c < (m.material ? 7 : 4); ++c) CALF_RETURN_IF_ERROR(exr.require_float(idx[c]));
-  if (out->face_size != n || out->has_material != m.material ||
+  if (m.coverage) {
+    for (int c = 7; c < 10; ++c) CALF_RETURN_IF_ERROR(exr.require_float(idx[c]));
+  }
+  if (out->face_size != n || out->has_material != m.material || out->has_coverage != m.coverage ||
       out->depth.size() != out->texel_count()) {
-    out->resize(n, m.material);
+    out->resize(n, m.material, m.coverage);
   }
   // One face at a time keeps the decode buffer at 1/6 of the image.
   const size_t nch = static_cast<size_t>(exr.channel_count());
@@ -213,6 +242,9 @@ Status CaptureSetReader::read(uint32_t view, uint32_t frame, ViewFrame* out) con
       out->depth[base + i] = px[idx[3]];
       if (m.material) {
         for (int c = 0; c < 3; ++c) out->material[3 * (base + i) + c] = px[idx[4 + c]];
+      }
+      if (m.coverage) {
+        for (int c = 0; c < 3; ++c) out->coverage[3 * (base + i) + c] = px[idx[7 + c]];
       }
     }
   }
@@ -255,11 +287,14 @@ Status CaptureSetWriter::write(uint32_t view, uint32_t frame, const ViewFrame& d
                                               " is outside the manifest's counts");
   }
   const std::filesystem::path path = directory_ / capture_file_name(m, view, frame);
-  if (data.face_size != m.face_size || data.has_material != m.material) {
+  if (data.face_size != m.face_size || data.has_material != m.material ||
+      data.has_coverage != m.coverage) {
     return Status(ErrorId::kCaptureWriterMisuse,
                   path.string() + ": view-frame has face size " + std::to_string(data.face_size) +
-                      (data.has_material ? " with" : " without") + " material; the manifest says " +
-                      std::to_string(m.face_size) + (m.material ? " with" : " without"));
+                      (data.has_material ? " with" : " without") + " material," +
+                      (data.has_coverage ? " with" : " without") + " coverage; the manifest says " +
+                      std::to_string(m.face_size) + (m.material ? " with" : " without") +
+                      " material," + (m.coverage ? " with" : " without") + " coverage");
   }
   const size_t slot = static_cast<size_t>(view) * m.frame_count + frame;
   if (written_[slot]) {
@@ -276,6 +311,11 @@ Status CaptureSetWriter::write(uint32_t view, uint32_t frame, const ViewFrame& d
   if (m.material) {
     for (int c = 0; c < 3; ++c) {
       channels.push_back({kMaterialChannels[c], true, data.material.data() + c, 3});
+    }
+  }
+  if (m.coverage) {
+    for (int c = 0; c < 3; ++c) {
+      channels.push_back({kCoverageChannels[c], c < 2, data.coverage.data() + c, 3});
     }
   }
   CALF_RETURN_IF_ERROR(detail::write_exr(path, n, 6 * n, channels));

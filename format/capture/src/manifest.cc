@@ -30,9 +30,12 @@ std::string point_text(const Vec3& p) {
 Status check_manifest(const CaptureManifest& m, std::string_view source) {
   std::string src(source);
   auto fail = [&](ErrorId id, const std::string& what) { return Status(id, src + ": " + what); };
-  if (m.version != kCaptureFormatVersion) {
+  if (m.version != kCaptureFormatVersion && m.version != kCaptureCoverageVersion) {
     return fail(ErrorId::kManifestVersion,
-                "version " + std::to_string(m.version) + " is not supported (expected 1)");
+                "version " + std::to_string(m.version) + " is not supported (expected 1 or 2)");
+  }
+  if (m.coverage && m.version < kCaptureCoverageVersion) {
+    return fail(ErrorId::kManifestVersion, "field 'coverage': needs version 2");
   }
   if (m.frame_count == 0) return fail(ErrorId::kManifestField, "field 'frame_count': is 0");
   if (m.frame_count > kMaxFrames) {
@@ -118,10 +121,20 @@ Expected<CaptureManifest> parse_manifest(std::string_view json, std::string_view
   }
   CaptureManifest m;
   CALF_ASSIGN_OR_RETURN(m.version, r.uint("version", 0, UINT32_MAX));
-  if (m.version != kCaptureFormatVersion) return check_manifest(m, source);
-  CALF_RETURN_IF_ERROR(
-      r.check_keys({"format", "version", "scene", "generator", "frame_count", "fps", "face_size",
-                    "file_pattern", "material", "view_volume", "viewpoints"}));
+  if (m.version != kCaptureFormatVersion && m.version != kCaptureCoverageVersion) {
+    return check_manifest(m, source);
+  }
+  // Version 1 has no "coverage" key: a misplaced one is an unknown key there.
+  if (m.version == kCaptureFormatVersion) {
+    CALF_RETURN_IF_ERROR(
+        r.check_keys({"format", "version", "scene", "generator", "frame_count", "fps", "face_size",
+                      "file_pattern", "material", "view_volume", "viewpoints"}));
+  } else {
+    CALF_RETURN_IF_ERROR(
+        r.check_keys({"format", "version", "scene", "generator", "frame_count", "fps", "face_size",
+                      "file_pattern", "material", "coverage", "view_volume", "viewpoints"}));
+    CALF_ASSIGN_OR_RETURN(m.coverage, r.boolean_or("coverage", false));
+  }
   CALF_ASSIGN_OR_RETURN(m.scene, r.string_or("scene", ""));
   CALF_ASSIGN_OR_RETURN(m.generator, r.string_or("generator", ""));
   CALF_ASSIGN_OR_RETURN(m.frame_count, r.uint("frame_count", 0, UINT32_MAX));
@@ -170,6 +183,7 @@ std::string serialize_manifest(const CaptureManifest& m) {
   j["face_size"] = m.face_size;
   j["file_pattern"] = m.file_pattern;
   j["material"] = m.material;
+  if (m.version >= kCaptureCoverageVersion) j["coverage"] = m.coverage;
   j["view_volume"] = {{"min", {m.view_volume.min.x, m.view_volume.min.y, m.view_volume.min.z}},
                       {"max", {m.view_volume.max.x, m.view_volume.max.y, m.view_volume.max.z}}};
   auto views = nlohmann::ordered_json::array();

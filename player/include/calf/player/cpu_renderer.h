@@ -134,6 +134,18 @@ struct RenderOptions {
   // weights), the bend >= 0 and finite.
   double mixed_texel_penalty = 3;
   double mixed_texel_bend_texels = 5;
+  // Coverage (views that carry it, format/CAPTURE.md "Coverage"): where a point lies at or behind
+  // the surface a view's footprint test names, the view asks whether that front surface covers
+  // the point's direction at sub-texel precision; where it does not, the point is compared with
+  // the surface behind (the farthest of the bilinear taps outside the front cluster). 0: off;
+  // 1: the bilinear blend of the taps' front shares (1 - far for a front tap, near for a tap
+  // behind) against `coverage_threshold`; 2: the nearest texel's 4 x 4 cell mask; 3: that mask
+  // grown by one cell. The front cluster: taps within a relative depth `coverage_cluster` of the
+  // footprint's surface. Off by default: it lifts the spider's silhouettes but carves thin parts
+  // of turntable at 128² faces (docs/RENDERING.md "Coverage").
+  uint32_t coverage = 0;
+  double coverage_threshold = 0.5;
+  double coverage_cluster = 0.05;
   // Start each march where the first surface can be: no point nearer to view j's centre than
   // z_near_j can be behind its surface, so the march starts at max_j (z_near_j - |o - P_j|)
   // (over the active views, at least the ray's own start) and spends its steps beyond.

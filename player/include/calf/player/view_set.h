@@ -29,6 +29,15 @@
 
 namespace calf::player {
 
+// Per-texel coverage (format/CAPTURE.md "Coverage"): the shares of the texel's square whose first
+// surface lies nearer / farther than the texel's depth, and the 4 x 4 cell mask of the cells that
+// show the texel's own surface (bit 4 y + x for cell (x, y), x along the face's x). A view without
+// coverage answers (0, 0, all cells): every texel wholly its own surface.
+struct Coverage {
+  float near = 0, far = 0;
+  uint16_t mask = 0xFFFF;
+};
+
 // Per-texel material (paper 002 Sec. 6.1).
 struct Material {
   float reflect = 0;  // reflect weight in [0, 1]
@@ -48,6 +57,9 @@ class View {
   const LogDepthRange& range() const { return range_; }
   uint32_t face_size() const { return face_size_; }
   bool has_material() const { return !material_[0].empty(); }
+  bool has_coverage() const { return !coverage_[0].empty(); }
+  // Gives the view coverage faces (all texels wholly their own surface) if it has none.
+  void add_coverage();
 
   // Texture updates: copy `rect` of `face` from `src`, whose rows are `src_stride` elements apart
   // (elements: floats for colour / material, codes for depth; a row of the rect holds
@@ -60,6 +72,10 @@ class View {
   Status write_depth_rect(CubeFace face, const PixelRect& rect, std::span<const uint16_t> src,
                           size_t src_stride = 0);
   Status write_material_rect(CubeFace face, const PixelRect& rect, std::span<const float> src,
+                             size_t src_stride = 0);
+  // Coverage rows hold 3 floats per texel: near share, far share, mask (an integer 0..65535).
+  // The first write gives the view coverage faces (add_coverage).
+  Status write_coverage_rect(CubeFace face, const PixelRect& rect, std::span<const float> src,
                              size_t src_stride = 0);
 
   // Whole faces, row-major, for filling and for reading back (face_size^2 * channels elements).
@@ -77,6 +93,10 @@ class View {
   }
   // (0, 0, 1) when the view has no material.
   Material material_at(CubeFace f, uint32_t x, uint32_t y) const;
+  Coverage coverage_at(CubeFace f, uint32_t x, uint32_t y) const {
+    if (!has_coverage()) return {};
+    return coverage_[cube_face_index(f)][texel_index(x, y)];
+  }
 
  private:
   View() = default;
@@ -90,6 +110,7 @@ class View {
   std::array<std::vector<float>, kCubeFaceCount> color_;
   std::array<std::vector<uint16_t>, kCubeFaceCount> depth_;
   std::array<std::vector<float>, kCubeFaceCount> material_;
+  std::array<std::vector<Coverage>, kCubeFaceCount> coverage_;
 };
 
 // The views one frame renders from. Views may differ in face size and depth range.

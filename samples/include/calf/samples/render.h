@@ -69,6 +69,12 @@ struct RenderOptions {
 // E177 when an option is outside its range.
 Status validate_render_options(const RenderOptions& options);
 
+// The relative depth within which a colour sample's first hit counts as the texel's own surface
+// for coverage: 2 texel angles (4 / face size; a surface at up to 76 degrees incidence stays
+// within it across the texel), at most 5 %.
+float coverage_tolerance(uint32_t face_size);
+inline constexpr uint32_t kCoverageCells = 4;  // cells per texel side
+
 // Rays traced (primary, shadow, AO, secondary) and wall time, for Mrays/s.
 struct RenderStats {
   uint64_t rays = 0;
@@ -95,8 +101,14 @@ class FrameTracer {
   // channels when `with_material`). `view` and `frame` only seed random numbers. Each texel's
   // centre ray (depth, material; the colour when spp is 1) is calf::direction_from_texel(face, x,
   // y, face_size); colour samples lie in its square, calf::direction_from_texel_coord.
+  // `with_coverage`: also the coverage channels (format/CAPTURE.md "Coverage") from the first
+  // hits of cell rays: a cell shows the texel's surface when its first hit is within a
+  // relative depth of coverage_tolerance(face_size) of the centre ray's (both sky, or both not),
+  // else nearer or farther. Coverage takes 16 intersection rays per texel, at the centres of a
+  // 4 x 4 grid of cells over the texel's square.
   RenderStats render_cube(const Vec3& center, uint32_t view, uint32_t frame, uint32_t face_size,
-                          bool with_material, capture::ViewFrame* out) const;
+                          bool with_material, capture::ViewFrame* out,
+                          bool with_coverage = false) const;
 
   // Renders one perspective ground-truth image (the camera convention of eye_path.h).
   RenderStats render_perspective(const capture::EyePose& pose, uint32_t width, uint32_t height,
@@ -122,6 +134,7 @@ class FrameTracer {
 // the scene from every viewpoint of `rig`.
 struct CaptureRequest {
   uint32_t face_size = 256;  // 1..4096
+  bool coverage = false;     // write the coverage channels (manifest version 2)
   uint32_t frames = 0;       // 0: scene.frame_count; else 1..100000
   Rig rig;
   RenderOptions render;

@@ -6,6 +6,9 @@
 //   R, G, B                      linear colour, half float (HDR values kept)
 //   Z                            radial depth from the viewpoint centre, float; +inf = sky
 //   material.reflect/refract/ior optional (manifest "material": true), half float
+//   coverage.near/far            optional (manifest version 2, "coverage": true), half float: the
+//                                share of the texel's square whose first surface lies nearer /
+//                                farther than the texel's depth (CAPTURE.md "Coverage")
 // The manifest is written last, so a set without one is incomplete by definition: a renderer that
 // fails half-way never leaves a set that looks complete.
 //
@@ -33,6 +36,8 @@ inline constexpr uint32_t kMaxViewpoints = 4096;
 // The largest face a capture set may use (the container's kMaxFaceSize, calf/format/grid.h).
 inline constexpr uint32_t kMaxCaptureFaceSize = 16384;
 inline constexpr uint32_t kCaptureFormatVersion = 1;
+// Version 2 adds the optional coverage channels; a set without them is written as version 1.
+inline constexpr uint32_t kCaptureCoverageVersion = 2;
 inline constexpr const char* kManifestFileName = "manifest.json";
 inline constexpr const char* kDefaultFilePattern = "view{view:03}_frame{frame:05}.exr";
 
@@ -61,6 +66,8 @@ struct CaptureManifest {
   std::string file_pattern = kDefaultFilePattern;
   // Whether every image has the three material channels.
   bool material = false;
+  // Whether every image has the two coverage channels (version 2 only).
+  bool coverage = false;
   // Informative: the scene and program that made the set ("" when absent).
   std::string scene;
   std::string generator;
@@ -81,16 +88,22 @@ std::string capture_file_name(const CaptureManifest& manifest, uint32_t view, ui
 // The pixels of one view-frame: six N x N faces, face-major then row-major, exactly the order of
 // the image's vertical strip. Texel (face, x, y) is element texel_index(face, x, y) of depth and
 // element 3 * texel_index(...) + c of color (c = R, G, B) and of material (c = reflect, refract,
-// ior). The caller owns it; the reader resizes it only when face size or material change.
+// ior) and element 2 * texel_index(...) + c of coverage (c = near, far). The caller owns it; the
+// reader resizes it only when face size, material or coverage change.
 struct ViewFrame {
   uint32_t face_size = 0;
   bool has_material = false;
+  bool has_coverage = false;
   std::vector<float> color;     // 3 per texel, linear RGB, >= 0 and finite
   std::vector<float> depth;     // 1 per texel, radial distance > 0, or +inf for sky
   std::vector<float> material;  // 3 per texel when has_material, else empty
+  // 2 per texel when has_coverage, else empty: the shares of the texel's square (a box over its
+  // face coordinates) whose first surface lies nearer than `depth` and farther than it (or is
+  // sky), each in [0, 1], summing to at most 1; the rest is the surface `depth` names.
+  std::vector<float> coverage;
 
   // Sizes the buffers for faces of `face_size` texels (contents unspecified).
-  void resize(uint32_t face_size, bool with_material);
+  void resize(uint32_t face_size, bool with_material, bool with_coverage = false);
   size_t texel_count() const { return size_t{6} * face_size * face_size; }
   size_t texel_index(CubeFace face, uint32_t x, uint32_t y) const {
     return (static_cast<size_t>(cube_face_index(face)) * face_size + y) * face_size + x;
@@ -99,7 +112,8 @@ struct ViewFrame {
 
 // Checks every pixel of a view-frame: depth classified by calf/format/log_depth.h (NaN, -inf and
 // values <= 0 are errors, +inf is sky), colour finite and >= 0, material weights in [0, 1] with
-// reflect + refract <= 1 and IOR finite and > 0. Errors (E137/E138/E139) name face, x and y;
+// reflect + refract <= 1 and IOR finite and > 0, coverage shares in [0, 1] summing to <= 1 (E197).
+// Errors (E137/E138/E139/E197) name face, x and y;
 // `context` (a file name) prefixes them.
 Status validate_view_frame(const ViewFrame& frame, std::string_view context);
 
