@@ -88,8 +88,8 @@ std::string capture_file_name(const CaptureManifest& manifest, uint32_t view, ui
 // The pixels of one view-frame: six N x N faces, face-major then row-major, exactly the order of
 // the image's vertical strip. Texel (face, x, y) is element texel_index(face, x, y) of depth and
 // element 3 * texel_index(...) + c of color (c = R, G, B) and of material (c = reflect, refract,
-// ior) and element 2 * texel_index(...) + c of coverage (c = near, far). The caller owns it; the
-// reader resizes it only when face size, material or coverage change.
+// ior) and element 3 * texel_index(...) + c of coverage (c = near, far, mask). The caller owns
+// it; the reader resizes it only when face size, material or coverage change.
 struct ViewFrame {
   uint32_t face_size = 0;
   bool has_material = false;
@@ -97,9 +97,10 @@ struct ViewFrame {
   std::vector<float> color;     // 3 per texel, linear RGB, >= 0 and finite
   std::vector<float> depth;     // 1 per texel, radial distance > 0, or +inf for sky
   std::vector<float> material;  // 3 per texel when has_material, else empty
-  // 2 per texel when has_coverage, else empty: the shares of the texel's square (a box over its
+  // 3 per texel when has_coverage, else empty: the shares of the texel's square (a box over its
   // face coordinates) whose first surface lies nearer than `depth` and farther than it (or is
-  // sky), each in [0, 1], summing to at most 1; the rest is the surface `depth` names.
+  // sky), each in [0, 1], summing to at most 1 (the rest is the surface `depth` names), and the
+  // 4 x 4 cell mask of format/CAPTURE.md "Coverage" as an integer 0..65535.
   std::vector<float> coverage;
 
   // Sizes the buffers for faces of `face_size` texels (contents unspecified).
@@ -112,9 +113,9 @@ struct ViewFrame {
 
 // Checks every pixel of a view-frame: depth classified by calf/format/log_depth.h (NaN, -inf and
 // values <= 0 are errors, +inf is sky), colour finite and >= 0, material weights in [0, 1] with
-// reflect + refract <= 1 and IOR finite and > 0, coverage shares in [0, 1] summing to <= 1 (E197).
-// Errors (E137/E138/E139/E197) name face, x and y;
-// `context` (a file name) prefixes them.
+// reflect + refract <= 1 and IOR finite and > 0, coverage shares in [0, 1] summing to <= 1 and an
+// integer mask 0..65535 (E136). Errors (E137/E138/E139/E136) name face, x and y; `context` (a file
+// name) prefixes them.
 Status validate_view_frame(const ViewFrame& frame, std::string_view context);
 
 // Reads a capture set one view-frame at a time. Movable, not copyable; no shared state, so
