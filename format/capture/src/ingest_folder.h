@@ -6,6 +6,8 @@
 #include <system_error>
 #include <vector>
 
+#include "calf/capture/capture_set.h"
+
 namespace calf::capture::detail {
 
 // `dir` and those of its parents that do not exist yet, deepest first: what creating `dir` makes.
@@ -30,6 +32,18 @@ inline void remove_empty_folders(const std::vector<std::filesystem::path>& folde
     if (!std::filesystem::is_empty(dir, ec) || ec) break;
     std::filesystem::remove(dir, ec);
   }
+}
+
+// Creates an ingest's capture-set writer in `out_dir`, recording in `created` the folders that
+// makes (for remove_empty_folders when the ingest fails later); when creating the writer fails,
+// those folders are removed at once.
+inline Expected<CaptureSetWriter> create_ingest_writer(
+    const std::filesystem::path& out_dir, const CaptureManifest& manifest,
+    std::vector<std::filesystem::path>* created) {
+  *created = missing_folders(out_dir);
+  Expected<CaptureSetWriter> writer = CaptureSetWriter::create(out_dir, manifest);
+  if (!writer.ok()) remove_empty_folders(*created);
+  return writer;
 }
 
 }  // namespace calf::capture::detail

@@ -328,13 +328,9 @@ Status ingest_seurat(const std::filesystem::path& manifest_path,
         m.face_size, options.max_image_pixels, 6));
   }
   // A failed ingest removes the folders it created (remove_empty_folders after abandon()).
-  const std::vector<std::filesystem::path> created = detail::missing_folders(out_dir);
-  Expected<CaptureSetWriter> created_writer = CaptureSetWriter::create(out_dir, m);
-  if (!created_writer.ok()) {
-    detail::remove_empty_folders(created);
-    return created_writer.status();
-  }
-  CaptureSetWriter writer = std::move(*created_writer);
+  std::vector<std::filesystem::path> created;
+  CALF_ASSIGN_OR_RETURN(CaptureSetWriter writer,
+                        detail::create_ingest_writer(out_dir, m, &created));
 
   ViewFrame frame;
   frame.resize(m.face_size, false);
