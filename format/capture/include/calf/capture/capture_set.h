@@ -9,6 +9,8 @@
 //   coverage.near/far            optional (manifest version 2, "coverage": true), half float: the
 //                                share of the texel's square whose first surface lies nearer /
 //                                farther than the texel's depth (CAPTURE.md "Coverage")
+//   coverage.mask                optional (with coverage), float holding an integer 0..65535: the
+//                                4 x 4 cells of the texel that show its own surface
 // The manifest is written last, so a set without one is incomplete by definition: a renderer that
 // fails half-way never leaves a set that looks complete.
 //
@@ -66,7 +68,7 @@ struct CaptureManifest {
   std::string file_pattern = kDefaultFilePattern;
   // Whether every image has the three material channels.
   bool material = false;
-  // Whether every image has the two coverage channels (version 2 only).
+  // Whether every image has the three coverage channels (version 2 only).
   bool coverage = false;
   // Informative: the scene and program that made the set ("" when absent).
   std::string scene;
