@@ -28,6 +28,9 @@ PACKAGES=(
   # tests and benchmarks; clang + its runtime for the libFuzzer run of tools/test.sh; clang-format
   # for the style check
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev clang-format
+  # the clean-room conformance reader (tests/conformance/clean_room/calf_clean_room.py): Python
+  # with its zstd and xxHash bindings, so that it reads the clips without calf
+  python3 python3-zstandard python3-xxhash
   # measurement peers and plots
   ffmpeg zstd xz-utils gnuplot-nox
   # sharded pipeline (docs/FARM.md): the single-node Slurm of tests/cli/slurm_pipeline.sh, GNU
