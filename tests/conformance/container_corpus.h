@@ -5,6 +5,8 @@
 // (container_conformance_test.cc, RunnerXxx tests) reads only the committed data and manifest.
 #pragma once
 
+#include <xxhash.h>
+
 #include <algorithm>
 #include <cstdint>
 #include <span>
@@ -119,10 +121,13 @@ inline Parts take_apart(const Bytes& file) {
 
 // `bytes` as one zstd frame (RFC 8878) of Raw_Blocks, built by hand so that the corpus never
 // depends on a compressor's version: Frame_Header_Descriptor 0xE0 (Single_Segment, an 8-byte
-// Frame_Content_Size, no checksum, no dictionary), `content_size` (normally bytes.size()), then
-// blocks of at most 128 KiB, each with its 3-byte header (Last_Block, Block_Type 0, size).
-inline Bytes raw_zstd_frame(std::span<const uint8_t> bytes, uint64_t content_size) {
-  Bytes f = {0x28, 0xB5, 0x2F, 0xFD, 0xE0};
+// Frame_Content_Size, no dictionary), `content_size` (normally bytes.size()), then blocks of at
+// most 128 KiB, each with its 3-byte header (Last_Block, Block_Type 0, size). With
+// `content_checksum` the descriptor is 0xE4 (Content_Checksum_flag) and the frame ends with the
+// low 32 bits of XXH64(bytes, seed 0), little-endian.
+inline Bytes raw_zstd_frame(std::span<const uint8_t> bytes, uint64_t content_size,
+                            bool content_checksum = false) {
+  Bytes f = {0x28, 0xB5, 0x2F, 0xFD, static_cast<uint8_t>(content_checksum ? 0xE4 : 0xE0)};
   for (int i = 0; i < 8; ++i) f.push_back(static_cast<uint8_t>(content_size >> (8 * i)));
   size_t at = 0;
   do {
@@ -134,6 +139,10 @@ inline Bytes raw_zstd_frame(std::span<const uint8_t> bytes, uint64_t content_siz
              bytes.begin() + static_cast<std::ptrdiff_t>(at + n));
     at += n;
   } while (at < bytes.size());
+  if (content_checksum) {
+    const auto sum = static_cast<uint32_t>(XXH64(bytes.data(), bytes.size(), 0));
+    for (int i = 0; i < 4; ++i) f.push_back(static_cast<uint8_t>(sum >> (8 * i)));
+  }
   return f;
 }
 

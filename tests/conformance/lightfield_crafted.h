@@ -10,8 +10,6 @@
 // it (tests/decoder/lightfield_crafted_test.cc) includes it; the runners read only the files.
 #pragma once
 
-#include <xxhash.h>
-
 #include <algorithm>
 #include <cstdint>
 #include <span>
@@ -25,6 +23,7 @@
 #include "calf/format/container_io.h"
 #include "calf/format/grid.h"
 #include "calf/format/lightfield_layout.h"
+#include "container_corpus.h"
 
 namespace calf::conformance::crafted {
 
@@ -132,27 +131,6 @@ inline void bc1_block(uint32_t i, Rng& rng, uint8_t* block) {
       std::fill(block + 4, block + 8, uint8_t{0x1B});
     }
   }
-}
-
-// `bytes` as one zstd frame (RFC 8878) of Raw_Blocks with a **content checksum**: Frame_Header_
-// Descriptor 0xE4 (Single_Segment, 8-byte Frame_Content_Size, Content_Checksum_flag), blocks of at
-// most 128 KiB, then the low 32 bits of XXH64(bytes, seed 0), little-endian.
-inline Bytes checksummed_zstd_frame(std::span<const uint8_t> bytes) {
-  Bytes f = {0x28, 0xB5, 0x2F, 0xFD, 0xE4};
-  for (int i = 0; i < 8; ++i) f.push_back(static_cast<uint8_t>(uint64_t{bytes.size()} >> (8 * i)));
-  size_t at = 0;
-  do {
-    const size_t n = std::min<size_t>(bytes.size() - at, size_t{1} << 17);
-    const bool last = at + n == bytes.size();
-    const uint32_t header = (static_cast<uint32_t>(n) << 3) | (last ? 1u : 0u);
-    for (int i = 0; i < 3; ++i) f.push_back(static_cast<uint8_t>(header >> (8 * i)));
-    f.insert(f.end(), bytes.begin() + static_cast<std::ptrdiff_t>(at),
-             bytes.begin() + static_cast<std::ptrdiff_t>(at + n));
-    at += n;
-  } while (at < bytes.size());
-  const auto sum = static_cast<uint32_t>(XXH64(bytes.data(), bytes.size(), 0));
-  for (int i = 0; i < 4; ++i) f.push_back(static_cast<uint8_t>(sum >> (8 * i)));
-  return f;
 }
 
 // One crafted clip's parameters.
@@ -333,8 +311,10 @@ inline Expected<Bytes> make_clip(const ClipSpec& s) {
   auto add = [&](const ChunkKeys& k, const Bytes& raw, bool checksummed) -> Status {
     Expected<uint32_t> id =
         checksummed
-            ? w.add_stored_chunk(k, container::StoredChunk{container::Compression::kZstd,
-                                                           raw.size(), checksummed_zstd_frame(raw)})
+            ? w.add_stored_chunk(
+                  k,
+                  container::StoredChunk{container::Compression::kZstd, raw.size(),
+                                         container::corpus::raw_zstd_frame(raw, raw.size(), true)})
             : w.add_chunk(k, raw, container::Compression::kNone);
     if (!id.ok()) return id.status();
     if (s.chunk_flags_and_checksums && lf_chunks % 3 == 1) flagged.push_back(*id);
