@@ -415,16 +415,17 @@ inline Expected<uint16_t> add_mesh_track(container::Writer& w, Chunks& chunks, c
 // a prototype with every flag (normals, colours, triangle materials naming every material and
 // the object's, UVs) and 2 vertex states, a prototype drawing its triangles with UVs only, an
 // empty prototype (no vertex, no triangle), a prototype with colours and 1 state; objects with a
-// subset of two runs and per-frame transforms, all triangles, an empty subset, the empty
-// prototype; textures 5 x 3 MED-coded, 1 x 1 and 4 x 2 plain, materials with a texture, none and
-// the last texture; track 2 a layout-1 mesh of one prototype and one object.
+// subset of two runs (the first after a gap, the last ending at the last triangle) and per-frame
+// transforms, with all triangles, with an empty subset, and of the empty prototype; textures
+// 5 x 3 MED-coded, 1 x 1 and 4 x 2 plain, materials with a texture, none and the last texture;
+// track 2 a layout-1 mesh of one prototype and one object.
 inline MeshSpec rich_mesh() {
   MeshSpec s;
   s.frames = 3;
   s.material_textures = {0, 0xFFFFFFFFu, 2};
   s.texture_sizes = {5, 3, 0, 1, 1, 1, 4, 2, 1};
-  s.prototypes = {{5, 3, 15, 2, 0}, {5, 3, 12, 0, 0}, {0, 0, 0, 0, 2}, {4, 2, 2, 1, 3}};
-  s.objects = {{0, 0, 3, 0, {0, 2}}, {1, 1, 1, 1, {}}, {3, 2, 3, 0, {}}, {2, 0, 1, 1, {}}};
+  s.prototypes = {{5, 5, 15, 2, 0}, {5, 5, 12, 0, 0}, {0, 0, 0, 0, 2}, {4, 2, 2, 1, 3}};
+  s.objects = {{0, 0, 3, 0, {1, 3, 4}}, {1, 1, 1, 1, {}}, {3, 2, 3, 0, {}}, {2, 0, 1, 1, {}}};
   return s;
 }
 inline MeshSpec small_mesh(uint32_t prototypes) {
@@ -528,17 +529,17 @@ inline Status add_surfels_track(container::Writer& w, Chunks& chunks, uint32_t m
   return Status::Ok();
 }
 
-// crafted_levels_multi: track 0 surfels (prototypes of 2500 surfels: 3 levels, colour is base;
-// 1024: exactly one level, a box flat in y; 0; 1025: a level of one surfel, a negative box) and
-// track 2 surfels (1, 0, 3 and 2 surfels), both naming the mesh track 1 that follows track 0 (4
-// prototypes).
+// crafted_levels_multi: track 0 surfels (prototypes of 3100 surfels: 3 levels, the last of 1052, so
+// levels double, colour is base; 1024: exactly one level, a box flat in y; 0; 1025: a level of one
+// surfel, a negative box) and track 2 surfels (1, 0, 3 and 2 surfels), both naming the mesh track 1
+// that follows track 0 (4 prototypes).
 inline Expected<Bytes> make_surfels_clip() {
   Bytes file;
   CALF_ASSIGN_OR_RETURN(container::Writer w, plain_writer(&file));
   CALF_RETURN_IF_ERROR(w.set_metadata("calf.conformance", "crafted crafted_levels_multi"));
   Chunks chunks{w, 0, {}};
   Rng rng{0x5E4F};
-  const std::vector<SurfelsProto> a = {{2500, 1, {-1.5f, -2.0f, 0.25f}, {3.0f, 2.0f, 0.75f}},
+  const std::vector<SurfelsProto> a = {{3100, 1, {-1.5f, -2.0f, 0.25f}, {3.0f, 2.0f, 0.75f}},
                                        {1024, 0, {-1.0f, 0.5f, -1.0f}, {1.0f, 0.5f, 1.0f}},
                                        {0, 0, {0, 0, 0}, {0, 0, 0}},
                                        {1025, 0, {-9.0f, -8.5f, -7.0f}, {-8.0f, -8.25f, -6.5f}}};
