@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Reproduces docs/SURFELS.md "Measured on the factory" (issue 20's playback acceptance): export the
+# Reproduces docs/SURFELS.md "Measured on the factory" (the playback acceptance): export the
 # factory, ray-cast its surfel candidates, build the surfel clip and the full-mesh clip, write a
 # walk at ground level, then
 #   1. play the surfels against the full mesh along the walk at each point size of SIZES

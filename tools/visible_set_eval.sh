@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Reproduces docs/VISIBILITY.md "Measured" (issue 19's acceptance on real runs): for each scene,
+# Reproduces docs/VISIBILITY.md "Measured" (the acceptance on real runs): for each scene,
 # export it as a scene file, encode the full scene and its visible set (calf-encode --mode mesh
 # [--visible-set]), write a walk trace inside the view region (the scene's validation eye path,
 # see below), play the visible set against the full scene along it (calf-play --headless

@@ -312,7 +312,7 @@ static int command_main(int argc, char** argv) {
   bool fixed_groups = false;
   app.add_flag("--depth-fixed-groups", fixed_groups,
                "one depth / material chunk per K frames even where a tile does not change (the "
-               "layout of writers before issue 17); default off: a tile unchanged over whole "
+               "layout without static groups); default off: a tile unchanged over whole "
                "groups of K frames keeps one chunk, one keyframe, across them (SPEC 11.1.2)");
   std::string colour_rdo = "auto";
   app.add_option(
@@ -330,7 +330,7 @@ static int command_main(int argc, char** argv) {
   std::string bc1_fit = "cluster";
   app.add_option("--bc1-fit", bc1_fit,
                  "how BC1 colour blocks are fitted: range (libsquish's range fit, the fastest; "
-                 "the encoder before stop 38), refined (range fit, then least-squares endpoints "
+                 "the least accurate), refined (range fit, then least-squares endpoints "
                  "for its indices: +0.1 dB for ~1.3x the BC1 encode time) or cluster (libsquish's "
                  "cluster fit: +0.2-0.3 dB for 1.1-2.6x the encode time) (docs/ENCODER.md \"BC1 "
                  "fit\") (default cluster)")

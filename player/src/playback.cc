@@ -6,9 +6,7 @@
 
 #include "calf/capture/eye_path.h"
 #include "calf/format/container.h"
-#include "calf/player/mesh_representation.h"
-#include "calf/player/surfel_representation.h"
-#include "calf/player/tiles_representation.h"
+#include "kind_table.h"
 
 namespace calf::player {
 
@@ -35,39 +33,25 @@ Expected<std::unique_ptr<Playback>> Playback::open(const std::string& clip_path,
   CALF_ASSIGN_OR_RETURN(container::Reader reader, container::Reader::open(clip_path));
   impl->reader = std::make_unique<container::Reader>(std::move(reader));
   const RenderBackend backend = options.use_gl ? RenderBackend::kGl : RenderBackend::kCpu;
-  // A surfels track plays its paired mesh track itself (near objects as meshes): that mesh track
-  // is not opened again.
-  std::vector<bool> played_by_surfels(impl->reader->tracks().size(), false);
-  for (size_t t = 0; t < impl->reader->tracks().size(); ++t) {
-    if (!std::holds_alternative<container::SurfelsTrackHeader>(impl->reader->tracks()[t].header)) {
-      continue;
-    }
-    CALF_ASSIGN_OR_RETURN(std::unique_ptr<SurfelRepresentation> surfels,
-                          SurfelRepresentation::open(*impl->reader, static_cast<uint16_t>(t),
-                                                     options.surfels, backend, gl));
-    played_by_surfels[surfels->mesh_track()] = true;
-    impl->owned.push_back(std::move(surfels));
-  }
-  // The track kinds calf can play, one case each (representation.h: "Adding a representation").
-  for (size_t t = 0; t < impl->reader->tracks().size(); ++t) {
-    const auto& header = impl->reader->tracks()[t].header;
-    if (played_by_surfels[t]) continue;
-    if (std::holds_alternative<container::LightfieldTrackHeader>(header)) {
-      CALF_ASSIGN_OR_RETURN(std::unique_ptr<LightfieldRepresentation> lf,
-                            LightfieldRepresentation::open(*impl->reader, static_cast<uint16_t>(t),
-                                                           options.lightfield, backend, gl));
-      if (impl->lightfield == nullptr) impl->lightfield = lf.get();
-      impl->owned.push_back(std::move(lf));
-    } else if (std::holds_alternative<container::MeshTrackHeader>(header)) {
-      CALF_ASSIGN_OR_RETURN(std::unique_ptr<MeshRepresentation> mesh,
-                            MeshRepresentation::open(*impl->reader, static_cast<uint16_t>(t),
-                                                     options.mesh, backend, gl));
-      impl->owned.push_back(std::move(mesh));
-    } else if (std::holds_alternative<container::TilesTrackHeader>(header)) {
-      CALF_ASSIGN_OR_RETURN(std::unique_ptr<TilesRepresentation> tiles,
-                            TilesRepresentation::open(*impl->reader, static_cast<uint16_t>(t),
-                                                      options.tiles, backend, gl));
-      impl->owned.push_back(std::move(tiles));
+  // Each track through its kind's entry in the player table (kind_table.h). The kinds whose
+  // representation plays other tracks too (a surfels track its paired mesh track) are opened
+  // first, in track order; then the others, in track order, but for the tracks already played.
+  const auto& tracks = impl->reader->tracks();
+  std::vector<bool> claimed(tracks.size(), false);
+  for (const bool first_pass : {true, false}) {
+    for (size_t t = 0; t < tracks.size(); ++t) {
+      const PlayerKind* kind = find_player_kind(tracks[t].record.kind);
+      if (kind == nullptr || kind->claims_tracks != first_pass || claimed[t]) continue;
+      CALF_ASSIGN_OR_RETURN(
+          OpenedRepresentation opened,
+          kind->open(*impl->reader, static_cast<uint16_t>(t), options, backend, gl));
+      for (const uint16_t other : opened.claimed_tracks) {
+        if (other < claimed.size()) claimed[other] = true;
+      }
+      if (impl->lightfield == nullptr && kind->kind == container::TrackKind::kLightfield) {
+        impl->lightfield = static_cast<LightfieldRepresentation*>(opened.representation.get());
+      }
+      impl->owned.push_back(std::move(opened.representation));
     }
   }
   if (impl->owned.empty()) {

@@ -1,4 +1,4 @@
-// The "factory" scene (issue 20, the surfel mode's heavy scene): a machine hall of 72 m x 72 m
+// The "factory" scene (the surfel mode's heavy scene): a machine hall of 72 m x 72 m
 // whose rows of machines are built from a handful of detailed CAD-like parts (factory_parts.h),
 // each part made once and instanced thousands of times with rigid transforms. Counting
 // instances it is about 30 M triangles, far more than a rasteriser on llvmpipe draws at

@@ -12,7 +12,7 @@ Scene city_scene();
 Scene blades_scene();
 // spheres_scene.cc: analytic spheres bouncing on a floor among walls and pillars.
 Scene spheres_scene();
-// factory_scene.cc (the surfel mode, issue 20): a machine hall of instanced CAD-like parts.
+// factory_scene.cc (the surfel mode): a machine hall of instanced CAD-like parts.
 Scene factory_scene();
 
 }  // namespace calf::samples

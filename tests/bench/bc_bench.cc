@@ -337,7 +337,7 @@ int main(int argc, char** argv) {
     if (row.f == Format::kBc1 && row.q == 0 && !row.refine) std::copy(mean, mean + 2, bc1_range);
     if (row.f == Format::kBc7) std::copy(mean, mean + 2, bc7[row.q]);
   }
-  // Issue 4 acceptance: BC7 at least 3 dB above BC1 range fit on the LDR set.
+  // Acceptance: BC7 at least 3 dB above BC1 range fit on the LDR set.
   for (int g = 0; g < 2; ++g) {
     const bool present = std::any_of(ldr.begin(), ldr.end(),
                                      [&](const Ldr& i) { return group_index(i.group) == g; });

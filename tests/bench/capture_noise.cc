@@ -1,4 +1,4 @@
-// The noise floor and cost of calf-capture's rendering (issue 16; docs/RENDERING.md "Converged
+// The noise floor and cost of calf-capture's rendering (docs/RENDERING.md "Converged
 // capture"): renders one frame of a built-in scene, every viewpoint of its default rig (cube
 // maps) or the first poses of its validation eye path (ground truth), twice with two seeds, and
 // prints the PSNR / SSIM between the two renders (image_compare.h: sRGB-encoded, clamped; cube

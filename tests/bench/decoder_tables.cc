@@ -21,7 +21,7 @@
 //   image per frame), encoded losslessly with FFV1 and with x265, and the time ffmpeg takes to
 //   decode them per frame (process start-up included and reported apart).
 //
-// The limit beside every decode figure (issue 17): the time to read and decompress just the chunks
+// The limit beside every decode figure: the time to read and decompress just the chunks
 //   the frame used (FrameUpdates::chunks, each time it was used) plus a memcpy of the frame's
 //   update bytes. The decoder runs on one thread by default (no background prefetch), so its time
 //   holds every decompression it does.

@@ -1,4 +1,4 @@
-// Decode cost of a clip's depth stream (issue 17: predicted depth must not make decoding much
+// Decode cost of a clip's depth stream (predicted depth must not make decoding much
 // slower than raw16): for every depth chunk of the first lightfield track, the time to
 // decompress its stored bytes (zstd / LZMA2, held in memory: no file I/O), then the time to turn
 // every rectangle into GPU-ready codes (lf::parse_region_chunk + lf::region_rect_gpu_bytes: the

@@ -23,7 +23,7 @@
 //     bits each), so each channel is a coarse, smooth copy of the depth rather than noisy low
 //     bits. The channels are coded as the Y, U, V planes of yuv444p with -x265-params lossless=1
 //     (no colour conversion happens: the input already is yuv444p).
-// Colour (issue 9): frames of W x H 8-bit sRGB (rgb24, interleaved). x265 at the CRF that brings
+// Colour: frames of W x H 8-bit sRGB (rgb24, interleaved). x265 at the CRF that brings
 //   the mean per-frame PSNR (RGB, peak 255, each frame capped at 100 dB so that an exact frame
 //   does not make the mean infinite) within `tolerance_db` of a target, found by bisection of the
 //   CRF over [0, 51]; pixel format yuv444p by default (no chroma subsampling: the strongest

@@ -8,7 +8,7 @@
 //
 // With --depth-format pred16 (pred16m) the depth column is the predicted coding (format r16p,
 // r16pm). Unless the
-// run is the encoder before issue 17 itself (raw16 and --depth-fixed-groups), one more zstd encode
+// run is the encoder without predicted depth (raw16 and --depth-fixed-groups), one more zstd encode
 // with raw16 depth and one chunk per K frames gives those depth bytes beside it, "today's" of the
 // issue. --no-colour-peers skips the colour peers (most of the run's time on noisy colour) when
 // only depth is being measured; --no-lzma2 skips the LZMA2 encode.
@@ -243,7 +243,7 @@ int run_one(const fs::path& dir, const Run& run) {
     failed = r.status();
     if (r.ok()) x = *r;
   }
-  // The depth bytes of the encoder before issue 17 (raw16, one chunk per K frames).
+  // The depth bytes without predicted depth or static groups (raw16, one chunk per K frames).
   std::optional<EncodeRun> before;
   if (failed.ok() && (run.depth != DepthCoding::kRaw16 || merge)) {
     auto r = encode(dir, tmp / "before.calf",
@@ -326,8 +326,7 @@ int run_one(const fs::path& dir, const Run& run) {
   row("+zstd (level 19, per chunk)", s.colour.stored, s.depth.stored);
   row("+LZMA2 (preset 6, per chunk)", lz(sx.colour.stored), lz(sx.depth.stored));
   if (before) {
-    row("+zstd, depth raw16, one chunk per K frames (before issue 17)", {},
-        before->stats.depth.stored);
+    row("+zstd, depth raw16, one chunk per K frames", {}, before->stats.depth.stored);
   }
   row("peer: `zstd -19` of raw", zs_c.size, zs_d.size);
   row("peer: `xz -9` of raw", xz_c.size, xz_d.size);
@@ -351,7 +350,7 @@ int run_one(const fs::path& dir, const Run& run) {
     return b && *b ? fmt::format("{:.2f}×", static_cast<double>(a) / static_cast<double>(*b))
                    : std::string("—");
   };
-  fmt::print("- depth +zstd: {} of `xz -9` of raw, {} of the encoder before issue 17\n",
+  fmt::print("- depth +zstd: {} of `xz -9` of raw, {} of depth raw16 in chunks of K frames\n",
              times(s.depth.stored, xz_d.size),
              times(s.depth.stored,
                    before ? std::optional<uint64_t>(before->stats.depth.stored) : std::nullopt));

@@ -1,5 +1,5 @@
 // Reconstruction quality of the CPU reference renderer (paper 002 Alg. 4, plain and RR) on a
-// capture set read directly (uncompressed), against ground truth (issue 8; docs/RENDERING.md
+// capture set read directly (uncompressed), against ground truth (docs/RENDERING.md
 // "Quality"). Three measurements, each per pose and as means:
 //
 //   between   the poses of a ground-truth eye path (calf-capture --ground-truth): inside the view
@@ -459,7 +459,7 @@ std::vector<uint32_t> parse_list(const std::string& text) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Reconstruction quality of the CPU renderer on a capture set (issue 8).",
+  CLI::App app{"Reconstruction quality of the CPU renderer on a capture set.",
                "bench-player_quality"};
   std::string capture_dir, eye_path_file, vp_gt_file, write_vp_file, out_dir, poses_arg;
   std::string variants_arg = "plain,rr", active_arg;

@@ -11,7 +11,7 @@
 //   plane  a --candidates grid on the unit square (flat; spacing known: 1 / sqrt(n) for n
 //          surfels ideally)
 //
-// Limits beside the figures (issue 20): the sampler >= 50x faster than the exact permutation at
+// Limits beside the figures: the sampler >= 50x faster than the exact permutation at
 // 10k surfels; its r_min / r_max within 10 % of the exact one's.
 // Times: the median of --repeats runs (exact: one run, it takes seconds), wall clock and process
 // CPU time with --threads workers (the exact permutation is the only parallel part).

@@ -273,7 +273,7 @@ TEST_F(CaptureSetTest, HeaderDeclaringMoreRowsThanTheFileHolds) {
 }
 
 // A PNG (or any other image) named .exr never reaches another format's decoder: it is refused by
-// its magic bytes, so that no library prints its own line (issue 22 item 13).
+// its magic bytes, so that no library prints its own line.
 TEST_F(CaptureSetTest, ImageOfAnotherFormatNamedExr) {
   write_set(false);
   auto out = OIIO::ImageOutput::create("png");

@@ -347,7 +347,7 @@ fs::path scratch(const std::string& name) {
   return p;
 }
 
-// The acceptance case of issue 21: EYE_Z, row-major matrices, Unity's face order, a separate
+// The acceptance case of calf-ingest: EYE_Z, row-major matrices, Unity's face order, a separate
 // depth EXR with channel R, sky cleared to 0. An exact cube map: every texel is a pixel copy.
 TEST(SeuratIngest, EyeZUnityOrderMatchesNativeCapture) {
   const fs::path dir = scratch("eye_z");

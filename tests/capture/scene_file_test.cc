@@ -203,7 +203,7 @@ TEST(SceneFile, ManifestIsReadableJson) {
   EXPECT_EQ(encoded->buffer.substr(0, 16), expected);
 }
 
-// The surfel mode's factory (issue 20): 20 M triangles counting instances. Instances share their
+// The surfel mode's factory: 20 M triangles counting instances. Instances share their
 // prototype, so the file holds one 20,000-triangle part and 1,000 transforms.
 TEST(SceneFile, InstancedTwentyMillionTriangles) {
   SceneFile s;

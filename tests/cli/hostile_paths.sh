@@ -1,5 +1,5 @@
 #!/bin/sh
-# Hostile paths and inputs given to the calf commands (issue 22), one case per run:
+# Hostile paths and inputs given to the calf commands, one case per run:
 #   hostile_paths.sh CASE BIN_DIR WORK_DIR CAPTURE_SET SOURCE_DIR
 # Each case builds its paths under WORK_DIR (emptied first), runs one calf command with its
 # stdout and stderr passed through, and exits with that command's status, so calf_add_cli_test

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 21's acceptance for calf-ingest, end to end on a built-in scene (interior, faces of 16,
+# The acceptance of calf-ingest, end to end on a built-in scene (interior, faces of 16,
 # one frame, ground truth 24 x 24):
 #  - the native capture, rewritten as a Seurat capture (EYE_Z and RAY_DEPTH, row-major matrices,
 #    Unity's face order, a separate depth EXR with channel R; tests/capture/foreign_from_capture),

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The sharded pipeline on a real Slurm (issue 21, docs/FARM.md): starts a private single-node
+# The sharded pipeline on a real Slurm (docs/FARM.md): starts a private single-node
 # Slurm on localhost (munged, slurmctld, slurmd from Debian's packages, configured in a temp dir
 # on free ports, run as root), submits tools/farm/slurm_submit.sh's job arrays (capture shards ->
 # join + analysis -> encode shards -> merge) on a small scene, and checks

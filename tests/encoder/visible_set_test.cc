@@ -1,7 +1,7 @@
 // Tests of the from-segment visibility builder and its from-point baseline
 // (encoder/include/calf/encoder/visible_set.h).
 //
-// The acceptance property (issue 19): on a segment, every primitive seen in a from-point ID buffer
+// The acceptance property: on a segment, every primitive seen in a from-point ID buffer
 // at >= 1000 random points of the segment is in the set, and every primitive of the set is seen
 // at some point of its interval. The first half uses the from-point baseline, itself checked
 // against an independent brute-force ray caster written here (Moller-Trumbore through

@@ -1,4 +1,4 @@
-// Numerical extremes of clip shape (issue 9): a clip of one frame; a depth window W at or beyond
+// Numerical extremes of clip shape: a clip of one frame; a depth window W at or beyond
 // the frame count; one rectangle per P-frame (A = 1); faces of 1 and 4 texels, a face that is not
 // a multiple of the cell size (20 with cells of 16), and 2048-texel faces. Each is encoded,
 // decoded by playing, seeking and wandering, compared with the capture it came from, and played.

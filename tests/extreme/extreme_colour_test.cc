@@ -1,4 +1,4 @@
-// Numerical extremes of colour (issue 9): HDR values up to 65504 (the largest half) and tiny
+// Numerical extremes of colour: HDR values up to 65504 (the largest half) and tiny
 // positives down to the smallest subnormal half (2^-24), through rgba16f (exact) and BC6H (within
 // the block codec's documented error); and cells whose reconstruction error is zero (constant
 // and black cells: PSNR +inf), which must neither break the keyframe search nor put a NaN in the

@@ -1,4 +1,4 @@
-// Shared helpers of the numerical-extremes tests (tests/extreme/, issue 9): hand-built capture
+// Shared helpers of the numerical-extremes tests (tests/extreme/): hand-built capture
 // sets in a temporary directory, encoding them with the real encoder, decoding every cell with the
 // view-dependent decoder into CpuTextures (as a GPU would hold them), player views from that
 // state, an OSMesa context shared by a test program, and the NaN / Inf checks every case makes.

@@ -1,4 +1,4 @@
-// Numerical extremes of depth (issue 9): a log-16 range from 1e-4 to 1e6 (ten decades, the
+// Numerical extremes of depth: a log-16 range from 1e-4 to 1e6 (ten decades, the
 // widest calf promises to code) and a flat scene whose every depth is equal (z_near == z_far
 // measured). Expected codes and depths are computed here from Eq. 13 in long double, never read
 // back from calf/format/log_depth.h.

@@ -1,4 +1,4 @@
-// Numerical extremes of emptiness (issue 9): a capture set whose every depth is +inf (sky
+// Numerical extremes of emptiness: a capture set whose every depth is +inf (sky
 // everywhere), and eyes that see nothing any view has data for: placed far outside the view
 // volume looking away from everything, inside geometry (behind every view's surface), with every
 // view abstaining, or with nothing decoded at all. Each renders the sky colour or a documented

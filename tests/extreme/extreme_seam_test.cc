@@ -1,4 +1,4 @@
-// Eye rays grazing a face seam and a cube corner (issue 9): the CPU renderer and the GL renderer
+// Eye rays grazing a face seam and a cube corner: the CPU renderer and the GL renderer
 // must return a finite colour taken from the texel that the tie-break rule of calf/format/cube.h
 // names ("the face of the first axis whose magnitude is the largest, in X, Y, Z order"), and, with
 // bilinear colour, the mix of the taps on both sides of the seam.

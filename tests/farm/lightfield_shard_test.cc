@@ -1,4 +1,4 @@
-// Sharded capture and encode (issue 21, docs/FARM.md; calf/encoder/lightfield_shard.h and
+// Sharded capture and encode (docs/FARM.md; calf/encoder/lightfield_shard.h and
 // calf/capture/capture_shard.h): on every built-in scene, clips merged from 1, 2 and 3 view
 // shards equal a one-machine encode byte for byte; frame-range shards equal a one-machine encode
 // with the same closed segment length; capture shards joined equal a one-machine capture; and the

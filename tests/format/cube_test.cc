@@ -171,7 +171,7 @@ TEST(CubeTest, EveryDirectionOnASphereMapsToATexelThatMapsBack) {
   }
 }
 
-// Upright faces (issue 21): a 90-degree camera looking along a face's major axis with the face's
+// Upright faces: a 90-degree camera looking along a face's major axis with the face's
 // up vector, through the one camera model (camera.h, upright and unmirrored), sees at pixel
 // (i, j) exactly what texel (N - 1 - i, j) holds; and the up / right table in cube.h is right.
 TEST(CubeUprightFace, CameraPixelIsMirroredTexel) {

@@ -43,9 +43,9 @@ struct PinCase {
   // CompressionOptions::compress_directory: the clips frozen before container 1.1 are 1.0 files
   // with a plain directory (their pins unchanged since); `*_zdir` clips are their 1.1 twins.
   bool compress_directory = false;
-  // LightfieldEncodeOptions::bc1_fit: the clips frozen before stop 38 used the range fit.
+  // LightfieldEncodeOptions::bc1_fit: the earlier frozen clips use the range fit.
   Bc1Fit bc1_fit = Bc1Fit::kRange;
-  // CompressionOptions::store_when_larger: the clips frozen before stop 38 keep zstd / LZMA2
+  // CompressionOptions::store_when_larger: the earlier frozen clips keep zstd / LZMA2
   // chunks that are larger than their raw bytes.
   bool store_when_larger = false;
 };
@@ -58,30 +58,30 @@ const PinCase kCases[] = {
     {"rgba8_raw16_none",   {.face = 8, .frames = 4, .views = 1},                    ColourCoding::kRgba8,   DepthCoding::kRaw16, container::Compression::kNone,  "26f6acc8e30259fa"},
     {"rgba16f_bc5_zstd",   {.face = 8, .frames = 3, .views = 2, .hdr = true},       ColourCoding::kRgba16f, DepthCoding::kBc5,   container::Compression::kZstd,  "aa687605ccacb1d4"},
     {"auto_raw16_static",  {.face = 16, .frames = 6, .views = 2, .animated = false, .material = true}, ColourCoding::kAuto, DepthCoding::kRaw16, container::Compression::kZstd, "382569247fa8c205"},
-    // Depth format r16p (SPEC §11.1.8, issue 17): the raw16 clips' scenes and codings with predicted
+    // Depth format r16p (SPEC §11.1.8): the raw16 clips' scenes and codings with predicted
     // depth; they decode to their raw16 twins' hashes (lightfield_conformance_test).
     {"bc1_pred16_zstd",    {.face = 16, .frames = 5, .views = 2},                   ColourCoding::kBc1,     DepthCoding::kRaw16Predicted, container::Compression::kZstd,  "4f52fb389266f4ed"},
     {"bc6h_pred16_lzma2",  {.face = 8, .frames = 3, .views = 2, .hdr = true},       ColourCoding::kBc6h,    DepthCoding::kRaw16Predicted, container::Compression::kLzma2, "3a4515816c9670ef"},
     {"auto_pred16_static", {.face = 16, .frames = 6, .views = 2, .animated = false, .material = true}, ColourCoding::kAuto, DepthCoding::kRaw16Predicted, container::Compression::kZstd, "8792a19d652f5f4f"},
-    // Static depth and material groups merged (SPEC §11.1.2; issue 17): K = 2 over 7 frames.
+    // Static depth and material groups merged (SPEC §11.1.2): K = 2 over 7 frames.
     {"bc1_raw16_groups",   {.face = 16, .frames = 7, .views = 2, .material = true},  ColourCoding::kBc1,     DepthCoding::kRaw16, container::Compression::kZstd,  "cefa7985168c295a", 0, 2},
-    // Colour RDO (issue 17, docs/ENCODER.md "Colour RDO"): standard BC6H / BC7 blocks, rewritten
+    // Colour RDO (docs/ENCODER.md "Colour RDO"): standard BC6H / BC7 blocks, rewritten
     // towards copies of their neighbours' bytes; same decoder, its own frozen clips.
     {"bc6h_rdo_zstd",      {.face = 16, .frames = 5, .views = 2, .hdr = true},      ColourCoding::kBc6h,    DepthCoding::kRaw16, container::Compression::kZstd,  "e40d1fb3ffd8ba6f", 4.0},
     {"bc7_rdo_zstd",       {.face = 16, .frames = 5, .views = 2},                   ColourCoding::kBc7,     DepthCoding::kRaw16, container::Compression::kZstd,  "5b143c1103044687", 4.0},
-    // BC1 RDO (stop 37): standard BC1 blocks with endpoints or indices of a neighbour, indices
+    // BC1 RDO: standard BC1 blocks with endpoints or indices of a neighbour, indices
     // re-chosen for borrowed endpoints; stored block-split as every BC1 chunk.
     {"bc1_rdo_zstd",       {.face = 16, .frames = 5, .views = 2},                   ColourCoding::kBc1,     DepthCoding::kRaw16, container::Compression::kZstd,  "43deb744d350afa1", 4.0},
-    // Depth format r16pm (SPEC §11.1.9, issue 17): P-frame rectangles with change masks; the
+    // Depth format r16pm (SPEC §11.1.9): P-frame rectangles with change masks; the
     // twins of bc1_raw16_zstd and bc1_raw16_groups, they decode to their hashes. One rectangle
     // per P-frame, so that it spans the unchanged column inside the moving square (W = 2).
     {"bc1_pred16m_zstd",   {.face = 16, .frames = 5, .views = 2},                   ColourCoding::kBc1,     DepthCoding::kRaw16PredictedMasked, container::Compression::kZstd,  "a21f65e106f413f6", 0, 30, 1},
     {"bc1_pred16m_groups", {.face = 16, .frames = 7, .views = 2, .material = true},  ColourCoding::kBc1,     DepthCoding::kRaw16PredictedMasked, container::Compression::kZstd,  "61d24cbe36d26996", 0, 2, 1},
-    // Container 1.1 (SPEC §4.1, issue 17): the directory as one zstd frame, the encoders'
+    // Container 1.1 (SPEC §4.1): the directory as one zstd frame, the encoders'
     // default since; twins of the 1.0 clips, they decode to their hashes.
     {"bc1_raw16_zstd_zdir",   {.face = 16, .frames = 5, .views = 2},                ColourCoding::kBc1,     DepthCoding::kRaw16, container::Compression::kZstd,  "fba3ff8193f27a11", 0, 30, 2, true},
     {"bc1_pred16m_groups_zdir", {.face = 16, .frames = 7, .views = 2, .material = true}, ColourCoding::kBc1, DepthCoding::kRaw16PredictedMasked, container::Compression::kZstd, "03502347f39cf975", 0, 2, 1, true},
-    // Stop 38's defaults: BC1 by cluster fit with BC1's own RDO lambda (auto = 12; docs/ENCODER.md
+    // Today's defaults: BC1 by cluster fit with BC1's own RDO lambda (auto = 12; docs/ENCODER.md
     // "BC1 fit"), r16pm depth, the 1.1 directory, and chunks that zstd would enlarge (the 16-byte
     // t chunks here) stored as they are.
     {"bc1_cluster_rdo_pred16m", {.face = 16, .frames = 5, .views = 2},                 ColourCoding::kBc1,     DepthCoding::kRaw16PredictedMasked, container::Compression::kZstd, "f1c992d88578e467", kColourRdoAuto, 30, 2, true, Bc1Fit::kCluster, true},

@@ -1,4 +1,4 @@
-// Mesh playback end to end (paper 004, issue 19): mesh_scene.h's scene encoded as a full-scene and
+// Mesh playback end to end (paper 004): mesh_scene.h's scene encoded as a full-scene and
 // as a visible-set mesh track (encode_mesh_track), played through Playback / MeshRepresentation:
 // GL against the CPU reference, vertex states and transforms following the frame, and epsilon of
 // a visible set that lost an object against the full scene.

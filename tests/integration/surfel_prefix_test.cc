@@ -1,5 +1,5 @@
-// Any prefix of a built surfel buffer renders (issue 20: "any prefix renders (property test), and
-// prefixes of one buffer are nested"): candidates on two surfaces are ordered by the surfel
+// Any prefix of a built surfel buffer renders (the acceptance: "any prefix renders (property test),
+// and prefixes of one buffer are nested"): candidates on two surfaces are ordered by the surfel
 // sampler (calf/encoder/surfel_sampler.h, every method) and drawn by the player's CPU splatter
 // (calf/player/surfel_renderer.h; the GL one too where OSMesa gives a context) at many prefix
 // lengths, each a level of detail:

@@ -551,7 +551,7 @@ constexpr Clip kClips[] = {{"levels_none", Compression::kNone},
                            {"levels_lzma2", Compression::kLzma2}};
 
 // The frozen clips are container 1.0 files: a plain directory (SPEC §4.1 is 1.1), every chunk in
-// the clip's scheme even where it is larger than raw (as writers before stop 38 stored them).
+// the clip's scheme even where it is larger than raw (as the pinned 1.0 clips store them).
 std::vector<uint8_t> make_clip(const Clip& c) {
   encoder::SurfelsEncodeOptions o = opts(c.compression);
   o.levels.compress_directory = false;

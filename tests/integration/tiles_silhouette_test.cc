@@ -1,4 +1,4 @@
-// Where a tile set puts a straight silhouette, against where it is (issue 18: texel, tile, alpha
+// Where a tile set puts a straight silhouette, against where it is (texel, tile, alpha
 // and atlas conventions end to end). A box room with a square panel (x = 1, rotated 0.3 rad about
 // x so its edges cross pixel rows at every sub-pixel phase) in front of the +X wall, captured from
 // 9 viewpoints (colour box-filtered over the texel, depth of its centre ray, as calf-capture);

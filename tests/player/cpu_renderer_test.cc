@@ -296,9 +296,9 @@ TEST(CpuRenderer, SurfaceHintsFindPartsThinnerThanAStep) {
 // Hint vetoes at fine captures: a sphere seen by an eye nearer to it than the views (as a model's
 // path inside its ring rig), 1024² faces. Beside the sphere's silhouette the hint view sees the
 // eye ray enter the sphere's shadow; the other views see that point in front of the sphere, but
-// by little, since the sphere lies right behind it. A margin of 0.5 % of depth (the rule before
-// stop 40: 2.56 texels here) lets many of those crossings through, a rim of wall pixels on one
-// side of the silhouette; 0.2 texels (the default) vetoes most. Counted: wall pixels the render
+// by little, since the sphere lies right behind it. A margin of 0.5 % of depth (a fixed
+// relative rule: 2.56 texels here) lets many of those crossings through, a rim of wall pixels on
+// one side of the silhouette; 0.2 texels (the default) vetoes most. Counted: wall pixels the render
 // puts on the sphere beyond those the march alone (no hints) puts there, which is the depth
 // footprint's own growth (measured: 70 without hints, +71 with the old margin, +34 with 0.2).
 TEST(CpuRenderer, HintMarginInTexelsKeepsSilhouettesFromGrowingAtFineCaptures) {
@@ -694,7 +694,7 @@ TEST(CpuRenderer, RejectsBadOptionsAndCameras) {
 
 // The RR variant on a mirror floor between viewpoints. Known gap: on this scene RR does not yet
 // beat the plain blend (the room's smooth albedo reflects with little parallax); this pins that
-// it at least does not lose, and prints both for the report. Issue 8 asks for a clear win on the
+// it at least does not lose, and prints both for the report. The goal is a clear win on the
 // mirror/glass scene: tighten to rr > plain + 1 dB once it holds.
 TEST(CpuRenderer, RrVariantBeatsPlainOnAMirrorFloor) {
   Scene scene;

@@ -21,7 +21,7 @@ TEST(DisplayClock, NoFigureBeforeTheSecondFrame) {
   EXPECT_EQ(c.last_frame_ms(), 0);
 }
 
-// The case of issue 15: frames of 4.8 s on llvmpipe must read 0.21 fps, not thousands.
+// A slow renderer: frames of 4.8 s on llvmpipe must read 0.21 fps, not thousands.
 TEST(DisplayClock, SlowFramesReadAsSlow) {
   DisplayClock c;
   for (int i = 0; i < 5; ++i) c.displayed(kT0 + milliseconds(4800 * i));

@@ -240,7 +240,7 @@ TEST(Antialias, TwoSeedsAgreeAtTheDefaults) {
     std::printf("%s: seed 1 vs 2 %.2f dB, %.2f samples per texel\n", name, psnr,
                 static_cast<double>(st.samples) / st.pixels);
     EXPECT_GE(psnr, 45.0) << name;
-    // And spp 1 (calf before issue 16) does not: the test can tell.
+    // And spp 1 (one centre sample) does not: the test can tell.
     a.spp = b.spp = 1;
     auto ua = FrameTracer::create(*scene, 0, a);
     auto ub = FrameTracer::create(*scene, 0, b);
@@ -275,8 +275,8 @@ Scene legacy_scene() {
   return s;
 }
 
-// Colours of a 4 x 4 cube map from the origin, 8 AO samples, seed 7, rendered by calf before
-// issue 16 (commit 5610434), printed with %.9g.
+// Colours of a 4 x 4 cube map from the origin, 8 AO samples, seed 7, rendered with one centre
+// sample per texel (commit 5610434), printed with %.9g.
 const float kLegacyColors[] = {
 #include "antialias_legacy_colors.inc"
 };

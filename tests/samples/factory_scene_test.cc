@@ -56,7 +56,7 @@ TEST(FactoryScene, HoldsTheTrianglesItsListingPromisesMostlyInstanced) {
   ASSERT_NE(info, nullptr);
   EXPECT_EQ(triangles_in(info->description), scene->triangle_count());
   EXPECT_EQ(triangles_in(scene->description), scene->triangle_count());
-  EXPECT_GE(scene->triangle_count(), 20000000u) << "issue 20: >= 20 M triangles with instances";
+  EXPECT_GE(scene->triangle_count(), 20000000u) << "the factory: >= 20 M triangles with instances";
   size_t unique = 0, instanced_objects = 0;
   std::set<const TriangleMesh*> seen;
   for (const Object& o : scene->objects) {

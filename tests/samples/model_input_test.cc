@@ -1,4 +1,4 @@
-// Hostile model files through the scene loader (calf/samples/scene.h, load_scene_file, issue 22):
+// Hostile model files through the scene loader (calf/samples/scene.h, load_scene_file):
 // non-finite vertices wherever they sit (E174); declared counts beyond the file size refused
 // before assimp allocates, and glTF URIs that leave the model's folder (both E171, the message
 // naming the element or field).

@@ -323,11 +323,11 @@ Expected<PlacementResult> place_on_model(double scale) {
   return place_cameras(*scene, o, 1);
 }
 
-// Until stop 42 k was per scene unit and a model's view volume held the model: in centimetres
-// every camera's suitability underflowed but the nearest ones', the ring the model file comes
-// with scored coverage 0.000000 and Alg. 1 put cameras between the spider's legs (7.94 dB on
-// issue 16's protocol). Now k is per the model's bounding radius and no camera goes inside its
-// bounding sphere: the same model in any unit gets the same rig, scaled.
+// With k per scene unit and a view volume holding the model, in centimetres every camera's
+// suitability would underflow but the nearest ones', the ring the model file comes with would
+// score coverage 0.000000 and Alg. 1 would put cameras between the spider's legs (7.94 dB on
+// docs/RENDERING.md's protocol). Here k is per the model's bounding radius and no camera goes
+// inside its bounding sphere: the same model in any unit gets the same rig, scaled.
 TEST(RigPlacement, ModelFileGetsTheSameRigInAnyUnit) {
   auto metres = place_on_model(1);
   auto centimetres = place_on_model(100);

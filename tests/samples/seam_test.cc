@@ -1,4 +1,4 @@
-// Colour continuity across cube-face seams in what calf-capture renders (issue 5 acceptance:
+// Colour continuity across cube-face seams in what calf-capture renders (the acceptance:
 // "colour and depth continuous across face seams"; depth is checked exactly in render_test.cc).
 //
 // A capture of the built-in interior (checkerboard floor, columns, walls: detail in every face)

@@ -30,7 +30,7 @@ namespace fs = std::filesystem;
 
 struct Promise {
   const char* name;
-  uint64_t min_triangles;  // issue 19: city >= 1 M, blades >= 5 M
+  uint64_t min_triangles;  // city >= 1 M, blades >= 5 M
   size_t min_spheres;
 };
 // gtest prints a parameter in test names and messages: the scene's name.

@@ -1,4 +1,4 @@
-// calf-bench: the speed <-> accuracy sweeps of calf on the built-in scenes (issue 9;
+// calf-bench: the speed <-> accuracy sweeps of calf on the built-in scenes (
 // docs/BENCH.md). Per scene: capture once, ground truth once, then one knob at a time around a base
 // configuration (sweep.h), the peers in the same run (peers.h); writes sweep.md, sweep.csv and
 // gnuplot PNGs into

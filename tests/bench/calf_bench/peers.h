@@ -1,5 +1,5 @@
 // calf-bench: the peers of a scene, measured in the same run on the same capture (DESIGN.md
-// "Measuring"; issue 9): general-purpose coders on the raw streams, ffmpeg's lossless video coders
+// "Measuring"): general-purpose coders on the raw streams, ffmpeg's lossless video coders
 // on the log-16 depth and x265 on the colour at the PSNR calf's colour reached.
 //
 // The frames every peer codes: per clip frame one image holding every view's six cube faces, a

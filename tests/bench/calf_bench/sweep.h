@@ -1,4 +1,4 @@
-// calf-bench: the speed <-> accuracy sweeps of calf (issue 9; docs/BENCH.md).
+// calf-bench: the speed <-> accuracy sweeps of calf (docs/BENCH.md).
 //
 // What one run does, per built-in scene: capture it once, render ground truth along its eye
 // path once, then measure a base configuration (the calf-encode / calf-play defaults with colour

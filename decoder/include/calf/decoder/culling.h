@@ -93,7 +93,7 @@ struct PreparedEye {
 };
 PreparedEye prepare_eye(const Frustum& eye);
 
-// Culling for one grid, fast enough to run every frame (issue 17): the directions of every
+// Culling for one grid, fast enough to run every frame: the directions of every
 // quadtree node of every face are computed once, at construction (they depend on the face, the
 // face size and the node's rectangle only; the viewpoint and depth range enter per call through 8
 // multiply-adds per node). Each node is then tested against each eye's 6 face planes only: the
@@ -127,7 +127,7 @@ class GridCuller {
                std::vector<uint32_t>* out) const;
 
   // The same set for one eye, reusing the decisions `memory` kept from earlier calls where they
-  // provably still hold (a moving eye, issue 17): a node decision is kept with its slack — the
+  // provably still hold (a moving eye): a node decision is kept with its slack — the
   // smallest distance by which the node points it rests on lay inside or outside the eye's
   // planes, and that distance over their distance from the eye — and taken again while the eye's
   // planes (their unit normals and offsets) and the node frusta (viewpoint, depth range) have

@@ -69,7 +69,7 @@ enum class ColourCoding : uint8_t { kAuto, kBc1, kBc7, kBc6h, kRgba8, kRgba16f }
 // format r16pm, SPEC §11.1.9). Values are recorded in analysis files: append only.
 enum class DepthCoding : uint8_t { kRaw16, kBc5, kRaw16Predicted, kRaw16PredictedMasked };
 // How BC1 colour blocks are fitted (calf/encoder/bc_encode.h): kRange = libsquish's range fit
-// (the encoder before stop 38), kRefined = range fit plus least-squares endpoint refinement
+// (the fastest), kRefined = range fit plus least-squares endpoint refinement
 // (Bc1Options::refine), kCluster = libsquish's cluster fit. Costs and gains: docs/ENCODER.md
 // "BC1 fit". Values are recorded in analysis files: append only.
 enum class Bc1Fit : uint8_t { kRange, kRefined, kCluster };
@@ -97,16 +97,16 @@ struct LightfieldEncodeOptions {
   // keeps one chunk across them (empty P-frames there, but for the first W - 1) instead of a new
   // keyframe every K frames: static content costs one keyframe per tile, and a seek still reads
   // one chunk of it (SPEC §11.1.2 "Static groups"). Groups never merge across a segment
-  // boundary. false: one chunk per K frames, as writers before issue 17 did.
+  // boundary. false: one chunk per K frames (the layout without static groups).
   bool merge_static_groups = true;
   // Colour RDO strength (calf/encoder/bc_rdo.h): lambda, squared 8-bit sRGB error per estimated
   // bit saved, [0, 1e6]; 0 = off (the blocks as the BCn encoder made them). BC1, BC6H and BC7
-  // keyframes (BC1 since stop 37); rgba8 / rgba16f ignore it. Applied to the keyframes after the
+  // keyframes; rgba8 / rgba16f ignore it. Applied to the keyframes after the
   // keyframe search. kColourRdoAuto (the default): 0.5 for BC6H / BC7, 12 for BC1, each chosen
   // by measurement (docs/ENCODER.md "Colour RDO", "BC1 fit"); see colour_rdo_lambda.
   double colour_rdo = kColourRdoAuto;
-  // BC1 colour only: the block fit (above). Cluster fit by default since stop 38: with the BC1
-  // RDO at its default it is what keeps LDR content within 0.05 dB of the encoder before issue 17
+  // BC1 colour only: the block fit (above). Cluster fit by default: with the BC1
+  // RDO at its default it is what keeps LDR content within 0.05 dB of --colour-rdo 0
   // while saving 30 % of its colour bytes.
   Bc1Fit bc1_fit = Bc1Fit::kCluster;
   container::Compression supercompression = container::Compression::kZstd;

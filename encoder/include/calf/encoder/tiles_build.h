@@ -164,7 +164,7 @@ struct TilesBuildOptions {
   // more than edge_depth_ratio nearer or farther, or sky beside a surface) relative to 1
   // elsewhere: a box-filtered capture's edge texels blend foreground and background, which the
   // tiles' own alpha then blends a second time; other views, and the texels beside the edge, see
-  // the same surface unblended. [0, 1]; 1 = every sample alike (before stop 38). Measured
+  // the same surface unblended. [0, 1]; 1 = every sample alike (no edge weight). Measured
   // (docs/TILES.md "Edge colour weight", capture viewpoints / novel views, dB, 1 -> 0.3): interior
   // 64² 36.12 / 33.42 -> 36.27 / 33.58, 256² 37.30 / 40.27 -> 37.69 / 40.36, 512² 35.54 / 40.02
   // -> 35.65 / 40.08; CesiumMilkTruck 256² 50.88 / 32.04 -> 50.92 / 32.19.

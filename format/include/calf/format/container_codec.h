@@ -37,7 +37,7 @@ struct CompressionOptions {
   // compress_chunk stores a chunk as kNone when zstd / LZMA2 would make it no smaller (a short
   // chunk, or bytes that do not compress: SPEC §6.3 lets every chunk name its own scheme, and
   // every reader, 1.0 included, reads kNone). False keeps the requested scheme whatever it costs,
-  // as writers before stop 38 did (the pinned 1.0 clips).
+  // as the writers of the pinned 1.0 clips did.
   bool store_when_larger = true;
 };
 

@@ -1,6 +1,6 @@
 // The mesh track (kind 4, format/SPEC.md §11.4): a visible-set mesh (paper 004). This header
 // holds what the frozen 1.0 file (tests/conformance/container/valid/v1_frozen.calf) fixed for
-// the kind: its track header and stream tags. Below them (issue 19) the byte layout of its chunks,
+// the kind: its track header and stream tags. Below them (§11.4) the byte layout of its chunks,
 // both directions: the versioned index chunk (stream 0) declared once with the fields visitor
 // (container_fields.h), and the coded arrays of the vertices, triangles, visibility and (layout 2)
 // textures chunks.
@@ -44,7 +44,7 @@ struct MeshTrackHeader {
   uint32_t fps_denominator = 1;
   uint64_t vertex_count = 0;
   uint64_t triangle_count = 0;
-  // Issue 19 (SPEC §11.4): vertex_count is the sum of the prototypes' vertex counts (what the
+  // SPEC §11.4: vertex_count is the sum of the prototypes' vertex counts (what the
   // track stores), triangle_count the triangles its objects draw (instances counted each time,
   // a subset by its size); both equal the index chunk's sums. segment_count: the perimeter
   // segments the visible set was computed from (0 for a full-scene track). flags bit 0

@@ -2,7 +2,7 @@
 // one ordered surfel buffer per prototype of the clip's mesh track (§11.4), every prefix of which
 // is a level of detail. This header holds what the frozen 1.0 file
 // (tests/conformance/container/valid/v1_frozen.calf) fixed for the kind: its track header and
-// stream tags. Below them (issue 20) the byte layout of its chunks, both directions: the
+// stream tags. Below them (SPEC §11.3) the byte layout of its chunks, both directions: the
 // versioned index chunk (stream 0) declared once with the fields visitor (container_fields.h),
 // and the level chunks (stream 1) holding each prototype's quantised surfels in prefix order,
 // cut at fixed surfel counts so that a reader fetches only the bytes of the prefix it draws.
@@ -40,7 +40,7 @@ struct SurfelsTrackHeader {
   uint32_t frame_count = 1;
   uint32_t fps_numerator = 24;
   uint32_t fps_denominator = 1;
-  // Issue 20 (SPEC §11.3): object_count is the number of prototypes P the index chunk lists (one
+  // SPEC §11.3: object_count is the number of prototypes P the index chunk lists (one
   // per prototype of the paired mesh track, a prototype without surfels included), surfel_count
   // the sum of their surfel counts; both equal the index chunk's (CALF-E230). flags: reserved,
   // 0 (CALF-E231). The timing fields are the paired mesh track's (informative: surfels are in

@@ -1,7 +1,7 @@
 // The tiles track (kind 2, format/SPEC.md §11.2): layered quad tiles with an RGBA atlas (paper
 // 000, Seurat). This header holds what the frozen 1.0 file
 // (tests/conformance/container/valid/v1_frozen.calf) fixed for the kind: its track header and
-// stream tags. Below them (issue 18) the byte layout of its chunks, both directions: the
+// stream tags. Below them (SPEC §11.2) the byte layout of its chunks, both directions: the
 // versioned index chunk (stream 0) declared once with the fields visitor (container_fields.h),
 // the quads chunk (stream 2: every tile's four corners, positions and projective texture
 // coordinates as lossless binary32, predicted and in byte planes) and the atlas chunks (stream 1:
@@ -41,7 +41,7 @@ struct TilesTrackHeader {
   uint32_t frame_count = 1;
   uint32_t fps_numerator = 24;
   uint32_t fps_denominator = 1;
-  // Issue 18 (SPEC §11.2): frame_count is 1 in layout 1 (a static view region; CALF-E211
+  // SPEC §11.2: frame_count is 1 in layout 1 (a static view region; CALF-E211
   // otherwise). tile_count: the tiles of the quads chunk (<= tiles::kMaxTiles, E213).
   // atlas_format: PixelFormat kBc7 (8) or kRgba8 (1) (E211 otherwise). flags: reserved, 0 (E211).
   uint32_t tile_count = 0;

@@ -161,9 +161,9 @@ struct RenderOptions {
   // `surface_hint_vetoes` active views see it as empty by more than
   // `surface_hint_margin_texels` of their own texels: the relative depth margin x 2 / face size
   // (a texel's angular width at the face centre), in code units that / relative_step of the
-  // view. A fixed relative depth (0.5 %, the default before stop 40) was 2.56 texels of a 1024²
-  // face: near a silhouette the hint view's shadow edge of the object lies that close to the
-  // object's surface in the other views, so no view vetoed it and silhouettes grew by a pixel.
+  // view. A fixed relative depth (0.5 %) would be 2.56 texels of a 1024² face: near a
+  // silhouette the hint view's shadow edge of the object would lie that close to the object's
+  // surface in the other views, so no view would veto it and silhouettes would grow by a pixel.
   // Of several hints crossing in one interval the nearest confirmed crossing wins. This finds
   // parts thinner than a step (wings, chains, leaves) that the plain march steps over, and at a
   // viewpoint puts the hit exactly on that view's surface. 0: the paper's march alone.

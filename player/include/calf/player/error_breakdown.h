@@ -1,4 +1,4 @@
-// Where the error against ground truth comes from (issue 16, docs/PLAYER.md "Error breakdown"):
+// Where the error against ground truth comes from (docs/PLAYER.md "Error breakdown"):
 // each pixel's squared error is split into five classes, and a pose's (or a path's) MSE into
 // their shares, so that a figure says what to fix.
 //

@@ -71,7 +71,7 @@ Expected<double> ssim(const RgbImageRef& a, const RgbImageRef& b);
 // than the reference is not counted: a subset of the scene's triangles cannot occlude more. The
 // tolerance absorbs float noise between two renders of the same triangle, which the same renderer
 // makes bit-identical anyway; its default (0.1 % + 1e-6 scene units) lies far below the depth gap
-// a missing triangle leaves on the walk traces of issue 19.
+// a missing triangle leaves on the visible-set walk traces (docs/VISIBILITY.md).
 struct DepthTolerance {
   double relative = 1e-3;  // >= 0, finite
   double absolute = 1e-6;  // >= 0, finite

@@ -16,8 +16,8 @@
 //   stats()               what the HUD and reports print, generically.
 //
 // Adding a representation: implement this interface in player/src/<kind>_representation.cc with
-// its header player/include/calf/player/<kind>_representation.h, give both backends, add a case
-// to Playback::open's track dispatch (playback.cc) and a GL-vs-CPU test.
+// its header player/include/calf/player/<kind>_representation.h, give both backends, add its
+// entry to the player's kind table (player/src/kind_table.h) and a GL-vs-CPU test.
 #pragma once
 
 #include <cstdint>

@@ -18,8 +18,8 @@
 // from the samples' sRGB-encoded values, is at most `tolerance` in every channel. Positions and AO
 // directions are points of a per-pixel scrambled (0, 2)-sequence (calf/samples/pixel_samples.h):
 // every round's samples, and the AO rays of all of a pixel's samples at a surface together, are
-// stratified. spp = 1 is one sample through the texel centre with the AO pattern of calf before
-// issue 16, bit for bit.
+// stratified. spp = 1 is one sample through the texel centre with a fixed AO pattern, bit for bit
+// the colours tests/samples/antialias_legacy_colors.inc holds.
 // Depth is the radial distance of the primary hit of the ray through the pixel centre from the
 // ray origin (the viewpoint centre), whatever `spp`: the player re-projects each texel along its
 // centre direction at its depth, so the depth must be the surface on that very ray (a mean of

@@ -1,17 +1,16 @@
 // calf-info: an ffprobe-like summary of a .calf clip: version, tracks (kind, frames, fps, views,
-// face size, formats; a mesh track's objects, prototypes and triangles; a surfels track's
-// prototypes, surfels and bytes per surfel; a tiles track's tiles, atlas and bytes per tile),
-// metadata, and bytes per
-// stream with the ratio to raw. --json prints the
-// same as one JSON object; --chunks adds the chunk index. Reads only the header and directory.
+// face size, formats, and the figures of its kind's entry in the decoder table,
+// calf/decoder/kind_table.h: a mesh track's objects, prototypes and triangles, ...), metadata,
+// and bytes per stream with the ratio to raw. --json prints the same as one JSON object;
+// --chunks adds the chunk index. Reads only the header and directory.
 #include <fmt/core.h>
 #include <CLI/CLI.hpp>
 
 #include <map>
 #include <optional>
 #include <string>
-#include <variant>
 
+#include "calf/decoder/kind_table.h"
 #include "calf/format/container.h"
 #include "calf/format/version.h"
 #include "command_line.h"
@@ -87,81 +86,12 @@ std::map<uint16_t, StreamStats> stream_stats(const Reader& r, uint16_t track) {
   return out;
 }
 
-// A mesh track's figures from its header and directory alone (SPEC §11.4: one vertices chunk per
-// prototype, one visibility chunk per object), or nothing for another kind.
-struct MeshFigures {
-  uint64_t objects = 0, prototypes = 0, triangles = 0, vertices = 0;
-};
-std::optional<MeshFigures> mesh_figures(const Reader& r, const Track& t) {
-  const auto* h = std::get_if<MeshTrackHeader>(&t.header);
-  if (!h) return std::nullopt;
-  MeshFigures f;
-  const auto streams = stream_stats(r, t.id);
-  auto count = [&](MeshStream s) {
-    const auto it = streams.find(static_cast<uint16_t>(s));
-    return it == streams.end() ? uint64_t{0} : it->second.chunks;
-  };
-  f.objects = count(MeshStream::kVisibility);
-  f.prototypes = count(MeshStream::kVertices);
-  f.triangles = h->triangle_count;
-  f.vertices = h->vertex_count;
-  return f;
-}
-
-// A surfels track's figures from its header and directory alone (SPEC §11.3: the header's
-// prototype and surfel counts; level chunks are stream 1, region = prototype), or nothing for
-// another kind.
-struct SurfelsFigures {
-  uint64_t prototypes = 0, with_surfels = 0, surfels = 0, stored = 0;
-  double bytes_per_surfel() const {
-    return surfels ? static_cast<double>(stored) / static_cast<double>(surfels) : 0.0;
-  }
-};
-std::optional<SurfelsFigures> surfels_figures(const Reader& r, const Track& t) {
-  const auto* h = std::get_if<SurfelsTrackHeader>(&t.header);
-  if (!h) return std::nullopt;
-  SurfelsFigures f;
-  f.prototypes = h->object_count;
-  f.surfels = h->surfel_count;
-  for (const auto& c : r.chunks()) {
-    if (c.keys.track != t.id || c.keys.stream != static_cast<uint16_t>(SurfelsStream::kSurfels))
-      continue;
-    f.stored += c.stored_size;
-    if (c.keys.layer == 0) ++f.with_surfels;
-  }
-  return f;
-}
-
-// A tiles track's figures from its header and directory alone (SPEC §11.2: the quads chunk is
-// stream 2, the atlas bands stream 1), or nothing for another kind.
-struct TilesFigures {
-  uint64_t tiles = 0, width = 0, height = 0, quads_stored = 0, atlas_stored = 0;
-  std::string format;
-  double bytes_per_tile() const {
-    return tiles ? static_cast<double>(quads_stored) / static_cast<double>(tiles) : 0.0;
-  }
-  double bits_per_texel() const {
-    return width && height
-               ? 8.0 * static_cast<double>(atlas_stored) / static_cast<double>(width * height)
-               : 0.0;
-  }
-};
-std::optional<TilesFigures> tiles_figures(const Reader& r, const Track& t) {
-  const auto* h = std::get_if<TilesTrackHeader>(&t.header);
-  if (!h) return std::nullopt;
-  TilesFigures f;
-  f.tiles = h->tile_count;
-  f.width = h->atlas_width;
-  f.height = h->atlas_height;
-  f.format = pixel_format_name(h->atlas_format);
-  for (const auto& c : r.chunks()) {
-    if (c.keys.track != t.id) continue;
-    if (c.keys.stream == static_cast<uint16_t>(TilesStream::kQuads))
-      f.quads_stored += c.stored_size;
-    if (c.keys.stream == static_cast<uint16_t>(TilesStream::kAtlas))
-      f.atlas_stored += c.stored_size;
-  }
-  return f;
+// The track's summary figures through its kind's entry in the decoder table (none for a kind it
+// lacks or a kind without figures).
+std::optional<calf::decoder::TrackFigures> figures(const Reader& r, const Track& t) {
+  const auto* kind = calf::decoder::find_decoder_kind(t.record.kind);
+  if (kind == nullptr || kind->figures == nullptr) return std::nullopt;
+  return kind->figures(r, t);
 }
 
 bool compressed_directory(const FileHeader& h) {
@@ -203,23 +133,7 @@ void print_text(const std::string& path, const Reader& r, bool list_chunks) {
       fmt::print("  {} frames at {:.3f} fps ({}/{}), {:.3f} s\n", frames,
                  static_cast<double>(num) / den, num, den, static_cast<double>(frames) * den / num);
     for (const auto& e : fields) fmt::print("  {}: {}\n", e.name, printable(field_text(e)));
-    if (const auto m = mesh_figures(r, t)) {
-      fmt::print("  mesh: {} objects, {} prototypes, {} triangles drawn, {} vertices stored\n",
-                 m->objects, m->prototypes, m->triangles, m->vertices);
-    }
-    if (const auto m = surfels_figures(r, t)) {
-      fmt::print(
-          "  surfels: {} prototypes ({} with surfels), {} surfels, {} stored bytes, {:.3f} "
-          "bytes per surfel\n",
-          m->prototypes, m->with_surfels, m->surfels, m->stored, m->bytes_per_surfel());
-    }
-    if (const auto m = tiles_figures(r, t)) {
-      fmt::print(
-          "  tiles: {} tiles, {} triangles, quads {} stored bytes ({:.3f} bytes per tile), atlas "
-          "{} x {} {} {} stored bytes ({:.3f} bits per texel)\n",
-          m->tiles, 2 * m->tiles, m->quads_stored, m->bytes_per_tile(), m->width, m->height,
-          m->format, m->atlas_stored, m->bits_per_texel());
-    }
+    if (const auto f = figures(r, t)) fmt::print("  {}\n", f->text);
     fmt::print("  {:<12} {:>8} {:>14} {:>14} {:>8}\n", "stream", "chunks", "stored bytes",
                "raw bytes", "ratio");
     for (const auto& [tag, s] : stream_stats(r, t.id)) {
@@ -273,25 +187,7 @@ void print_json(const std::string& path, const Reader& r, bool list_chunks) {
       o += fmt::format("{}{}:{}", i ? "," : "", json_string(fields[i].name),
                        fields[i].numeric ? fields[i].value : json_string(fields[i].value));
     o += "}";
-    if (const auto m = mesh_figures(r, t)) {
-      o += fmt::format(
-          ",\"mesh\":{{\"objects\":{},\"prototypes\":{},\"triangles\":{},\"vertices\":{}}}",
-          m->objects, m->prototypes, m->triangles, m->vertices);
-    }
-    if (const auto m = surfels_figures(r, t)) {
-      o += fmt::format(
-          ",\"surfels\":{{\"prototypes\":{},\"with_surfels\":{},\"surfels\":{},"
-          "\"stored_bytes\":{},\"bytes_per_surfel\":{:.3f}}}",
-          m->prototypes, m->with_surfels, m->surfels, m->stored, m->bytes_per_surfel());
-    }
-    if (const auto m = tiles_figures(r, t)) {
-      o += fmt::format(
-          ",\"tiles\":{{\"tiles\":{},\"triangles\":{},\"quads_stored_bytes\":{},"
-          "\"bytes_per_tile\":{:.3f},\"atlas_width\":{},\"atlas_height\":{},\"atlas_format\":{},"
-          "\"atlas_stored_bytes\":{},\"atlas_bits_per_texel\":{:.3f}}}",
-          m->tiles, 2 * m->tiles, m->quads_stored, m->bytes_per_tile(), m->width, m->height,
-          json_string(m->format), m->atlas_stored, m->bits_per_texel());
-    }
+    if (const auto f = figures(r, t)) o += "," + f->json;
     o += ",\"streams\":[";
     bool first = true;
     for (const auto& [tag, s] : stream_stats(r, t.id)) {
