@@ -48,8 +48,9 @@ def parser():
         "(sky +inf), manifest.json written last. With --ground-truth, render ground truth along "
         "an eye path for calf-play --compare instead. Positions are in calf's frame: calf "
         "(x, y, z) = Blender (x, z, -y), as Blender's glTF exporter writes (docs/BLENDER.md).")
-    p.add_argument("--out", required=True, metavar="DIR",
-                   help="output folder (created): the capture set, or the ground truth")
+    p.add_argument("--out", default="", metavar="DIR",
+                   help="output folder (created): the capture set, or the ground truth; required "
+                   "unless --write-eye-path")
     g = p.add_argument_group("viewpoints and view volume (capture set)")
     g.add_argument("--rig", default="", metavar="STRING",
                    help="a calf rig string in calf coordinates, as calf-capture --rig takes it: "
@@ -104,6 +105,8 @@ def run(argv):
     import bpy
 
     args = parser().parse_args(argv)
+    if not args.out and not args.write_eye_path:
+        raise capture.CaptureError("CALF-E006", "--out DIR is required", usage=True)
     scene = bpy.context.scene
     if args.ground_truth or args.write_eye_path:
         if bool(args.eye_path) == bool(args.camera):
