@@ -54,6 +54,7 @@ class CaptureOptions:
         self.clip_start = 0.01
         self.clip_end = 1e5
         self.threads = 0          # 0: Blender's automatic thread count
+        self.coverage = False     # also write coverage (a version-2 set) from a 4x finer depth
 
 
 def _fmt(p):
@@ -212,6 +213,14 @@ class _Renderer:
             key = matches[0]
         return channels[key]
 
+    def depth(self, matrix, fov_y, width, height):
+        """Only the planar depth through the pixel centres of a W x H image."""
+        self.camera_data.sensor_fit = "VERTICAL"
+        self.camera_data.angle_y = fov_y
+        self.camera.matrix_world = matrix
+        channels = self._render_once(width, height, 1, 0.01, self.seed)
+        return list(self._channel(channels, "Depth", "Z"))
+
     def render(self, matrix, fov_y, width, height, seed_offset=0):
         cam = self.camera_data
         cam.sensor_fit = "VERTICAL"
@@ -356,10 +365,11 @@ def capture_set(scene, options, log=print):
         os.remove(manifest_path)  # a set being rewritten never looks complete
     n = options.face_size
     manifest = {
-        "format": "calf-capture-set", "version": 1,
+        "format": "calf-capture-set", "version": 2 if options.coverage else 1,
         "scene": scene.name, "generator": "calf_capture (Blender %s)" % bpy.app.version_string,
         "frame_count": last - first + 1, "fps": scene_fps(scene), "face_size": n,
         "file_pattern": FILE_PATTERN,
+        **({"coverage": True} if options.coverage else {}),
         "view_volume": {"min": list(volume[0]), "max": list(volume[1])},
         "viewpoints": [{"name": name, "position": list(p)} for name, p in views],
     }
@@ -371,17 +381,29 @@ def capture_set(scene, options, log=print):
             scene.frame_set(frame)
             for v, (name, position) in enumerate(views):
                 rgb_faces, depth_faces = [], []
+                cover = ([], [], [])
                 for forward, up in convention.FACE_CAMERAS:
-                    rgb, planar = renderer.render(_matrix(position, forward, up), math.pi / 2,
-                                                  n, n)
+                    m = _matrix(position, forward, up)
+                    rgb, planar = renderer.render(m, math.pi / 2, n, n)
                     rgb_faces += convention.texels_from_upright(rgb, n, 3)
-                    depth_faces += convention.texels_from_upright(
+                    depth = convention.texels_from_upright(
                         convention.radial_from_planar(planar, n), n)
+                    depth_faces += depth
+                    if options.coverage:
+                        fn = convention.COVERAGE_CELLS * n
+                        fine = convention.texels_from_upright(convention.radial_from_planar(
+                            renderer.depth(m, math.pi / 2, fn, fn), fn), fn)
+                        for c, values in enumerate(convention.coverage_from_fine(depth, fine, n)):
+                            cover[c].extend(values)
                 path = os.path.join(options.out, FILE_PATTERN.format(view=v, frame=frame - first))
+                channels = {"R": ("HALF", rgb_faces[0::3]), "G": ("HALF", rgb_faces[1::3]),
+                            "B": ("HALF", rgb_faces[2::3]), "Z": ("FLOAT", depth_faces)}
+                if options.coverage:
+                    channels.update({"coverage.near": ("HALF", cover[0]),
+                                     "coverage.far": ("HALF", cover[1]),
+                                     "coverage.mask": ("FLOAT", cover[2])})
                 try:
-                    exr.write_exr(path, n, 6 * n, {
-                        "R": ("HALF", rgb_faces[0::3]), "G": ("HALF", rgb_faces[1::3]),
-                        "B": ("HALF", rgb_faces[2::3]), "Z": ("FLOAT", depth_faces)})
+                    exr.write_exr(path, n, 6 * n, channels)
                 except OSError as e:
                     raise CaptureError("CALF-E004", "%s: cannot write: %s" %
                                        (path, e.strerror or e))

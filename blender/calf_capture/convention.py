@@ -157,3 +157,44 @@ def parse_rig(text):
         return views, (tuple(min(lo[k], hi[k]) for k in range(3)),
                        tuple(max(lo[k], hi[k]) for k in range(3)))
     raise ValueError("rig '%s': unknown rig kind '%s' (box, ring, sphere, grid, list)" % (text, kind))
+
+
+COVERAGE_CELLS = 4  # a texel's square split into 4 x 4 cells (CAPTURE.md, "Coverage")
+
+
+def coverage_from_fine(depth, fine, n):
+    """CAPTURE.md's coverage of one face: `depth` the face's N x N radial depths in texel order,
+    `fine` the radial depths of the same face rendered 4N x 4N (texel order too; cell (i, j) of
+    texel (x, y) is fine pixel (4x + i, 4y + j)). Returns (near, far, mask) lists: the shares of
+    cells nearer and farther than the texel's own surface, and the 16-bit mask of the cells that
+    show it (|ln(z / d)| <= min(4 / N, 0.05); both sky counts as the same surface)."""
+    k = COVERAGE_CELLS
+    tol = min(4.0 / n, 0.05)
+    near, far, mask = [0.0] * (n * n), [0.0] * (n * n), [0.0] * (n * n)
+    fn = k * n
+    for y in range(n):
+        for x in range(n):
+            d = depth[y * n + x]
+            nn = ff = m = 0
+            for j in range(k):
+                row = (k * y + j) * fn + k * x
+                for i in range(k):
+                    z = fine[row + i]
+                    if d == math.inf:
+                        if z == math.inf:
+                            m |= 1 << (k * j + i)
+                        else:
+                            nn += 1
+                    elif z == math.inf:
+                        ff += 1
+                    elif abs(math.log(z / d)) > tol:
+                        if z < d:
+                            nn += 1
+                        else:
+                            ff += 1
+                    else:
+                        m |= 1 << (k * j + i)
+            near[y * n + x] = nn / (k * k)
+            far[y * n + x] = ff / (k * k)
+            mask[y * n + x] = float(m)
+    return near, far, mask

@@ -8,9 +8,11 @@
 #     the clip with calf-verify and plays it with calf-play --compare: the mean PSNR must reach
 #     MIN_DB.
 #   blender_capture.sh room BIN_DIR SRC_DIR WORK_DIR BOX_ROOM_CHECK
-#     renders a box room of known walls (tests/blender/box_room.py) from two viewpoints and checks
-#     every texel's radial depth against the distance along calf's direction_from_texel
-#     (tests/capture/box_room_check.cc): fails on a wrong face order, orientation or depth.
+#     renders a box room with a block in it (tests/blender/box_room.py) from two viewpoints, with
+#     coverage, and checks every texel's radial depth against the distance along calf's
+#     direction_from_texel and its coverage against the cells' distances
+#     (tests/capture/box_room_check.cc): fails on a wrong face order, orientation, depth or cell
+#     order.
 #   blender_capture.sh errors BIN_DIR SRC_DIR WORK_DIR
 #     each refusal is one line with its id and exit status, and leaves no manifest.
 # Without Blender it is skipped (exit 77, one line), except with CI=true, where it fails.
@@ -58,8 +60,8 @@ case $mode in
     ;;
   room)
     blend box_room.py --out room --rig "list:0,0,0/0.4,0.3,-0.2" --face-size 16 --samples 1 \
-      | tail -n 1
-    "$5" room -1.5,-0.8,-1.3,2.1,1.7,1.9 1e-4
+      --coverage | tail -n 1
+    "$5" room -1.5,-0.8,-1.3,2.1,1.7,1.9 0.6,-0.5,0.5,1.2,0.2,1.1 1e-4
     ;;
   errors)
     # The refusals in one Blender process (tests/blender/error_cases.py), then one of them through
