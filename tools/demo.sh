@@ -29,6 +29,9 @@
 # (walk poses, default 2: the full mesh takes tens of seconds a pose on llvmpipe);
 # tiles part: CALF_DEMO_TILES (default 1; empty skips the part), CALF_DEMO_TILES_TRIANGLES
 # (the triangle budget, default 72000);
+# Blender part (off by default): CALF_DEMO_BLENDER=1 renders a small animated scene built by
+# script (tests/blender/make_scene.py) with the Blender add-on (blender/calf_capture, Cycles):
+# capture set and ground truth, then encodes and plays it against Blender's own images.
 # CALF_DEMO_BUILD (build directory, default build/release).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -60,6 +63,9 @@ SF=$OUT/surfels
 TL_ON=${CALF_DEMO_TILES-1}
 TL_TRIANGLES=${CALF_DEMO_TILES_TRIANGLES:-72000}
 TL=$OUT/tiles
+# --- Blender part (docs/BLENDER.md)
+BL_ON=${CALF_DEMO_BLENDER-}
+BL=$OUT/blender
 rm -rf "$OUT"
 mkdir -p "$LOGS"
 
@@ -155,6 +161,28 @@ if [ -n "$SF_SCENE" ]; then
 fi
 # --- end of the surfel mode
 
+# --- Blender part: the add-on renders a scene built by script; calf plays it against Cycles.
+if [ -n "$BL_ON" ] && ! command -v blender >/dev/null; then
+  echo "calf demo: CALF_DEMO_BLENDER is set but blender is not installed (tools/setup.sh installs" \
+    "it); skipping the Blender part"
+  BL_ON=
+fi
+if [ -n "$BL_ON" ]; then
+  echo "calf demo: Blender add-on on tests/blender/make_scene.py (3 viewpoints, 3 frames, faces" \
+    "of 32, 16 samples)"
+  BLENDER_RUN=(blender -b --factory-startup -noaudio -P tests/blender/make_scene.py
+    -P blender/calf_capture/cli.py --)
+  run bl-capture "${BLENDER_RUN[@]}" --out "$BL/capture" --collection calf_viewpoints \
+    --volume-object calf_volume --face-size 32 --samples 16
+  BL_CAPTURE_S=$LAST_SECONDS
+  run bl-ground-truth "${BLENDER_RUN[@]}" --out "$BL/ground-truth" --ground-truth --camera Eye \
+    --gt-size 64x48 --samples 16
+  run bl-encode "$BUILD"/calf-encode "$BL/capture" -o "$BL/scene.calf" --quiet
+  run bl-play "$BUILD"/calf-play "$BL/scene.calf" --headless --compare "$BL/ground-truth" \
+    --out "$BL/play"
+fi
+# --- end of the Blender part
+
 PLAY=$LOGS/calf-play.log
 ENC=$LOGS/calf-encode.log
 CAPTURE_BYTES=$(du -sb "$OUT/capture" | cut -f1)
@@ -224,6 +252,13 @@ if [ -n "$SF_SCENE" ]; then
     else print "          render n/a" }'
   echo "          $(line_of "$SFPLAY" '^against the full scene' |
     sed -E 's/ \(an identical[^)]*\)//; s/epsilon[^;]*; //')"
+fi
+# --- Blender part report
+if [ -n "$BL_ON" ]; then
+  echo "blender   the add-on's capture of make_scene.py: 3 viewpoints x 3 frames, faces of 32" \
+    "(Blender + Cycles $BL_CAPTURE_S s)"
+  echo "          $(line_of "$LOGS/bl-play.log" '^mean PSNR') against Cycles' ground truth at 64x48"
+  echo "          $(line_of "$LOGS/bl-play.log" '^noise floor')"
 fi
 echo "total     $(seconds_since "$DEMO_T0") s wall, the whole demo (setup and build included)"
 echo "files     capture set $OUT/capture, frames and heat maps $OUT/play, logs $LOGS"

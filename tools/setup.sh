@@ -36,6 +36,8 @@ PACKAGES=(
   # sharded pipeline (docs/FARM.md): the single-node Slurm of tests/cli/slurm_pipeline.sh, GNU
   # parallel for tools/farm/parallel_run.sh, GNU time for the per-task time and memory lines
   slurmctld slurmd slurm-client munge parallel time
+  # the Blender add-on's tests and the demo's optional Blender part (blender/calf_capture, Cycles)
+  blender
 )
 
 # node and npm for the glTF-Validator below, from Debian when the machine has none.

@@ -647,6 +647,205 @@ TEST(SeuratIngest, GroupThatIsNotOneViewpoint) {
   EXPECT_NE(e.find("no view sees direction"), std::string::npos) << e;
 }
 
+// Every frame of a capture set, view-major: frames[v][f].
+std::vector<std::vector<ViewFrame>> read_all(const fs::path& dir) {
+  auto reader = CaptureSetReader::open(dir);
+  EXPECT_TRUE(reader.ok()) << reader.status().to_string();
+  if (!reader.ok()) return {};
+  const CaptureManifest& m = reader->manifest();
+  std::vector<std::vector<ViewFrame>> out(m.viewpoints.size(),
+                                          std::vector<ViewFrame>(m.frame_count));
+  for (uint32_t v = 0; v < out.size(); ++v) {
+    for (uint32_t f = 0; f < m.frame_count; ++f) {
+      EXPECT_TRUE(reader->read(v, f, &out[v][f]).ok()) << v << " " << f;
+    }
+  }
+  return out;
+}
+
+bool same_pixels(const ViewFrame& a, const ViewFrame& b) {
+  return a.face_size == b.face_size && a.color == b.color &&
+         std::equal(a.depth.begin(), a.depth.end(), b.depth.begin(), b.depth.end(),
+                    [](float x, float y) { return x == y || (std::isnan(x) && std::isnan(y)); });
+}
+
+// A sequence of Seurat captures (one manifest per frame, named by a pattern) becomes one animated
+// set whose frames equal the single-frame ingests of each manifest. The frames differ: frame 0 is
+// an exact cube map, frames 1 and 2 are rotated rigs of the same image size, resampled.
+TEST(SeuratIngest, SequenceEqualsSingleFrameIngests) {
+  const fs::path dir = scratch("sequence");
+  std::vector<SeuratCase> cases(3);
+  cases[1].yaw = 0.3;
+  cases[2].yaw = -0.2;
+  cases[2].pitch = 0.1;
+  for (size_t f = 0; f < cases.size(); ++f) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%04zu", f + 5);
+    write_seurat(dir / name, kCentres, kN, cases[f]);
+  }
+  auto manifests = frame_manifests((dir / "frame_%04d/manifest.json").string(), 5, 0);
+  ASSERT_TRUE(manifests.ok()) << manifests.status().to_string();
+  ASSERT_EQ(manifests->size(), 3u);  // up to the first missing number (8)
+  EXPECT_EQ((*manifests)[2], dir / "frame_0007/manifest.json");
+  IngestReport report;
+  const Status s = ingest_seurat(*manifests, dir / "set", {}, &report);
+  ASSERT_TRUE(s.ok()) << s.to_string();
+  EXPECT_EQ(report.frames, 3u);
+  EXPECT_EQ(report.exact_groups, 0u);  // exact in frame 0 only
+  const auto sequence = read_all(dir / "set");
+  ASSERT_EQ(sequence.size(), 2u);
+  for (size_t f = 0; f < 3; ++f) {
+    const fs::path single = dir / ("single" + std::to_string(f));
+    ASSERT_TRUE(ingest_seurat((*manifests)[f], single, {}).ok());
+    const auto one = read_all(single);
+    for (size_t v = 0; v < 2; ++v) {
+      ASSERT_EQ(sequence[v].size(), 3u);
+      EXPECT_TRUE(same_pixels(sequence[v][f], one[v][0])) << "view " << v << " frame " << f;
+    }
+  }
+  EXPECT_FALSE(same_pixels(sequence[0][0], sequence[0][1]));  // the frames do differ
+  // A count past the last manifest: the missing one is E002 when it is read.
+  auto four = frame_manifests((dir / "frame_%04d/manifest.json").string(), 5, 4);
+  ASSERT_TRUE(four.ok());
+  const Status missing = ingest_seurat(*four, dir / "set_missing", {});
+  EXPECT_NE(missing.to_string().find("CALF-E002"), std::string::npos) << missing.to_string();
+  EXPECT_FALSE(fs::exists(dir / "set_missing"));
+}
+
+// Frames of a sequence that are not the same rig: one line naming both manifests, nothing
+// written.
+TEST(SeuratIngest, SequenceOfMismatchedFrames) {
+  const fs::path dir = scratch("sequence_mismatch");
+  const fs::path first = write_seurat(dir / "f0", kCentres, kN, {});
+  const std::vector<Vec3> moved = {{0, 0, 0}, {0.3, 0.1, -0.25}};
+  SeuratCase bigger;
+  bigger.image_size = 2 * kN;
+  const struct {
+    const char* name;
+    fs::path manifest;
+    const char* id;
+    const char* says;
+  } cases[] = {
+      {"moved", write_seurat(dir / "moved", moved, kN, {}), "CALF-E145", "view_groups[1] is at"},
+      {"fewer", write_seurat(dir / "fewer", {kCentres[0]}, kN, {}), "CALF-E145",
+       "1 view group(s) against 2"},
+      {"bigger", write_seurat(dir / "bigger", kCentres, kN, bigger), "CALF-E147",
+       "is 48 x 48 against 24 x 24"},
+  };
+  for (const auto& c : cases) {
+    const fs::path out = dir / (std::string("set_") + c.name);
+    const Status s = ingest_seurat(std::vector<fs::path>{first, first, c.manifest}, out, {});
+    const std::string e = s.to_string();
+    EXPECT_NE(e.find(c.id), std::string::npos) << c.name << ": " << e;
+    EXPECT_NE(e.find(c.says), std::string::npos) << c.name << ": " << e;
+    EXPECT_NE(e.find(c.manifest.string()), std::string::npos) << c.name << ": " << e;
+    EXPECT_NE(e.find(first.string()), std::string::npos) << c.name << ": " << e;
+    EXPECT_EQ(e.find('\n'), std::string::npos) << c.name << ": " << e;
+    EXPECT_FALSE(fs::exists(out)) << c.name;
+  }
+}
+
+TEST(IngestSequence, FramePatterns) {
+  const fs::path dir = scratch("patterns");
+  fs::create_directories(dir);
+  for (int i : {0, 1, 2, 10}) std::ofstream(dir / ("m" + std::to_string(i) + ".json")) << "{}";
+  auto plain = frame_manifests((dir / "m0.json").string(), 0, 0);
+  ASSERT_TRUE(plain.ok());
+  EXPECT_EQ(*plain, std::vector<fs::path>{dir / "m0.json"});
+  auto run = frame_manifests((dir / "m%d.json").string(), 0, 0);
+  ASSERT_TRUE(run.ok());
+  EXPECT_EQ(run->size(), 3u);  // 0, 1, 2: stops at the first gap
+  auto counted = frame_manifests((dir / "m%d.json").string(), 9, 2);
+  ASSERT_TRUE(counted.ok());  // named, not checked: 9 does not exist
+  EXPECT_EQ(*counted, (std::vector<fs::path>{dir / "m9.json", dir / "m10.json"}));
+  auto padded = frame_manifests("f_%03d.json", 7, 1);
+  ASSERT_TRUE(padded.ok());
+  EXPECT_EQ(padded->at(0), fs::path("f_007.json"));
+  const auto error = [](std::string_view pattern, uint32_t first, uint32_t count) {
+    auto r = frame_manifests(pattern, first, count);
+    return r.ok() ? std::string("ok") : r.status().to_string();
+  };
+  EXPECT_NE(error("m%x.json", 0, 0).find("CALF-E001"), std::string::npos);
+  EXPECT_NE(error("m%00d.json", 0, 0).find("CALF-E001"), std::string::npos);
+  EXPECT_NE(error("m%d_%d.json", 0, 0).find("CALF-E001"), std::string::npos);
+  EXPECT_NE(error("m%d.json", 0, 1000001).find("CALF-E001"), std::string::npos);
+  const std::string none = error((dir / "m%d.json").string(), 3, 0);
+  EXPECT_NE(none.find("CALF-E002"), std::string::npos) << none;
+  EXPECT_NE(none.find("m3.json"), std::string::npos) << none;
+}
+
+// An equirectangular sequence: the frames of each part in turn. Parts of another rig or image
+// size are refused (E149) with nothing written.
+TEST(EquirectIngest, SequenceOfParts) {
+  const fs::path dir = scratch("equirect_sequence");
+  const uint32_t W = 32;
+  const auto write_part = [&](const std::string& name, uint32_t frames, float gain,
+                              const std::vector<Vec3>& centres, uint32_t w) {
+    fs::create_directories(dir / name);
+    for (size_t c = 0; c < centres.size(); ++c) {
+      for (uint32_t f = 0; f < frames; ++f) {
+        std::vector<std::vector<float>> planes(4, std::vector<float>(size_t{w} * (w / 2)));
+        for (uint32_t j = 0; j < w / 2; ++j) {
+          for (uint32_t i = 0; i < w; ++i) {
+            const Hit h = trace(centres[c], direction_from_equirect(i + 0.5, j + 0.5, w, w / 2));
+            const size_t p = size_t{j} * w + i;
+            planes[0][p] = static_cast<float>(h.colour.x) * gain * (f + 1);
+            planes[1][p] = static_cast<float>(h.colour.y) * gain;
+            planes[2][p] = static_cast<float>(h.colour.z);
+            planes[3][p] = static_cast<float>(h.t);
+          }
+        }
+        write_image(dir / name / ("pano_" + std::to_string(c) + "_" + std::to_string(f) + ".exr"),
+                    w, w / 2, {"R", "G", "B", "Z"}, planes);
+      }
+    }
+    std::string views;
+    for (size_t c = 0; c < centres.size(); ++c) {
+      char buf[120];
+      std::snprintf(buf, sizeof buf, "%s{\"position\": [%.17g, %.17g, %.17g]}", c ? ", " : "",
+                    centres[c].x, centres[c].y, centres[c].z);
+      views += buf;
+    }
+    std::ofstream(dir / name / "equirect.json")
+        << "{\"format\": \"calf-equirect-set\", \"version\": 1, \"frame_count\": " << frames
+        << ", \"fps\": 24, \"file_pattern\": \"pano_{view}_{frame}.exr\", \"view_volume\": "
+           "{\"min\": [0, 0, -0.2], \"max\": [0.3, 0.1, 0]}, \"viewpoints\": ["
+        << views << "]}";
+    return dir / name / "equirect.json";
+  };
+  const fs::path a = write_part("part_1", 2, 1.0f, kCentres, W);
+  const fs::path b = write_part("part_2", 1, 0.5f, kCentres, W);
+  auto parts = frame_manifests((dir / "part_%d/equirect.json").string(), 1, 0);
+  ASSERT_TRUE(parts.ok());
+  ASSERT_EQ(parts->size(), 2u);
+  IngestReport report;
+  const Status s = ingest_equirect(*parts, dir / "set", {}, &report);
+  ASSERT_TRUE(s.ok()) << s.to_string();
+  EXPECT_EQ(report.frames, 3u);
+  ASSERT_TRUE(ingest_equirect(a, dir / "set_a", {}).ok());
+  ASSERT_TRUE(ingest_equirect(b, dir / "set_b", {}).ok());
+  const auto seq = read_all(dir / "set"), sa = read_all(dir / "set_a"),
+             sb = read_all(dir / "set_b");
+  for (size_t v = 0; v < 2; ++v) {
+    ASSERT_EQ(seq[v].size(), 3u);
+    EXPECT_TRUE(same_pixels(seq[v][0], sa[v][0])) << v;
+    EXPECT_TRUE(same_pixels(seq[v][1], sa[v][1])) << v;
+    EXPECT_TRUE(same_pixels(seq[v][2], sb[v][0])) << v;
+    EXPECT_FALSE(same_pixels(seq[v][1], seq[v][2])) << v;
+  }
+  const std::vector<Vec3> moved = {{0, 0, 0}, {0.3, 0.1, -0.1}};
+  const fs::path c = write_part("moved", 1, 1.0f, moved, W);
+  const fs::path d = write_part("bigger", 1, 1.0f, kCentres, 2 * W);
+  for (const fs::path& bad : {c, d}) {
+    const Status e = ingest_equirect(std::vector<fs::path>{a, bad}, dir / "set_bad", {});
+    EXPECT_NE(e.to_string().find("CALF-E149"), std::string::npos) << e.to_string();
+    EXPECT_FALSE(fs::exists(dir / "set_bad")) << e.to_string();
+  }
+  const Status moved_error = ingest_equirect(std::vector<fs::path>{a, c}, dir / "set_bad", {});
+  EXPECT_NE(moved_error.to_string().find("viewpoints differ"), std::string::npos)
+      << moved_error.to_string();
+}
+
 // Equirectangular: render the scene as W x W/2 images, convert with the default face size
 // round(W / pi), and compare with the native capture at that size.
 TEST(EquirectIngest, MatchesNativeCaptureAtEqualDensity) {

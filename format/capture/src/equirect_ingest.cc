@@ -251,7 +251,19 @@ void resample(const Equirect& e, uint32_t n, const IngestOptions& options, ViewF
 Status ingest_equirect(const std::filesystem::path& manifest_path,
                        const std::filesystem::path& out_dir, const IngestOptions& options,
                        IngestReport* report) {
-  const std::string source = manifest_path.string();
+  return ingest_equirect(std::vector<std::filesystem::path>{manifest_path}, out_dir, options,
+                         report);
+}
+
+Status ingest_equirect(const std::vector<std::filesystem::path>& manifests,
+                       const std::filesystem::path& out_dir, const IngestOptions& options,
+                       IngestReport* report) {
+  if (manifests.empty() || manifests.size() > 1000000) {
+    return Status(ErrorId::kInvalidArgument,
+                  "an equirectangular sequence needs 1..1000000 manifests, not " +
+                      std::to_string(manifests.size()));
+  }
+  const std::string source = manifests[0].string();
   if (options.supersample < 1 || options.supersample > 8) {
     return Status(ErrorId::kInvalidArgument,
                   "supersample " + std::to_string(options.supersample) + " is outside 1..8");
@@ -264,14 +276,39 @@ Status ingest_equirect(const std::filesystem::path& manifest_path,
     return check_image_budget(what + std::to_string(n), n, n, options.max_image_pixels, 6);
   };
   if (options.face_size) CALF_RETURN_IF_ERROR(check_faces("face size ", options.face_size));
-  CALF_ASSIGN_OR_RETURN(std::string text, read_small_file(manifest_path));
-  CALF_ASSIGN_OR_RETURN(CaptureManifest input, parse_equirect_manifest(text, source));
-  const std::filesystem::path dir = manifest_path.parent_path();
+  // Every manifest first: the same rig, volume and fps as the first, frames added up.
+  std::vector<CaptureManifest> inputs;
+  uint64_t frame_total = 0;
+  for (const std::filesystem::path& path : manifests) {
+    CALF_ASSIGN_OR_RETURN(std::string text, read_small_file(path));
+    CALF_ASSIGN_OR_RETURN(CaptureManifest in, parse_equirect_manifest(text, path.string()));
+    if (!inputs.empty()) {
+      const CaptureManifest& a = inputs[0];
+      const char* what = a.viewpoints != in.viewpoints        ? "viewpoints"
+                         : !(a.view_volume == in.view_volume) ? "view_volume"
+                         : a.fps != in.fps                    ? "fps"
+                                                              : nullptr;
+      if (what) {
+        return Status(ErrorId::kEquirectInput,
+                      path.string() + " (a part of the sequence): its " + what + " differ from " +
+                          source + "'s (the first part); every part must be the same rig");
+      }
+    }
+    frame_total += in.frame_count;
+    if (frame_total > 1000000) {
+      return Status(ErrorId::kCaptureLimit, path.string() +
+                                                ": the sequence has more than "
+                                                "1000000 frames");
+    }
+    inputs.push_back(std::move(in));
+  }
+  std::filesystem::path dir = manifests[0].parent_path();
   // The first image decides the face size (and every other image must match it).
   Equirect image;
   CALF_RETURN_IF_ERROR(
-      load(dir / capture_file_name(input, 0, 0), options.max_image_pixels, &image));
-  CaptureManifest m = input;
+      load(dir / capture_file_name(inputs[0], 0, 0), options.max_image_pixels, &image));
+  CaptureManifest m = inputs[0];
+  m.frame_count = static_cast<uint32_t>(frame_total);
   m.generator = "calf-ingest";
   m.file_pattern = kDefaultFilePattern;
   m.face_size =
@@ -288,22 +325,28 @@ Status ingest_equirect(const std::filesystem::path& manifest_path,
                         detail::create_ingest_writer(out_dir, m, &created));
   ViewFrame frame;
   frame.resize(m.face_size, false);
-  for (uint32_t v = 0; v < m.viewpoints.size(); ++v) {
-    for (uint32_t f = 0; f < m.frame_count; ++f) {
-      Status s;
-      if (v != 0 || f != 0) {
-        s = load(dir / capture_file_name(input, v, f), options.max_image_pixels, &image);
-      }
-      if (s.ok()) {
-        resample(image, m.face_size, options, &frame);
-        s = writer.write(v, f, frame);
-      }
-      if (!s.ok()) {
-        writer.abandon();
-        detail::remove_empty_folders(created);
-        return s;
+  uint32_t out_frame = 0;
+  for (size_t part = 0; part < inputs.size(); ++part) {
+    const CaptureManifest& input = inputs[part];
+    dir = manifests[part].parent_path();
+    for (uint32_t v = 0; v < m.viewpoints.size(); ++v) {
+      for (uint32_t f = 0; f < input.frame_count; ++f) {
+        Status s;
+        if (part != 0 || v != 0 || f != 0) {
+          s = load(dir / capture_file_name(input, v, f), options.max_image_pixels, &image);
+        }
+        if (s.ok()) {
+          resample(image, m.face_size, options, &frame);
+          s = writer.write(v, out_frame + f, frame);
+        }
+        if (!s.ok()) {
+          writer.abandon();
+          detail::remove_empty_folders(created);
+          return s;
+        }
       }
     }
+    out_frame += input.frame_count;
   }
   if (Status s = writer.finish(); !s.ok()) {
     writer.abandon();

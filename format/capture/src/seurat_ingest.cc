@@ -261,26 +261,30 @@ Status resample_group(const std::vector<PreparedView>& views, const std::string&
 Status ingest_seurat(const std::filesystem::path& manifest_path,
                      const std::filesystem::path& out_dir, const IngestOptions& options,
                      IngestReport* report) {
-  const std::string source = manifest_path.string();
-  if (options.face_size) {
-    CALF_RETURN_IF_ERROR(check_image_budget("face size " + std::to_string(options.face_size),
-                                            options.face_size, options.face_size,
-                                            options.max_image_pixels, 6));
-  }
-  CALF_ASSIGN_OR_RETURN(std::string text, read_small_file(manifest_path));
-  CALF_ASSIGN_OR_RETURN(SeuratCapture capture, parse_seurat_manifest(text, source));
-  const std::filesystem::path dir = manifest_path.parent_path();
+  return ingest_seurat(std::vector<std::filesystem::path>{manifest_path}, out_dir, options, report);
+}
 
-  // Geometry first: centres, sizes and the view volume, before any image is read.
+namespace {
+
+// One frame of a sequence: its manifest, parsed, and its views' geometry (no pixels yet).
+struct SeuratFrame {
+  std::string source;
+  std::filesystem::path dir;
+  SeuratCapture capture;
   std::vector<std::vector<PreparedView>> groups;
-  CaptureManifest m;
-  m.frame_count = 1;
-  m.fps = options.fps;
-  m.generator = "calf-ingest";
-  uint32_t density = 1;
-  for (size_t g = 0; g < capture.view_groups.size(); ++g) {
+  std::vector<Vec3> centres;
+  uint32_t density = 1;  // the largest pixel density of any view (the default face size)
+};
+
+Status prepare_frame(const std::filesystem::path& manifest_path, SeuratFrame* out) {
+  out->source = manifest_path.string();
+  const std::string& source = out->source;
+  CALF_ASSIGN_OR_RETURN(std::string text, read_small_file(manifest_path));
+  CALF_ASSIGN_OR_RETURN(out->capture, parse_seurat_manifest(text, source));
+  out->dir = manifest_path.parent_path();
+  for (size_t g = 0; g < out->capture.view_groups.size(); ++g) {
     std::vector<PreparedView> prepared;
-    for (const SeuratView& v : capture.view_groups[g]) {
+    for (const SeuratView& v : out->capture.view_groups[g]) {
       prepared.push_back(prepare_geometry(v));
       const PreparedView& p = prepared.back();
       if (!(std::fabs(p.q[0] * p.q[4] - p.q[1] * p.q[3]) > 1e-12)) {
@@ -288,7 +292,8 @@ Status ingest_seurat(const std::filesystem::path& manifest_path,
                                                  "]: a clip_from_eye_matrix is singular in x, y");
       }
       const double side = std::max(p.w * std::fabs(p.q[0]), p.h * std::fabs(p.q[4]));
-      density = std::max(density, static_cast<uint32_t>(std::min(std::round(side), 16384.0)));
+      out->density =
+          std::max(out->density, static_cast<uint32_t>(std::min(std::round(side), 16384.0)));
     }
     const Vec3 centre = prepared[0].origin;
     const double tol = 1e-5 * std::max(1.0, length(centre));
@@ -301,13 +306,81 @@ Status ingest_seurat(const std::filesystem::path& manifest_path,
                           ": a group's views must share one centre of projection");
       }
     }
-    m.viewpoints.push_back({"group" + std::to_string(g), centre});
-    groups.push_back(std::move(prepared));
+    out->centres.push_back(centre);
+    out->groups.push_back(std::move(prepared));
+  }
+  return Status::Ok();
+}
+
+// Frame `b` of a sequence against frame 0 (`a`): the same rig, view for view.
+Status same_rig(const SeuratFrame& a, const SeuratFrame& b) {
+  const std::string both =
+      b.source + " (a frame of the sequence) against " + a.source + " (its first frame): ";
+  if (a.groups.size() != b.groups.size()) {
+    return Status(ErrorId::kSeuratViewGroup,
+                  both + std::to_string(b.groups.size()) + " view group(s) against " +
+                      std::to_string(a.groups.size()) + "; every frame must be the same rig");
+  }
+  for (size_t g = 0; g < a.groups.size(); ++g) {
+    const std::string where = "view_groups[" + std::to_string(g) + "]";
+    if (a.groups[g].size() != b.groups[g].size()) {
+      return Status(ErrorId::kSeuratViewGroup,
+                    both + where + " has " + std::to_string(b.groups[g].size()) +
+                        " view(s) against " + std::to_string(a.groups[g].size()) +
+                        "; every frame must be the same rig");
+    }
+    const double tol = 1e-5 * std::max(1.0, length(a.centres[g]));
+    if (length(a.centres[g] - b.centres[g]) > tol) {
+      return Status(ErrorId::kSeuratViewGroup, both + where + " is at " + vec_text(b.centres[g]) +
+                                                   " against " + vec_text(a.centres[g]) +
+                                                   "; every frame must be the same rig");
+    }
+    for (size_t k = 0; k < a.groups[g].size(); ++k) {
+      const PreparedView &va = a.groups[g][k], &vb = b.groups[g][k];
+      if (va.w != vb.w || va.h != vb.h) {
+        return Status(ErrorId::kSeuratImageSize,
+                      both + where + ".views[" + std::to_string(k) + "] is " +
+                          std::to_string(vb.w) + " x " + std::to_string(vb.h) + " against " +
+                          std::to_string(va.w) + " x " + std::to_string(va.h) +
+                          "; every frame must have the same image sizes");
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status ingest_seurat(const std::vector<std::filesystem::path>& manifests,
+                     const std::filesystem::path& out_dir, const IngestOptions& options,
+                     IngestReport* report) {
+  if (manifests.empty() || manifests.size() > 1000000) {
+    return Status(ErrorId::kInvalidArgument, "a Seurat sequence needs 1..1000000 manifests, not " +
+                                                 std::to_string(manifests.size()));
+  }
+  if (options.face_size) {
+    CALF_RETURN_IF_ERROR(check_image_budget("face size " + std::to_string(options.face_size),
+                                            options.face_size, options.face_size,
+                                            options.max_image_pixels, 6));
+  }
+  // Geometry first, of every frame: centres, sizes and the view volume, before any image is read.
+  std::vector<SeuratFrame> frames(manifests.size());
+  for (size_t f = 0; f < manifests.size(); ++f) {
+    CALF_RETURN_IF_ERROR(prepare_frame(manifests[f], &frames[f]));
+    if (f) CALF_RETURN_IF_ERROR(same_rig(frames[0], frames[f]));
+  }
+  const std::string& source = frames[0].source;
+  CaptureManifest m;
+  m.frame_count = static_cast<uint32_t>(frames.size());
+  m.fps = options.fps;
+  m.generator = "calf-ingest";
+  for (size_t g = 0; g < frames[0].centres.size(); ++g) {
+    m.viewpoints.push_back({"group" + std::to_string(g), frames[0].centres[g]});
   }
   Box3 box{m.viewpoints[0].position, m.viewpoints[0].position};
   for (const Viewpoint& v : m.viewpoints) box = box_union(box, v.position);
   if (options.headbox_size > 0) {
-    const Vec3 c = capture.headbox_center.value_or((box.min + box.max) * 0.5);
+    const Vec3 c = frames[0].capture.headbox_center.value_or((box.min + box.max) * 0.5);
     const double h = options.headbox_size * 0.5;
     m.view_volume = {c - Vec3{h, h, h}, c + Vec3{h, h, h}};
   } else {
@@ -320,7 +393,7 @@ Status ingest_seurat(const std::filesystem::path& manifest_path,
     }
     m.view_volume = box;
   }
-  m.face_size = options.face_size ? options.face_size : density;
+  m.face_size = options.face_size ? options.face_size : frames[0].density;
   if (!options.face_size) {
     // The cameras' pixel density (a matrix term of 1e300 implies the largest face size).
     CALF_RETURN_IF_ERROR(check_image_budget(
@@ -334,27 +407,30 @@ Status ingest_seurat(const std::filesystem::path& manifest_path,
 
   ViewFrame frame;
   frame.resize(m.face_size, false);
-  uint32_t exact_groups = 0;
-  for (size_t g = 0; g < groups.size(); ++g) {
-    const std::string where = source + ": view_groups[" + std::to_string(g) + "]";
-    Status s;
-    for (size_t k = 0; k < groups[g].size() && s.ok(); ++k) {
-      s = load_pixels(capture.view_groups[g][k], dir, m.viewpoints[g].position,
-                      where + ".views[" + std::to_string(k) + "]", options.max_image_pixels,
-                      &groups[g][k]);
+  std::vector<bool> exact_always(m.viewpoints.size(), true);
+  for (size_t f = 0; f < frames.size(); ++f) {
+    SeuratFrame& sf = frames[f];
+    for (size_t g = 0; g < sf.groups.size(); ++g) {
+      const std::string where = sf.source + ": view_groups[" + std::to_string(g) + "]";
+      Status s;
+      for (size_t k = 0; k < sf.groups[g].size() && s.ok(); ++k) {
+        s = load_pixels(sf.capture.view_groups[g][k], sf.dir, m.viewpoints[g].position,
+                        where + ".views[" + std::to_string(k) + "]", options.max_image_pixels,
+                        &sf.groups[g][k]);
+      }
+      bool exact = false;
+      if (s.ok()) {
+        s = resample_group(sf.groups[g], where, m.face_size, &frame, &exact);
+      }
+      sf.groups[g].clear();  // release the pixels: one group in memory at a time
+      if (s.ok()) s = writer.write(static_cast<uint32_t>(g), static_cast<uint32_t>(f), frame);
+      if (!s.ok()) {
+        writer.abandon();
+        detail::remove_empty_folders(created);
+        return s;
+      }
+      exact_always[g] = exact_always[g] && exact;
     }
-    bool exact = false;
-    if (s.ok()) {
-      s = resample_group(groups[g], where, m.face_size, &frame, &exact);
-    }
-    groups[g].clear();  // release the pixels: one group in memory at a time
-    if (s.ok()) s = writer.write(static_cast<uint32_t>(g), 0, frame);
-    if (!s.ok()) {
-      writer.abandon();
-      detail::remove_empty_folders(created);
-      return s;
-    }
-    exact_groups += exact ? 1 : 0;
   }
   if (Status s = writer.finish(); !s.ok()) {
     writer.abandon();
@@ -362,7 +438,8 @@ Status ingest_seurat(const std::filesystem::path& manifest_path,
     return s;
   }
   if (report) {
-    *report = {static_cast<uint32_t>(m.viewpoints.size()), 1, m.face_size, exact_groups};
+    *report = {static_cast<uint32_t>(m.viewpoints.size()), m.frame_count, m.face_size,
+               static_cast<uint32_t>(std::count(exact_always.begin(), exact_always.end(), true))};
   }
   return Status::Ok();
 }

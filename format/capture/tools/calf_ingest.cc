@@ -16,7 +16,11 @@ static int command_main(int argc, char** argv) {
                            "  calf-ingest seurat MANIFEST OUT_DIR     a Seurat capture manifest "
                            "(Maya, Unity, Unreal): one viewpoint per view group\n"
                            "  calf-ingest equirect MANIFEST OUT_DIR   equirectangular colour + "
-                           "radial depth per viewpoint and frame\n") +
+                           "radial depth per viewpoint and frame\n"
+                           "A MANIFEST holding a frame number, %d or %0Nd (e.g. "
+                           "frame_%04d/manifest.json), is a sequence: one manifest per frame "
+                           "(equirect: per run of frames) from --first-frame on, all made one "
+                           "animated capture set; every frame must be the same rig.\n") +
                calf::tools::kExitStatusHelp};
   app.set_version_flag("--version", std::string("calf ") + calf::kVersionString);
   app.require_subcommand(1);
@@ -24,7 +28,17 @@ static int command_main(int argc, char** argv) {
   calf::capture::IngestOptions options;
   std::string manifest, out, filter = "catmull-rom", depth = "nearest";
   bool quiet = false;
+  uint32_t first_frame = 0, frame_count = 0;
   app.add_flag("--quiet", quiet, "print no summary line (default: print one)");
+  const auto add_sequence_options = [&](CLI::App* sub) {
+    sub->add_option("--first-frame", first_frame,
+                    "with a MANIFEST pattern: the number of its first frame; default 0")
+        ->check(CLI::Range(0u, 999999999u));
+    sub->add_option("--frame-count", frame_count,
+                    "with a MANIFEST pattern: how many manifests; default 0 = every one from "
+                    "--first-frame up to the first number with no file")
+        ->check(CLI::Range(0u, 1000000u));
+  };
 
   CLI::App* seurat = app.add_subcommand(
       "seurat",
@@ -32,7 +46,9 @@ static int command_main(int argc, char** argv) {
       "common centre, its faces resampled from the views (an exact cube map is copied "
       "texel for texel); colour bilinear, depth from the nearest pixel, made radial.");
   seurat
-      ->add_option("MANIFEST", manifest, "the Seurat JSON manifest; image paths are relative to it")
+      ->add_option("MANIFEST", manifest,
+                   "the Seurat JSON manifest, or a pattern naming one per frame (%d or %0Nd); "
+                   "image paths are relative to each manifest")
       ->required();
   seurat->add_option("OUT_DIR", out, "the capture set to write (created; manifest.json last)")
       ->required();
@@ -61,7 +77,8 @@ static int command_main(int argc, char** argv) {
                          "samples per texel, depth the nearest pixel's.");
   equirect
       ->add_option("MANIFEST", manifest,
-                   "the calf-equirect-set manifest (CAPTURE.md); images relative to it")
+                   "the calf-equirect-set manifest (CAPTURE.md), or a pattern naming several "
+                   "(%d or %0Nd) whose frames follow each other; images relative to each")
       ->required();
   equirect->add_option("OUT_DIR", out, "the capture set to write (created; manifest.json last)")
       ->required();
@@ -97,6 +114,8 @@ static int command_main(int argc, char** argv) {
                    calf::capture::kMaxImagePixelsHelp)
       ->check(CLI::Range(uint64_t{1}, calf::capture::kMaxImagePixelsLimit));
 
+  add_sequence_options(seurat);
+  add_sequence_options(equirect);
   if (int rc = calf::tools::parse_command_line(app, "calf-ingest", argc, argv); rc >= 0) return rc;
   options.equirect_filter = filter == "bilinear" ? calf::capture::EquirectFilter::kBilinear
                                                  : calf::capture::EquirectFilter::kCatmullRom;
@@ -104,9 +123,22 @@ static int command_main(int argc, char** argv) {
                                                  : calf::capture::EquirectDepth::kNearest;
   calf::capture::IngestReport report;
   const bool is_seurat = seurat->parsed();
+  if (manifest.find('%') == std::string::npos && (first_frame || frame_count)) {
+    return calf::tools::usage_error("calf-ingest",
+                                    "--first-frame and --frame-count need a MANIFEST pattern "
+                                    "(%d or %0Nd)");
+  }
+  auto manifests = calf::capture::frame_manifests(manifest, first_frame, frame_count);
+  if (!manifests.ok()) {
+    // A malformed pattern is a bad argument (exit 2); a missing first manifest an error.
+    if (manifests.status().id() == calf::ErrorId::kInvalidArgument) {
+      return calf::tools::usage_error("calf-ingest", manifests.status().message());
+    }
+    return calf::tools::print_error("calf-ingest", manifests.status());
+  }
   const calf::Status s = is_seurat
-                             ? calf::capture::ingest_seurat(manifest, out, options, &report)
-                             : calf::capture::ingest_equirect(manifest, out, options, &report);
+                             ? calf::capture::ingest_seurat(*manifests, out, options, &report)
+                             : calf::capture::ingest_equirect(*manifests, out, options, &report);
   if (!s.ok()) return calf::tools::print_error("calf-ingest", s);
   if (!quiet) {
     fmt::print("calf-ingest: wrote {} viewpoint(s) x {} frame(s), face size {}{} to {}\n",

@@ -42,6 +42,7 @@ enum class ErrorKind : uint8_t {
   X(kOutputIsInput, 7, kInvalidArgument, "an output path names one of the command's inputs")    \
   X(kImageBudget, 12, kLimit, "an image or a viewpoint's faces exceed the image budget")        \
   X(kOutOfMemory, 13, kLimit, "the command ran out of memory")                                  \
+  X(kRendererUnavailable, 14, kUnsupported, "the renderer a command needs is not available")    \
   /* conventions */                                                                             \
   X(kDepthRange, 20, kInvalidArgument, "z_near / z_far do not form a valid log-depth range")    \
   X(kDepthValue, 21, kCorrupt, "a depth value is NaN, negative, zero or -inf")                  \

@@ -117,11 +117,28 @@ struct IngestReport {
   uint32_t exact_groups = 0;  // Seurat: groups whose every texel was an exact pixel copy
 };
 
+// The manifests of a sequence, one per frame (or, equirectangular, one per run of frames):
+// `pattern` holds one printf-style frame number, `%d` or `%0Nd` (N in 1..9; no other `%`), replaced
+// by first, first + 1, ...: `count` of them, or with count 0 every one that exists up to the first
+// missing number (at least one must exist, else E002 naming it). A pattern without `%` is the one
+// manifest it names. Errors: E001 a malformed pattern, a count over 1 000 000 frames; E002.
+Expected<std::vector<std::filesystem::path>> frame_manifests(std::string_view pattern,
+                                                             uint32_t first, uint32_t count);
+
 // Converts the Seurat manifest at `manifest_path` into a capture set in `out_dir`.
 // Errors: E130/E143 manifest, E144 headbox, E145 group, E146 channel, E147 sizes (an image's
 // header against its camera, before it is decoded), E148 depth, E135/E136 images, E012 budget,
 // E137/E138 converted pixels, E004 writing.
 Status ingest_seurat(const std::filesystem::path& manifest_path,
+                     const std::filesystem::path& out_dir, const IngestOptions& options,
+                     IngestReport* report = nullptr);
+
+// A sequence: manifest k is frame k of one animated capture set (a Seurat capture is one frame).
+// Every frame must be the same rig: as many view groups, each of as many views of the same image
+// sizes at the same centre (within 10^-5 relative) as frame 0's (E145 for the groups and centres,
+// E147 for the sizes, naming both manifests). The view volume and the face size are frame 0's.
+// The report's exact_groups counts groups copied exactly in every frame.
+Status ingest_seurat(const std::vector<std::filesystem::path>& manifests,
                      const std::filesystem::path& out_dir, const IngestOptions& options,
                      IngestReport* report = nullptr);
 
@@ -134,6 +151,12 @@ Status ingest_seurat(const std::filesystem::path& manifest_path,
 // Errors: E130-E134 and E149 manifest, E135/E136/E149 images, E012 budget, E137/E138 pixels,
 // E004 writing.
 Status ingest_equirect(const std::filesystem::path& manifest_path,
+                       const std::filesystem::path& out_dir, const IngestOptions& options,
+                       IngestReport* report = nullptr);
+// A sequence: the frames of every manifest in turn, one animated capture set. Every manifest must
+// have frame 0's viewpoints (names and positions), view volume and fps, and every image the first
+// image's size (E149 naming both manifests, or the image).
+Status ingest_equirect(const std::vector<std::filesystem::path>& manifests,
                        const std::filesystem::path& out_dir, const IngestOptions& options,
                        IngestReport* report = nullptr);
 

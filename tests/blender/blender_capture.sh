@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# The Blender add-on (blender/calf_capture) end to end, headless:
+#   blender_capture.sh playback BIN_DIR SRC_DIR WORK_DIR MIN_DB
+#     builds the test scene (tests/blender/make_scene.py: checker-textured floor and wall, a moving
+#     cube, a glossy sphere; 3 viewpoints from a collection, view volume from a box object, 3
+#     frames), renders its capture set (faces of 32, 16 samples) and ground truth along the
+#     camera's animation (64 x 48, noise floor at seed + 1), encodes it with calf-encode, verifies
+#     the clip with calf-verify and plays it with calf-play --compare: the mean PSNR must reach
+#     MIN_DB.
+#   blender_capture.sh room BIN_DIR SRC_DIR WORK_DIR BOX_ROOM_CHECK
+#     renders a box room with a block in it (tests/blender/box_room.py) from two viewpoints, with
+#     coverage, and checks every texel's radial depth against the distance along calf's
+#     direction_from_texel and its coverage against the cells' distances
+#     (tests/capture/box_room_check.cc): fails on a wrong face order, orientation, depth or cell
+#     order.
+#   blender_capture.sh errors BIN_DIR SRC_DIR WORK_DIR
+#     each refusal is one line with its id and exit status, and leaves no manifest.
+# Without Blender it is skipped (exit 77, one line), except with CI=true, where it fails.
+set -euo pipefail
+mode=$1 bin=$2 src=$3 work=$4
+if ! command -v blender >/dev/null; then
+  if [ "${CI:-}" = "true" ]; then
+    echo "blender_capture: FAILED: blender missing with CI=true (tools/setup.sh installs it)"
+    exit 1
+  fi
+  echo "blender_capture: skipped: blender missing (tools/setup.sh installs it)"
+  exit 77
+fi
+rm -rf "$work"
+mkdir -p "$work"
+cd "$work"
+cli="$src/blender/calf_capture/cli.py"
+blend() {  # scene script, then the add-on's arguments; prints the add-on's lines
+  local scene=$1 rc
+  shift
+  set +e
+  blender -b --factory-startup -noaudio -P "$src/tests/blender/$scene" -P "$cli" -- --threads 2 \
+    "$@" 2>&1 | grep '^calf-blender'
+  rc=${PIPESTATUS[0]}
+  set -e
+  return "$rc"
+}
+case $mode in
+  playback)
+    min_db=$5
+    blend make_scene.py --out cap --collection calf_viewpoints --volume-object calf_volume \
+      --face-size 32 --samples 16 | tail -n 2
+    blend make_scene.py --out gt --ground-truth --camera Eye --gt-size 64x48 --samples 16 | tail -n 1
+    "$bin/calf-encode" cap -o clip.calf --quiet
+    "$bin/calf-verify" clip.calf
+    out=$("$bin/calf-play" clip.calf --headless --renderer cpu --compare gt)
+    echo "$out" | grep -E '^(mean PSNR|noise floor)'
+    psnr=$(echo "$out" | sed -n 's/^mean PSNR \([0-9.]*\) dB.*/\1/p')
+    if awk -v a="$psnr" -v b="$min_db" 'BEGIN { exit !(a >= b) }'; then
+      echo "blender_capture: mean PSNR $psnr dB >= $min_db dB"
+    else
+      echo "blender_capture: FAIL mean PSNR $psnr dB below $min_db dB"
+      exit 1
+    fi
+    ;;
+  room)
+    blend box_room.py --out room --rig "list:0,0,0/0.4,0.3,-0.2" --face-size 16 --samples 1 \
+      --coverage | tail -n 1
+    "$5" room -1.5,-0.8,-1.3,2.1,1.7,1.9 0.6,-0.5,0.5,1.2,0.2,1.1 1e-4
+    ;;
+  errors)
+    # The refusals in one Blender process (tests/blender/error_cases.py), then one of them through
+    # the command itself: one line on stderr, exit status 2, no manifest.
+    blender -b --factory-startup -noaudio -P "$src/tests/blender/error_cases.py" -- "$work" \
+      2>&1 | grep '^error_cases'
+    set +e
+    blender -b --factory-startup -noaudio -P "$cli" -- --out "$work/big" --rig list:0,1,0 \
+      --face-size 16385 >/dev/null 2>stderr.txt
+    rc=$?
+    set -e
+    line=$(cat stderr.txt)
+    if [ "$rc" = 2 ] && [ "$(echo "$line" | wc -l)" = 1 ] &&
+       echo "$line" | grep -qE '^calf-blender: CALF-E006 face size 16385 ' && ! [ -e big/manifest.json ]; then
+      echo "blender_capture: the command: exit $rc, $line"
+    else
+      echo "blender_capture: FAIL the command: exit $rc (want 2), stderr: $line"
+      exit 1
+    fi
+    ;;
+  *)
+    echo "blender_capture: unknown mode $mode"
+    exit 2
+    ;;
+esac
