@@ -8,7 +8,9 @@
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <set>
 #include <system_error>
+#include <utility>
 
 #include <OpenImageIO/fmath.h>
 
@@ -270,6 +272,22 @@ constexpr uint8_t kExrMagic[4] = {0x76, 0x2f, 0x31, 0x01};
 constexpr uint32_t kExrTiled = 0x200, kExrLongNames = 0x400, kExrNonImage = 0x800,
                    kExrMultiPart = 0x1000;
 
+// The value size of the fixed-size attribute types (OpenEXR reads that many bytes whatever the
+// size field says, so a header whose size differs is read differently by OpenEXR than walked
+// here); 0 for types of any size.
+int32_t exr_fixed_size(const std::string& type) {
+  static const std::pair<const char*, int32_t> kSizes[] = {
+      {"box2i", 16},      {"box2f", 16},    {"float", 4},    {"double", 8},         {"int", 4},
+      {"v2i", 8},         {"v2f", 8},       {"v2d", 16},     {"v3i", 12},           {"v3f", 12},
+      {"v3d", 24},        {"m33f", 36},     {"m33d", 72},    {"m44f", 64},          {"m44d", 128},
+      {"compression", 1}, {"lineOrder", 1}, {"envmap", 1},   {"deepImageState", 1}, {"rational", 8},
+      {"keycode", 28},    {"timecode", 8},  {"tiledesc", 9}, {"chromaticities", 32}};
+  for (const auto& [name, size] : kSizes) {
+    if (type == name) return size;
+  }
+  return 0;
+}
+
 int32_t le32(const uint8_t* p) {
   return static_cast<int32_t>(uint32_t{p[0]} | uint32_t{p[1]} << 8 | uint32_t{p[2]} << 16 |
                               uint32_t{p[3]} << 24);
@@ -304,6 +322,7 @@ class ExrWalk {
     int32_t window[4] = {0, 0, 0, 0};
     int compression = -1;
     uint64_t pixel_bytes = 0;  // the bytes of one pixel of every channel
+    std::set<std::string> names;
     for (;;) {
       std::string attribute, type;
       CALF_RETURN_IF_ERROR(read_name(&attribute));
@@ -318,6 +337,13 @@ class ExrWalk {
         return bad("header attribute '" + attribute + "' (" + type + ") declares " +
                    std::to_string(size) + " bytes, more than the " + std::to_string(left) +
                    " bytes left in the file");
+      }
+      if (const int32_t fixed = exr_fixed_size(type); fixed != 0 && size != fixed) {
+        return bad("header attribute '" + attribute + "' (" + type + ") has " +
+                   std::to_string(size) + " bytes; the type has " + std::to_string(fixed));
+      }
+      if (!names.insert(attribute).second) {
+        return bad("header attribute '" + attribute + "' appears twice");
       }
       const uint64_t value = at_, end = at_ + static_cast<uint64_t>(size);
       if (attribute == "dataWindow") {
