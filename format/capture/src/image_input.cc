@@ -375,7 +375,6 @@ class ExrWalk {
       at_ = end;
     }
     if (!have_window) return bad("the header has no dataWindow");
-    if (!have_channels || out->channels == 0) return bad("the header has no channels");
     const int64_t w = int64_t{window[2]} - window[0] + 1, h = int64_t{window[3]} - window[1] + 1;
     if (w < 1 || h < 1 || w > kMaxExrSide || h > kMaxExrSide) {
       return bad("data window " + std::to_string(w) + " x " + std::to_string(h) +
@@ -394,6 +393,7 @@ class ExrWalk {
                  " chunk offsets, more than the file's " + std::to_string(bytes_.size()) +
                  " bytes hold");
     }
+    if (!have_channels || out->channels == 0) return bad("the header has no channels");
     const uint64_t chunk_bytes = static_cast<uint64_t>(w) * pixel_bytes * std::min(lines, h);
     if (chunk_bytes > kMaxExrChunkBytes) {
       return bad(std::to_string(out->channels) + " channels of " + std::to_string(w) +
