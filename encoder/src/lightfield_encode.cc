@@ -939,7 +939,7 @@ Expected<LightfieldEncodeStats> encode_lightfield_file(const std::filesystem::pa
                                                        const LightfieldEncodeOptions& options) {
   CALF_RETURN_IF_ERROR(lightfield_internal::validate_options(options));
   CALF_ASSIGN_OR_RETURN(capture::CaptureSetReader input,
-                        capture::CaptureSetReader::open(capture_dir));
+                        capture::CaptureSetReader::open(capture_dir, options.max_image_pixels));
   // The output must not be one of the inputs: renaming over the manifest or an image would
   // destroy the set the clip is made from (CALF-E007; the directory itself is E004's).
   std::vector<std::string> inputs = {capture_dir.string(),

@@ -318,7 +318,7 @@ Expected<LightfieldAnalysisFile> write_lightfield_analysis(const std::filesystem
                                                            const LightfieldEncodeOptions& options) {
   CALF_RETURN_IF_ERROR(lightfield_internal::validate_options(options));
   CALF_ASSIGN_OR_RETURN(capture::CaptureSetReader input,
-                        capture::CaptureSetReader::open(capture_dir));
+                        capture::CaptureSetReader::open(capture_dir, options.max_image_pixels));
   CALF_RETURN_IF_ERROR(files::check_output_not_input(out_path, capture_inputs(input)));
   LightfieldAnalysisFile file;
   file.path = out_path;
@@ -389,14 +389,12 @@ Expected<LightfieldAnalysisFile> read_lightfield_analysis(const std::string& pat
   return file;
 }
 
-Expected<LightfieldEncodeStats> encode_lightfield_shard(const std::filesystem::path& capture_dir,
-                                                        const LightfieldAnalysisFile& analysis,
-                                                        std::span<const uint32_t> views,
-                                                        uint32_t first_frame, uint32_t frame_count,
-                                                        uint32_t threads,
-                                                        const std::string& out_path) {
+Expected<LightfieldEncodeStats> encode_lightfield_shard(
+    const std::filesystem::path& capture_dir, const LightfieldAnalysisFile& analysis,
+    std::span<const uint32_t> views, uint32_t first_frame, uint32_t frame_count, uint32_t threads,
+    const std::string& out_path, uint64_t max_image_pixels) {
   CALF_ASSIGN_OR_RETURN(capture::CaptureSetReader input,
-                        capture::CaptureSetReader::open(capture_dir));
+                        capture::CaptureSetReader::open(capture_dir, max_image_pixels));
   const capture::CaptureManifest& m = input.manifest();
   const container::LightfieldTrackHeader& h = analysis.analysis.header;
   if (m.viewpoints.size() != h.view_count || m.frame_count != h.frame_count ||

@@ -210,6 +210,22 @@ Status add_part(container::Writer* writer, uint16_t track, Part& part, MeshEncod
   return Status::Ok();
 }
 
+Status compress_into(Part& part, MeshStream stream, uint32_t region, std::span<const uint8_t> raw,
+                     const MeshEncodeOptions& options, const std::string& what) {
+  if (raw.size() > container::kMaxRawChunkSize)
+    return Status(ErrorId::kMeshLimit, cat(what, ": ", raw.size(),
+                                           " bytes exceed the "
+                                           "container's chunk limit"));
+  CALF_ASSIGN_OR_RETURN(StoredChunk c,
+                        container::compress_chunk(raw, options.supercompression, options.levels));
+  ChunkKeys keys;
+  keys.stream = static_cast<uint16_t>(stream);
+  keys.region = region;
+  part.chunks.emplace_back(keys, std::move(c));
+  return Status::Ok();
+}
+
+// The same for a chunk the layout encodes first; its raw bytes are released on return.
 Status compress_into(Part& part, MeshStream stream, uint32_t region,
                      Expected<std::vector<uint8_t>> raw, const MeshEncodeOptions& options,
                      const std::string& what) {
@@ -219,17 +235,7 @@ Status compress_into(Part& part, MeshStream stream, uint32_t region,
     return st.id() == ErrorId::kContainerWriterMisuse ? input_error(what + ": " + st.message())
                                                       : st;
   }
-  if (raw->size() > container::kMaxRawChunkSize)
-    return Status(ErrorId::kMeshLimit, cat(what, ": ", raw->size(),
-                                           " bytes exceed the "
-                                           "container's chunk limit"));
-  CALF_ASSIGN_OR_RETURN(StoredChunk c,
-                        container::compress_chunk(*raw, options.supercompression, options.levels));
-  ChunkKeys keys;
-  keys.stream = static_cast<uint16_t>(stream);
-  keys.region = region;
-  part.chunks.emplace_back(keys, std::move(c));
-  return Status::Ok();
+  return compress_into(part, stream, region, std::span<const uint8_t>(*raw), options, what);
 }
 
 uint64_t plain_bytes(const Plan& plan) {
@@ -379,12 +385,17 @@ Status encode_mesh_track(const capture::SceneFile& scene,
               const auto& st = scene.textures[t];
               const mesh::TextureTexels texels{st.width, st.height, st.rgba};
               Part ways[2];
-              for (uint32_t c : {mesh::kTextureSrgba8Med, mesh::kTextureSrgba8Plain}) {
-                mesh::TextureRecord r = x.textures[t];
-                r.coding = c;
-                ways[c].status = compress_into(
-                    ways[c], MeshStream::kTextures, static_cast<uint32_t>(t),
-                    mesh::encode_texture(r, texels), options, cat("scene texture ", t));
+              mesh::TextureRecord r = x.textures[t];
+              r.coding = mesh::kTextureSrgba8Med;
+              ways[0].status =
+                  compress_into(ways[0], MeshStream::kTextures, static_cast<uint32_t>(t),
+                                mesh::encode_texture(r, texels), options, cat("scene texture ", t));
+              // The plain coding is the texels themselves (SPEC §11.4.6): compressed from the
+              // scene's buffer, not from a copy of it.
+              if (ways[0].status.ok()) {
+                ways[1].status = compress_into(
+                    ways[1], MeshStream::kTextures, static_cast<uint32_t>(t),
+                    std::span<const uint8_t>(st.rgba), options, cat("scene texture ", t));
               }
               const bool plain =
                   ways[0].status.ok() && ways[1].status.ok() &&

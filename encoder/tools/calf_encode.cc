@@ -270,7 +270,9 @@ static int command_main(int argc, char** argv) {
       ->default_val(0);
   uint64_t max_image_pixels = calf::capture::kDefaultMaxImagePixels;
   app.add_option("--max-image-pixels", max_image_pixels,
-                 std::string("mesh, surfels: ") + calf::capture::kMaxImagePixelsHelp)
+                 std::string("every mode: ") + calf::capture::kMaxImagePixelsHelp +
+                     " (lightfield, tiles: a capture set's face size counts 6 x its square; "
+                     "mesh, surfels: scene-file textures)")
       ->check(CLI::Range(uint64_t{1}, calf::capture::kMaxImagePixelsLimit));
   app.add_option("--cell", o.cell_size, "colour cell side in px, multiple of 4 (default 64)")
       ->default_val(64);
@@ -609,6 +611,7 @@ static int command_main(int argc, char** argv) {
                                                       : calf::container::Compression::kZstd;
     tiles.encode.levels.compress_directory = !plain_directory;
     tiles.quiet = quiet;
+    tiles.max_image_pixels = max_image_pixels;
     if (calf::Status s = calf::encoder::validate_tiles_build_options(tiles.build); !s.ok()) {
       return calf::tools::print_error("calf-encode", s, calf::tools::kExitUsage);
     }
@@ -690,6 +693,7 @@ static int command_main(int argc, char** argv) {
   }
   if (analysis_only) {
     const auto t0 = std::chrono::steady_clock::now();
+    o.max_image_pixels = max_image_pixels;
     auto a = calf::write_lightfield_analysis(dir, out, o);
     if (!a.ok()) return fail(a.status());
     if (!quiet) {
@@ -733,7 +737,8 @@ static int command_main(int argc, char** argv) {
       first = f->front();
       count = static_cast<uint32_t>(f->size());
     }
-    auto s = calf::encode_lightfield_shard(dir, *a, *views, first, count, o.threads, out);
+    auto s = calf::encode_lightfield_shard(dir, *a, *views, first, count, o.threads, out,
+                                           max_image_pixels);
     if (!s.ok()) return fail(s.status());
     if (!quiet) {
       std::fprintf(
@@ -767,6 +772,7 @@ static int command_main(int argc, char** argv) {
       std::fflush(stderr);
     };
   }
+  o.max_image_pixels = max_image_pixels;
   auto stats = calf::encode_lightfield_file(dir, out, o);
   if (!stats.ok()) return fail(stats.status());
   const double seconds =

@@ -53,7 +53,9 @@ Expected<StoredChunk> compress_zstd(std::span<const uint8_t> raw, int level) {
       ZSTD_compress2(cctx.get(), out.bytes.data(), out.bytes.size(), raw.data(), raw.size());
   if (ZSTD_isError(n))
     return Status(ErrorId::kContainerCompressor, cat("zstd: ", ZSTD_getErrorName(n)));
+  // The bound's capacity is released: a writer may hold several chunks before it stores them.
   out.bytes.resize(n);
+  out.bytes.shrink_to_fit();
   return out;
 }
 
@@ -74,6 +76,7 @@ Expected<StoredChunk> compress_lzma2(std::span<const uint8_t> raw, uint32_t pres
                                             out.bytes.data(), &pos, out.bytes.size());
   if (r != LZMA_OK) return Status(ErrorId::kContainerCompressor, cat("lzma: error ", int(r)));
   out.bytes.resize(pos);
+  out.bytes.shrink_to_fit();
   return out;
 }
 

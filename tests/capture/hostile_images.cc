@@ -6,6 +6,9 @@
 //   big.exr         an OpenEXR header (ZIP) of 16384 x 16384, channel R, without pixels
 //   wide.exr        an OpenEXR header of 4096 x 4096 with R and 63 more channels
 //   e000_00000.exr  an OpenEXR header of 16384 x 8192 with R G B Z (the equirectangular image)
+//   attribute.exr   an OpenEXR header whose string attribute declares 2^31 - 1 bytes (100 bytes)
+//   set/            a capture set manifest of face size 16384 and its one image, big_set.exr
+//   set_exr/        a capture set of face size 16 whose one image is attribute.exr
 //   seurat_*.json   Seurat manifests of 16 x 16 cameras naming them (seurat_focal.json: every
 //                   focal term 1e6, which implies a face size of 16384)
 //   equirect.json   an equirectangular set of one viewpoint naming it
@@ -46,6 +49,22 @@ int main(int argc, char** argv) {
   for (int c = 1; c < 64; ++c) many.push_back("C" + std::to_string(c));
   write(dir / "wide.exr", t::exr_header_only(4096, 4096, many));
   write(dir / "e000_00000.exr", t::exr_header_only(16384, 8192, {"B", "G", "R", "Z"}));
+  const std::string attribute = t::exr_with("comments", "string", 0x7fffffff, "abc");
+  write(dir / "attribute.exr", attribute);
+  write(dir / "seurat_attribute.json", t::seurat_manifest(16, "attribute.exr", "attribute.exr"));
+  for (const char* set : {"set", "set_exr"}) {
+    const bool big = std::string(set) == "set";
+    std::filesystem::create_directories(dir / set);
+    write(dir / set / "manifest.json",
+          "{\"format\": \"calf-capture-set\", \"version\": 1, \"frame_count\": 1, "
+          "\"fps\": 30, \"face_size\": " +
+              std::string(big ? "16384" : "16") +
+              ", \"file_pattern\": \"view{view:03}_frame{frame:05}.exr\", \"material\": false, "
+              "\"view_volume\": {\"min\": [-1, -1, -1], \"max\": [1, 1, 1]}, \"viewpoints\": "
+              "[{\"name\": \"v\", \"position\": [0, 0, 0]}]}\n");
+    write(dir / set / "view000_frame00000.exr",
+          big ? t::exr_header_only(16384, 6 * 16384, {"B", "G", "R", "Z"}) : attribute);
+  }
   write(dir / "seurat_png.json", t::seurat_manifest(16, "big.png", "big.exr"));
   write(dir / "seurat_exr.json", t::seurat_manifest(16, "big.exr", "big.exr"));
   write(dir / "seurat_wide.json", t::seurat_manifest(16, "wide.exr", "big.exr"));

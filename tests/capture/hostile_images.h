@@ -1,8 +1,9 @@
 // Small image files built byte by byte for the tests of the image budget and the header checks
 // (tests/capture/image_input_test.cc, ingest_test.cc, the hostile_images tool of
 // tests/cli/hostile_images.sh): PNGs whose header declares any size over a few bytes of data,
-// valid PNGs in stored (uncompressed) deflate blocks, and OpenEXR headers without pixels. Written
-// from the PNG and OpenEXR specifications, not through the readers under test.
+// valid PNGs in stored (uncompressed) deflate blocks, and OpenEXR headers without pixels or whose
+// attributes declare more bytes than the file holds. Written from the PNG and OpenEXR
+// specifications, not through the readers under test.
 #pragma once
 
 #include <algorithm>
@@ -128,6 +129,20 @@ inline std::string exr_header_only(uint32_t width, uint32_t height,
     put_le32(&out, static_cast<uint32_t>(end >> 32));
   }
   return out;
+}
+
+// An OpenEXR header of one attribute (`name`, `type`, the 4-byte size `declared`, then `value`)
+// after the magic number and the version field `version`, then the end of the header and 64
+// zero bytes.
+inline std::string exr_with(const std::string& name, const std::string& type, uint32_t declared,
+                            const std::string& value, uint32_t version = 2) {
+  std::string out("\x76\x2f\x31\x01", 4);
+  put_le32(&out, version);
+  out += name + '\0' + type + '\0';
+  put_le32(&out, declared);
+  out += value;
+  out += '\0';
+  return out + std::string(64, '\0');
 }
 
 // A Seurat manifest of two view groups (at x = -0.5 and 0.5) of six 90-degree face cameras of

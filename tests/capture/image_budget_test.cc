@@ -1,7 +1,9 @@
 // The image budget and the header rule where images enter (calf/capture/image_budget.h,
 // scene_file.h's texture readers): a PNG is measured from its header before a buffer exists,
 // libpng's errors come back as one Status and never reach stderr, and the PNG kinds calf reads
-// decode to the bytes the PNG specification gives them.
+// decode to the bytes the PNG specification gives them; an OpenEXR header is walked before OpenEXR
+// reads it, in memory and in a file.
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -12,6 +14,7 @@
 
 #include "../scratch_dir.h"
 #include "calf/capture/image_budget.h"
+#include "calf/capture/ingest.h"
 #include "calf/capture/scene_file.h"
 #include "hostile_images.h"
 
@@ -19,9 +22,12 @@ namespace calf::capture {
 namespace {
 
 namespace fs = std::filesystem;
+using calf::test::exr_header_only;
+using calf::test::exr_with;
 using calf::test::png_chunk;
 using calf::test::png_declaring;
 using calf::test::png_file;
+using calf::test::put_le32;
 using calf::test::zlib_stored;
 
 std::span<const uint8_t> bytes_of(const std::string& s) {
@@ -141,6 +147,116 @@ TEST(PngDecode, GreyPaletteColourKeyAndSixteenBit) {
                   .ok());
   EXPECT_EQ(t.rgba, (std::vector<uint8_t>{18, 18, 18, 255}));
   EXPECT_EQ(t.width, 1u);
+}
+
+// Checks that an in-memory texture, the same bytes as a texture file, and the same file as a
+// Seurat image all give their reader's id with `message` in it.
+void expect_refused(const std::string& exr, const std::string& message) {
+  SceneTexture t;
+  const Status memory = decode_texture_image(bytes_of(exr), "exr", "embedded", &t);
+  EXPECT_EQ(memory.id(), ErrorId::kSceneFileTexture) << memory.to_string();
+  EXPECT_NE(memory.message().find(message), std::string::npos) << memory.message();
+  EXPECT_TRUE(t.rgba.empty());
+  const fs::path file = write("hostile.exr", exr);
+  const Status from_file = read_texture_image(file, &t);
+  EXPECT_EQ(from_file.id(), ErrorId::kSceneFileTexture) << from_file.to_string();
+  EXPECT_NE(from_file.message().find(message), std::string::npos) << from_file.message();
+  // The same bytes without the .exr name: found by their magic number.
+  const Status unnamed = read_texture_image(write("hostile.img", exr), &t);
+  EXPECT_NE(unnamed.message().find(message), std::string::npos) << unnamed.message();
+  // The capture-set and ingest reader (ExrReader) through a Seurat manifest.
+  const fs::path dir = file.parent_path();
+  std::ofstream(dir / "seurat.json")
+      << calf::test::seurat_manifest(16, "hostile.exr", "hostile.exr");
+  fs::remove_all(dir / "out");
+  const Status ingest = ingest_seurat(dir / "seurat.json", dir / "out", IngestOptions{});
+  EXPECT_EQ(ingest.id(), ErrorId::kCaptureImageFormat) << ingest.to_string();
+  EXPECT_NE(ingest.message().find(message), std::string::npos) << ingest.message();
+}
+
+// A string attribute declaring 2^31 - 1 bytes in a 100-byte file: OpenEXR 3.1 resized a
+// std::string to that size before noticing the file ends (2 GB for an embedded texture, found
+// by libFuzzer). Refused from the walk, naming the attribute, in memory and from a file.
+TEST(ExrHeader, AttributeLargerThanTheBytesLeftIsRefused) {
+  const std::string exr = exr_with("comments", "string", 0x7fffffff, "abc");
+  ASSERT_LT(exr.size(), 200u);
+  const auto start = std::chrono::steady_clock::now();
+  expect_refused(exr, "header attribute 'comments' (string) declares 2147483647 bytes, more than");
+  // A negative size.
+  expect_refused(exr_with("comments", "string", 0xfffffff0u, "abc"), "declares -16 bytes");
+  EXPECT_LT(seconds_since(start), 2.0);
+}
+
+// Sizes inside an attribute: a preview whose pixels are not its bytes, a string vector whose
+// string runs past it; and the file kinds calf does not read.
+TEST(ExrHeader, InnerSizesAndFileKinds) {
+  std::string preview;
+  put_le32(&preview, 65535);
+  put_le32(&preview, 65535);
+  expect_refused(exr_with("preview", "preview", 8, preview),
+                 "preview 'preview' declares 65535 x 65535 pixels in 8 bytes");
+  std::string strings;
+  put_le32(&strings, 0x7ffffff0u);
+  strings += "abcd";
+  expect_refused(exr_with("multiView", "stringvector", 8, strings),
+                 "string vector 'multiView' declares a string of 2147483632 bytes");
+  expect_refused(exr_with("comments", "string", 1, "a", 2 | 0x1000), "a multi-part OpenEXR file");
+  expect_refused(exr_with("comments", "string", 1, "a", 2 | 0x200), "a tiled OpenEXR file");
+  expect_refused(exr_with("comments", "string", 1, "a", 2 | 0x800), "a deep OpenEXR file");
+  expect_refused(exr_with("comments", "string", 1, "a"), "the header has no dataWindow");
+  // A float of 0 bytes (OpenEXR reads 4 whatever the size says, so its walk and ours would part)
+  // and an attribute given twice (found by libFuzzer: OpenEXR then took 17 s and 400 MB).
+  expect_refused(exr_with("screenWindowWidth", "float", 0, ""),
+                 "'screenWindowWidth' (float) has 0 bytes; the type has 4");
+  std::string second = std::string("x") + "comments" + '\0' + "string" + '\0';
+  put_le32(&second, 1);
+  expect_refused(exr_with("comments", "string", 1, second + "y"),
+                 "header attribute 'comments' appears twice");
+  // 1000 HALF channels of 16384 pixels in 16-row ZIP chunks: 500 MB a chunk.
+  std::vector<std::string> many;
+  for (int i = 0; i < 1000; ++i) many.push_back("c" + std::to_string(i));
+  expect_refused(exr_header_only(16384, 16, many), "bytes a chunk, more than 268435456");
+}
+
+// Within the walk's limits, a header alone is then measured against the texture budget before
+// OpenEXR opens it.
+TEST(ExrHeader, TextureBudgetFromTheHeader) {
+  SceneTexture t;
+  const std::string big = exr_header_only(16384, 16384, {"R"});
+  Status s = decode_texture_image(bytes_of(big), "", "big", &t);
+  EXPECT_EQ(s.id(), ErrorId::kImageBudget) << s.to_string();
+  EXPECT_NE(s.message().find("16384 x 16384 = 268435456 pixels"), std::string::npos);
+  s = read_texture_image(write("big.exr", big), &t);
+  EXPECT_EQ(s.id(), ErrorId::kImageBudget) << s.to_string();
+  // A hint of "exr" over bytes that are not: refused by the walk, not tried as other formats.
+  s = decode_texture_image(bytes_of(std::string(64, 'x')), "exr", "notexr", &t);
+  EXPECT_EQ(s.id(), ErrorId::kSceneFileTexture) << s.to_string();
+  EXPECT_NE(s.message().find("not an OpenEXR file"), std::string::npos) << s.message();
+}
+
+// A valid OpenEXR texture still decodes, from memory and from a file: 0 and 1 are bytes 0, 255.
+TEST(ExrHeader, ValidTextureDecodes) {
+  const fs::path file = calf::test::scratch_dir("image_budget_test") / "valid.exr";
+  {
+    std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create("exr");
+    ASSERT_TRUE(out);
+    OIIO::ImageSpec spec(2, 1, 4, OIIO::TypeDesc::HALF);
+    ASSERT_TRUE(out->open(file.string(), spec));
+    const float pixels[8] = {0, 1, 0, 1, 1, 0, 1, 1};
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels));
+    ASSERT_TRUE(out->close());
+  }
+  const std::vector<uint8_t> expected = {0, 255, 0, 255, 255, 0, 255, 255};
+  SceneTexture t;
+  ASSERT_TRUE(read_texture_image(file, &t).ok());
+  EXPECT_EQ(t.rgba, expected);
+  std::ifstream in(file, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  SceneTexture m;
+  const Status s = decode_texture_image(bytes_of(bytes), "", "embedded", &m);
+  ASSERT_TRUE(s.ok()) << s.to_string();
+  EXPECT_EQ(m.rgba, expected);
+  EXPECT_EQ(m.width, 2u);
 }
 
 }  // namespace

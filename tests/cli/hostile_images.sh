@@ -62,6 +62,7 @@ ingest-png-truncated) run "$bin/calf-ingest" seurat "$work/seurat_cut.json" "$wo
 ingest-face-size) run "$bin/calf-ingest" seurat --face-size 16384 "$work/seurat_png.json" "$work/out" ;;
 ingest-implied-face-size) run "$bin/calf-ingest" seurat "$work/seurat_focal.json" "$work/out" ;;
 ingest-equirect-budget) run "$bin/calf-ingest" equirect "$work/equirect.json" "$work/out" ;;
+ingest-exr-attribute) run "$bin/calf-ingest" seurat "$work/seurat_attribute.json" "$work/out" ;;
 ingest-equirect-face-size) run "$bin/calf-ingest" equirect --face-size 16384 "$work/equirect.json" "$work/out" ;;
 # the budget raised past what the machine gives (a 2 GB address space): CALF-E013, never an abort
 ingest-out-of-memory)
@@ -82,6 +83,12 @@ capture-embedded-header)
   embedded_gltf big.png
   run "$bin/calf-capture" --scene "$work/model.gltf" --max-image-pixels 268435456 --face-size 8 \
     --frames 1 --out "$work/out" ;;
+capture-texture-exr)
+  textured_obj attribute.exr
+  run "$bin/calf-capture" --scene "$work/model.obj" --face-size 8 --frames 1 --out "$work/out" ;;
+capture-embedded-exr)
+  embedded_gltf attribute.exr
+  run "$bin/calf-capture" --scene "$work/model.gltf" --face-size 8 --frames 1 --out "$work/out" ;;
 capture-embedded-truncated)
   embedded_gltf cut.png
   run "$bin/calf-capture" --scene "$work/model.gltf" --face-size 8 --frames 1 --out "$work/out" ;;
@@ -93,6 +100,19 @@ encode-scene-texture)
     --quiet >/dev/null 2>&1 || broken "the scene could not be exported"
   for t in "$work"/scene/textures/*.png; do cp "$work/big.png" "$t"; done
   run "$bin/calf-encode" --mode mesh "$work/scene" -o "$work/c.calf" ;;
+encode-scene-exr)
+  textured_obj ok.png
+  "$bin/calf-capture" --scene "$work/model.obj" --export-scene "$work/scene" --frames 1 \
+    --quiet >/dev/null 2>&1 || broken "the scene could not be exported"
+  for t in "$work"/scene/textures/*.png; do cp "$work/attribute.exr" "$t"; done
+  run "$bin/calf-encode" --mode mesh "$work/scene" -o "$work/c.calf" ;;
+# calf-encode on a capture set: a manifest declaring face size 16384 with a matching header and
+# no pixels (the budget, from the manifest, before a frame is allocated), and a set whose image
+# is attribute.exr
+encode-lightfield-face-size) run "$bin/calf-encode" "$work/set" -o "$work/c.calf" ;;
+encode-analysis-face-size) run "$bin/calf-encode" --analysis-only "$work/set" -o "$work/c.calf" ;;
+encode-tiles-face-size) run "$bin/calf-encode" --mode tiles "$work/set" -o "$work/c.calf" ;;
+encode-lightfield-exr) run "$bin/calf-encode" "$work/set_exr" -o "$work/c.calf" ;;
 *)
   echo "hostile_images.sh: unknown case $name" >&2
   exit 98

@@ -27,7 +27,7 @@ int encode_tiles(const std::string& input, const std::string& out,
   if (dir.filename() == capture::kManifestFileName) dir = dir.parent_path();
   if (dir.empty()) dir = ".";
   const auto start = std::chrono::steady_clock::now();
-  auto reader = capture::CaptureSetReader::open(dir);
+  auto reader = capture::CaptureSetReader::open(dir, options.max_image_pixels);
   if (!reader.ok()) return fail(reader.status());
 
   encoder::TilesBuildOptions build = options.build;

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 
+#include "calf/capture/image_budget.h"
 #include "calf/encoder/tiles_build.h"
 #include "calf/encoder/tiles_encode.h"
 
@@ -15,7 +16,8 @@ struct TilesModeOptions {
   uint32_t frame = 0;  // the capture frame the tiles are built from
   encoder::TilesBuildOptions build;
   encoder::TilesEncodeOptions encode;
-  bool quiet = false;  // no progress line
+  bool quiet = false;                                           // no progress line
+  uint64_t max_image_pixels = capture::kDefaultMaxImagePixels;  // the capture set's budget
 };
 
 // Builds the tile set of `options.frame` of the capture set at `input` (its directory or

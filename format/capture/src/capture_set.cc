@@ -138,12 +138,16 @@ Status write_file_atomically(const std::filesystem::path& path, std::string_view
 
 // ---- reader ------------------------------------------------------------------------------------
 
-Expected<CaptureSetReader> CaptureSetReader::open(const std::filesystem::path& directory) {
+Expected<CaptureSetReader> CaptureSetReader::open(const std::filesystem::path& directory,
+                                                  uint64_t max_image_pixels) {
   std::filesystem::path manifest_path = directory / kManifestFileName;
   CALF_ASSIGN_OR_RETURN(
       std::string text,
       read_small_file(manifest_path, " (not a capture set, or an incomplete one)"));
   CALF_ASSIGN_OR_RETURN(CaptureManifest m, parse_manifest(text, manifest_path.string()));
+  CALF_RETURN_IF_ERROR(
+      check_image_budget(manifest_path.string() + ": face size " + std::to_string(m.face_size),
+                         m.face_size, m.face_size, max_image_pixels, 6));
   return CaptureSetReader(directory, std::move(m));
 }
 

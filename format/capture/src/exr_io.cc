@@ -1,11 +1,10 @@
 #include "exr_io.h"
 
 #include <algorithm>
-#include <cstring>
-#include <fstream>
 #include <system_error>
 
 #include "calf/format/files.h"
+#include "image_input.h"
 
 namespace calf::capture::detail {
 
@@ -15,84 +14,6 @@ namespace {
 std::string oiio_error(const std::string& fallback) {
   std::string e = OIIO::geterror();
   return e.empty() ? fallback : e;
-}
-
-// The largest image side any calf image has: 6 x 16384 (a capture set's N x 6N strip).
-constexpr int64_t kMaxExrSide = 6 * 16384;
-
-// Checks the header of a single-part scanline OpenEXR file (format/CAPTURE.md) before OpenEXR
-// reads it: OpenEXR sizes its line-offset table by the declared data window, so a 90-byte file
-// declaring 2^28 rows made it allocate 2 GB. Every chunk of scanlines has an 8-byte entry in that
-// table, so the declared rows must fit in the file's bytes.
-Status check_exr_header(const std::string& name, std::ifstream& in, uint64_t file_size) {
-  auto bad = [&](const std::string& why) {
-    return Status(ErrorId::kCaptureImageFormat, name + ": " + why);
-  };
-  char head[8];
-  if (!in.read(head, 8)) return bad("not an OpenEXR file (shorter than its header)");
-  if (head[0] != 0x76 || head[1] != 0x2f || head[2] != 0x31 || head[3] != 0x01) {
-    return bad("not an OpenEXR file (its first bytes are not 76 2f 31 01)");
-  }
-  uint32_t version = 0;
-  std::memcpy(&version, head + 4, 4);
-  if ((version & 0xff) != 2 || (version & 0x1a00) != 0) {
-    return bad("not a single-part scanline OpenEXR 2 file (version field " +
-               std::to_string(version) + ")");
-  }
-  auto read_name = [&](std::string* out) {
-    out->clear();
-    char c = 0;
-    while (in.get(c) && c != '\0') {
-      if (out->size() >= 255) return false;
-      out->push_back(c);
-    }
-    return static_cast<bool>(in);
-  };
-  bool have_window = false;
-  int32_t window[4] = {0, 0, 0, 0};
-  int compression = -1;
-  std::string attribute, type;
-  for (;;) {
-    if (!read_name(&attribute)) return bad("truncated header");
-    if (attribute.empty()) break;
-    int32_t size = 0;
-    if (!read_name(&type) || !in.read(reinterpret_cast<char*>(&size), 4)) {
-      return bad("truncated header");
-    }
-    const std::streamoff at = in.tellg();
-    if (size < 0 || at < 0 || static_cast<uint64_t>(at) + static_cast<uint64_t>(size) > file_size) {
-      return bad("header attribute '" + attribute + "' declares " + std::to_string(size) +
-                 " bytes beyond the file");
-    }
-    if (attribute == "dataWindow" && type == "box2i" && size == 16) {
-      if (!in.read(reinterpret_cast<char*>(window), 16)) return bad("truncated header");
-      have_window = true;
-    } else if (attribute == "compression" && size == 1) {
-      char c = 0;
-      if (!in.get(c)) return bad("truncated header");
-      compression = static_cast<unsigned char>(c);
-    } else {
-      in.seekg(size, std::ios::cur);
-    }
-  }
-  if (!have_window) return bad("the header has no dataWindow");
-  const int64_t w = int64_t{window[2]} - window[0] + 1, h = int64_t{window[3]} - window[1] + 1;
-  if (w < 1 || h < 1 || w > kMaxExrSide || h > kMaxExrSide) {
-    return bad("data window " + std::to_string(w) + " x " + std::to_string(h) +
-               " is empty or larger than any calf image (" + std::to_string(kMaxExrSide) +
-               " per side)");
-  }
-  // Scanlines per chunk by compression (NONE, RLE, ZIPS: 1; ZIP, PXR24: 16; PIZ, B44, B44A,
-  // DWAA: 32; DWAB and anything newer: at most 256).
-  static const int kLines[] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};
-  const int64_t lines = compression >= 0 && compression < 10 ? kLines[compression] : 256;
-  const int64_t chunks = (h + lines - 1) / lines;
-  const std::streamoff end = in.tellg();
-  if (end < 0 || static_cast<uint64_t>(end) + 8 * static_cast<uint64_t>(chunks) > file_size) {
-    return bad(std::to_string(h) + " rows need " + std::to_string(chunks) +
-               " chunk offsets, more than the file's " + std::to_string(file_size) + " bytes hold");
-  }
-  return Status::Ok();
 }
 
 }  // namespace
@@ -156,18 +77,13 @@ Expected<ExrReader> ExrReader::open(const std::filesystem::path& path) {
     }
     return s;
   }
-  std::error_code ec;
   ExrReader r;
   r.path_ = path.string();
   // Only the OpenEXR reader ever sees the bytes, and only after its header passed
   // check_exr_header: OIIO's open() would hand a file that is not EXR to whichever of its format
   // plugins claims it (a PNG named .exr reached libpng, which printed its own stderr line).
-  {
-    const uint64_t size = std::filesystem::file_size(path, ec);
-    std::ifstream in(path, std::ios::binary);
-    if (ec || !in) return Status(ErrorId::kCaptureImageFormat, r.path_ + ": cannot be read");
-    CALF_RETURN_IF_ERROR(check_exr_header(r.path_, in, size));
-  }
+  ExrHeader header;
+  CALF_RETURN_IF_ERROR(check_exr_header(path, ErrorId::kCaptureImageFormat, &header));
   try {
     r.input_ = OIIO::ImageInput::create("openexr");
     if (r.input_) {

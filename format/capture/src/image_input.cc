@@ -2,11 +2,15 @@
 
 #include <png.h>
 
+#include <algorithm>
 #include <csetjmp>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <set>
+#include <system_error>
+#include <utility>
 
 #include <OpenImageIO/fmath.h>
 
@@ -66,11 +70,11 @@ constexpr unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, 
 // Deflate's largest expansion: a 258-byte match coded in 2 bits is 1032:1.
 constexpr uint64_t kMaxInflateRatio = 1032;
 
-// The bytes of a PNG, from memory or from a file, read at any offset.
-class PngBytes {
+// The bytes of an image, from memory or from a file, read at any offset.
+class ImageBytes {
  public:
-  explicit PngBytes(std::span<const uint8_t> bytes) : bytes_(bytes), size_(bytes.size()) {}
-  PngBytes(std::FILE* file, uint64_t size) : file_(file), size_(size) {}
+  explicit ImageBytes(std::span<const uint8_t> bytes) : bytes_(bytes), size_(bytes.size()) {}
+  ImageBytes(std::FILE* file, uint64_t size) : file_(file), size_(size) {}
   uint64_t size() const { return size_; }
   // Copies [offset, offset + n) into `out`; false when the bytes end first.
   bool read_at(uint64_t offset, void* out, size_t n) {
@@ -101,7 +105,7 @@ uint32_t be32(const uint8_t* p) {
 }
 
 // The chunk walk before decoding: IHDR's size and format, and the bytes of image data present.
-Status check_png_chunks(PngBytes& bytes, const std::string& name, const ImageExpect& expect) {
+Status check_png_chunks(ImageBytes& bytes, const std::string& name, const ImageExpect& expect) {
   const auto bad = [&](const std::string& why) {
     return Status(expect.undecodable, name + ": " + why);
   };
@@ -172,7 +176,7 @@ void on_png_error(png_structp png, png_const_charp message) {
 void on_png_warning(png_structp, png_const_charp) {}  // warnings are not errors: ignored
 
 void on_png_read(png_structp png, png_bytep out, size_t n) {
-  if (!static_cast<PngBytes*>(png_get_io_ptr(png))->read_next(out, n)) {
+  if (!static_cast<ImageBytes*>(png_get_io_ptr(png))->read_next(out, n)) {
     png_error(png, "the file ends before its image data");
   }
 }
@@ -187,7 +191,7 @@ struct PngDecode {
 
 // The libpng calls, in a frame that holds no C++ object: a longjmp out of libpng lands in
 // setjmp here and returns false with `error` set.
-bool decode_with_libpng(PngBytes* bytes, PngDecode* d, PngError* error) {
+bool decode_with_libpng(ImageBytes* bytes, PngDecode* d, PngError* error) {
   png_structp png =
       png_create_read_struct(PNG_LIBPNG_VER_STRING, error, on_png_error, on_png_warning);
   if (!png) return false;
@@ -242,7 +246,7 @@ bool decode_with_libpng(PngBytes* bytes, PngDecode* d, PngError* error) {
   return true;
 }
 
-Status decode(PngBytes& bytes, const std::string& name, const ImageExpect& expect, Png8* out) {
+Status decode(ImageBytes& bytes, const std::string& name, const ImageExpect& expect, Png8* out) {
   CALF_RETURN_IF_ERROR(check_png_chunks(bytes, name, expect));
   PngDecode d;
   d.out = out;
@@ -255,6 +259,237 @@ Status decode(PngBytes& bytes, const std::string& name, const ImageExpect& expec
   }
   return Status::Ok();
 }
+
+// The OpenEXR header walk (the file layout of openexr.com's "OpenEXR File Layout"): the magic
+// number, the version field, then attributes (name NUL, type NUL, 4-byte little-endian size,
+// value) up to an empty name. OpenEXR allocates what a header declares before it checks it
+// against the bytes present (a string attribute declaring 2^31 bytes was a 2 GB allocation for a
+// 512-byte image), so every size is checked here first.
+
+constexpr uint8_t kExrMagic[4] = {0x76, 0x2f, 0x31, 0x01};
+
+// Version field flags (the low byte is the version, 2).
+constexpr uint32_t kExrTiled = 0x200, kExrLongNames = 0x400, kExrNonImage = 0x800,
+                   kExrMultiPart = 0x1000;
+
+// The value size of the fixed-size attribute types (OpenEXR reads that many bytes whatever the
+// size field says, so a header whose size differs is read differently by OpenEXR than walked
+// here); 0 for types of any size.
+int32_t exr_fixed_size(const std::string& type) {
+  static const std::pair<const char*, int32_t> kSizes[] = {
+      {"box2i", 16},      {"box2f", 16},    {"float", 4},    {"double", 8},         {"int", 4},
+      {"v2i", 8},         {"v2f", 8},       {"v2d", 16},     {"v3i", 12},           {"v3f", 12},
+      {"v3d", 24},        {"m33f", 36},     {"m33d", 72},    {"m44f", 64},          {"m44d", 128},
+      {"compression", 1}, {"lineOrder", 1}, {"envmap", 1},   {"deepImageState", 1}, {"rational", 8},
+      {"keycode", 28},    {"timecode", 8},  {"tiledesc", 9}, {"chromaticities", 32}};
+  for (const auto& [name, size] : kSizes) {
+    if (type == name) return size;
+  }
+  return 0;
+}
+
+int32_t le32(const uint8_t* p) {
+  return static_cast<int32_t>(uint32_t{p[0]} | uint32_t{p[1]} << 8 | uint32_t{p[2]} << 16 |
+                              uint32_t{p[3]} << 24);
+}
+
+class ExrWalk {
+ public:
+  ExrWalk(ImageBytes& bytes, const std::string& name, ErrorId id)
+      : bytes_(bytes), name_(name), id_(id) {}
+
+  Status walk(ExrHeader* out) {
+    uint8_t head[8];
+    if (!bytes_.read_at(0, head, 8)) return bad("not an OpenEXR file (shorter than its header)");
+    if (std::memcmp(head, kExrMagic, 4) != 0) {
+      return bad("not an OpenEXR file (its first bytes are not 76 2f 31 01)");
+    }
+    const auto version = static_cast<uint32_t>(le32(head + 4));
+    if ((version & 0xff) != 2 ||
+        (version & ~uint32_t{0xff | kExrTiled | kExrLongNames | kExrNonImage | kExrMultiPart})) {
+      return bad("OpenEXR version field " + std::to_string(version) + " is not version 2");
+    }
+    if (version & (kExrTiled | kExrNonImage | kExrMultiPart)) {
+      return bad(std::string("a ") +
+                 (version & kExrMultiPart  ? "multi-part"
+                  : version & kExrNonImage ? "deep"
+                                           : "tiled") +
+                 " OpenEXR file; calf reads single-part scanline OpenEXR (version field " +
+                 std::to_string(version) + ")");
+    }
+    at_ = 8;
+    bool have_window = false, have_channels = false;
+    int32_t window[4] = {0, 0, 0, 0};
+    int compression = -1;
+    uint64_t pixel_bytes = 0;  // the bytes of one pixel of every channel
+    std::set<std::string> names;
+    for (;;) {
+      std::string attribute, type;
+      CALF_RETURN_IF_ERROR(read_name(&attribute));
+      if (attribute.empty()) break;
+      CALF_RETURN_IF_ERROR(read_name(&type));
+      uint8_t size_bytes[4];
+      if (!bytes_.read_at(at_, size_bytes, 4)) return bad("the header ends in an attribute");
+      at_ += 4;
+      const int32_t size = le32(size_bytes);
+      const uint64_t left = bytes_.size() - at_;
+      if (size < 0 || static_cast<uint64_t>(size) > left) {
+        return bad("header attribute '" + attribute + "' (" + type + ") declares " +
+                   std::to_string(size) + " bytes, more than the " + std::to_string(left) +
+                   " bytes left in the file");
+      }
+      if (const int32_t fixed = exr_fixed_size(type); fixed != 0 && size != fixed) {
+        return bad("header attribute '" + attribute + "' (" + type + ") has " +
+                   std::to_string(size) + " bytes; the type has " + std::to_string(fixed));
+      }
+      if (!names.insert(attribute).second) {
+        return bad("header attribute '" + attribute + "' appears twice");
+      }
+      const uint64_t value = at_, end = at_ + static_cast<uint64_t>(size);
+      if (attribute == "dataWindow") {
+        if (type != "box2i" || size != 16) return bad("dataWindow is not a box2i");
+        uint8_t box[16];
+        if (!bytes_.read_at(value, box, 16)) return bad("the header ends in dataWindow");
+        for (int i = 0; i < 4; ++i) window[i] = le32(box + 4 * i);
+        have_window = true;
+      } else if (attribute == "compression") {
+        uint8_t c = 0;
+        if (type != "compression" || size != 1 || !bytes_.read_at(value, &c, 1)) {
+          return bad("compression is not a compression attribute");
+        }
+        compression = c;
+      } else if (attribute == "channels") {
+        if (type != "chlist") return bad("channels is not a chlist");
+        CALF_RETURN_IF_ERROR(read_channels(value, end, &out->channels, &pixel_bytes));
+        have_channels = true;
+      } else if (attribute == "type") {
+        // Single-part files may name their part type; only a scanline image is read.
+        std::string part(static_cast<size_t>(std::min<int32_t>(size, 32)), '\0');
+        if (!bytes_.read_at(value, part.data(), part.size())) return bad("the header ends");
+        if (type != "string" || part != "scanlineimage") {
+          return bad("part type '" + part + "'; calf reads single-part scanline OpenEXR");
+        }
+      }
+      if (type == "preview") CALF_RETURN_IF_ERROR(check_preview(attribute, value, size));
+      if (type == "stringvector") CALF_RETURN_IF_ERROR(check_strings(attribute, value, end));
+      at_ = end;
+    }
+    if (!have_window) return bad("the header has no dataWindow");
+    const int64_t w = int64_t{window[2]} - window[0] + 1, h = int64_t{window[3]} - window[1] + 1;
+    if (w < 1 || h < 1 || w > kMaxExrSide || h > kMaxExrSide) {
+      return bad("data window " + std::to_string(w) + " x " + std::to_string(h) +
+                 " is empty or larger than any calf image (" + std::to_string(kMaxExrSide) +
+                 " per side)");
+    }
+    // Scanlines per chunk by compression (NONE, RLE, ZIPS: 1; ZIP, PXR24: 16; PIZ, B44, B44A,
+    // DWAA: 32; DWAB and anything newer: at most 256).
+    static const int kLines[] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};
+    const int64_t lines = compression >= 0 && compression < 10 ? kLines[compression] : 256;
+    // OpenEXR sizes its line-offset table by the rows declared (8 bytes a chunk, which the file
+    // must hold) and a chunk's buffers by its width and channels.
+    const uint64_t chunks = static_cast<uint64_t>((h + lines - 1) / lines);
+    if (at_ + 8 * chunks > bytes_.size()) {
+      return bad(std::to_string(h) + " rows need " + std::to_string(chunks) +
+                 " chunk offsets, more than the file's " + std::to_string(bytes_.size()) +
+                 " bytes hold");
+    }
+    if (!have_channels || out->channels == 0) return bad("the header has no channels");
+    const uint64_t chunk_bytes = static_cast<uint64_t>(w) * pixel_bytes * std::min(lines, h);
+    if (chunk_bytes > kMaxExrChunkBytes) {
+      return bad(std::to_string(out->channels) + " channels of " + std::to_string(w) +
+                 " pixels in chunks of " + std::to_string(std::min(lines, h)) + " rows need " +
+                 std::to_string(chunk_bytes) + " bytes a chunk, more than " +
+                 std::to_string(kMaxExrChunkBytes));
+    }
+    out->width = w;
+    out->height = h;
+    return Status::Ok();
+  }
+
+ private:
+  Status bad(const std::string& why) const { return Status(id_, name_ + ": " + why); }
+
+  // A NUL-terminated name at at_ (at most 255 bytes, the long-name limit).
+  Status read_name(std::string* out) {
+    out->clear();
+    for (;;) {
+      char c = 0;
+      if (!bytes_.read_at(at_, &c, 1)) return bad("the header ends in an attribute name");
+      ++at_;
+      if (c == '\0') return Status::Ok();
+      if (out->size() >= 255) return bad("a header name longer than 255 bytes");
+      out->push_back(c);
+    }
+  }
+
+  // The channel list in [at, end): name NUL, pixel type, pLinear and 3 reserved bytes, x and y
+  // sampling; an empty name ends it.
+  Status read_channels(uint64_t at, uint64_t end, uint32_t* count, uint64_t* pixel_bytes) {
+    *count = 0;
+    *pixel_bytes = 0;
+    for (;;) {
+      size_t length = 0;
+      for (char c = 1; c != '\0'; ++length) {
+        if (at + length >= end || !bytes_.read_at(at + length, &c, 1)) {
+          return bad("the channel list runs past its attribute");
+        }
+        if (length > 255) return bad("a channel name longer than 255 bytes");
+      }
+      at += length;
+      if (length == 1) return Status::Ok();  // the empty name
+      uint8_t fields[16];
+      if (at + 16 > end || !bytes_.read_at(at, fields, 16)) {
+        return bad("the channel list runs past its attribute");
+      }
+      at += 16;
+      const int32_t pixel_type = le32(fields);
+      if (pixel_type < 0 || pixel_type > 2) {
+        return bad("a channel of pixel type " + std::to_string(pixel_type) +
+                   " (UINT 0, HALF 1 and FLOAT 2 exist)");
+      }
+      if (++*count > kMaxExrChannels) {
+        return bad("more than " + std::to_string(kMaxExrChannels) + " channels");
+      }
+      *pixel_bytes += pixel_type == 1 ? 2 : 4;
+    }
+  }
+
+  // A preview image: width, height, then 4 bytes a pixel, exactly the attribute's size.
+  Status check_preview(const std::string& attribute, uint64_t at, int32_t size) {
+    uint8_t wh[8];
+    if (size < 8 || !bytes_.read_at(at, wh, 8)) return bad("preview '" + attribute + "' is cut");
+    const auto w = static_cast<uint32_t>(le32(wh)), h = static_cast<uint32_t>(le32(wh + 4));
+    if (uint64_t{w} * h * 4 + 8 != static_cast<uint64_t>(size)) {
+      return bad("preview '" + attribute + "' declares " + std::to_string(w) + " x " +
+                 std::to_string(h) + " pixels in " + std::to_string(size) + " bytes");
+    }
+    return Status::Ok();
+  }
+
+  // A string vector: 4-byte sizes each followed by that many bytes, within the attribute.
+  Status check_strings(const std::string& attribute, uint64_t at, uint64_t end) {
+    while (at < end) {
+      uint8_t n[4];
+      if (at + 4 > end || !bytes_.read_at(at, n, 4)) {
+        return bad("string vector '" + attribute + "' runs past its attribute");
+      }
+      at += 4;
+      const int32_t length = le32(n);
+      if (length < 0 || static_cast<uint64_t>(length) > end - at) {
+        return bad("string vector '" + attribute + "' declares a string of " +
+                   std::to_string(length) + " bytes, more than its " + std::to_string(end - at) +
+                   " bytes left");
+      }
+      at += static_cast<uint64_t>(length);
+    }
+    return Status::Ok();
+  }
+
+  ImageBytes& bytes_;
+  const std::string& name_;
+  ErrorId id_;
+  uint64_t at_ = 0;
+};
 
 }  // namespace
 
@@ -276,14 +511,44 @@ Status read_png8(const std::filesystem::path& path, const ImageExpect& expect, P
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(name.c_str(), "rb"),
                                                        &std::fclose);
   if (ec || !file) return Status(ErrorId::kFileOpen, name + ": cannot be opened");
-  PngBytes bytes(file.get(), size);
+  ImageBytes bytes(file.get(), size);
   return decode(bytes, name, expect, out);
 }
 
 Status decode_png8(std::span<const uint8_t> bytes, const std::string& name,
                    const ImageExpect& expect, Png8* out) {
-  PngBytes source(bytes);
+  ImageBytes source(bytes);
   return decode(source, name, expect, out);
+}
+
+bool has_exr_signature(std::span<const uint8_t> head) {
+  return head.size() >= 4 && std::memcmp(head.data(), kExrMagic, 4) == 0;
+}
+
+bool has_exr_signature(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  uint8_t head[4] = {};
+  in.read(reinterpret_cast<char*>(head), 4);
+  return in.gcount() == 4 && has_exr_signature(head);
+}
+
+Status check_exr_header(const std::filesystem::path& path, ErrorId undecodable, ExrHeader* out) {
+  const std::string name = path.string();
+  std::error_code ec;
+  const uint64_t size = std::filesystem::file_size(path, ec);
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(name.c_str(), "rb"),
+                                                       &std::fclose);
+  if (ec || !file) return Status(undecodable, name + ": cannot be read");
+  ImageBytes bytes(file.get(), size);
+  *out = ExrHeader{};
+  return ExrWalk(bytes, name, undecodable).walk(out);
+}
+
+Status check_exr_header(std::span<const uint8_t> bytes, const std::string& name,
+                        ErrorId undecodable, ExrHeader* out) {
+  ImageBytes source(bytes);
+  *out = ExrHeader{};
+  return ExrWalk(source, name, undecodable).walk(out);
 }
 
 }  // namespace detail

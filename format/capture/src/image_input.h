@@ -1,8 +1,9 @@
 // Where images enter calf (internal to the capture layer): the size rule every image reader
 // applies to a header before it decodes a pixel, and the PNG reader (libpng, called directly so
 // that its errors become Status values and never reach stderr, and so that the header is checked
-// before a row buffer exists). OpenEXR headers are checked by exr_io.h, other formats (JPEG) by
-// OpenImageIO's open(); all of them then pass check_image_size.
+// before a row buffer exists), and the OpenEXR header walk that runs before OpenEXR sees a file or
+// buffer. Other formats (JPEG) are checked by OpenImageIO's open(); all of them then pass
+// check_image_size.
 #pragma once
 
 #include <cstdint>
@@ -57,5 +58,33 @@ bool has_png_signature(const std::filesystem::path& path);
 Status read_png8(const std::filesystem::path& path, const ImageExpect& expect, Png8* out);
 Status decode_png8(std::span<const uint8_t> bytes, const std::string& name,
                    const ImageExpect& expect, Png8* out);
+
+// The largest side of an OpenEXR image calf reads: a capture set's images are N x 6N.
+inline constexpr int64_t kMaxExrSide = 6 * int64_t{kMaxImageSide};
+// The most channels an OpenEXR header may declare, and the most bytes one chunk of scanlines
+// may need uncompressed (OpenEXR allocates its buffers by that when it opens a file).
+inline constexpr uint32_t kMaxExrChannels = 1024;
+inline constexpr uint64_t kMaxExrChunkBytes = uint64_t{1} << 28;
+
+// What an OpenEXR header declares.
+struct ExrHeader {
+  int64_t width = 0, height = 0;  // the data window's
+  uint32_t channels = 0;
+};
+
+// True when `head` starts with the OpenEXR magic number 76 2f 31 01.
+bool has_exr_signature(std::span<const uint8_t> head);
+bool has_exr_signature(const std::filesystem::path& path);
+
+// Walks the header of the OpenEXR file at `path` / in `bytes` before OpenEXR reads it, and
+// returns `undecodable` naming the file and field unless it is a single-part scanline OpenEXR 2
+// image whose every attribute fits in the bytes left (strings in a string vector, a preview's
+// pixels in its attribute), with a dataWindow of 1..kMaxExrSide per side, 1..kMaxExrChannels
+// channels of UINT, HALF or FLOAT, a chunk of scanlines of at most kMaxExrChunkBytes, and room
+// for its line-offset table. Only the header is read. The caller then applies check_image_size
+// (or its own size rule) to out->width x out->height.
+Status check_exr_header(const std::filesystem::path& path, ErrorId undecodable, ExrHeader* out);
+Status check_exr_header(std::span<const uint8_t> bytes, const std::string& name,
+                        ErrorId undecodable, ExrHeader* out);
 
 }  // namespace calf::capture::detail

@@ -878,16 +878,25 @@ void texture_from_png(detail::Png8&& image, SceneTexture* t) {
 }
 
 // Decodes the image `name` (read through `proxy` when given, else from the file of that name)
-// with OpenImageIO: formats other than PNG.
-Status decode_image(const std::string& name, OIIO::Filesystem::IOProxy* proxy, uint64_t max_pixels,
-                    SceneTexture* t) {
+// with OpenImageIO: formats other than PNG. `exr`: the bytes are OpenEXR whose header passed
+// check_exr_header, and only OpenImageIO's OpenEXR reader may see them (its open() would hand
+// bytes its first choice refuses to every other format reader in turn).
+Status decode_image(const std::string& name, OIIO::Filesystem::IOProxy* proxy, bool exr,
+                    uint64_t max_pixels, SceneTexture* t) {
   try {
     // Unassociated alpha: the bytes of the file, not colour premultiplied by alpha.
     OIIO::ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);
     // The readers of OpenImageIO 2.4 take the proxy from the configuration, not the argument.
     if (proxy) config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
-    std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(name, &config, proxy);
+    std::unique_ptr<OIIO::ImageInput> in;
+    if (exr) {
+      in = OIIO::ImageInput::create("openexr");
+      OIIO::ImageSpec spec;
+      if (in && !in->open(name, spec, config)) in.reset();
+    } else {
+      in = OIIO::ImageInput::open(name, &config, proxy);
+    }
     if (!in) return Status(ErrorId::kSceneFileTexture, name + ": " + oiio_error("cannot decode"));
     const OIIO::ImageSpec& spec = in->spec();
     CALF_RETURN_IF_ERROR(
@@ -1145,7 +1154,14 @@ Status read_texture_image(const std::filesystem::path& path, SceneTexture* textu
     texture_from_png(std::move(image), texture);
     return Status::Ok();
   }
-  return decode_image(path.string(), nullptr, max_image_pixels, texture);
+  const bool exr = detail::has_exr_signature(path) || path.extension() == ".exr";
+  if (exr) {
+    detail::ExrHeader header;
+    CALF_RETURN_IF_ERROR(detail::check_exr_header(path, ErrorId::kSceneFileTexture, &header));
+    CALF_RETURN_IF_ERROR(detail::check_image_size(path.string(), header.width, header.height,
+                                                  texture_expect(max_image_pixels)));
+  }
+  return decode_image(path.string(), nullptr, exr, max_image_pixels, texture);
 }
 
 Status decode_texture_image(std::span<const uint8_t> bytes, std::string_view format_hint,
@@ -1165,13 +1181,25 @@ Status decode_texture_image(std::span<const uint8_t> bytes, std::string_view for
     ext = "png";
   } else if (bytes.size() >= 3 && bytes[0] == 0xff && bytes[1] == 0xd8 && bytes[2] == 0xff) {
     ext = "jpg";
+  } else if (detail::has_exr_signature(bytes)) {
+    ext = "exr";
   }
   if (ext.empty() || ext.find_first_of("./\\") != std::string::npos) {
     return Status(ErrorId::kSceneFileTexture,
                   std::string(name) + ": an image of unknown format (not PNG or JPEG, no hint)");
   }
+  // OpenEXR by its magic number or its hint: the header walked first, in the bytes given.
+  const bool exr = ext == "exr";
+  if (exr) {
+    const std::string label = std::string(name) + " (exr)";
+    detail::ExrHeader header;
+    CALF_RETURN_IF_ERROR(
+        detail::check_exr_header(bytes, label, ErrorId::kSceneFileTexture, &header));
+    CALF_RETURN_IF_ERROR(detail::check_image_size(label, header.width, header.height,
+                                                  texture_expect(max_image_pixels)));
+  }
   OIIO::Filesystem::IOMemReader reader(bytes.data(), bytes.size());
-  Status s = decode_image("embedded." + ext, &reader, max_image_pixels, texture);
+  Status s = decode_image("embedded." + ext, &reader, exr, max_image_pixels, texture);
   if (s.ok()) return s;
   return Status(s.id(), std::string(name) + " (" + ext + "): " + s.message());
 }

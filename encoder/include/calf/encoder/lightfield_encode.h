@@ -112,6 +112,9 @@ struct LightfieldEncodeOptions {
   container::Compression supercompression = container::Compression::kZstd;
   container::CompressionOptions levels;  // zstd level / LZMA preset (fixed per clip)
   uint32_t threads = 1;                  // 0 = all cores; never changes the output
+  // The image budget of the capture set read (CaptureSetReader::open): 6 face_size^2 pixels per
+  // view-frame at most, else E012 before any frame is read. Never changes the output.
+  uint64_t max_image_pixels = capture::kDefaultMaxImagePixels;
   // Called after each view-face is coded (done, total), by encode_lightfield_view() on the
   // calling thread only; the analysis pass does not report.
   std::function<void(uint64_t done, uint64_t total)> progress;

@@ -59,19 +59,18 @@ Expected<LightfieldAnalysisFile> write_lightfield_analysis(const std::filesystem
 Expected<LightfieldAnalysisFile> read_lightfield_analysis(const std::string& path);
 
 // Codes `views` (ascending) x frames [first_frame, first_frame + frame_count) of the capture set
-// at `capture_dir` with the analysis file's options (`threads` worker threads) and writes the
+// at `capture_dir` with the analysis file's options (`threads` worker threads; the capture set
+// read within the image budget `max_image_pixels`, CaptureSetReader::open) and writes the
 // shard file `out_path` whole. A frame range short of the clip must be whole segments of the
 // analysis's segment_frames (encode_lightfield_view_frames()). Errors: kShardRange;
 // kShardMismatch (the capture set is not the one analysed: other view count, frames or face size,
 // or an image whose bytes differ from the analysis's fingerprint of its segment);
 // encode_lightfield_view()'s (kEncoderInput when an image changed since the analysis);
 // kOutputIsInput (`out_path` is the analysis file, the manifest or an image of the set).
-Expected<LightfieldEncodeStats> encode_lightfield_shard(const std::filesystem::path& capture_dir,
-                                                        const LightfieldAnalysisFile& analysis,
-                                                        std::span<const uint32_t> views,
-                                                        uint32_t first_frame, uint32_t frame_count,
-                                                        uint32_t threads,
-                                                        const std::string& out_path);
+Expected<LightfieldEncodeStats> encode_lightfield_shard(
+    const std::filesystem::path& capture_dir, const LightfieldAnalysisFile& analysis,
+    std::span<const uint32_t> views, uint32_t first_frame, uint32_t frame_count, uint32_t threads,
+    const std::string& out_path, uint64_t max_image_pixels = capture::kDefaultMaxImagePixels);
 
 // Joins shard files (views x frame ranges) into the clip `out_path` (written whole or not at all);
 // the partial t chunks of frame-range shards are joined and compressed as one encode does. Errors:

@@ -26,6 +26,7 @@
 #include <string_view>
 #include <vector>
 
+#include "calf/capture/image_budget.h"
 #include "calf/format/cube.h"
 #include "calf/format/geometry.h"
 #include "calf/format/status.h"
@@ -125,7 +126,10 @@ Status validate_view_frame(const ViewFrame& frame, std::string_view context);
 class CaptureSetReader {
  public:
   // Reads and validates `directory`/manifest.json. Does not touch the images (see check_files).
-  static Expected<CaptureSetReader> open(const std::filesystem::path& directory);
+  // A view-frame's six faces, 6 face_size^2 pixels, must fit `max_image_pixels`
+  // (calf/capture/image_budget.h), else E012 naming the manifest, before any frame is allocated.
+  static Expected<CaptureSetReader> open(const std::filesystem::path& directory,
+                                         uint64_t max_image_pixels = kDefaultMaxImagePixels);
 
   const CaptureManifest& manifest() const { return manifest_; }
   const std::filesystem::path& directory() const { return directory_; }
