@@ -61,6 +61,8 @@ if(TINYGLTF_INCLUDE_DIR)
   set_target_properties(calf::tinygltf PROPERTIES INTERFACE_INCLUDE_DIRECTORIES ${TINYGLTF_INCLUDE_DIR})
 endif()
 calf_require(TINYGLTF_FOUND tinygltf libtinygltf-dev)
+# export: EXT_meshopt_compression (vertex and index codecs)
+calf_find_config(meshoptimizer libmeshoptimizer-dev)
 # player
 calf_find_config(glm libglm-dev)
 calf_find_config(glfw3 libglfw3-dev)

@@ -4,13 +4,13 @@
 # must equal the counts calf-export printed. Run as
 #   cmake -DEXPORT=<calf-export> -DCLIP=<.calf> -DOUT=<.glb|.gltf> -DNODE=<node>
 #         -DSCRIPT=<gltf_validate.js> -DVALIDATOR=<build/npm/node_modules/gltf-validator>
-#         -P CalfGltfCheck.cmake
+#         [-DOPTION=<a calf-export option, e.g. --meshopt>] -P CalfGltfCheck.cmake
 if(NOT NODE OR NOT EXISTS "${VALIDATOR}/package.json")
   message(FATAL_ERROR "node or the glTF-Validator is missing (node '${NODE}', '${VALIDATOR}'): "
                       "tools/setup.sh installs both")
 endif()
-execute_process(COMMAND ${EXPORT} ${CLIP} -o ${OUT} RESULT_VARIABLE rc OUTPUT_VARIABLE out
-                ERROR_VARIABLE err)
+execute_process(COMMAND ${EXPORT} ${CLIP} -o ${OUT} ${OPTION} RESULT_VARIABLE rc
+                OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "calf-export failed (${rc}): ${out}${err}")
 endif()

@@ -19,8 +19,9 @@ PACKAGES=(
   libsquish-dev
   # capture ray tracer and scene loading
   libembree-dev libassimp-dev
-  # export: glTF writer (header-only); headless Chromium, the browser of the three.js export test
-  libtinygltf-dev chromium
+  # export: glTF writer (header-only) and meshoptimizer (EXT_meshopt_compression); headless
+  # Chromium, the browser of the three.js export test; Blender, the OBJ import test
+  libtinygltf-dev libmeshoptimizer-dev chromium blender
   # textured models the texture tests load when present (BoxTextured, CesiumMilkTruck)
   assimp-testmodels
   # player: GL, window, headless, maths, HUD

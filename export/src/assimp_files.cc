@@ -66,8 +66,11 @@ std::string embed_png(aiScene* scene, const std::vector<uint8_t>& png) {
 }
 
 Expected<std::vector<ExportedFile>> write_scene(const aiScene& scene, MeshExportFormat format,
-                                                const std::string& stem) {
-  if (format != MeshExportFormat::kObj) return write_gltf(scene, format, stem);
+                                                const std::string& stem, const GltfOptions& gltf) {
+  if (format != MeshExportFormat::kObj) return write_gltf(scene, format, stem, gltf);
+  if (gltf.meshopt) {
+    return Status(ErrorId::kExportInput, "meshopt compression applies to .glb / .gltf");
+  }
   Assimp::Exporter exporter;
   const aiExportDataBlob* blob = exporter.ExportToBlob(&scene, "obj", 0);
   if (blob == nullptr) {

@@ -23,11 +23,13 @@ Expected<std::vector<uint8_t>> png_bytes(const uint8_t* rgba, uint32_t width, ui
 // that path.
 std::string embed_png(aiScene* scene, const std::vector<uint8_t>& png);
 
-// Writes `scene` in `format` (glTF: write_gltf; OBJ: assimp's exporter): the main file first
-// (suffix ""), then its side files (".bin", ".mtl"), each named after `stem` in the main file.
-// CALF-E481 when the writer fails (assimp's message quoted).
+// Writes `scene` in `format` (glTF: write_gltf with `gltf`; OBJ: assimp's exporter): the main
+// file first (suffix ""), then its side files (".bin", ".mtl"), each named after `stem` in the
+// main file. CALF-E481 when the writer fails (assimp's message quoted), CALF-E480 for an OBJ with
+// a glTF option set.
 Expected<std::vector<ExportedFile>> write_scene(const aiScene& scene, MeshExportFormat format,
-                                                const std::string& stem);
+                                                const std::string& stem,
+                                                const GltfOptions& gltf = {});
 
 // CALF-E480 unless `stem` holds only A-Z a-z 0-9 _ - . (a .gltf / .obj names its side files
 // after it; a .glb has none, so any stem passes).

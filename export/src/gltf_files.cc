@@ -6,13 +6,16 @@
 #include "gltf_files.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <sstream>
 #include <utility>
 
 #include <assimp/GltfMaterial.h>
+#include <assimp/light.h>
 #include <assimp/material.h>
+#include <meshoptimizer.h>
 #include <tiny_gltf.h>
 #include <nlohmann/json.hpp>
 
@@ -20,13 +23,25 @@ namespace calf::exporter {
 namespace {
 
 constexpr const char* kUnlit = "KHR_materials_unlit";
+constexpr const char* kSpecular = "KHR_materials_specular";
+constexpr const char* kMeshopt = "EXT_meshopt_compression";
+
+// How a view's bytes are compressed with EXT_meshopt_compression: mode "ATTRIBUTES" (vertex
+// data: count elements of stride bytes) or "TRIANGLES" (a triangle list of 32-bit indices);
+// empty mode: kept as it is (images).
+struct ViewCodec {
+  std::string mode;
+  size_t stride = 0;
+  size_t count = 0;
+};
 
 // The binary buffer and its views, each view 4-byte aligned.
 class BufferBuilder {
  public:
   explicit BufferBuilder(tinygltf::Model* model) : model_(model) {}
 
-  int add_view(const void* data, size_t bytes, int target) {
+  int add_view(const void* data, size_t bytes, int target, ViewCodec codec = {}) {
+    codecs_.push_back(std::move(codec));
     while (bin_.size() % 4 != 0) bin_.push_back(0);
     tinygltf::BufferView view;
     view.buffer = 0;
@@ -45,7 +60,8 @@ class BufferBuilder {
     const size_t count = values.size() / components;
     tinygltf::Accessor accessor;
     accessor.bufferView =
-        add_view(values.data(), values.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER);
+        add_view(values.data(), values.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER,
+                 {"ATTRIBUTES", components * sizeof(float), count});
     accessor.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
     accessor.count = count;
     accessor.type = components == 2   ? TINYGLTF_TYPE_VEC2
@@ -71,7 +87,8 @@ class BufferBuilder {
   int add_indices(const std::vector<uint32_t>& indices) {
     tinygltf::Accessor accessor;
     accessor.bufferView = add_view(indices.data(), indices.size() * sizeof(uint32_t),
-                                   TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+                                   TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER,
+                                   {"TRIANGLES", sizeof(uint32_t), indices.size()});
     accessor.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
     accessor.count = indices.size();
     accessor.type = TINYGLTF_TYPE_SCALAR;
@@ -80,10 +97,12 @@ class BufferBuilder {
   }
 
   std::vector<uint8_t>& bytes() { return bin_; }
+  const std::vector<ViewCodec>& codecs() const { return codecs_; }
 
  private:
   tinygltf::Model* model_;
   std::vector<uint8_t> bin_;
+  std::vector<ViewCodec> codecs_;  // per view
 };
 
 tinygltf::Primitive make_primitive(const aiMesh& mesh, int material, BufferBuilder* buffer) {
@@ -162,6 +181,12 @@ Expected<tinygltf::Material> make_material(const aiScene& scene, const aiMateria
       shading == aiShadingMode_Unlit) {
     material.extensions[kUnlit] = tinygltf::Value(tinygltf::Value::Object());
   }
+  float specular = 1.0f;
+  if (source.Get(AI_MATKEY_SPECULAR_FACTOR, specular) == AI_SUCCESS && specular != 1.0f) {
+    tinygltf::Value::Object factor;
+    factor["specularFactor"] = tinygltf::Value(static_cast<double>(specular));
+    material.extensions[kSpecular] = tinygltf::Value(std::move(factor));
+  }
   aiString path;
   if (source.Get(AI_MATKEY_TEXTURE(aiTextureType_DIFFUSE, 0), path) == AI_SUCCESS) {
     const std::string p = path.C_Str();
@@ -228,10 +253,111 @@ Expected<tinygltf::Material> make_material(const aiScene& scene, const aiMateria
   return material;
 }
 
+// The node of a directional light travelling along `direction` (glTF's lights shine along the
+// node's -Z): the rotation taking -Z onto the unit direction.
+tinygltf::Node light_node(const aiLight& light, int index) {
+  tinygltf::Node node;
+  node.name = light.mName.C_Str();
+  aiVector3D d = light.mDirection;
+  d.Normalize();
+  // q = (a x b, 1 + a . b) normalised, a = (0, 0, -1), b = d; half a turn about y when b = -a.
+  const double w = 1.0 - d.z;
+  if (w < 1e-9) {
+    node.rotation = {0.0, 1.0, 0.0, 0.0};
+  } else {
+    const double x = d.y, y = -d.x, norm = std::sqrt(x * x + y * y + w * w);
+    node.rotation = {x / norm, y / norm, 0.0, w / norm};
+  }
+  tinygltf::Value::Object reference;
+  reference["light"] = tinygltf::Value(index);
+  node.extensions["KHR_lights_punctual"] = tinygltf::Value(std::move(reference));
+  return node;
+}
+
+// The GLB container (glTF 2.0 §4.4): header, the JSON chunk padded with spaces, the BIN chunk
+// padded with zeros.
+std::vector<uint8_t> glb_bytes(std::string json, const std::vector<uint8_t>& bin) {
+  while (json.size() % 4 != 0) json.push_back(' ');
+  std::vector<uint8_t> out;
+  const auto put32 = [&](uint32_t v) {
+    for (int b = 0; b < 4; ++b) out.push_back(static_cast<uint8_t>(v >> (8 * b)));
+  };
+  const size_t bin_padded = (bin.size() + 3) / 4 * 4;
+  put32(0x46546C67u);  // "glTF"
+  put32(2);
+  put32(static_cast<uint32_t>(12 + 8 + json.size() + (bin.empty() ? 0 : 8 + bin_padded)));
+  put32(static_cast<uint32_t>(json.size()));
+  put32(0x4E4F534Au);  // "JSON"
+  out.insert(out.end(), json.begin(), json.end());
+  if (!bin.empty()) {
+    put32(static_cast<uint32_t>(bin_padded));
+    put32(0x004E4942u);  // "BIN\0"
+    out.insert(out.end(), bin.begin(), bin.end());
+    out.resize(out.size() + bin_padded - bin.size(), 0);
+  }
+  return out;
+}
+
+// EXT_meshopt_compression: every view with a codec is stored compressed in buffer 0 (the GLB's
+// BIN chunk / <stem>.bin), the others (images) as they are; the compressed views' own buffer is
+// buffer 1, the fallback, which holds no data (only its byteLength). `doc` is tinygltf's JSON;
+// `bin` becomes buffer 0.
+Status compress_views(const BufferBuilder& buffer, tinygltf::Model* model, nlohmann::json* doc,
+                      std::vector<uint8_t>* bin) {
+  const std::vector<uint8_t> plain = *bin;
+  bin->clear();
+  size_t fallback = 0;
+  nlohmann::json& views = (*doc)["bufferViews"];
+  for (size_t v = 0; v < model->bufferViews.size(); ++v) {
+    const tinygltf::BufferView& view = model->bufferViews[v];
+    const ViewCodec& codec = buffer.codecs()[v];
+    const uint8_t* data = plain.data() + view.byteOffset;
+    while (bin->size() % 4 != 0) bin->push_back(0);
+    const size_t at = bin->size();
+    if (codec.mode.empty()) {
+      bin->insert(bin->end(), data, data + view.byteLength);
+      views[v]["buffer"] = 0;
+      views[v]["byteOffset"] = at;
+      continue;
+    }
+    size_t size = 0;
+    if (codec.mode == "TRIANGLES") {
+      std::vector<uint32_t> indices(codec.count);
+      std::memcpy(indices.data(), data, view.byteLength);
+      const uint32_t vertices =
+          indices.empty() ? 0 : *std::max_element(indices.begin(), indices.end()) + 1;
+      bin->resize(at + meshopt_encodeIndexBufferBound(codec.count, vertices));
+      size = meshopt_encodeIndexBuffer(bin->data() + at, bin->size() - at, indices.data(),
+                                       codec.count);
+    } else {
+      bin->resize(at + meshopt_encodeVertexBufferBound(codec.count, codec.stride));
+      size = meshopt_encodeVertexBuffer(bin->data() + at, bin->size() - at, data, codec.count,
+                                        codec.stride);
+    }
+    if (size == 0) return Status(ErrorId::kExportWrite, "meshoptimizer could not encode a view");
+    bin->resize(at + size);
+    while (fallback % 4 != 0) ++fallback;
+    views[v]["buffer"] = 1;
+    views[v]["byteOffset"] = fallback;
+    fallback += view.byteLength;
+    views[v]["extensions"][kMeshopt] = {{"buffer", 0},          {"byteOffset", at},
+                                        {"byteLength", size},   {"byteStride", codec.stride},
+                                        {"count", codec.count}, {"mode", codec.mode}};
+  }
+  while (bin->size() % 4 != 0) bin->push_back(0);
+  (*doc)["buffers"] = nlohmann::json::array(
+      {{{"byteLength", bin->size()}},
+       {{"byteLength", fallback}, {"extensions", {{kMeshopt, {{"fallback", true}}}}}}});
+  (*doc)["extensionsUsed"].push_back(kMeshopt);
+  (*doc)["extensionsRequired"].push_back(kMeshopt);
+  return Status::Ok();
+}
+
 }  // namespace
 
 Expected<std::vector<ExportedFile>> write_gltf(const aiScene& scene, MeshExportFormat format,
-                                               const std::string& stem) {
+                                               const std::string& stem,
+                                               const GltfOptions& options) {
   tinygltf::Model model;
   model.asset.version = "2.0";
   model.asset.generator = "calf-export";
@@ -280,41 +406,79 @@ Expected<std::vector<ExportedFile>> write_gltf(const aiScene& scene, MeshExportF
   }
   tinygltf::Scene gltf_scene;
   gltf_scene.nodes = {root};
+  // Lights: directional ones as KHR_lights_punctual (tinygltf declares the extension), each on a
+  // node of the scene's own; an ambient one as the scene's extras (glTF has no ambient light).
+  tinygltf::Value::Object scene_extras;
+  for (unsigned l = 0; l < scene.mNumLights; ++l) {
+    const aiLight& source = *scene.mLights[l];
+    if (source.mType == aiLightSource_DIRECTIONAL) {
+      const aiColor3D& c = source.mColorDiffuse;
+      const double intensity = std::max({c.r, c.g, c.b});
+      tinygltf::Light light;
+      light.name = source.mName.C_Str();
+      light.type = "directional";
+      light.intensity = intensity;
+      light.color = {c.r / intensity, c.g / intensity, c.b / intensity};
+      model.lights.push_back(light);
+      model.nodes.push_back(light_node(source, static_cast<int>(model.lights.size() - 1)));
+      gltf_scene.nodes.push_back(static_cast<int>(model.nodes.size() - 1));
+    } else if (source.mType == aiLightSource_AMBIENT) {
+      const aiColor3D& c = source.mColorAmbient;
+      scene_extras["calf_ambient_radiance"] = tinygltf::Value(tinygltf::Value::Array{
+          tinygltf::Value(static_cast<double>(c.r)), tinygltf::Value(static_cast<double>(c.g)),
+          tinygltf::Value(static_cast<double>(c.b))});
+    }
+  }
+  if (!scene_extras.empty()) gltf_scene.extras = tinygltf::Value(std::move(scene_extras));
   model.scenes.push_back(std::move(gltf_scene));
   model.defaultScene = 0;
-  for (const tinygltf::Material& m : model.materials) {
-    if (m.extensions.count(kUnlit) != 0) {
-      model.extensionsUsed = {kUnlit};
-      break;
+  for (const char* extension : {kUnlit, kSpecular}) {
+    for (const tinygltf::Material& m : model.materials) {
+      if (m.extensions.count(extension) != 0) {
+        model.extensionsUsed.push_back(extension);
+        break;
+      }
     }
   }
   while (buffer.bytes().size() % 4 != 0) buffer.bytes().push_back(0);
   const size_t bin_size = buffer.bytes().size();
   tinygltf::Buffer bin;
-  if (format == MeshExportFormat::kGlb) bin.data = std::move(buffer.bytes());
+  if (format == MeshExportFormat::kGlb && !options.meshopt) bin.data = std::move(buffer.bytes());
   model.buffers.push_back(std::move(bin));
 
   tinygltf::TinyGLTF writer;
   std::ostringstream out;
-  if (!writer.WriteGltfSceneToStream(&model, out, false, format == MeshExportFormat::kGlb)) {
+  const bool tinygltf_glb = format == MeshExportFormat::kGlb && !options.meshopt;
+  if (!writer.WriteGltfSceneToStream(&model, out, false, tinygltf_glb)) {
     return Status(ErrorId::kExportWrite, "tinygltf could not write the glTF");
   }
   const std::string text = out.str();
   std::vector<ExportedFile> files;
-  if (format == MeshExportFormat::kGlb) {
+  if (tinygltf_glb) {
     files.push_back({"", std::vector<uint8_t>(text.begin(), text.end())});
     return files;
   }
-  // tinygltf's stream writer embeds a .gltf's buffers as data URIs; calf writes the buffer
-  // beside it, so the (empty) buffer's entry is replaced by the side file's.
+  // tinygltf's stream writer embeds a .gltf's buffers as data URIs and cannot write a
+  // bufferView's extensions: calf writes the buffer beside a .gltf (the (empty) buffer's entry is
+  // replaced by the side file's), and adds EXT_meshopt_compression's objects to the JSON.
   nlohmann::json doc = nlohmann::json::parse(text, nullptr, false);
   if (doc.is_discarded() || !doc.contains("buffers")) {
     return Status(ErrorId::kExportWrite, "tinygltf wrote a .gltf calf cannot read back");
   }
-  doc["buffers"][0] = {{"byteLength", bin_size}, {"uri", stem + ".bin"}};
+  std::vector<uint8_t> data = std::move(buffer.bytes());
+  if (options.meshopt) {
+    CALF_RETURN_IF_ERROR(compress_views(buffer, &model, &doc, &data));
+  } else {
+    doc["buffers"][0] = {{"byteLength", bin_size}};
+  }
+  if (format == MeshExportFormat::kGlb) {
+    files.push_back({"", glb_bytes(doc.dump(), data)});
+    return files;
+  }
+  doc["buffers"][0]["uri"] = stem + ".bin";
   const std::string patched = doc.dump(2) + "\n";
   files.push_back({"", std::vector<uint8_t>(patched.begin(), patched.end())});
-  files.push_back({".bin", std::move(buffer.bytes())});
+  files.push_back({".bin", std::move(data)});
   return files;
 }
 

@@ -25,12 +25,21 @@ namespace calf::exporter {
 //     embedded texture, a PNG, stored in the binary buffer) with its sampler (wrap modes from
 //     AI_MATKEY_MAPPINGMODE_U / _V: clamp or glTF's default repeat; filters from
 //     AI_MATKEY_GLTF_MAPPINGFILTER_MAG / _MIN, else none), AI_MATKEY_GLTF_ALPHAMODE,
-//     AI_MATKEY_TWOSIDED, and AI_MATKEY_SHADING_MODEL aiShadingMode_Unlit as KHR_materials_unlit;
+//     AI_MATKEY_TWOSIDED, AI_MATKEY_SHADING_MODEL aiShadingMode_Unlit as KHR_materials_unlit,
+//     AI_MATKEY_SPECULAR_FACTOR (when not 1) as KHR_materials_specular's specularFactor;
 //     metallic 0;
+//   - lights: a directional light as a KHR_lights_punctual light (intensity: the largest
+//     channel of its diffuse colour, in lux; colour: the diffuse colour over it) on a node of its
+//     own among the scene's root nodes, rotated so that its -Z is the light's direction; an
+//     ambient light as the scene's extras "calf_ambient_radiance": [r, g, b] (its ambient colour:
+//     the radiance of a uniform environment; glTF has no ambient light); other lights are left out;
 //   - extensionsUsed lists exactly the extensions the file uses.
 // A .glb is one file; a .gltf is its JSON and the buffer as the side file "<stem>.bin" (suffix
-// ".bin"). CALF-E481 when tinygltf fails.
+// ".bin"). With options.meshopt, EXT_meshopt_compression (required): vertex attributes
+// (mode ATTRIBUTES) and indices (mode TRIANGLES) compressed by meshoptimizer into buffer 0 (the
+// GLB's binary chunk / <stem>.bin) beside the images, their views' own buffer being buffer 1, a
+// fallback buffer without data. CALF-E481 when tinygltf or meshoptimizer fails.
 Expected<std::vector<ExportedFile>> write_gltf(const aiScene& scene, MeshExportFormat format,
-                                               const std::string& stem);
+                                               const std::string& stem, const GltfOptions& options);
 
 }  // namespace calf::exporter

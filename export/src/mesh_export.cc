@@ -7,12 +7,14 @@
 #include <memory>
 #include <utility>
 
+#include <assimp/light.h>
 #include <assimp/material.h>
 #include <assimp/mesh.h>
 #include <assimp/scene.h>
 #include <assimp/texture.h>
 
 #include "assimp_files.h"
+#include "calf/format/mesh_lighting.h"
 
 namespace calf::exporter {
 namespace {
@@ -133,7 +135,34 @@ std::unique_ptr<aiMaterial> make_material(const decoder::MeshMaterial& m, uint32
   const aiColor3D emissive(std::min(m.emission[0], 1.0f), std::min(m.emission[1], 1.0f),
                            std::min(m.emission[2], 1.0f));
   material->AddProperty(&emissive, 1, AI_MATKEY_COLOR_EMISSIVE);
+  // The renderers' materials are Lambertian with no specular reflection, seen from both sides
+  // (the normal flipped towards the eye), as glTF's doubleSided draws them.
+  const float specular = 0.0f;
+  material->AddProperty(&specular, 1, AI_MATKEY_SPECULAR_FACTOR);
+  const int two_sided = 1;
+  material->AddProperty(&two_sided, 1, AI_MATKEY_TWOSIDED);
   return material;
+}
+
+// The lights of calf/format/mesh_lighting.h: the key light (directional, travelling along
+// -kMeshKeyLight, colour (1 - kMeshAmbient) * pi: illuminance in lux for glTF) and the ambient
+// term (aiLightSource_AMBIENT, colour kMeshAmbient: a uniform environment's radiance).
+void add_lights(aiScene* scene) {
+  scene->mNumLights = 2;
+  scene->mLights = new aiLight*[2];
+  auto* key = new aiLight();
+  key->mName = aiString("calf key light");
+  key->mType = aiLightSource_DIRECTIONAL;
+  key->mDirection =
+      aiVector3D(-mesh::kMeshKeyLight[0], -mesh::kMeshKeyLight[1], -mesh::kMeshKeyLight[2]);
+  const float illuminance = (1.0f - mesh::kMeshAmbient) * 3.14159265f;
+  key->mColorDiffuse = aiColor3D(illuminance, illuminance, illuminance);
+  scene->mLights[0] = key;
+  auto* ambient = new aiLight();
+  ambient->mName = aiString("calf ambient light");
+  ambient->mType = aiLightSource_AMBIENT;
+  ambient->mColorAmbient = aiColor3D(mesh::kMeshAmbient, mesh::kMeshAmbient, mesh::kMeshAmbient);
+  scene->mLights[1] = ambient;
 }
 
 aiMatrix4x4 node_matrix(const decoder::MeshTransform& m) {
@@ -160,7 +189,8 @@ Expected<MeshExportFormat> mesh_export_format_from_path(const std::string& path)
 Expected<std::vector<ExportedFile>> export_mesh_track(const decoder::MeshTrack& track,
                                                       uint32_t frame, MeshExportFormat format,
                                                       const std::string& stem,
-                                                      MeshExportStats* stats) {
+                                                      MeshExportStats* stats,
+                                                      const GltfOptions& gltf) {
   if (frame >= track.frame_count()) {
     return export_error("frame " + std::to_string(frame) + " is past the track's " +
                         std::to_string(track.frame_count()) + " frames");
@@ -302,12 +332,13 @@ Expected<std::vector<ExportedFile>> export_mesh_track(const decoder::MeshTrack& 
       scene->mTextures[e] = tex;
     }
   }
+  add_lights(scene.get());
   local.objects = nodes.size();
   local.meshes = scene->mNumMeshes;
   local.textures =
       pngs.size() - static_cast<size_t>(std::count(needed.begin(), needed.end(), false));
 
-  CALF_ASSIGN_OR_RETURN(std::vector<ExportedFile> files, write_scene(*scene, format, stem));
+  CALF_ASSIGN_OR_RETURN(std::vector<ExportedFile> files, write_scene(*scene, format, stem, gltf));
   if (format == MeshExportFormat::kObj) {
     for (uint32_t t = 0; t < pngs.size(); ++t) {
       if (needed[t]) files.push_back({"_texture" + std::to_string(t) + ".png", std::move(pngs[t])});

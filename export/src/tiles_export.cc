@@ -310,7 +310,8 @@ Expected<std::vector<ExportedFile>> export_tile_set(const TileSet& set, MeshExpo
   scene->mRootNode->mNumMeshes = 1;
   scene->mRootNode->mMeshes = new unsigned[1]{0};
 
-  CALF_ASSIGN_OR_RETURN(std::vector<ExportedFile> files, write_scene(*scene, format, stem));
+  CALF_ASSIGN_OR_RETURN(std::vector<ExportedFile> files,
+                        write_scene(*scene, format, stem, options.gltf));
   if (format == MeshExportFormat::kObj) files.push_back({"_atlas.png", std::move(png)});
   if (stats != nullptr) *stats = local;
   return files;

@@ -53,7 +53,14 @@ static int command_main(int argc, char** argv) {
       ".obj, as map_Kd and map_d). Texture coordinates are the tiles' projective ones divided out "
       "per vertex (affine "
       "inside a triangle: --subdivide bounds the difference; the largest is printed in texels, "
-      "and a warning when a fixed --subdivide leaves more than 2)."
+      "and a warning when a fixed --subdivide leaves more than 2).\n"
+      "A mesh track's glTF carries the lighting calf-play shades it with: its key light as a "
+      "KHR_lights_punctual directional light, the ambient share as the scene's extras "
+      "\"calf_ambient_radiance\" (glTF has no ambient light), and its materials as diffuse only "
+      "(KHR_materials_specular factor 0), double-sided.\n"
+      "--meshopt compresses a .glb / .gltf's vertex and index data losslessly with "
+      "EXT_meshopt_compression (a required extension: the loader needs a meshoptimizer decoder, "
+      "e.g. three.js's GLTFLoader.setMeshoptDecoder); the sizes are printed."
       " Each file is written whole or not at all (a temporary file renamed into "
       "place); an output or side file that is the input clip is refused (CALF-E007).\n" +
       std::string(calf::tools::kExitStatusHelp)};
@@ -61,6 +68,7 @@ static int command_main(int argc, char** argv) {
   uint32_t frame = 0;
   int track_option = -1;
   bool quiet = false;
+  bool meshopt = false;
   std::string subdivide = "auto";
   app.add_option("CLIP", clip, "input .calf holding a mesh or tiles track")->required();
   app.add_option("-o,--output", out, "output .glb, .gltf or .obj")->required();
@@ -76,6 +84,9 @@ static int command_main(int argc, char** argv) {
                  "the affine texture approximation, or auto: each tile the smallest N that keeps "
                  "its error within 1 atlas texel (default auto)")
       ->default_val("auto");
+  app.add_flag("--meshopt", meshopt,
+               ".glb / .gltf: compress vertex and index data with EXT_meshopt_compression "
+               "(meshoptimizer; a required extension)");
   app.add_flag("-q,--quiet", quiet, "print nothing on success");
   if (const int exit = calf::tools::parse_command_line(app, kCommand, argc, argv); exit >= 0) {
     return exit;
@@ -83,6 +94,15 @@ static int command_main(int argc, char** argv) {
 
   auto format = calf::exporter::mesh_export_format_from_path(out);
   if (!format.ok()) return calf::tools::print_error(kCommand, format.status(), 2);
+  if (meshopt && format.value() == calf::exporter::MeshExportFormat::kObj) {
+    return calf::tools::print_error(
+        kCommand,
+        calf::Status(calf::ErrorId::kExportInput,
+                     "--meshopt applies to a .glb or .gltf output, not " + file_name(out)),
+        2);
+  }
+  calf::exporter::GltfOptions gltf;
+  gltf.meshopt = meshopt;
   auto reader = calf::container::Reader::open(clip);
   if (!reader.ok()) return fail(reader.status());
   const auto& tracks = reader.value().tracks();
@@ -126,6 +146,7 @@ static int command_main(int argc, char** argv) {
     auto set = calf::decoder::decode_tiles_track(reader.value(), static_cast<uint16_t>(track));
     if (!set.ok()) return fail(set.status().with_context(clip));
     calf::exporter::TilesExportOptions options;
+    options.gltf = gltf;
     if (subdivide != "auto") {
       uint32_t n = 0;
       const auto [end, ec] =
@@ -169,7 +190,7 @@ static int command_main(int argc, char** argv) {
     if (!mesh.ok()) return fail(mesh.status().with_context(clip));
     calf::exporter::MeshExportStats stats;
     files = calf::exporter::export_mesh_track(mesh.value(), frame, format.value(), file_name(base),
-                                              &stats);
+                                              &stats, gltf);
     if (!files.ok()) return fail(files.status().with_context(clip));
     summary = fmt::format(
         "{}: frame {}: {} objects, {} meshes, {} vertices, {} triangles, {} textures", out, frame,
@@ -197,6 +218,11 @@ static int command_main(int argc, char** argv) {
   }
   for (auto& temp : temps) {
     if (calf::Status s = temp.commit(); !s.ok()) return fail(s);
+  }
+  if (meshopt) {
+    uint64_t bytes = 0;
+    for (const auto& file : files.value()) bytes += file.bytes.size();
+    summary += fmt::format(" ({} bytes with EXT_meshopt_compression)", bytes);
   }
   if (!quiet) std::printf("%s\n", summary.c_str());
   if (!warning.empty()) std::fprintf(stderr, "%s\n", warning.c_str());

@@ -27,6 +27,7 @@
 #include "calf/encoder/mesh_encode.h"
 #include "calf/encoder/sphere_mesh.h"
 #include "calf/format/container.h"
+#include "glb_reading.h"
 
 namespace calf {
 namespace {
@@ -360,6 +361,82 @@ TEST(MeshExport, TexturesAndUvsTravelIntoGlbAndObj) {
   Box box;
   expected(scene, 0, nullptr, &triangles, &box);
   EXPECT_EQ(back.triangles, triangles);
+}
+
+// calf-play shades a mesh track under fixed lights (docs/PLAYER.md: colour x (0.3 + 0.7 max(0,
+// n . L)) with L = (0.3, 0.8, 0.5) normalised, both sides of every triangle, no specular): a
+// glTF carries them, so that an engine lights the file the same way.
+TEST(MeshExport, GlbCarriesThePlayersLighting) {
+  const capture::SceneFile scene = test::make_mesh_test_scene(2, false);
+  auto files = export_clip(encode(scene, nullptr), 0, MeshExportFormat::kGlb);
+  ASSERT_TRUE(files.ok()) << files.status().to_string();
+  const nlohmann::json j = test::read_glb(files->front().bytes).json;
+  ASSERT_FALSE(j.is_discarded());
+  // The key light: directional, illuminance 0.7 pi lux (a Lambertian surface of albedo c then
+  // reflects 0.7 c cos), travelling along -L: glTF's light shines along its node's -Z.
+  const nlohmann::json& lights = j["extensions"]["KHR_lights_punctual"]["lights"];
+  ASSERT_EQ(lights.size(), 1u);
+  EXPECT_EQ(lights[0]["type"], "directional");
+  EXPECT_NEAR(lights[0]["intensity"].get<double>(), 0.7 * M_PI, 1e-5);
+  int light_nodes = 0;
+  for (const auto& node : j["nodes"]) {
+    if (!node.contains("extensions")) continue;
+    ++light_nodes;
+    EXPECT_EQ(node["extensions"]["KHR_lights_punctual"]["light"], 0);
+    const std::vector<double> q = node["rotation"];  // x, y, z, w
+    // The rotated -Z axis: -(third column of the rotation matrix).
+    const double dir[3] = {-2 * (q[0] * q[2] + q[3] * q[1]), -2 * (q[1] * q[2] - q[3] * q[0]),
+                           -(1 - 2 * (q[0] * q[0] + q[1] * q[1]))};
+    const double n = std::sqrt(0.3 * 0.3 + 0.8 * 0.8 + 0.5 * 0.5);
+    EXPECT_NEAR(dir[0], -0.3 / n, 1e-6);
+    EXPECT_NEAR(dir[1], -0.8 / n, 1e-6);
+    EXPECT_NEAR(dir[2], -0.5 / n, 1e-6);
+  }
+  EXPECT_EQ(light_nodes, 1);
+  // The ambient share: a uniform environment of radiance 0.3, as the scene's extras.
+  const nlohmann::json& extras = j["scenes"][0]["extras"];
+  ASSERT_EQ(extras["calf_ambient_radiance"].size(), 3u);
+  for (double v : extras["calf_ambient_radiance"]) EXPECT_NEAR(v, 0.3, 1e-6);
+  // Materials: diffuse only, seen from both sides.
+  ASSERT_FALSE(j["materials"].empty());
+  for (const auto& m : j["materials"]) {
+    EXPECT_EQ(m["extensions"]["KHR_materials_specular"]["specularFactor"], 0.0);
+    EXPECT_EQ(m["doubleSided"], true);
+  }
+  std::vector<std::string> used = j["extensionsUsed"];
+  std::sort(used.begin(), used.end());
+  EXPECT_EQ(used, (std::vector<std::string>{"KHR_lights_punctual", "KHR_materials_specular"}));
+  EXPECT_FALSE(j.contains("extensionsRequired"));
+}
+
+// GltfOptions::meshopt: every vertex and index view decodes (meshoptimizer) to the plain file's,
+// in a smaller file; the same track gives the same bytes; OBJ refuses the option.
+TEST(MeshExport, MeshoptHoldsTheSameGeometry) {
+  const capture::SceneFile scene = test::make_mesh_test_scene(3, true);
+  const std::vector<uint8_t> clip = encode(scene, nullptr);
+  auto reader = container::Reader::open(container::memory_source(std::span<const uint8_t>(clip)));
+  ASSERT_TRUE(reader.ok());
+  auto track = decoder::MeshTrack::open(*reader, 0);
+  ASSERT_TRUE(track.ok());
+  exporter::GltfOptions meshopt;
+  meshopt.meshopt = true;
+  auto plain = exporter::export_mesh_track(*track, 1, MeshExportFormat::kGlb, "s");
+  auto compressed =
+      exporter::export_mesh_track(*track, 1, MeshExportFormat::kGlb, "s", nullptr, meshopt);
+  auto again =
+      exporter::export_mesh_track(*track, 1, MeshExportFormat::kGlb, "s", nullptr, meshopt);
+  ASSERT_TRUE(plain.ok() && compressed.ok() && again.ok()) << compressed.status().to_string();
+  EXPECT_EQ(compressed->front().bytes, again->front().bytes);
+  size_t encoded = 0, decoded = 0;
+  test::expect_meshopt_equals_plain(test::read_glb(plain->front().bytes),
+                                    test::read_glb(compressed->front().bytes), &encoded, &decoded);
+  EXPECT_GT(decoded, 0u);
+  EXPECT_LT(encoded, decoded);
+  EXPECT_LT(compressed->front().bytes.size(), plain->front().bytes.size());
+  EXPECT_EQ(exporter::export_mesh_track(*track, 1, MeshExportFormat::kObj, "s", nullptr, meshopt)
+                .status()
+                .id(),
+            ErrorId::kExportInput);
 }
 
 TEST(MeshExport, SameTrackSameBytes) {

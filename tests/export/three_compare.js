@@ -8,9 +8,13 @@
 //     writes an eye path of 5 poses inside the capture set's view volume: its centre and four
 //     points at 40 % of the way to corners, each looking in another direction
 //   node three_compare.js compare NPM_DIR CHROMIUM MODEL.glb EYE_PATH.json FRAMES_DIR MIN_DB
+//                         [SECOND.glb MIN_SAME_DB]
 //     prints "pose P: PSNR X dB (blending in linear colour: Y dB)" per pose (X: three.js's
-//     default rendering into the canvas, the figure MIN_DB applies to) and "three.js <version>: min PSNR X dB over N poses in
-//     T s"; exits 1 when a pose is below MIN_DB or its canvas is blank (one colour)
+//     default rendering into the canvas, the figure MIN_DB applies to) and "three.js <version>:
+//     min PSNR X dB over N poses in T s"; exits 1 when a pose is below MIN_DB or its canvas is
+//     blank (one colour). With SECOND.glb (the same export with EXT_meshopt_compression), each
+//     pose also prints SECOND's PSNR against MODEL's frame, which must reach MIN_SAME_DB, and a
+//     line gives both files' bytes, their ratio and their load times in the page.
 'use strict';
 const fs = require('fs');
 const http = require('http');
@@ -71,7 +75,7 @@ function serve(routes) {
   return new Promise((resolve) => server.listen(0, '127.0.0.1', () => resolve(server)));
 }
 
-async function compare([npmDir, chromium, model, eyePath, framesDir, minDb]) {
+async function compare([npmDir, chromium, model, eyePath, framesDir, minDb, second, minSameDb]) {
   const started = Date.now();
   const modules = path.resolve(npmDir, 'node_modules');
   const {chromium: browserType} = require(path.join(modules, 'playwright-core'));
@@ -80,6 +84,7 @@ async function compare([npmDir, chromium, model, eyePath, framesDir, minDb]) {
     ['/', path.join(__dirname, 'three_compare.html')],
     ['/three/', path.join(modules, 'three')],
     ['/model.glb', path.resolve(model)],
+    ...(second ? [['/second.glb', path.resolve(second)]] : []),
     ['/eye_path.json', path.resolve(eyePath)],
     ['/frames/', path.resolve(framesDir)],
   ]);
@@ -98,7 +103,8 @@ async function compare([npmDir, chromium, model, eyePath, framesDir, minDb]) {
     page.on('pageerror', (e) => logs.push(String(e)));
     // CALF_THREE_SAVE=DIR: three.js's frames are written there as three_NNNNN.png.
     const save = process.env.CALF_THREE_SAVE;
-    await page.goto(`http://127.0.0.1:${server.address().port}/${save ? '?save' : ''}`);
+    const query = [save ? 'save' : '', second ? 'second' : ''].filter((q) => q).join('&');
+    await page.goto(`http://127.0.0.1:${server.address().port}/${query ? '?' + query : ''}`);
     try {
       await page.waitForFunction(() => window.calfResult !== undefined, null, {timeout: 15000});
       result = await page.evaluate(() => window.calfResult);
@@ -116,25 +122,41 @@ async function compare([npmDir, chromium, model, eyePath, framesDir, minDb]) {
         path.join(process.env.CALF_THREE_SAVE, `three_${String(i).padStart(5, '0')}.png`),
         Buffer.from(p.png.split(',')[1], 'base64')));
   }
+  // CALF_THREE_JSON=FILE: the per-pose figures are written there too (tests/export/blender_compare.sh).
+  if (process.env.CALF_THREE_JSON) {
+    fs.writeFileSync(process.env.CALF_THREE_JSON, JSON.stringify(
+        result.poses.map((p) => ({psnr: p.psnr, psnr_linear: p.psnrLinear}))) + '\n');
+  }
   let worst = Infinity, ok = true;
   result.poses.forEach((p, i) => {
+    const same = second ? `; ${path.basename(second)} against it: ${p.psnrSecond.toFixed(2)} dB` : '';
     console.log(`pose ${i}: PSNR ${p.psnr.toFixed(2)} dB${p.blank ? ' (blank canvas)' : ''} ` +
-                `(blending in linear colour: ${p.psnrLinear.toFixed(2)} dB)`);
+                `(blending in linear colour: ${p.psnrLinear.toFixed(2)} dB)${same}`);
     worst = Math.min(worst, p.psnr);
     if (p.blank || !(p.psnr >= Number(minDb))) ok = false;
+    if (second && !(p.psnrSecond >= Number(minSameDb))) ok = false;
   });
+  if (second) {
+    const bytes = fs.statSync(model).size, secondBytes = fs.statSync(second).size;
+    console.log(`${path.basename(model)}: ${bytes} bytes, loaded in ${result.loadMs.toFixed(1)} ms; ` +
+                `${path.basename(second)}: ${secondBytes} bytes (${(bytes / secondBytes).toFixed(2)} x ` +
+                `smaller), loaded in ${result.secondLoadMs.toFixed(1)} ms (median of 5 loads each)`);
+  }
   console.log(`three.js ${threeVersion} (${result.renderer}): min PSNR ${worst.toFixed(2)} dB over ` +
               `${result.poses.length} poses in ${((Date.now() - started) / 1000).toFixed(1)} s`);
-  if (!ok) fail(`a pose is below ${minDb} dB or blank`);
+  if (!ok) {
+    fail(`a pose is below ${minDb} dB or blank` +
+         (second ? `, or ${path.basename(second)} is below ${minSameDb} dB against it` : ''));
+  }
 }
 
 const [command, ...args] = process.argv.slice(2);
 if (command === 'poses' && args.length === 4) {
   writePoses(args);
-} else if (command === 'compare' && args.length === 6) {
+} else if (command === 'compare' && (args.length === 6 || args.length === 8)) {
   compare(args).catch((e) => fail(String(e && e.stack || e)));
 } else {
   console.error('usage: node three_compare.js poses MANIFEST OUT WIDTH HEIGHT | ' +
-                'compare NPM_DIR CHROMIUM MODEL.glb EYE_PATH FRAMES_DIR MIN_DB');
+                'compare NPM_DIR CHROMIUM MODEL.glb EYE_PATH FRAMES_DIR MIN_DB [SECOND.glb MIN_SAME_DB]');
   process.exit(2);
 }

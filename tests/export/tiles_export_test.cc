@@ -26,6 +26,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../integration/synthetic_tiles.h"
+#include "glb_reading.h"
 
 namespace calf {
 namespace {
@@ -297,6 +298,30 @@ TEST(TilesExport, ObjWritesMtlAndAtlasPng) {
   EXPECT_EQ(w, set.atlas_width);
   EXPECT_EQ(h, set.atlas_height);
   std::filesystem::remove_all(dir);
+}
+
+// --meshopt: the same tiles (triangles in the same back-to-front order) and atlas, decoded by
+// meshoptimizer, in a smaller file; OBJ refuses the option.
+TEST(TilesExport, MeshoptHoldsTheSameGeometry) {
+  const TileSet set = small_set();
+  auto plain = exporter::export_tile_set(set, MeshExportFormat::kGlb, "t");
+  exporter::TilesExportOptions o;
+  o.gltf.meshopt = true;
+  auto compressed = exporter::export_tile_set(set, MeshExportFormat::kGlb, "t", o);
+  ASSERT_TRUE(plain.ok() && compressed.ok()) << compressed.status().to_string();
+  size_t encoded = 0, decoded = 0;
+  test::expect_meshopt_equals_plain(test::read_glb(plain->front().bytes),
+                                    test::read_glb(compressed->front().bytes), &encoded, &decoded);
+  EXPECT_LT(encoded, decoded);
+  EXPECT_LT(compressed->front().bytes.size(), plain->front().bytes.size());
+  auto gltf = exporter::export_tile_set(set, MeshExportFormat::kGltf, "t", o);
+  ASSERT_TRUE(gltf.ok());
+  ASSERT_EQ(gltf->size(), 2u);
+  const nlohmann::json json = nlohmann::json::parse((*gltf)[0].bytes);
+  EXPECT_EQ(json["buffers"][0]["uri"], "t.bin");
+  EXPECT_EQ(json["buffers"][0]["byteLength"], (*gltf)[1].bytes.size());
+  EXPECT_EQ(exporter::export_tile_set(set, MeshExportFormat::kObj, "t", o).status().id(),
+            ErrorId::kExportInput);
 }
 
 TEST(TilesExport, BadRequestsAreRefused) {

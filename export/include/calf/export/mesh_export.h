@@ -49,6 +49,14 @@ struct ExportedFile {
   std::vector<uint8_t> bytes;
 };
 
+// How a glTF export (.glb / .gltf) stores its geometry.
+struct GltfOptions {
+  // EXT_meshopt_compression (a required extension: loaders need a meshoptimizer decoder, e.g.
+  // three.js's GLTFLoader.setMeshoptDecoder): vertex attributes and indices compressed
+  // losslessly by meshoptimizer; images are stored as they are. CALF-E480 for OBJ.
+  bool meshopt = false;
+};
+
 struct MeshExportStats {
   uint64_t objects = 0;    // nodes written
   uint64_t meshes = 0;     // meshes written (after splitting by material)
@@ -62,10 +70,11 @@ struct MeshExportStats {
 // without its extension), and the main file refers to them by those names. Errors: the track's
 // decoding errors (naming the object or prototype), CALF-E480 for a frame out of range, an empty
 // track or a stem of other characters than A-Z a-z 0-9 _ - . (for .gltf / .obj), CALF-E481 when
-// the glTF or OBJ writer fails (assimp's message quoted).
+// the glTF or OBJ writer fails (assimp's message quoted), CALF-E480 for a glTF option with OBJ.
 Expected<std::vector<ExportedFile>> export_mesh_track(const decoder::MeshTrack& track,
                                                       uint32_t frame, MeshExportFormat format,
                                                       const std::string& stem,
-                                                      MeshExportStats* stats = nullptr);
+                                                      MeshExportStats* stats = nullptr,
+                                                      const GltfOptions& gltf = {});
 
 }  // namespace calf::exporter

@@ -50,6 +50,8 @@ struct TilesExportOptions {
   // With subdivide 0: the largest affine texture error a tile may keep, in atlas texels (> 0,
   // else CALF-E482).
   double target_texel_error = 1.0;
+  // How a .glb / .gltf stores the geometry (mesh_export.h; CALF-E480 for OBJ).
+  GltfOptions gltf;
 };
 
 // A fixed subdivision whose largest affine texture error exceeds this many atlas texels is worth

@@ -51,15 +51,15 @@
 #include <cstdint>
 #include <vector>
 
+#include "calf/format/mesh_lighting.h"
 #include "calf/format/mesh_texture.h"
 #include "calf/format/status.h"
 
 namespace calf::player {
 
-// The fixed key light: a unit direction towards it in world space, (0.3, 0.8, 0.5) normalised.
-inline constexpr std::array<float, 3> kMeshKeyLight = {0.30304576f, 0.80812204f, 0.50507627f};
-// The ambient share of the shading (the rest is Lambert under the key light).
-inline constexpr float kMeshAmbient = 0.3f;
+// The fixed key light and the ambient share of the shading (calf/format/mesh_lighting.h).
+using mesh::kMeshAmbient;
+using mesh::kMeshKeyLight;
 
 // A per-triangle material of this value takes the object's material (as the mesh track's
 // mesh::kObjectMaterial: an analytic sphere's triangles in a mesh with per-triangle materials).

@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# The tiles OBJ in Blender (ctest cli.calf_export_tiles_blender): the play fixture's tiles clip
+# exported with calf-export's defaults as .obj (+ .mtl + atlas with map_d) and as .glb; Blender 3.4
+# imports the .obj and renders it unlit with Cycles (tests/export/blender_obj_render.py), three.js
+# in headless Chromium renders the .glb (tests/export/three_compare.js), both at the 5 poses of
+# cli.calf_export_tiles_three, each compared with calf-play's frame of the pose. Every pose's
+# Blender PSNR must be at least the .glb's minus MAX_LOSS_DB.
+# Usage: blender_compare.sh BIN_DIR SOURCE_DIR MANIFEST.json CLIP WORK_DIR MAX_LOSS_DB
+# Without Blender, Chromium, node or build/npm's three / playwright-core it is skipped (exit 77,
+# one line), except with CI=true, where it fails.
+set -euo pipefail
+bin=$1 src=$2 manifest=$3 clip=$4 work=$5 max_loss=$6
+npm_dir="$src/build/npm"
+missing=()
+command -v blender >/dev/null || missing+=(blender)
+chromium="$(command -v chromium || true)"
+[ -n "$chromium" ] || missing+=(chromium)
+command -v node >/dev/null || missing+=(node)
+for p in three playwright-core; do
+  [ -f "$npm_dir/node_modules/$p/package.json" ] || missing+=("npm:$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  if [ "${CI:-}" = "true" ]; then
+    echo "blender_compare: FAILED: ${missing[*]} missing with CI=true (tools/setup.sh installs them)"
+    exit 1
+  fi
+  echo "blender_compare: skipped: ${missing[*]} missing (tools/setup.sh installs them)"
+  exit 77
+fi
+rm -rf "$work"
+mkdir -p "$work"
+node "$src/tests/export/three_compare.js" poses "$manifest" "$work/eye_path.json" 160 120
+"$bin/calf-export" "$clip" -o "$work/tiles.glb"
+"$bin/calf-export" "$clip" -o "$work/tiles.obj"
+"$bin/calf-play" "$clip" --headless --eye-path "$work/eye_path.json" --out "$work/frames" >/dev/null
+CALF_THREE_JSON="$work/three.json" node "$src/tests/export/three_compare.js" compare "$npm_dir" \
+  "$chromium" "$work/tiles.glb" "$work/eye_path.json" "$work/frames" 0 >/dev/null
+started=$(date +%s)
+blender -b --factory-startup -noaudio -P "$src/tests/export/blender_obj_render.py" -- \
+  "$work/tiles.obj" "$work/eye_path.json" "$work/frames" "$work" >"$work/blender.log" 2>&1 ||
+  { tail -20 "$work/blender.log"; echo "blender_compare: FAILED: Blender failed"; exit 1; }
+seconds=$(($(date +%s) - started))
+# Each pose: Blender's PSNR (OBJ) beside three.js's (.glb), both against calf-play.
+node - "$work/blender.log" "$work/three.json" "$max_loss" "$seconds" <<'JS'
+const fs = require('fs');
+const [log, threeFile, maxLoss, seconds] = process.argv.slice(2);
+const three = JSON.parse(fs.readFileSync(threeFile, 'utf8'));
+const blender = [...fs.readFileSync(log, 'utf8').matchAll(/^pose (\d+): PSNR ([0-9.]+) dB$/gm)]
+    .map((m) => Number(m[2]));
+let ok = blender.length === three.length && blender.length > 0, worst = Infinity;
+blender.forEach((b, i) => {
+  const loss = three[i].psnr - b;
+  worst = Math.min(worst, -loss);
+  console.log(`pose ${i}: OBJ in Blender ${b.toFixed(2)} dB, .glb in three.js ` +
+              `${three[i].psnr.toFixed(2)} dB (linear blending ${three[i].psnr_linear.toFixed(2)} dB): ` +
+              `${loss >= 0 ? loss.toFixed(2) + ' dB below' : (-loss).toFixed(2) + ' dB above'}`);
+  if (!(loss <= Number(maxLoss))) ok = false;
+});
+console.log(`blender_compare: ${blender.length} poses, OBJ at least ${worst.toFixed(2)} dB against ` +
+            `the .glb (Blender ${seconds} s)`);
+if (!ok) {
+  console.log(`blender_compare: FAILED: a pose is more than ${maxLoss} dB below the .glb`);
+  process.exit(1);
+}
+JS
