@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -535,8 +534,9 @@ TEST(SeuratIngest, ColourAndDepthOfDifferentSizes) {
 }
 
 // Images whose headers disagree with their camera are refused from the header, before a pixel
-// is decoded: a 100-byte PNG and a 16 KB EXR header declaring 16384 x 16384 for 16 x 16 cameras
-// (they took 5 GB and 59 s, and 6.8 GB then an uncaught bad_alloc).
+// is decoded: a 100-byte PNG and a 16 KB EXR header declaring 16384 x 16384 for 16 x 16 cameras.
+// The memory and time bounds of the same cases are measured, relative to the command's start-up,
+// by cli.hostile_image_ingest-* (tests/cli/hostile_images.sh), not by a wall clock here.
 TEST(SeuratIngest, ImageHeaderAgainstTheCameraBeforeDecoding) {
   const fs::path dir = scratch("hostile_header");
   fs::create_directories(dir);
@@ -547,7 +547,6 @@ TEST(SeuratIngest, ImageHeaderAgainstTheCameraBeforeDecoding) {
   for (int c = 0; c < 64; ++c) many.push_back("C" + std::to_string(c));
   std::ofstream(dir / "wide.exr", std::ios::binary)
       << calf::test::exr_header_only(4096, 4096, many);
-  const auto start = std::chrono::steady_clock::now();
   for (const char* colour : {"big.png", "big.exr", "wide.exr"}) {
     std::ofstream(dir / "manifest.json") << calf::test::seurat_manifest(16, colour, "big.exr");
     const std::string e = error_of(dir / "manifest.json");
@@ -555,7 +554,6 @@ TEST(SeuratIngest, ImageHeaderAgainstTheCameraBeforeDecoding) {
     EXPECT_NE(e.find(std::string(colour) + ": the image is "), std::string::npos) << e;
     EXPECT_NE(e.find(" but the camera says 16 x 16"), std::string::npos) << e;
   }
-  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0);
 }
 
 // Face sizes whose six faces exceed the image budget: E012 before anything is read or written
