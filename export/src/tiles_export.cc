@@ -151,6 +151,10 @@ Expected<std::vector<ExportedFile>> export_tile_set(const TileSet& set, MeshExpo
     return Status(
         ErrorId::kExportTilesOption,
         "target texel error " + std::to_string(options.target_texel_error) + " is not > 0");
+  if (!(options.alpha_cutoff >= 0 && options.alpha_cutoff < 1))
+    return Status(
+        ErrorId::kExportTilesOption,
+        "alpha cutoff " + std::to_string(options.alpha_cutoff) + " is not 0 (BLEND) or in (0, 1)");
   if (set.tiles.empty()) return Status(ErrorId::kExportTilesEmpty, "the tile set has no tile");
   const size_t texels = size_t{set.atlas_width} * set.atlas_height;
   if (texels == 0 || set.atlas_rgba.size() != 4 * texels)
@@ -209,8 +213,12 @@ Expected<std::vector<ExportedFile>> export_tile_set(const TileSet& set, MeshExpo
   material->AddProperty(&white3, 1, AI_MATKEY_COLOR_DIFFUSE);
   const float opaque = 1.0f;
   material->AddProperty(&opaque, 1, AI_MATKEY_OPACITY);
-  const aiString blend("BLEND");
+  const aiString blend(options.alpha_cutoff > 0 ? "MASK" : "BLEND");
   material->AddProperty(&blend, AI_MATKEY_GLTF_ALPHAMODE);
+  if (options.alpha_cutoff > 0) {
+    const float cutoff = static_cast<float>(options.alpha_cutoff);
+    material->AddProperty(&cutoff, 1, AI_MATKEY_GLTF_ALPHACUTOFF);
+  }
   const int two_sided = 0;
   material->AddProperty(&two_sided, 1, AI_MATKEY_TWOSIDED);
   // Baked radiance: glTF's KHR_materials_unlit (gltf_files.h).

@@ -69,6 +69,7 @@ static int command_main(int argc, char** argv) {
   int track_option = -1;
   bool quiet = false;
   bool meshopt = false;
+  double alpha_mask = 0;
   std::string subdivide = "auto";
   app.add_option("CLIP", clip, "input .calf holding a mesh or tiles track")->required();
   app.add_option("-o,--output", out, "output .glb, .gltf or .obj")->required();
@@ -84,6 +85,9 @@ static int command_main(int argc, char** argv) {
                  "the affine texture approximation, or auto: each tile the smallest N that keeps "
                  "its error within 1 atlas texel (default auto)")
       ->default_val("auto");
+  app.add_option("--alpha-mask", alpha_mask,
+                 "tiles track: alphaMode MASK with this alphaCutoff, in (0, 1), instead of BLEND: "
+                 "alpha-tested tiles that need no draw order, with hard edges");
   app.add_flag("--meshopt", meshopt,
                ".glb / .gltf: compress vertex and index data with EXT_meshopt_compression "
                "(meshoptimizer; a required extension)");
@@ -147,6 +151,16 @@ static int command_main(int argc, char** argv) {
     if (!set.ok()) return fail(set.status().with_context(clip));
     calf::exporter::TilesExportOptions options;
     options.gltf = gltf;
+    if (app.get_option("--alpha-mask")->count() > 0) {
+      if (!(alpha_mask > 0 && alpha_mask < 1)) {
+        return calf::tools::print_error(
+            kCommand,
+            calf::Status(calf::ErrorId::kExportTilesOption,
+                         fmt::format("alpha mask cutoff {} is not in (0, 1)", alpha_mask)),
+            2);
+      }
+      options.alpha_cutoff = alpha_mask;
+    }
     if (subdivide != "auto") {
       uint32_t n = 0;
       const auto [end, ec] =
@@ -181,10 +195,12 @@ static int command_main(int argc, char** argv) {
           kCommand, subdivide, stats.max_texel_error, calf::exporter::kTilesTexelErrorWarning);
     }
   } else {
-    if (app.get_option("--subdivide")->count() > 0) {
-      return calf::tools::usage_error(
-          kCommand,
-          fmt::format("--subdivide applies to a tiles track; track {} is a mesh track", track));
+    for (const char* tiles_only : {"--subdivide", "--alpha-mask"}) {
+      if (app.get_option(tiles_only)->count() > 0) {
+        return calf::tools::usage_error(
+            kCommand, fmt::format("{} applies to a tiles track; track {} is a mesh track",
+                                  tiles_only, track));
+      }
     }
     auto mesh = calf::decoder::MeshTrack::open(reader.value(), static_cast<uint16_t>(track));
     if (!mesh.ok()) return fail(mesh.status().with_context(clip));

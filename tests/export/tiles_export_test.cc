@@ -324,6 +324,30 @@ TEST(TilesExport, MeshoptHoldsTheSameGeometry) {
             ErrorId::kExportInput);
 }
 
+// alpha_cutoff: alphaMode MASK with that cutoff (glTF's default BLEND otherwise).
+TEST(TilesExport, AlphaCutoffWritesMask) {
+  const TileSet set = small_set();
+  exporter::TilesExportOptions o;
+  o.alpha_cutoff = 0.25;
+  auto glb = exporter::export_tile_set(set, MeshExportFormat::kGlb, "t", o);
+  ASSERT_TRUE(glb.ok()) << glb.status().to_string();
+  const nlohmann::json j = test::read_glb(glb->front().bytes).json;
+  ASSERT_EQ(j["materials"].size(), 1u);
+  EXPECT_EQ(j["materials"][0]["alphaMode"], "MASK");
+  EXPECT_NEAR(j["materials"][0]["alphaCutoff"].get<double>(), 0.25, 1e-6);
+  auto blend = exporter::export_tile_set(set, MeshExportFormat::kGlb, "t");
+  ASSERT_TRUE(blend.ok());
+  const nlohmann::json b = test::read_glb(blend->front().bytes).json;
+  EXPECT_EQ(b["materials"][0]["alphaMode"], "BLEND");
+  EXPECT_FALSE(b["materials"][0].contains("alphaCutoff"));
+  for (double bad : {-0.5, 1.0, 2.0}) {
+    o.alpha_cutoff = bad;
+    EXPECT_EQ(exporter::export_tile_set(set, MeshExportFormat::kGlb, "t", o).status().id(),
+              ErrorId::kExportTilesOption)
+        << bad;
+  }
+}
+
 TEST(TilesExport, BadRequestsAreRefused) {
   const TileSet set = small_set();
   exporter::TilesExportOptions o;

@@ -18,7 +18,12 @@
 //     it, "material <i> untextured", as the renderers draw it untextured and glTF needs TEXCOORD_0
 //     for a texture); triangles with a per-triangle material are split into one mesh per material,
 //     as glTF primitives carry one material each. Only materials a mesh uses are written, and only
-//     the extensions the file uses are declared.
+//     the extensions the file uses are declared;
+//   - the renderers' lighting (calf/format/mesh_lighting.h), in a glTF: materials double-sided
+//     and diffuse only (KHR_materials_specular, specularFactor 0), the key light as a
+//     KHR_lights_punctual directional light of (1 - kMeshAmbient) * pi lux on a node of its own
+//     (its -Z along -kMeshKeyLight), and the ambient share as the scene's extras
+//     "calf_ambient_radiance": [kMeshAmbient x 3] (glTF has no ambient light).
 // Triangle counts are preserved exactly: the export of a track whose objects draw T triangles in
 // all holds T triangles; vertices are written as counted (MeshExportStats), never welded.
 #pragma once

@@ -8,8 +8,8 @@
 // region's centre, so an engine's back-face culling keeps the side the tile faces), and one
 // material "tiles atlas": the atlas as its base-colour texture (PNG, embedded in a .glb / .gltf,
 // <stem>_atlas.png beside an .obj, also its map_d so OBJ importers take the alpha), alphaMode
-// BLEND, doubleSided false, base colour factor 1, metallic 0, unlit (KHR_materials_unlit: the
-// atlas is baked radiance).
+// BLEND (or MASK: TilesExportOptions::alpha_cutoff), doubleSided false, base colour factor 1,
+// metallic 0, unlit (KHR_materials_unlit: the atlas is baked radiance).
 //
 // Order: the tiles' triangles are written back to front from the view region's centre (farthest
 // tile centre first, paper 000's fixed draw order), so an engine drawing the one blended mesh in
@@ -50,6 +50,11 @@ struct TilesExportOptions {
   // With subdivide 0: the largest affine texture error a tile may keep, in atlas texels (> 0,
   // else CALF-E482).
   double target_texel_error = 1.0;
+  // 0 (the default): alphaMode BLEND, the tiles composited in their back-to-front order. In
+  // (0, 1): alphaMode MASK with this alphaCutoff (glTF's alpha test: a texel is drawn opaque
+  // where its alpha >= the cutoff, else not at all), which needs no draw order but loses the
+  // tiles' soft edges. Outside [0, 1): CALF-E482.
+  double alpha_cutoff = 0;
   // How a .glb / .gltf stores the geometry (mesh_export.h; CALF-E480 for OBJ).
   GltfOptions gltf;
 };
