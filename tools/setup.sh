@@ -20,8 +20,8 @@ PACKAGES=(
   # capture ray tracer and scene loading
   libembree-dev libassimp-dev
   # export: glTF writer (header-only) and meshoptimizer (EXT_meshopt_compression); headless
-  # Chromium, the browser of the three.js export test; Blender, the OBJ import test
-  libtinygltf-dev libmeshoptimizer-dev chromium blender
+  # Chromium, the browser of the three.js export test
+  libtinygltf-dev libmeshoptimizer-dev chromium
   # textured models the texture tests load when present (BoxTextured, CesiumMilkTruck)
   assimp-testmodels
   # player: GL, window, headless, maths, HUD
@@ -37,7 +37,8 @@ PACKAGES=(
   # sharded pipeline (docs/FARM.md): the single-node Slurm of tests/cli/slurm_pipeline.sh, GNU
   # parallel for tools/farm/parallel_run.sh, GNU time for the per-task time and memory lines
   slurmctld slurmd slurm-client munge parallel time
-  # the Blender add-on's tests and the demo's optional Blender part (blender/calf_capture, Cycles)
+  # Blender: the add-on's tests and the demo's optional part (blender/calf_capture, Cycles), and
+  # the export's OBJ import test (tests/export/blender_compare.sh)
   blender
 )
 
