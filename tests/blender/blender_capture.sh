@@ -18,14 +18,8 @@
 # Without Blender it is skipped (exit 77, one line), except with CI=true, where it fails.
 set -euo pipefail
 mode=$1 bin=$2 src=$3 work=$4
-if ! command -v blender >/dev/null; then
-  if [ "${CI:-}" = "true" ]; then
-    echo "blender_capture: FAILED: blender missing with CI=true (tools/setup.sh installs it)"
-    exit 1
-  fi
-  echo "blender_capture: skipped: blender missing (tools/setup.sh installs it)"
-  exit 77
-fi
+. "$src/tests/cli/require_tools.sh"
+require_tools blender_capture "" blender
 rm -rf "$work"
 mkdir -p "$work"
 cd "$work"

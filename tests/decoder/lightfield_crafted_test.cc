@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "../conformance/block_census.h"
 #include "../conformance/lightfield_crafted.h"
 #include "calf/decoder/lightfield_reference.h"
 #include "calf/format/container.h"
@@ -85,32 +86,13 @@ std::vector<std::pair<container::ChunkKeys, Bytes>> chunks_of(const container::R
   return out;
 }
 
-uint32_t bits(const uint8_t* block, int pos, int n) {
-  uint32_t v = 0;
-  for (int i = 0; i < n; ++i) v |= uint32_t{(block[(pos + i) / 8] >> ((pos + i) % 8)) & 1u} << i;
-  return v;
-}
-
 // Every BC7 mode with every partition (modes 0-3, 7), rotation and index selection (4, 5), and
 // the reserved mode, read from the blocks by SPEC §11.1.10's bit layout.
 TEST(LightfieldCrafted, Bc7ClipHasEveryModeAndPartition) {
   const container::Reader r = open_clip("crafted_bc7_raw16_mat");
   std::set<std::pair<int, int>> seen;  // (mode, partition / rotation + 4 index selection)
   for (const auto& [k, raw] : chunks_of(r, LightfieldStream::kColour)) {
-    for (size_t b = 0; b + 16 <= raw.size(); b += 16) {
-      const uint8_t* block = &raw[b];
-      int mode = 0;
-      while (mode < 8 && !((block[0] >> mode) & 1)) ++mode;
-      if (mode == 8) {
-        seen.insert({-1, 0});
-        continue;
-      }
-      const int shape = mode == 4   ? static_cast<int>(bits(block, 5, 3))
-                        : mode == 5 ? static_cast<int>(bits(block, 6, 2))
-                        : mode == 6 ? 0
-                                    : static_cast<int>(bits(block, mode + 1, mode == 0 ? 4 : 6));
-      seen.insert({mode, shape});
-    }
+    add_bc7_shapes(raw.data(), raw.size(), seen);
   }
   EXPECT_EQ(seen.size(), 1u + 16 + 64 * 4 + 8 + 4 + 1);
 }
@@ -125,7 +107,7 @@ TEST(LightfieldCrafted, Bc6hClipHasEveryModeAndPartition) {
       // Two-region modes: the 2-bit ones and the 5-bit values 2 ... 30 ending in binary 10.
       const bool one_region = value == 3 || value == 7 || value == 11 || value == 15;
       const bool reserved = value == 19 || value == 23 || value == 27 || value == 31;
-      seen.insert({value, one_region || reserved ? 0 : static_cast<int>(bits(block, 77, 5))});
+      seen.insert({value, one_region || reserved ? 0 : static_cast<int>(block_bits(block, 77, 5))});
     }
   }
   EXPECT_EQ(seen.size(), 10u * 32 + 4 + 4);

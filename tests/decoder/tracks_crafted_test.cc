@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "../conformance/block_census.h"
 #include "../conformance/tracks_crafted.h"
 #include "calf/format/container.h"
 
@@ -55,12 +56,6 @@ TEST(TracksCrafted, GeneratorReproducesTheCommittedClips) {
   }
 }
 
-uint32_t bits(const uint8_t* block, int pos, int n) {
-  uint32_t v = 0;
-  for (int i = 0; i < n; ++i) v |= uint32_t{(block[(pos + i) / 8] >> ((pos + i) % 8)) & 1u} << i;
-  return v;
-}
-
 uint32_t u32_at(const Bytes& b, size_t at) {
   return b[at] | uint32_t{b[at + 1]} << 8 | uint32_t{b[at + 2]} << 16 | uint32_t{b[at + 3]} << 24;
 }
@@ -79,20 +74,7 @@ TEST(TracksCrafted, TilesClipHasEveryBc7ModeAndPartialBlocks) {
     auto raw = r.read_chunk(id);
     ASSERT_TRUE(raw.ok()) << raw.status().to_string();
     band_sizes.push_back(raw->size());
-    for (size_t b = 0; b + 16 <= raw->size(); b += 16) {
-      const uint8_t* block = &(*raw)[b];
-      int mode = 0;
-      while (mode < 8 && !((block[0] >> mode) & 1)) ++mode;
-      if (mode == 8) {
-        seen.insert({-1, 0});
-        continue;
-      }
-      const int shape = mode == 4   ? static_cast<int>(bits(block, 5, 3))
-                        : mode == 5 ? static_cast<int>(bits(block, 6, 2))
-                        : mode == 6 ? 0
-                                    : static_cast<int>(bits(block, mode + 1, mode == 0 ? 4 : 6));
-      seen.insert({mode, shape});
-    }
+    add_bc7_shapes(raw->data(), raw->size(), seen);
   }
   EXPECT_EQ(seen.size(), 1u + 16 + 64 * 4 + 8 + 4 + 1);
   // 19 blocks per row: 5, 5, 5 and 2 block rows.

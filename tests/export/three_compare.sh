@@ -11,21 +11,9 @@
 set -euo pipefail
 bin=$1 src=$2 manifest=$3 clip=$4 work=$5 min_db=$6 min_same_db=$7
 npm_dir="$src/build/npm"
-missing=()
-chromium="$(command -v chromium || true)"
-[ -n "$chromium" ] || missing+=(chromium)
-command -v node >/dev/null || missing+=(node)
-for p in three playwright-core; do
-  [ -f "$npm_dir/node_modules/$p/package.json" ] || missing+=("npm:$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  if [ "${CI:-}" = "true" ]; then
-    echo "three_compare: FAILED: ${missing[*]} missing with CI=true (tools/setup.sh installs them)"
-    exit 1
-  fi
-  echo "three_compare: skipped: ${missing[*]} missing (tools/setup.sh installs them)"
-  exit 77
-fi
+. "$src/tests/cli/require_tools.sh"
+require_tools three_compare "$npm_dir" chromium node npm:three npm:playwright-core
+chromium="$(command -v chromium)"
 rm -rf "$work"
 mkdir -p "$work"
 node "$src/tests/export/three_compare.js" poses "$manifest" "$work/eye_path.json" 160 120
