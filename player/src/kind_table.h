@@ -40,6 +40,19 @@ struct PlayerKind {
                                          const GlFunctions* gl);
 };
 
+// The `open` of a kind whose representation R plays its own track only, with the options
+// `options.*kind_options`: R::open(reader, track, options.*kind_options, backend, gl).
+template <class R, auto kind_options>
+Expected<OpenedRepresentation> open_own_track(const container::Reader& reader, uint16_t track,
+                                              const PlaybackOptions& options, RenderBackend backend,
+                                              const GlFunctions* gl) {
+  CALF_ASSIGN_OR_RETURN(std::unique_ptr<R> r,
+                        R::open(reader, track, options.*kind_options, backend, gl));
+  OpenedRepresentation out;
+  out.representation = std::move(r);
+  return out;
+}
+
 // Every kind the player plays, in table order.
 std::span<const PlayerKind* const> player_kinds();
 // The entry of kind number `kind`, or nullptr for a kind the player does not play.
