@@ -31,6 +31,12 @@ run() {
   /usr/bin/time -f '%M %e' -o "$work/time" timeout 60 "$@"
   rc=$?
 }
+# capture MODEL [OPTION...]: calf-capture of WORK_DIR/MODEL at faces of 8, one frame, through run.
+capture() {
+  local model=$1
+  shift
+  run "$bin/calf-capture" --scene "$work/$model" "$@" --face-size 8 --frames 1 --out "$work/out"
+}
 # A textured triangle (OBJ + MTL) whose map_Kd is $1; an embedded one (glTF, data URI) of $1.
 textured_obj() {
   printf 'newmtl m\nmap_Kd %s\n' "$1" >"$work/model.mtl"
@@ -71,27 +77,25 @@ ingest-out-of-memory)
 # calf-capture: model textures, external and embedded
 capture-texture-budget)
   textured_obj big.png
-  run "$bin/calf-capture" --scene "$work/model.obj" --face-size 8 --frames 1 --out "$work/out" ;;
+  capture model.obj ;;
 capture-texture-header)
   textured_obj big.png
-  run "$bin/calf-capture" --scene "$work/model.obj" --max-image-pixels 268435456 --face-size 8 \
-    --frames 1 --out "$work/out" ;;
+  capture model.obj --max-image-pixels 268435456 ;;
 capture-embedded-budget)
   embedded_gltf big.png
-  run "$bin/calf-capture" --scene "$work/model.gltf" --face-size 8 --frames 1 --out "$work/out" ;;
+  capture model.gltf ;;
 capture-embedded-header)
   embedded_gltf big.png
-  run "$bin/calf-capture" --scene "$work/model.gltf" --max-image-pixels 268435456 --face-size 8 \
-    --frames 1 --out "$work/out" ;;
+  capture model.gltf --max-image-pixels 268435456 ;;
 capture-texture-exr)
   textured_obj attribute.exr
-  run "$bin/calf-capture" --scene "$work/model.obj" --face-size 8 --frames 1 --out "$work/out" ;;
+  capture model.obj ;;
 capture-embedded-exr)
   embedded_gltf attribute.exr
-  run "$bin/calf-capture" --scene "$work/model.gltf" --face-size 8 --frames 1 --out "$work/out" ;;
+  capture model.gltf ;;
 capture-embedded-truncated)
   embedded_gltf cut.png
-  run "$bin/calf-capture" --scene "$work/model.gltf" --face-size 8 --frames 1 --out "$work/out" ;;
+  capture model.gltf ;;
 # calf-encode --mode mesh: a scene file's texture (the scene exported from a model with a valid
 # texture, whose PNG is then replaced)
 encode-scene-texture)
