@@ -201,33 +201,35 @@ Status CaptureSetReader::read(uint32_t view, uint32_t frame, ViewFrame* out) con
                     name + ": channel '" + required[c] + "' is missing");
     }
   }
-  for (int c = 0; c < 3; ++c) {
-    idx[4 + c] = exr.channel(kMaterialChannels[c]);
-    if (m.material && idx[4 + c] < 0) {
-      return Status(ErrorId::kCaptureImageFormat, name + ": channel '" + kMaterialChannels[c] +
-                                                      "' is missing (the manifest says material)");
-    }
-    if (!m.material && idx[4 + c] >= 0) {
-      return Status(ErrorId::kCaptureImageFormat,
-                    name + ": has channel '" + kMaterialChannels[c] +
-                        "' but the manifest says \"material\": false");
+  // The optional channel groups, each present exactly when its manifest flag says so.
+  struct OptionalChannels {
+    const char* const* names;  // 3 channels, at idx[first ... first + 2]
+    int first;
+    bool wanted;
+    const char* wanted_wording;    // what the manifest says when the group is on ...
+    const char* unwanted_wording;  // ... and when it is off
+  };
+  const OptionalChannels groups[2] = {
+      {kMaterialChannels, 4, m.material, "says material", "says \"material\": false"},
+      {kCoverageChannels, 7, m.coverage, "says coverage", "does not say \"coverage\": true"}};
+  for (const OptionalChannels& g : groups) {
+    for (int c = 0; c < 3; ++c) {
+      idx[g.first + c] = exr.channel(g.names[c]);
+      if (g.wanted && idx[g.first + c] < 0) {
+        return Status(ErrorId::kCaptureImageFormat, name + ": channel '" + g.names[c] +
+                                                        "' is missing (the manifest " +
+                                                        g.wanted_wording + ")");
+      }
+      if (!g.wanted && idx[g.first + c] >= 0) {
+        return Status(ErrorId::kCaptureImageFormat, name + ": has channel '" + g.names[c] +
+                                                        "' but the manifest " + g.unwanted_wording);
+      }
     }
   }
-  for (int c = 0; c < 3; ++c) {
-    idx[7 + c] = exr.channel(kCoverageChannels[c]);
-    if (m.coverage && idx[7 + c] < 0) {
-      return Status(ErrorId::kCaptureImageFormat, name + ": channel '" + kCoverageChannels[c] +
-                                                      "' is missing (the manifest says coverage)");
-    }
-    if (!m.coverage && idx[7 + c] >= 0) {
-      return Status(ErrorId::kCaptureImageFormat,
-                    name + ": has channel '" + kCoverageChannels[c] +
-                        "' but the manifest does not say \"coverage\": true");
-    }
-  }
-  for (int c = 0; c < (m.material ? 7 : 4); ++c) CALF_RETURN_IF_ERROR(exr.require_float(idx[c]));
-  if (m.coverage) {
-    for (int c = 7; c < 10; ++c) CALF_RETURN_IF_ERROR(exr.require_float(idx[c]));
+  for (int c = 0; c < 4; ++c) CALF_RETURN_IF_ERROR(exr.require_float(idx[c]));
+  for (const OptionalChannels& g : groups) {
+    if (!g.wanted) continue;
+    for (int c = g.first; c < g.first + 3; ++c) CALF_RETURN_IF_ERROR(exr.require_float(idx[c]));
   }
   if (out->face_size != n || out->has_material != m.material || out->has_coverage != m.coverage ||
       out->depth.size() != out->texel_count()) {
