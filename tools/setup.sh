@@ -38,8 +38,9 @@ PACKAGES=(
   # parallel for tools/farm/parallel_run.sh, GNU time for the per-task time and memory lines
   slurmctld slurmd slurm-client munge parallel time
   # Blender: the add-on's tests and the demo's optional part (blender/calf_capture, Cycles), and
-  # the export's OBJ import test (tests/export/blender_compare.sh)
-  blender
+  # the export's OBJ import test (tests/export/blender_compare.sh); numpy for Blender's glTF
+  # exporter (tests/blender/export_gltf.py)
+  blender python3-numpy
 )
 
 # node and npm for the glTF-Validator below, from Debian when the machine has none.
