@@ -66,8 +66,9 @@ case $mode in
   gltf)
     min_db=$5
     blender -b --factory-startup -noaudio --python-exit-code 1 \
-      -P "$src/tests/blender/make_scene.py" -P "$src/tests/blender/export_gltf.py" -- "$work/scene.gltf" --camera Eye \
-      --eye-path eye.json --size 64x48 --bake-size 256 2>&1 | grep '^export_gltf'
+      -P "$src/tests/blender/make_scene.py" -P "$src/tests/blender/export_gltf.py" -- \
+      "$work/scene.gltf" --camera Eye --eye-path eye.json --size 64x48 --bake-size 256 2>&1 |
+      grep '^export_gltf'
     # The file holds what the comparison needs: both checker textures baked into images, and the
     # cube's animation at 0, 1/30 and 2/30 s (capture frames 0-2 of calf-capture).
     python3 - <<'PY'

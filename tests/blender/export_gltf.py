@@ -7,12 +7,14 @@ calf's own tracer:
 Blender's glTF exporter (io_scene_gltf2, which needs numpy: Debian's python3-numpy) writes image
 textures only; a procedural base colour (a Checker node here) would be lost. So every material
 whose Principled BSDF takes its Base Color from a node other than an image is first baked with
-Cycles (bake type Diffuse, colour only: the albedo without light) into an N x N image on the
-object's UV map, and that image is wired to Base Color. calf-capture samples a file's animation
-at 30 fps from time 0, so the scene is retimed before the export: its first frame goes to frame
-0 and its fps to 30, which puts scene frame FIRST + k at k / 30 s in the file, capture frame k of
-calf-capture. Objects not rendered (hide_render) are left out; lights and cameras are not
-exported (calf's tracer lights a file with its own sun and sky).
+Cycles into an N x N image on the object's UV map (the colour through an Emission shader, bake
+type Emit: the albedo without light; denoising off, since with it on the Debian build, which
+has no OpenImageDenoise, bakes black), and that image is wired to Base Color. calf-capture
+samples a file's animation at 30 fps from time 0, so the scene is retimed before the export:
+its first frame goes to frame 0 and its fps to 30, which puts scene frame FIRST + k at k / 30 s
+in the file, capture frame k of calf-capture. Objects not rendered (hide_render) are left out;
+lights, the world and cameras are not exported (calf's tracer lights a file with its own sun and
+sky).
 
 With --camera, the camera's animation is also written as a calf eye path (the add-on's
 --write-eye-path, at WxH) in the file's time: pose k at k / 30 s. Nothing is saved to the .blend
