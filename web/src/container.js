@@ -4,7 +4,7 @@
 //
 // A source is { size, read(offset, length) → Promise<Uint8Array> }: bytes in memory
 // (bytesSource) or an HTTP resource read with range requests (web/src/http_source.js).
-import { E, fail } from './errors.js';
+import { E, CalfError, fail } from './errors.js';
 import { zstdBound, zstdDecode, lzma2Bound, lzma2Decode } from './codecs.js';
 
 export const IDENTIFIER = [0xab, 0x43, 0x41, 0x4c, 0x46, 0x20, 0x31, 0xbb, 0x0d, 0x0a, 0x1a, 0x0a];
@@ -42,14 +42,18 @@ const TRACK_HEADERS = {
   1: [...TIMING, ['view_count', 4, 1, 65536], ['face_size', 4, 1, 16384], ['cell_size', 4, 1, 16384],
     ['depth_tile_size', 4, 1, 16384], ['colour_format', 2, 0, null], ['depth_format', 2, 0, null],
     ['material_format', 2, 0, null], ['flags', 2, 0, null]],
-  2: TIMING, 3: TIMING, 4: TIMING,
+  2: [...TIMING, ['tile_count', 4, 0, null], ['atlas_width', 4, 1, 16384], ['atlas_height', 4, 1, 16384],
+    ['atlas_format', 2, 0, null], ['flags', 2, 0, null]],
+  3: [...TIMING, ['object_count', 4, 0, null], ['surfel_count', 8, 0, null], ['flags', 2, 0, null]],
+  4: [...TIMING, ['vertex_count', 8, 0, null], ['triangle_count', 8, 0, null], ['segment_count', 4, 0, null],
+    ['flags', 2, 0, null]],
 };
 
 function decodeTrackHeader(kind, blob, t) {
   const f = new Fields(blob, (what) => fail(E.trackHeader, `track ${t}: header too short for ${what}`));
   const h = {};
   for (const [name, width, min, max] of TRACK_HEADERS[kind]) {
-    const v = width === 4 ? f.u32(name) : f.u16(name);
+    const v = width === 8 ? f.u64(name) : width === 4 ? f.u32(name) : f.u16(name);
     if (v < min) fail(E.trackHeader, `track ${t}: ${name} ${v} below ${min}`);
     if (max !== null && v > max) fail(E.limit, `track ${t}: ${name} ${v} above ${max}`);
     h[name] = v;
@@ -197,4 +201,24 @@ export async function decodeStored(clip, c, stored) {
   if (c.compression === 0) return stored;
   if (c.compression === 1) return zstdDecode(clip.codecs, stored, c.rawSize, what);
   return lzma2Decode(clip.codecs, stored, c.rawSize, what);
+}
+
+// Full verification at the container level (SPEC §10): every chunk read, hashed and
+// decompressed, then its padding; returns every problem, in order, as CalfErrors.
+export async function verifyContainer(clip) {
+  const problems = [];
+  for (const c of clip.chunks) {
+    try {
+      await readChunk(clip, c.id);
+    } catch (e) {
+      if (!(e instanceof CalfError)) throw e;
+      problems.push(e);
+    }
+    const end = c.offset + c.storedSize, pad = align16(end) - end;
+    const bytes = await clip.source.read(end, pad);
+    for (let k = 0; k < pad; ++k) {
+      if (bytes[k] !== 0) problems.push(new CalfError(E.padding, `padding byte at ${end + k} is not zero`));
+    }
+  }
+  return problems;
 }

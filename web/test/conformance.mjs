@@ -8,7 +8,7 @@
 import { readFileSync, readdirSync, existsSync } from 'node:fs';
 import { join, basename } from 'node:path';
 import { ROOT, loadCodecs } from './node_codecs.mjs';
-import { openClip, bytesSource, readChunk } from '../src/container.js';
+import { openClip, bytesSource, readChunk, verifyContainer } from '../src/container.js';
 import { openLightfield, decodeFaceFrames, faceHash } from '../src/lightfield.js';
 import { CalfError } from '../src/errors.js';
 import { generate } from '../tools/gen_bc_tables.mjs';
@@ -81,6 +81,42 @@ async function negativeChecks(codecs) {
   return problems;
 }
 
+// The container corpus (tests/conformance/container/manifest.txt): every valid file opens,
+// verifies and decodes each chunk to the manifest's size and XXH3-64; every malformed file
+// gives the manifest's id first (open's error, else verification's first problem).
+async function containerCorpus(codecs) {
+  const dir = join(ROOT, 'tests/conformance/container');
+  const problems = [];
+  let files = 0;
+  const opened = new Map();
+  for (const line of readFileSync(join(dir, 'manifest.txt'), 'utf8').split('\n')) {
+    const w = line.split(' ');
+    if (w[0] === 'valid' || w[0] === 'malformed') {
+      ++files;
+      const bytes = new Uint8Array(readFileSync(join(dir, w[1])));
+      let first = null;
+      try {
+        const clip = await openClip(bytesSource(bytes), codecs);
+        opened.set(w[1], clip);
+        const found = await verifyContainer(clip);
+        if (found.length) first = found[0];
+      } catch (e) {
+        if (!(e instanceof CalfError)) throw e;
+        first = e;
+      }
+      const want = w[0] === 'valid' ? null : w[2];
+      if ((first?.id ?? null) !== want) problems.push(`${w[1]}: expected ${want ?? 'no problem'}, got ${first?.message ?? 'no problem'}`);
+    } else if (w[0] === 'chunk') {
+      const clip = opened.get(w[1]);
+      if (!clip) continue;
+      const raw = await readChunk(clip, Number(w[2]));
+      const hash = codecs.xxh3(raw).toString(16).padStart(16, '0');
+      if (raw.length !== Number(w[3]) || hash !== w[4]) problems.push(`${w[1]} chunk ${w[2]}: ${raw.length} bytes ${hash}, expected ${w[3]} ${w[4]}`);
+    }
+  }
+  return { files, problems };
+}
+
 async function main() {
   const loaded = await loadCodecs();
   if (!loaded.codecs) {
@@ -131,6 +167,11 @@ async function main() {
     for (const p of negative) console.log(`web conformance: ${p}`);
     if (!negative.length) console.log('web conformance: a flipped colour byte is refused (CALF-E058), and with its hash rewritten changes a hash line');
     failures += negative.length;
+    const t0 = performance.now();
+    const corpus = await containerCorpus(codecs);
+    for (const p of corpus.problems) console.log(`web conformance: container corpus: ${p}`);
+    console.log(`web conformance: container corpus: ${corpus.files - corpus.problems.length} of ${corpus.files} files as the manifest says, ${(performance.now() - t0).toFixed(0)} ms`);
+    failures += corpus.problems.length;
   }
   console.log(`web conformance: ${clips.length - failures} of ${clips.length} clips reproduce their hashes, ${totalMs.toFixed(0)} ms decoding`);
   process.exit(failures ? 1 : 0);
