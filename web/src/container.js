@@ -185,9 +185,12 @@ export async function openClip(source, codecs) {
     directoryOffset: dOff };
 }
 
-// Chunk i's raw bytes: one read of its stored bytes, the hash (E058), then §6.3 (E059, E049).
+// Chunk i's raw bytes: from clip.chunkCache when a streaming reader put them there (stream.js),
+// else one read of its stored bytes, the hash (E058), then §6.3 (E059, E049).
 export async function readChunk(clip, i) {
   if (!(i >= 0 && i < clip.chunks.length)) fail(E.chunkId, `chunk ${i} outside the index`);
+  const cached = clip.chunkCache?.get(i);
+  if (cached) return cached;
   const c = clip.chunks[i];
   const stored = await clip.source.read(c.offset, c.storedSize);
   if (stored.length !== c.storedSize) fail(E.truncated, `chunk ${i}: file ends inside it`);
