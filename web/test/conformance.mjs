@@ -11,7 +11,8 @@ import { ROOT, loadCodecs } from './node_codecs.mjs';
 import { openClip, bytesSource, readChunk, verifyContainer } from '../src/container.js';
 import { openLightfield, decodeFaceFrames, faceHash } from '../src/lightfield.js';
 import { CalfError } from '../src/errors.js';
-import { generate } from '../tools/gen_bc_tables.mjs';
+import { generate as generateBcTables } from '../tools/gen_bc_tables.mjs';
+import { generate as generateGlsl } from '../tools/gen_glsl_conventions.mjs';
 
 // The lines calf-verify --decode prints for a clip's lightfield tracks, and the problems.
 export async function decodeLines(bytes, codecs) {
@@ -125,10 +126,13 @@ async function main() {
   }
   const { codecs } = loaded;
   let failures = 0;
-  const tables = readFileSync(join(ROOT, 'web/src/bc_tables.js'), 'utf8');
-  if (tables !== generate()) {
-    console.log('web conformance: web/src/bc_tables.js is not what bc_tables.h gives (node web/tools/gen_bc_tables.mjs)');
-    ++failures;
+  // The generated sources are what their native sources give today.
+  for (const [file, generate, tool] of [['web/src/bc_tables.js', generateBcTables, 'gen_bc_tables.mjs'],
+    ['web/src/glsl_conventions.js', generateGlsl, 'gen_glsl_conventions.mjs']]) {
+    if (readFileSync(join(ROOT, file), 'utf8') !== generate()) {
+      console.log(`web conformance: ${file} is out of date (node web/tools/${tool})`);
+      ++failures;
+    }
   }
   const dir = join(ROOT, 'tests/conformance/lightfield');
   const clips = process.argv.length > 2 ? process.argv.slice(2)
