@@ -130,7 +130,8 @@ export function interpolate(a, b, t) {
 }
 
 // §11.1.6: a region chunk parsed; frames[i] = rectangles of frame i, each with its texel
-// values (codes for depth, 3 bytes a texel for material) in `values` (r16pm: changed mask).
+// values in `values` (depth codes, or 3 material bytes a texel), or for r16pm its residuals
+// and change mask (`residuals`, `mask`; none for the keyframe's rectangle).
 export function parseRegion(raw, kind, format, tw, th, frameCount, what) {
   const v = new DataView(raw.buffer, raw.byteOffset, raw.length);
   if (raw.length < 4) bad(`${what}: ${raw.length} bytes`);
@@ -177,7 +178,7 @@ export function parseRegion(raw, kind, format, tw, th, frameCount, what) {
         const n = r.w * r.h;
         r.values = new Uint16Array(n);
         for (let k = 0; k < n; ++k, ++q) r.values[k] = (payload[q] << 8) | payload[T + q];
-        if (format === FORMAT.r16p) unpredict(r.values, r.w, r.h, null, null);
+        if (format === FORMAT.r16p) unpredict(r.values, r.w, r.h);
       }
     } else if (format === FORMAT.r16pm) {
       let m = 0, changed = rects[0].w * rects[0].h;
@@ -249,8 +250,9 @@ export function parseRegion(raw, kind, format, tw, th, frameCount, what) {
   return frames;
 }
 
-// §11.1.8 / §11.1.9: residuals → codes in place (r16p: every texel; r16pm: `state` is the tile
-// state of the rectangle, the codes read and written there, only the `changed` texels coded).
+// §11.1.8: an r16p rectangle's residuals → codes, in place, row-major (each texel predicted
+// from its already decoded neighbours in the rectangle). r16pm's rectangles are decoded
+// against the tile state instead, in applyRegionFrame.
 function unpredict(values, w, h) {
   for (let y = 0; y < h; ++y) for (let x = 0; x < w; ++x) {
     const i = y * w + x;

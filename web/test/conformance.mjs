@@ -118,6 +118,26 @@ async function containerCorpus(codecs) {
   return { files, problems };
 }
 
+// The damaged lightfield clips of the decoder's fuzz corpus (valid chunk hashes, a broken
+// §11.1 layout): each bad_* gives CALF-E202, each valid_* decodes without a problem.
+async function lightfieldCorpus(codecs) {
+  const dir = join(ROOT, 'tests/fuzz/corpus/clip_decoder_fuzz');
+  const problems = [];
+  const files = readdirSync(dir).filter((f) => f.endsWith('.calf')).sort();
+  for (const f of files) {
+    let first;
+    try {
+      first = (await decodeLines(new Uint8Array(readFileSync(join(dir, f))), codecs)).problems[0] ?? null;
+    } catch (e) {
+      if (!(e instanceof CalfError)) throw e;
+      first = e.message;
+    }
+    const ok = f.startsWith('bad_') ? first?.startsWith('CALF-E202 ') : first === null;
+    if (!ok) problems.push(`${f}: ${first ?? 'no problem'}`);
+  }
+  return { files: files.length, problems };
+}
+
 async function main() {
   const loaded = await loadCodecs();
   if (!loaded.codecs) {
@@ -176,6 +196,10 @@ async function main() {
     for (const p of corpus.problems) console.log(`web conformance: container corpus: ${p}`);
     console.log(`web conformance: container corpus: ${corpus.files - corpus.problems.length} of ${corpus.files} files as the manifest says, ${(performance.now() - t0).toFixed(0)} ms`);
     failures += corpus.problems.length;
+    const damaged = await lightfieldCorpus(codecs);
+    for (const p of damaged.problems) console.log(`web conformance: lightfield fuzz corpus: ${p}`);
+    console.log(`web conformance: lightfield fuzz corpus: ${damaged.files - damaged.problems.length} of ${damaged.files} clips refused (CALF-E202) or decoded as their names say`);
+    failures += damaged.problems.length;
   }
   console.log(`web conformance: ${clips.length - failures} of ${clips.length} clips reproduce their hashes, ${totalMs.toFixed(0)} ms decoding`);
   process.exit(failures ? 1 : 0);
