@@ -2,6 +2,8 @@
 // tests/conformance/lightfield/ under node and compares its hash lines with CLIP.hashes.
 //
 //   node web/test/conformance.mjs [CLIP.calf...]     default: every clip of the folder
+//   node web/test/conformance.mjs --time CLIP.calf... decode ms of each clip: median, min and
+//                                                    max of 5 runs (no comparison)
 //
 // Prints one line per clip (lines, decode ms) and one per difference; exits 1 on any
 // difference, 77 (ctest's skip code) when node's packages are missing, unless CI=true.
@@ -145,6 +147,21 @@ async function main() {
     process.exit(process.env.CI === 'true' ? 1 : 77);
   }
   const { codecs } = loaded;
+  if (process.argv[2] === '--time') {
+    for (const path of process.argv.slice(3)) {
+      const bytes = new Uint8Array(readFileSync(path));
+      const ms = [];
+      let lines = 0;
+      for (let i = 0; i < 5; ++i) {
+        const t0 = performance.now();
+        lines = (await decodeLines(bytes, codecs)).lines.length;
+        ms.push(performance.now() - t0);
+      }
+      ms.sort((a, b) => a - b);
+      console.log(`${basename(path)}: ${lines} faces decoded and hashed in ${ms[2].toFixed(0)} ms (median of 5; ${ms[0].toFixed(0)} – ${ms[4].toFixed(0)})`);
+    }
+    process.exit(0);
+  }
   let failures = 0;
   // The generated sources are what their native sources give today.
   for (const [file, generate, tool] of [['web/src/bc_tables.js', generateBcTables, 'gen_bc_tables.mjs'],
