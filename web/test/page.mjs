@@ -31,7 +31,7 @@ try {
   page.on('pageerror', (e) => consoleLines.push(e.message));
   const clip = 'tests/conformance/lightfield/bc7_bc5_zstd_mat.calf';
   const t0 = Date.now();
-  await page.goto(`${base}/web/index.html?clip=/${clip}`);
+  await page.goto(`${base}/web/index.html?mode=env&clip=/${clip}`);
   await page.waitForFunction(() => window.calfStatus !== 'loading', null, { timeout: 60000 });
   const overlay = await page.textContent('#overlay');
   console.log(`page: ${clip}: '${overlay}' (${Date.now() - t0} ms)`);
