@@ -343,9 +343,10 @@ export async function openLightfield(clip, t) {
 }
 
 // Decodes every frame of one face of one view in order; calls onFrame(n, colour, depth,
-// material) with the face's arrays (reused between frames). Frames are decoded in order, so a
+// material) with the face's arrays (reused between frames). With `only` ({ cells, tiles }: Sets
+// of colour cell and depth tile indices) the other regions are neither read nor written. Frames are decoded in order, so a
 // region chunk is read once and its P-frames applied as they come.
-export async function decodeFaceFrames(lf, v, face, onFrame) {
+export async function decodeFaceFrames(lf, v, face, onFrame, only = null) {
   const h = lf.header, N = h.face_size, t = lf.track;
   const view = lf.views[v];
   const colour = new Float32Array(3 * N * N), depth = new Uint16Array(N * N);
@@ -355,13 +356,17 @@ export async function decodeFaceFrames(lf, v, face, onFrame) {
   // Colour cells: timelines and a cache of decoded keyframes.
   const cellState = [];
   for (let r = 0; r < lf.cells.count; ++r) {
+    if (only && !only.cells.has(r)) {
+      cellState.push(null);
+      continue;
+    }
     const where = `track ${t} view ${v} face ${face} cell ${r}`;
     const tc = find(STREAM.t, r);
     if (tc.length !== 1) bad(`${where}: ${tc.length} t chunks`);
     if (tc[0].frameCount !== h.frame_count) bad(`${where}: t chunk of ${tc[0].frameCount} frames`);
     cellState.push({ rect: lf.cells.rect(r), where, timeline: parseTimeline(await read(tc[0]), h.frame_count, `${where} t`), keys: new Map() });
   }
-  const tileState = (stream, channels) => Array.from({ length: lf.tiles.count }, (_, r) => {
+  const tileState = (stream, channels) => Array.from({ length: lf.tiles.count }, (_, r) => r).filter((r) => !only || only.tiles.has(r)).map((r) => {
     const rect = lf.tiles.rect(r);
     return { r, rect, chunk: null, frames: null, state: new (channels === 1 ? Uint16Array : Uint8Array)(channels * rect.w * rect.h), stream, channels };
   });
@@ -370,6 +375,7 @@ export async function decodeFaceFrames(lf, v, face, onFrame) {
   for (let n = 0; n < h.frame_count; ++n) {
     for (let r = 0; r < cellState.length; ++r) {
       const cell = cellState[r];
+      if (!cell) continue;
       const { keys, t: tv } = cell.timeline;
       let m = 0;
       while (m + 1 < keys.length && keys[m + 1] <= n) ++m;

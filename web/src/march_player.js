@@ -1,12 +1,14 @@
 // The page's lightfield player: calf-play's GL render (raymarch.js: the native ray-march shader,
-// its view selection and march range) of a clip opened by URL over range requests. A view's
-// faces are decoded on the CPU when the view first becomes active, every frame of them, and a
-// frame's faces are uploaded when a pose needs that frame.
+// its view selection and march range) of a clip opened by URL over range requests. Only the
+// cells and depth tiles the pose's eye can see (culling.js, the native decoder's culling) of the
+// active views are fetched and decoded, every frame of them, when first needed; a frame's faces
+// are uploaded when a pose needs that frame or new cells.
 import { openClip } from './container.js';
 import { openLightfield, decodeFaceFrames } from './lightfield.js';
 import { httpSource } from './stream.js';
 import { makeCodecs } from './codecs.js';
-import { makeRaymarcher, selectViews } from './raymarch.js';
+import { makeRaymarcher, marchRange, selectViews } from './raymarch.js';
+import { visibleSets } from './culling.js';
 
 // frame_at_time (format/capture/src/eye_path.cc).
 export function frameAtTime(seconds, fps, frameCount) {
@@ -27,35 +29,67 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
   const lf = await openLightfield(clip, t);
   const h = lf.header, N = h.face_size, F = h.frame_count, fps = h.fps_numerator / h.fps_denominator;
   const renderer = makeRaymarcher(gl, { views: lf.views, faceSize: N, cellSize: h.cell_size });
-  const decoded = new Map();  // view -> [frame] -> { colour: [6], depth: [6] }
+  const decoded = new Map();  // view -> { frames: [frame] -> { colour: [6], depth: [6] }, have: [6] -> { cells, tiles } }
   const uploaded = new Int32Array(lf.views.length).fill(-1);
   const selection = {};
-  const stats = { decodeMs: 0, facesDecoded: 0 };
-  async function ensureView(v) {
-    if (decoded.has(v)) return decoded.get(v);
-    const t0 = performance.now();
-    const frames = Array.from({ length: F }, () => ({ colour: [], depth: [] }));
-    for (let face = 0; face < 6; ++face) {
-      await decodeFaceFrames(lf, v, face, (n, colour, depth) => {
-        frames[n].colour[face] = colour.slice();
-        frames[n].depth[face] = depth.slice();
+  const stats = { decodeMs: 0, cellsDecoded: 0, tilesDecoded: 0 };
+  // Decodes (every frame of) the cells and tiles of view v that `sets` names and that are not
+  // decoded yet; returns whether anything was.
+  async function ensureCells(v, sets) {
+    if (!decoded.has(v)) {
+      decoded.set(v, {
+        frames: Array.from({ length: F }, () => ({
+          colour: Array.from({ length: 6 }, () => new Float32Array(3 * N * N)),
+          depth: Array.from({ length: 6 }, () => new Uint16Array(N * N)),
+        })),
+        have: Array.from({ length: 6 }, () => ({ cells: new Set(), tiles: new Set() })),
       });
-      ++stats.facesDecoded;
     }
-    stats.decodeMs += performance.now() - t0;
-    decoded.set(v, frames);
-    return frames;
+    const d = decoded.get(v);
+    let any = false;
+    for (let face = 0; face < 6; ++face) {
+      const have = d.have[face];
+      const only = { cells: new Set([...sets.cells[face]].filter((r) => !have.cells.has(r))),
+        tiles: new Set([...sets.tiles[face]].filter((r) => !have.tiles.has(r))) };
+      if (only.cells.size === 0 && only.tiles.size === 0) continue;
+      any = true;
+      const t0 = performance.now();
+      await decodeFaceFrames(lf, v, face, (n, colour, depth) => {
+        const dst = d.frames[n];
+        for (const r of only.cells) {
+          const { x, y, w, h: rh } = lf.cells.rect(r);
+          for (let j = y; j < y + rh; ++j) dst.colour[face].set(colour.subarray(3 * (j * N + x), 3 * (j * N + x + w)), 3 * (j * N + x));
+        }
+        for (const r of only.tiles) {
+          const { x, y, w, h: rh } = lf.tiles.rect(r);
+          for (let j = y; j < y + rh; ++j) dst.depth[face].set(depth.subarray(j * N + x, j * N + x + w), j * N + x);
+        }
+      }, only);
+      stats.decodeMs += performance.now() - t0;
+      stats.cellsDecoded += only.cells.size;
+      stats.tilesDecoded += only.tiles.size;
+      for (const r of only.cells) have.cells.add(r);
+      for (const r of only.tiles) have.tiles.add(r);
+    }
+    return any;
   }
   // camera: { position, forward, up, fovY (radians), width, height }; time in seconds.
   async function renderPose(camera, time) {
     const frame = frameAtTime(time, fps, F);
     const active = selectViews(lf.views, camera.position, selection);
+    const { near, far } = marchRange(lf.views, camera.position);
+    const sets = visibleSets(lf, camera, near, far, active);
+    let visibleCells = 0;
     for (const v of active) {
-      const frames = await ensureView(v);
-      if (uploaded[v] === frame) continue;
-      for (let face = 0; face < 6; ++face) renderer.uploadFace(v, face, frames[frame].colour[face], frames[frame].depth[face]);
+      const vs = sets.get(v);
+      for (let face = 0; face < 6; ++face) visibleCells += vs.cells[face].size;
+      const changed = await ensureCells(v, vs);
+      if (uploaded[v] === frame && !changed) continue;
+      const f = decoded.get(v).frames[frame];
+      for (let face = 0; face < 6; ++face) renderer.uploadFace(v, face, f.colour[face], f.depth[face]);
       uploaded[v] = frame;
     }
+    const totalCells = active.length * 6 * lf.cells.count;
     if (canvas.width !== camera.width || canvas.height !== camera.height) {
       canvas.width = camera.width;
       canvas.height = camera.height;
@@ -64,9 +98,10 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
     renderer.render(camera, active);
     gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));  // waits for the draw
     const renderMs = performance.now() - t0;
-    status(`frame ${frame}: ${active.length} of ${lf.views.length} views, render ${renderMs.toFixed(1)} ms; ` +
-      `${stats.facesDecoded} faces decoded (${stats.decodeMs.toFixed(0)} ms), ${source.stats.bytes} of ${source.size} bytes fetched`);
-    return { frame, active, renderMs };
+    status(`frame ${frame}: ${active.length} of ${lf.views.length} views, ${visibleCells}/${totalCells} cells, ` +
+      `render ${renderMs.toFixed(1)} ms; ${stats.cellsDecoded} cells decoded (${stats.decodeMs.toFixed(0)} ms), ` +
+      `${source.stats.bytes} of ${source.size} bytes fetched`);
+    return { frame, active, renderMs, visibleCells, totalCells, bytes: source.stats.bytes, size: source.size };
   }
   // The canvas as 8-bit RGB rows, top row first (as calf-play's PNG frames).
   function pixels() {

@@ -2,8 +2,9 @@
 // and encoded here, calf-play renders the poses of calf-capture's ground-truth eye path headless
 // (GL through OSMesa, PNG frames), and the page (web/index.html, headless Chromium with
 // SwiftShader) renders the same poses with the same shader body; each frame must be within
-// MIN_DB of calf-play's, and a blank canvas fails. Prints the dB per pose and the render ms of
-// both.
+// MIN_DB of calf-play's, a blank canvas fails, and the page's active views and visible cells
+// (the only ones it fetches) are calf-play's. Prints the dB per pose, the render ms of both and
+// the bytes fetched.
 //
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM
 import { execFileSync, spawn } from 'node:child_process';
@@ -73,7 +74,9 @@ run('calf-capture', ['--scene', 'interior', '--ground-truth', '--gt-size', '64x4
 run('calf-encode', [join(dir, 'cap'), '-o', join(dir, 'clip.calf'), '--color-format', 'rgba16f', '--cell', '16', '--quiet']);
 const played = run('calf-play', [join(dir, 'clip.calf'), '--headless', '--eye-path', join(dir, 'gt', 'eye_path.json'), '--out', join(dir, 'play')]);
 console.log(`web.match: clip and calf-play frames made in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
-const nativeMs = [...played.matchAll(/^pose (\d+) .*render ([0-9.]+) ms/gm)].map((m) => Number(m[2]));
+const native = [...played.matchAll(/^pose (\d+) frame \d+: (\d+) views, (\d+)\/(\d+) cells, .*render ([0-9.]+) ms/gm)]
+  .map((m) => ({ views: Number(m[2]), cells: Number(m[3]), total: Number(m[4]), ms: Number(m[5]) }));
+if (native.length === 0) throw new Error(`no pose lines in calf-play's output: ${played}`);
 const path = JSON.parse(readFileSync(join(dir, 'gt', 'eye_path.json'), 'utf8'));
 
 const server = spawn('/usr/bin/python3', [join(ROOT, 'web/test/range_server.py'), ROOT], { stdio: ['ignore', 'pipe', 'ignore'] });
@@ -111,8 +114,14 @@ try {
       const distinct = new Set();
       for (let k = 0; k < rgb.length; k += 3) distinct.add((rgb[k] << 16) | (rgb[k + 1] << 8) | rgb[k + 2]);
       const db = psnr(rgb, want.rgb);
-      console.log(`web.match: pose ${i} frame ${got.frame}: ${got.active.length} views, ${db.toFixed(2)} dB against calf-play; ` +
-        `render ${got.renderMs.toFixed(1)} ms (SwiftShader) against calf-play's ${nativeMs[i] ?? '?'} ms (llvmpipe)`);
+      const n = native[i] ?? {};
+      console.log(`web.match: pose ${i} frame ${got.frame}: ${got.active.length} views, ${got.visibleCells}/${got.totalCells} cells ` +
+        `(calf-play ${n.views} views, ${n.cells}/${n.total}), ${db.toFixed(2)} dB against calf-play; ` +
+        `render ${got.renderMs.toFixed(1)} ms (SwiftShader) against calf-play's ${n.ms} ms (llvmpipe); ` +
+        `${got.bytes} of ${got.size} bytes fetched so far`);
+      if (got.active.length !== n.views || got.visibleCells !== n.cells || got.totalCells !== n.total) {
+        problems.push(`pose ${i}: ${got.active.length} views, ${got.visibleCells}/${got.totalCells} cells; calf-play ${n.views}, ${n.cells}/${n.total}`);
+      }
       if (distinct.size < 16) problems.push(`pose ${i}: the canvas is blank (${distinct.size} colours)`);
       if (!(db >= MIN_DB)) problems.push(`pose ${i}: ${db.toFixed(2)} dB against calf-play, below ${MIN_DB}`);
     }
