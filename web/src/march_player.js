@@ -4,8 +4,8 @@
 // active views are fetched and decoded, every frame of them, when first needed; a frame's faces
 // are uploaded when a pose needs that frame or new cells.
 import { openClip } from './container.js';
-import { openLightfield, decodeFaceFrames } from './lightfield.js';
-import { httpSource } from './stream.js';
+import { openLightfield, decodeFaceFrames, STREAM } from './lightfield.js';
+import { httpSource, prefetch } from './stream.js';
 import { makeCodecs } from './codecs.js';
 import { makeRaymarcher, marchRange, selectViews } from './raymarch.js';
 import { visibleSets } from './culling.js';
@@ -32,6 +32,7 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
   const decoded = new Map();  // view -> { frames: [frame] -> { colour: [6], depth: [6] }, have: [6] -> { cells, tiles } }
   const uploaded = new Int32Array(lf.views.length).fill(-1);
   const selection = {};
+  const rateSamples = [];
   const stats = { decodeMs: 0, cellsDecoded: 0, tilesDecoded: 0 };
   // Decodes (every frame of) the cells and tiles of view v that `sets` names and that are not
   // decoded yet; returns whether anything was.
@@ -46,11 +47,23 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
       });
     }
     const d = decoded.get(v);
-    let any = false;
+    // What is missing, fetched first in one request per run of neighbouring chunks.
+    const missing = [], ids = [];
+    const chunks = (stream, face, r) => (lf.byKey.get(`${stream}/${v}/${face}/${r}`) ?? []).map((c) => c.id);
     for (let face = 0; face < 6; ++face) {
       const have = d.have[face];
       const only = { cells: new Set([...sets.cells[face]].filter((r) => !have.cells.has(r))),
         tiles: new Set([...sets.tiles[face]].filter((r) => !have.tiles.has(r))) };
+      missing.push(only);
+      for (const r of only.cells) ids.push(...chunks(STREAM.t, face, r), ...chunks(STREAM.colour, face, r));
+      for (const r of only.tiles) ids.push(...chunks(STREAM.depth, face, r), ...chunks(STREAM.material, face, r));
+    }
+    const tf = performance.now();
+    await prefetch(lf.clip, ids.sort((a, b) => a - b));
+    stats.decodeMs += performance.now() - tf;
+    let any = false;
+    for (let face = 0; face < 6; ++face) {
+      const have = d.have[face], only = missing[face];
       if (only.cells.size === 0 && only.tiles.size === 0) continue;
       any = true;
       const t0 = performance.now();
@@ -90,6 +103,12 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
       uploaded[v] = frame;
     }
     const totalCells = active.length * 6 * lf.cells.count;
+    // Bytes fetched per second over the last second or more of poses.
+    const now = performance.now();
+    rateSamples.push({ now, bytes: source.stats.bytes });
+    while (rateSamples.length > 2 && now - rateSamples[1].now >= 1000) rateSamples.shift();
+    const span = (now - rateSamples[0].now) / 1000;
+    const rate = span > 0 ? (source.stats.bytes - rateSamples[0].bytes) / span : 0;
     if (canvas.width !== camera.width || canvas.height !== camera.height) {
       canvas.width = camera.width;
       canvas.height = camera.height;
@@ -100,8 +119,9 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
     const renderMs = performance.now() - t0;
     status(`frame ${frame}: ${active.length} of ${lf.views.length} views, ${visibleCells}/${totalCells} cells, ` +
       `render ${renderMs.toFixed(1)} ms; ${stats.cellsDecoded} cells decoded (${stats.decodeMs.toFixed(0)} ms), ` +
-      `${source.stats.bytes} of ${source.size} bytes fetched`);
-    return { frame, active, renderMs, visibleCells, totalCells, bytes: source.stats.bytes, size: source.size };
+      `${source.stats.bytes} of ${source.size} bytes fetched (${(100 * source.stats.bytes / source.size).toFixed(1)} %, ` +
+      `${source.stats.requests} requests), ${(rate / 1024).toFixed(1)} KiB/s`);
+    return { frame, active, renderMs, visibleCells, totalCells, bytes: source.stats.bytes, size: source.size, requests: source.stats.requests };
   }
   // The canvas as 8-bit RGB rows, top row first (as calf-play's PNG frames).
   function pixels() {

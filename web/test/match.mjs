@@ -118,7 +118,7 @@ try {
       console.log(`web.match: pose ${i} frame ${got.frame}: ${got.active.length} views, ${got.visibleCells}/${got.totalCells} cells ` +
         `(calf-play ${n.views} views, ${n.cells}/${n.total}), ${db.toFixed(2)} dB against calf-play; ` +
         `render ${got.renderMs.toFixed(1)} ms (SwiftShader) against calf-play's ${n.ms} ms (llvmpipe); ` +
-        `${got.bytes} of ${got.size} bytes fetched so far`);
+        `${got.bytes} of ${got.size} bytes fetched so far in ${got.requests} requests`);
       if (got.active.length !== n.views || got.visibleCells !== n.cells || got.totalCells !== n.total) {
         problems.push(`pose ${i}: ${got.active.length} views, ${got.visibleCells}/${got.totalCells} cells; calf-play ${n.views}, ${n.cells}/${n.total}`);
       }
