@@ -60,7 +60,7 @@ export function parseViewIndex(raw, what, materialFormat) {
 }
 
 // §11.1.4
-function parseTimeline(raw, frameCount, what) {
+export function parseTimeline(raw, frameCount, what) {
   if (raw.length < 4) bad(`${what}: ${raw.length} bytes`);
   const v = new DataView(raw.buffer, raw.byteOffset, raw.length);
   const nk = v.getUint32(0, true);
@@ -116,6 +116,22 @@ export function decodeColour(raw, format, w, h, what) {
         out[3 * i + c] = halfToFloat((raw[q] << 8) | raw[4 * n + q]);
       }
     }
+  }
+  return out;
+}
+
+// A BC1, BC7 or BC6H colour keyframe of a w × h rect as the blocks a GPU takes (8 or 16 bytes a
+// block, row by row): BC7 and BC6H are stored so, BC1's endpoints and indices are interleaved
+// back (§11.1.5).
+export function bcBlocks(raw, format, w, h, what) {
+  const B = Math.ceil(w / 4) * Math.ceil(h / 4);
+  const size = format === FORMAT.bc1 ? 8 : 16;
+  if (raw.length !== size * B) bad(`${what}: ${raw.length} bytes, expected ${size * B}`);
+  if (format !== FORMAT.bc1) return raw;
+  const out = new Uint8Array(8 * B);
+  for (let k = 0; k < B; ++k) {
+    out.set(raw.subarray(4 * k, 4 * k + 4), 8 * k);
+    out.set(raw.subarray(4 * B + 4 * k, 4 * B + 4 * k + 4), 8 * k + 4);
   }
   return out;
 }

@@ -4,10 +4,12 @@
 // active views are fetched and decoded, every frame of them, when first needed; a frame's faces
 // are uploaded when a pose needs that frame or new cells.
 import { openClip } from './container.js';
-import { openLightfield, decodeFaceFrames, STREAM } from './lightfield.js';
+import { openLightfield, decodeFaceFrames, parseTimeline, bcBlocks, STREAM } from './lightfield.js';
+import { readChunk } from './container.js';
+import { E, fail } from './errors.js';
 import { httpSource, prefetch } from './stream.js';
 import { makeCodecs } from './codecs.js';
-import { makeRaymarcher, marchRange, selectViews } from './raymarch.js';
+import { bcUpload, makeRaymarcher, marchRange, selectViews } from './raymarch.js';
 import { visibleSets } from './culling.js';
 
 // frame_at_time (format/capture/src/eye_path.cc).
@@ -28,7 +30,11 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
   if (t < 0) throw new Error('the clip has no lightfield track this page can play');
   const lf = await openLightfield(clip, t);
   const h = lf.header, N = h.face_size, F = h.frame_count, fps = h.fps_numerator / h.fps_denominator;
-  const renderer = makeRaymarcher(gl, { views: lf.views, faceSize: N, cellSize: h.cell_size });
+  // BCn colour goes to the GPU as blocks where the browser takes them (the query string's
+  // bc=0 turns it off), else it is decoded to RGBA on the CPU.
+  const bc = deps.noBc ? null : bcUpload(gl, h.colour_format, N);
+  const renderer = makeRaymarcher(gl, { views: lf.views, faceSize: N, cellSize: h.cell_size, bc });
+  const cellInfo = new Map();  // BCn: `view/face/cell` -> { keys, t, slot: [keyframe in slot 0, 1] }
   const decoded = new Map();  // view -> { frames: [frame] -> { colour: [6], depth: [6] }, have: [6] -> { cells, tiles } }
   const uploaded = new Int32Array(lf.views.length).fill(-1);
   const selection = {};
@@ -67,6 +73,18 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
       if (only.cells.size === 0 && only.tiles.size === 0) continue;
       any = true;
       const t0 = performance.now();
+      if (bc) {
+        for (const r of only.cells) {
+          const tc = lf.byKey.get(`${STREAM.t}/${v}/${face}/${r}`)?.[0];
+          const what = `track ${lf.track} view ${v} face ${face} cell ${r} t`;
+          if (!tc) fail(E.lightfieldChunk, `${what}: no t chunk`);
+          cellInfo.set(`${v}/${face}/${r}`, { ...parseTimeline(await readChunk(lf.clip, tc.id), F, what), slot: [-1, -1] });
+          have.cells.add(r);
+        }
+        stats.cellsDecoded += only.cells.size;
+        only.cells = new Set();
+        if (only.tiles.size === 0) continue;
+      }
       await decodeFaceFrames(lf, v, face, (n, colour, depth) => {
         const dst = d.frames[n];
         for (const r of only.cells) {
@@ -86,6 +104,31 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
     }
     return any;
   }
+  // BCn: per fetched cell of view v, keyframe m (the one whose frames hold `frame`) in slot m % 2
+  // and the next one in the other slot when t ≠ 0 (docs/DECODER.md), and the cell texture.
+  async function uploadBc(v, frame) {
+    const d = decoded.get(v);
+    for (let face = 0; face < 6; ++face) {
+      const values = new Uint32Array(lf.cells.count);
+      for (const r of d.have[face].cells) {
+        const info = cellInfo.get(`${v}/${face}/${r}`), { keys } = info;
+        let m = 0;
+        while (m + 1 < keys.length && keys[m + 1] <= frame) ++m;
+        const w = m + 1 < keys.length ? info.t[frame] : 0;
+        for (const i of w ? [m, m + 1] : [m]) {
+          if (info.slot[i % 2] === keys[i]) continue;
+          const c = (lf.byKey.get(`${STREAM.colour}/${v}/${face}/${r}`) ?? []).find((x) => x.firstFrame === keys[i]);
+          const what = `track ${lf.track} view ${v} face ${face} cell ${r} keyframe ${keys[i]}`;
+          if (!c) fail(E.lightfieldChunk, `${what}: no colour chunk`);
+          const rect = lf.cells.rect(r);
+          renderer.uploadBlocks(v, face, i % 2, rect, bcBlocks(await readChunk(lf.clip, c.id), h.colour_format, rect.w, rect.h, what));
+          info.slot[i % 2] = keys[i];
+        }
+        values[r] = ((m % 2) << 8) | w;
+      }
+      renderer.uploadCells(v, face, values);
+    }
+  }
   // camera: { position, forward, up, fovY (radians), width, height }; time in seconds.
   async function renderPose(camera, time) {
     const frame = frameAtTime(time, fps, F);
@@ -97,9 +140,13 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
       const vs = sets.get(v);
       for (let face = 0; face < 6; ++face) visibleCells += vs.cells[face].size;
       const changed = await ensureCells(v, vs);
+      if (bc) await uploadBc(v, frame);
       if (uploaded[v] === frame && !changed) continue;
       const f = decoded.get(v).frames[frame];
-      for (let face = 0; face < 6; ++face) renderer.uploadFace(v, face, f.colour[face], f.depth[face]);
+      for (let face = 0; face < 6; ++face) {
+        if (bc) renderer.uploadDepth(v, face, f.depth[face]);
+        else renderer.uploadFace(v, face, f.colour[face], f.depth[face]);
+      }
       uploaded[v] = frame;
     }
     const totalCells = active.length * 6 * lf.cells.count;
@@ -121,7 +168,7 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
       `render ${renderMs.toFixed(1)} ms; ${stats.cellsDecoded} cells decoded (${stats.decodeMs.toFixed(0)} ms), ` +
       `${source.stats.bytes} of ${source.size} bytes fetched (${(100 * source.stats.bytes / source.size).toFixed(1)} %, ` +
       `${source.stats.requests} requests), ${(rate / 1024).toFixed(1)} KiB/s`);
-    return { frame, active, renderMs, visibleCells, totalCells, bytes: source.stats.bytes, size: source.size, requests: source.stats.requests };
+    return { frame, active, renderMs, colourUpload: bc ? bc.name : 'RGBA32F (decoded on the CPU)', visibleCells, totalCells, bytes: source.stats.bytes, size: source.size, requests: source.stats.requests };
   }
   // The canvas as 8-bit RGB rows, top row first (as calf-play's PNG frames).
   function pixels() {

@@ -124,9 +124,28 @@ function program(gl, vs, fs, what) {
   return p;
 }
 
+// The compressed colour texture for a BCn colour format where the browser exposes it (the
+// native GlViews formats: sRGB BC1 and BC7, unsigned BC6H), else null (decode to RGBA).
+export function bcUpload(gl, format, faceSize) {
+  if (faceSize % 4 !== 0) return null;
+  if (format === 4) {  // bc1
+    const e = gl.getExtension('WEBGL_compressed_texture_s3tc_srgb');
+    return e && { internal: e.COMPRESSED_SRGB_S3TC_DXT1_EXT, blockBytes: 8, name: 'BC1 (WEBGL_compressed_texture_s3tc_srgb)' };
+  }
+  if (format === 8 || format === 7) {  // bc7, bc6h
+    const e = gl.getExtension('EXT_texture_compression_bptc');
+    if (!e) return null;
+    return format === 8 ? { internal: e.COMPRESSED_SRGB_ALPHA_BPTC_UNORM_EXT, blockBytes: 16, name: 'BC7 (EXT_texture_compression_bptc)' }
+      : { internal: e.COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT_EXT, blockBytes: 16, name: 'BC6H (EXT_texture_compression_bptc)' };
+  }
+  return null;
+}
+
 // A renderer for one lightfield track: `views` are the clip's view records (null: dropped),
-// faces of `faceSize` texels in cells of `cellSize`.
-export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER_DEFAULTS }) {
+// faces of `faceSize` texels in cells of `cellSize`. With `bc` (bcUpload), colour keyframes are
+// uploaded as blocks into two slots a face and the cell texture holds each cell's slot and t, as
+// in the native player; without, one RGBA32F slot holds the colour the CPU decoded.
+export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER_DEFAULTS, bc = null }) {
   if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('WebGL2 without EXT_color_buffer_float: no float render target');
   const vertex = `#version 300 es\n${GL_FULLSCREEN_VERTEX}`;
   const march = program(gl, vertex, fragmentSource({ hints: options.surface_hints }), 'ray-march');
@@ -142,7 +161,8 @@ export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER
     return t;
   };
   // Units as the native binding qualifiers: colour 0, depth 1, cells 2, material 3.
-  const colourTex = texture(0, gl.RGBA32F, N, N, layers);
+  const slots = bc ? 2 : 1;
+  const colourTex = texture(0, bc ? bc.internal : gl.RGBA32F, N, N, slots * layers);
   const depthTex = texture(1, gl.R16UI, N, N, layers);
   const cellTex = texture(2, gl.R32UI, cellsPerSide, cellsPerSide, layers);
   gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 0, cellsPerSide, cellsPerSide, layers, gl.RED_INTEGER, gl.UNSIGNED_INT,
@@ -167,6 +187,25 @@ export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER
     gl.activeTexture(gl.TEXTURE1);
     gl.bindTexture(gl.TEXTURE_2D_ARRAY, depthTex);
     gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 6 * view + face, N, N, 1, gl.RED_INTEGER, gl.UNSIGNED_SHORT, depth);
+  }
+
+  // The depth codes of one face of one view.
+  function uploadDepth(view, face, depth) {
+    gl.activeTexture(gl.TEXTURE1);
+    gl.bindTexture(gl.TEXTURE_2D_ARRAY, depthTex);
+    gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 6 * view + face, N, N, 1, gl.RED_INTEGER, gl.UNSIGNED_SHORT, depth);
+  }
+  // BCn: a keyframe's blocks (rect's blocks row by row) into a slot of one face of one view.
+  function uploadBlocks(view, face, slot, rect, blocks) {
+    gl.activeTexture(gl.TEXTURE0);
+    gl.bindTexture(gl.TEXTURE_2D_ARRAY, colourTex);
+    gl.compressedTexSubImage3D(gl.TEXTURE_2D_ARRAY, 0, rect.x, rect.y, slots * (6 * view + face) + slot, rect.w, rect.h, 1, bc.internal, blocks);
+  }
+  // BCn: the cells of one face of one view: (slot a << 8) | t per cell (the native cell texture).
+  function uploadCells(view, face, values) {
+    gl.activeTexture(gl.TEXTURE2);
+    gl.bindTexture(gl.TEXTURE_2D_ARRAY, cellTex);
+    gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 6 * view + face, cellsPerSide, cellsPerSide, 1, gl.RED_INTEGER, gl.UNSIGNED_INT, values);
   }
 
   // camera: { position, forward, up, fovY (radians), width, height }; active: clip view indices.
@@ -208,7 +247,7 @@ export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER
     gl.useProgram(march);
     const U = (name) => gl.getUniformLocation(march, name);
     gl.uniform1ui(U('view_count'), active.length);
-    gl.uniform1ui(U('colour_slots'), 1);
+    gl.uniform1ui(U('colour_slots'), slots);
     gl.uniform1ui(U('steps'), o.steps);
     gl.uniform1ui(U('refine_steps'), o.refine_steps);
     gl.uniform1f(U('march_near'), near);
@@ -248,5 +287,5 @@ export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER
     gl.drawArrays(gl.TRIANGLES, 0, 3);
     gl.bindVertexArray(null);
   }
-  return { uploadFace, render };
+  return { uploadFace, uploadDepth, uploadBlocks, uploadCells, render };
 }

@@ -71,12 +71,18 @@ const run = (tool, args) => execFileSync(join(bin, tool), args, { encoding: 'utf
 const t0 = Date.now();
 run('calf-capture', ['--scene', 'interior', '--face-size', '64', '--frames', '2', '--spp', '4', '--quiet', '--out', join(dir, 'cap')]);
 run('calf-capture', ['--scene', 'interior', '--ground-truth', '--gt-size', '64x48', '--frames', '2', '--spp', '1', '--quiet', '--out', join(dir, 'gt')]);
-run('calf-encode', [join(dir, 'cap'), '-o', join(dir, 'clip.calf'), '--color-format', 'rgba16f', '--cell', '16', '--quiet']);
-const played = run('calf-play', [join(dir, 'clip.calf'), '--headless', '--eye-path', join(dir, 'gt', 'eye_path.json'), '--out', join(dir, 'play')]);
-console.log(`web.match: clip and calf-play frames made in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
-const native = [...played.matchAll(/^pose (\d+) frame \d+: (\d+) views, (\d+)\/(\d+) cells, .*render ([0-9.]+) ms/gm)]
-  .map((m) => ({ views: Number(m[2]), cells: Number(m[3]), total: Number(m[4]), ms: Number(m[5]) }));
-if (native.length === 0) throw new Error(`no pose lines in calf-play's output: ${played}`);
+// The same capture twice: rgba16f colour (the page decodes it to RGBA on the CPU) and BC1 (the
+// page uploads the blocks where WEBGL_compressed_texture_s3tc_srgb exists, as SwiftShader has).
+const clips = [['rgba16f', ['--color-format', 'rgba16f']], ['bc1', ['--color-format', 'bc1', '--bc1-fit', 'range', '--colour-rdo', '0']]];
+const native = {};
+for (const [name, args] of clips) {
+  run('calf-encode', [join(dir, 'cap'), '-o', join(dir, `${name}.calf`), '--cell', '16', '--quiet', ...args]);
+  const played = run('calf-play', [join(dir, `${name}.calf`), '--headless', '--eye-path', join(dir, 'gt', 'eye_path.json'), '--out', join(dir, `play-${name}`)]);
+  native[name] = [...played.matchAll(/^pose (\d+) frame \d+: (\d+) views, (\d+)\/(\d+) cells, .*render ([0-9.]+) ms/gm)]
+    .map((m) => ({ views: Number(m[2]), cells: Number(m[3]), total: Number(m[4]), ms: Number(m[5]) }));
+  if (native[name].length === 0) throw new Error(`no pose lines in calf-play's output: ${played}`);
+}
+console.log(`web.match: clips and calf-play frames made in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
 const path = JSON.parse(readFileSync(join(dir, 'gt', 'eye_path.json'), 'utf8'));
 
 const server = spawn('/usr/bin/python3', [join(ROOT, 'web/test/range_server.py'), ROOT], { stdio: ['ignore', 'pipe', 'ignore'] });
@@ -87,14 +93,15 @@ const browser = await browserType.launch({
   args: ['--no-sandbox', '--enable-unsafe-swiftshader', '--use-angle=swiftshader', '--ignore-gpu-blocklist'],
 });
 try {
+for (const [name] of clips) {
   const page = await browser.newPage();
   const consoleLines = [];
   page.on('console', (m) => consoleLines.push(m.text()));
   page.on('pageerror', (e) => consoleLines.push(e.message));
-  await page.goto(`http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/build/web-match/clip.calf`);
+  await page.goto(`http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/build/web-match/${name}.calf`);
   await page.waitForFunction(() => window.calfStatus !== 'loading', null, { timeout: 60000 });
   if ((await page.evaluate(() => window.calfStatus)) !== 'ready') {
-    problems.push(`the page did not open the clip: ${await page.textContent('#overlay')} ${consoleLines.join(' | ')}`);
+    problems.push(`${name}: the page did not open the clip: ${await page.textContent('#overlay')} ${consoleLines.join(' | ')}`);
   } else {
     for (let i = 0; i < path.poses.length; ++i) {
       const p = path.poses[i];
@@ -106,26 +113,29 @@ try {
           return { ...r, rgb: Array.from(window.calfPlayer.pixels()) };
         }, { camera, time: p.time });
       } catch (e) {
-        problems.push(`pose ${i}: ${e.message.split('\n')[0]} ${consoleLines.join(' | ')}`);
+        problems.push(`${name} pose ${i}: ${e.message.split('\n')[0]} ${consoleLines.join(' | ')}`);
         continue;
       }
-      const want = readPng(join(dir, 'play', `frame_${String(i).padStart(5, '0')}.png`));
+      const want = readPng(join(dir, `play-${name}`, `frame_${String(i).padStart(5, '0')}.png`));
       const rgb = Uint8Array.from(got.rgb);
       const distinct = new Set();
       for (let k = 0; k < rgb.length; k += 3) distinct.add((rgb[k] << 16) | (rgb[k + 1] << 8) | rgb[k + 2]);
       const db = psnr(rgb, want.rgb);
-      const n = native[i] ?? {};
-      console.log(`web.match: pose ${i} frame ${got.frame}: ${got.active.length} views, ${got.visibleCells}/${got.totalCells} cells ` +
+      const n = native[name][i] ?? {};
+      console.log(`web.match: ${name} pose ${i} frame ${got.frame} (colour ${got.colourUpload}): ${got.active.length} views, ${got.visibleCells}/${got.totalCells} cells ` +
         `(calf-play ${n.views} views, ${n.cells}/${n.total}), ${db.toFixed(2)} dB against calf-play; ` +
         `render ${got.renderMs.toFixed(1)} ms (SwiftShader) against calf-play's ${n.ms} ms (llvmpipe); ` +
         `${got.bytes} of ${got.size} bytes fetched so far in ${got.requests} requests`);
       if (got.active.length !== n.views || got.visibleCells !== n.cells || got.totalCells !== n.total) {
-        problems.push(`pose ${i}: ${got.active.length} views, ${got.visibleCells}/${got.totalCells} cells; calf-play ${n.views}, ${n.cells}/${n.total}`);
+        problems.push(`${name} pose ${i}: ${got.active.length} views, ${got.visibleCells}/${got.totalCells} cells; calf-play ${n.views}, ${n.cells}/${n.total}`);
       }
-      if (distinct.size < 16) problems.push(`pose ${i}: the canvas is blank (${distinct.size} colours)`);
-      if (!(db >= MIN_DB)) problems.push(`pose ${i}: ${db.toFixed(2)} dB against calf-play, below ${MIN_DB}`);
+      if (name === 'bc1' && !got.colourUpload.startsWith('BC1')) problems.push(`bc1 pose ${i}: colour went up as ${got.colourUpload}, not as BC1 blocks`);
+      if (distinct.size < 16) problems.push(`${name} pose ${i}: the canvas is blank (${distinct.size} colours)`);
+      if (!(db >= MIN_DB)) problems.push(`${name} pose ${i}: ${db.toFixed(2)} dB against calf-play, below ${MIN_DB}`);
     }
   }
+  await page.close();
+}
 } finally {
   await browser.close();
   server.kill();
