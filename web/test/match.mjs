@@ -8,7 +8,8 @@
 //
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM
 import { execFileSync, spawn } from 'node:child_process';
-import { mkdirSync, readFileSync, rmSync } from 'node:fs';
+import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
 import { createRequire } from 'node:module';
 import { join } from 'node:path';
 import { createInterface } from 'node:readline';
@@ -64,12 +65,12 @@ function psnr(a, b) {
   return se === 0 ? Infinity : 10 * Math.log10((255 * 255) / (se / a.length));
 }
 
-const dir = join(ROOT, 'build', 'web-match');
-rmSync(dir, { recursive: true, force: true });
-mkdirSync(dir, { recursive: true });
+// Everything goes into a fresh temporary folder (the source tree is only read), served by the
+// range server under /clips/.
+const dir = mkdtempSync(join(process.env.CALF_WEB_TMP ?? tmpdir(), 'calf-web-match-'));
 const run = (tool, args) => execFileSync(join(bin, tool), args, { encoding: 'utf8', stdio: ['ignore', 'pipe', 'pipe'] });
 const t0 = Date.now();
-run('calf-capture', ['--scene', 'interior', '--face-size', '64', '--frames', '2', '--spp', '4', '--quiet', '--out', join(dir, 'cap')]);
+run('calf-capture', ['--scene', 'interior', '--face-size', '64', '--frames', '2', '--spp', '1', '--quiet', '--out', join(dir, 'cap')]);
 run('calf-capture', ['--scene', 'interior', '--ground-truth', '--gt-size', '64x48', '--frames', '2', '--spp', '1', '--quiet', '--out', join(dir, 'gt')]);
 // The same capture twice: rgba16f colour (the page decodes it to RGBA on the CPU) and BC1 (the
 // page uploads the blocks where WEBGL_compressed_texture_s3tc_srgb exists, as SwiftShader has).
@@ -85,7 +86,7 @@ for (const [name, args] of clips) {
 console.log(`web.match: clips and calf-play frames made in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
 const path = JSON.parse(readFileSync(join(dir, 'gt', 'eye_path.json'), 'utf8'));
 
-const server = spawn('/usr/bin/python3', [join(ROOT, 'web/test/range_server.py'), ROOT], { stdio: ['ignore', 'pipe', 'ignore'] });
+const server = spawn('/usr/bin/python3', [join(ROOT, 'web/test/range_server.py'), ROOT, '--mount', `/clips=${dir}`], { stdio: ['ignore', 'pipe', 'ignore'] });
 const port = (await new Promise((resolve) => createInterface({ input: server.stdout }).once('line', resolve))).split(' ')[1];
 const problems = [];
 const browser = await browserType.launch({
@@ -98,7 +99,7 @@ for (const [name] of clips) {
   const consoleLines = [];
   page.on('console', (m) => consoleLines.push(m.text()));
   page.on('pageerror', (e) => consoleLines.push(e.message));
-  await page.goto(`http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/build/web-match/${name}.calf`);
+  await page.goto(`http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/clips/${name}.calf`);
   await page.waitForFunction(() => window.calfStatus !== 'loading', null, { timeout: 60000 });
   if ((await page.evaluate(() => window.calfStatus)) !== 'ready') {
     problems.push(`${name}: the page did not open the clip: ${await page.textContent('#overlay')} ${consoleLines.join(' | ')}`);
@@ -142,4 +143,5 @@ for (const [name] of clips) {
 }
 for (const p of problems) console.log(`web.match: FAIL ${p}`);
 if (problems.length === 0) rmSync(dir, { recursive: true, force: true });
+else console.log(`web.match: its files are kept in ${dir}`);
 process.exit(problems.length ? 1 : 0);

@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """A static file server with HTTP range requests (single ranges), for the web player's tests.
 
-  range_server.py DIR [--no-range]
+  range_server.py DIR [--no-range] [--mount /PREFIX=DIR2]
 
 Listens on 127.0.0.1 at a free port and prints `port N` on its first line; with --no-range it
-answers every request with the whole file (200), as a server without range support does. Each
+answers every request with the whole file (200), as a server without range support does. With
+--mount, paths under /PREFIX/ are served from DIR2 (e.g. clips written outside DIR). Each
 request is logged to stderr as `GET PATH RANGE STATUS BYTES`.
 """
 
@@ -16,6 +17,15 @@ import sys
 
 class Handler(http.server.SimpleHTTPRequestHandler):
     ranges = True
+    mounts = {}
+
+    def translate_path(self, path):
+        for prefix, root in self.mounts.items():
+            if path.startswith(prefix + "/"):
+                rest = path[len(prefix) + 1:].split("?", 1)[0].split("#", 1)[0]
+                parts = [p for p in rest.split("/") if p not in ("", ".", "..")]
+                return os.path.join(root, *parts)
+        return super().translate_path(path)
 
     def log_message(self, fmt, *args):
         pass
@@ -53,8 +63,12 @@ class Handler(http.server.SimpleHTTPRequestHandler):
 
 
 def main():
-    os.chdir(sys.argv[1])
     Handler.ranges = "--no-range" not in sys.argv
+    for i, arg in enumerate(sys.argv):
+        if arg == "--mount" and i + 1 < len(sys.argv):
+            prefix, root = sys.argv[i + 1].split("=", 1)
+            Handler.mounts[prefix.rstrip("/")] = os.path.abspath(root)
+    os.chdir(sys.argv[1])
     server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Handler)
     print(f"port {server.server_address[1]}", flush=True)
     server.serve_forever()
