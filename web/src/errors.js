@@ -8,7 +8,7 @@ export const E = {
   chunkRange: 'CALF-E053', chunkLayout: 'CALF-E054', chunkTrack: 'CALF-E055',
   compression: 'CALF-E056', chunkSize: 'CALF-E057', chunkHash: 'CALF-E058',
   decompress: 'CALF-E059', padding: 'CALF-E060', chunkId: 'CALF-E061', lightfieldChunk: 'CALF-E202',
-  lightfieldFormat: 'CALF-E203',
+  lightfieldFormat: 'CALF-E203', playbackClip: 'CALF-E460',
 };
 
 export class CalfError extends Error {

@@ -27,7 +27,7 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
   if (source.notice) status(source.notice);
   const clip = await openClip(source, codecs);
   const t = clip.tracks.findIndex((x) => x.kind === 1);
-  if (t < 0) throw new Error('the clip has no lightfield track this page can play');
+  if (t < 0) fail(E.playbackClip, 'the clip has no lightfield track (the only kind this page plays)');
   const lf = await openLightfield(clip, t);
   const h = lf.header, N = h.face_size, F = h.frame_count, fps = h.fps_numerator / h.fps_denominator;
   // BCn colour goes to the GPU as blocks where the browser takes them (the query string's
@@ -129,12 +129,39 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
       renderer.uploadCells(v, face, values);
     }
   }
-  // camera: { position, forward, up, fovY (radians), width, height }; time in seconds.
-  async function renderPose(camera, time) {
+  // The view volume: the clip's `view_volume` metadata ("x0 y0 z0 x1 y1 z1") where well formed,
+  // else the bounds of the usable views' positions (LightfieldRepresentation).
+  const volume = (() => {
+    const meta = clip.metadata?.find(([k]) => k === 'view_volume');
+    const v = meta ? meta[1].trim().split(/\s+/).map(Number) : [];
+    if (v.length === 6 && v.every(Number.isFinite) && v[0] <= v[3] && v[1] <= v[4] && v[2] <= v[5]) return { lo: v.slice(0, 3), hi: v.slice(3) };
+    const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+    for (const view of lf.views) {
+      if (!view) continue;
+      for (let k = 0; k < 3; ++k) { lo[k] = Math.min(lo[k], view.position[k]); hi[k] = Math.max(hi[k], view.position[k]); }
+    }
+    return { lo, hi };
+  })();
+  // Playback::inside_view_volume.
+  const inside = (p) => [0, 1, 2].every((k) => p[k] >= volume.lo[k] - 1e-9 && p[k] <= volume.hi[k] + 1e-9);
+  const selections = new Map();  // the view selection's incumbents, one set per eye
+  // The eye's frustum for culling: a camera with an (asymmetric) projection is culled with the
+  // symmetric frustum that holds it.
+  function cullCamera(camera) {
+    const P = camera.projection;
+    if (!P) return camera;
+    const tx = (1 + Math.abs(P[8])) / P[0], ty = (1 + Math.abs(P[9])) / P[5];
+    return { ...camera, fovY: 2 * Math.atan(ty), width: tx, height: ty };
+  }
+  // Fetches, decodes and uploads what the pose needs; camera: { position, forward, up, fovY
+  // (radians), width, height, projection (optional, a WebGL column-major perspective matrix that
+  // replaces fovY) }; time in seconds; eye: which incumbent set the view selection keeps.
+  async function prepare(camera, time, eye = 0) {
     const frame = frameAtTime(time, fps, F);
-    const active = selectViews(lf.views, camera.position, selection);
+    if (!selections.has(eye)) selections.set(eye, {});
+    const active = selectViews(lf.views, camera.position, selections.get(eye));
     const { near, far } = marchRange(lf.views, camera.position);
-    const sets = visibleSets(lf, camera, near, far, active);
+    const sets = visibleSets(lf, cullCamera(camera), near, far, active);
     let visibleCells = 0;
     for (const v of active) {
       const vs = sets.get(v);
@@ -149,26 +176,48 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
       }
       uploaded[v] = frame;
     }
-    const totalCells = active.length * 6 * lf.cells.count;
-    // Bytes fetched per second over the last second or more of poses.
+    return { frame, active, visibleCells, totalCells: active.length * 6 * lf.cells.count };
+  }
+  // Draws a prepared pose (synchronous: a WebXR frame draws inside its callback); target:
+  // { framebuffer, viewport: { x, y, width, height } } or the whole canvas.
+  function draw(camera, prepared, target) {
+    if (!target && (canvas.width !== camera.width || canvas.height !== camera.height)) {
+      canvas.width = camera.width;
+      canvas.height = camera.height;
+    }
+    const t0 = performance.now();
+    renderer.render(camera, prepared.active, target);
+    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));  // waits for the draw
+    return performance.now() - t0;
+  }
+  // The overlay line of a drawn pose; position: the viewer's.
+  function report(prepared, renderMs, position, eyes = 1) {
     const now = performance.now();
     rateSamples.push({ now, bytes: source.stats.bytes });
     while (rateSamples.length > 2 && now - rateSamples[1].now >= 1000) rateSamples.shift();
     const span = (now - rateSamples[0].now) / 1000;
     const rate = span > 0 ? (source.stats.bytes - rateSamples[0].bytes) / span : 0;
-    if (canvas.width !== camera.width || canvas.height !== camera.height) {
-      canvas.width = camera.width;
-      canvas.height = camera.height;
-    }
-    const t0 = performance.now();
-    renderer.render(camera, active);
-    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));  // waits for the draw
-    const renderMs = performance.now() - t0;
-    status(`frame ${frame}: ${active.length} of ${lf.views.length} views, ${visibleCells}/${totalCells} cells, ` +
+    const out = inside(position) ? '' : '; the eye is outside the view volume';
+    status(`frame ${prepared.frame}: ${eyes === 2 ? 'two eyes, ' : ''}${prepared.active.length} of ${lf.views.length} views, ${prepared.visibleCells}/${prepared.totalCells} cells, ` +
       `render ${renderMs.toFixed(1)} ms; ${stats.cellsDecoded} cells decoded (${stats.decodeMs.toFixed(0)} ms), ` +
       `${source.stats.bytes} of ${source.size} bytes fetched (${(100 * source.stats.bytes / source.size).toFixed(1)} %, ` +
-      `${source.stats.requests} requests), ${(rate / 1024).toFixed(1)} KiB/s`);
-    return { frame, active, renderMs, colourUpload: bc ? bc.name : 'RGBA32F (decoded on the CPU)', visibleCells, totalCells, bytes: source.stats.bytes, size: source.size, requests: source.stats.requests };
+      `${source.stats.requests} requests), ${(rate / 1024).toFixed(1)} KiB/s${out}`);
+    return !out;
+  }
+  // One pose into the canvas. An error (a damaged chunk, say) is one line in the overlay and is
+  // thrown again; nothing is drawn, so the last good frame stays.
+  async function renderPose(camera, time) {
+    let prepared;
+    try {
+      prepared = await prepare(camera, time);
+    } catch (e) {
+      status(e.message.split('\n')[0]);
+      throw e;
+    }
+    const renderMs = draw(camera, prepared);
+    const insideVolume = report(prepared, renderMs, camera.position);
+    const { frame, active, visibleCells, totalCells } = prepared;
+    return { frame, active, renderMs, insideVolume, colourUpload: bc ? bc.name : 'RGBA32F (decoded on the CPU)', visibleCells, totalCells, bytes: source.stats.bytes, size: source.size, requests: source.stats.requests };
   }
   // The canvas as 8-bit RGB rows, top row first (as calf-play's PNG frames).
   function pixels() {
@@ -183,5 +232,5 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
     }
     return rgb;
   }
-  return { gl, lf, renderPose, pixels, stats, fps };
+  return { gl, lf, renderPose, prepare, draw, report, pixels, stats, fps, volume, inside };
 }

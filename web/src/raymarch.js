@@ -39,13 +39,14 @@ export function fragmentSource({ depthBc5 = false, hints = 1 } = {}) {
 const PRESENT = `#version 300 es
 precision highp float;
 uniform highp sampler2D frame_tex;
+uniform ivec2 origin;  // the viewport's lower left corner (one eye of a stereo frame)
 out vec4 out_colour;
 // srgb8_from_linear (player/src/image_compare.cc): clamp, sRGB transfer.
 vec3 srgb(vec3 c) {
   c = clamp(c, 0.0, 1.0);
   return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
 }
-void main() { out_colour = vec4(srgb(texelFetch(frame_tex, ivec2(gl_FragCoord.xy), 0).rgb), 1.0); }`;
+void main() { out_colour = vec4(srgb(texelFetch(frame_tex, ivec2(gl_FragCoord.xy) - origin, 0).rgb), 1.0); }`;
 
 const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
 const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -208,13 +209,20 @@ export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER
     gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 6 * view + face, cellsPerSide, cellsPerSide, 1, gl.RED_INTEGER, gl.UNSIGNED_INT, values);
   }
 
-  // camera: { position, forward, up, fovY (radians), width, height }; active: clip view indices.
-  // Draws into the canvas (sRGB, as calf-play's PNG frames).
-  function render(camera, active) {
+  // camera: { position, forward, up, fovY (radians), width, height, projection (optional: a
+  // column-major perspective matrix, e.g. an XRView's, whose frustum replaces fovY) }; active:
+  // clip view indices. Draws into the canvas (sRGB, as calf-play's PNG frames), or into
+  // out.framebuffer at out.viewport (one eye of a WebXR frame).
+  function render(camera, active, out = null) {
     const o = options;
     const { near, far } = marchRange(views, camera.position);
     const fwd = normalize(camera.forward), right = normalize(cross(fwd, camera.up)), up = cross(right, fwd);
     const h = Math.tan(camera.fovY / 2), aspect = camera.width / camera.height;
+    // The eye ray through NDC (a, b) is forward + a right + b up; a perspective matrix P puts it
+    // at forward + (a + P[8]) / P[0] right + (b + P[9]) / P[5] up.
+    const P = camera.projection;
+    const rayForward = P ? [0, 1, 2].map((k) => fwd[k] + (P[8] / P[0]) * right[k] + (P[9] / P[5]) * up[k]) : fwd;
+    const rayRight = P ? scale(right, 1 / P[0]) : scale(right, h * aspect), rayUp = P ? scale(up, 1 / P[5]) : scale(up, h);
     const records = new ArrayBuffer(MAX_ACTIVE_VIEWS * 48);
     const f32 = new Float32Array(records), u32 = new Uint32Array(records), i32 = new Int32Array(records);
     active.forEach((v, k) => {
@@ -272,18 +280,21 @@ export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER
     gl.uniform1ui(U('rr_max_depth'), o.rr_max_depth);
     gl.uniform2ui(U('image_size'), camera.width, camera.height);
     gl.uniform1ui(U('supersample'), o.supersample);
-    gl.uniform3f(U('cam_forward'), ...fwd);
-    gl.uniform3f(U('cam_right'), ...scale(right, h * aspect));
-    gl.uniform3f(U('cam_up'), ...scale(up, h));
+    gl.uniform3f(U('cam_forward'), ...rayForward);
+    gl.uniform3f(U('cam_right'), ...rayRight);
+    gl.uniform3f(U('cam_up'), ...rayUp);
     for (const cap of [gl.DEPTH_TEST, gl.BLEND, gl.SCISSOR_TEST, gl.CULL_FACE, gl.STENCIL_TEST]) gl.disable(cap);
     gl.viewport(0, 0, camera.width, camera.height);
     gl.bindVertexArray(vao);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
-    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, out ? out.framebuffer : null);
+    const vp = out ? out.viewport : { x: 0, y: 0 };
+    gl.viewport(vp.x, vp.y, camera.width, camera.height);
     gl.useProgram(present);
     gl.activeTexture(gl.TEXTURE4);
     gl.bindTexture(gl.TEXTURE_2D, targetTex);
     gl.uniform1i(gl.getUniformLocation(present, 'frame_tex'), 4);
+    gl.uniform2i(gl.getUniformLocation(present, 'origin'), vp.x, vp.y);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
     gl.bindVertexArray(null);
   }
