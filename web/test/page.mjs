@@ -2,21 +2,45 @@
 // SwiftShader without a GPU): it opens a clip over range requests, its shader (calf's GLSL
 // conventions, generated) compiles under WebGL2, and the centre pixel looking along each of the
 // six axes shows the texel SPEC §11.1.1 puts there (face from the major axis, (s, t) from the
-// face table), as the decoder decoded it; a file that is not a clip gives one CALF-E040 line.
+// face table), as the decoder decoded it. Bad input is one line in the overlay with its id: a file
+// that is not a clip (CALF-E040), a clip with no lightfield track (CALF-E460), and a chunk whose
+// hash fails (CALF-E058) when a later pose first needs it, the last good frame staying on the
+// canvas and the page still drawing afterwards.
 //
 //   node web/test/page.mjs CHROMIUM
 import { spawn } from 'node:child_process';
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
 import { createRequire } from 'node:module';
 import { join } from 'node:path';
 import { createInterface } from 'node:readline';
 import { pathToFileURL } from 'node:url';
-import { ROOT, NPM } from './node_codecs.mjs';
+import { ROOT, NPM, loadCodecs } from './node_codecs.mjs';
+import { bytesSource, openClip } from '../src/container.js';
+import { openLightfield, STREAM } from '../src/lightfield.js';
 
 const chromium = process.argv[2] ?? '/usr/bin/chromium';
 const require = createRequire(pathToFileURL(join(NPM, 'package.json')));
 const { chromium: browserType } = require('playwright-core');
 
-const server = spawn('/usr/bin/python3', [join(ROOT, 'web/test/range_server.py'), ROOT], { stdio: ['ignore', 'pipe', 'ignore'] });
+// A damaged copy of the clip: one byte flipped in each colour chunk of face 4 (+z) of every view,
+// which a pose looking down -z does not need and one looking down +z does.
+const clipFile = 'tests/conformance/lightfield/bc7_bc5_zstd_mat.calf';
+const work = mkdtempSync(join(tmpdir(), 'calf-web-page-'));
+{
+  const bytes = new Uint8Array(readFileSync(join(ROOT, clipFile)));
+  const { codecs } = await loadCodecs();
+  const lf = await openLightfield(await openClip(bytesSource(bytes), codecs), 0);
+  let flipped = 0;
+  for (const [key, chunks] of lf.byKey) {
+    const [stream, , face] = key.split('/').map(Number);
+    if (stream !== STREAM.colour || face !== 4) continue;
+    for (const c of chunks) { bytes[lf.clip.chunks[c.id].offset] ^= 0x40; ++flipped; }
+  }
+  if (flipped === 0) throw new Error('no colour chunk of face 4 to damage');
+  writeFileSync(join(work, 'damaged.calf'), bytes);
+}
+const server = spawn('/usr/bin/python3', [join(ROOT, 'web/test/range_server.py'), ROOT, '--mount', `/clips=${work}`], { stdio: ['ignore', 'pipe', 'ignore'] });
 const port = (await new Promise((resolve) => createInterface({ input: server.stdout }).once('line', resolve))).split(' ')[1];
 const base = `http://127.0.0.1:${port}`;
 const problems = [];
@@ -90,9 +114,40 @@ try {
   const line = await bad.textContent('#overlay');
   console.log(`page: not a clip: '${line}'`);
   if (!line.startsWith('CALF-E040 ') || line.includes('\n')) problems.push(`not a clip gave '${line}'`);
+  // A kind the page cannot play: a mesh clip.
+  const mesh = await browser.newPage();
+  await mesh.goto(`${base}/web/index.html?clip=/tests/conformance/mesh/full_none.calf`);
+  await mesh.waitForFunction(() => window.calfStatus !== 'loading', null, { timeout: 30000 });
+  const meshLine = await mesh.textContent('#overlay');
+  console.log(`page: a mesh clip: '${meshLine}'`);
+  if (!meshLine.startsWith('CALF-E460 ') || meshLine.includes('\n')) problems.push(`a mesh clip gave '${meshLine}'`);
+  // A damaged chunk, first needed by the second pose.
+  const dmg = await browser.newPage();
+  await dmg.goto(`${base}/web/index.html?autoplay=0&clip=/clips/damaged.calf`);
+  await dmg.waitForFunction(() => window.calfStatus !== 'loading', null, { timeout: 60000 });
+  if ((await dmg.evaluate(() => window.calfStatus)) !== 'ready') {
+    problems.push(`the damaged clip did not open: ${await dmg.textContent('#overlay')}`);
+  } else {
+    const poses = await dmg.evaluate(async () => {
+      const p = window.calfPlayer, cam = (z) => ({ position: [0, 0, 0], forward: [0, 0, z], up: [0, 1, 0], fovY: Math.PI / 3, width: 32, height: 32 });
+      await p.renderPose(cam(-1), 0);
+      const good = Array.from(p.pixels()), goodLine = document.getElementById('overlay').textContent;
+      let thrown = null;
+      try { await p.renderPose(cam(1), 0); } catch (e) { thrown = e.message; }
+      const after = Array.from(p.pixels()), line = document.getElementById('overlay').textContent;
+      await p.renderPose(cam(-1), 1 / 24);  // the page still draws
+      return { good, goodLine, thrown, after, line, again: document.getElementById('overlay').textContent };
+    });
+    console.log(`page: damaged chunk: '${poses.goodLine}', then '${poses.line}', then '${poses.again}'`);
+    if (!poses.line.startsWith('CALF-E058 ') || poses.line.includes('\n')) problems.push(`a damaged chunk gave '${poses.line}'`);
+    if (!poses.thrown) problems.push('a damaged chunk did not fail the pose');
+    if (poses.after.join() !== poses.good.join()) problems.push('the last good frame did not stay after the damaged chunk');
+    if (!poses.again.startsWith('frame 1:')) problems.push(`after the damaged chunk the page did not draw: '${poses.again}'`);
+  }
 } finally {
   await browser.close();
   server.kill();
+  rmSync(work, { recursive: true, force: true });
 }
 for (const p of problems) console.log(`web page: ${p}`);
 console.log(`web page: ${problems.length ? 'FAILED' : 'ok'}`);
