@@ -55,9 +55,12 @@ done
 
 # The npm packages of the export tests, pinned, into build/npm: Khronos' glTF-Validator (the
 # second glTF reader, tests/export/gltf_validate.js), three.js and playwright-core (the browser
-# test, tests/export/three_compare.js, which drives Debian's chromium). node and npm from Debian
-# when the machine has none.
-NPM_PACKAGES=(gltf-validator@2.0.0-dev.3.10 three@0.187.0 playwright-core@1.64.1)
+# test, tests/export/three_compare.js, which drives Debian's chromium); and the web player's
+# decoder (web/, docs/WEB.md): hash-wasm (XXH3-64, XXH64), fzstd (zstd) and xz-decompress
+# (LZMA2, through xz-embedded in WebAssembly), each pure JavaScript or WebAssembly, for node and
+# the browser alike. node and npm from Debian when the machine has none.
+NPM_PACKAGES=(gltf-validator@2.0.0-dev.3.10 three@0.187.0 playwright-core@1.64.1
+              hash-wasm@4.13.0 fzstd@0.1.1 xz-decompress@0.2.3)
 install_npm_packages() {
   local dir p name version
   dir="$(cd "$(dirname "$0")/.." && pwd)/build/npm"

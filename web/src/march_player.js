@@ -1,0 +1,236 @@
+// The page's lightfield player: calf-play's GL render (raymarch.js: the native ray-march shader,
+// its view selection and march range) of a clip opened by URL over range requests. Only the
+// cells and depth tiles the pose's eye can see (culling.js, the native decoder's culling) of the
+// active views are fetched and decoded, every frame of them, when first needed; a frame's faces
+// are uploaded when a pose needs that frame or new cells.
+import { openClip } from './container.js';
+import { openLightfield, decodeFaceFrames, parseTimeline, bcBlocks, STREAM } from './lightfield.js';
+import { readChunk } from './container.js';
+import { E, fail } from './errors.js';
+import { httpSource, prefetch } from './stream.js';
+import { makeCodecs } from './codecs.js';
+import { bcUpload, makeRaymarcher, marchRange, selectViews } from './raymarch.js';
+import { visibleSets } from './culling.js';
+
+// frame_at_time (format/capture/src/eye_path.cc).
+export function frameAtTime(seconds, fps, frameCount) {
+  if (!(seconds > 0)) return 0;
+  return Math.min(Math.floor(seconds * fps + 1e-9), frameCount - 1);
+}
+
+// deps: the npm modules ({hashWasm, fzstd, xz}); status(text) shows one line.
+export async function openMarchPlayer({ canvas, url, deps, status }) {
+  const gl = canvas.getContext('webgl2', { preserveDrawingBuffer: true, antialias: false });
+  if (!gl) throw new Error('WebGL2 is not available');
+  const codecs = await makeCodecs(deps);
+  const source = await httpSource(url);
+  if (source.notice) status(source.notice);
+  const clip = await openClip(source, codecs);
+  const t = clip.tracks.findIndex((x) => x.kind === 1);
+  if (t < 0) fail(E.playbackClip, 'the clip has no lightfield track (the only kind this page plays)');
+  const lf = await openLightfield(clip, t);
+  const h = lf.header, N = h.face_size, F = h.frame_count, fps = h.fps_numerator / h.fps_denominator;
+  // BCn colour goes to the GPU as blocks where the browser takes them (the query string's
+  // bc=0 turns it off), else it is decoded to RGBA on the CPU.
+  const bc = deps.noBc ? null : bcUpload(gl, h.colour_format, N);
+  const renderer = makeRaymarcher(gl, { views: lf.views, faceSize: N, cellSize: h.cell_size, bc });
+  const cellInfo = new Map();  // BCn: `view/face/cell` -> { keys, t, slot: [keyframe in slot 0, 1] }
+  const decoded = new Map();  // view -> { frames: [frame] -> { colour: [6], depth: [6] }, have: [6] -> { cells, tiles } }
+  const uploaded = new Int32Array(lf.views.length).fill(-1);
+  const selection = {};
+  const rateSamples = [];
+  const stats = { decodeMs: 0, cellsDecoded: 0, tilesDecoded: 0 };
+  // Decodes (every frame of) the cells and tiles of view v that `sets` names and that are not
+  // decoded yet; returns whether anything was.
+  async function ensureCells(v, sets) {
+    if (!decoded.has(v)) {
+      decoded.set(v, {
+        frames: Array.from({ length: F }, () => ({
+          colour: Array.from({ length: 6 }, () => new Float32Array(3 * N * N)),
+          depth: Array.from({ length: 6 }, () => new Uint16Array(N * N)),
+        })),
+        have: Array.from({ length: 6 }, () => ({ cells: new Set(), tiles: new Set() })),
+      });
+    }
+    const d = decoded.get(v);
+    // What is missing, fetched first in one request per run of neighbouring chunks.
+    const missing = [], ids = [];
+    const chunks = (stream, face, r) => (lf.byKey.get(`${stream}/${v}/${face}/${r}`) ?? []).map((c) => c.id);
+    for (let face = 0; face < 6; ++face) {
+      const have = d.have[face];
+      const only = { cells: new Set([...sets.cells[face]].filter((r) => !have.cells.has(r))),
+        tiles: new Set([...sets.tiles[face]].filter((r) => !have.tiles.has(r))) };
+      missing.push(only);
+      for (const r of only.cells) ids.push(...chunks(STREAM.t, face, r), ...chunks(STREAM.colour, face, r));
+      for (const r of only.tiles) ids.push(...chunks(STREAM.depth, face, r), ...chunks(STREAM.material, face, r));
+    }
+    const tf = performance.now();
+    await prefetch(lf.clip, ids.sort((a, b) => a - b));
+    stats.decodeMs += performance.now() - tf;
+    let any = false;
+    for (let face = 0; face < 6; ++face) {
+      const have = d.have[face], only = missing[face];
+      if (only.cells.size === 0 && only.tiles.size === 0) continue;
+      any = true;
+      const t0 = performance.now();
+      if (bc) {
+        for (const r of only.cells) {
+          const tc = lf.byKey.get(`${STREAM.t}/${v}/${face}/${r}`)?.[0];
+          const what = `track ${lf.track} view ${v} face ${face} cell ${r} t`;
+          if (!tc) fail(E.lightfieldChunk, `${what}: no t chunk`);
+          cellInfo.set(`${v}/${face}/${r}`, { ...parseTimeline(await readChunk(lf.clip, tc.id), F, what), slot: [-1, -1] });
+          have.cells.add(r);
+        }
+        stats.cellsDecoded += only.cells.size;
+        only.cells = new Set();
+        if (only.tiles.size === 0) continue;
+      }
+      await decodeFaceFrames(lf, v, face, (n, colour, depth) => {
+        const dst = d.frames[n];
+        for (const r of only.cells) {
+          const { x, y, w, h: rh } = lf.cells.rect(r);
+          for (let j = y; j < y + rh; ++j) dst.colour[face].set(colour.subarray(3 * (j * N + x), 3 * (j * N + x + w)), 3 * (j * N + x));
+        }
+        for (const r of only.tiles) {
+          const { x, y, w, h: rh } = lf.tiles.rect(r);
+          for (let j = y; j < y + rh; ++j) dst.depth[face].set(depth.subarray(j * N + x, j * N + x + w), j * N + x);
+        }
+      }, only);
+      stats.decodeMs += performance.now() - t0;
+      stats.cellsDecoded += only.cells.size;
+      stats.tilesDecoded += only.tiles.size;
+      for (const r of only.cells) have.cells.add(r);
+      for (const r of only.tiles) have.tiles.add(r);
+    }
+    return any;
+  }
+  // BCn: per fetched cell of view v, keyframe m (the one whose frames hold `frame`) in slot m % 2
+  // and the next one in the other slot when t ≠ 0 (docs/DECODER.md), and the cell texture.
+  async function uploadBc(v, frame) {
+    const d = decoded.get(v);
+    for (let face = 0; face < 6; ++face) {
+      const values = new Uint32Array(lf.cells.count);
+      for (const r of d.have[face].cells) {
+        const info = cellInfo.get(`${v}/${face}/${r}`), { keys } = info;
+        let m = 0;
+        while (m + 1 < keys.length && keys[m + 1] <= frame) ++m;
+        const w = m + 1 < keys.length ? info.t[frame] : 0;
+        for (const i of w ? [m, m + 1] : [m]) {
+          if (info.slot[i % 2] === keys[i]) continue;
+          const c = (lf.byKey.get(`${STREAM.colour}/${v}/${face}/${r}`) ?? []).find((x) => x.firstFrame === keys[i]);
+          const what = `track ${lf.track} view ${v} face ${face} cell ${r} keyframe ${keys[i]}`;
+          if (!c) fail(E.lightfieldChunk, `${what}: no colour chunk`);
+          const rect = lf.cells.rect(r);
+          renderer.uploadBlocks(v, face, i % 2, rect, bcBlocks(await readChunk(lf.clip, c.id), h.colour_format, rect.w, rect.h, what));
+          info.slot[i % 2] = keys[i];
+        }
+        values[r] = ((m % 2) << 8) | w;
+      }
+      renderer.uploadCells(v, face, values);
+    }
+  }
+  // The view volume: the clip's `view_volume` metadata ("x0 y0 z0 x1 y1 z1") where well formed,
+  // else the bounds of the usable views' positions (LightfieldRepresentation).
+  const volume = (() => {
+    const meta = clip.metadata?.find(([k]) => k === 'view_volume');
+    const v = meta ? meta[1].trim().split(/\s+/).map(Number) : [];
+    if (v.length === 6 && v.every(Number.isFinite) && v[0] <= v[3] && v[1] <= v[4] && v[2] <= v[5]) return { lo: v.slice(0, 3), hi: v.slice(3) };
+    const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+    for (const view of lf.views) {
+      if (!view) continue;
+      for (let k = 0; k < 3; ++k) { lo[k] = Math.min(lo[k], view.position[k]); hi[k] = Math.max(hi[k], view.position[k]); }
+    }
+    return { lo, hi };
+  })();
+  // Playback::inside_view_volume.
+  const inside = (p) => [0, 1, 2].every((k) => p[k] >= volume.lo[k] - 1e-9 && p[k] <= volume.hi[k] + 1e-9);
+  const selections = new Map();  // the view selection's incumbents, one set per eye
+  // The eye's frustum for culling: a camera with an (asymmetric) projection is culled with the
+  // symmetric frustum that holds it.
+  function cullCamera(camera) {
+    const P = camera.projection;
+    if (!P) return camera;
+    const tx = (1 + Math.abs(P[8])) / P[0], ty = (1 + Math.abs(P[9])) / P[5];
+    return { ...camera, fovY: 2 * Math.atan(ty), width: tx, height: ty };
+  }
+  // Fetches, decodes and uploads what the pose needs; camera: { position, forward, up, fovY
+  // (radians), width, height, projection (optional, a WebGL column-major perspective matrix that
+  // replaces fovY) }; time in seconds; eye: which incumbent set the view selection keeps.
+  async function prepare(camera, time, eye = 0) {
+    const frame = frameAtTime(time, fps, F);
+    if (!selections.has(eye)) selections.set(eye, {});
+    const active = selectViews(lf.views, camera.position, selections.get(eye));
+    const { near, far } = marchRange(lf.views, camera.position);
+    const sets = visibleSets(lf, cullCamera(camera), near, far, active);
+    let visibleCells = 0;
+    for (const v of active) {
+      const vs = sets.get(v);
+      for (let face = 0; face < 6; ++face) visibleCells += vs.cells[face].size;
+      const changed = await ensureCells(v, vs);
+      if (bc) await uploadBc(v, frame);
+      if (uploaded[v] === frame && !changed) continue;
+      const f = decoded.get(v).frames[frame];
+      for (let face = 0; face < 6; ++face) {
+        if (bc) renderer.uploadDepth(v, face, f.depth[face]);
+        else renderer.uploadFace(v, face, f.colour[face], f.depth[face]);
+      }
+      uploaded[v] = frame;
+    }
+    return { frame, active, visibleCells, totalCells: active.length * 6 * lf.cells.count };
+  }
+  // Draws a prepared pose (synchronous: a WebXR frame draws inside its callback); target:
+  // { framebuffer, viewport: { x, y, width, height } } or the whole canvas.
+  function draw(camera, prepared, target) {
+    if (!target && (canvas.width !== camera.width || canvas.height !== camera.height)) {
+      canvas.width = camera.width;
+      canvas.height = camera.height;
+    }
+    const t0 = performance.now();
+    renderer.render(camera, prepared.active, target);
+    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));  // waits for the draw
+    return performance.now() - t0;
+  }
+  // The overlay line of a drawn pose; position: the viewer's.
+  function report(prepared, renderMs, position, eyes = 1) {
+    const now = performance.now();
+    rateSamples.push({ now, bytes: source.stats.bytes });
+    while (rateSamples.length > 2 && now - rateSamples[1].now >= 1000) rateSamples.shift();
+    const span = (now - rateSamples[0].now) / 1000;
+    const rate = span > 0 ? (source.stats.bytes - rateSamples[0].bytes) / span : 0;
+    const out = inside(position) ? '' : '; the eye is outside the view volume';
+    status(`frame ${prepared.frame}: ${eyes === 2 ? 'two eyes, ' : ''}${prepared.active.length} of ${lf.views.length} views, ${prepared.visibleCells}/${prepared.totalCells} cells, ` +
+      `render ${renderMs.toFixed(1)} ms; ${stats.cellsDecoded} cells decoded (${stats.decodeMs.toFixed(0)} ms), ` +
+      `${source.stats.bytes} of ${source.size} bytes fetched (${(100 * source.stats.bytes / source.size).toFixed(1)} %, ` +
+      `${source.stats.requests} requests), ${(rate / 1024).toFixed(1)} KiB/s${out}`);
+    return !out;
+  }
+  // One pose into the canvas. An error (a damaged chunk, say) is one line in the overlay and is
+  // thrown again; nothing is drawn, so the last good frame stays.
+  async function renderPose(camera, time) {
+    let prepared;
+    try {
+      prepared = await prepare(camera, time);
+    } catch (e) {
+      status(e.message.split('\n')[0]);
+      throw e;
+    }
+    const renderMs = draw(camera, prepared);
+    const insideVolume = report(prepared, renderMs, camera.position);
+    const { frame, active, visibleCells, totalCells } = prepared;
+    return { frame, active, renderMs, insideVolume, colourUpload: bc ? bc.name : 'RGBA32F (decoded on the CPU)', visibleCells, totalCells, bytes: source.stats.bytes, size: source.size, requests: source.stats.requests };
+  }
+  // The canvas as 8-bit RGB rows, top row first (as calf-play's PNG frames).
+  function pixels() {
+    const W = canvas.width, H = canvas.height, px = new Uint8Array(4 * W * H);
+    gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    const rgb = new Uint8Array(3 * W * H);
+    for (let y = 0; y < H; ++y) {
+      for (let x = 0; x < W; ++x) {
+        const s = 4 * ((H - 1 - y) * W + x), d = 3 * (y * W + x);
+        rgb[d] = px[s]; rgb[d + 1] = px[s + 1]; rgb[d + 2] = px[s + 2];
+      }
+    }
+    return rgb;
+  }
+  return { gl, lf, renderPose, prepare, draw, report, pixels, stats, fps, volume, inside };
+}

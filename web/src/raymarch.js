@@ -1,0 +1,302 @@
+// The lightfield render of calf-play's GL renderer in WebGL2: the native ray-march shader
+// (glsl_raymarch.js, generated from player/src/gl_raymarch_shader.cc) after the native GLSL
+// conventions, with the uniforms, view records and march range that player/src/gl_renderer.cc
+// and lightfield_representation.cc give it, and the view selection of
+// player/src/view_selection.cc. Colour is uploaded per frame as decoded (one slot, t already
+// applied on the CPU, SPEC §11.1.4), depth as r16 codes.
+import { GLSL_CONVENTIONS } from './glsl_conventions.js';
+import { GL_FULLSCREEN_VERTEX, GL_RAYMARCH_FRAGMENT } from './glsl_raymarch.js';
+
+export const MAX_ACTIVE_VIEWS = 256;  // kGlMaxActiveViews
+
+// calf-play's defaults (RenderOptions, ViewSelectionOptions; headless: no frame budget).
+export const RENDER_DEFAULTS = {
+  steps: 64, refine_steps: 8, depth_footprint: 0.9, smooth_depth_ratio: 0, min_view_distance: -1,
+  depth_decay: 500, cam_decay: 20, bilinear_color: true, depth_aware_color: true,
+  color_depth_tolerance: 0.1, mixed_texel_penalty: 3, mixed_texel_bend_texels: 5,
+  tight_march_start: true, surface_hints: 1, surface_hint_margin_texels: 0.2, surface_hint_vetoes: 1,
+  surface_hint_substeps: 4, supersample: 1, rr: false, rr_start: 0.05, rr_max_depth: 1,
+  rr_replace_view_reflection: true,
+};
+export const SELECTION_DEFAULTS = { redundancy_angle_deg: 5, max_active: 9, incumbent_margin: 0.05 };
+
+// GLSL 4.50 → GLSL ES 3.00: ES has no binding qualifier (the page sets sampler units and the
+// block binding from JavaScript instead); everything else compiles as it is.
+export function fragmentSource({ depthBc5 = false, hints = 1 } = {}) {
+  let body = GL_RAYMARCH_FRAGMENT;
+  const rewrites = [[/layout\(std140, binding = 0\) uniform CalfViews/, 'layout(std140) uniform CalfViews'],
+    [/layout\(binding = (\d)\) uniform/g, 'uniform']];
+  for (const [from, to] of rewrites) {
+    if (!from.test(body)) throw new Error(`raymarch: the native shader no longer has ${from}`);
+    body = body.replace(from, to);
+  }
+  return '#version 300 es\nprecision highp float;\nprecision highp int;\n' +
+    'precision highp sampler2DArray;\nprecision highp usampler2DArray;\n' +
+    `#define CALF_MAX_VIEWS ${MAX_ACTIVE_VIEWS}\n${depthBc5 ? '#define CALF_DEPTH_BC5\n' : ''}` +
+    `#define CALF_HINTS ${hints}\n${GLSL_CONVENTIONS}${body}`;
+}
+
+const PRESENT = `#version 300 es
+precision highp float;
+uniform highp sampler2D frame_tex;
+uniform ivec2 origin;  // the viewport's lower left corner (one eye of a stereo frame)
+out vec4 out_colour;
+// srgb8_from_linear (player/src/image_compare.cc): clamp, sRGB transfer.
+vec3 srgb(vec3 c) {
+  c = clamp(c, 0.0, 1.0);
+  return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
+}
+void main() { out_colour = vec4(srgb(texelFetch(frame_tex, ivec2(gl_FragCoord.xy) - origin, 0).rgb), 1.0); }`;
+
+const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+const len = (a) => Math.sqrt(dot(a, a));
+const scale = (a, s) => [a[0] * s, a[1] * s, a[2] * s];
+const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+const normalize = (a) => scale(a, 1 / len(a));
+function angleBetween(a, b) {  // sampling.cc: atan2(|a x b|, a . b)
+  return Math.atan2(len(cross(a, b)), dot(a, b));
+}
+
+// ViewSelector::select without a frame budget or view cone (calf-play headless): rank by
+// distance (incumbents discounted), drop views within the redundancy angle of a kept one, keep
+// at most max_active. `state.wasActive` carries the incumbents from frame to frame.
+export function selectViews(views, eye, state, o = SELECTION_DEFAULTS) {
+  if (!state.wasActive) state.wasActive = new Uint8Array(views.length);
+  const ranked = [];
+  views.forEach((v, i) => {
+    if (!v) return;  // dropped view (excluded)
+    const distance = len(sub(v.position, eye));
+    let key = distance;
+    if (state.wasActive[i]) key *= 1 - o.incumbent_margin;
+    ranked.push({ view: i, key: Number.isNaN(key) ? Infinity : key, distance });
+  });
+  ranked.sort((a, b) => (a.key !== b.key ? a.key - b.key : a.distance !== b.distance ? a.distance - b.distance : a.view - b.view));
+  const red = (o.redundancy_angle_deg * Math.PI) / 180;
+  const kept = [];
+  for (const r of ranked) {
+    if (kept.length === o.max_active) continue;
+    const dir = sub(views[r.view].position, eye);
+    let redundant = false;
+    if (red > 0 && r.distance !== 0) {
+      for (const k of kept) {
+        const kdir = sub(views[k].position, eye);
+        if (len(kdir) > 0 && angleBetween(dir, kdir) < red) { redundant = true; break; }
+      }
+    }
+    if (!redundant) kept.push(r.view);
+  }
+  state.wasActive = new Uint8Array(views.length);
+  for (const v of kept) state.wasActive[v] = 1;
+  return kept;
+}
+
+// march_range_for over every usable view of the clip (LightfieldRepresentation::frame_options).
+export function marchRange(views, eye) {
+  let far = 0, near = Infinity;
+  for (const v of views) {
+    if (!v) continue;
+    far = Math.max(far, len(sub(eye, v.position)) + v.zFar);
+    near = Math.min(near, v.zNear / 4);
+  }
+  return { near: Math.max(near, far / (1 << 20)), far };
+}
+
+// glsl_log_range: ln z_near and the step in double, rounded to float once.
+function logRange(v) {
+  const step = (Math.log(v.zFar) - Math.log(v.zNear)) / 65534;
+  return { log_near: Math.log(v.zNear), step, inv_step: 1 / step };
+}
+
+function compile(gl, type, source, what) {
+  const s = gl.createShader(type);
+  gl.shaderSource(s, source);
+  gl.compileShader(s);
+  if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(`${what} shader: ${gl.getShaderInfoLog(s).split('\n')[0]}`);
+  return s;
+}
+
+function program(gl, vs, fs, what) {
+  const p = gl.createProgram();
+  gl.attachShader(p, compile(gl, gl.VERTEX_SHADER, vs, what));
+  gl.attachShader(p, compile(gl, gl.FRAGMENT_SHADER, fs, what));
+  gl.linkProgram(p);
+  if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error(`${what} program: ${gl.getProgramInfoLog(p).split('\n')[0]}`);
+  return p;
+}
+
+// The compressed colour texture for a BCn colour format where the browser exposes it (the
+// native GlViews formats: sRGB BC1 and BC7, unsigned BC6H), else null (decode to RGBA).
+export function bcUpload(gl, format, faceSize) {
+  if (faceSize % 4 !== 0) return null;
+  if (format === 4) {  // bc1
+    const e = gl.getExtension('WEBGL_compressed_texture_s3tc_srgb');
+    return e && { internal: e.COMPRESSED_SRGB_S3TC_DXT1_EXT, blockBytes: 8, name: 'BC1 (WEBGL_compressed_texture_s3tc_srgb)' };
+  }
+  if (format === 8 || format === 7) {  // bc7, bc6h
+    const e = gl.getExtension('EXT_texture_compression_bptc');
+    if (!e) return null;
+    return format === 8 ? { internal: e.COMPRESSED_SRGB_ALPHA_BPTC_UNORM_EXT, blockBytes: 16, name: 'BC7 (EXT_texture_compression_bptc)' }
+      : { internal: e.COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT_EXT, blockBytes: 16, name: 'BC6H (EXT_texture_compression_bptc)' };
+  }
+  return null;
+}
+
+// A renderer for one lightfield track: `views` are the clip's view records (null: dropped),
+// faces of `faceSize` texels in cells of `cellSize`. With `bc` (bcUpload), colour keyframes are
+// uploaded as blocks into two slots a face and the cell texture holds each cell's slot and t, as
+// in the native player; without, one RGBA32F slot holds the colour the CPU decoded.
+export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER_DEFAULTS, bc = null }) {
+  if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('WebGL2 without EXT_color_buffer_float: no float render target');
+  const vertex = `#version 300 es\n${GL_FULLSCREEN_VERTEX}`;
+  const march = program(gl, vertex, fragmentSource({ hints: options.surface_hints }), 'ray-march');
+  const present = program(gl, vertex, PRESENT, 'present');
+  const N = faceSize, layers = 6 * views.length, cellsPerSide = Math.ceil(N / cellSize);
+  const texture = (unit, internal, w, h, d) => {
+    const t = gl.createTexture();
+    gl.activeTexture(gl.TEXTURE0 + unit);
+    gl.bindTexture(gl.TEXTURE_2D_ARRAY, t);
+    gl.texStorage3D(gl.TEXTURE_2D_ARRAY, 1, internal, w, h, d);
+    gl.texParameteri(gl.TEXTURE_2D_ARRAY, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
+    gl.texParameteri(gl.TEXTURE_2D_ARRAY, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
+    return t;
+  };
+  // Units as the native binding qualifiers: colour 0, depth 1, cells 2, material 3.
+  const slots = bc ? 2 : 1;
+  const colourTex = texture(0, bc ? bc.internal : gl.RGBA32F, N, N, slots * layers);
+  const depthTex = texture(1, gl.R16UI, N, N, layers);
+  const cellTex = texture(2, gl.R32UI, cellsPerSide, cellsPerSide, layers);
+  gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 0, cellsPerSide, cellsPerSide, layers, gl.RED_INTEGER, gl.UNSIGNED_INT,
+    new Uint32Array(cellsPerSide * cellsPerSide * layers));  // slot 0, t = 0: the colour as uploaded
+  const materialTex = texture(3, gl.RGBA8, 1, 1, 1);
+  gl.useProgram(march);
+  ['colour_tex', 'depth_tex', 'cell_tex', 'material_tex'].forEach((name, unit) => gl.uniform1i(gl.getUniformLocation(march, name), unit));
+  gl.uniformBlockBinding(march, gl.getUniformBlockIndex(march, 'CalfViews'), 0);
+  const viewBuffer = gl.createBuffer();
+  const vao = gl.createVertexArray();
+  let target = null, targetTex = null, targetW = 0, targetH = 0;
+  const rgba = new Float32Array(4 * N * N);
+
+  // colour: 3 floats a texel (linear RGB), depth: r16 codes, of one face of one view.
+  function uploadFace(view, face, colour, depth) {
+    for (let i = 0; i < N * N; ++i) {
+      rgba[4 * i] = colour[3 * i]; rgba[4 * i + 1] = colour[3 * i + 1]; rgba[4 * i + 2] = colour[3 * i + 2]; rgba[4 * i + 3] = 1;
+    }
+    gl.activeTexture(gl.TEXTURE0);
+    gl.bindTexture(gl.TEXTURE_2D_ARRAY, colourTex);
+    gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 6 * view + face, N, N, 1, gl.RGBA, gl.FLOAT, rgba);
+    gl.activeTexture(gl.TEXTURE1);
+    gl.bindTexture(gl.TEXTURE_2D_ARRAY, depthTex);
+    gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 6 * view + face, N, N, 1, gl.RED_INTEGER, gl.UNSIGNED_SHORT, depth);
+  }
+
+  // The depth codes of one face of one view.
+  function uploadDepth(view, face, depth) {
+    gl.activeTexture(gl.TEXTURE1);
+    gl.bindTexture(gl.TEXTURE_2D_ARRAY, depthTex);
+    gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 6 * view + face, N, N, 1, gl.RED_INTEGER, gl.UNSIGNED_SHORT, depth);
+  }
+  // BCn: a keyframe's blocks (rect's blocks row by row) into a slot of one face of one view.
+  function uploadBlocks(view, face, slot, rect, blocks) {
+    gl.activeTexture(gl.TEXTURE0);
+    gl.bindTexture(gl.TEXTURE_2D_ARRAY, colourTex);
+    gl.compressedTexSubImage3D(gl.TEXTURE_2D_ARRAY, 0, rect.x, rect.y, slots * (6 * view + face) + slot, rect.w, rect.h, 1, bc.internal, blocks);
+  }
+  // BCn: the cells of one face of one view: (slot a << 8) | t per cell (the native cell texture).
+  function uploadCells(view, face, values) {
+    gl.activeTexture(gl.TEXTURE2);
+    gl.bindTexture(gl.TEXTURE_2D_ARRAY, cellTex);
+    gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 6 * view + face, cellsPerSide, cellsPerSide, 1, gl.RED_INTEGER, gl.UNSIGNED_INT, values);
+  }
+
+  // camera: { position, forward, up, fovY (radians), width, height, projection (optional: a
+  // column-major perspective matrix, e.g. an XRView's, whose frustum replaces fovY) }; active:
+  // clip view indices. Draws into the canvas (sRGB, as calf-play's PNG frames), or into
+  // out.framebuffer at out.viewport (one eye of a WebXR frame).
+  function render(camera, active, out = null) {
+    const o = options;
+    const { near, far } = marchRange(views, camera.position);
+    const fwd = normalize(camera.forward), right = normalize(cross(fwd, camera.up)), up = cross(right, fwd);
+    const h = Math.tan(camera.fovY / 2), aspect = camera.width / camera.height;
+    // The eye ray through NDC (a, b) is forward + a right + b up; a perspective matrix P puts it
+    // at forward + (a + P[8]) / P[0] right + (b + P[9]) / P[5] up.
+    const P = camera.projection;
+    const rayForward = P ? [0, 1, 2].map((k) => fwd[k] + (P[8] / P[0]) * right[k] + (P[9] / P[5]) * up[k]) : fwd;
+    const rayRight = P ? scale(right, 1 / P[0]) : scale(right, h * aspect), rayUp = P ? scale(up, 1 / P[5]) : scale(up, h);
+    const records = new ArrayBuffer(MAX_ACTIVE_VIEWS * 48);
+    const f32 = new Float32Array(records), u32 = new Uint32Array(records), i32 = new Int32Array(records);
+    active.forEach((v, k) => {
+      const info = views[v], r = logRange(info), b = 12 * k;
+      f32.set([info.position[0] - camera.position[0], info.position[1] - camera.position[1], info.position[2] - camera.position[2],
+        r.log_near, r.step, r.inv_step, info.zNear, info.zFar], b);
+      u32[b + 8] = N; u32[b + 9] = cellSize; u32[b + 10] = 6 * v; i32[b + 11] = -1;
+    });
+    gl.bindBuffer(gl.UNIFORM_BUFFER, viewBuffer);
+    gl.bufferData(gl.UNIFORM_BUFFER, records, gl.STREAM_DRAW);
+    gl.bindBufferBase(gl.UNIFORM_BUFFER, 0, viewBuffer);
+    [colourTex, depthTex, cellTex, materialTex].forEach((t, unit) => {
+      gl.activeTexture(gl.TEXTURE0 + unit);
+      gl.bindTexture(gl.TEXTURE_2D_ARRAY, t);
+    });
+    if (!target || targetW !== camera.width || targetH !== camera.height) {
+      if (target) { gl.deleteFramebuffer(target); gl.deleteTexture(targetTex); }
+      targetTex = gl.createTexture();
+      gl.activeTexture(gl.TEXTURE4);
+      gl.bindTexture(gl.TEXTURE_2D, targetTex);
+      gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA32F, camera.width, camera.height);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
+      target = gl.createFramebuffer();
+      gl.bindFramebuffer(gl.FRAMEBUFFER, target);
+      gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, targetTex, 0);
+      targetW = camera.width; targetH = camera.height;
+    }
+    gl.bindFramebuffer(gl.FRAMEBUFFER, target);
+    gl.useProgram(march);
+    const U = (name) => gl.getUniformLocation(march, name);
+    gl.uniform1ui(U('view_count'), active.length);
+    gl.uniform1ui(U('colour_slots'), slots);
+    gl.uniform1ui(U('steps'), o.steps);
+    gl.uniform1ui(U('refine_steps'), o.refine_steps);
+    gl.uniform1f(U('march_near'), near);
+    gl.uniform1f(U('march_log_ratio'), Math.log(far / near));
+    gl.uniform1f(U('min_view_distance'), o.min_view_distance < 0 ? near : o.min_view_distance);
+    gl.uniform1f(U('footprint_limit'), o.depth_footprint - 1e-9);
+    gl.uniform1f(U('smooth_log_ratio'), Math.log1p(o.smooth_depth_ratio));
+    gl.uniform1f(U('depth_decay'), o.depth_decay);
+    gl.uniform1f(U('cam_decay'), o.cam_decay);
+    gl.uniform1f(U('color_depth_tolerance'), o.color_depth_tolerance);
+    gl.uniform1f(U('mixed_penalty_factor'), Math.exp(-o.mixed_texel_penalty));
+    gl.uniform1f(U('mixed_texel_bend_texels'), o.mixed_texel_bend_texels);
+    gl.uniform1i(U('tight_march_start'), o.tight_march_start ? 1 : 0);
+    gl.uniform1i(U('bilinear_color'), o.bilinear_color ? 1 : 0);
+    gl.uniform1i(U('depth_aware_color'), o.depth_aware_color ? 1 : 0);
+    gl.uniform1f(U('surface_hint_margin_texels'), o.surface_hint_margin_texels);
+    gl.uniform1ui(U('surface_hint_vetoes'), o.surface_hint_vetoes);
+    gl.uniform1ui(U('surface_hint_substeps'), o.surface_hint_substeps);
+    gl.uniform1i(U('rr'), 0);  // no material textures on the page yet
+    gl.uniform1i(U('rr_replace_view_reflection'), o.rr_replace_view_reflection ? 1 : 0);
+    gl.uniform1f(U('rr_start'), o.rr_start);
+    gl.uniform1ui(U('rr_max_depth'), o.rr_max_depth);
+    gl.uniform2ui(U('image_size'), camera.width, camera.height);
+    gl.uniform1ui(U('supersample'), o.supersample);
+    gl.uniform3f(U('cam_forward'), ...rayForward);
+    gl.uniform3f(U('cam_right'), ...rayRight);
+    gl.uniform3f(U('cam_up'), ...rayUp);
+    for (const cap of [gl.DEPTH_TEST, gl.BLEND, gl.SCISSOR_TEST, gl.CULL_FACE, gl.STENCIL_TEST]) gl.disable(cap);
+    gl.viewport(0, 0, camera.width, camera.height);
+    gl.bindVertexArray(vao);
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, out ? out.framebuffer : null);
+    const vp = out ? out.viewport : { x: 0, y: 0 };
+    gl.viewport(vp.x, vp.y, camera.width, camera.height);
+    gl.useProgram(present);
+    gl.activeTexture(gl.TEXTURE4);
+    gl.bindTexture(gl.TEXTURE_2D, targetTex);
+    gl.uniform1i(gl.getUniformLocation(present, 'frame_tex'), 4);
+    gl.uniform2i(gl.getUniformLocation(present, 'origin'), vp.x, vp.y);
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
+    gl.bindVertexArray(null);
+  }
+  return { uploadFace, uploadDepth, uploadBlocks, uploadCells, render };
+}

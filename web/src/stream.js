@@ -1,0 +1,125 @@
+// Streaming a clip over HTTP (docs/WEB.md): the header and directory with two range requests,
+// then only the chunks a frame needs, found from the chunk index alone (format/SPEC.md §11.1.2),
+// fetched as few coalesced byte ranges and kept in a cache so that no chunk is fetched twice.
+import { STREAM } from './lightfield.js';
+import { decodeStored } from './container.js';
+
+
+// A source over HTTP range requests. When the server answers a range request with the whole
+// body (200 instead of 206), the source keeps the body and serves every read from it; `notice`
+// then holds one line saying so.
+export async function httpSource(url, { fetch: fetchImpl = fetch } = {}) {
+  const stats = { requests: 0, bytes: 0 };
+  let whole = null, notice = null;
+  const get = async (start, end) => {
+    ++stats.requests;
+    const r = await fetchImpl(url, { headers: { Range: `bytes=${start}-${end - 1}` } });
+    if (r.status !== 206 && r.status !== 200) throw new Error(`${url}: HTTP ${r.status}`);
+    const body = new Uint8Array(await r.arrayBuffer());
+    stats.bytes += body.length;
+    return { r, body };
+  };
+  const first = await get(0, 64);
+  let size;
+  if (first.r.status === 200) {
+    whole = first.body;
+    size = whole.length;
+    notice = `the server ignores range requests: downloaded the whole clip (${size} bytes)`;
+  } else {
+    const m = /\/(\d+)$/.exec(first.r.headers.get('content-range') ?? '');
+    if (!m) throw new Error(`${url}: a 206 answer without the file size in Content-Range`);
+    size = Number(m[1]);
+  }
+  const head = first.body;
+  return {
+    size, stats, url,
+    get notice() { return notice; },
+    async read(offset, length) {
+      if (whole) return whole.subarray(offset, offset + length);
+      if (offset === 0 && length <= head.length) return head.subarray(0, length);
+      if (length === 0) return new Uint8Array(0);
+      return (await get(offset, offset + length)).body;
+    },
+  };
+}
+
+// The chunk ids lightfield track `lf` needs for frame n of the cells `needed` ([{view, face,
+// cell}]): per cell its t chunk and the colour chunk of keyframe k_m (the one whose frames hold
+// n) and of the next keyframe, which is needed only when t[n] ≠ 0 (`tValue(view, face, cell)`
+// gives t[n] when the t chunk is at hand, else undefined and the next keyframe is planned);
+// per depth (and, for a view with material, material) tile overlapping the cell, the chunk
+// whose frames hold n.
+export function planFrame(lf, n, needed, tValue = () => undefined) {
+  const ids = new Set();
+  const list = (stream, v, f, r) => lf.byKey.get(`${stream}/${v}/${f}/${r}`) ?? [];
+  const holding = (chunks) => chunks.find((c) => c.firstFrame <= n && n < c.firstFrame + c.frameCount);
+  for (const { view, face, cell } of needed) {
+    if (!lf.views[view]) continue;
+    for (const c of list(STREAM.t, view, face, cell)) ids.add(c.id);
+    const colour = list(STREAM.colour, view, face, cell);
+    const key = holding(colour);
+    if (key) {
+      ids.add(key.id);
+      const t = tValue(view, face, cell);
+      const next = colour.find((c) => c.firstFrame === key.firstFrame + key.frameCount);
+      if (next && t !== 0) ids.add(next.id);
+    }
+    const rect = lf.cells.rect(cell), side = lf.tiles.side, per = lf.tiles.per;
+    const streams = lf.views[view].hasMaterial ? [STREAM.depth, STREAM.material] : [STREAM.depth];
+    for (let j = Math.floor(rect.y / side); j <= Math.floor((rect.y + rect.h - 1) / side); ++j) {
+      for (let i = Math.floor(rect.x / side); i <= Math.floor((rect.x + rect.w - 1) / side); ++i) {
+        for (const s of streams) {
+          const c = holding(list(s, view, face, j * per + i));
+          if (c) ids.add(c.id);
+        }
+      }
+    }
+  }
+  return [...ids].sort((a, b) => a - b);
+}
+
+// Byte ranges covering the chunks `ids` (sorted), neighbours in the file merged when the gap
+// between them is at most `gap` bytes: [{start, end, ids}].
+export function byteRanges(clip, ids, gap = 0) {
+  const ranges = [];
+  for (const id of ids) {
+    const c = clip.chunks[id];
+    const last = ranges[ranges.length - 1];
+    if (last && c.offset - last.end <= gap) {
+      last.end = c.offset + c.storedSize;
+      last.ids.push(id);
+    } else {
+      ranges.push({ start: c.offset, end: c.offset + c.storedSize, ids: [id] });
+    }
+  }
+  return ranges;
+}
+
+// Fetches the chunks `ids` that are not cached yet (one request per coalesced range), checks
+// each one's hash, decompresses it and caches its raw bytes in clip.chunkCache, which
+// container.readChunk consults first. Returns the ids it fetched.
+export async function prefetch(clip, ids, { gap = 0 } = {}) {
+  clip.chunkCache ??= new Map();
+  const missing = ids.filter((id) => !clip.chunkCache.has(id));
+  for (const r of byteRanges(clip, missing, gap)) {
+    const bytes = await clip.source.read(r.start, r.end - r.start);
+    for (const id of r.ids) {
+      const c = clip.chunks[id];
+      const stored = bytes.subarray(c.offset - r.start, c.offset - r.start + c.storedSize);
+      clip.chunkCache.set(id, await decodeStored(clip, c, stored));
+    }
+  }
+  return missing;
+}
+
+
+// tValue for planFrame from the t chunks already in clip.chunkCache (SPEC §11.1.4).
+export function cachedT(lf, n) {
+  return (view, face, cell) => {
+    const c = (lf.byKey.get(`${STREAM.t}/${view}/${face}/${cell}`) ?? [])[0];
+    const raw = c && lf.clip.chunkCache?.get(c.id);
+    if (!raw || raw.length < 4) return undefined;
+    const nk = raw[0] | (raw[1] << 8) | (raw[2] << 16) | (raw[3] << 24);
+    return raw[4 + 4 * nk + n];
+  };
+}

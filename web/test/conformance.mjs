@@ -1,0 +1,227 @@
+// The page decoder's conformance run (format/SPEC.md §14): decodes every clip of
+// tests/conformance/lightfield/ under node and compares its hash lines with CLIP.hashes.
+//
+//   node web/test/conformance.mjs [CLIP.calf...]     default: every clip of the folder
+//   node web/test/conformance.mjs --time CLIP.calf... decode ms of each clip: median, min and
+//                                                    max of 5 runs (no comparison)
+//
+// Prints one line per clip (lines, decode ms) and one per difference; exits 1 on any
+// difference, 77 (ctest's skip code) when node's packages are missing, unless CI=true.
+import { readFileSync, readdirSync, existsSync } from 'node:fs';
+import { join, basename } from 'node:path';
+import { ROOT, loadCodecs } from './node_codecs.mjs';
+import { openClip, bytesSource, readChunk, verifyContainer } from '../src/container.js';
+import { openLightfield, decodeFaceFrames, faceHash } from '../src/lightfield.js';
+import { CalfError } from '../src/errors.js';
+import { generate as generateBcTables } from '../tools/gen_bc_tables.mjs';
+import { generate as generateGlsl } from '../tools/gen_glsl_conventions.mjs';
+import { generate as generateRaymarch } from '../tools/gen_glsl_raymarch.mjs';
+
+// The lines calf-verify --decode prints for a clip's lightfield tracks, and the problems.
+export async function decodeLines(bytes, codecs) {
+  const clip = await openClip(bytesSource(bytes), codecs);
+  for (let i = 0; i < clip.chunks.length; ++i) await readChunk(clip, i);  // every hash and scheme
+  const lines = [], problems = [];
+  for (let t = 0; t < clip.tracks.length; ++t) {
+    if (clip.tracks[t].kind !== 1) continue;
+    const lf = await openLightfield(clip, t);
+    const h = lf.header;
+    const hashes = new Map();
+    for (let v = 0; v < h.view_count; ++v) {
+      if (!lf.views[v]) { problems.push(lf.viewProblems[v].message); continue; }
+      for (let f = 0; f < 6; ++f) {
+        try {
+          await decodeFaceFrames(lf, v, f, (n, colour, depth, material) => {
+            hashes.set(`${n}/${v}/${f}`, faceHash(codecs, colour, depth, material));
+          });
+        } catch (e) {
+          if (!(e instanceof CalfError)) throw e;
+          problems.push(e.message);
+        }
+      }
+    }
+    for (let n = 0; n < h.frame_count; ++n) {
+      for (let v = 0; v < h.view_count; ++v) {
+        for (let f = 0; f < 6; ++f) {
+          const x = hashes.get(`${n}/${v}/${f}`);
+          if (x) lines.push(`track ${t} frame ${n} view ${v} face ${f} ${x}`);
+        }
+      }
+    }
+  }
+  return { lines, problems };
+}
+
+
+// A wrong decode must fail: one byte of a colour chunk's payload flipped in
+// rgba8_raw16_none (stored, plain directory), with the chunk's hash and the directory checksum
+// rewritten so that the container accepts it, must change a hash line; without the rewrite the
+// reader must refuse the chunk (CALF-E058).
+async function negativeChecks(codecs) {
+  const problems = [];
+  const path = join(ROOT, 'tests/conformance/lightfield/rgba8_raw16_none.calf');
+  const want = readFileSync(path.replace(/\.calf$/, '.hashes'), 'utf8').split('\n').filter(Boolean);
+  const clean = new Uint8Array(readFileSync(path));
+  const clip = await openClip(bytesSource(clean), codecs);
+  const c = clip.chunks.find((x) => x.stream === 1 && x.compression === 0 && x.storedSize > 0);
+  const bytes = clean.slice();
+  bytes[c.offset + Math.floor(c.storedSize / 2)] ^= 0x01;
+  try {
+    await decodeLines(bytes, codecs);
+    problems.push('a flipped colour byte without its hash rewritten decoded without CALF-E058');
+  } catch (e) {
+    if (!(e instanceof CalfError) || e.id !== 'CALF-E058') throw e;
+  }
+  const view = new DataView(bytes.buffer);
+  const dirOffset = clip.directoryOffset, dirSize = bytes.length - dirOffset;
+  const entry = dirOffset + (dirSize - 8) - 64 * (clip.chunks.length - c.id);
+  view.setBigUint64(entry + 24, codecs.xxh3(bytes.subarray(c.offset, c.offset + c.storedSize)), true);
+  view.setBigUint64(bytes.length - 8, codecs.xxh3(bytes.subarray(dirOffset, bytes.length - 8)), true);
+  const got = await decodeLines(bytes, codecs);
+  const changed = got.lines.filter((l, i) => l !== want[i]).length;
+  if (got.lines.length !== want.length || changed === 0) {
+    problems.push(`a flipped colour byte (chunk ${c.id}) left every hash line as it was`);
+  }
+  return problems;
+}
+
+// The container corpus (tests/conformance/container/manifest.txt): every valid file opens,
+// verifies and decodes each chunk to the manifest's size and XXH3-64; every malformed file
+// gives the manifest's id first (open's error, else verification's first problem).
+async function containerCorpus(codecs) {
+  const dir = join(ROOT, 'tests/conformance/container');
+  const problems = [];
+  let files = 0;
+  const opened = new Map();
+  for (const line of readFileSync(join(dir, 'manifest.txt'), 'utf8').split('\n')) {
+    const w = line.split(' ');
+    if (w[0] === 'valid' || w[0] === 'malformed') {
+      ++files;
+      const bytes = new Uint8Array(readFileSync(join(dir, w[1])));
+      let first = null;
+      try {
+        const clip = await openClip(bytesSource(bytes), codecs);
+        opened.set(w[1], clip);
+        const found = await verifyContainer(clip);
+        if (found.length) first = found[0];
+      } catch (e) {
+        if (!(e instanceof CalfError)) throw e;
+        first = e;
+      }
+      const want = w[0] === 'valid' ? null : w[2];
+      if ((first?.id ?? null) !== want) problems.push(`${w[1]}: expected ${want ?? 'no problem'}, got ${first?.message ?? 'no problem'}`);
+    } else if (w[0] === 'chunk') {
+      const clip = opened.get(w[1]);
+      if (!clip) continue;
+      const raw = await readChunk(clip, Number(w[2]));
+      const hash = codecs.xxh3(raw).toString(16).padStart(16, '0');
+      if (raw.length !== Number(w[3]) || hash !== w[4]) problems.push(`${w[1]} chunk ${w[2]}: ${raw.length} bytes ${hash}, expected ${w[3]} ${w[4]}`);
+    }
+  }
+  return { files, problems };
+}
+
+// The damaged lightfield clips of the decoder's fuzz corpus (valid chunk hashes, a broken
+// §11.1 layout): each bad_* gives CALF-E202, each valid_* decodes without a problem.
+async function lightfieldCorpus(codecs) {
+  const dir = join(ROOT, 'tests/fuzz/corpus/clip_decoder_fuzz');
+  const problems = [];
+  const files = readdirSync(dir).filter((f) => f.endsWith('.calf')).sort();
+  for (const f of files) {
+    let first;
+    try {
+      first = (await decodeLines(new Uint8Array(readFileSync(join(dir, f))), codecs)).problems[0] ?? null;
+    } catch (e) {
+      if (!(e instanceof CalfError)) throw e;
+      first = e.message;
+    }
+    const ok = f.startsWith('bad_') ? first?.startsWith('CALF-E202 ') : first === null;
+    if (!ok) problems.push(`${f}: ${first ?? 'no problem'}`);
+  }
+  return { files: files.length, problems };
+}
+
+async function main() {
+  const loaded = await loadCodecs();
+  if (!loaded.codecs) {
+    console.log(`web conformance: skipped: ${loaded.missing}`);
+    process.exit(process.env.CI === 'true' ? 1 : 77);
+  }
+  const { codecs } = loaded;
+  if (process.argv[2] === '--time') {
+    for (const path of process.argv.slice(3)) {
+      const bytes = new Uint8Array(readFileSync(path));
+      const ms = [];
+      let lines = 0;
+      for (let i = 0; i < 5; ++i) {
+        const t0 = performance.now();
+        lines = (await decodeLines(bytes, codecs)).lines.length;
+        ms.push(performance.now() - t0);
+      }
+      ms.sort((a, b) => a - b);
+      console.log(`${basename(path)}: ${lines} faces decoded and hashed in ${ms[2].toFixed(0)} ms (median of 5; ${ms[0].toFixed(0)} – ${ms[4].toFixed(0)})`);
+    }
+    process.exit(0);
+  }
+  let failures = 0;
+  // The generated sources are what their native sources give today.
+  for (const [file, generate, tool] of [['web/src/bc_tables.js', generateBcTables, 'gen_bc_tables.mjs'],
+    ['web/src/glsl_conventions.js', generateGlsl, 'gen_glsl_conventions.mjs'],
+    ['web/src/glsl_raymarch.js', generateRaymarch, 'gen_glsl_raymarch.mjs']]) {
+    if (readFileSync(join(ROOT, file), 'utf8') !== generate()) {
+      console.log(`web conformance: ${file} is out of date (node web/tools/${tool})`);
+      ++failures;
+    }
+  }
+  const dir = join(ROOT, 'tests/conformance/lightfield');
+  const clips = process.argv.length > 2 ? process.argv.slice(2)
+    : readdirSync(dir).filter((f) => f.endsWith('.calf')).sort().map((f) => join(dir, f));
+  let totalMs = 0;
+  for (const path of clips) {
+    const name = basename(path, '.calf');
+    const hashesPath = path.replace(/\.calf$/, '.hashes');
+    const want = existsSync(hashesPath) ? readFileSync(hashesPath, 'utf8').split('\n').filter(Boolean) : [];
+    const bytes = new Uint8Array(readFileSync(path));
+    const t0 = performance.now();
+    let got;
+    try {
+      got = await decodeLines(bytes, codecs);
+    } catch (e) {
+      if (!(e instanceof CalfError)) throw e;
+      got = { lines: [], problems: [e.message] };
+    }
+    const ms = performance.now() - t0;
+    totalMs += ms;
+    const diffs = [];
+    for (let i = 0; i < Math.max(want.length, got.lines.length); ++i) {
+      if (want[i] !== got.lines[i]) diffs.push(`line ${i + 1}: expected '${want[i] ?? ''}', got '${got.lines[i] ?? ''}'`);
+    }
+    // A clip with a dropped view has problems (SPEC §14); any other clip must have none.
+    const expectProblem = name.includes('dropped_view');
+    if (expectProblem !== (got.problems.length > 0)) diffs.push(`problems: ${got.problems.join('; ') || 'none'}`);
+    if (expectProblem && !got.problems.every((p) => p.startsWith('CALF-E202'))) diffs.push(`problems: ${got.problems.join('; ')}`);
+    console.log(`${name}: ${diffs.length ? 'FAIL' : 'ok'}, ${got.lines.length} lines, ${ms.toFixed(1)} ms` +
+      (got.problems.length ? ` (${got.problems[0]})` : ''));
+    for (const d of diffs.slice(0, 5)) console.log(`  ${name}: ${d}`);
+    if (diffs.length) ++failures;
+  }
+  if (process.argv.length <= 2) {
+    const negative = await negativeChecks(codecs);
+    for (const p of negative) console.log(`web conformance: ${p}`);
+    if (!negative.length) console.log('web conformance: a flipped colour byte is refused (CALF-E058), and with its hash rewritten changes a hash line');
+    failures += negative.length;
+    const t0 = performance.now();
+    const corpus = await containerCorpus(codecs);
+    for (const p of corpus.problems) console.log(`web conformance: container corpus: ${p}`);
+    console.log(`web conformance: container corpus: ${corpus.files - corpus.problems.length} of ${corpus.files} files as the manifest says, ${(performance.now() - t0).toFixed(0)} ms`);
+    failures += corpus.problems.length;
+    const damaged = await lightfieldCorpus(codecs);
+    for (const p of damaged.problems) console.log(`web conformance: lightfield fuzz corpus: ${p}`);
+    console.log(`web conformance: lightfield fuzz corpus: ${damaged.files - damaged.problems.length} of ${damaged.files} clips refused (CALF-E202) or decoded as their names say`);
+    failures += damaged.problems.length;
+  }
+  console.log(`web conformance: ${clips.length - failures} of ${clips.length} clips reproduce their hashes, ${totalMs.toFixed(0)} ms decoding`);
+  process.exit(failures ? 1 : 0);
+}
+
+if (process.argv[1] && import.meta.url.endsWith(basename(process.argv[1]))) await main();
