@@ -192,6 +192,11 @@ TEST(Playback, OneTrackRendersExactlyItsRepresentation) {
   const auto stats = (*play)->stats();
   ASSERT_EQ(stats.size(), 1u);
   EXPECT_EQ(stats[0].title, "lightfield track 0 (cpu)");
+  // A light field draws no triangles, quads or points.
+  const FrameFigures fig = (*play)->figures();
+  EXPECT_EQ(fig.triangles_drawn, 0u);
+  EXPECT_FALSE(fig.quads.has_value());
+  EXPECT_FALSE(fig.points.has_value());
 }
 
 TEST(Playback, FileWithoutLightfieldIsRefused) {

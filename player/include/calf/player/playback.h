@@ -79,6 +79,9 @@ class Playback {
   LightfieldRepresentation* lightfield() const;
   // Every representation's figures of the latest frame, in track order (HUD, reports).
   std::vector<RepresentationStats> stats() const;
+  // The representations' numbers of the latest frame together: the triangles drawn summed, the
+  // first representation's quads and points (in track order) that has them.
+  FrameFigures figures() const;
   // Wall time of the last render(), all representations and the compositing, in ms.
   double last_render_ms() const;
   const PlaybackOptions& options() const;
