@@ -416,7 +416,8 @@ static int command_main(int argc, char** argv) {
   bool headless = false;
   std::string renderer = "gl", priority = "distance";
   PlaybackOptions play_options;
-  LightfieldOptions& o = play_options.lightfield;  // the knobs below are the light field's
+  LightfieldOptions& o =
+      play_options.of<LightfieldOptions>();  // the knobs below are the light field's
   WindowOptions w;
   app.add_option("CLIP", clip,
                  "the .calf file: every lightfield and mesh track is played, composited by depth")
@@ -470,7 +471,7 @@ static int command_main(int argc, char** argv) {
                  "poses on the contact sheet, spread evenly along "
                  "the path, first and last included (default 8)")
       ->check(CLI::Range(1, 256));
-  SurfelOptions& so = play_options.surfels;
+  SurfelOptions& so = play_options.of<SurfelOptions>();
   app.add_option("--surfel-point-size", so.point_size,
                  "surfels: disc diameter in pixels the prefixes are chosen for (the start value "
                  "with --surfel-target-ms), 1..64 (default 1.5)")
@@ -504,7 +505,7 @@ static int command_main(int argc, char** argv) {
                  "over; paper 000) or alpha-test (depth test, texels below 50 % alpha dropped, "
                  "any order; hard silhouettes) (default sort)")
       ->check(CLI::IsMember({"sort", "alpha-test"}));
-  TilesRenderOptions& tr = play_options.tiles.render;
+  TilesRenderOptions& tr = play_options.of<TilesOptions>().render;
   app.add_option("--tiles-occlusion-alpha", tr.occlusion_alpha,
                  "tiles, sort: an occlusion pre-pass keeps each pixel's nearest fragment at least "
                  "this opaque, and the sorted pass drops fragments behind it (what one sort "
@@ -567,7 +568,7 @@ static int command_main(int argc, char** argv) {
 
   play_options.use_gl = renderer == "gl";
   so.controller_clock = surfel_clock == "cpu" ? SurfelClock::kCpu : SurfelClock::kWall;
-  play_options.tiles.render.blend = *tiles_blend_from_name(tiles_blend);  // checked above
+  tr.blend = *tiles_blend_from_name(tiles_blend);  // checked above
   if (Status st = validate_tiles_render_options(tr); !st.ok()) {
     return tools::print_error("calf-play", st, tools::kExitUsage);  // CALF-E478, exit 2
   }
