@@ -71,7 +71,7 @@ step "making the inputs in $IN"
   --ao-samples 0 --max-bounces 0 --spp 1 --no-noise-floor
 "$CAPTURE" --scene spheres --frames 2 --export-scene "$IN/scene" --quiet
 "$CAPTURE" --scene "$IN/scene" --surfel-candidates "$IN/surfels.cand" --surfel-resolution 64 \
-  >/dev/null
+  --quiet
 "$CAPTURE" --scene spheres --frames 2 --ground-truth --gt-size 48x32 --ao-samples 0 \
   --max-bounces 0 --spp 1 --no-noise-floor --quiet --out "$IN/walk"
 
@@ -131,7 +131,7 @@ for kind in lightfield tiles mesh surfels; do
         cmp -s "$f" "$b/$renderer/${f##*/}" || problems+=("$renderer ${f##*/} differs")
         n=$((n + 1))
       done
-      counts+=" $renderer $n files"
+      counts+="${counts:+,} $renderer $n files"
     done
   fi
   if [ ${#problems[@]} -eq 0 ]; then
