@@ -32,6 +32,127 @@ std::string file_name(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
+// What a kind's export reads: the clip, the track and the command line.
+struct ExportRequest {
+  const calf::container::Reader& reader;
+  const std::string& clip;
+  const std::string& out;
+  const std::string& base;  // OUT without its extension: side files are named after it
+  uint16_t track;
+  uint32_t frame;
+  calf::exporter::MeshExportFormat format;
+  calf::exporter::GltfOptions gltf;
+  const CLI::App& app;
+  double alpha_mask;
+  const std::string& subdivide;
+};
+
+// What a kind's export made: its files (not yet written), the summary line and a warning.
+struct ExportResult {
+  std::vector<calf::exporter::ExportedFile> files;
+  std::string summary, warning;
+};
+
+// A tiles track: one mesh of the tiles, the atlas as its texture. The exit status of an error
+// (printed), or -1.
+int export_tiles(const ExportRequest& r, ExportResult* result) {
+  if (r.frame != 0) {
+    return fail(calf::Status(
+        calf::ErrorId::kExportInput,
+        fmt::format("{}: frame {} is past the tiles track's 1 frame", r.clip, r.frame)));
+  }
+  auto set = calf::decoder::decode_tiles_track(r.reader, r.track);
+  if (!set.ok()) return fail(set.status().with_context(r.clip));
+  calf::exporter::TilesExportOptions options;
+  options.gltf = r.gltf;
+  if (r.app.get_option("--alpha-mask")->count() > 0) {
+    if (!(r.alpha_mask > 0 && r.alpha_mask < 1)) {
+      return calf::tools::print_error(
+          kCommand,
+          calf::Status(calf::ErrorId::kExportTilesOption,
+                       fmt::format("alpha mask cutoff {} is not in (0, 1)", r.alpha_mask)),
+          2);
+    }
+    options.alpha_cutoff = r.alpha_mask;
+  }
+  const std::string& subdivide = r.subdivide;
+  if (subdivide != "auto") {
+    uint32_t n = 0;
+    const auto [end, ec] =
+        std::from_chars(subdivide.data(), subdivide.data() + subdivide.size(), n);
+    if (ec != std::errc() || end != subdivide.data() + subdivide.size() || n == 0) {
+      return calf::tools::print_error(
+          kCommand,
+          calf::Status(calf::ErrorId::kExportTilesOption,
+                       "subdivide " + subdivide + " is not auto or 1 .. 16"),
+          2);
+    }
+    options.subdivide = n;
+  }
+  calf::exporter::TilesExportStats stats;
+  auto files =
+      calf::exporter::export_tile_set(set.value(), r.format, file_name(r.base), options, &stats);
+  if (!files.ok()) {
+    const bool usage = files.status().id() == calf::ErrorId::kExportTilesOption;
+    return calf::tools::print_error(kCommand, files.status().with_context(r.clip), usage ? 2 : 1);
+  }
+  result->files = std::move(files.value());
+  result->summary = fmt::format(
+      "{}: {} tiles, {} vertices, {} triangles ({:.2f} x the {} of whole tiles, subdivision {} "
+      "to {}), atlas {} x {}, largest affine texture error {:.3f} texels",
+      r.out, stats.tiles, stats.vertices, stats.triangles,
+      static_cast<double>(stats.triangles) / static_cast<double>(2 * stats.tiles), 2 * stats.tiles,
+      stats.min_subdivide, stats.max_subdivide, stats.atlas_width, stats.atlas_height,
+      stats.max_texel_error);
+  if (options.subdivide != 0 && stats.max_texel_error > calf::exporter::kTilesTexelErrorWarning) {
+    result->warning = fmt::format(
+        "{}: warning: --subdivide {} leaves an affine texture error of {:.3f} texels (above "
+        "{:.0f}); --subdivide auto keeps every tile within 1",
+        kCommand, subdivide, stats.max_texel_error, calf::exporter::kTilesTexelErrorWarning);
+  }
+  return -1;
+}
+
+// A mesh track: its objects at --frame as nodes, prototypes as shared meshes.
+int export_mesh(const ExportRequest& r, ExportResult* result) {
+  auto mesh = calf::decoder::MeshTrack::open(r.reader, r.track);
+  if (!mesh.ok()) return fail(mesh.status().with_context(r.clip));
+  calf::exporter::MeshExportStats stats;
+  auto files = calf::exporter::export_mesh_track(mesh.value(), r.frame, r.format, file_name(r.base),
+                                                 &stats, r.gltf);
+  if (!files.ok()) return fail(files.status().with_context(r.clip));
+  result->files = std::move(files.value());
+  result->summary = fmt::format(
+      "{}: frame {}: {} objects, {} meshes, {} vertices, {} triangles, {} textures", r.out, r.frame,
+      stats.objects, stats.meshes, stats.vertices, stats.triangles, stats.textures);
+  return -1;
+}
+
+// The kinds calf-export writes, in the order their names are listed in messages: each with the
+// options only it reads (given for a track of another kind: a usage error) and its export.
+struct ExportKind {
+  calf::container::TrackKind kind;
+  const char* name;
+  std::vector<const char*> own_options;
+  int (*run)(const ExportRequest& request, ExportResult* result);
+};
+
+const std::vector<ExportKind>& export_kinds() {
+  static const std::vector<ExportKind> kinds = {
+      {calf::container::TrackKind::kMesh, "mesh", {}, export_mesh},
+      {calf::container::TrackKind::kTiles, "tiles", {"--subdivide", "--alpha-mask"}, export_tiles},
+  };
+  return kinds;
+}
+
+// The entry of track kind number `kind`, or nullptr for a kind calf-export does not write.
+const ExportKind* find_export_kind(uint16_t kind) {
+  for (const ExportKind& k : export_kinds()) {
+    if (static_cast<uint16_t>(k.kind) == kind) return &k;
+  }
+  return nullptr;
+}
+
 }  // namespace
 
 static int command_main(int argc, char** argv) {
@@ -110,13 +231,16 @@ static int command_main(int argc, char** argv) {
   auto reader = calf::container::Reader::open(clip);
   if (!reader.ok()) return fail(reader.status());
   const auto& tracks = reader.value().tracks();
-  const auto kind_of = [&](size_t t) {
-    return static_cast<calf::container::TrackKind>(tracks[t].record.kind);
-  };
   const auto exportable = [&](size_t t) {
-    return kind_of(t) == calf::container::TrackKind::kMesh ||
-           kind_of(t) == calf::container::TrackKind::kTiles;
+    return find_export_kind(tracks[t].record.kind) != nullptr;
   };
+  // "mesh or tiles", "no mesh track and no tiles track": the table's names.
+  std::string kinds_or, no_kinds;
+  for (const ExportKind& k : export_kinds()) {
+    const bool first = kinds_or.empty();
+    kinds_or += fmt::format("{}{}", first ? "" : " or ", k.name);
+    no_kinds += fmt::format("{}{} track", first ? "no " : " and no ", k.name);
+  }
   int track = track_option;
   if (track < 0) {
     for (size_t i = 0; i < tracks.size(); ++i) {
@@ -126,98 +250,46 @@ static int command_main(int argc, char** argv) {
       }
     }
     if (track < 0) {
-      return fail(calf::Status(calf::ErrorId::kExportInput,
-                               clip + ": the clip has no mesh track and no tiles track"));
+      return fail(calf::Status(calf::ErrorId::kExportInput, clip + ": the clip has " + no_kinds));
     }
   }
   if (static_cast<size_t>(track) >= tracks.size() || !exportable(track)) {
-    return fail(
-        calf::Status(calf::ErrorId::kExportInput,
-                     fmt::format("{}: track {} is not a mesh or tiles track", clip, track)));
+    return fail(calf::Status(calf::ErrorId::kExportInput,
+                             fmt::format("{}: track {} is not a {} track", clip, track, kinds_or)));
+  }
+  const ExportKind& kind = *find_export_kind(tracks[track].record.kind);
+  for (const ExportKind& other : export_kinds()) {
+    if (&other == &kind) continue;
+    for (const char* option : other.own_options) {
+      if (app.get_option(option)->count() > 0) {
+        return calf::tools::usage_error(
+            kCommand, fmt::format("{} applies to a {} track; track {} is a {} track", option,
+                                  other.name, track, kind.name));
+      }
+    }
   }
 
   // The side files (.bin of a .gltf, .mtl of an .obj) go beside the output, named after it.
   const std::string base = out.substr(0, out.find_last_of('.'));
-  calf::Expected<std::vector<calf::exporter::ExportedFile>> files =
-      std::vector<calf::exporter::ExportedFile>{};
-  std::string summary, warning;
-  if (kind_of(track) == calf::container::TrackKind::kTiles) {
-    if (frame != 0) {
-      return fail(
-          calf::Status(calf::ErrorId::kExportInput,
-                       fmt::format("{}: frame {} is past the tiles track's 1 frame", clip, frame)));
-    }
-    auto set = calf::decoder::decode_tiles_track(reader.value(), static_cast<uint16_t>(track));
-    if (!set.ok()) return fail(set.status().with_context(clip));
-    calf::exporter::TilesExportOptions options;
-    options.gltf = gltf;
-    if (app.get_option("--alpha-mask")->count() > 0) {
-      if (!(alpha_mask > 0 && alpha_mask < 1)) {
-        return calf::tools::print_error(
-            kCommand,
-            calf::Status(calf::ErrorId::kExportTilesOption,
-                         fmt::format("alpha mask cutoff {} is not in (0, 1)", alpha_mask)),
-            2);
-      }
-      options.alpha_cutoff = alpha_mask;
-    }
-    if (subdivide != "auto") {
-      uint32_t n = 0;
-      const auto [end, ec] =
-          std::from_chars(subdivide.data(), subdivide.data() + subdivide.size(), n);
-      if (ec != std::errc() || end != subdivide.data() + subdivide.size() || n == 0) {
-        return calf::tools::print_error(
-            kCommand,
-            calf::Status(calf::ErrorId::kExportTilesOption,
-                         "subdivide " + subdivide + " is not auto or 1 .. 16"),
-            2);
-      }
-      options.subdivide = n;
-    }
-    calf::exporter::TilesExportStats stats;
-    files = calf::exporter::export_tile_set(set.value(), format.value(), file_name(base), options,
-                                            &stats);
-    if (!files.ok()) {
-      const bool usage = files.status().id() == calf::ErrorId::kExportTilesOption;
-      return calf::tools::print_error(kCommand, files.status().with_context(clip), usage ? 2 : 1);
-    }
-    summary = fmt::format(
-        "{}: {} tiles, {} vertices, {} triangles ({:.2f} x the {} of whole tiles, subdivision {} "
-        "to {}), atlas {} x {}, largest affine texture error {:.3f} texels",
-        out, stats.tiles, stats.vertices, stats.triangles,
-        static_cast<double>(stats.triangles) / static_cast<double>(2 * stats.tiles),
-        2 * stats.tiles, stats.min_subdivide, stats.max_subdivide, stats.atlas_width,
-        stats.atlas_height, stats.max_texel_error);
-    if (options.subdivide != 0 && stats.max_texel_error > calf::exporter::kTilesTexelErrorWarning) {
-      warning = fmt::format(
-          "{}: warning: --subdivide {} leaves an affine texture error of {:.3f} texels (above "
-          "{:.0f}); --subdivide auto keeps every tile within 1",
-          kCommand, subdivide, stats.max_texel_error, calf::exporter::kTilesTexelErrorWarning);
-    }
-  } else {
-    for (const char* tiles_only : {"--subdivide", "--alpha-mask"}) {
-      if (app.get_option(tiles_only)->count() > 0) {
-        return calf::tools::usage_error(
-            kCommand, fmt::format("{} applies to a tiles track; track {} is a mesh track",
-                                  tiles_only, track));
-      }
-    }
-    auto mesh = calf::decoder::MeshTrack::open(reader.value(), static_cast<uint16_t>(track));
-    if (!mesh.ok()) return fail(mesh.status().with_context(clip));
-    calf::exporter::MeshExportStats stats;
-    files = calf::exporter::export_mesh_track(mesh.value(), frame, format.value(), file_name(base),
-                                              &stats, gltf);
-    if (!files.ok()) return fail(files.status().with_context(clip));
-    summary = fmt::format(
-        "{}: frame {}: {} objects, {} meshes, {} vertices, {} triangles, {} textures", out, frame,
-        stats.objects, stats.meshes, stats.vertices, stats.triangles, stats.textures);
-  }
+  const ExportRequest request{.reader = reader.value(),
+                              .clip = clip,
+                              .out = out,
+                              .base = base,
+                              .track = static_cast<uint16_t>(track),
+                              .frame = frame,
+                              .format = format.value(),
+                              .gltf = gltf,
+                              .app = app,
+                              .alpha_mask = alpha_mask,
+                              .subdivide = subdivide};
+  ExportResult exported;
+  if (const int exit = kind.run(request, &exported); exit >= 0) return exit;
+  const std::vector<calf::exporter::ExportedFile>& files = exported.files;
 
   // No output may replace the clip: neither OUT nor a side file beside it (CALF-E007), checked
   // for every file before any is written.
   std::vector<std::string> paths;
-  for (const auto& file : files.value())
-    paths.push_back(file.suffix.empty() ? out : base + file.suffix);
+  for (const auto& file : files) paths.push_back(file.suffix.empty() ? out : base + file.suffix);
   const std::vector<std::string> inputs = {clip};
   for (const std::string& path : paths) {
     if (calf::Status s = calf::files::check_output_not_input(path, inputs); !s.ok()) return fail(s);
@@ -225,7 +297,7 @@ static int command_main(int argc, char** argv) {
   // Every file is written to its temporary name first and renamed only when all were written.
   std::vector<calf::files::TempFile> temps;
   for (size_t i = 0; i < paths.size(); ++i) {
-    const auto& file = files.value()[i];
+    const auto& file = files[i];
     const std::string& path = paths[i];
     auto temp = calf::files::TempFile::create(path);
     if (!temp.ok()) return fail(temp.status());
@@ -237,11 +309,11 @@ static int command_main(int argc, char** argv) {
   }
   if (meshopt) {
     uint64_t bytes = 0;
-    for (const auto& file : files.value()) bytes += file.bytes.size();
-    summary += fmt::format(" ({} bytes with EXT_meshopt_compression)", bytes);
+    for (const auto& file : files) bytes += file.bytes.size();
+    exported.summary += fmt::format(" ({} bytes with EXT_meshopt_compression)", bytes);
   }
-  if (!quiet) std::printf("%s\n", summary.c_str());
-  if (!warning.empty()) std::fprintf(stderr, "%s\n", warning.c_str());
+  if (!quiet) std::printf("%s\n", exported.summary.c_str());
+  if (!exported.warning.empty()) std::fprintf(stderr, "%s\n", exported.warning.c_str());
   return calf::tools::kExitOk;
 }
 

@@ -40,14 +40,13 @@ struct PlayerKind {
                                          const GlFunctions* gl);
 };
 
-// The `open` of a kind whose representation R plays its own track only, with the options
-// `options.*kind_options`: R::open(reader, track, options.*kind_options, backend, gl).
-template <class R, auto kind_options>
+// The `open` of a kind whose representation R plays its own track only, with its options of
+// type O: R::open(reader, track, options.of<O>(), backend, gl).
+template <class R, class O>
 Expected<OpenedRepresentation> open_own_track(const container::Reader& reader, uint16_t track,
                                               const PlaybackOptions& options, RenderBackend backend,
                                               const GlFunctions* gl) {
-  CALF_ASSIGN_OR_RETURN(std::unique_ptr<R> r,
-                        R::open(reader, track, options.*kind_options, backend, gl));
+  CALF_ASSIGN_OR_RETURN(std::unique_ptr<R> r, R::open(reader, track, options.of<O>(), backend, gl));
   OpenedRepresentation out;
   out.representation = std::move(r);
   return out;

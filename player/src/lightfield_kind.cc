@@ -7,7 +7,7 @@ namespace calf::player {
 extern const PlayerKind kLightfieldPlayerKind = {
     .kind = container::TrackKind::kLightfield,
     .claims_tracks = false,
-    .open = open_own_track<LightfieldRepresentation, &PlaybackOptions::lightfield>,
+    .open = open_own_track<LightfieldRepresentation, LightfieldOptions>,
 };
 
 }  // namespace calf::player

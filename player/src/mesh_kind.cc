@@ -7,7 +7,7 @@ namespace calf::player {
 extern const PlayerKind kMeshPlayerKind = {
     .kind = container::TrackKind::kMesh,
     .claims_tracks = false,
-    .open = open_own_track<MeshRepresentation, &PlaybackOptions::mesh>,
+    .open = open_own_track<MeshRepresentation, MeshOptions>,
 };
 
 }  // namespace calf::player

@@ -249,6 +249,12 @@ Status MeshRepresentation::report_frame_time(double frame_ms) {
   return Status::Ok();
 }
 
+FrameFigures MeshRepresentation::figures() const {
+  FrameFigures f;
+  f.triangles_drawn = triangles_drawn();
+  return f;
+}
+
 RepresentationStats MeshRepresentation::stats() const {
   const Impl& d = *impl_;
   RepresentationStats out;

@@ -107,6 +107,17 @@ std::vector<RepresentationStats> Playback::stats() const {
   return out;
 }
 
+FrameFigures Playback::figures() const {
+  FrameFigures out;
+  for (const Representation* r : impl_->representations) {
+    const FrameFigures f = r->figures();
+    out.triangles_drawn += f.triangles_drawn;
+    if (!out.quads) out.quads = f.quads;
+    if (!out.points) out.points = f.points;
+  }
+  return out;
+}
+
 Status Playback::prepare(uint32_t frame, std::span<const Camera> eyes) {
   if (eyes.empty()) return Status(ErrorId::kPlayerOptions, "prepare() needs at least one eye");
   for (Representation* r : impl_->representations) {

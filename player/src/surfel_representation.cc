@@ -400,6 +400,17 @@ Status SurfelRepresentation::report_frame_time(double frame_ms) {
   return Status::Ok();
 }
 
+FrameFigures SurfelRepresentation::figures() const {
+  FrameFigures f;
+  f.triangles_drawn = triangles_drawn();
+  f.points = FrameFigures::Points{.drawn = surfels_drawn(),
+                                  .point_size = point_size(),
+                                  .peripheral_objects = peripheral_objects(),
+                                  .passes = last_pass_times(),
+                                  .predicted_frame_ms = predicted_frame_ms()};
+  return f;
+}
+
 RepresentationStats SurfelRepresentation::stats() const {
   const Impl& d = *impl_;
   RepresentationStats out;

@@ -8,8 +8,9 @@ namespace {
 Expected<OpenedRepresentation> open(const container::Reader& reader, uint16_t track,
                                     const PlaybackOptions& options, RenderBackend backend,
                                     const GlFunctions* gl) {
-  CALF_ASSIGN_OR_RETURN(std::unique_ptr<SurfelRepresentation> r,
-                        SurfelRepresentation::open(reader, track, options.surfels, backend, gl));
+  CALF_ASSIGN_OR_RETURN(
+      std::unique_ptr<SurfelRepresentation> r,
+      SurfelRepresentation::open(reader, track, options.of<SurfelOptions>(), backend, gl));
   OpenedRepresentation out;
   // It plays its paired mesh track too (near objects as meshes).
   out.claimed_tracks.push_back(r->mesh_track());

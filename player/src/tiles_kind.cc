@@ -7,7 +7,7 @@ namespace calf::player {
 extern const PlayerKind kTilesPlayerKind = {
     .kind = container::TrackKind::kTiles,
     .claims_tracks = false,
-    .open = open_own_track<TilesRepresentation, &PlaybackOptions::tiles>,
+    .open = open_own_track<TilesRepresentation, TilesOptions>,
 };
 
 }  // namespace calf::player

@@ -135,6 +135,15 @@ Status TilesRepresentation::report_frame_time(double frame_ms) {
   return Status::Ok();
 }
 
+FrameFigures TilesRepresentation::figures() const {
+  const TilesFrameStats& s = last_frame_stats();
+  FrameFigures f;
+  f.quads = FrameFigures::Quads{.count = tile_set().tiles.size(),
+                                .mean_overdraw = s.mean_overdraw(),
+                                .peak_overdraw = s.peak};
+  return f;
+}
+
 RepresentationStats TilesRepresentation::stats() const {
   const Impl& d = *impl_;
   RepresentationStats out;

@@ -19,10 +19,7 @@
 #include "calf/player/error_breakdown.h"
 #include "calf/player/gl_context.h"
 #include "calf/player/image_compare.h"
-#include "calf/player/mesh_representation.h"
 #include "calf/player/playback.h"
-#include "calf/player/surfel_representation.h"
-#include "calf/player/tiles_representation.h"
 #include "calf_play/play_window.h"
 #include "command_line.h"
 
@@ -78,31 +75,6 @@ struct ClipComparison {
   uint32_t count = 0;
   std::vector<double> render_ms;  // the full-scene clip's
 };
-
-// Triangles drawn by the mesh representations of `play`, for the per-pose line.
-uint64_t mesh_triangles(const Playback& play) {
-  uint64_t n = 0;
-  for (const Representation* r : play.representations()) {
-    if (const auto* m = dynamic_cast<const MeshRepresentation*>(r)) n += m->triangles_drawn();
-    if (const auto* s = dynamic_cast<const SurfelRepresentation*>(r)) n += s->triangles_drawn();
-  }
-  return n;
-}
-
-// The first surfels track's representation, or nullptr.
-TilesRepresentation* tiles_of(const Playback& play) {
-  for (Representation* r : play.representations()) {
-    if (auto* t = dynamic_cast<TilesRepresentation*>(r)) return t;
-  }
-  return nullptr;
-}
-
-SurfelRepresentation* surfels_of(const Playback& play) {
-  for (Representation* r : play.representations()) {
-    if (auto* s = dynamic_cast<SurfelRepresentation*>(r)) return s;
-  }
-  return nullptr;
-}
 
 // Plays `path` pose by pose; poses sharing a time (a stereo pair) are prepared together. With
 // `full`, the same poses are rendered from the full-scene clip too and compared (epsilon).
@@ -229,30 +201,31 @@ int run_headless(Playback& play, Playback* full, Playback* lossless, const Headl
             return fail(s);
         }
       }
+      const FrameFigures fig = play.figures();
       if (lf != nullptr) {
         std::printf(
             "pose %zu frame %u: %zu views, %u/%u cells, %.2f Mbps@24, decode %.2f ms, "
             "render %.1f ms",
             k, frame, lf->last_selection().active.size(), st.visible_cells, st.total_cells,
             st.mbps_at_24fps(), st.decode_ms, play.last_render_ms());
-      } else if (const TilesRepresentation* tr = tiles_of(play)) {
-        const TilesFrameStats& ts = tr->last_frame_stats();
+      } else if (fig.quads) {
         std::printf("pose %zu frame %u: %zu tiles, overdraw mean %.2f peak %u, render %.1f ms", k,
-                    frame, tr->tile_set().tiles.size(), ts.mean_overdraw(), ts.peak,
+                    frame, fig.quads->count, fig.quads->mean_overdraw, fig.quads->peak_overdraw,
                     play.last_render_ms());
       } else {
         std::printf("pose %zu frame %u: %llu triangles, render %.1f ms", k, frame,
-                    static_cast<unsigned long long>(mesh_triangles(play)), play.last_render_ms());
+                    static_cast<unsigned long long>(fig.triangles_drawn), play.last_render_ms());
       }
-      if (SurfelRepresentation* sr = surfels_of(play)) {
-        std::printf(", %llu surfels at %.2f px",
-                    static_cast<unsigned long long>(sr->surfels_drawn()), sr->point_size());
-        if (a.surfel_foveation) std::printf(" (%u objects peripheral)", sr->peripheral_objects());
+      if (fig.points) {
+        const FrameFigures::Points& pts = *fig.points;
+        std::printf(", %llu surfels at %.2f px", static_cast<unsigned long long>(pts.drawn),
+                    pts.point_size);
+        if (a.surfel_foveation) std::printf(" (%u objects peripheral)", pts.peripheral_objects);
         // The passes the controller models apart, wall and process CPU time; its prediction.
-        const SurfelPassTimes pt = sr->last_pass_times();
+        const SurfelPassTimes& pt = pts.passes;
         std::printf(" (passes: mesh %.1f + surfels %.1f ms; CPU %.1f + %.1f of %.1f ms)",
                     pt.mesh_ms, pt.surfels_ms, pt.mesh_cpu_ms, pt.surfels_cpu_ms, pt.frame_cpu_ms);
-        if (a.surfel_target_ms > 0) std::printf(", predicted %.1f ms", sr->predicted_frame_ms());
+        if (a.surfel_target_ms > 0) std::printf(", predicted %.1f ms", pts.predicted_frame_ms);
         // Headless has no display: the render time stands for the frame time the point-size
         // controller follows (only when it has a target; not the first, which compiles shaders).
         if (a.surfel_target_ms > 0 && k > 0) {
@@ -443,7 +416,8 @@ static int command_main(int argc, char** argv) {
   bool headless = false;
   std::string renderer = "gl", priority = "distance";
   PlaybackOptions play_options;
-  LightfieldOptions& o = play_options.lightfield;  // the knobs below are the light field's
+  LightfieldOptions& o =
+      play_options.of<LightfieldOptions>();  // the knobs below are the light field's
   WindowOptions w;
   app.add_option("CLIP", clip,
                  "the .calf file: every lightfield and mesh track is played, composited by depth")
@@ -497,7 +471,7 @@ static int command_main(int argc, char** argv) {
                  "poses on the contact sheet, spread evenly along "
                  "the path, first and last included (default 8)")
       ->check(CLI::Range(1, 256));
-  SurfelOptions& so = play_options.surfels;
+  SurfelOptions& so = play_options.of<SurfelOptions>();
   app.add_option("--surfel-point-size", so.point_size,
                  "surfels: disc diameter in pixels the prefixes are chosen for (the start value "
                  "with --surfel-target-ms), 1..64 (default 1.5)")
@@ -531,7 +505,7 @@ static int command_main(int argc, char** argv) {
                  "over; paper 000) or alpha-test (depth test, texels below 50 % alpha dropped, "
                  "any order; hard silhouettes) (default sort)")
       ->check(CLI::IsMember({"sort", "alpha-test"}));
-  TilesRenderOptions& tr = play_options.tiles.render;
+  TilesRenderOptions& tr = play_options.of<TilesOptions>().render;
   app.add_option("--tiles-occlusion-alpha", tr.occlusion_alpha,
                  "tiles, sort: an occlusion pre-pass keeps each pixel's nearest fragment at least "
                  "this opaque, and the sorted pass drops fragments behind it (what one sort "
@@ -594,7 +568,7 @@ static int command_main(int argc, char** argv) {
 
   play_options.use_gl = renderer == "gl";
   so.controller_clock = surfel_clock == "cpu" ? SurfelClock::kCpu : SurfelClock::kWall;
-  play_options.tiles.render.blend = *tiles_blend_from_name(tiles_blend);  // checked above
+  tr.blend = *tiles_blend_from_name(tiles_blend);  // checked above
   if (Status st = validate_tiles_render_options(tr); !st.ok()) {
     return tools::print_error("calf-play", st, tools::kExitUsage);  // CALF-E478, exit 2
   }

@@ -327,7 +327,7 @@ void check_face_size(uint32_t n, uint32_t cell, const Vec3& ray_to_last_texel) {
       if (gl && ctx == nullptr) continue;
       PlaybackOptions po;
       po.use_gl = gl;
-      po.lightfield.selection.budget.target_frame_ms = 0;
+      po.of<player::LightfieldOptions>().selection.budget.target_frame_ms = 0;
       auto play = Playback::open(clip, po, gl ? &ctx->gl() : nullptr);
       ASSERT_TRUE(play.ok()) << what << ": " << play.status().to_string();
       for (uint32_t frame : {0u, 1u}) {

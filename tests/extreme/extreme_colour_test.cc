@@ -161,7 +161,7 @@ TEST(HdrColour, HalfExtremesComeBackExactlyThroughRgba16fAndWithinBc6hError) {
     player::OsMesaContext* gl = bc6h ? gl_context() : nullptr;
     if (gl == nullptr) continue;
     player::PlaybackOptions po;
-    po.lightfield.selection.budget.target_frame_ms = 0;
+    po.of<player::LightfieldOptions>().selection.budget.target_frame_ms = 0;
     auto gpu = player::Playback::open(clip, po, &gl->gl());
     ASSERT_TRUE(gpu.ok()) << gpu.status().to_string();
     ASSERT_TRUE((*gpu)->prepare(0, std::span<const Camera>(&cam, 1)).ok());

@@ -208,7 +208,7 @@ TEST(DepthRange1e4To1e6, CaptureEncodeDecodeRenderRoundTrip) {
   const double default_near = std::max(1e-4f / 4.0, 1e6 / 1048576.0);
   PlaybackOptions po;
   po.use_gl = false;
-  po.lightfield.selection.budget.target_frame_ms = 0;
+  po.of<player::LightfieldOptions>().selection.budget.target_frame_ms = 0;
   auto cpu = Playback::open(clip, po, nullptr);
   ASSERT_TRUE(cpu.ok()) << cpu.status().to_string();
   for (int f = 0; f < 6; ++f) {
@@ -222,9 +222,9 @@ TEST(DepthRange1e4To1e6, CaptureEncodeDecodeRenderRoundTrip) {
   }
   // With the march range set to the data's (near 1e-4 / 4, far 1.01e6; 64 steps of 46 %, 8
   // bisections) every face, the 1e-4 one included, comes back at its depth.
-  po.lightfield.fixed_march_range = true;
-  po.lightfield.render.near = 2.5e-5;
-  po.lightfield.render.far = 1.01e6;
+  po.of<player::LightfieldOptions>().fixed_march_range = true;
+  po.of<player::LightfieldOptions>().render.near = 2.5e-5;
+  po.of<player::LightfieldOptions>().render.far = 1.01e6;
   auto wide = Playback::open(clip, po, nullptr);
   ASSERT_TRUE(wide.ok());
   for (int f = 0; f < 6; ++f) {
@@ -241,7 +241,7 @@ TEST(DepthRange1e4To1e6, CaptureEncodeDecodeRenderRoundTrip) {
   auto gpu = Playback::open(clip, po, &gl->gl());
   ASSERT_TRUE(gpu.ok()) << gpu.status().to_string();
   for (bool data_range : {true, false}) {
-    player::RenderOptions ro = po.lightfield.render;
+    player::RenderOptions ro = po.of<player::LightfieldOptions>().render;
     if (!data_range) {
       ro.near = default_near;
       ro.far = 1e6;
@@ -341,7 +341,7 @@ TEST(FlatDepth, EveryDepthEqualEncodesDecodesAndRendersExactly) {
       if (gl && ctx == nullptr) continue;
       PlaybackOptions po;
       po.use_gl = gl;
-      po.lightfield.selection.budget.target_frame_ms = 0;
+      po.of<player::LightfieldOptions>().selection.budget.target_frame_ms = 0;
       auto play = Playback::open(clip, po, gl ? &ctx->gl() : nullptr);
       ASSERT_TRUE(play.ok()) << play.status().to_string();
       for (int f = 0; f < 6; ++f) {

@@ -79,7 +79,7 @@ void play_and_check(
     const std::function<void(const RenderedImage&, size_t, const std::string&)>& check) {
   PlaybackOptions po;
   po.use_gl = gl;
-  po.lightfield.selection.budget.target_frame_ms = 0;
+  po.of<player::LightfieldOptions>().selection.budget.target_frame_ms = 0;
   player::OsMesaContext* ctx = gl ? gl_context() : nullptr;
   if (gl && ctx == nullptr) {
     std::printf("no OSMesa GL 4.5 context: GL half skipped\n");

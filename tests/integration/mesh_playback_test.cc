@@ -156,6 +156,25 @@ TEST(MeshPlayback, StatesAndTransformsFollowTheFrame) {
   EXPECT_EQ((*rep)->prepare(3, std::span<const Camera>(&cam, 1)).id(), ErrorId::kMeshPlayback);
 }
 
+// Playback::figures() of a mesh clip: every triangle of the scene drawn (counted from the scene
+// itself), no quads, no points.
+TEST(MeshPlayback, FiguresCountEveryTriangleDrawn) {
+  PlaybackOptions o;
+  o.use_gl = false;
+  auto play = Playback::open(full_clip(), o, nullptr);
+  ASSERT_TRUE(play.ok()) << play.status().to_string();
+  const Camera cam = eye();
+  ASSERT_TRUE((*play)->prepare(1, std::span<const Camera>(&cam, 1)).ok());
+  RenderedImage out;
+  ASSERT_TRUE((*play)->render(cam, &out).ok());
+  uint64_t triangles = 0;
+  for (const auto& object : visible_all_but({})) triangles += object.size();
+  const FrameFigures fig = (*play)->figures();
+  EXPECT_EQ(fig.triangles_drawn, triangles);
+  EXPECT_FALSE(fig.quads.has_value());
+  EXPECT_FALSE(fig.points.has_value());
+}
+
 // A visible set holding every triangle plays exactly as the full scene (epsilon 0, same bytes);
 // one that lost the moving quad misses the pixels where the full scene shows it.
 TEST(MeshPlayback, EpsilonOfAVisibleSetAgainstTheFullScene) {

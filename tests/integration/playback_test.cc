@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <utility>
 
 #include "../scratch_dir.h"
 #include "calf/capture/capture_set.h"
@@ -39,6 +40,23 @@ const std::string& clip_path() {
     return clip;
   }();
   return path;
+}
+
+// Each kind's options by their type: the defaults until set, then the value set, copied by value.
+TEST(PlaybackOptions, KindOptionsByTypeAreValues) {
+  PlaybackOptions o;
+  const PlaybackOptions& unset = o;
+  EXPECT_EQ(unset.of<LightfieldOptions>().render.steps, LightfieldOptions{}.render.steps);
+  EXPECT_EQ(unset.of<SurfelOptions>().point_size, SurfelOptions{}.point_size);
+  o.of<LightfieldOptions>().render.steps = 7;
+  o.of<SurfelOptions>().point_size = 3;
+  PlaybackOptions copy = o;
+  o.of<LightfieldOptions>().render.steps = 9;
+  const PlaybackOptions& set = copy;
+  EXPECT_EQ(set.of<LightfieldOptions>().render.steps, 7);
+  EXPECT_EQ(set.of<SurfelOptions>().point_size, 3.0);
+  EXPECT_EQ(set.of<TilesOptions>().render.occlusion_alpha, TilesOptions{}.render.occlusion_alpha);
+  EXPECT_EQ(std::as_const(o).of<LightfieldOptions>().render.steps, 9);
 }
 
 TEST(Playback, TimeMapsToFramesAndClamps) {
@@ -73,8 +91,8 @@ TEST(Playback, GlAndCpuRenderTheSameFrames) {
   auto context = OsMesaContext::make();
   if (!context.ok()) GTEST_SKIP() << context.status().to_string();
   PlaybackOptions o;
-  o.lightfield.render.steps = 48;
-  o.lightfield.selection.budget.target_frame_ms = 0;
+  o.of<LightfieldOptions>().render.steps = 48;
+  o.of<LightfieldOptions>().selection.budget.target_frame_ms = 0;
   auto gl = Playback::open(clip_path(), o, &(*context)->gl());
   ASSERT_TRUE(gl.ok()) << gl.status().to_string();
   o.use_gl = false;
@@ -170,7 +188,8 @@ TEST(Playback, OneTrackRendersExactlyItsRepresentation) {
   ASSERT_NE((*play)->lightfield(), nullptr);
   auto reader = container::Reader::open(clip_path());
   ASSERT_TRUE(reader.ok());
-  auto lf = LightfieldRepresentation::open(*reader, 0, o.lightfield, RenderBackend::kCpu, nullptr);
+  auto lf = LightfieldRepresentation::open(*reader, 0, o.of<LightfieldOptions>(),
+                                           RenderBackend::kCpu, nullptr);
   ASSERT_TRUE(lf.ok());
   const auto& [lo, hi] = (*play)->view_volume();
   Camera cam;
@@ -192,6 +211,11 @@ TEST(Playback, OneTrackRendersExactlyItsRepresentation) {
   const auto stats = (*play)->stats();
   ASSERT_EQ(stats.size(), 1u);
   EXPECT_EQ(stats[0].title, "lightfield track 0 (cpu)");
+  // A light field draws no triangles, quads or points.
+  const FrameFigures fig = (*play)->figures();
+  EXPECT_EQ(fig.triangles_drawn, 0u);
+  EXPECT_FALSE(fig.quads.has_value());
+  EXPECT_FALSE(fig.points.has_value());
 }
 
 TEST(Playback, FileWithoutLightfieldIsRefused) {

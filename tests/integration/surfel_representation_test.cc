@@ -144,6 +144,30 @@ TEST(SurfelRepresentation, FoveationShortensOnlyPeripheralPrefixes) {
   EXPECT_GT(on[1], on[2]);
 }
 
+// The numbers reports compute with (FrameFigures): the points drawn are the draw list's prefixes,
+// at the fixed point size; no quads.
+TEST(SurfelRepresentation, FiguresAreTheDrawListsPoints) {
+  Fixture f;
+  SurfelOptions o;
+  o.point_size = 2.0;
+  auto rep = SurfelRepresentation::open(f.reader, 1, o, player::RenderBackend::kCpu, nullptr);
+  ASSERT_TRUE(rep.ok()) << rep.status().to_string();
+  const Camera c = eye();
+  ASSERT_TRUE((*rep)->prepare(0, std::span<const Camera>(&c, 1)).ok());
+  player::RenderedImage out;
+  ASSERT_TRUE((*rep)->render(c, &out).ok());
+  uint64_t prefixes = 0;
+  for (const auto& obj : (*rep)->draw_list().objects) prefixes += obj.count;
+  const player::FrameFigures fig = (*rep)->figures();
+  ASSERT_TRUE(fig.points.has_value());
+  EXPECT_GT(fig.points->drawn, 0u);
+  EXPECT_EQ(fig.points->drawn, prefixes);
+  EXPECT_EQ(fig.points->point_size, 2.0);
+  EXPECT_EQ(fig.points->peripheral_objects, 0u);   // no foveation
+  EXPECT_EQ(fig.points->predicted_frame_ms, 0.0);  // no target
+  EXPECT_FALSE(fig.quads.has_value());
+}
+
 // The controller's wiring (its law is tested on a simulated cost in
 // tests/player/surfel_frame_controller_test.cc): prepare asks it for the size, report_frame_time
 // feeds it the frame and the passes' times; far too slow frames drive the size to its maximum,

@@ -496,6 +496,14 @@ TEST(TilesRepresentation, PlaysASetWithStatistics) {
   EXPECT_TRUE(r.last_frame_stats().measured);
   EXPECT_GT(r.last_frame_stats().peak, 0u);
   EXPECT_EQ(s.entries[3].value, "64 x 32 (0.0 Mtexels)");
+  // The numbers reports compute with: the set's 10 quads and this render's overdraw, nothing else.
+  const FrameFigures fig = r.figures();
+  ASSERT_TRUE(fig.quads.has_value());
+  EXPECT_EQ(fig.quads->count, 10u);
+  EXPECT_EQ(fig.quads->peak_overdraw, r.last_frame_stats().peak);
+  EXPECT_EQ(fig.quads->mean_overdraw, r.last_frame_stats().mean_overdraw());
+  EXPECT_EQ(fig.triangles_drawn, 0u);
+  EXPECT_FALSE(fig.points.has_value());
   EXPECT_EQ(TilesRepresentation::make(set, 0, 0, {}, RenderBackend::kCpu, nullptr).status().id(),
             ErrorId::kTilesDraw);
   if (gl_context() == nullptr) return;

@@ -101,13 +101,14 @@ Expected<EncodeOutcome> SceneInputs::encode(const EncodeConfig& c, const fs::pat
 
 Status SceneInputs::play(const fs::path& clip, const PlayConfig& config, PointResult* out) const {
   player::PlaybackOptions o;
-  o.lightfield.render.steps = config.steps;
-  o.lightfield.selection.max_active = config.views;
-  o.lightfield.selection.budget.target_frame_ms =
+  o.of<player::LightfieldOptions>().render.steps = config.steps;
+  o.of<player::LightfieldOptions>().selection.max_active = config.views;
+  o.of<player::LightfieldOptions>().selection.budget.target_frame_ms =
       0;  // calf-play --headless: quality first, no performance culling
   o.use_gl = settings_.use_gl;
   const uint32_t cores = std::max(1u, std::thread::hardware_concurrency());
-  o.lightfield.render.threads = std::min(256u, settings_.threads ? settings_.threads : cores);
+  o.of<player::LightfieldOptions>().render.threads =
+      std::min(256u, settings_.threads ? settings_.threads : cores);
   CALF_ASSIGN_OR_RETURN(std::unique_ptr<player::Playback> play,
                         player::Playback::open(clip.string(), o, settings_.gl));
 

@@ -67,6 +67,8 @@ class MeshRepresentation final : public Representation {
   // No frame budget: ignored (CALF-E453 for a negative or non-finite time, as the interface says).
   Status report_frame_time(double frame_ms) override;
   RepresentationStats stats() const override;
+  // The triangles drawn.
+  FrameFigures figures() const override;
 
   // The draw list at the prepared frame.
   const MeshDrawList& draw_list() const;

@@ -10,10 +10,14 @@
 // frames shows its last frame past its end.
 #pragma once
 
+#include <any>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <span>
 #include <string>
+#include <typeindex>
+#include <typeinfo>
 #include <utility>
 #include <vector>
 
@@ -27,18 +31,33 @@
 
 namespace calf::player {
 
-struct PlaybackOptions {
+// What Playback opens a clip's representations with: the backend, and the options of each kind's
+// representation by their type (LightfieldOptions, MeshOptions, SurfelOptions, TilesOptions: the
+// type a kind's entry in the player table opens with), held by value.
+class PlaybackOptions {
+ public:
   // true: the GL 4.5 renderers (a current context and its functions are needed); false: the
   // scalar CPU reference renderers.
   bool use_gl = true;
-  // Options of every lightfield track's representation.
-  LightfieldOptions lightfield;
-  // Options of every mesh track's representation.
-  MeshOptions mesh;
-  // Options of every surfels track's representation (which also plays its paired mesh track).
-  SurfelOptions surfels;
-  // Options of every tiles track's representation.
-  TilesOptions tiles;
+
+  // The options of type T, set to T's defaults on the first call.
+  template <class T>
+  T& of() {
+    std::any& held = kinds_[std::type_index(typeid(T))];
+    if (!held.has_value()) held = T{};
+    return *std::any_cast<T>(&held);
+  }
+  // The options of type T as set, or T's defaults.
+  template <class T>
+  const T& of() const {
+    const auto it = kinds_.find(std::type_index(typeid(T)));
+    if (it != kinds_.end()) return *std::any_cast<T>(&it->second);
+    static const T defaults{};
+    return defaults;
+  }
+
+ private:
+  std::map<std::type_index, std::any> kinds_;
 };
 
 class Playback {
@@ -79,6 +98,9 @@ class Playback {
   LightfieldRepresentation* lightfield() const;
   // Every representation's figures of the latest frame, in track order (HUD, reports).
   std::vector<RepresentationStats> stats() const;
+  // The representations' numbers of the latest frame together: the triangles drawn summed, the
+  // first representation's quads and points (in track order) that has them.
+  FrameFigures figures() const;
   // Wall time of the last render(), all representations and the compositing, in ms.
   double last_render_ms() const;
   const PlaybackOptions& options() const;

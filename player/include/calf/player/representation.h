@@ -13,7 +13,8 @@
 //   report_frame_time(ms) after the frame is displayed: the wall time between displayed frames,
 //                         for representations that fit their work to a frame budget
 //                         (frame_budget.h);
-//   stats()               what the HUD and reports print, generically.
+//   stats()               what the HUD and reports print, generically;
+//   figures()             the numbers reports compute with, the same struct for every kind.
 //
 // Adding a representation: implement this interface in player/src/<kind>_representation.cc with
 // its header player/include/calf/player/<kind>_representation.h, give both backends, add its
@@ -21,6 +22,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -52,6 +54,39 @@ struct RepresentationStats {
   std::vector<Statistic> entries;
 };
 
+// The passes' times of the renders since the latest prepare, ms: wall clock and process CPU time.
+// frame_* is every render() call whole (both passes, the compositing and what lies between).
+struct SurfelPassTimes {
+  double mesh_ms = 0, surfels_ms = 0, frame_ms = 0;
+  double mesh_cpu_ms = 0, surfels_cpu_ms = 0, frame_cpu_ms = 0;
+};
+
+// The numbers of the latest frame that reports compute with (calf-play's headless line per pose),
+// one struct for every kind: a representation fills what it draws and leaves the rest empty, and
+// Playback::figures() gathers them over a clip's representations.
+struct FrameFigures {
+  // Triangles rasterised from meshes (mesh tracks, a surfels track's near objects).
+  uint64_t triangles_drawn = 0;
+  // Textured quads (a tiles track): how many, and the last render's overdraw.
+  struct Quads {
+    size_t count = 0;
+    double mean_overdraw = 0;  // fragments per covered pixel
+    uint32_t peak_overdraw = 0;
+  };
+  std::optional<Quads> quads;
+  // Points (a surfels track): how many were drawn, at which diameter in pixels, the objects a
+  // foveation factor above 1 enlarged, the passes' times and the frame-time controller's
+  // prediction (0 without a target).
+  struct Points {
+    uint64_t drawn = 0;
+    double point_size = 0;
+    uint32_t peripheral_objects = 0;
+    SurfelPassTimes passes;
+    double predicted_frame_ms = 0;
+  };
+  std::optional<Points> points;
+};
+
 class Representation {
  public:
   virtual ~Representation() = default;
@@ -79,6 +114,8 @@ class Representation {
   virtual Status report_frame_time(double frame_ms) = 0;
   // The figures of the latest prepare() / render().
   virtual RepresentationStats stats() const = 0;
+  // The numbers of the latest prepare() / render() (empty: a kind that draws none of them).
+  virtual FrameFigures figures() const { return {}; }
 };
 
 }  // namespace calf::player

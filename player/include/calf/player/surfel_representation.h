@@ -61,13 +61,6 @@ struct SurfelFoveation {
 
 enum class SurfelClock : uint8_t { kWall, kCpu };
 
-// The passes' times of the renders since the latest prepare, ms: wall clock and process CPU time.
-// frame_* is every render() call whole (both passes, the compositing and what lies between).
-struct SurfelPassTimes {
-  double mesh_ms = 0, surfels_ms = 0, frame_ms = 0;
-  double mesh_cpu_ms = 0, surfels_cpu_ms = 0, frame_cpu_ms = 0;
-};
-
 struct SurfelOptions {
   SurfelRenderOptions render;
   MeshOptions mesh;
@@ -119,6 +112,9 @@ class SurfelRepresentation final : public Representation {
   Status render(const Camera& camera, RenderedImage* out) override;
   Status report_frame_time(double frame_ms) override;
   RepresentationStats stats() const override;
+  // Triangles and points drawn, the point size, peripheral objects, the passes' times and the
+  // controller's prediction.
+  FrameFigures figures() const override;
 
   // The mesh track this representation also plays (Playback does not open it again).
   uint16_t mesh_track() const;

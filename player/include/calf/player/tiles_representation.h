@@ -65,6 +65,8 @@ class TilesRepresentation final : public Representation {
   // No frame budget: ignored (CALF-E453 for a negative or non-finite time, as the interface says).
   Status report_frame_time(double frame_ms) override;
   RepresentationStats stats() const override;
+  // The quads: the tile count and the last render's overdraw.
+  FrameFigures figures() const override;
 
   const TileSet& tile_set() const;
   // The last render's overdraw and time.
