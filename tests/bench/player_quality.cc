@@ -69,6 +69,8 @@ double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+double g_unmix_jump = 0;  // --coverage-unmix-jump
+
 // Views per capture frame, loaded on first use.
 class FrameCache {
  public:
@@ -81,7 +83,7 @@ class FrameCache {
       if (cache_.size() >= 4) cache_.clear();  // bounded memory on long paths
       it = cache_.emplace(frame, need(load_capture_views(reader_, frame))).first;
       if (unmix_min_share_ >= 0) {
-        for (View& v : it->second.views) unmix_coverage_colour(&v, unmix_min_share_);
+        for (View& v : it->second.views) unmix_coverage_colour(&v, unmix_min_share_, g_unmix_jump);
       }
     }
     return it->second;
@@ -505,6 +507,9 @@ int main(int argc, char** argv) {
   app.add_option("--coverage-agreement", base.coverage_agreement, "coverage_agreement")
       ->capture_default_str();
   double unmix = -1;
+  app.add_option("--coverage-unmix-jump", g_unmix_jump,
+                 "unmix only across depth steps above this relative depth")
+      ->capture_default_str();
   app.add_option("--coverage-unmix", unmix,
                  "unmix edge texels' colour from coverage with this minimum own share "
                  "(unmix_coverage_colour; negative: off)")

@@ -135,7 +135,7 @@ TEST(ViewSet, UnmixingRecoversTheOwnColourOfEdgeTexels) {
   ASSERT_TRUE(v.write_color_rect(CubeFace::kNegZ, {0, 0, n, n}, sky_colour).ok());
   ASSERT_TRUE(v.write_coverage_rect(CubeFace::kNegZ, {0, 0, n, n}, sky_cov).ok());
 
-  unmix_coverage_colour(&v, 0.25);
+  unmix_coverage_colour(&v, 0.25, 0.1);
   for (uint32_t y = 0; y < n; ++y) {
     for (uint32_t x = 0; x < n; ++x) {
       const float* want = x < 4 ? a : b;
@@ -157,7 +157,7 @@ TEST(ViewSet, UnmixingLeavesViewsWithoutCoverageAlone) {
   std::vector<float> colour(3 * 16);
   for (size_t k = 0; k < colour.size(); ++k) colour[k] = 0.01f * k;
   ASSERT_TRUE(v.write_color_rect(CubeFace::kPosX, {0, 0, 4, 4}, colour).ok());
-  unmix_coverage_colour(&v, 0);
+  unmix_coverage_colour(&v, 0, 0);
   const std::span<const float> got = v.color_face(CubeFace::kPosX);
   EXPECT_TRUE(std::equal(got.begin(), got.end(), colour.begin()));
 }

@@ -142,7 +142,8 @@ struct RenderOptions {
   // behind) against `coverage_threshold`; 2: the nearest texel's 4 x 4 cell mask; 3: that mask
   // grown by one cell. The front cluster: taps within a relative depth `coverage_cluster` of the
   // footprint's surface. Off by default: it lifts the spider's silhouettes but carves thin parts
-  // of turntable at 128² faces (docs/RENDERING.md "Coverage").
+  // of turntable at 128² faces unless coverage_agreement asks for 2 or 3 views, which in turn
+  // gives back part of the spider's gain (docs/RENDERING.md "Coverage").
   uint32_t coverage = 0;
   double coverage_threshold = 0.5;
   double coverage_cluster = 0.05;
