@@ -89,6 +89,9 @@ Status validate_render_options(const RenderOptions& o, size_t view_count) {
   if (!(o.coverage_cluster >= 0) || !std::isfinite(o.coverage_cluster)) {
     return option_error("coverage_cluster must be finite and >= 0");
   }
+  if (o.coverage_agreement < 1 || o.coverage_agreement > 65536) {
+    return option_error("coverage_agreement is outside [1, 65536]");
+  }
   if (!std::isfinite(o.min_view_distance)) return option_error("min_view_distance is not finite");
   if (o.threads < 1 || o.threads > 256) return option_error("threads is outside [1, 256]");
   if (o.supersample < 1 || o.supersample > 8) return option_error("supersample is outside [1, 8]");
@@ -261,18 +264,23 @@ bool CpuRenderer::empty_at(const Vec3& p) const {
 
 bool CpuRenderer::empty_beyond(const Vec3& p, double margin_texels, uint32_t vetoes_ignored) const {
   bool consulted = false;
-  uint32_t vetoes = 0;
+  // Votes of views whose footprint test alone sees p as empty, and of those whose coverage does
+  // where the footprint test does not: the latter count once coverage_agreement of them agree.
+  uint32_t vetoes = 0, coverage_votes = 0;
   for (const View* v : active_) {
     const Vec3 x = p - v->position();
     const double r = length(x);
     if (r <= min_view_distance_) continue;
     consulted = true;
-    const double m = coverage_margin(
-        *v, x, r, code_margin(*v, x, r, options_.depth_footprint, smooth_log_ratio_),
-        options_.coverage, options_.coverage_threshold, options_.coverage_cluster);
-    if (m > texel_angles_in_codes(*v, margin_texels) && ++vetoes > vetoes_ignored) {
-      return true;
-    }
+    const double plain = code_margin(*v, x, r, options_.depth_footprint, smooth_log_ratio_);
+    const double m = coverage_margin(*v, x, r, plain, options_.coverage,
+                                     options_.coverage_threshold, options_.coverage_cluster);
+    const double threshold = texel_angles_in_codes(*v, margin_texels);
+    if (!(m > threshold)) continue;
+    ++(plain > threshold ? vetoes : coverage_votes);
+    const uint32_t counted =
+        vetoes + (coverage_votes >= options_.coverage_agreement ? coverage_votes : 0);
+    if (counted > vetoes_ignored) return true;
   }
   return !consulted;
 }

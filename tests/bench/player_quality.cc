@@ -69,21 +69,29 @@ double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+double g_unmix_jump = 0;  // --coverage-unmix-jump
+
 // Views per capture frame, loaded on first use.
 class FrameCache {
  public:
-  explicit FrameCache(const capture::CaptureSetReader& r) : reader_(r) {}
+  // `unmix_min_share` >= 0: unmix_coverage_colour on every view with that minimum share.
+  FrameCache(const capture::CaptureSetReader& r, double unmix_min_share)
+      : reader_(r), unmix_min_share_(unmix_min_share) {}
   const ViewSet& at(uint32_t frame) {
     auto it = cache_.find(frame);
     if (it == cache_.end()) {
       if (cache_.size() >= 4) cache_.clear();  // bounded memory on long paths
       it = cache_.emplace(frame, need(load_capture_views(reader_, frame))).first;
+      if (unmix_min_share_ >= 0) {
+        for (View& v : it->second.views) unmix_coverage_colour(&v, unmix_min_share_, g_unmix_jump);
+      }
     }
     return it->second;
   }
 
  private:
   const capture::CaptureSetReader& reader_;
+  double unmix_min_share_;
   std::map<uint32_t, ViewSet> cache_;
 };
 
@@ -496,6 +504,16 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--coverage-cluster", base.coverage_cluster, "coverage_cluster")
       ->capture_default_str();
+  app.add_option("--coverage-agreement", base.coverage_agreement, "coverage_agreement")
+      ->capture_default_str();
+  double unmix = -1;
+  app.add_option("--coverage-unmix-jump", g_unmix_jump,
+                 "unmix only across depth steps above this relative depth")
+      ->capture_default_str();
+  app.add_option("--coverage-unmix", unmix,
+                 "unmix edge texels' colour from coverage with this minimum own share "
+                 "(unmix_coverage_colour; negative: off)")
+      ->capture_default_str();
   app.add_option("--hint-margin", base.surface_hint_margin_texels,
                  "surface_hint_margin_texels (of the vetoing view)")
       ->capture_default_str();
@@ -583,12 +601,30 @@ int main(int argc, char** argv) {
         vp.poses.size(), write_vp_file.c_str(), m.scene.c_str(), write_vp_file.c_str());
     return 0;
   }
+  std::vector<uint32_t> picked_index;
+  for (uint32_t i = 0; i < between.size(); ++i) picked_index.push_back(i);
   if (!poses_arg.empty()) {
     std::vector<Pose> picked;
+    picked_index.clear();
     for (uint32_t i : parse_list(poses_arg)) {
-      if (i < between.size()) picked.push_back(between[i]);
+      if (i < between.size()) picked.push_back(between[i]), picked_index.push_back(i);
     }
     between = std::move(picked);
+  }
+  // The noise floor of the picked poses: their ground truth against the one calf-capture renders
+  // with another seed into noise-floor/ beside the eye path, where there is one.
+  const fs::path floor_dir = fs::path(eye_path_file).parent_path() / "noise-floor";
+  if (!between.empty() && fs::is_directory(floor_dir)) {
+    double sum_p = 0, sum_s = 0;
+    for (size_t k = 0; k < between.size(); ++k) {
+      const RenderedImage other = from_ground_truth(need(capture::read_perspective_image(
+          floor_dir / capture::eye_image_file_name(path, picked_index[k]))));
+      sum_p += need(psnr(rgb_ref(other), rgb_ref(between[k].reference)));
+      sum_s += need(ssim(rgb_ref(other), rgb_ref(between[k].reference)));
+    }
+    std::printf(
+        "noise floor (%s, another seed): mean PSNR %.2f dB, mean SSIM %.4f over %zu poses\n",
+        floor_dir.string().c_str(), sum_p / between.size(), sum_s / between.size(), between.size());
   }
 
   std::printf(
@@ -596,15 +632,17 @@ int main(int argc, char** argv) {
       "%.2f, depth_decay %.0f, cam_decay %.0f, colour tolerance %.2f, mixed texels %.1f (bend %.2f "
       "texels), tight start %d, "
       "hints %u (margin %.3f texels, vetoes %u, substeps %u), rr_start %.3f, rr replace %d, "
-      "supersample %u (renderer %u), threads %u; coverage %u (threshold %.2f, cluster %.3f)\n",
+      "supersample %u (renderer %u), threads %u; coverage %u (threshold %.2f, cluster %.3f, "
+      "agreement %u, unmix %.2f)\n",
       m.scene.c_str(), m.viewpoints.size(), m.face_size, m.frame_count, base.steps,
       base.refine_steps, base.depth_footprint, base.smooth_depth_ratio, base.depth_decay,
       base.cam_decay, base.color_depth_tolerance, base.mixed_texel_penalty,
       base.mixed_texel_bend_texels, base.tight_march_start, base.surface_hints,
       base.surface_hint_margin_texels, base.surface_hint_vetoes, base.surface_hint_substeps,
       base.rr_start, base.rr_replace_view_reflection, g_supersample, base.supersample, base.threads,
-      base.coverage, base.coverage_threshold, base.coverage_cluster);
-  FrameCache frames(reader);
+      base.coverage, base.coverage_threshold, base.coverage_cluster, base.coverage_agreement,
+      unmix);
+  FrameCache frames(reader, unmix);
   if (!between.empty()) measure("between", between, frames, m, variants, out_dir, false);
   if (!vp_gt_file.empty()) {
     const capture::EyePath vp = need(capture::read_eye_path(vp_gt_file));

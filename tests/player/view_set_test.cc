@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -72,6 +73,93 @@ TEST(ViewSet, RejectsBadViewsAndRects) {
             ErrorId::kPlayerNoMaterial);
   // Nothing was written by the failed calls.
   for (uint16_t c : v.depth_face(CubeFace::kPosX)) ASSERT_EQ(c, kLog16Sky);
+}
+
+// Unmixed colour (unmix_coverage_colour) on a synthetic vertical edge of +Z with known colours:
+// columns 0..3 a near surface at depth 1 in colour A, columns 4..7 a far one at depth 4 in colour
+// B. The edge crosses rows 0..3 at x = 3.75 and rows 4..7 at x = 4.25: there column 3's texels
+// are a quarter far (their last cell column), here column 4's a quarter near (their first), each
+// holding the anti-aliased mix of both colours; after unmixing each holds its own surface's
+// colour. Row 0 of column 3 is only 1/16 its own surface: it takes A from its
+// neighbour. A texel of sky beside a surface unmixes the same way.
+TEST(ViewSet, UnmixingRecoversTheOwnColourOfEdgeTexels) {
+  constexpr uint32_t n = 8;
+  View v = make(n, false);
+  const float a[3] = {0.8f, 0.6f, 0.2f}, b[3] = {0.1f, 0.2f, 0.9f};
+  const LogDepthRange& range = v.range();
+  std::vector<uint16_t> depth(n * n);
+  std::vector<float> colour(3 * n * n), cov(3 * n * n);
+  for (uint32_t y = 0; y < n; ++y) {
+    for (uint32_t x = 0; x < n; ++x) {
+      const size_t k = y * n + x;
+      const bool near = x < 4;
+      depth[k] = range.encode_unchecked(near ? 1.0f : 4.0f);
+      float own = 1, near_share = 0, far_share = 0;
+      uint32_t mask = 0xFFFF;
+      if (x == 3 && y < 4) {
+        far_share = 0.25f;
+        mask = 0x7777;  // cells i = 0..2 of every row
+        if (y == 0) far_share = 15 / 16.0f, mask = 0x0001;
+      } else if (x == 4 && y >= 4) {
+        near_share = 0.25f;
+        mask = 0xEEEE;  // cells i = 1..3
+      }
+      own = 1 - near_share - far_share;
+      for (int c = 0; c < 3; ++c) {
+        const float mine = near ? a[c] : b[c], other = near ? b[c] : a[c];
+        colour[3 * k + c] = own * mine + (1 - own) * other;
+      }
+      cov[3 * k] = near_share;
+      cov[3 * k + 1] = far_share;
+      cov[3 * k + 2] = static_cast<float>(mask);
+    }
+  }
+  ASSERT_TRUE(v.write_depth_rect(CubeFace::kPosZ, {0, 0, n, n}, depth).ok());
+  ASSERT_TRUE(v.write_color_rect(CubeFace::kPosZ, {0, 0, n, n}, colour).ok());
+  ASSERT_TRUE(v.write_coverage_rect(CubeFace::kPosZ, {0, 0, n, n}, cov).ok());
+  // On -Z (all sky, colour B) texel (2, 2) is sky a quarter covered by a near surface in colour
+  // A, texel (1, 2) beside it that surface (depth 2).
+  std::vector<uint16_t> sky_depth(n * n, kLog16Sky);
+  std::vector<float> sky_colour(3 * n * n), sky_cov(3 * n * n);
+  for (size_t k = 0; k < n * n; ++k) {
+    std::copy(b, b + 3, &sky_colour[3 * k]);
+    sky_cov[3 * k + 2] = 65535;
+  }
+  const size_t s = 2 * n + 2, t = 2 * n + 1;
+  sky_depth[t] = range.encode_unchecked(2.0f);
+  std::copy(a, a + 3, &sky_colour[3 * t]);
+  for (int c = 0; c < 3; ++c) sky_colour[3 * s + c] = 0.75f * b[c] + 0.25f * a[c];
+  sky_cov[3 * s] = 0.25f;
+  sky_cov[3 * s + 2] = 0xEEEE;
+  ASSERT_TRUE(v.write_depth_rect(CubeFace::kNegZ, {0, 0, n, n}, sky_depth).ok());
+  ASSERT_TRUE(v.write_color_rect(CubeFace::kNegZ, {0, 0, n, n}, sky_colour).ok());
+  ASSERT_TRUE(v.write_coverage_rect(CubeFace::kNegZ, {0, 0, n, n}, sky_cov).ok());
+
+  unmix_coverage_colour(&v, 0.25, 0.1);
+  for (uint32_t y = 0; y < n; ++y) {
+    for (uint32_t x = 0; x < n; ++x) {
+      const float* want = x < 4 ? a : b;
+      const float* got = v.color_at(CubeFace::kPosZ, x, y);
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(got[c], want[c], 1e-5) << "texel (" << x << ", " << y << ") channel " << c;
+      }
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(v.color_at(CubeFace::kNegZ, 2, 2)[c], b[c], 1e-5);
+    EXPECT_NEAR(v.color_at(CubeFace::kNegZ, 1, 2)[c], a[c], 1e-5);
+  }
+}
+
+// A view without coverage is left as it is.
+TEST(ViewSet, UnmixingLeavesViewsWithoutCoverageAlone) {
+  View v = make(4, false);
+  std::vector<float> colour(3 * 16);
+  for (size_t k = 0; k < colour.size(); ++k) colour[k] = 0.01f * k;
+  ASSERT_TRUE(v.write_color_rect(CubeFace::kPosX, {0, 0, 4, 4}, colour).ok());
+  unmix_coverage_colour(&v, 0, 0);
+  const std::span<const float> got = v.color_face(CubeFace::kPosX);
+  EXPECT_TRUE(std::equal(got.begin(), got.end(), colour.begin()));
 }
 
 }  // namespace

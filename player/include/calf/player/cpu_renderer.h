@@ -142,10 +142,17 @@ struct RenderOptions {
   // behind) against `coverage_threshold`; 2: the nearest texel's 4 x 4 cell mask; 3: that mask
   // grown by one cell. The front cluster: taps within a relative depth `coverage_cluster` of the
   // footprint's surface. Off by default: it lifts the spider's silhouettes but carves thin parts
-  // of turntable at 128² faces (docs/RENDERING.md "Coverage").
+  // of turntable at 128² faces unless coverage_agreement asks for 2 or 3 views, which in turn
+  // gives back part of the spider's gain (docs/RENDERING.md "Coverage").
   uint32_t coverage = 0;
   double coverage_threshold = 0.5;
   double coverage_cluster = 0.05;
+  // Emptiness by agreement: a point that a view calls empty only through its coverage (its
+  // footprint test puts the point at or behind a surface) is empty once at least this many views
+  // say so (1..65536; votes of the footprint test alone count as before). One view's cells
+  // straddle a part thinner than a texel as easily as its texels do; the views that see the part
+  // as covered keep it. 1: every coverage vote counts.
+  uint32_t coverage_agreement = 1;
   // Start each march where the first surface can be: no point nearer to view j's centre than
   // z_near_j can be behind its surface, so the march starts at max_j (z_near_j - |o - P_j|)
   // (over the active views, at least the ray's own start) and spends its steps beyond.

@@ -113,6 +113,21 @@ class View {
   std::array<std::vector<Coverage>, kCubeFaceCount> coverage_;
 };
 
+// Unmixed colour from coverage (docs/RENDERING.md "Coverage"). A texel on a depth edge holds the
+// anti-aliased mean of its own surface and the others its square shows:
+// c = a c_own + near c_nearer + far c_farther, with a the share of its own cells. This solves for
+// c_own, in linear light, taking c_nearer and c_farther from the texel's eight neighbours
+// (across face seams) whose depth lies nearer / farther than its own by more than
+// max(min_jump, the capture's own-surface tolerance min(4 / N, 0.05)) as relative depth: a
+// neighbour wholly its own surface first, then the one lying most towards the cells the texel's
+// surface does not cover. The result is clamped to [0, c / a], and where a neighbour (within the
+// tolerance) shows the texel's own surface, to the range between c and that neighbour's colour,
+// so that a wrong estimate of the other side is not amplified by 1 / a. Where a < `min_share` that
+// neighbour's colour is taken instead; a texel whose other sides have no neighbour keeps its
+// colour. Done once per view (all texels read before any is written), so any renderer can take
+// the texels; a view without coverage is unchanged.
+void unmix_coverage_colour(View* view, double min_share, double min_jump);
+
 // The views one frame renders from. Views may differ in face size and depth range.
 struct ViewSet {
   std::vector<View> views;
