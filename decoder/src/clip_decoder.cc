@@ -60,6 +60,7 @@ struct ClipDecoder::Impl {
   FaceGrid tiles = *FaceGrid::with_cell_size(1, 1);
   lf::RegionCoding depth_coding = lf::RegionCoding::kR16;
   std::optional<lf::RegionCoding> material_coding;
+  bool has_coverage = false;  // the track holds a coverage stream
   std::unique_ptr<ChunkCache> cache;
   // Node directions of the colour-cell and depth-tile quadtrees, computed once (culling.h).
   std::optional<GridCuller> cell_culler, tile_culler;
@@ -85,7 +86,7 @@ struct ClipDecoder::Impl {
   };
   // Indexed [view][face * count + index].
   std::vector<std::vector<CellState>> cell_state;
-  std::vector<std::vector<TileState>> depth_state, material_state;
+  std::vector<std::vector<TileState>> depth_state, material_state, coverage_state;
 
   // The frame being built: update payloads in one arena, spans fixed at the end.
   std::vector<uint8_t> arena;
@@ -166,17 +167,19 @@ struct ClipDecoder::Impl {
     spans.emplace_back(arena.size(), bytes.size());
     arena.insert(arena.end(), bytes.begin(), bytes.end());
     out->updates.push_back(u);
-    uint64_t& counter = target == UpdateTarget::kColour  ? out->stats.colour_bytes
-                        : target == UpdateTarget::kDepth ? out->stats.depth_bytes
-                                                         : out->stats.material_bytes;
+    uint64_t& counter = target == UpdateTarget::kColour     ? out->stats.colour_bytes
+                        : target == UpdateTarget::kDepth    ? out->stats.depth_bytes
+                        : target == UpdateTarget::kCoverage ? out->stats.coverage_bytes
+                                                            : out->stats.material_bytes;
     counter += bytes.size();
   }
 
   Status open_tables();
   Status update_cell(uint32_t view, uint32_t face, uint32_t cell, uint32_t frame,
                      FrameUpdates* out);
-  Status update_tile(bool depth, uint32_t view, uint32_t face, uint32_t tile, uint32_t frame,
-                     FrameUpdates* out);
+  // `stream`: kDepth, kMaterial or kCoverage.
+  Status update_tile(LightfieldStream stream, uint32_t view, uint32_t face, uint32_t tile,
+                     uint32_t frame, FrameUpdates* out);
   void queue_prefetch(bool depth_like, uint32_t view, uint32_t face, uint32_t index,
                       uint32_t frame);
 };
@@ -193,7 +196,7 @@ Status ClipDecoder::Impl::open_tables() {
                    std::to_string(regions_per_face) + " regions need more than the file's " +
                    std::to_string(all.size()) + " chunks");
   }
-  constexpr uint32_t kStreams = 5;  // index, colour, depth, material, t (SPEC §11.1)
+  constexpr uint32_t kStreams = 6;  // index, colour, depth, material, t, coverage (SPEC §11.1)
   chunks.assign(size_t{kStreams} * header.view_count * 6 * regions_per_face, {});
   for (uint32_t id = 0; id < all.size(); ++id) {
     const container::ChunkKeys& k = all[id].keys;
@@ -201,7 +204,8 @@ Status ClipDecoder::Impl::open_tables() {
     const bool cell_stream = k.stream == static_cast<uint16_t>(LightfieldStream::kColour) ||
                              k.stream == static_cast<uint16_t>(LightfieldStream::kTParams);
     const bool known = cell_stream || k.stream == static_cast<uint16_t>(LightfieldStream::kDepth) ||
-                       k.stream == static_cast<uint16_t>(LightfieldStream::kMaterial);
+                       k.stream == static_cast<uint16_t>(LightfieldStream::kMaterial) ||
+                       k.stream == static_cast<uint16_t>(LightfieldStream::kCoverage);
     if (!known) continue;  // streams of later minor versions are skipped
     if (k.view >= header.view_count || k.face >= 6 ||
         k.region >= (cell_stream ? cell_count : tile_count)) {
@@ -225,6 +229,7 @@ Status ClipDecoder::Impl::open_tables() {
   cell_state.assign(header.view_count, std::vector<CellState>(size_t{6} * cell_count));
   depth_state.assign(header.view_count, std::vector<TileState>(size_t{6} * tile_count));
   material_state.assign(header.view_count, std::vector<TileState>(size_t{6} * tile_count));
+  coverage_state.assign(header.view_count, std::vector<TileState>(size_t{6} * tile_count));
   visible_cache.assign(header.view_count, {});
   return Status::Ok();
 }
@@ -279,21 +284,27 @@ Status ClipDecoder::Impl::update_cell(uint32_t view, uint32_t face, uint32_t cel
   return Status::Ok();
 }
 
-Status ClipDecoder::Impl::update_tile(bool depth, uint32_t view, uint32_t face, uint32_t tile,
-                                      uint32_t frame, FrameUpdates* out) {
-  TileState& s =
-      (depth ? depth_state : material_state)[view][size_t{face} * tiles.cell_count() + tile];
+Status ClipDecoder::Impl::update_tile(LightfieldStream stream, uint32_t view, uint32_t face,
+                                      uint32_t tile, uint32_t frame, FrameUpdates* out) {
+  const bool depth = stream == LightfieldStream::kDepth;
+  const bool coverage = stream == LightfieldStream::kCoverage;
+  TileState& s = (depth      ? depth_state
+                  : coverage ? coverage_state
+                             : material_state)[view][size_t{face} * tiles.cell_count() + tile];
   if (s.frame == frame) return Status::Ok();
-  const LightfieldStream stream = depth ? LightfieldStream::kDepth : LightfieldStream::kMaterial;
   CALF_ASSIGN_OR_RETURN(uint32_t id, chunk_serving(stream, view, face, tile, frame, false));
   const container::ChunkKeys& keys = reader->chunks()[id].keys;
   CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out));
   const PixelRect r = tiles.cell_rect(tile % tiles.cells_per_side(), tile / tiles.cells_per_side());
-  const lf::RegionCoding coding = depth ? depth_coding : *material_coding;
+  const lf::RegionCoding coding = depth      ? depth_coding
+                                  : coverage ? lf::RegionCoding::kCoverage
+                                             : *material_coding;
   CALF_ASSIGN_OR_RETURN(
       lf::RegionChunk chunk,
       lf::parse_region_chunk(*raw, keys.frame_count, r.width, r.height, coding,
-                             where(view, face, tile) + (depth ? " depth" : " material")));
+                             where(view, face, tile) + (depth      ? " depth"
+                                                        : coverage ? " coverage"
+                                                                   : " material")));
   // Sec. 7.1: from the tile's current frame when it lies in this chunk's group and before the
   // target, else from the group keyframe; then P-frames at most W apart, each valid on top of any
   // frame of the W before it (SPEC §11.1.3 depth_window).
@@ -311,7 +322,9 @@ Status ClipDecoder::Impl::update_tile(bool depth, uint32_t view, uint32_t face, 
     at = target - at > window ? at + window : target;
     steps.push_back(at);
   }
-  const UpdateTarget which = depth ? UpdateTarget::kDepth : UpdateTarget::kMaterial;
+  const UpdateTarget which = depth      ? UpdateTarget::kDepth
+                             : coverage ? UpdateTarget::kCoverage
+                                        : UpdateTarget::kMaterial;
   const PixelFormat format = lf::region_gpu_format(coding);
   const bool shadow = depth && coding == lf::RegionCoding::kR16PredictedMasked;
   if (shadow) s.codes.resize(size_t{r.width} * r.height);
@@ -356,7 +369,9 @@ void ClipDecoder::Impl::queue_prefetch(bool cell, uint32_t view, uint32_t face, 
     }
     return;
   }
-  for (LightfieldStream st : {LightfieldStream::kDepth, LightfieldStream::kMaterial}) {
+  for (LightfieldStream st :
+       {LightfieldStream::kDepth, LightfieldStream::kMaterial, LightfieldStream::kCoverage}) {
+    if (st == LightfieldStream::kCoverage && !(has_coverage && options.coverage)) continue;
     auto id = chunk_serving(st, view, face, index, frame, false);
     if (id.ok()) prefetch_ids.push_back(*id);
   }
@@ -372,6 +387,9 @@ const container::LightfieldTrackHeader& ClipDecoder::header() const {
 }
 const LightfieldViewInfo& ClipDecoder::view(uint32_t v) const {
   return impl_->views[v];
+}
+bool ClipDecoder::has_coverage() const {
+  return impl_->has_coverage;
 }
 
 const Status& ClipDecoder::view_problem(uint32_t v) const {
@@ -390,6 +408,7 @@ Expected<ClipDecoder> ClipDecoder::open(const container::Reader& reader, uint16_
   impl->reader = &reader;
   impl->track = track;
   impl->header = ref.header();
+  impl->has_coverage = ref.has_coverage();
   impl->options = options;
   for (uint32_t v = 0; v < impl->header.view_count; ++v) {
     impl->views.push_back(ref.view(v));
@@ -420,7 +439,7 @@ void ClipDecoder::reset() {
   for (auto& view : d.cell_state) {
     for (auto& c : view) c.slot_keyframe[0] = c.slot_keyframe[1] = -1;
   }
-  for (auto* states : {&d.depth_state, &d.material_state}) {
+  for (auto* states : {&d.depth_state, &d.material_state, &d.coverage_state}) {
     for (auto& view : *states) {
       for (auto& t : view) t.frame = -1;
     }
@@ -567,6 +586,7 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
   }
   for (uint32_t v : active) {
     const bool has_material = d.views[v].has_material && d.material_coding.has_value();
+    const bool with_coverage = d.has_coverage && d.options.coverage;
     const Impl::VisibleSets& vs = d.visible_cache[v];
     for (uint32_t f = 0; f < 6; ++f) {
       const CubeFace face = static_cast<CubeFace>(f);
@@ -581,9 +601,16 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
       }
       for (uint32_t t : vis_tiles) {
         out->tiles.push_back(TileRef{v, face, t});
-        if (Status s = d.update_tile(true, v, f, t, frame, out); !s.ok()) report(s);
+        if (Status s = d.update_tile(LightfieldStream::kDepth, v, f, t, frame, out); !s.ok()) {
+          report(s);
+        }
         if (has_material) {
-          if (Status s = d.update_tile(false, v, f, t, frame, out); !s.ok()) report(s);
+          Status s = d.update_tile(LightfieldStream::kMaterial, v, f, t, frame, out);
+          if (!s.ok()) report(s);
+        }
+        if (with_coverage) {
+          Status s = d.update_tile(LightfieldStream::kCoverage, v, f, t, frame, out);
+          if (!s.ok()) report(s);
         }
       }
       // Without the background thread nothing would read the queue.

@@ -184,6 +184,21 @@ Status CpuTextures::apply(const FrameUpdates& frame) {
         }
         break;
       }
+      case UpdateTarget::kCoverage: {
+        if (u.format != PixelFormat::kRgba8 || u.bytes.size() != n * lf::kCoverageGpuBytes) {
+          return wrong_size("coverage", u.bytes.size(), n * lf::kCoverageGpuBytes);
+        }
+        if (s.coverage[0].empty()) {
+          for (auto& face : s.coverage) face.assign(size_t{face_size_} * face_size_, {});
+        }
+        for (uint32_t y = 0; y < r.height; ++y) {
+          for (uint32_t x = 0; x < r.width; ++x) {
+            s.coverage[f][size_t{r.y + y} * face_size_ + r.x + x] =
+                lf::coverage_from_gpu(&u.bytes[(size_t{y} * r.width + x) * lf::kCoverageGpuBytes]);
+          }
+        }
+        break;
+      }
       case UpdateTarget::kMaterial: {
         mat.resize(n * 3);
         CALF_RETURN_IF_ERROR(decode_gpu_material(u.format, u.bytes, r.width, r.height, mat));
@@ -257,6 +272,9 @@ std::span<const uint16_t> CpuTextures::depth(uint32_t view, CubeFace face) const
 }
 std::span<const uint8_t> CpuTextures::material(uint32_t view, CubeFace face) const {
   return views_[view].material[cube_face_index(face)];
+}
+std::span<const lf::CoverageTexel> CpuTextures::coverage(uint32_t view, CubeFace face) const {
+  return views_[view].coverage[cube_face_index(face)];
 }
 CellParams CpuTextures::cell(uint32_t view, CubeFace face, uint32_t cell) const {
   return views_[view].cells[cube_face_index(face)][cell];

@@ -2,12 +2,14 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <string>
 
 #include "calf/decoder/cpu_textures.h"
 #include "calf/format/grid.h"
 #include "calf/format/lightfield_layout.h"
+#include "calf/format/log_depth.h"
 
 namespace calf::decoder {
 namespace {
@@ -18,6 +20,12 @@ using container::PixelFormat;
 
 Status corrupt(const std::string& what) {
   return Status(ErrorId::kLightfieldChunk, what);
+}
+
+std::string hex_text(uint16_t v) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "%04x", v);
+  return buf;
 }
 
 std::string where(uint32_t view, uint32_t face, uint32_t region) {
@@ -57,6 +65,13 @@ Expected<uint32_t> find_one(const container::Reader& r, uint16_t track, Lightfie
 
 }  // namespace
 
+bool track_has_coverage(const container::Reader& reader, uint16_t track) {
+  ChunkQuery q;
+  q.track = track;
+  q.stream = static_cast<uint16_t>(LightfieldStream::kCoverage);
+  return !reader.find_chunks(q).empty();
+}
+
 Status LightfieldReference::read_view_index(uint32_t v) {
   ChunkQuery q;
   q.track = track_;
@@ -87,6 +102,7 @@ Expected<LightfieldReference> LightfieldReference::open(const container::Reader&
   d.reader_ = &reader;
   d.track_ = track;
   d.header_ = std::get<container::LightfieldTrackHeader>(reader.tracks()[track].header);
+  d.has_coverage_ = track_has_coverage(reader, track);
   const auto& h = d.header_;
   CALF_RETURN_IF_ERROR(lf::check_colour_format(h.colour_format));
   CALF_RETURN_IF_ERROR(lf::depth_coding(h.depth_format).status());
@@ -155,6 +171,7 @@ Status LightfieldReference::decode_face(uint32_t view, uint32_t face, uint32_t f
   out->colour.assign(size_t{n} * n * 3, 0.0f);
   out->depth.assign(size_t{n} * n, 0);
   out->material.clear();
+  out->coverage.clear();
 
   // Colour: per cell, (1 - w) K_m + w K_m+1 with w = t / 255 (SPEC §11.1.4).
   std::vector<float> a, b;
@@ -188,26 +205,34 @@ Status LightfieldReference::decode_face(uint32_t view, uint32_t face, uint32_t f
     }
   }
 
-  // Depth and material: the region chunk serving the frame, every frame of it applied in order
-  // from its keyframe (no window jumps: the plain reading of §11.1.6).
+  // Depth, material and coverage: the region chunk serving the frame, every frame of it applied
+  // in order from its keyframe (no window jumps: the plain reading of §11.1.6).
   const bool with_material = views_[view].has_material;
   if (with_material) out->material.assign(size_t{n} * n * 3, 0);
+  if (has_coverage_) out->coverage.assign(size_t{n} * n, lf::CoverageTexel{});
   std::vector<uint16_t> codes;
   std::vector<uint8_t> mat;
-  for (int pass = 0; pass < (with_material ? 2 : 1); ++pass) {
-    const bool depth = pass == 0;
-    CALF_ASSIGN_OR_RETURN(lf::RegionCoding coding, depth ? lf::depth_coding(h.depth_format)
-                                                         : lf::material_coding(h.material_format));
+  for (const LightfieldStream stream :
+       {LightfieldStream::kDepth, LightfieldStream::kMaterial, LightfieldStream::kCoverage}) {
+    const bool depth = stream == LightfieldStream::kDepth;
+    const bool coverage = stream == LightfieldStream::kCoverage;
+    if ((stream == LightfieldStream::kMaterial && !with_material) || (coverage && !has_coverage_)) {
+      continue;
+    }
+    CALF_ASSIGN_OR_RETURN(lf::RegionCoding coding,
+                          depth      ? lf::depth_coding(h.depth_format)
+                          : coverage ? Expected<lf::RegionCoding>(lf::RegionCoding::kCoverage)
+                                     : lf::material_coding(h.material_format));
     for (uint32_t tile = 0; tile < tiles.cell_count(); ++tile) {
       const PixelRect r =
           tiles.cell_rect(tile % tiles.cells_per_side(), tile / tiles.cells_per_side());
-      CALF_ASSIGN_OR_RETURN(
-          uint32_t id,
-          find_one(*reader_, track_, depth ? LightfieldStream::kDepth : LightfieldStream::kMaterial,
-                   view, face, tile, frame, -1));
+      CALF_ASSIGN_OR_RETURN(uint32_t id,
+                            find_one(*reader_, track_, stream, view, face, tile, frame, -1));
       const container::ChunkKeys& keys = reader_->chunks()[id].keys;
       CALF_ASSIGN_OR_RETURN(std::vector<uint8_t> raw, reader_->read_chunk(id));
-      const std::string what = where(view, face, tile) + (depth ? " depth" : " material");
+      const std::string what = where(view, face, tile) + (depth      ? " depth"
+                                                          : coverage ? " coverage"
+                                                                     : " material");
       CALF_ASSIGN_OR_RETURN(
           lf::RegionChunk chunk,
           lf::parse_region_chunk(raw, keys.frame_count, r.width, r.height, coding, what));
@@ -227,6 +252,15 @@ Status LightfieldReference::decode_face(uint32_t view, uint32_t face, uint32_t f
         }
         lf::region_rect_gpu_bytes(chunk, rect, gpu);
         const size_t texels = size_t{rr.w} * rr.h;
+        if (coverage) {
+          for (uint32_t y = 0; y < rr.h; ++y) {
+            for (uint32_t x = 0; x < rr.w; ++x) {
+              out->coverage[(size_t{r.y} + rr.y + y) * n + r.x + rr.x + x] =
+                  lf::coverage_from_gpu(&gpu[(size_t{y} * rr.w + x) * lf::kCoverageGpuBytes]);
+            }
+          }
+          continue;
+        }
         if (depth) {
           codes.resize(texels);
           CALF_RETURN_IF_ERROR(decode_gpu_depth(format, gpu, rr.w, rr.h, codes));
@@ -242,6 +276,21 @@ Status LightfieldReference::decode_face(uint32_t view, uint32_t face, uint32_t f
             std::memcpy(&out->material[o * 3], &mat[size_t{y} * rr.w * 3], size_t{rr.w} * 3);
           }
         }
+      }
+    }
+  }
+  // §11.1.11: with lossless depth, a sky texel has nothing farther than it.
+  CALF_ASSIGN_OR_RETURN(lf::RegionCoding depth_coding, lf::depth_coding(h.depth_format));
+  if (has_coverage_ && depth_coding != lf::RegionCoding::kBc5) {
+    for (size_t i = 0; i < out->coverage.size(); ++i) {
+      const lf::CoverageTexel& t = out->coverage[i];
+      if (out->depth[i] == kLog16Sky && t.far() != 0) {
+        return Status(ErrorId::kCoverageDepth,
+                      "view " + std::to_string(view) + " face " + std::to_string(face) + " frame " +
+                          std::to_string(frame) + " texel (" + std::to_string(i % n) + ", " +
+                          std::to_string(i / n) + "): sky depth with coverage mask 0x" +
+                          hex_text(t.mask) + " and near count " + std::to_string(t.near) + ", " +
+                          std::to_string(t.far()) + " cells farther than sky");
       }
     }
   }

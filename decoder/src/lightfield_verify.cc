@@ -24,6 +24,11 @@ uint64_t face_hash(const LightfieldFace& face) {
   for (float c : face.colour) put_le(bytes, std::bit_cast<uint32_t>(c));
   for (uint16_t d : face.depth) put_le(bytes, d);
   bytes.insert(bytes.end(), face.material.begin(), face.material.end());
+  // SPEC §14 item 4, a track with coverage only: per texel its mask (u16) and near count (u8).
+  for (const lf::CoverageTexel& t : face.coverage) {
+    put_le(bytes, t.mask);
+    bytes.push_back(t.near);
+  }
   return container::hash64(bytes);
 }
 

@@ -205,6 +205,7 @@ Expected<LightfieldAnalysis> plan_lightfield(const capture::CaptureManifest& m,
   h.cell_size = cells.cell_size();
   h.depth_tile_size = tiles.cell_size();
   h.flags = a.hdr ? 1 : 0;
+  a.coverage = m.coverage && options.coverage;
   return a;
 }
 

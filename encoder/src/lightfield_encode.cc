@@ -51,12 +51,13 @@ uint16_t half_from_colour(float v) {
 
 struct ViewData {
   uint32_t frames = 0, face_size = 0;
-  size_t texels = 0;                   // per frame, all six faces
-  std::vector<uint16_t> colour;        // half RGB, [frame][texel][3]
-  std::vector<uint16_t> depth;         // log-16 codes, [frame][texel]
-  std::vector<uint8_t> material;       // [frame][texel][3] codes, empty without material
-  std::optional<LogDepthRange> range;  // none when the view sees only sky
-  bool has_material = false;           // some texel of some frame reflects or refracts
+  size_t texels = 0;                        // per frame, all six faces
+  std::vector<uint16_t> colour;             // half RGB, [frame][texel][3]
+  std::vector<uint16_t> depth;              // log-16 codes, [frame][texel]
+  std::vector<uint8_t> material;            // [frame][texel][3] codes, empty without material
+  std::vector<lf::CoverageTexel> coverage;  // [frame][texel], empty without a coverage stream
+  std::optional<LogDepthRange> range;       // none when the view sees only sky
+  bool has_material = false;                // some texel of some frame reflects or refracts
 
   size_t index(uint32_t frame, uint32_t face, uint32_t x, uint32_t y) const {
     return static_cast<size_t>(frame) * texels +
@@ -66,9 +67,37 @@ struct ViewData {
 
 // Reads every frame of `view` and checks that the images still say what the analysis saw
 // (`expected`): the depth codes are taken in the analysis's range.
+// The coverage of view-frame `vf` as the stream codes it (SPEC §11.1.11): near and far shares
+// whole sixteenths and near + far + the mask's cells = 16, else kEncoderCoverage.
+Status coverage_texels(const capture::CaptureSetReader& input, uint32_t view, uint32_t frame,
+                       const capture::ViewFrame& vf, lf::CoverageTexel* out) {
+  const size_t n = vf.texel_count(), per_face = size_t{vf.face_size} * vf.face_size;
+  for (size_t i = 0; i < n; ++i) {
+    const float near = vf.coverage[3 * i] * 16, far = vf.coverage[3 * i + 1] * 16;
+    const uint16_t mask = static_cast<uint16_t>(vf.coverage[3 * i + 2]);  // validated 0..65535
+    // A sky texel has nothing farther than it (SPEC §11.1.11 "Coverage and depth").
+    if (near != std::nearbyint(near) || far != std::nearbyint(far) ||
+        near + far + static_cast<float>(std::popcount(mask)) != 16.0f ||
+        (std::isinf(vf.depth[i]) && far != 0)) {
+      const size_t texel = i % per_face;
+      return Status(ErrorId::kEncoderCoverage,
+                    input.image_path(view, frame).string() + ": face " +
+                        std::to_string(i / per_face) + " texel (" +
+                        std::to_string(texel % vf.face_size) + ", " +
+                        std::to_string(texel / vf.face_size) + "): coverage near " +
+                        std::to_string(vf.coverage[3 * i]) + ", far " +
+                        std::to_string(vf.coverage[3 * i + 1]) + ", mask " + std::to_string(mask) +
+                        " is not 16 cells of 1/16 (near + far + mask bits), or has cells "
+                        "farther than its sky depth; --no-coverage drops coverage");
+    }
+    out[i] = {mask, static_cast<uint8_t>(near)};
+  }
+  return Status::Ok();
+}
+
 Status read_view(const capture::CaptureSetReader& input, uint32_t view,
-                 const LightfieldViewFacts& expected, uint32_t first_frame, uint32_t frame_count,
-                 ViewData* out) {
+                 const LightfieldViewFacts& expected, bool with_coverage, uint32_t first_frame,
+                 uint32_t frame_count, ViewData* out) {
   const capture::CaptureManifest& m = input.manifest();
   out->frames = frame_count;
   out->face_size = m.face_size;
@@ -76,6 +105,8 @@ Status read_view(const capture::CaptureSetReader& input, uint32_t view,
   out->colour.assign(out->texels * 3 * frame_count, 0);
   out->material.clear();
   if (m.material) out->material.assign(out->texels * 3 * frame_count, 0);
+  out->coverage.clear();
+  if (with_coverage) out->coverage.resize(out->texels * frame_count);
   std::vector<float> depth(out->texels * frame_count);
   lightfield_internal::ViewFactsBuilder facts;
   capture::ViewFrame vf;
@@ -85,6 +116,10 @@ Status read_view(const capture::CaptureSetReader& input, uint32_t view,
     uint16_t* c = &out->colour[f * out->texels * 3];
     for (size_t i = 0; i < out->texels * 3; ++i) c[i] = half_from_colour(vf.color[i]);
     std::copy(vf.depth.begin(), vf.depth.end(), &depth[f * out->texels]);
+    if (with_coverage) {
+      CALF_RETURN_IF_ERROR(
+          coverage_texels(input, view, first_frame + f, vf, &out->coverage[f * out->texels]));
+    }
     if (m.material) {
       uint8_t* mc = &out->material[f * out->texels * 3];
       for (size_t i = 0; i < out->texels; ++i) {
@@ -121,7 +156,7 @@ struct Pending {
 };
 
 struct TaskStats {
-  StreamBytes colour, depth, material;
+  StreamBytes colour, depth, material, coverage;
   uint64_t keyframes = 0, depth_keyframes = 0, pframes = 0, empty_pframes = 0;
   double min_quality = kInf;
   double max_rel = 0, sum_rel = 0;
@@ -427,7 +462,15 @@ ChangeMask material_change_mask(const TileFrames& t, uint32_t first, uint32_t cu
 // kRawPredicted: depth only, raw codes replaced by their prediction residuals per rectangle;
 // kRawPredictedMasked: the same, but a P-frame rectangle keeps only its changed texels' residuals
 // behind a change mask (SPEC §11.1.9).
-enum class RegionCoding : uint8_t { kRaw, kRawPredicted, kRawPredictedMasked, kBc5, kBc1 };
+// kCoverage: the coverage stream's edge bitmaps and planes (SPEC §11.1.11).
+enum class RegionCoding : uint8_t {
+  kRaw,
+  kRawPredicted,
+  kRawPredictedMasked,
+  kBc5,
+  kBc1,
+  kCoverage
+};
 
 // Codes frames [first, first + count) of a tile into one chunk (SPEC §11.1 "Region chunk").
 // `decoded` is the decoder's tile state (bytes_per_texel == 2 only), for the BC5 error report.
@@ -457,9 +500,10 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
   AabbOptions ao;
   ao.max_boxes = o.max_aabbs;
   const bool masked = coding == RegionCoding::kRawPredictedMasked;
+  const bool coverage = coding == RegionCoding::kCoverage;
   const bool raw_texels =
       coding == RegionCoding::kRaw || coding == RegionCoding::kRawPredicted || masked;
-  ao.alignment = raw_texels ? 1 : 4;
+  ao.alignment = raw_texels || coverage ? 1 : 4;
   rects[0].push_back({0, 0, t.width, t.height});
   std::vector<ChangeMask> masks(masked ? count : 0);
   for (uint32_t f = 1; f < count; ++f) {
@@ -492,6 +536,8 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
   std::vector<uint8_t> texels, blocks, rect_bytes, decoded_rect, mask_bytes;
 
   std::vector<uint16_t> rect_codes, residuals;
+  std::vector<lf::CoverageTexel> coverage_texels;  // kCoverage: every rectangle's, in order
+  std::vector<std::pair<uint32_t, uint32_t>> coverage_sizes;
   for (uint32_t f = 0; f < count; ++f) {
     if (f == 0) {
       s.depth_keyframes += is_depth ? 1 : 0;
@@ -508,6 +554,15 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
       }
       if (coding == RegionCoding::kRaw) {
         texels.insert(texels.end(), rect_bytes.begin(), rect_bytes.end());
+        continue;
+      }
+      if (coverage) {
+        // Tile bytes per texel: mask high, mask low, near count.
+        for (size_t i = 0; i + 2 < rect_bytes.size(); i += 3) {
+          coverage_texels.push_back(
+              {static_cast<uint16_t>(rect_bytes[i] << 8 | rect_bytes[i + 1]), rect_bytes[i + 2]});
+        }
+        coverage_sizes.emplace_back(r.width, r.height);
         continue;
       }
       if (coding == RegionCoding::kRawPredicted || masked) {
@@ -583,6 +638,19 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
       }
     }
   }
+  if (coverage) {
+    std::vector<lf::CoverageRect> list;
+    size_t at = 0;
+    for (const auto& [w, h] : coverage_sizes) {
+      list.push_back({w, h, std::span(coverage_texels).subspan(at, size_t{w} * h)});
+      at += size_t{w} * h;
+    }
+    const size_t before = raw.size();
+    lf::append_coverage_payload(raw, list);
+    bytes.raw += static_cast<uint64_t>(count) * t.width * t.height * t.bytes_per_texel;
+    bytes.temporal += raw.size() - before + header;
+    return Status::Ok();
+  }
   if (raw_texels) {
     // r16pm: every mask of the chunk before the planes (measured: a little smaller under zstd
     // than after them, or one byte per texel, or one bit string across rectangles).
@@ -624,8 +692,14 @@ uint32_t static_group_span(const Context& ctx, const TileFrames& t, uint32_t fir
   return count;
 }
 
-void region_task(const Context& ctx, uint32_t face, uint32_t tile, bool is_depth, TaskOut& out) {
+// The region streams a tile is coded in.
+enum class TileStream : uint8_t { kDepth, kMaterial, kCoverage };
+
+void region_task(const Context& ctx, uint32_t face, uint32_t tile, TileStream stream,
+                 TaskOut& out) {
   const ViewData& v = *ctx.view;
+  const bool is_depth = stream == TileStream::kDepth;
+  const bool is_coverage = stream == TileStream::kCoverage;
   const PixelRect r =
       ctx.tiles.cell_rect(tile % ctx.tiles.cells_per_side(), tile / ctx.tiles.cells_per_side());
   TileFrames t;
@@ -642,6 +716,10 @@ void region_task(const Context& ctx, uint32_t face, uint32_t tile, bool is_depth
         if (is_depth) {
           t.data[o++] = static_cast<uint8_t>(v.depth[i] >> 8);
           t.data[o++] = static_cast<uint8_t>(v.depth[i]);
+        } else if (is_coverage) {
+          t.data[o++] = static_cast<uint8_t>(v.coverage[i].mask >> 8);
+          t.data[o++] = static_cast<uint8_t>(v.coverage[i].mask);
+          t.data[o++] = v.coverage[i].near;
         } else {
           for (int c = 0; c < 3; ++c) t.data[o++] = v.material[i * 3 + c];
         }
@@ -651,14 +729,17 @@ void region_task(const Context& ctx, uint32_t face, uint32_t tile, bool is_depth
   const bool lossy = ctx.options->depth == DepthCoding::kBc5;
   const bool predicted = is_depth && ctx.options->depth == DepthCoding::kRaw16Predicted;
   const bool masked = is_depth && ctx.options->depth == DepthCoding::kRaw16PredictedMasked;
-  const RegionCoding coding = masked      ? RegionCoding::kRawPredictedMasked
+  const RegionCoding coding = is_coverage ? RegionCoding::kCoverage
+                              : masked    ? RegionCoding::kRawPredictedMasked
                               : predicted ? RegionCoding::kRawPredicted
                               : !lossy    ? RegionCoding::kRaw
                               : is_depth  ? RegionCoding::kBc5
                                           : RegionCoding::kBc1;
   std::vector<uint16_t> decoded;
   if (is_depth && lossy) decoded.assign(static_cast<size_t>(r.width) * r.height, 0);
-  StreamBytes& bytes = is_depth ? out.stats.depth : out.stats.material;
+  StreamBytes& bytes = is_depth      ? out.stats.depth
+                       : is_coverage ? out.stats.coverage
+                                     : out.stats.material;
   std::vector<uint8_t> raw;
   const uint32_t k = ctx.options->depth_keyframe_interval;
   for (uint32_t first = 0, count = 0; first < v.frames; first += count) {
@@ -668,8 +749,9 @@ void region_task(const Context& ctx, uint32_t face, uint32_t tile, bool is_depth
                                    decoded.empty() ? nullptr : &decoded);
     if (!out.status.ok()) return;
     ChunkKeys keys;
-    keys.stream =
-        static_cast<uint16_t>(is_depth ? LightfieldStream::kDepth : LightfieldStream::kMaterial);
+    keys.stream = static_cast<uint16_t>(is_depth      ? LightfieldStream::kDepth
+                                        : is_coverage ? LightfieldStream::kCoverage
+                                                      : LightfieldStream::kMaterial);
     keys.face = face;
     keys.region = tile;
     keys.first_frame = ctx.first_frame + first;
@@ -693,6 +775,7 @@ LightfieldEncodeStats figures_of(const TaskStats& task) {
   f.colour = task.colour;
   f.depth = task.depth;
   f.material = task.material;
+  f.coverage = task.coverage;
   f.colour_keyframes = task.keyframes;
   f.depth_keyframes = task.depth_keyframes;
   f.depth_pframes = task.pframes;
@@ -710,6 +793,7 @@ void add_figures(LightfieldEncodeStats& total, const LightfieldEncodeStats& part
   add_into(total.colour, part.colour);
   add_into(total.depth, part.depth);
   add_into(total.material, part.material);
+  add_into(total.coverage, part.coverage);
   total.index_bytes += part.index_bytes;
   total.colour_cells += part.colour_cells;
   total.colour_keyframes += part.colour_keyframes;
@@ -807,7 +891,8 @@ Expected<LightfieldViewEncoding> encode_lightfield_view_frames(
                         container::encode_track_header(plan.header));
   CALF_ASSIGN_OR_RETURN(const std::vector<uint8_t> given,
                         container::encode_track_header(analysis.header));
-  if (planned != given || plan.colour != analysis.colour || plan.hdr != analysis.hdr) {
+  if (planned != given || plan.colour != analysis.colour || plan.hdr != analysis.hdr ||
+      plan.coverage != analysis.coverage) {
     return Status(ErrorId::kEncoderInput,
                   "the analysis was made for another capture set or other options");
   }
@@ -824,7 +909,8 @@ Expected<LightfieldViewEncoding> encode_lightfield_view_frames(
   stats.hdr = analysis.hdr;
   stats.min_colour_quality_db = kInf;
   ViewData view;
-  CALF_RETURN_IF_ERROR(read_view(input, v, analysis.views[v], first_frame, frame_count, &view));
+  CALF_RETURN_IF_ERROR(
+      read_view(input, v, analysis.views[v], analysis.coverage, first_frame, frame_count, &view));
   if (view.has_material) stats.material_views += 1;
 
   // The view's index chunk (SPEC §11.1 "View index chunk").
@@ -854,20 +940,24 @@ Expected<LightfieldViewEncoding> encode_lightfield_view_frames(
   const Context ctx{&options, &view, v,           analysis.colour, analysis.hdr,
                     cells,    tiles, first_frame, !whole};
   for (uint32_t face = 0; face < 6; ++face) {
-    // Tasks of one face in file order: cells, depth tiles, material tiles.
+    // Tasks of one face in file order: cells, depth tiles, material tiles, coverage tiles.
     const uint32_t nc = cells.cell_count(), nt = tiles.cell_count();
     const uint32_t nm = view.has_material ? nt : 0;
-    std::vector<TaskOut> outs(nc + nt + nm);
+    const uint32_t nv = analysis.coverage ? nt : 0;
+    std::vector<TaskOut> outs(nc + nt + nm + nv);
     arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<uint32_t>(0, nc + nt + nm, 1),
+      tbb::parallel_for(tbb::blocked_range<uint32_t>(0, nc + nt + nm + nv, 1),
                         [&](const tbb::blocked_range<uint32_t>& range) {
                           for (uint32_t i = range.begin(); i < range.end(); ++i) {
                             if (i < nc) {
                               colour_task(ctx, face, i, outs[i]);
                             } else if (i < nc + nt) {
-                              region_task(ctx, face, i - nc, true, outs[i]);
+                              region_task(ctx, face, i - nc, TileStream::kDepth, outs[i]);
+                            } else if (i < nc + nt + nm) {
+                              region_task(ctx, face, i - nc - nt, TileStream::kMaterial, outs[i]);
                             } else {
-                              region_task(ctx, face, i - nc - nt, false, outs[i]);
+                              region_task(ctx, face, i - nc - nt - nm, TileStream::kCoverage,
+                                          outs[i]);
                             }
                           }
                         });
@@ -887,6 +977,8 @@ Expected<LightfieldViewEncoding> encode_lightfield_view_frames(
 Expected<LightfieldTrackWriter> LightfieldTrackWriter::begin(container::Writer& writer,
                                                              const LightfieldAnalysis& analysis) {
   CALF_ASSIGN_OR_RETURN(uint16_t track, writer.add_track(analysis.header));
+  // A coverage stream is a 1.2 feature (SPEC §11.1.11): the file says so in its minor version.
+  if (analysis.coverage) writer.require_minor_version(container::kVersionMinorCoverage);
   LightfieldEncodeStats stats;
   stats.colour_format = analysis.header.colour_format;
   stats.depth_format = analysis.header.depth_format;

@@ -35,7 +35,7 @@ constexpr const char* kAnalysisKey = "calf.lightfield_analysis";
 constexpr const char* kAnalysisIdKey = "calf.lightfield_analysis_id";
 constexpr const char* kShardViewsKey = "calf.lightfield_shard_views";
 constexpr const char* kShardFramesKey = "calf.lightfield_shard_frames";  // "first-last"
-constexpr const char* kRecordMagic = "calf-lightfield-analysis 4";
+constexpr const char* kRecordMagic = "calf-lightfield-analysis 5";
 constexpr const char* kRecordMagicPrefix = "calf-lightfield-analysis ";
 
 std::string hex_double(double v) {
@@ -57,8 +57,9 @@ std::string analysis_record(const LightfieldAnalysis& a, const LightfieldEncodeO
     << static_cast<int>(o.supercompression) << "\nzstd_level " << o.levels.zstd_level
     << "\nlzma_preset " << o.levels.lzma_preset << "\nsegment_frames " << o.segment_frames
     << "\nmerge_static_groups " << (o.merge_static_groups ? 1 : 0) << "\ncolour_rdo "
-    << hex_double(o.colour_rdo) << "\nbc1_fit " << static_cast<int>(o.bc1_fit)
-    << "\nresolved_colour " << static_cast<int>(a.colour) << "\nviews " << a.views.size() << "\n";
+    << hex_double(o.colour_rdo) << "\nbc1_fit " << static_cast<int>(o.bc1_fit) << "\ncoverage "
+    << (o.coverage ? 1 : 0) << "\nresolved_colour " << static_cast<int>(a.colour) << "\nviews "
+    << a.views.size() << "\n";
   for (size_t v = 0; v < a.views.size(); ++v) {
     const LightfieldViewFacts& f = a.views[v];
     s << "view " << v << " " << (f.depth_range ? 1 : 0) << " "
@@ -162,6 +163,8 @@ Status parse_record(const std::string& path, const std::string& text, Lightfield
   if (!field("bc1_fit", static_cast<uint64_t>(Bc1Fit::kCluster)))
     return bad_record(path, "bc1_fit");
   o->bc1_fit = static_cast<Bc1Fit>(x);
+  if (!field("coverage", 1)) return bad_record(path, "coverage");
+  o->coverage = x != 0;
   if (!field("resolved_colour", static_cast<uint64_t>(ColourCoding::kRgba16f)))
     return bad_record(path, "resolved_colour");
   *resolved_colour = x;
@@ -467,6 +470,7 @@ Expected<LightfieldEncodeStats> encode_lightfield_shard(
     total.colour.stored += enc.stats.colour.stored;
     total.depth.stored += enc.stats.depth.stored;
     total.material.stored += enc.stats.material.stored;
+    total.coverage.stored += enc.stats.coverage.stored;
     total.colour_cells += enc.stats.colour_cells;
     total.depth_tiles += enc.stats.depth_tiles;
     total.min_colour_quality_db =
@@ -571,8 +575,10 @@ Status merge_lightfield_shards(const LightfieldAnalysisFile& analysis,
         return 2;
       case LightfieldStream::kDepth:
         return 3;
-      default:
+      case LightfieldStream::kMaterial:
         return 4;
+      default:
+        return 5;
     }
   };
   struct Ref {
@@ -592,7 +598,7 @@ Status merge_lightfield_shards(const LightfieldAnalysisFile& analysis,
     }
     auto order = [&](const Ref& r) {
       const int c = stream_class(r.keys.stream);
-      // Colour cells (t and keyframes together), then depth tiles, then material tiles.
+      // Colour cells (t and keyframes together), then depth, material and coverage tiles.
       const int group = c == 0 ? 0 : c <= 2 ? 1 : c;
       return std::tuple(c == 0 ? 0 : 1, r.keys.face, group, r.keys.region, c, r.keys.first_frame);
     };
@@ -600,6 +606,9 @@ Status merge_lightfield_shards(const LightfieldAnalysisFile& analysis,
                      [&](const Ref& a, const Ref& b) { return order(a) < order(b); });
     for (size_t i = 0; i < refs.size();) {
       const Ref& ref = refs[i];
+      if (ref.keys.stream == static_cast<uint16_t>(LightfieldStream::kCoverage)) {
+        writer.require_minor_version(container::kVersionMinorCoverage);
+      }
       const container::Reader& r = readers[ref.shard];
       const container::ChunkEntry& e = r.chunks()[ref.id];
       container::ChunkKeys keys = e.keys;

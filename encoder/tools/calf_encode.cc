@@ -311,6 +311,11 @@ static int command_main(int argc, char** argv) {
                  "shards (--frame-range) code apart into the bytes of one encode; a multiple of "
                  "--depth-keyframe-interval; costs bytes (docs/FARM.md) (default 0: no segments)")
       ->default_val(0);
+  bool no_coverage = false;
+  app.add_flag("--no-coverage", no_coverage,
+               "leave a capture set's coverage (format/CAPTURE.md \"Coverage\") out of the clip: "
+               "no coverage stream, a 1.1 file as for a set without coverage; default: a set "
+               "with coverage gets the track's coverage stream (SPEC 11.1.11, a 1.2 file)");
   bool fixed_groups = false;
   app.add_flag("--depth-fixed-groups", fixed_groups,
                "one depth / material chunk per K frames even where a tile does not change (the "
@@ -571,7 +576,8 @@ static int command_main(int argc, char** argv) {
     for (const char* opt :
          {"--cell", "--psnr", "--color-format", "--depth-format", "--depth-window", "--max-aabbs",
           "--depth-keyframe-interval", "--segment-frames", "--colour-rdo", "--bc1-fit",
-          "--depth-fixed-groups", "--analysis-only", "--analysis", "--views", "--frame-range"}) {
+          "--depth-fixed-groups", "--no-coverage", "--analysis-only", "--analysis", "--views",
+          "--frame-range"}) {
       if (given(opt)) {
         return calf::tools::usage_error("calf-encode",
                                         std::string(opt) + " needs --mode lightfield");
@@ -669,6 +675,7 @@ static int command_main(int argc, char** argv) {
             : depth == "pred16m" ? calf::DepthCoding::kRaw16PredictedMasked
                                  : calf::DepthCoding::kRaw16;
   o.merge_static_groups = !fixed_groups;
+  o.coverage = !no_coverage;
   o.levels.compress_directory = !plain_directory;
   o.supercompression = super == "lzma2"  ? calf::container::Compression::kLzma2
                        : super == "none" ? calf::container::Compression::kNone
@@ -708,7 +715,7 @@ static int command_main(int argc, char** argv) {
     for (const char* opt :
          {"--cell", "--psnr", "--color-format", "--depth-format", "--depth-window", "--max-aabbs",
           "--depth-keyframe-interval", "--supercompression", "--segment-frames", "--colour-rdo",
-          "--bc1-fit", "--depth-fixed-groups", "--plain-directory"}) {
+          "--bc1-fit", "--depth-fixed-groups", "--no-coverage", "--plain-directory"}) {
       if (app.get_option(opt)->count() > 0) {
         return calf::tools::usage_error(
             "calf-encode",
@@ -741,15 +748,15 @@ static int command_main(int argc, char** argv) {
                                            max_image_pixels);
     if (!s.ok()) return fail(s.status());
     if (!quiet) {
-      std::fprintf(
-          stderr,
-          "calf-encode: shard %s (views %s, %llu colour keyframes, %llu bytes stored) in "
-          "%.2f s, peak RSS %.1f MiB\n",
-          out.c_str(), calf::capture::index_list_text(*views).c_str(),
-          static_cast<unsigned long long>(s->colour_keyframes),
-          static_cast<unsigned long long>(s->colour.stored + s->depth.stored + s->material.stored),
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
-          peak_rss_mib());
+      std::fprintf(stderr,
+                   "calf-encode: shard %s (views %s, %llu colour keyframes, %llu bytes stored) in "
+                   "%.2f s, peak RSS %.1f MiB\n",
+                   out.c_str(), calf::capture::index_list_text(*views).c_str(),
+                   static_cast<unsigned long long>(s->colour_keyframes),
+                   static_cast<unsigned long long>(s->colour.stored + s->depth.stored +
+                                                   s->material.stored + s->coverage.stored),
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                   peak_rss_mib());
     }
     return 0;
   }
@@ -795,6 +802,7 @@ static int command_main(int argc, char** argv) {
   line("colour", stats->colour);
   line("depth", stats->depth);
   if (stats->material_views) line("material", stats->material);
+  if (stats->coverage.chunks) line("coverage", stats->coverage);
   std::fprintf(stderr,
                "  colour: %llu cells, %llu keyframes, min temporal quality %.2f dB; depth: %llu "
                "P-frames (%llu empty)\n",

@@ -15,7 +15,8 @@ struct Writer::State {
   std::map<std::string, std::string> metadata;  // sorted by key: deterministic order
   std::vector<ChunkEntry> chunks;
   bool finished = false;
-  Status failed;  // a sink failure poisons the writer: the file could be inconsistent
+  uint16_t minor_version = 0;  // the least minor version the file's contents ask for
+  Status failed;               // a sink failure poisons the writer: the file could be inconsistent
 };
 
 namespace {
@@ -31,6 +32,10 @@ Status misuse(std::string message) {
 }  // namespace
 
 Writer::Writer(std::unique_ptr<State> state) : s_(std::move(state)) {}
+
+void Writer::require_minor_version(uint16_t minor) {
+  s_->minor_version = std::max(s_->minor_version, minor);
+}
 Writer::Writer(Writer&&) noexcept = default;
 Writer& Writer::operator=(Writer&&) noexcept = default;
 Writer::~Writer() = default;
@@ -164,6 +169,7 @@ Status Writer::finish() {
   } else {
     dir = std::move(body);
   }
+  h.version_minor = std::max(h.version_minor, s_->minor_version);
   CALF_RETURN_IF_ERROR(write_fields(Checksum{hash64(dir)}, dir));
   h.directory_offset = s_->position;
   h.directory_size = dir.size();

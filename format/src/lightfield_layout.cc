@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstdio>
 
 #include "calf/format/bc.h"
 #include "calf/format/depth_predict.h"
@@ -197,6 +198,7 @@ container::PixelFormat region_gpu_format(RegionCoding coding) {
     case RegionCoding::kBc5:
       return PixelFormat::kBc5;
     case RegionCoding::kRgb8:
+    case RegionCoding::kCoverage:
       return PixelFormat::kRgba8;
     case RegionCoding::kBc1:
       return PixelFormat::kBc1;
@@ -217,6 +219,7 @@ size_t unit_bytes(RegionCoding coding) {
     case RegionCoding::kBc5:
       return 16;
     case RegionCoding::kRgb8:
+    case RegionCoding::kCoverage:
       return 3;
     case RegionCoding::kBc1:
       return 8;
@@ -224,6 +227,91 @@ size_t unit_bytes(RegionCoding coding) {
   return 0;
 }
 }  // namespace
+
+namespace {
+
+std::string hex16(uint16_t v) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "%04x", v);
+  return buf;
+}
+
+Status coverage_corrupt(const std::string& what) {
+  return Status(ErrorId::kCoverageChunk, what);
+}
+
+// §11.1.11: the bitmaps of every rectangle before the planes; counts the edge texels and checks
+// each one (near <= 16, near + popcount(mask) <= 16, not the plain texel).
+Status parse_coverage(RegionChunk& chunk, const std::string& what) {
+  for (RegionRect& r : chunk.rects) {
+    r.mask_offset = chunk.mask_bytes;
+    chunk.mask_bytes += mask_bytes_of(r.w, r.h);
+  }
+  if (chunk.payload.size() < chunk.mask_bytes) {
+    return corrupt(what + ": payload of " + std::to_string(chunk.payload.size()) +
+                   " bytes, shorter than its " + std::to_string(chunk.mask_bytes) +
+                   " bytes of edge bitmaps");
+  }
+  chunk.units = 0;
+  for (size_t k = 0; k < chunk.rects.size(); ++k) {
+    RegionRect& r = chunk.rects[k];
+    r.first_unit = chunk.units;
+    const uint8_t* m = &chunk.payload[r.mask_offset];
+    const uint64_t bits = uint64_t{r.w} * r.h, bytes = mask_bytes_of(r.w, r.h);
+    for (uint64_t b = 0; b < bytes; ++b) chunk.units += std::popcount(m[b]);
+    if (bits % 8 != 0 && (m[bytes - 1] >> (bits % 8)) != 0) {
+      return coverage_corrupt(what + ": edge bitmap of rectangle " + std::to_string(k) +
+                              " has bits set past its " + std::to_string(bits) + " texels");
+    }
+  }
+  const uint64_t e = chunk.units;
+  if (chunk.payload.size() != chunk.mask_bytes + 3 * e) return Status::Ok();  // size: caller
+  const uint8_t* hi = chunk.payload.data() + chunk.mask_bytes;
+  for (uint64_t i = 0; i < e; ++i) {
+    const CoverageTexel t{static_cast<uint16_t>(hi[i] << 8 | hi[e + i]), hi[2 * e + i]};
+    if (!t.valid() || t.plain()) {
+      return coverage_corrupt(
+          what + ": edge texel " + std::to_string(i) + " has mask 0x" + hex16(t.mask) +
+          " and near count " + std::to_string(t.near) +
+          (t.plain() ? " (a plain texel, not an edge)" : " (more than 16 cells)"));
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+bool CoverageTexel::valid() const {
+  return near <= 16 && near + std::popcount(mask) <= 16;
+}
+
+uint8_t CoverageTexel::far() const {
+  return static_cast<uint8_t>(16 - near - std::popcount(mask));
+}
+
+void coverage_to_gpu(const CoverageTexel& t, uint8_t* p) {
+  p[0] = static_cast<uint8_t>(t.mask);
+  p[1] = static_cast<uint8_t>(t.mask >> 8);
+  p[2] = t.near;
+  p[3] = t.valid() ? t.far() : 0;
+}
+
+void append_coverage_payload(std::vector<uint8_t>& out, std::span<const CoverageRect> rects) {
+  std::vector<uint8_t> planes[3];
+  for (const CoverageRect& r : rects) {
+    const size_t n = size_t{r.width} * r.height, at = out.size();
+    out.resize(at + mask_bytes_of(r.width, r.height), 0);
+    for (size_t i = 0; i < n; ++i) {
+      const CoverageTexel& t = r.texels[i];
+      if (t.plain()) continue;
+      out[at + i / 8] |= static_cast<uint8_t>(1u << (i % 8));
+      planes[0].push_back(static_cast<uint8_t>(t.mask >> 8));
+      planes[1].push_back(static_cast<uint8_t>(t.mask));
+      planes[2].push_back(t.near);
+    }
+  }
+  for (const auto& plane : planes) out.insert(out.end(), plane.begin(), plane.end());
+}
 
 Expected<RegionChunk> parse_region_chunk(std::span<const uint8_t> raw, uint32_t frame_count,
                                          uint32_t tile_width, uint32_t tile_height,
@@ -295,6 +383,7 @@ Expected<RegionChunk> parse_region_chunk(std::span<const uint8_t> raw, uint32_t 
       }
     }
   }
+  if (coding == RegionCoding::kCoverage) CALF_RETURN_IF_ERROR(parse_coverage(chunk, what));
   const uint64_t expected = chunk.mask_bytes + chunk.units * unit_bytes(coding);
   if (chunk.payload.size() != expected) {
     return corrupt(what + ": payload of " + std::to_string(chunk.payload.size()) +
@@ -362,6 +451,27 @@ void region_rect_gpu_bytes(const RegionChunk& chunk, size_t index, std::vector<u
         d[8] = e[2];
         d[9] = e[3];
         std::memcpy(d + 10, ix + 6, 6);
+      }
+      return;
+    }
+    case RegionCoding::kCoverage: {
+      // §11.1.11: a texel whose bitmap bit is clear is plain; the others take the next texel of
+      // the three planes (mask high byte, mask low byte, near count).
+      const size_t n = size_t{r.w} * r.h;
+      out.resize(n * kCoverageGpuBytes);
+      const uint8_t* bits = p.data() + r.mask_offset;
+      const uint8_t* hi = p.data() + chunk.mask_bytes + r.first_unit;
+      const uint8_t* lo = hi + units;
+      const uint8_t* nr = lo + units;
+      size_t e = 0;
+      for (size_t i = 0; i < n; ++i) {
+        CoverageTexel t;
+        if ((bits[i / 8] >> (i % 8)) & 1) {
+          t.mask = static_cast<uint16_t>(hi[e] << 8 | lo[e]);
+          t.near = nr[e];
+          ++e;
+        }
+        coverage_to_gpu(t, &out[i * kCoverageGpuBytes]);
       }
       return;
     }

@@ -88,7 +88,10 @@ std::string format_name(PixelFormat f) {
 }
 
 const char* target_name(UpdateTarget t) {
-  return t == UpdateTarget::kColour ? "colour" : t == UpdateTarget::kDepth ? "depth" : "material";
+  return t == UpdateTarget::kColour     ? "colour"
+         : t == UpdateTarget::kDepth    ? "depth"
+         : t == UpdateTarget::kCoverage ? "coverage"
+                                        : "material";
 }
 
 // Bytes of a rect of `width` x `height` texels in format `f` (compressed: whole blocks).

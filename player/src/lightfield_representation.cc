@@ -84,6 +84,7 @@ struct LightfieldRepresentation::Impl {
   Status refresh_cpu_views();
   Status build_view(uint32_t v);
   Status convert_material(uint32_t v, CubeFace face, const PixelRect& rect);
+  Status convert_coverage(uint32_t v, CubeFace face, const PixelRect& rect);
   RenderOptions frame_options(const Vec3& eye) const;
 };
 
@@ -104,8 +105,12 @@ Expected<std::unique_ptr<LightfieldRepresentation>> LightfieldRepresentation::op
   impl->track = track;
   impl->backend = backend;
   impl->options = options;
+  // The CPU reference reads a clip's coverage (SPEC §11.1.11) into its views as it reads a capture
+  // set's; the GL renderer has no coverage textures, so its decoder never reads the stream.
+  decoder::ClipDecoderOptions decoder_options = options.decoder;
+  decoder_options.coverage = backend == RenderBackend::kCpu;
   CALF_ASSIGN_OR_RETURN(decoder::ClipDecoder d,
-                        decoder::ClipDecoder::open(reader, track, options.decoder));
+                        decoder::ClipDecoder::open(reader, track, decoder_options));
   impl->decoder.emplace(std::move(d));
   const auto& h = impl->decoder->header();
   std::vector<decoder::LightfieldViewInfo> views;
@@ -176,6 +181,9 @@ const Box3& LightfieldRepresentation::view_volume() const {
 }
 bool LightfieldRepresentation::has_material() const {
   return impl_->has_material;
+}
+const ViewSet* LightfieldRepresentation::cpu_views() const {
+  return impl_->cpu_textures ? &impl_->view_set : nullptr;
 }
 const std::vector<Vec3>& LightfieldRepresentation::viewpoints() const {
   return impl_->viewpoints;
@@ -294,6 +302,27 @@ Status LightfieldRepresentation::Impl::convert_material(uint32_t v, CubeFace fac
   return view_set.views[v].write_material_rect(face, rect, scratch);
 }
 
+// Coverage texels of `rect` of a face as the renderer's (near share, far share, mask) floats, the
+// values a capture set's coverage channels hold, into the CPU view. Nothing before the view's
+// first coverage update (its texels are plain, as the view's default).
+Status LightfieldRepresentation::Impl::convert_coverage(uint32_t v, CubeFace face,
+                                                        const PixelRect& rect) {
+  const uint32_t n = cpu_textures->face_size();
+  const auto texels = cpu_textures->coverage(v, face);
+  if (texels.empty()) return Status::Ok();
+  scratch.resize(size_t{rect.width} * rect.height * 3);
+  for (uint32_t y = 0; y < rect.height; ++y) {
+    for (uint32_t x = 0; x < rect.width; ++x) {
+      const lf::CoverageTexel& t = texels[size_t{rect.y + y} * n + rect.x + x];
+      float* to = &scratch[(size_t{y} * rect.width + x) * 3];
+      to[0] = t.near / 16.0f;
+      to[1] = t.far() / 16.0f;
+      to[2] = static_cast<float>(t.mask);
+    }
+  }
+  return view_set.views[v].write_coverage_rect(face, rect, scratch);
+}
+
 // A view that becomes active for the first time: full size, every face converted.
 Status LightfieldRepresentation::Impl::build_view(uint32_t v) {
   const auto& info = decoder->view(v);
@@ -308,6 +337,7 @@ Status LightfieldRepresentation::Impl::build_view(uint32_t v) {
     CALF_RETURN_IF_ERROR(out.write_color_rect(face, whole, cpu_textures->colour(v, face)));
     CALF_RETURN_IF_ERROR(out.write_depth_rect(face, whole, cpu_textures->depth(v, face)));
     if (out.has_material()) CALF_RETURN_IF_ERROR(convert_material(v, face, whole));
+    CALF_RETURN_IF_ERROR(convert_coverage(v, face, whole));
   }
   view_built[v] = 1;
   return Status::Ok();
@@ -342,6 +372,9 @@ Status LightfieldRepresentation::Impl::refresh_cpu_views() {
         break;
       case decoder::UpdateTarget::kMaterial:
         if (view.has_material()) CALF_RETURN_IF_ERROR(convert_material(u.view, u.face, r));
+        break;
+      case decoder::UpdateTarget::kCoverage:
+        CALF_RETURN_IF_ERROR(convert_coverage(u.view, u.face, r));
         break;
     }
   }

@@ -541,6 +541,12 @@ static int command_main(int argc, char** argv) {
                  "comes from texels wholly on one surface; 0..50, 0 = off (default 3; "
                  "docs/RENDERING.md \"Mixed texels\")")
       ->check(CLI::Range(0.0, 50.0));
+  app.add_option("--coverage", o.render.coverage,
+                 "light field, --renderer cpu: how the CPU reference uses a clip's coverage "
+                 "stream (SPEC 11.1.11), as bench-player_quality --coverage uses a capture set's: "
+                 "0 off, 1 bilinear front shares, 2 cell mask, 3 grown cell mask; clips without "
+                 "coverage play as with 0 (default 0)")
+      ->check(CLI::Range(0u, 3u));
   app.add_option("--supersample", o.render.supersample,
                  "light field: N x N eye rays per pixel on an even grid, colour their mean (a box "
                  "filter, as the ground truth's), depth the nearest; anti-aliases silhouettes and "

@@ -22,6 +22,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   for (uint16_t t = 0; t < r->tracks().size(); ++t) {
     decoder::ClipDecoderOptions o;
     o.background_thread = (size % 2) == 0;  // both paths, deterministic per input
+    o.coverage = (size % 3) != 0;           // decode a coverage stream where the input has one
     o.view_dependent = false;
     auto d = decoder::ClipDecoder::open(*r, t, o);
     if (!d.ok()) continue;

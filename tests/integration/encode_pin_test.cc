@@ -85,6 +85,10 @@ const PinCase kCases[] = {
     // "BC1 fit"), r16pm depth, the 1.1 directory, and chunks that zstd would enlarge (the 16-byte
     // t chunks here) stored as they are.
     {"bc1_cluster_rdo_pred16m", {.face = 16, .frames = 5, .views = 2},                 ColourCoding::kBc1,     DepthCoding::kRaw16PredictedMasked, container::Compression::kZstd, "f1c992d88578e467", kColourRdoAuto, 30, 2, true, Bc1Fit::kCluster, true},
+    // Container 1.2: a capture set with coverage (format/CAPTURE.md) gets the coverage stream
+    // (SPEC §11.1.11) at today's defaults; K = 2, so that groups, static runs and P-frames carry
+    // coverage.
+    {"coverage_bc1_pred16m", {.face = 16, .frames = 5, .views = 2, .coverage = true}, ColourCoding::kBc1, DepthCoding::kRaw16PredictedMasked, container::Compression::kZstd, "c84a73d098538a5a", kColourRdoAuto, 2, 2, true, Bc1Fit::kCluster, true},
 };
 // clang-format on
 

@@ -218,6 +218,7 @@ TEST(LightfieldConformance, ViewDependentDecoderReproducesEveryHash) {
     ClipDecoderOptions o;
     o.view_dependent = false;
     o.background_thread = false;
+    o.coverage = true;  // the hash of a track with coverage holds it (SPEC §14 item 4)
     auto d = ClipDecoder::open(reader, track, o);
     ASSERT_TRUE(d.ok()) << name << ": " << d.status().to_string();
     std::vector<LightfieldViewInfo> views;
@@ -239,6 +240,9 @@ TEST(LightfieldConformance, ViewDependentDecoderReproducesEveryHash) {
           decoded.depth.assign(depth.begin(), depth.end());
           const auto material = tex.material(v, face);
           decoded.material.assign(material.begin(), material.end());
+          const auto coverage = tex.coverage(v, face);
+          ASSERT_EQ(coverage.empty(), !d->has_coverage()) << name;
+          decoded.coverage.assign(coverage.begin(), coverage.end());
           ASSERT_LT(line, want.size()) << name;
           EXPECT_EQ(face_hash_line(track, {frame, v, f, face_hash(decoded)}), want[line])
               << name << " line " << line + 1;
@@ -261,6 +265,11 @@ TEST(LightfieldConformance, FaceHashIsOfLittleEndianValues) {
   EXPECT_EQ(face_hash(face), container::hash64(bytes));
   face.material.clear();
   EXPECT_EQ(face_hash(face), container::hash64(std::span(bytes).first(6)));
+  // A track with coverage: each texel's mask (u16) and near count after the material.
+  face.material = {7};
+  face.coverage = {{0x0a0b, 12}};
+  const std::vector<uint8_t> with = {0x00, 0x00, 0x80, 0x3f, 0x02, 0x01, 0x07, 0x0b, 0x0a, 0x0c};
+  EXPECT_EQ(face_hash(face), container::hash64(with));
 }
 
 }  // namespace

@@ -23,7 +23,39 @@ struct SceneSpec {
   bool material = false;
   // Viewpoint v sits at first_viewpoint + v * viewpoint_step.
   Vec3 first_viewpoint{0, 0, 0}, viewpoint_step{0.5, 0, 0};
+  // Coverage channels (a version-2 set, format/CAPTURE.md "Coverage"): add_coverage below.
+  bool coverage = false;
 };
+
+// The coverage of make_frame's scene: the moving square's border texels on face 0 are half
+// covered (8 own cells, 8 nearer or farther), the last sky row of face 3 holds a finite surface
+// in 4 of its cells (nearer), and one texel of face 4 moves and changes its cells with the frame,
+// so that P-frames carry coverage too. Everything else is plain (0, 0, 65535).
+inline void add_coverage(capture::ViewFrame& vf, uint32_t frame_index) {
+  const uint32_t n = vf.face_size, frame = frame_index;
+  vf.resize(n, vf.has_material, true);
+  for (size_t i = 0; i < vf.texel_count(); ++i) {
+    vf.coverage[3 * i] = 0;
+    vf.coverage[3 * i + 1] = 0;
+    vf.coverage[3 * i + 2] = 65535;
+  }
+  auto set = [&](CubeFace f, uint32_t x, uint32_t y, uint16_t mask, uint32_t near) {
+    const size_t i = vf.texel_index(f, x, y);
+    uint32_t own = 0;
+    for (uint16_t m = mask; m != 0; m &= static_cast<uint16_t>(m - 1)) ++own;
+    vf.coverage[3 * i] = static_cast<float>(near) / 16;
+    vf.coverage[3 * i + 1] = static_cast<float>(16 - near - own) / 16;
+    vf.coverage[3 * i + 2] = mask;
+  };
+  const uint32_t sx = 1 + 2 * frame;
+  for (uint32_t y = 4; y < 9 && y < n; ++y) {
+    if (sx - 1 < n) set(CubeFace::kPosX, sx - 1, y, 0x3333, 8);  // the square is nearer
+    if (sx + 5 < n) set(CubeFace::kPosX, sx + 5, y, 0xcccc, 8);  // the square is nearer
+    if (sx < n) set(CubeFace::kPosX, sx, y, 0xcccc, 0);  // the square's edge: the wall is farther
+  }
+  for (uint32_t x = 0; x < n; ++x) set(CubeFace::kNegY, x, n / 2 - 1, 0x0fff, 4);
+  set(CubeFace::kPosZ, frame % n, 3 % n, static_cast<uint16_t>(0x00ff << (frame % 8)), 0);
+}
 
 // A small animated scene: smooth colour everywhere, a square that moves across face 0 (colour and
 // depth), a slow global fade on face 2, sky on the top half of face 3, everything else static.
@@ -68,6 +100,7 @@ inline capture::ViewFrame make_frame(const SceneSpec& s, uint32_t view, uint32_t
       }
     }
   }
+  if (s.coverage) add_coverage(vf, f);
   return vf;
 }
 
@@ -81,6 +114,8 @@ inline Status write_capture(const std::filesystem::path& dir, const SceneSpec& s
   m.face_size = s.face;
   m.fps = 24;
   m.material = s.material;
+  m.coverage = s.coverage;
+  m.version = s.coverage ? capture::kCaptureCoverageVersion : capture::kCaptureFormatVersion;
   m.view_volume = {{-1, -1, -1}, {1, 1, 1}};
   for (uint32_t v = 0; v < s.views; ++v) {
     std::string id = "v";  // append, not operator+: GCC 12 -O3 misfires -Wrestrict on it

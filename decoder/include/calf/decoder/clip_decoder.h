@@ -25,6 +25,8 @@
 //           kBc5     16-byte BC5 blocks; code = 256 * R + G of the decoded 8-bit channels
 //   material kRgba8  4 bytes per texel: reflect, refract, ior code, 255 (material_from_codes)
 //           kBc1     BC1 blocks of (reflect, refract, ior code), not sRGB
+//   coverage kRgba8  4 bytes per texel: mask low byte, mask high byte, near count, far count
+//                    (lf::coverage_from_gpu; only with ClipDecoderOptions::coverage)
 // Block formats cover ceil(w / 4) x ceil(h / 4) blocks; rect x and y are multiples of 4 and w, h
 // are too unless the rect reaches the face's right / bottom edge.
 //
@@ -52,7 +54,7 @@
 
 namespace calf::decoder {
 
-enum class UpdateTarget : uint8_t { kColour = 0, kDepth = 1, kMaterial = 2 };
+enum class UpdateTarget : uint8_t { kColour = 0, kDepth = 1, kMaterial = 2, kCoverage = 3 };
 
 // Replace texels `rect` (face texel coordinates) of the (view, face[, slot]) image with `bytes`.
 struct TextureUpdate {
@@ -93,6 +95,7 @@ struct FrameStats {
   uint32_t total_tiles = 0;
   uint32_t updates = 0;                                            // texture updates yielded
   uint64_t colour_bytes = 0, depth_bytes = 0, material_bytes = 0;  // update payload bytes
+  uint64_t coverage_bytes = 0;
   uint32_t chunks_needed = 0;          // chunks this frame's updates were decoded from
   uint32_t chunks_read_on_demand = 0;  // of those, read by advance() itself (not prefetched)
   size_t cached_bytes = 0;             // decompressed chunks held by the cache after the frame
@@ -100,7 +103,9 @@ struct FrameStats {
   double culling_ms = 0;               // of which the culling (visible sets of every view)
   uint32_t errors = 0;                 // chunks that failed this frame
   std::string first_error;  // the first of them, with its id, e.g. "CALF-E202 view 0 ..."
-  uint64_t update_bytes() const { return colour_bytes + depth_bytes + material_bytes; }
+  uint64_t update_bytes() const {
+    return colour_bytes + depth_bytes + material_bytes + coverage_bytes;
+  }
   // The bitrate of the updates if every frame were like this one, at 24 frames per second
   // (paper 002 Table 3).
   double mbps_at_24fps() const { return update_bytes() * 8.0 * 24.0 / 1e6; }
@@ -131,6 +136,9 @@ struct ClipDecoderOptions {
   size_t cache_bytes = size_t{256} << 20;
   // Fetch chunks on a background thread (false: everything on the caller's thread).
   bool background_thread = true;
+  // Decode the track's coverage stream (SPEC §11.1.11), when it has one, into kCoverage updates
+  // of every visible tile; off, the stream is never read.
+  bool coverage = false;
 };
 
 class ClipDecoder {
@@ -145,6 +153,8 @@ class ClipDecoder {
 
   const container::LightfieldTrackHeader& header() const;
   const LightfieldViewInfo& view(uint32_t v) const;
+  // The track has a coverage stream (decoded only with ClipDecoderOptions::coverage).
+  bool has_coverage() const;
   // Ok, or why view v was dropped at open (its index chunk unusable; LightfieldReference::open):
   // a dropped view is never decoded, and naming it in advance()'s active views is an error.
   const Status& view_problem(uint32_t v) const;

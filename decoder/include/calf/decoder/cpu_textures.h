@@ -12,6 +12,7 @@
 
 #include "calf/decoder/clip_decoder.h"
 #include "calf/format/container_types.h"
+#include "calf/format/lightfield_layout.h"
 #include "calf/format/status.h"
 
 namespace calf::decoder {
@@ -53,6 +54,9 @@ class CpuTextures {
   std::span<const float> colour_slot(uint32_t view, CubeFace face, uint32_t slot) const;
   std::span<const uint16_t> depth(uint32_t view, CubeFace face) const;
   std::span<const uint8_t> material(uint32_t view, CubeFace face) const;  // empty without
+  // The coverage texels (row-major) of a view that received coverage updates (its faces start
+  // plain with the first); empty before.
+  std::span<const lf::CoverageTexel> coverage(uint32_t view, CubeFace face) const;
   CellParams cell(uint32_t view, CubeFace face, uint32_t cell) const;
 
  private:
@@ -60,6 +64,7 @@ class CpuTextures {
     std::array<std::array<std::vector<float>, 2>, kCubeFaceCount> slots;
     std::array<std::vector<uint16_t>, kCubeFaceCount> depth;
     std::array<std::vector<uint8_t>, kCubeFaceCount> material;
+    std::array<std::vector<lf::CoverageTexel>, kCubeFaceCount> coverage;
     std::array<std::vector<CellParams>, kCubeFaceCount> cells;
   };
   uint32_t face_size_ = 0;

@@ -21,12 +21,18 @@ namespace calf::decoder {
 using LightfieldViewInfo = lf::ViewIndex;
 
 // One decoded face. colour: face_size^2 * 3 linear floats (row-major); depth: face_size^2 codes;
-// material: face_size^2 * 3 codes (reflect, refract, ior) or empty.
+// material: face_size^2 * 3 codes (reflect, refract, ior) or empty; coverage (a track with a
+// coverage stream, SPEC §11.1.11): face_size^2 texels, else empty.
 struct LightfieldFace {
   std::vector<float> colour;
   std::vector<uint16_t> depth;
   std::vector<uint8_t> material;
+  std::vector<lf::CoverageTexel> coverage;
 };
+
+// Whether track `track` of `reader` holds a coverage stream: any chunk of stream 5 (SPEC
+// §11.1.11). Then every view's faces carry coverage.
+bool track_has_coverage(const container::Reader& reader, uint16_t track);
 
 class LightfieldReference {
  public:
@@ -37,6 +43,8 @@ class LightfieldReference {
   static Expected<LightfieldReference> open(const container::Reader& reader, uint16_t track);
 
   const container::LightfieldTrackHeader& header() const { return header_; }
+  // The track has a coverage stream (SPEC §11.1.11): decode_face fills LightfieldFace::coverage.
+  bool has_coverage() const { return has_coverage_; }
   // A dropped view's info is the default ViewIndex (position 0, no depth, no material).
   const LightfieldViewInfo& view(uint32_t v) const { return views_[v]; }
   // Ok for a usable view; for a dropped one, why its index chunk could not be used.
@@ -44,7 +52,8 @@ class LightfieldReference {
 
   // Decodes view `view`, face `face` (GL order), frame `frame` into `out` (resized).
   // Errors: kInvalidArgument (index out of range), kLightfieldChunk, container errors, and a
-  // dropped view's problem.
+  // dropped view's problem; with coverage kCoverageChunk, and kCoverageDepth for a texel whose
+  // coverage contradicts its lossless depth (sky with cells farther than it).
   Status decode_face(uint32_t view, uint32_t face, uint32_t frame, LightfieldFace* out) const;
 
   // The interpolation weights and keyframes of one colour cell (its t chunk), for tests and tools.
@@ -61,6 +70,7 @@ class LightfieldReference {
   const container::Reader* reader_ = nullptr;
   uint16_t track_ = 0;
   container::LightfieldTrackHeader header_;
+  bool has_coverage_ = false;
   std::vector<LightfieldViewInfo> views_;
   std::vector<Status> view_problems_;
 };

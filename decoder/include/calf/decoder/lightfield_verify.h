@@ -21,7 +21,8 @@ namespace calf::decoder {
 
 // The conformance hash of one decoded face (SPEC §14): XXH3-64, seed 0, of the colour floats'
 // IEEE-754 bit patterns, then the depth codes, then the material codes (absent without material),
-// each value little-endian, in the order LightfieldFace holds them.
+// then per texel the coverage mask and near count (a track with coverage only), each value
+// little-endian, in the order LightfieldFace holds them.
 uint64_t face_hash(const LightfieldFace& face);
 
 // One decoded face's hash.

@@ -99,6 +99,10 @@ struct LightfieldEncodeOptions {
   // one chunk of it (SPEC §11.1.2 "Static groups"). Groups never merge across a segment
   // boundary. false: one chunk per K frames (the layout without static groups).
   bool merge_static_groups = true;
+  // Code the capture set's coverage (format/CAPTURE.md "Coverage") as the track's coverage stream
+  // (SPEC §11.1.11) when the set has it; false drops it. A set without coverage is coded the same
+  // either way.
+  bool coverage = true;
   // Colour RDO strength (calf/encoder/bc_rdo.h): lambda, squared 8-bit sRGB error per estimated
   // bit saved, [0, 1e6]; 0 = off (the blocks as the BCn encoder made them). BC1, BC6H and BC7
   // keyframes; rgba8 / rgba16f ignore it. Applied to the keyframes after the
@@ -136,6 +140,7 @@ struct LightfieldEncodeStats {
   StreamBytes colour;  // keyframe chunks and t chunks together
   StreamBytes depth;
   StreamBytes material;
+  StreamBytes coverage;      // raw: 3 bytes per texel (mask, near count)
   uint64_t index_bytes = 0;  // stored bytes of the per-view index chunks
   uint64_t colour_cells = 0, colour_keyframes = 0;
   uint64_t depth_tiles = 0, depth_keyframes = 0, depth_pframes = 0, depth_empty_pframes = 0;
@@ -173,7 +178,10 @@ struct LightfieldAnalysis {
   // The colour format (never kAuto): options.colour, or for kAuto BC6H when some view is HDR
   // and BC1 otherwise.
   ColourCoding colour = ColourCoding::kBc1;
-  bool hdr = false;                        // colour is BC6H or RGBA16F (header.flags bit 0)
+  bool hdr = false;  // colour is BC6H or RGBA16F (header.flags bit 0)
+  // The track has a coverage stream: the set has coverage and options.coverage is on. The file
+  // is then container version 1.2 (SPEC §11.1.11).
+  bool coverage = false;
   std::vector<LightfieldViewFacts> views;  // one per viewpoint, in manifest order
 };
 

@@ -157,6 +157,9 @@ class Writer {
   Expected<uint32_t> add_stored_chunk(const ChunkKeys& keys, const StoredChunk& chunk);
   // Writes the directory, patches the header and commits. The writer is spent afterwards.
   Status finish();
+  // Raises the header's version_minor to at least `minor`, for contents of a later minor version
+  // that older readers skip (a lightfield coverage stream: kVersionMinorCoverage).
+  void require_minor_version(uint16_t minor);
 
   uint32_t chunk_count() const;
   uint64_t bytes_written() const;

@@ -36,6 +36,9 @@ inline constexpr uint16_t kVersionMajor = 1;  // a reader refuses any other majo
 // required_features bit. 1.1 defines bit 0 (a compressed directory); a writer writes minor 1 only
 // when it sets that bit, so a file with a plain directory is byte for byte a 1.0 file.
 inline constexpr uint16_t kVersionMinor = 1;
+// 1.2: a lightfield track may hold a coverage stream (stream tag 5, SPEC §11.1.11), which 1.0 and
+// 1.1 readers skip; a writer writes minor 2 only for a file that holds one.
+inline constexpr uint16_t kVersionMinorCoverage = 2;
 inline constexpr uint64_t kHeaderSize = 64;
 inline constexpr uint64_t kAlignment = 16;  // chunk offsets and the directory offset
 // Must-understand feature bits (SPEC.md "Header"). Bit 0 (1.1): the directory is its body's size

@@ -75,6 +75,8 @@ enum class ErrorKind : uint8_t {
   X(kContainerBufferSize, 62, kInvalidArgument, "a buffer does not match a chunk's raw length") \
   X(kContainerWriterMisuse, 63, kInvalidArgument, "the writer got a value the format forbids")  \
   X(kContainerCompressor, 64, kInternal, "the compression library failed")                      \
+  X(kCoverageChunk, 65, kCorrupt, "a coverage chunk's edge texels break their counts")        \
+  X(kCoverageDepth, 66, kCorrupt, "a coverage texel contradicts its depth")                    \
   /* block codecs: 100-129 */                                                                   \
   X(kBcDimensions, 100, kInvalidArgument, "an image is empty or wider/taller than 65536 px")   \
   X(kBcBufferSize, 101, kInvalidArgument, "a pixel or block buffer is smaller than needed")    \
@@ -188,6 +190,7 @@ enum class ErrorKind : uint8_t {
   X(kTilesEmpty, 252, kInvalidArgument, "the capture frame has no view or no finite depth")     \
   X(kTilesBudget, 253, kInvalidArgument, "the tile budget cannot cover the view region")        \
   X(kTilesAtlas, 254, kLimit, "the tile textures do not fit the largest atlas")                 \
+  X(kEncoderCoverage, 255, kCorrupt, "capture coverage is not whole 1/16 cells of its mask")     \
   /* decoder: 300-399 */                                                                        \
   X(kDecoderArgument, 300, kInvalidArgument, "a decoder option, frame, view or eye is invalid") \
   /* player: 400-499 */                                                                         \

@@ -29,7 +29,8 @@ namespace calf::container {
 // Stream tags (SPEC.md §11.1).
 #define CALF_LIGHTFIELD_STREAMS(X) \
   X(kIndex, 0, "index")            \
-  X(kColour, 1, "colour") X(kDepth, 2, "depth") X(kMaterial, 3, "material") X(kTParams, 4, "t")
+  X(kColour, 1, "colour")          \
+  X(kDepth, 2, "depth") X(kMaterial, 3, "material") X(kTParams, 4, "t") X(kCoverage, 5, "coverage")
 enum class LightfieldStream : uint16_t { CALF_LIGHTFIELD_STREAMS(CALF_STREAM_ENUM) };
 
 // Track header (36 bytes, SPEC.md §11.1); later fields are appended.
@@ -62,7 +63,7 @@ struct LightfieldTrackHeader {
 };
 static_assert(fixed_size<LightfieldTrackHeader>() == 36);
 static_assert(std::size(LightfieldTrackHeader::kStreamNames) ==
-              static_cast<size_t>(LightfieldStream::kTParams) + 1);
+              static_cast<size_t>(LightfieldStream::kCoverage) + 1);
 
 }  // namespace calf::container
 
@@ -166,6 +167,9 @@ enum class RegionCoding : uint8_t {
   kBc5,   // depth, BC5 with block split
   kRgb8,  // material, three byte planes
   kBc1,   // material, BC1 with block split
+  // coverage (§11.1.11): per rectangle a bitmap of its edge texels, then the edge texels' mask
+  // high bytes, mask low bytes and near counts as three planes; other texels are plain.
+  kCoverage,
 };
 // Errors: CALF-E203 for a format §11.1 does not allow for the stream.
 Expected<RegionCoding> depth_coding(uint16_t depth_format);
@@ -213,8 +217,9 @@ struct RegionChunk {
   std::vector<uint32_t>
       first_rect;  // frame_count + 1 entries: frame i owns rects [first_rect[i], first_rect[i + 1])
   std::vector<RegionRect> rects;
-  uint64_t units = 0;       // texels or blocks of all rects (kR16PredictedMasked: stored texels)
-  uint64_t mask_bytes = 0;  // kR16PredictedMasked: the masks before the planes; else 0
+  uint64_t units = 0;       // texels or blocks of all rects (kR16PredictedMasked: stored texels;
+                            // kCoverage: edge texels)
+  uint64_t mask_bytes = 0;  // kR16PredictedMasked, kCoverage: the masks before the planes; else 0
   std::span<const uint8_t> payload;
 };
 // `frame_count` is the chunk's key (ChunkKeys::frame_count); the chunk must agree with it.
@@ -225,18 +230,50 @@ Expected<RegionChunk> parse_region_chunk(std::span<const uint8_t> raw, uint32_t 
 // True when rect `index` stores only some of its texels (a kR16PredictedMasked P-frame rectangle):
 // its other texels are the decoder's tile state, which region_rect_gpu_bytes then reads from `out`.
 inline bool region_rect_reads_state(const RegionChunk& chunk, size_t index) {
-  return chunk.rects[index].mask_offset != RegionRect::kNoMask;
+  return chunk.coding == RegionCoding::kR16PredictedMasked &&
+         chunk.rects[index].mask_offset != RegionRect::kNoMask;
 }
 
 // The GPU-ready bytes (clip_decoder.h's update formats) of rect `index` of a parsed region chunk:
 // kR16, kR16Predicted, kR16PredictedMasked -> little-endian u16 codes; kBc5 / kBc1 -> whole
-// blocks, row-major; kRgb8 -> RGBA8 (reflect, refract, ior, 255). Replaces `out`, except when
-// region_rect_reads_state(): then `out` must hold on entry the rectangle's codes in the decoder's
-// tile state (2 w h bytes, little-endian, row-major; the frame before, or any frame of the window
-// §11.1.3 allows), and only its changed texels are rewritten.
+// blocks, row-major; kRgb8 -> RGBA8 (reflect, refract, ior, 255); kCoverage -> 4 bytes per texel
+// (CoverageTexel::gpu_bytes: mask low byte, mask high byte, near count, far count). Replaces `out`,
+// except when region_rect_reads_state(): then `out` must hold on entry the rectangle's codes in the
+// decoder's tile state (2 w h bytes, little-endian, row-major; the frame before, or any frame of
+// the window §11.1.3 allows), and only its changed texels are rewritten.
 void region_rect_gpu_bytes(const RegionChunk& chunk, size_t index, std::vector<uint8_t>& out);
 // The GPU format of those bytes.
 container::PixelFormat region_gpu_format(RegionCoding coding);
+
+// ---- Coverage (§11.1.11) ----
+
+// The coverage of one texel (format/CAPTURE.md "Coverage"): the 4 x 4 cell mask of the cells that
+// show the texel's own surface (bit 4 j + i for cell (i, j)) and how many of the others lie nearer
+// than its depth; the rest, 16 - near - popcount(mask), lie farther (or are sky).
+struct CoverageTexel {
+  uint16_t mask = 0xFFFF;
+  uint8_t near = 0;
+  // Whether it is the plain texel, wholly its own surface: a coverage chunk stores only others.
+  bool plain() const { return mask == 0xFFFF && near == 0; }
+  // near <= 16 and near + popcount(mask) <= 16.
+  bool valid() const;
+  uint8_t far() const;  // 16 - near - popcount(mask); valid() texels only
+  friend bool operator==(const CoverageTexel&, const CoverageTexel&) = default;
+};
+inline constexpr size_t kCoverageGpuBytes = 4;
+// A coverage texel from its 4 GPU bytes (region_rect_gpu_bytes), and back.
+inline CoverageTexel coverage_from_gpu(const uint8_t* p) {
+  return {static_cast<uint16_t>(p[0] | p[1] << 8), p[2]};
+}
+void coverage_to_gpu(const CoverageTexel& t, uint8_t* p);
+
+// Appends the coverage payload (§11.1.11) of `rects` (each `texels` of w x h row-major coverage
+// texels, in the head's order): every rectangle's edge bitmap, then the three planes.
+struct CoverageRect {
+  uint32_t width = 0, height = 0;
+  std::span<const CoverageTexel> texels;
+};
+void append_coverage_payload(std::vector<uint8_t>& out, std::span<const CoverageRect> rects);
 
 // CALF-E203 unless `colour_format` is one §11.1 allows for colour (BC1, BC7, BC6H, rgba8, rgba16f).
 Status check_colour_format(uint16_t colour_format);

@@ -76,6 +76,10 @@ class LightfieldRepresentation final : public Representation {
 
   // Whether any view carries material (the RR variant needs it).
   bool has_material() const;
+  // The CPU backend's views after the last prepare(), indexed like the clip (a view never active
+  // yet is a one-texel placeholder), with the clip's coverage where it has a coverage stream;
+  // nullptr for the GL backend. For tests and tools.
+  const ViewSet* cpu_views() const;
   const std::vector<Vec3>& viewpoints() const;
   // Changes render options (RR, steps, ...) from the next render; CALF-E403 on invalid ones.
   Status set_render_options(const RenderOptions& options);

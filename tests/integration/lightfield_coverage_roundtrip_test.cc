@@ -1,0 +1,354 @@
+// The lightfield coverage stream end to end (format/SPEC.md §11.1.11): a capture set with
+// coverage (format/CAPTURE.md "Coverage") encoded by calf-encode's library, decoded by the
+// reference decoder, the view-dependent decoder and the CPU player's views, each compared with the
+// capture set's own channels; the option that drops it; what the encoder refuses; and damaged
+// coverage chunks.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <bit>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "calf/capture/capture_set.h"
+#include "calf/decoder/clip_decoder.h"
+#include "calf/decoder/cpu_textures.h"
+#include "calf/decoder/lightfield_reference.h"
+#include "calf/decoder/lightfield_verify.h"
+#include "calf/encoder/lightfield_encode.h"
+#include "calf/format/container.h"
+#include "calf/format/lightfield_layout.h"
+#include "calf/player/lightfield_representation.h"
+#include "synthetic_capture.h"
+
+namespace calf {
+namespace {
+
+namespace fs = std::filesystem;
+using container::LightfieldStream;
+using testing_support::SceneSpec;
+
+capture::ViewFrame frame_with_coverage(const SceneSpec& s, uint32_t view, uint32_t frame) {
+  return testing_support::make_frame(s, view, frame);  // s.coverage: add_coverage's channels
+}
+
+// The set of `s` with or without its coverage channels.
+Status write_coverage_capture(const fs::path& dir, SceneSpec s, bool with_coverage) {
+  s.coverage = with_coverage;
+  return testing_support::write_synthetic_capture(dir, s);
+}
+
+class LightfieldCoverage : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root_ = fs::temp_directory_path() /
+            ("calf_cov_" + std::to_string(::getpid()) + "_" +
+             ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(root_);
+    fs::create_directories(root_);
+    spec_.face = 16;
+    spec_.frames = 5;
+    spec_.views = 2;
+    spec_.coverage = true;
+    ASSERT_TRUE(write_coverage_capture(root_ / "cov", spec_, true).ok());
+  }
+  void TearDown() override { fs::remove_all(root_); }
+
+  std::vector<uint8_t> encode(const fs::path& set, const LightfieldEncodeOptions& o,
+                              LightfieldEncodeStats* stats = nullptr) {
+    std::vector<uint8_t> bytes;
+    auto in = capture::CaptureSetReader::open(set);
+    EXPECT_TRUE(in.ok()) << in.status().to_string();
+    auto writer = container::Writer::create(container::memory_sink(&bytes));
+    EXPECT_TRUE(writer.ok());
+    auto s = encode_lightfield(*in, *writer, o);
+    EXPECT_TRUE(s.ok()) << s.status().to_string();
+    if (stats != nullptr && s.ok()) *stats = *s;
+    EXPECT_TRUE(writer->finish().ok());
+    return bytes;
+  }
+
+  static container::Reader open(const std::vector<uint8_t>& bytes) {
+    auto r = container::Reader::open(container::memory_source(bytes));
+    EXPECT_TRUE(r.ok()) << r.status().to_string();
+    return std::move(*r);
+  }
+
+  // The set's coverage of (view, frame, face) as the stream codes it.
+  std::vector<lf::CoverageTexel> expected(uint32_t view, uint32_t frame, uint32_t face) const {
+    const capture::ViewFrame vf = frame_with_coverage(spec_, view, frame);
+    std::vector<lf::CoverageTexel> out;
+    for (uint32_t y = 0; y < spec_.face; ++y) {
+      for (uint32_t x = 0; x < spec_.face; ++x) {
+        const size_t i = vf.texel_index(static_cast<CubeFace>(face), x, y);
+        out.push_back({static_cast<uint16_t>(vf.coverage[3 * i + 2]),
+                       static_cast<uint8_t>(vf.coverage[3 * i] * 16)});
+      }
+    }
+    return out;
+  }
+
+  fs::path root_;
+  SceneSpec spec_;
+};
+
+TEST_F(LightfieldCoverage, ReferenceDecoderGivesBackTheSetsCoverageExactly) {
+  for (const DepthCoding depth : {DepthCoding::kRaw16PredictedMasked, DepthCoding::kRaw16}) {
+    LightfieldEncodeOptions o;
+    o.cell_size = 8;
+    o.depth = depth;
+    o.depth_keyframe_interval = 2;  // groups, static runs and P-frames with coverage
+    LightfieldEncodeStats stats;
+    const std::vector<uint8_t> bytes = encode(root_ / "cov", o, &stats);
+    const container::Reader r = open(bytes);
+    EXPECT_EQ(r.header().version_minor, container::kVersionMinorCoverage);
+    EXPECT_GT(stats.coverage.chunks, 0u);
+    EXPECT_GT(stats.coverage.stored, 0u);
+    auto ref = decoder::LightfieldReference::open(r, 0);
+    ASSERT_TRUE(ref.ok()) << ref.status().to_string();
+    EXPECT_TRUE(ref->has_coverage());
+    decoder::LightfieldFace face;
+    for (uint32_t frame = 0; frame < spec_.frames; ++frame) {
+      for (uint32_t v = 0; v < spec_.views; ++v) {
+        for (uint32_t f = 0; f < 6; ++f) {
+          ASSERT_TRUE(ref->decode_face(v, f, frame, &face).ok());
+          EXPECT_EQ(face.coverage, expected(v, frame, f))
+              << "view " << v << " face " << f << " frame " << frame;
+        }
+      }
+    }
+    const decoder::LightfieldVerifyResult verified =
+        decoder::verify_lightfield_track(r, 0, true, 10);
+    EXPECT_TRUE(verified.problems.empty())
+        << (verified.problems.empty() ? "" : verified.problems[0].to_string());
+  }
+}
+
+TEST_F(LightfieldCoverage, ViewDependentDecoderAndCpuPlayerSeeTheSameCoverage) {
+  LightfieldEncodeOptions o;
+  o.cell_size = 8;
+  o.depth_keyframe_interval = 2;
+  const std::vector<uint8_t> bytes = encode(root_ / "cov", o);
+  const container::Reader r = open(bytes);
+  decoder::ClipDecoderOptions dopt;
+  dopt.view_dependent = false;
+  dopt.background_thread = false;
+  dopt.coverage = true;
+  auto dec = decoder::ClipDecoder::open(r, 0, dopt);
+  ASSERT_TRUE(dec.ok()) << dec.status().to_string();
+  EXPECT_TRUE(dec->has_coverage());
+  std::vector<decoder::LightfieldViewInfo> infos = {dec->view(0), dec->view(1)};
+  decoder::CpuTextures tex(dec->header(), infos);
+  decoder::FrameUpdates updates;
+  // Frames in an order that seeks backwards and across groups.
+  for (const uint32_t frame : {0u, 1u, 4u, 2u, 3u, 0u}) {
+    ASSERT_TRUE(dec->advance(frame, {}, {}, &updates).ok());
+    EXPECT_EQ(updates.stats.errors, 0u) << updates.stats.first_error;
+    ASSERT_TRUE(tex.apply(updates).ok());
+    for (uint32_t v = 0; v < spec_.views; ++v) {
+      for (uint32_t f = 0; f < 6; ++f) {
+        const auto got = tex.coverage(v, static_cast<CubeFace>(f));
+        const auto want = expected(v, frame, f);
+        ASSERT_EQ(std::vector<lf::CoverageTexel>(got.begin(), got.end()), want)
+            << "view " << v << " face " << f << " frame " << frame;
+      }
+    }
+  }
+  // Off (the default, and the GL player's): no coverage update at all.
+  dopt.coverage = false;
+  auto plain = decoder::ClipDecoder::open(r, 0, dopt);
+  ASSERT_TRUE(plain.ok());
+  ASSERT_TRUE(plain->advance(0, {}, {}, &updates).ok());
+  for (const auto& u : updates.updates) EXPECT_NE(u.target, decoder::UpdateTarget::kCoverage);
+  EXPECT_EQ(updates.stats.coverage_bytes, 0u);
+
+  // The CPU player's views hold the capture set's channels, value for value, as
+  // player::load_capture_views puts them into the views of a capture set.
+  player::LightfieldOptions lo;
+  lo.decoder.view_dependent = false;
+  lo.decoder.background_thread = false;
+  auto lf = player::LightfieldRepresentation::open(r, 0, lo, player::RenderBackend::kCpu, nullptr);
+  ASSERT_TRUE(lf.ok()) << lf.status().to_string();
+  Camera cam;
+  cam.position = {0.25, 0, 0};
+  cam.width = 8;
+  cam.height = 8;
+  for (const uint32_t frame : {0u, 3u, 1u}) {
+    ASSERT_TRUE((*lf)->prepare(frame, std::span<const Camera>(&cam, 1)).ok());
+    const player::ViewSet* views = (*lf)->cpu_views();
+    ASSERT_NE(views, nullptr);
+    for (uint32_t v = 0; v < spec_.views; ++v) {
+      const player::View& view = views->views[v];
+      ASSERT_TRUE(view.has_coverage());
+      const capture::ViewFrame vf = frame_with_coverage(spec_, v, frame);
+      for (uint32_t f = 0; f < 6; ++f) {
+        const CubeFace face = static_cast<CubeFace>(f);
+        for (uint32_t y = 0; y < spec_.face; ++y) {
+          for (uint32_t x = 0; x < spec_.face; ++x) {
+            const size_t i = vf.texel_index(face, x, y);
+            const player::Coverage c = view.coverage_at(face, x, y);
+            ASSERT_EQ(c.near, vf.coverage[3 * i]) << v << " " << f << " " << x << " " << y;
+            ASSERT_EQ(c.far, vf.coverage[3 * i + 1]) << v << " " << f << " " << x << " " << y;
+            ASSERT_EQ(c.mask, vf.coverage[3 * i + 2]) << v << " " << f << " " << x << " " << y;
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST_F(LightfieldCoverage, DroppedOrAbsentCoverageLeavesTheClipAsWithout) {
+  ASSERT_TRUE(write_coverage_capture(root_ / "plain", spec_, false).ok());
+  LightfieldEncodeOptions o;
+  o.cell_size = 8;
+  const std::vector<uint8_t> without = encode(root_ / "plain", o);
+  o.coverage = false;
+  const std::vector<uint8_t> dropped = encode(root_ / "cov", o);
+  // The same bytes: no coverage stream, container 1.1, whatever the manifest's version.
+  EXPECT_EQ(dropped, without);
+  const container::Reader r = open(dropped);
+  EXPECT_EQ(r.header().version_minor, container::kVersionMinor);
+  EXPECT_FALSE(decoder::track_has_coverage(r, 0));
+  o.coverage = true;
+  EXPECT_EQ(encode(root_ / "plain", o), without);
+}
+
+TEST_F(LightfieldCoverage, CoverageTheStreamCannotHoldIsRefusedWithE255) {
+  const fs::path dir = root_ / "bad";
+  SceneSpec s = spec_;
+  s.views = 1;
+  s.frames = 1;
+  capture::CaptureManifest m;
+  m.version = capture::kCaptureCoverageVersion;
+  m.coverage = true;
+  m.frame_count = 1;
+  m.face_size = s.face;
+  m.view_volume = {{-1, -1, -1}, {1, 1, 1}};
+  m.viewpoints.push_back({"v0", {0, 0, 0}});
+  m.fps = 24;
+  for (const auto& [near, far, mask] : std::vector<std::tuple<float, float, float>>{
+           {0.3f, 0.0f, 65535.0f},    // not a sixteenth
+           {0.25f, 0.25f, 65535.0f},  // 8 + 16 cells
+           {0.0f, 0.0f, 0.0f},        // no cell at all
+           {0.0f, 0.5f, 255.0f},      // a sky texel (face 3, row 2) with cells farther than sky
+       }) {
+    fs::remove_all(dir);
+    auto w = capture::CaptureSetWriter::create(dir, m);
+    ASSERT_TRUE(w.ok());
+    capture::ViewFrame vf = frame_with_coverage(s, 0, 0);
+    const bool sky = mask == 255.0f;
+    const size_t i = vf.texel_index(sky ? CubeFace::kNegY : CubeFace::kPosY, 2, sky ? 2 : 3);
+    vf.coverage[3 * i] = near;
+    vf.coverage[3 * i + 1] = far;
+    vf.coverage[3 * i + 2] = mask;
+    ASSERT_TRUE(w->write(0, 0, vf).ok());
+    ASSERT_TRUE(w->finish().ok());
+    const fs::path out = root_ / "bad.calf";
+    LightfieldEncodeOptions o;
+    auto stats = encode_lightfield_file(dir, out.string(), o);
+    ASSERT_FALSE(stats.ok());
+    EXPECT_EQ(stats.status().id(), ErrorId::kEncoderCoverage) << stats.status().to_string();
+    EXPECT_NE(stats.status().message().find(sky ? "face 3 texel (2, 2)" : "face 2 texel (2, 3)"),
+              std::string::npos)
+        << stats.status().message();
+    EXPECT_FALSE(fs::exists(out));  // nothing written
+    o.coverage = false;
+    EXPECT_TRUE(encode_lightfield_file(dir, out.string(), o).ok());
+    fs::remove(out);
+  }
+}
+
+// The clip with one coverage chunk's payload rewritten by `edit` (every chunk stored raw).
+std::vector<uint8_t> with_coverage_chunk(const container::Reader& r, uint32_t view, uint32_t face,
+                                         uint32_t tile,
+                                         const std::function<void(std::vector<uint8_t>&)>& edit) {
+  std::vector<uint8_t> out;
+  auto w = container::Writer::create(container::memory_sink(&out));
+  EXPECT_TRUE(w.ok());
+  EXPECT_TRUE(w->add_track(std::get<container::LightfieldTrackHeader>(r.tracks()[0].header)).ok());
+  w->require_minor_version(r.header().version_minor);
+  bool edited = false;
+  for (uint32_t id = 0; id < r.chunks().size(); ++id) {
+    const container::ChunkKeys& k = r.chunks()[id].keys;
+    auto raw = r.read_chunk(id);
+    EXPECT_TRUE(raw.ok());
+    if (k.stream == static_cast<uint16_t>(LightfieldStream::kCoverage) && k.view == view &&
+        k.face == face && k.region == tile && !edited) {
+      edit(*raw);
+      edited = true;
+    }
+    EXPECT_TRUE(w->add_chunk(k, *raw, container::Compression::kNone).ok());
+  }
+  EXPECT_TRUE(edited);
+  EXPECT_TRUE(w->finish().ok());
+  return out;
+}
+
+// Rewrites a coverage chunk's keyframe so that tile texel 0 is the edge texel (mask, near).
+void first_texel_edge(std::vector<uint8_t>& raw, uint32_t tile_side, uint16_t mask, uint8_t near) {
+  container::FieldReader reader(raw, ErrorId::kLightfieldChunk, ErrorId::kLightfieldChunk, "t",
+                                ErrorId::kLightfieldChunk);
+  lf::RegionHead head;
+  ASSERT_TRUE(container::read_fields(head, reader).ok());
+  // Keep the head; every rectangle plain but texel 0 of the keyframe's.
+  std::vector<uint8_t> out;
+  ASSERT_TRUE(container::write_fields(head, out, "head").ok());
+  std::vector<std::vector<lf::CoverageTexel>> texels;
+  std::vector<lf::CoverageRect> rects;
+  for (const lf::RegionRect& rr : head.rects) texels.emplace_back(size_t{rr.w} * rr.h);
+  texels[0][0] = {mask, near};
+  for (size_t k = 0; k < head.rects.size(); ++k)
+    rects.push_back({head.rects[k].w, head.rects[k].h, texels[k]});
+  lf::append_coverage_payload(out, rects);
+  ASSERT_EQ(head.rects[0].w, tile_side);
+  raw = std::move(out);
+}
+
+TEST_F(LightfieldCoverage, DamagedCoverageChunksAreE065AndContradictionsE066) {
+  LightfieldEncodeOptions o;
+  o.cell_size = 8;
+  const std::vector<uint8_t> bytes = encode(root_ / "cov", o);
+  const container::Reader r = open(bytes);
+  // Face 3 (-Y), tile 0: its top half is sky (make_frame), so tile texel 0 is sky.
+  const auto counts_over_16 = with_coverage_chunk(
+      r, 1, 3, 0, [](std::vector<uint8_t>& raw) { first_texel_edge(raw, 8, 0x00ff, 9); });
+  const auto far_behind_sky = with_coverage_chunk(
+      r, 1, 3, 0, [](std::vector<uint8_t>& raw) { first_texel_edge(raw, 8, 0x00ff, 4); });
+  const auto fine_over_sky = with_coverage_chunk(
+      r, 1, 3, 0, [](std::vector<uint8_t>& raw) { first_texel_edge(raw, 8, 0x00ff, 8); });
+  struct Case {
+    const std::vector<uint8_t>* file;
+    ErrorId id;
+  };
+  for (const Case& c : {Case{&counts_over_16, ErrorId::kCoverageChunk},
+                        Case{&far_behind_sky, ErrorId::kCoverageDepth}}) {
+    const container::Reader damaged = open(*c.file);
+    const decoder::LightfieldVerifyResult v = decoder::verify_lightfield_track(damaged, 0, true, 4);
+    ASSERT_FALSE(v.problems.empty());
+    EXPECT_EQ(v.problems[0].id(), c.id) << v.problems[0].to_string();
+    EXPECT_NE(v.problems[0].message().find("view 1 face 3"), std::string::npos)
+        << v.problems[0].message();
+    EXPECT_TRUE(v.hashes.empty());
+  }
+  // 8 own sky cells and 8 nearer: no cell farther than sky, a valid clip.
+  const container::Reader fine = open(fine_over_sky);
+  const decoder::LightfieldVerifyResult ok = decoder::verify_lightfield_track(fine, 0, true, 4);
+  EXPECT_TRUE(ok.problems.empty()) << ok.problems[0].to_string();
+  // The view-dependent decoder reports the damaged chunk as a frame error, with its id.
+  const container::Reader damaged = open(counts_over_16);
+  decoder::ClipDecoderOptions dopt;
+  dopt.view_dependent = false;
+  dopt.background_thread = false;
+  dopt.coverage = true;
+  auto dec = decoder::ClipDecoder::open(damaged, 0, dopt);
+  ASSERT_TRUE(dec.ok());
+  decoder::FrameUpdates updates;
+  ASSERT_TRUE(dec->advance(0, {}, {}, &updates).ok());
+  EXPECT_EQ(updates.stats.errors, 1u);
+  EXPECT_EQ(updates.stats.first_error.rfind("CALF-E065", 0), 0u) << updates.stats.first_error;
+}
+
+}  // namespace
+}  // namespace calf
