@@ -7,7 +7,8 @@ export const E = {
   limit: 'CALF-E049', trackKind: 'CALF-E050', trackHeader: 'CALF-E051', metadata: 'CALF-E052',
   chunkRange: 'CALF-E053', chunkLayout: 'CALF-E054', chunkTrack: 'CALF-E055',
   compression: 'CALF-E056', chunkSize: 'CALF-E057', chunkHash: 'CALF-E058',
-  decompress: 'CALF-E059', padding: 'CALF-E060', chunkId: 'CALF-E061', lightfieldChunk: 'CALF-E202',
+  decompress: 'CALF-E059', padding: 'CALF-E060', chunkId: 'CALF-E061', coverageChunk: 'CALF-E065',
+  coverageDepth: 'CALF-E066', lightfieldChunk: 'CALF-E202',
   lightfieldFormat: 'CALF-E203', playbackClip: 'CALF-E460',
 };
 

@@ -1,12 +1,12 @@
 // The lightfield track (format/SPEC.md §11.1): the view index, t, colour keyframe and region
-// (depth, material) chunks, decoded on the CPU to the values the conformance hash covers
-// (§14): linear binary32 RGB, log-16 depth codes, material codes.
+// (depth, material, coverage) chunks, decoded on the CPU to the values the conformance hash
+// covers (§14): linear binary32 RGB, log-16 depth codes, material codes, coverage.
 import { E, CalfError, fail } from './errors.js';
 import { readChunk } from './container.js';
 import { decodeBc1, decodeBc4, decodeBc6h, decodeBc7 } from './bc.js';
 
 export const FORMAT = { none: 0, rgba8: 1, rgba16f: 2, r16: 3, bc1: 4, bc4: 5, bc5: 6, bc6h: 7, bc7: 8, rg8: 9, r16p: 10, r16pm: 11 };
-export const STREAM = { index: 0, colour: 1, depth: 2, material: 3, t: 4 };
+export const STREAM = { index: 0, colour: 1, depth: 2, material: 3, t: 4, coverage: 5 };
 const COLOUR_FORMATS = [FORMAT.bc1, FORMAT.bc7, FORMAT.bc6h, FORMAT.rgba8, FORMAT.rgba16f];
 const DEPTH_FORMATS = [FORMAT.r16, FORMAT.r16p, FORMAT.r16pm, FORMAT.bc5];
 const MATERIAL_FORMATS = [FORMAT.rgba8, FORMAT.bc1];
@@ -146,8 +146,9 @@ export function interpolate(a, b, t) {
 }
 
 // §11.1.6: a region chunk parsed; frames[i] = rectangles of frame i, each with its texel
-// values in `values` (depth codes, or 3 material bytes a texel), or for r16pm its residuals
-// and change mask (`residuals`, `mask`; none for the keyframe's rectangle).
+// values in `values` (depth codes, 3 material bytes a texel, or for kind 'coverage' (§11.1.11)
+// 2 values a texel: mask and near count), or for r16pm its residuals and
+// change mask (`residuals`, `mask`; none for the keyframe's rectangle).
 export function parseRegion(raw, kind, format, tw, th, frameCount, what) {
   const v = new DataView(raw.buffer, raw.byteOffset, raw.length);
   if (raw.length < 4) bad(`${what}: ${raw.length} bytes`);
@@ -186,7 +187,9 @@ export function parseRegion(raw, kind, format, tw, th, frameCount, what) {
   const payload = raw.subarray(p);
   const T = rects.reduce((s, r) => s + r.w * r.h, 0);
   const B = rects.reduce((s, r) => s + Math.ceil(r.w / 4) * Math.ceil(r.h / 4), 0);
-  if (kind === 'depth') {
+  if (kind === 'coverage') {
+    parseCoverage(payload, rects, what);
+  } else if (kind === 'depth') {
     if (format === FORMAT.r16 || format === FORMAT.r16p) {
       if (payload.length !== 2 * T) bad(`${what}: payload of ${payload.length} bytes, expected ${2 * T}`);
       let q = 0;
@@ -266,6 +269,42 @@ export function parseRegion(raw, kind, format, tw, th, frameCount, what) {
   return frames;
 }
 
+// §11.1.11: the edge bitmaps of every rectangle, then the mask high bytes, mask low bytes and
+// near counts of the E edge texels; each rectangle's values get (mask, near) a texel, the
+// plain texel (65535, 0) where it is no edge. A bitmap bit past its rectangle or an edge
+// texel that breaks its counts is CALF-E065, a payload of another size CALF-E202 (checked
+// before the texels, as the reference decoder does).
+function parseCoverage(payload, rects, what) {
+  let m = 0, edges = 0;
+  for (let k = 0; k < rects.length; ++k) {
+    const r = rects[k], n = r.w * r.h, M = Math.ceil(n / 8);
+    if (m + M > payload.length) bad(`${what}: payload of ${payload.length} bytes, shorter than its edge bitmaps`);
+    r.mask = payload.subarray(m, m + M);
+    for (let i = 0; i < n; ++i) edges += (r.mask[i >> 3] >> (i & 7)) & 1;
+    if (n % 8 && (r.mask[M - 1] >> (n % 8))) fail(E.coverageChunk, `${what}: edge bitmap of rectangle ${k} has bits set past its ${n} texels`);
+    m += M;
+  }
+  if (payload.length !== m + 3 * edges) bad(`${what}: payload of ${payload.length} bytes, expected ${m + 3 * edges}`);
+  let q = 0;
+  for (const r of rects) {
+    const n = r.w * r.h;
+    r.values = new Uint16Array(2 * n);
+    for (let i = 0; i < n; ++i) {
+      if (!((r.mask[i >> 3] >> (i & 7)) & 1)) { r.values[2 * i] = 0xffff; continue; }
+      const mask = (payload[m + q] << 8) | payload[m + edges + q], near = payload[m + 2 * edges + q];
+      let pop = 0;
+      for (let b = mask; b; b &= b - 1) ++pop;
+      if (near > 16 || near + pop > 16 || (mask === 0xffff && near === 0)) {
+        fail(E.coverageChunk, `${what}: edge texel ${q} has mask 0x${mask.toString(16).padStart(4, '0')} and near count ${near}` +
+          (mask === 0xffff && near === 0 ? ' (a plain texel, not an edge)' : ' (more than 16 cells)'));
+      }
+      r.values[2 * i] = mask; r.values[2 * i + 1] = near;
+      ++q;
+    }
+    r.mask = null;
+  }
+}
+
 // §11.1.8: an r16p rectangle's residuals → codes, in place, row-major (each texel predicted
 // from its already decoded neighbours in the rectangle). r16pm's rectangles are decoded
 // against the tile state instead, in applyRegionFrame.
@@ -316,7 +355,8 @@ export function applyRegionFrame(rects, state, tw, channels) {
 }
 
 // Opens lightfield track t of an opened clip: formats, chunk keys, view index chunks.
-// Returns the track, with `views[v]` null and `viewProblems[v]` set for a dropped view.
+// Returns the track, with `views[v]` null and `viewProblems[v]` set for a dropped view, and
+// `hasCoverage` when it holds any coverage chunk (§11.1.11).
 export async function openLightfield(clip, t) {
   const h = clip.tracks[t].header;
   if (!COLOUR_FORMATS.includes(h.colour_format)) fail(E.lightfieldFormat, `track ${t}: colour format ${h.colour_format}`);
@@ -326,7 +366,7 @@ export async function openLightfield(clip, t) {
   const byKey = new Map();
   const indexChunks = Array.from({ length: h.view_count }, () => []);
   for (const c of clip.chunks) {
-    if (c.track !== t || c.stream > 4) continue;
+    if (c.track !== t || c.stream > STREAM.coverage) continue;
     if (c.stream === STREAM.index) {
       if (c.view < h.view_count) indexChunks[c.view].push(c);
       continue;
@@ -355,18 +395,23 @@ export async function openLightfield(clip, t) {
     }
   }
   if (views.every((x) => x === null)) throw viewProblems[0];
-  return { clip, track: t, header: h, cells, tiles, byKey, views, viewProblems };
+  const hasCoverage = clip.chunks.some((c) => c.track === t && c.stream === STREAM.coverage);
+  return { clip, track: t, header: h, cells, tiles, byKey, views, viewProblems, hasCoverage };
 }
 
 // Decodes every frame of one face of one view in order; calls onFrame(n, colour, depth,
-// material) with the face's arrays (reused between frames). With `only` ({ cells, tiles }: Sets
-// of colour cell and depth tile indices) the other regions are neither read nor written. Frames are decoded in order, so a
-// region chunk is read once and its P-frames applied as they come.
-export async function decodeFaceFrames(lf, v, face, onFrame, only = null) {
+// material, coverage) with the face's arrays (reused between frames). With `only` ({ cells,
+// tiles }: Sets of colour cell and depth tile indices) the other regions are neither read nor
+// written. Coverage (§11.1.11; mask and near count a texel) is decoded only with
+// `{ coverage: true }` in a track with coverage, else it is null and no coverage chunk is read.
+// Frames are decoded in order, so a region chunk is read once and its P-frames applied as
+// they come.
+export async function decodeFaceFrames(lf, v, face, onFrame, only = null, { coverage: withCoverage = false } = {}) {
   const h = lf.header, N = h.face_size, t = lf.track;
   const view = lf.views[v];
   const colour = new Float32Array(3 * N * N), depth = new Uint16Array(N * N);
   const material = view.hasMaterial ? new Uint8Array(3 * N * N) : null;
+  const coverage = withCoverage && lf.hasCoverage ? new Uint16Array(2 * N * N) : null;
   const find = (stream, region) => lf.byKey.get(`${stream}/${v}/${face}/${region}`) ?? [];
   const read = (c) => readChunk(lf.clip, c.id);
   // Colour cells: timelines and a cache of decoded keyframes.
@@ -384,10 +429,14 @@ export async function decodeFaceFrames(lf, v, face, onFrame, only = null) {
   }
   const tileState = (stream, channels) => Array.from({ length: lf.tiles.count }, (_, r) => r).filter((r) => !only || only.tiles.has(r)).map((r) => {
     const rect = lf.tiles.rect(r);
-    return { r, rect, chunk: null, frames: null, state: new (channels === 1 ? Uint16Array : Uint8Array)(channels * rect.w * rect.h), stream, channels };
+    return { r, rect, chunk: null, frames: null, state: new (channels === 3 ? Uint8Array : Uint16Array)(channels * rect.w * rect.h), stream, channels };
   });
   const depthTiles = tileState(STREAM.depth, 1);
   const materialTiles = material ? tileState(STREAM.material, 3) : [];
+  const coverageTiles = coverage ? tileState(STREAM.coverage, 2) : [];
+  const KIND = { [STREAM.depth]: 'depth', [STREAM.material]: 'material', [STREAM.coverage]: 'coverage' };
+  const FORMATS = { [STREAM.depth]: h.depth_format, [STREAM.material]: h.material_format, [STREAM.coverage]: 0 };
+  const lossless = h.depth_format !== FORMAT.bc5;
   for (let n = 0; n < h.frame_count; ++n) {
     for (let r = 0; r < cellState.length; ++r) {
       const cell = cellState[r];
@@ -409,30 +458,50 @@ export async function decodeFaceFrames(lf, v, face, onFrame, only = null) {
       const { x: cx, y: cy, w: cw, h: ch } = cell.rect;
       for (let y = 0; y < ch; ++y) colour.set(values.subarray(3 * y * cw, 3 * (y + 1) * cw), 3 * ((cy + y) * N + cx));
     }
-    for (const tile of [...depthTiles, ...materialTiles]) {
-      const isDepth = tile.stream === STREAM.depth;
-      const where = `track ${t} view ${v} face ${face} ${isDepth ? 'depth' : 'material'} tile ${tile.r}`;
+    for (const tile of [...depthTiles, ...materialTiles, ...coverageTiles]) {
+      const kind = KIND[tile.stream];
+      const where = `track ${t} view ${v} face ${face} ${kind} tile ${tile.r}`;
       if (!tile.chunk || n >= tile.chunk.firstFrame + tile.chunk.frameCount) {
         const c = find(tile.stream, tile.r).find((x) => x.firstFrame <= n && n < x.firstFrame + x.frameCount);
         if (!c) bad(`${where}: no chunk for frame ${n}`);
         tile.chunk = c;
-        tile.frames = parseRegion(await read(c), isDepth ? 'depth' : 'material', isDepth ? h.depth_format : h.material_format,
+        tile.frames = parseRegion(await read(c), kind, FORMATS[tile.stream],
           tile.rect.w, tile.rect.h, c.frameCount, `${where} frames ${c.firstFrame}+${c.frameCount}`);
         if (n !== c.firstFrame) bad(`${where}: frame ${n} inside a chunk not decoded from its start`);
       }
       applyRegionFrame(tile.frames[n - tile.chunk.firstFrame], tile.state, tile.rect.w, tile.channels);
-      const dst = isDepth ? depth : material, ch = tile.channels, { x: tx, y: ty, w: tw, h: th } = tile.rect;
+      const dst = { depth, material, coverage }[kind], ch = tile.channels, { x: tx, y: ty, w: tw, h: th } = tile.rect;
       for (let y = 0; y < th; ++y) dst.set(tile.state.subarray(ch * y * tw, ch * (y + 1) * tw), ch * ((ty + y) * N + tx));
     }
-    await onFrame(n, colour, depth, material);
+    // §11.1.11: with lossless depth, a sky texel has no cell farther than it.
+    if (coverage && lossless) {
+      for (let i = 0; i < N * N; ++i) {
+        if (depth[i] !== 65535) continue;
+        const mask = coverage[2 * i], near = coverage[2 * i + 1];
+        let pop = 0;
+        for (let b = mask; b; b &= b - 1) ++pop;
+        if (16 - near - pop !== 0) {
+          fail(E.coverageDepth, `track ${t} view ${v} face ${face} frame ${n} texel (${i % N}, ${Math.floor(i / N)}): sky depth with coverage mask 0x${mask.toString(16).padStart(4, '0')} and near count ${near}, ${16 - near - pop} cells farther than sky`);
+        }
+      }
+    }
+    await onFrame(n, colour, depth, material, coverage);
   }
 }
 
-// §14: the conformance hash of one decoded face.
-export function faceHash(codecs, colour, depth, material) {
+// §14: the conformance hash of one decoded face (coverage: a track with coverage's, as
+// decodeFaceFrames gives it; null otherwise).
+export function faceHash(codecs, colour, depth, material, coverage = null) {
   const parts = [new Uint8Array(colour.buffer, colour.byteOffset, colour.byteLength),
     new Uint8Array(depth.buffer, depth.byteOffset, depth.byteLength)];
   if (material) parts.push(material);
+  if (coverage) {
+    const n = coverage.length / 2, bytes = new Uint8Array(3 * n);
+    for (let i = 0; i < n; ++i) {
+      bytes[3 * i] = coverage[2 * i] & 0xff; bytes[3 * i + 1] = coverage[2 * i] >> 8; bytes[3 * i + 2] = coverage[2 * i + 1];
+    }
+    parts.push(bytes);
+  }
   const total = parts.reduce((s, p) => s + p.length, 0);
   const bytes = new Uint8Array(total);
   let o = 0;

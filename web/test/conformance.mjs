@@ -31,9 +31,9 @@ export async function decodeLines(bytes, codecs) {
       if (!lf.views[v]) { problems.push(lf.viewProblems[v].message); continue; }
       for (let f = 0; f < 6; ++f) {
         try {
-          await decodeFaceFrames(lf, v, f, (n, colour, depth, material) => {
-            hashes.set(`${n}/${v}/${f}`, faceHash(codecs, colour, depth, material));
-          });
+          await decodeFaceFrames(lf, v, f, (n, colour, depth, material, coverage) => {
+            hashes.set(`${n}/${v}/${f}`, faceHash(codecs, colour, depth, material, coverage));
+          }, null, { coverage: true });
         } catch (e) {
           if (!(e instanceof CalfError)) throw e;
           problems.push(e.message);
