@@ -48,8 +48,9 @@ export async function httpSource(url, { fetch: fetchImpl = fetch } = {}) {
 // n) and of the next keyframe, which is needed only when t[n] ≠ 0 (`tValue(view, face, cell)`
 // gives t[n] when the t chunk is at hand, else undefined and the next keyframe is planned);
 // per depth (and, for a view with material, material) tile overlapping the cell, the chunk
-// whose frames hold n.
-export function planFrame(lf, n, needed, tValue = () => undefined) {
+// whose frames hold n; and with `{ coverage: true }` in a track with coverage, the tile's
+// coverage chunk whose frames hold n (§11.1.11; not planned otherwise).
+export function planFrame(lf, n, needed, tValue = () => undefined, { coverage = false } = {}) {
   const ids = new Set();
   const list = (stream, v, f, r) => lf.byKey.get(`${stream}/${v}/${f}/${r}`) ?? [];
   const holding = (chunks) => chunks.find((c) => c.firstFrame <= n && n < c.firstFrame + c.frameCount);
@@ -66,6 +67,7 @@ export function planFrame(lf, n, needed, tValue = () => undefined) {
     }
     const rect = lf.cells.rect(cell), side = lf.tiles.side, per = lf.tiles.per;
     const streams = lf.views[view].hasMaterial ? [STREAM.depth, STREAM.material] : [STREAM.depth];
+    if (coverage && lf.hasCoverage) streams.push(STREAM.coverage);
     for (let j = Math.floor(rect.y / side); j <= Math.floor((rect.y + rect.h - 1) / side); ++j) {
       for (let i = Math.floor(rect.x / side); i <= Math.floor((rect.x + rect.w - 1) / side); ++i) {
         for (const s of streams) {

@@ -1,7 +1,8 @@
 // The streaming reader (web/src/stream.js) against a local server with range requests
 // (web/test/range_server.py): the clip opens with two requests; per frame the plan for one
 // face's cells fetches only those chunks, never one twice, and they decode to the face's hash
-// lines with no other read; a server without range support gives one notice and the whole clip.
+// lines with no other read (coverage chunks only when the plan asks for coverage); a server
+// without range support gives one notice and the whole clip.
 //
 //   node web/test/streaming.mjs
 import { spawn } from 'node:child_process';
@@ -27,7 +28,7 @@ async function startServer(args) {
 }
 
 // Streams the cells of one face frame by frame, then decodes the face from the cache alone.
-async function streamFace(codecs, base, name, view, face) {
+async function streamFace(codecs, base, name, view, face, coverage = false) {
   const source = await httpSource(`${base}/${name}.calf`);
   const clip = await openClip(source, codecs);
   const openRequests = source.stats.requests;
@@ -38,15 +39,21 @@ async function streamFace(codecs, base, name, view, face) {
   let twice = 0;
   for (let n = 0; n < lf.header.frame_count; ++n) {
     // t chunks first, so that the plan knows whether the next keyframe is needed.
-    const ids = planFrame(lf, n, needed, cachedT(lf, n));
+    const ids = planFrame(lf, n, needed, cachedT(lf, n), { coverage });
     for (const id of await prefetch(clip, ids.filter((id) => clip.chunks[id].stream === 4))) twice += fetched.has(id) ? 1 : (fetched.add(id), 0);
-    for (const id of await prefetch(clip, planFrame(lf, n, needed, cachedT(lf, n)))) twice += fetched.has(id) ? 1 : (fetched.add(id), 0);
+    const plan = planFrame(lf, n, needed, cachedT(lf, n), { coverage });
+    const plain = planFrame(lf, n, needed, cachedT(lf, n));
+    check(!plain.some((id) => clip.chunks[id].stream === 5), `${name} frame ${n}: a plan without coverage holds a coverage chunk`);
+    if (coverage) check(plan.some((id) => clip.chunks[id].stream === 5), `${name} frame ${n}: a plan with coverage holds no coverage chunk`);
+    for (const id of await prefetch(clip, plan)) twice += fetched.has(id) ? 1 : (fetched.add(id), 0);
   }
   const bytes = source.stats.bytes;
   clip.source = { size: source.size, read: async (o, l) => { throw new Error(`read of ${l} bytes at ${o} after streaming`); } };
   const lines = [];
   try {
-    await decodeFaceFrames(lf, view, face, (n, c, d, m) => { lines.push(`track ${t} frame ${n} view ${view} face ${face} ${faceHash(codecs, c, d, m)}`); });
+    await decodeFaceFrames(lf, view, face, (n, c, d, m, cov) => {
+      lines.push(`track ${t} frame ${n} view ${view} face ${face} ${faceHash(codecs, c, d, m, cov)}`);
+    }, null, { coverage });
   } catch (e) {
     problems.push(`${name}: ${e.message}`);
   }
@@ -73,6 +80,7 @@ try {
   await streamFace(codecs, ranged.base, 'crafted_bc7_raw16_mat', 0, 4);
   await streamFace(codecs, ranged.base, 'bc1_raw16_groups', 0, 1);
   await streamFace(codecs, ranged.base, 'bc6h_raw16_lzma2', 0, 0);
+  await streamFace(codecs, ranged.base, 'coverage_bc1_pred16m', 1, 2, true);
   // No range support: one download, one notice, the same pictures.
   const source = await httpSource(`${plain.base}/bc1_raw16_zstd.calf`);
   check(source.notice && source.stats.requests === 1 && source.stats.bytes === source.size,
