@@ -17,10 +17,16 @@ import { generate as generateBcTables } from '../tools/gen_bc_tables.mjs';
 import { generate as generateGlsl } from '../tools/gen_glsl_conventions.mjs';
 import { generate as generateRaymarch } from '../tools/gen_glsl_raymarch.mjs';
 
-// The lines calf-verify --decode prints for a clip's lightfield tracks, and the problems.
-export async function decodeLines(bytes, codecs) {
+// The lines calf-verify --decode prints for a clip's lightfield tracks, and the problems. With
+// `tamper`, every chunk's raw bytes are cached first and tamper(clip) may change them.
+export async function decodeLines(bytes, codecs, tamper = null) {
   const clip = await openClip(bytesSource(bytes), codecs);
-  for (let i = 0; i < clip.chunks.length; ++i) await readChunk(clip, i);  // every hash and scheme
+  if (tamper) clip.chunkCache = new Map();
+  for (let i = 0; i < clip.chunks.length; ++i) {  // every hash and scheme
+    const raw = await readChunk(clip, i);
+    if (tamper) clip.chunkCache.set(i, raw.slice());
+  }
+  if (tamper) tamper(clip);
   const lines = [], problems = [];
   for (let t = 0; t < clip.tracks.length; ++t) {
     if (clip.tracks[t].kind !== 1) continue;
@@ -82,6 +88,62 @@ async function negativeChecks(codecs) {
   if (got.lines.length !== want.length || changed === 0) {
     problems.push(`a flipped colour byte (chunk ${c.id}) left every hash line as it was`);
   }
+  problems.push(...await coverageChecks(codecs));
+  return problems;
+}
+
+// A wrong coverage decode must fail (SPEC §11.1.11): in coverage_bc1_pred16m's coverage chunk
+// with the most edge texels, a flipped bit of the first mask high byte, the first mask low
+// byte or the last near count changes a hash line or gives CALF-E065; a near count of 17
+// gives CALF-E065; a changed payload size gives CALF-E202.
+async function coverageChecks(codecs) {
+  const problems = [];
+  const path = join(ROOT, 'tests/conformance/lightfield/coverage_bc1_pred16m.calf');
+  const want = readFileSync(path.replace(/\.calf$/, '.hashes'), 'utf8').split('\n').filter(Boolean);
+  const bytes = new Uint8Array(readFileSync(path));
+  // The chunk's head (§11.1.6) and bitmaps read here, independently of the decoder.
+  const layout = (raw) => {
+    const v = new DataView(raw.buffer, raw.byteOffset, raw.length);
+    const F = v.getUint32(0, true);
+    let R = 0;
+    for (let i = 0; i < F; ++i) R += v.getUint32(4 + 4 * i, true);
+    let p = 4 + 4 * F + 8 * R, edges = 0;
+    for (let k = 0; k < R; ++k) {
+      const o = 4 + 4 * F + 8 * k, n = v.getUint16(o + 4, true) * v.getUint16(o + 6, true);
+      for (let i = 0; i < n; ++i) edges += (raw[p + (i >> 3)] >> (i & 7)) & 1;
+      p += Math.ceil(n / 8);
+    }
+    return { planes: p, edges };
+  };
+  let target = null;
+  await decodeLines(bytes, codecs, (clip) => {
+    for (const c of clip.chunks) {
+      if (c.stream !== 5) continue;
+      const l = layout(clip.chunkCache.get(c.id));
+      if (!target || l.edges > target.edges) target = { id: c.id, ...l };
+    }
+  });
+  if (!target || target.edges === 0) return ['coverage_bc1_pred16m: no coverage chunk with an edge texel'];
+  const { id, planes, edges } = target;
+  const run = async (what, change, accept) => {
+    let got;
+    try {
+      got = await decodeLines(bytes, codecs, (clip) => { clip.chunkCache.set(id, change(clip.chunkCache.get(id))); });
+    } catch (e) {
+      if (!(e instanceof CalfError)) throw e;
+      got = { lines: [], problems: [e.message] };
+    }
+    const changed = got.lines.length !== want.length || got.lines.some((l, i) => l !== want[i]);
+    const first = got.problems[0] ?? null;
+    if (!accept(changed, first)) problems.push(`coverage chunk ${id}: ${what}: ${first ?? (changed ? 'hash lines changed' : 'every hash line as it was')}`);
+  };
+  const flip = (at) => (raw) => { raw[at] ^= 0x01; return raw; };
+  const changedOr065 = (changed, first) => first ? first.startsWith('CALF-E065 ') : changed;
+  await run('a flipped mask high byte', flip(planes), changedOr065);
+  await run('a flipped mask low byte', flip(planes + edges), changedOr065);
+  await run('a flipped near count', flip(planes + 3 * edges - 1), changedOr065);
+  await run('near count 17', (raw) => { raw[planes + 2 * edges] = 17; return raw; }, (_, first) => first?.startsWith('CALF-E065 '));
+  await run('a byte short', (raw) => raw.subarray(0, raw.length - 1), (_, first) => first?.startsWith('CALF-E202 '));
   return problems;
 }
 
@@ -208,7 +270,10 @@ async function main() {
   if (process.argv.length <= 2) {
     const negative = await negativeChecks(codecs);
     for (const p of negative) console.log(`web conformance: ${p}`);
-    if (!negative.length) console.log('web conformance: a flipped colour byte is refused (CALF-E058), and with its hash rewritten changes a hash line');
+    if (!negative.length) {
+      console.log('web conformance: a flipped colour byte is refused (CALF-E058), and with its hash rewritten changes a hash line; ' +
+        'flipped coverage bytes change a hash line or give CALF-E065');
+    }
     failures += negative.length;
     const t0 = performance.now();
     const corpus = await containerCorpus(codecs);
