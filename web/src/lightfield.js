@@ -275,10 +275,11 @@ export function parseRegion(raw, kind, format, tw, th, frameCount, what) {
 // texel that breaks its counts is CALF-E065, a payload of another size CALF-E202 (checked
 // before the texels, as the reference decoder does).
 function parseCoverage(payload, rects, what) {
+  const bitmaps = rects.reduce((s, r) => s + Math.ceil(r.w * r.h / 8), 0);
+  if (bitmaps > payload.length) bad(`${what}: payload of ${payload.length} bytes, shorter than its ${bitmaps} bytes of edge bitmaps`);
   let m = 0, edges = 0;
   for (let k = 0; k < rects.length; ++k) {
     const r = rects[k], n = r.w * r.h, M = Math.ceil(n / 8);
-    if (m + M > payload.length) bad(`${what}: payload of ${payload.length} bytes, shorter than its edge bitmaps`);
     r.mask = payload.subarray(m, m + M);
     for (let i = 0; i < n; ++i) edges += (r.mask[i >> 3] >> (i & 7)) & 1;
     if (n % 8 && (r.mask[M - 1] >> (n % 8))) fail(E.coverageChunk, `${what}: edge bitmap of rectangle ${k} has bits set past its ${n} texels`);
