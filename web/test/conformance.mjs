@@ -11,7 +11,7 @@ import { readFileSync, readdirSync, existsSync } from 'node:fs';
 import { join, basename } from 'node:path';
 import { ROOT, loadCodecs } from './node_codecs.mjs';
 import { openClip, bytesSource, readChunk, verifyContainer } from '../src/container.js';
-import { openLightfield, decodeFaceFrames, faceHash } from '../src/lightfield.js';
+import { openLightfield, decodeFaceFrames, faceHash, parseRegion } from '../src/lightfield.js';
 import { CalfError } from '../src/errors.js';
 import { generate as generateBcTables } from '../tools/gen_bc_tables.mjs';
 import { generate as generateGlsl } from '../tools/gen_glsl_conventions.mjs';
@@ -92,12 +92,18 @@ async function negativeChecks(codecs) {
   return problems;
 }
 
-// A wrong coverage decode must fail (SPEC §11.1.11): in coverage_bc1_pred16m's coverage chunk
-// with the most edge texels, a flipped bit of the first mask high byte, the first mask low
-// byte or the last near count changes a hash line or gives CALF-E065; a near count of 17
-// gives CALF-E065; a changed payload size gives CALF-E202.
+// SPEC §11.1.11's worked example decodes to its texels. A wrong coverage decode must fail: in
+// coverage_bc1_pred16m's coverage chunk with the most edge texels, a flipped bit of the first
+// mask high byte, the first mask low byte or the last near count changes a hash line or gives
+// CALF-E065; a near count of 17 gives CALF-E065; a changed payload size gives CALF-E202.
 async function coverageChecks(codecs) {
   const problems = [];
+  // SPEC §11.1.11's worked example: a 4 × 2 tile, texel (1, 0) mask 0x0033 near 12, texel (3, 1)
+  // mask 0xfff0 near 0, the others plain.
+  const example = Uint8Array.from([1, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 4, 0, 2, 0, 0x82, 0x00, 0xff, 0x33, 0xf0, 0x0c, 0x00]);
+  const values = [...parseRegion(example, 'coverage', 0, 4, 2, 1, 'worked example')[0][0].values];
+  const expect = [0xffff, 0, 0x0033, 12, 0xffff, 0, 0xffff, 0, 0xffff, 0, 0xffff, 0, 0xffff, 0, 0xfff0, 0];
+  if (values.join() !== expect.join()) problems.push(`SPEC §11.1.11's worked example decodes to ${values.join()}`);
   const path = join(ROOT, 'tests/conformance/lightfield/coverage_bc1_pred16m.calf');
   const want = readFileSync(path.replace(/\.calf$/, '.hashes'), 'utf8').split('\n').filter(Boolean);
   const bytes = new Uint8Array(readFileSync(path));
