@@ -1,5 +1,6 @@
 // The page decoder's conformance run (format/SPEC.md §14): decodes every clip of
-// tests/conformance/lightfield/ under node and compares its hash lines with CLIP.hashes.
+// tests/conformance/lightfield/, tiles/ and mesh/ under node and compares its hash lines with
+// CLIP.hashes.
 //
 //   node web/test/conformance.mjs [CLIP.calf...]     default: every clip of the folder
 //   node web/test/conformance.mjs --time CLIP.calf... decode ms of each clip: median, min and
@@ -12,6 +13,8 @@ import { join, basename } from 'node:path';
 import { ROOT, loadCodecs } from './node_codecs.mjs';
 import { openClip, bytesSource, readChunk, verifyContainer } from '../src/container.js';
 import { openLightfield, decodeFaceFrames, faceHash } from '../src/lightfield.js';
+import { tilesLines } from '../src/tiles.js';
+import { meshLines } from '../src/mesh.js';
 import { CalfError } from '../src/errors.js';
 import { generate as generateBcTables } from '../tools/gen_bc_tables.mjs';
 import { generate as generateGlsl } from '../tools/gen_glsl_conventions.mjs';
@@ -23,6 +26,8 @@ export async function decodeLines(bytes, codecs) {
   for (let i = 0; i < clip.chunks.length; ++i) await readChunk(clip, i);  // every hash and scheme
   const lines = [], problems = [];
   for (let t = 0; t < clip.tracks.length; ++t) {
+    if (clip.tracks[t].kind === 2) lines.push(...await tilesLines(clip, t));
+    if (clip.tracks[t].kind === 4) lines.push(...await meshLines(clip, t));
     if (clip.tracks[t].kind !== 1) continue;
     const lf = await openLightfield(clip, t);
     const h = lf.header;
@@ -173,9 +178,9 @@ async function main() {
       ++failures;
     }
   }
-  const dir = join(ROOT, 'tests/conformance/lightfield');
   const clips = process.argv.length > 2 ? process.argv.slice(2)
-    : readdirSync(dir).filter((f) => f.endsWith('.calf')).sort().map((f) => join(dir, f));
+    : ['lightfield', 'tiles', 'mesh'].flatMap((d) => readdirSync(join(ROOT, 'tests/conformance', d))
+      .filter((f) => f.endsWith('.calf')).sort().map((f) => join(ROOT, 'tests/conformance', d, f)));
   let totalMs = 0;
   for (const path of clips) {
     const name = basename(path, '.calf');
