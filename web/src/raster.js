@@ -94,6 +94,16 @@ void main() {
 }
 `;
 
+// The tiles layer: the blended colour and, from its own float texture, the distance.
+const MERGE = `
+uniform sampler2D colour_tex, distance_tex;
+out vec4 out_colour;
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  out_colour = vec4(texelFetch(colour_tex, p, 0).rgb, texelFetch(distance_tex, p, 0).r);
+}
+`;
+
 // srgb8_from_linear (player/src/image_compare.cc): clamp, sRGB transfer.
 const PRESENT = `
 uniform sampler2D frame_tex;
@@ -272,12 +282,14 @@ export function makeRaster(gl) {
   const tilesProgram = program(gl, GL_TILES_VERTEX, TILES_FRAGMENT, 'the tiles program');
   const compositeProgram = program(gl, FULLSCREEN, COMPOSITE, 'the composite program');
   const presentProgram = program(gl, FULLSCREEN, PRESENT, 'the present program');
+  const mergeProgram = program(gl, FULLSCREEN, MERGE, 'the tiles merge program');
   const emptyVao = gl.createVertexArray();
   let targets = null;
   function ensureTargets(w, h) {
     if (targets && targets.w === w && targets.h === h) return;
     targets = { w, h, layers: [0, 1, 2].map(() => makeTarget(gl, w, h, gl.RGBA32F)),
-      tiles: makeTarget(gl, w, h, floatBlend ? gl.RGBA32F : gl.RGBA16F), occluders: makeTarget(gl, w, h, gl.R32F) };
+      tiles: makeTarget(gl, w, h, floatBlend ? gl.RGBA32F : gl.RGBA16F), occluders: makeTarget(gl, w, h, gl.R32F),
+      distance: makeTarget(gl, w, h, gl.R32F) };
   }
   const gpu = new Map();  // track data -> GL objects
 
@@ -478,7 +490,7 @@ export function makeRaster(gl) {
     gl.clearBufferfv(gl.COLOR, 0, [Infinity, Infinity, Infinity, Infinity]);
     nearest(targets.occluders.fb, OCCLUSION_ALPHA, [true, true, true, true]);
     // The sorted pass: src + (1 − src.a) dst over 0.
-    gl.bindFramebuffer(gl.FRAMEBUFFER, target.fb);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, targets.tiles.fb);
     gl.clearBufferfv(gl.COLOR, 0, [0, 0, 0, 0]);
     gl.activeTexture(gl.TEXTURE1);
     gl.bindTexture(gl.TEXTURE_2D, targets.occluders.tex);
@@ -492,15 +504,28 @@ export function makeRaster(gl) {
     draw();
     gl.colorMask(true, true, true, true);
     gl.disable(gl.BLEND);
-    // The layer's distance: the nearest tile with alpha ≥ 0.5, +inf elsewhere.
-    gl.colorMask(false, false, false, true);
-    gl.clearBufferfv(gl.COLOR, 0, [0, 0, 0, Infinity]);
-    nearest(target.fb, 0.5, [false, false, false, true]);
+    // The layer's distance (binary32, as the native target's): the nearest tile with alpha ≥ 0.5,
+    // +inf elsewhere; then colour and distance into the layer.
+    gl.bindFramebuffer(gl.FRAMEBUFFER, targets.distance.fb);
+    gl.clearBufferfv(gl.COLOR, 0, [Infinity, Infinity, Infinity, Infinity]);
+    nearest(targets.distance.fb, 0.5, [true, true, true, true]);
     gl.bindVertexArray(null);
+    gl.activeTexture(gl.TEXTURE1);
+    gl.bindTexture(gl.TEXTURE_2D, targets.distance.tex);
+    gl.activeTexture(gl.TEXTURE0);
+    gl.bindTexture(gl.TEXTURE_2D_ARRAY, null);
+    gl.bindTexture(gl.TEXTURE_2D, targets.tiles.tex);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, target.fb);
+    gl.useProgram(mergeProgram);
+    gl.uniform1i(gl.getUniformLocation(mergeProgram, 'colour_tex'), 0);
+    gl.uniform1i(gl.getUniformLocation(mergeProgram, 'distance_tex'), 1);
+    gl.bindVertexArray(emptyVao);
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
+    gl.bindVertexArray(null);
+    gl.bindTexture(gl.TEXTURE_2D, null);
     gl.activeTexture(gl.TEXTURE1);
     gl.bindTexture(gl.TEXTURE_2D, null);
     gl.activeTexture(gl.TEXTURE0);
-    gl.bindTexture(gl.TEXTURE_2D_ARRAY, null);
     return { tiles: s.n };
   }
 
@@ -527,8 +552,7 @@ export function makeRaster(gl) {
     const figures = [];
     let acc = null;
     for (const tr of tracks) {
-      if (acc === targets.tiles) acc = composite(acc, acc, targets.layers[0]);  // the tiles target is drawn again
-      const layer = tr.kind === 'mesh' ? targets.layers[acc === targets.layers[0] ? 1 : 0] : targets.tiles;
+      const layer = targets.layers[acc === targets.layers[0] ? 1 : 0];
       const f = Math.min(frame, tr.frameCount - 1);
       figures.push(tr.kind === 'mesh' ? drawMesh(tr, camera, f, layer) : drawTiles(tr, camera, layer));
       acc = acc ? composite(acc, layer, targets.layers.find((l) => l !== acc && l !== layer)) : layer;

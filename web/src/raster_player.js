@@ -23,9 +23,10 @@ export async function rasterTracks(clip) {
 
 export async function openRasterPlayer({ gl, canvas, clip, source, status, tracks }) {
   const raster = makeRaster(gl);
-  const meshes = tracks.filter((t) => t.kind === 'mesh');
-  const F = Math.max(...tracks.map((t) => t.frameCount));
-  const fps = meshes.length ? meshes[0].fps : clip.tracks[tracks[0].track].header.fps_numerator / clip.tracks[tracks[0].track].header.fps_denominator;
+  // The frame count and rate of the first track, as calf-play's Playback (each track then shows
+  // min(frame, its last frame)).
+  const F = tracks[0].frameCount, h0 = clip.tracks[tracks[0].track].header;
+  const fps = h0.fps_numerator / h0.fps_denominator;
   // The view region (the tracks' union): where the eye starts and what the overlay checks.
   const volume = { min: [Infinity, Infinity, Infinity], max: [-Infinity, -Infinity, -Infinity] };
   for (const t of tracks) {
