@@ -19,6 +19,7 @@ import { CalfError } from '../src/errors.js';
 import { generate as generateBcTables } from '../tools/gen_bc_tables.mjs';
 import { generate as generateGlsl } from '../tools/gen_glsl_conventions.mjs';
 import { generate as generateRaymarch } from '../tools/gen_glsl_raymarch.mjs';
+import { generate as generateRaster } from '../tools/gen_glsl_raster.mjs';
 
 // The lines calf-verify --decode prints for a clip's lightfield tracks, and the problems.
 export async function decodeLines(bytes, codecs) {
@@ -172,7 +173,8 @@ async function main() {
   // The generated sources are what their native sources give today.
   for (const [file, generate, tool] of [['web/src/bc_tables.js', generateBcTables, 'gen_bc_tables.mjs'],
     ['web/src/glsl_conventions.js', generateGlsl, 'gen_glsl_conventions.mjs'],
-    ['web/src/glsl_raymarch.js', generateRaymarch, 'gen_glsl_raymarch.mjs']]) {
+    ['web/src/glsl_raymarch.js', generateRaymarch, 'gen_glsl_raymarch.mjs'],
+    ['web/src/glsl_raster.js', generateRaster, 'gen_glsl_raster.mjs']]) {
     if (readFileSync(join(ROOT, file), 'utf8') !== generate()) {
       console.log(`web conformance: ${file} is out of date (node web/tools/${tool})`);
       ++failures;
