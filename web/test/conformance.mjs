@@ -147,6 +147,33 @@ async function lightfieldCorpus(codecs) {
   return { files: files.length, problems };
 }
 
+// The damaged tiles and mesh clips of the fuzz corpora: the first id of each bad_* file is the
+// one calf-verify (the C++ reader) gives; each valid_* file decodes without a problem.
+const KIND_CORPUS = {
+  'tiles_track_fuzz/bad_band_rows.calf': 'CALF-E212', 'tiles_track_fuzz/bad_index_version.calf': 'CALF-E211',
+  'tiles_track_fuzz/bad_quad_w.calf': 'CALF-E212', 'tiles_track_fuzz/bad_view_region.calf': 'CALF-E212',
+  'tiles_track_fuzz/valid_bc7_none.calf': null, 'tiles_track_fuzz/valid_rgba8_none.calf': null,
+  'mesh_track_fuzz/bad_index_version.calf': 'CALF-E220', 'mesh_track_fuzz/bad_position_nan.calf': 'CALF-E223',
+  'mesh_track_fuzz/bad_run_gap.calf': 'CALF-E222', 'mesh_track_fuzz/bad_texture_width.calf': 'CALF-E224',
+  'mesh_track_fuzz/bad_uv_nan.calf': 'CALF-E223', 'mesh_track_fuzz/bad_vertex_index.calf': 'CALF-E222',
+  'mesh_track_fuzz/valid_full_none.calf': null, 'mesh_track_fuzz/valid_subset_none.calf': null,
+  'mesh_track_fuzz/valid_subset_zstd.calf': null, 'mesh_track_fuzz/valid_textured_none.calf': null,
+};
+async function kindCorpus(codecs) {
+  const problems = [];
+  for (const [f, want] of Object.entries(KIND_CORPUS)) {
+    let got = null;
+    try {
+      await decodeLines(new Uint8Array(readFileSync(join(ROOT, 'tests/fuzz/corpus', f))), codecs);
+    } catch (e) {
+      if (!(e instanceof CalfError)) throw e;
+      got = e;
+    }
+    if ((got?.id ?? null) !== want) problems.push(`${f}: expected ${want ?? 'no problem'}, got ${got?.message ?? 'no problem'}`);
+  }
+  return { files: Object.keys(KIND_CORPUS).length, problems };
+}
+
 async function main() {
   const loaded = await loadCodecs();
   if (!loaded.codecs) {
@@ -226,6 +253,10 @@ async function main() {
     for (const p of damaged.problems) console.log(`web conformance: lightfield fuzz corpus: ${p}`);
     console.log(`web conformance: lightfield fuzz corpus: ${damaged.files - damaged.problems.length} of ${damaged.files} clips refused (CALF-E202) or decoded as their names say`);
     failures += damaged.problems.length;
+    const kinds = await kindCorpus(codecs);
+    for (const p of kinds.problems) console.log(`web conformance: tiles and mesh fuzz corpora: ${p}`);
+    console.log(`web conformance: tiles and mesh fuzz corpora: ${kinds.files - kinds.problems.length} of ${kinds.files} clips refused with calf-verify's id or decoded`);
+    failures += kinds.problems.length;
   }
   console.log(`web conformance: ${clips.length - failures} of ${clips.length} clips reproduce their hashes, ${totalMs.toFixed(0)} ms decoding`);
   process.exit(failures ? 1 : 0);
