@@ -1,17 +1,18 @@
 // The page's player of a clip's tiles and mesh tracks (drawn by raster.js as calf-play's GL
-// rasterisers draw them): every chunk of those tracks is fetched (coalesced range requests,
-// hashes checked) and decoded when the clip opens; renderPose draws one pose. Same interface as
-// march_player.js's player, so index.html drives either.
+// rasterisers draw them): every chunk of those tracks is fetched (range requests merged across
+// padding, hashes checked) and decoded when the clip opens; renderPose draws one pose. Same
+// interface as march_player.js's player, so index.html drives either.
 import { openTiles } from './tiles.js';
 import { openMesh } from './mesh.js';
 import { makeRaster, loadMesh, loadTiles } from './raster.js';
 import { prefetch } from './stream.js';
 import { frameAtTime } from './march_player.js';
 
-// The tracks of kind 2 and 4 with a representation (an index chunk), in clip order; [] if none.
+// The tracks of kind 2 and 4 with a representation (an index chunk), in clip order, every chunk
+// fetched (neighbouring chunks in one range request) and decoded; [] if none.
 export async function rasterTracks(clip) {
   const ids = clip.chunks.filter((c) => clip.tracks[c.track].kind === 2 || clip.tracks[c.track].kind === 4).map((c) => c.id);
-  await prefetch(clip, ids);
+  await prefetch(clip, ids, { gap: 15 });  // chunks apart by their padding only: one request
   const out = [];
   for (let t = 0; t < clip.tracks.length; ++t) {
     const kind = clip.tracks[t].kind;
