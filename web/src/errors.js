@@ -10,6 +10,9 @@ export const E = {
   decompress: 'CALF-E059', padding: 'CALF-E060', chunkId: 'CALF-E061', coverageChunk: 'CALF-E065',
   coverageDepth: 'CALF-E066', lightfieldChunk: 'CALF-E202',
   lightfieldFormat: 'CALF-E203', playbackClip: 'CALF-E460',
+  tilesChunk: 'CALF-E210', tilesUnsupported: 'CALF-E211', tilesValue: 'CALF-E212', tilesLimit: 'CALF-E213',
+  meshChunk: 'CALF-E220', meshUnsupported: 'CALF-E221', meshIndex: 'CALF-E222', meshValue: 'CALF-E223',
+  meshLimit: 'CALF-E224',
 };
 
 export class CalfError extends Error {

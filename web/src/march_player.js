@@ -11,6 +11,7 @@ import { httpSource, prefetch } from './stream.js';
 import { makeCodecs } from './codecs.js';
 import { bcUpload, makeRaymarcher, marchRange, selectViews } from './raymarch.js';
 import { visibleSets } from './culling.js';
+import { openRasterPlayer, rasterTracks } from './raster_player.js';
 
 // frame_at_time (format/capture/src/eye_path.cc).
 export function frameAtTime(seconds, fps, frameCount) {
@@ -27,7 +28,12 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
   if (source.notice) status(source.notice);
   const clip = await openClip(source, codecs);
   const t = clip.tracks.findIndex((x) => x.kind === 1);
-  if (t < 0) fail(E.playbackClip, 'the clip has no lightfield track (the only kind this page plays)');
+  if (t < 0) {
+    // No lightfield track: its tiles and mesh tracks, drawn as calf-play's rasterisers draw them.
+    const tracks = await rasterTracks(clip);
+    if (!tracks.length) fail(E.playbackClip, 'the clip has no lightfield, tiles or mesh track (the kinds this page plays)');
+    return openRasterPlayer({ gl, canvas, clip, source, status, tracks });
+  }
   const lf = await openLightfield(clip, t);
   const h = lf.header, N = h.face_size, F = h.frame_count, fps = h.fps_numerator / h.fps_denominator;
   // BCn colour goes to the GPU as blocks where the browser takes them (the query string's
@@ -232,5 +238,7 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
     }
     return rgb;
   }
-  return { gl, lf, renderPose, prepare, draw, report, pixels, stats, fps, volume, inside };
+  const views = lf.views.filter((v) => v);
+  const startEye = [0, 1, 2].map((k) => views.reduce((s, v) => s + v.position[k], 0) / views.length);
+  return { gl, lf, renderPose, prepare, draw, report, pixels, stats, fps, frameCount: F, startEye, volume, inside };
 }

@@ -1,5 +1,6 @@
 // The page decoder's conformance run (format/SPEC.md §14): decodes every clip of
-// tests/conformance/lightfield/ under node and compares its hash lines with CLIP.hashes.
+// tests/conformance/lightfield/, tiles/ and mesh/ under node and compares its hash lines with
+// CLIP.hashes.
 //
 //   node web/test/conformance.mjs [CLIP.calf...]     default: every clip of the folder
 //   node web/test/conformance.mjs --time CLIP.calf... decode ms of each clip: median, min and
@@ -12,10 +13,13 @@ import { join, basename } from 'node:path';
 import { ROOT, loadCodecs } from './node_codecs.mjs';
 import { openClip, bytesSource, readChunk, verifyContainer } from '../src/container.js';
 import { openLightfield, decodeFaceFrames, faceHash, parseRegion } from '../src/lightfield.js';
+import { tilesLines } from '../src/tiles.js';
+import { meshLines } from '../src/mesh.js';
 import { CalfError } from '../src/errors.js';
 import { generate as generateBcTables } from '../tools/gen_bc_tables.mjs';
 import { generate as generateGlsl } from '../tools/gen_glsl_conventions.mjs';
 import { generate as generateRaymarch } from '../tools/gen_glsl_raymarch.mjs';
+import { generate as generateRaster } from '../tools/gen_glsl_raster.mjs';
 
 // The lines calf-verify --decode prints for a clip's lightfield tracks, and the problems. With
 // `tamper`, every chunk's raw bytes are cached first and tamper(clip) may change them.
@@ -29,6 +33,8 @@ export async function decodeLines(bytes, codecs, tamper = null) {
   if (tamper) tamper(clip);
   const lines = [], problems = [];
   for (let t = 0; t < clip.tracks.length; ++t) {
+    if (clip.tracks[t].kind === 2) lines.push(...await tilesLines(clip, t));
+    if (clip.tracks[t].kind === 4) lines.push(...await meshLines(clip, t));
     if (clip.tracks[t].kind !== 1) continue;
     const lf = await openLightfield(clip, t);
     const h = lf.header;
@@ -209,6 +215,33 @@ async function lightfieldCorpus(codecs) {
   return { files: files.length, problems };
 }
 
+// The damaged tiles and mesh clips of the fuzz corpora: the first id of each bad_* file is the
+// one calf-verify (the C++ reader) gives; each valid_* file decodes without a problem.
+const KIND_CORPUS = {
+  'tiles_track_fuzz/bad_band_rows.calf': 'CALF-E212', 'tiles_track_fuzz/bad_index_version.calf': 'CALF-E211',
+  'tiles_track_fuzz/bad_quad_w.calf': 'CALF-E212', 'tiles_track_fuzz/bad_view_region.calf': 'CALF-E212',
+  'tiles_track_fuzz/valid_bc7_none.calf': null, 'tiles_track_fuzz/valid_rgba8_none.calf': null,
+  'mesh_track_fuzz/bad_index_version.calf': 'CALF-E220', 'mesh_track_fuzz/bad_position_nan.calf': 'CALF-E223',
+  'mesh_track_fuzz/bad_run_gap.calf': 'CALF-E222', 'mesh_track_fuzz/bad_texture_width.calf': 'CALF-E224',
+  'mesh_track_fuzz/bad_uv_nan.calf': 'CALF-E223', 'mesh_track_fuzz/bad_vertex_index.calf': 'CALF-E222',
+  'mesh_track_fuzz/valid_full_none.calf': null, 'mesh_track_fuzz/valid_subset_none.calf': null,
+  'mesh_track_fuzz/valid_subset_zstd.calf': null, 'mesh_track_fuzz/valid_textured_none.calf': null,
+};
+async function kindCorpus(codecs) {
+  const problems = [];
+  for (const [f, want] of Object.entries(KIND_CORPUS)) {
+    let got = null;
+    try {
+      await decodeLines(new Uint8Array(readFileSync(join(ROOT, 'tests/fuzz/corpus', f))), codecs);
+    } catch (e) {
+      if (!(e instanceof CalfError)) throw e;
+      got = e;
+    }
+    if ((got?.id ?? null) !== want) problems.push(`${f}: expected ${want ?? 'no problem'}, got ${got?.message ?? 'no problem'}`);
+  }
+  return { files: Object.keys(KIND_CORPUS).length, problems };
+}
+
 async function main() {
   const loaded = await loadCodecs();
   if (!loaded.codecs) {
@@ -235,15 +268,16 @@ async function main() {
   // The generated sources are what their native sources give today.
   for (const [file, generate, tool] of [['web/src/bc_tables.js', generateBcTables, 'gen_bc_tables.mjs'],
     ['web/src/glsl_conventions.js', generateGlsl, 'gen_glsl_conventions.mjs'],
-    ['web/src/glsl_raymarch.js', generateRaymarch, 'gen_glsl_raymarch.mjs']]) {
+    ['web/src/glsl_raymarch.js', generateRaymarch, 'gen_glsl_raymarch.mjs'],
+    ['web/src/glsl_raster.js', generateRaster, 'gen_glsl_raster.mjs']]) {
     if (readFileSync(join(ROOT, file), 'utf8') !== generate()) {
       console.log(`web conformance: ${file} is out of date (node web/tools/${tool})`);
       ++failures;
     }
   }
-  const dir = join(ROOT, 'tests/conformance/lightfield');
   const clips = process.argv.length > 2 ? process.argv.slice(2)
-    : readdirSync(dir).filter((f) => f.endsWith('.calf')).sort().map((f) => join(dir, f));
+    : ['lightfield', 'tiles', 'mesh'].flatMap((d) => readdirSync(join(ROOT, 'tests/conformance', d))
+      .filter((f) => f.endsWith('.calf')).sort().map((f) => join(ROOT, 'tests/conformance', d, f)));
   let totalMs = 0;
   for (const path of clips) {
     const name = basename(path, '.calf');
@@ -290,6 +324,10 @@ async function main() {
     for (const p of damaged.problems) console.log(`web conformance: lightfield fuzz corpus: ${p}`);
     console.log(`web conformance: lightfield fuzz corpus: ${damaged.files - damaged.problems.length} of ${damaged.files} clips refused (CALF-E202) or decoded as their names say`);
     failures += damaged.problems.length;
+    const kinds = await kindCorpus(codecs);
+    for (const p of kinds.problems) console.log(`web conformance: tiles and mesh fuzz corpora: ${p}`);
+    console.log(`web conformance: tiles and mesh fuzz corpora: ${kinds.files - kinds.problems.length} of ${kinds.files} clips refused with calf-verify's id or decoded`);
+    failures += kinds.problems.length;
   }
   console.log(`web conformance: ${clips.length - failures} of ${clips.length} clips reproduce their hashes, ${totalMs.toFixed(0)} ms decoding`);
   process.exit(failures ? 1 : 0);

@@ -3,7 +3,7 @@
 // conventions, generated) compiles under WebGL2, and the centre pixel looking along each of the
 // six axes shows the texel SPEC §11.1.1 puts there (face from the major axis, (s, t) from the
 // face table), as the decoder decoded it. Bad input is one line in the overlay with its id: a file
-// that is not a clip (CALF-E040), a clip with no lightfield track (CALF-E460), and a chunk whose
+// that is not a clip (CALF-E040), a clip with no track it plays (CALF-E460), and a chunk whose
 // hash fails (CALF-E058) when a later pose first needs it, the last good frame staying on the
 // canvas and the page still drawing afterwards.
 //
@@ -114,13 +114,13 @@ try {
   const line = await bad.textContent('#overlay');
   console.log(`page: not a clip: '${line}'`);
   if (!line.startsWith('CALF-E040 ') || line.includes('\n')) problems.push(`not a clip gave '${line}'`);
-  // A kind the page cannot play: a mesh clip.
+  // Nothing the page can play: a clip without tracks.
   const mesh = await browser.newPage();
-  await mesh.goto(`${base}/web/index.html?clip=/tests/conformance/mesh/full_none.calf`);
+  await mesh.goto(`${base}/web/index.html?clip=/tests/conformance/container/valid/empty.calf`);
   await mesh.waitForFunction(() => window.calfStatus !== 'loading', null, { timeout: 30000 });
   const meshLine = await mesh.textContent('#overlay');
-  console.log(`page: a mesh clip: '${meshLine}'`);
-  if (!meshLine.startsWith('CALF-E460 ') || meshLine.includes('\n')) problems.push(`a mesh clip gave '${meshLine}'`);
+  console.log(`page: a clip without tracks: '${meshLine}'`);
+  if (!meshLine.startsWith('CALF-E460 ') || meshLine.includes('\n')) problems.push(`a clip without tracks gave '${meshLine}'`);
   // A damaged chunk, first needed by the second pose.
   const dmg = await browser.newPage();
   await dmg.goto(`${base}/web/index.html?autoplay=0&clip=/clips/damaged.calf`);
