@@ -240,30 +240,41 @@ Status coverage_corrupt(const std::string& what) {
   return Status(ErrorId::kCoverageChunk, what);
 }
 
-// §11.1.11: the bitmaps of every rectangle before the planes; counts the edge texels and checks
-// each one (near <= 16, near + popcount(mask) <= 16, not the plain texel).
-Status parse_coverage(RegionChunk& chunk, const std::string& what) {
-  for (RegionRect& r : chunk.rects) {
-    r.mask_offset = chunk.mask_bytes;
-    chunk.mask_bytes += mask_bytes_of(r.w, r.h);
+// The per-rectangle bitmaps that lead a payload (§11.1.9's change masks from rectangle `first`,
+// §11.1.11's edge bitmaps of every rectangle): lays out their offsets, checks that they fit,
+// counts their set bits into chunk.units after `units`, and refuses bits past a rectangle's
+// texels with `past_end`.
+Status read_rect_bitmaps(RegionChunk& chunk, size_t first, uint64_t units, const char* name,
+                         ErrorId past_end, const std::string& what) {
+  for (size_t k = first; k < chunk.rects.size(); ++k) {
+    chunk.rects[k].mask_offset = chunk.mask_bytes;
+    chunk.mask_bytes += mask_bytes_of(chunk.rects[k].w, chunk.rects[k].h);
   }
   if (chunk.payload.size() < chunk.mask_bytes) {
     return corrupt(what + ": payload of " + std::to_string(chunk.payload.size()) +
-                   " bytes, shorter than its " + std::to_string(chunk.mask_bytes) +
-                   " bytes of edge bitmaps");
+                   " bytes, shorter than its " + std::to_string(chunk.mask_bytes) + " bytes of " +
+                   name + "s");
   }
-  chunk.units = 0;
-  for (size_t k = 0; k < chunk.rects.size(); ++k) {
+  chunk.units = units;
+  for (size_t k = first; k < chunk.rects.size(); ++k) {
     RegionRect& r = chunk.rects[k];
     r.first_unit = chunk.units;
     const uint8_t* m = &chunk.payload[r.mask_offset];
     const uint64_t bits = uint64_t{r.w} * r.h, bytes = mask_bytes_of(r.w, r.h);
     for (uint64_t b = 0; b < bytes; ++b) chunk.units += std::popcount(m[b]);
     if (bits % 8 != 0 && (m[bytes - 1] >> (bits % 8)) != 0) {
-      return coverage_corrupt(what + ": edge bitmap of rectangle " + std::to_string(k) +
-                              " has bits set past its " + std::to_string(bits) + " texels");
+      return Status(past_end, what + ": " + name + " of rectangle " + std::to_string(k) +
+                                  " has bits set past its " + std::to_string(bits) + " texels");
     }
   }
+  return Status::Ok();
+}
+
+// §11.1.11: the bitmaps of every rectangle before the planes; counts the edge texels and checks
+// each one (near <= 16, near + popcount(mask) <= 16, not the plain texel).
+Status parse_coverage(RegionChunk& chunk, const std::string& what) {
+  CALF_RETURN_IF_ERROR(
+      read_rect_bitmaps(chunk, 0, 0, "edge bitmap", ErrorId::kCoverageChunk, what));
   const uint64_t e = chunk.units;
   if (chunk.payload.size() != chunk.mask_bytes + 3 * e) return Status::Ok();  // size: caller
   const uint8_t* hi = chunk.payload.data() + chunk.mask_bytes;
@@ -361,27 +372,8 @@ Expected<RegionChunk> parse_region_chunk(std::span<const uint8_t> raw, uint32_t 
   if (coding == RegionCoding::kR16PredictedMasked) {
     // §11.1.9: the masks of every P-frame rectangle, then the two planes of the keyframe's texels
     // and every set mask bit's texel.
-    for (size_t k = 1; k < chunk.rects.size(); ++k) {
-      chunk.rects[k].mask_offset = chunk.mask_bytes;
-      chunk.mask_bytes += mask_bytes_of(chunk.rects[k].w, chunk.rects[k].h);
-    }
-    if (chunk.payload.size() < chunk.mask_bytes) {
-      return corrupt(what + ": payload of " + std::to_string(chunk.payload.size()) +
-                     " bytes, shorter than its " + std::to_string(chunk.mask_bytes) +
-                     " bytes of change masks");
-    }
-    chunk.units = uint64_t{tile_width} * tile_height;
-    for (size_t k = 1; k < chunk.rects.size(); ++k) {
-      RegionRect& r = chunk.rects[k];
-      r.first_unit = chunk.units;
-      const uint8_t* m = &chunk.payload[r.mask_offset];
-      const uint64_t bits = uint64_t{r.w} * r.h, bytes = mask_bytes_of(r.w, r.h);
-      for (uint64_t b = 0; b < bytes; ++b) chunk.units += std::popcount(m[b]);
-      if (bits % 8 != 0 && (m[bytes - 1] >> (bits % 8)) != 0) {
-        return corrupt(what + ": change mask of rectangle " + std::to_string(k) +
-                       " has bits set past its " + std::to_string(bits) + " texels");
-      }
-    }
+    CALF_RETURN_IF_ERROR(read_rect_bitmaps(chunk, 1, uint64_t{tile_width} * tile_height,
+                                           "change mask", ErrorId::kLightfieldChunk, what));
   }
   if (coding == RegionCoding::kCoverage) CALF_RETURN_IF_ERROR(parse_coverage(chunk, what));
   const uint64_t expected = chunk.mask_bytes + chunk.units * unit_bytes(coding);
