@@ -7,15 +7,12 @@
 // the bytes fetched.
 //
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM
-import { execFileSync, spawn } from 'node:child_process';
+import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
-import { createRequire } from 'node:module';
 import { join } from 'node:path';
-import { createInterface } from 'node:readline';
-import { pathToFileURL } from 'node:url';
 import { inflateSync } from 'node:zlib';
-import { ROOT, NPM } from './node_codecs.mjs';
+import { startRangeServer, launchChromium } from './browser.mjs';
 
 // The floor the brief sets is 40 dB; the measured figures are in docs/WEB.md.
 const MIN_DB = 40;
@@ -25,8 +22,6 @@ if (!bin) {
   console.log('web.match: CALF_BIN (the directory of calf-capture, calf-encode, calf-play) is not set');
   process.exit(1);
 }
-const require = createRequire(pathToFileURL(join(NPM, 'package.json')));
-const { chromium: browserType } = require('playwright-core');
 
 // An 8-bit RGB PNG (what calf-play writes) as rows of RGB bytes.
 function readPng(file) {
@@ -86,13 +81,9 @@ for (const [name, args] of clips) {
 console.log(`web.match: clips and calf-play frames made in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
 const path = JSON.parse(readFileSync(join(dir, 'gt', 'eye_path.json'), 'utf8'));
 
-const server = spawn('/usr/bin/python3', [join(ROOT, 'web/test/range_server.py'), ROOT, '--mount', `/clips=${dir}`], { stdio: ['ignore', 'pipe', 'ignore'] });
-const port = (await new Promise((resolve) => createInterface({ input: server.stdout }).once('line', resolve))).split(' ')[1];
+const { server, port } = await startRangeServer({ '/clips': dir });
 const problems = [];
-const browser = await browserType.launch({
-  executablePath: chromium,
-  args: ['--no-sandbox', '--enable-unsafe-swiftshader', '--use-angle=swiftshader', '--ignore-gpu-blocklist'],
-});
+const browser = await launchChromium(chromium);
 try {
 for (const [name] of clips) {
   const page = await browser.newPage();

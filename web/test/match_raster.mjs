@@ -7,15 +7,13 @@
 // mesh clip are played alone too (web/tools/join_clips.mjs joins calf-encode's two clips). Prints the dB per pose and the render ms of both.
 //
 //   CALF_BIN=BUILD_DIR node web/test/match_raster.mjs CHROMIUM
-import { execFileSync, spawn } from 'node:child_process';
+import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
-import { createRequire } from 'node:module';
 import { join } from 'node:path';
-import { createInterface } from 'node:readline';
-import { pathToFileURL } from 'node:url';
 import { inflateSync } from 'node:zlib';
-import { ROOT, NPM, loadCodecs } from './node_codecs.mjs';
+import { loadCodecs } from './node_codecs.mjs';
+import { startRangeServer, launchChromium } from './browser.mjs';
 import { joinClips } from '../tools/join_clips.mjs';
 
 // The floor the brief sets is 40 dB; the measured figures are in docs/WEB.md.
@@ -26,8 +24,6 @@ if (!bin) {
   console.log('web.match: CALF_BIN (the directory of calf-capture, calf-encode, calf-play) is not set');
   process.exit(1);
 }
-const require = createRequire(pathToFileURL(join(NPM, 'package.json')));
-const { chromium: browserType } = require('playwright-core');
 
 // An 8-bit RGB PNG (what calf-play writes) as rows of RGB bytes.
 function readPng(file) {
@@ -98,13 +94,9 @@ for (const name of clips) {
 console.log(`web.match_raster: clips and calf-play frames made in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
 const path = JSON.parse(readFileSync(join(dir, 'gt', 'eye_path.json'), 'utf8'));
 
-const server = spawn('/usr/bin/python3', [join(ROOT, 'web/test/range_server.py'), ROOT, '--mount', `/clips=${dir}`], { stdio: ['ignore', 'pipe', 'ignore'] });
-const port = (await new Promise((resolve) => createInterface({ input: server.stdout }).once('line', resolve))).split(' ')[1];
+const { server, port } = await startRangeServer({ '/clips': dir });
 const problems = [];
-const browser = await browserType.launch({
-  executablePath: chromium,
-  args: ['--no-sandbox', '--enable-unsafe-swiftshader', '--use-angle=swiftshader', '--ignore-gpu-blocklist'],
-});
+const browser = await launchChromium(chromium);
 try {
   for (const name of clips) {
     const page = await browser.newPage();

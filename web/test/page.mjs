@@ -8,20 +8,15 @@
 // canvas and the page still drawing afterwards.
 //
 //   node web/test/page.mjs CHROMIUM
-import { spawn } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
-import { createRequire } from 'node:module';
 import { join } from 'node:path';
-import { createInterface } from 'node:readline';
-import { pathToFileURL } from 'node:url';
-import { ROOT, NPM, loadCodecs } from './node_codecs.mjs';
+import { ROOT, loadCodecs } from './node_codecs.mjs';
+import { startRangeServer, launchChromium } from './browser.mjs';
 import { bytesSource, openClip } from '../src/container.js';
 import { openLightfield, STREAM } from '../src/lightfield.js';
 
 const chromium = process.argv[2] ?? '/usr/bin/chromium';
-const require = createRequire(pathToFileURL(join(NPM, 'package.json')));
-const { chromium: browserType } = require('playwright-core');
 
 // A damaged copy of the clip: one byte flipped in each colour chunk of face 4 (+z) of every view,
 // which a pose looking down -z does not need and one looking down +z does.
@@ -40,14 +35,10 @@ const work = mkdtempSync(join(tmpdir(), 'calf-web-page-'));
   if (flipped === 0) throw new Error('no colour chunk of face 4 to damage');
   writeFileSync(join(work, 'damaged.calf'), bytes);
 }
-const server = spawn('/usr/bin/python3', [join(ROOT, 'web/test/range_server.py'), ROOT, '--mount', `/clips=${work}`], { stdio: ['ignore', 'pipe', 'ignore'] });
-const port = (await new Promise((resolve) => createInterface({ input: server.stdout }).once('line', resolve))).split(' ')[1];
+const { server, port } = await startRangeServer({ '/clips': work });
 const base = `http://127.0.0.1:${port}`;
 const problems = [];
-const browser = await browserType.launch({
-  executablePath: chromium,
-  args: ['--no-sandbox', '--enable-unsafe-swiftshader', '--use-angle=swiftshader', '--ignore-gpu-blocklist'],
-});
+const browser = await launchChromium(chromium);
 try {
   const page = await browser.newPage();
   const consoleLines = [];

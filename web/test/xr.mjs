@@ -7,16 +7,9 @@
 // so when the head leaves the view volume.
 //
 //   node web/test/xr.mjs CHROMIUM
-import { spawn } from 'node:child_process';
-import { createRequire } from 'node:module';
-import { join } from 'node:path';
-import { createInterface } from 'node:readline';
-import { pathToFileURL } from 'node:url';
-import { ROOT, NPM } from './node_codecs.mjs';
+import { startRangeServer, launchChromium } from './browser.mjs';
 
 const chromium = process.argv[2] ?? '/usr/bin/chromium';
-const require = createRequire(pathToFileURL(join(NPM, 'package.json')));
-const { chromium: browserType } = require('playwright-core');
 const OFFSET = 0.25;  // half the eye separation, in scene units (the clip's views span [-1, 1]³)
 const EYE = 48;       // each eye's viewport, square
 
@@ -85,13 +78,9 @@ function psnr(a, b) {
   return se === 0 ? Infinity : 10 * Math.log10((255 * 255) / (se / a.length));
 }
 
-const server = spawn('/usr/bin/python3', [join(ROOT, 'web/test/range_server.py'), ROOT], { stdio: ['ignore', 'pipe', 'ignore'] });
-const port = (await new Promise((resolve) => createInterface({ input: server.stdout }).once('line', resolve))).split(' ')[1];
+const { server, port } = await startRangeServer();
 const problems = [];
-const browser = await browserType.launch({
-  executablePath: chromium,
-  args: ['--no-sandbox', '--enable-unsafe-swiftshader', '--use-angle=swiftshader', '--ignore-gpu-blocklist'],
-});
+const browser = await launchChromium(chromium);
 try {
   const page = await browser.newPage();
   const consoleLines = [];
