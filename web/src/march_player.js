@@ -20,6 +20,20 @@ export function frameAtTime(seconds, fps, frameCount) {
 }
 
 // deps: the npm modules ({hashWasm, fzstd, xz}); status(text) shows one line.
+// The canvas as 8-bit RGB rows, top row first (as calf-play's PNG frames).
+export function canvasRgb(gl, canvas) {
+  const W = canvas.width, H = canvas.height, px = new Uint8Array(4 * W * H);
+  gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, px);
+  const rgb = new Uint8Array(3 * W * H);
+  for (let y = 0; y < H; ++y) {
+    for (let x = 0; x < W; ++x) {
+      const s = 4 * ((H - 1 - y) * W + x), d = 3 * (y * W + x);
+      rgb[d] = px[s]; rgb[d + 1] = px[s + 1]; rgb[d + 2] = px[s + 2];
+    }
+  }
+  return rgb;
+}
+
 export async function openMarchPlayer({ canvas, url, deps, status }) {
   const gl = canvas.getContext('webgl2', { preserveDrawingBuffer: true, antialias: false });
   if (!gl) throw new Error('WebGL2 is not available');
@@ -225,19 +239,7 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
     const { frame, active, visibleCells, totalCells } = prepared;
     return { frame, active, renderMs, insideVolume, colourUpload: bc ? bc.name : 'RGBA32F (decoded on the CPU)', visibleCells, totalCells, bytes: source.stats.bytes, size: source.size, requests: source.stats.requests };
   }
-  // The canvas as 8-bit RGB rows, top row first (as calf-play's PNG frames).
-  function pixels() {
-    const W = canvas.width, H = canvas.height, px = new Uint8Array(4 * W * H);
-    gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, px);
-    const rgb = new Uint8Array(3 * W * H);
-    for (let y = 0; y < H; ++y) {
-      for (let x = 0; x < W; ++x) {
-        const s = 4 * ((H - 1 - y) * W + x), d = 3 * (y * W + x);
-        rgb[d] = px[s]; rgb[d + 1] = px[s + 1]; rgb[d + 2] = px[s + 2];
-      }
-    }
-    return rgb;
-  }
+  const pixels = () => canvasRgb(gl, canvas);
   const views = lf.views.filter((v) => v);
   const startEye = [0, 1, 2].map((k) => views.reduce((s, v) => s + v.position[k], 0) / views.length);
   return { gl, lf, renderPose, prepare, draw, report, pixels, stats, fps, frameCount: F, startEye, volume, inside };

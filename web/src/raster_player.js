@@ -6,7 +6,7 @@ import { openTiles } from './tiles.js';
 import { openMesh } from './mesh.js';
 import { makeRaster, loadMesh, loadTiles } from './raster.js';
 import { prefetch } from './stream.js';
-import { frameAtTime } from './march_player.js';
+import { canvasRgb, frameAtTime } from './march_player.js';
 
 // The tracks of kind 2 and 4 with a representation (an index chunk), in clip order, every chunk
 // fetched (neighbouring chunks in one range request) and decoded; [] if none.
@@ -72,17 +72,6 @@ export async function openRasterPlayer({ gl, canvas, clip, source, status, track
     return { frame: prepared.frame, renderMs, insideVolume, tracks: tracks.map((t, i) => ({ kind: t.kind, ...figures[i] })),
       bytes: source.stats.bytes, size: source.size, requests: source.stats.requests };
   }
-  function pixels() {
-    const W = canvas.width, H = canvas.height, px = new Uint8Array(4 * W * H);
-    gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, px);
-    const rgb = new Uint8Array(3 * W * H);
-    for (let y = 0; y < H; ++y) {
-      for (let x = 0; x < W; ++x) {
-        const s = 4 * ((H - 1 - y) * W + x), d = 3 * (y * W + x);
-        rgb[d] = px[s]; rgb[d + 1] = px[s + 1]; rgb[d + 2] = px[s + 2];
-      }
-    }
-    return rgb;
-  }
+  const pixels = () => canvasRgb(gl, canvas);
   return { gl, renderPose, prepare, draw, report, pixels, fps, frameCount: F, startEye, volume, inside, floatBlend: raster.floatBlend };
 }

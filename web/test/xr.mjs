@@ -8,6 +8,7 @@
 //
 //   node web/test/xr.mjs CHROMIUM
 import { startRangeServer, launchChromium } from './browser.mjs';
+import { psnr } from './frames.mjs';
 
 const chromium = process.argv[2] ?? '/usr/bin/chromium';
 const OFFSET = 0.25;  // half the eye separation, in scene units (the clip's views span [-1, 1]³)
@@ -70,12 +71,6 @@ function installFakeXr() {
   // The emulated device takes any context (Chromium's own call waits for a real device).
   WebGL2RenderingContext.prototype.makeXRCompatible = async () => {};
   window.fakeXr = fake;
-}
-
-function psnr(a, b) {
-  let se = 0;
-  for (let i = 0; i < a.length; ++i) se += (a[i] - b[i]) ** 2;
-  return se === 0 ? Infinity : 10 * Math.log10((255 * 255) / (se / a.length));
 }
 
 const { server, port } = await startRangeServer();
