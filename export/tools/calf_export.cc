@@ -293,8 +293,9 @@ int export_web(const std::string& clip, const std::string& dir, bool quiet) {
   const fs::path parent = target_name.has_parent_path() ? target_name.parent_path() : ".";
   TempDir temp(parent / fmt::format(".{}.tmp-{}", target_name.filename().string(), getpid()));
   const auto write_error = [&](const std::string& what) {
-    return fail(calf::Status(calf::ErrorId::kFileWrite,
-                             fmt::format("cannot write {}: {}", what, ec.message())));
+    return fail(
+        calf::Status(calf::ErrorId::kFileWrite,
+                     fmt::format("cannot write {}: {}", what, ec ? ec.message() : "write failed")));
   };
   if (!fs::create_directory(temp.path(), ec) || ec) return write_error(temp.path().string());
   uint64_t files = 0, bytes = 0;
