@@ -3,8 +3,14 @@
 // (+ .mtl, written by assimp's exporter) (calf/export/mesh_export.h, calf/export/tiles_export.h,
 // docs/EXPORT.md). Errors are one line with a stable id and exit status 1; usage errors exit 2;
 // every file is written whole or not at all.
+#include <unistd.h>
+
+#include <cctype>
 #include <charconv>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -153,6 +159,189 @@ const ExportKind* find_export_kind(uint16_t kind) {
   return nullptr;
 }
 
+// --web DIR: the web player (web/index.html, web/src/*.js), the npm modules its page imports and
+// the clip, in a folder any static web host serves. The files are looked up next to the
+// executable's prefix (share/calf/web, cmake --install) and then in the source tree it was built
+// from (web/, build/npm/node_modules).
+namespace fs = std::filesystem;
+
+// The npm modules' files the page loads, relative to node_modules (and to the folder's npm/).
+constexpr const char* kWebNpmFiles[] = {
+    "fzstd/esm/index.mjs",
+    "fzstd/LICENSE",
+    "hash-wasm/dist/index.esm.js",
+    "hash-wasm/LICENSE",
+    "xz-decompress/dist/package/xz-decompress.js",
+    "xz-decompress/package.json",
+};
+// What the page's imports of build/npm become in the folder.
+constexpr const char* kWebNpmFrom = "../build/npm/node_modules/";
+constexpr const char* kWebNpmTo = "./npm/";
+constexpr const char* kWebClipMeta = "<meta name=\"calf-clip\" content=\"\">";
+
+struct WebSources {
+  fs::path web, npm;  // web/ (index.html, src/) and node_modules
+};
+
+// The first place holding every file, or CALF-E485 naming the first file missing in the last.
+calf::Expected<WebSources> find_web_sources() {
+  std::vector<WebSources> candidates;
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path share = exe.parent_path().parent_path() / "share" / "calf" / "web";
+    candidates.push_back({share, share / "npm"});
+  }
+  candidates.push_back({CALF_WEB_SOURCE_DIR, CALF_WEB_NPM_DIR});
+  std::string missing;
+  for (const WebSources& c : candidates) {
+    std::vector<fs::path> needed = {c.web / "index.html", c.web / "src" / "player.js"};
+    for (const char* f : kWebNpmFiles) needed.push_back(c.npm / f);
+    missing.clear();
+    for (const fs::path& f : needed) {
+      if (!fs::is_regular_file(f, ec)) {
+        missing = f.string();
+        break;
+      }
+    }
+    if (missing.empty()) return c;
+  }
+  return calf::Status(calf::ErrorId::kExportWebFiles,
+                      "the web player's files are not installed or built: no " + missing +
+                          " (tools/setup.sh installs build/npm)");
+}
+
+calf::Expected<std::string> read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in.good() && !in.eof()) {
+    return calf::Status(calf::ErrorId::kFileRead, "cannot read " + path.string());
+  }
+  return text;
+}
+
+// Replaces every `from` in `text` by `to`; the count replaced.
+size_t replace_all(std::string* text, const std::string& from, const std::string& to) {
+  size_t count = 0;
+  for (size_t at = text->find(from); at != std::string::npos; at = text->find(from, at)) {
+    text->replace(at, from.size(), to);
+    at += to.size();
+    ++count;
+  }
+  return count;
+}
+
+// A folder being written, removed unless committed.
+class TempDir {
+ public:
+  explicit TempDir(fs::path path) : path_(std::move(path)) {}
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  ~TempDir() {
+    if (!path_.empty()) {
+      std::error_code ec;
+      fs::remove_all(path_, ec);
+    }
+  }
+  const fs::path& path() const { return path_; }
+  void release() { path_.clear(); }
+
+ private:
+  fs::path path_;
+};
+
+int export_web(const std::string& clip, const std::string& dir, bool quiet) {
+  // The clip must be one calf reads (not a calf file, unreadable: its own id).
+  {
+    auto reader = calf::container::Reader::open(clip);
+    if (!reader.ok()) return fail(reader.status());
+  }
+  std::error_code ec;
+  const fs::path target = fs::path(dir).lexically_normal();
+  const fs::path target_name = target.filename().empty() ? target.parent_path() : target;
+  const auto state = fs::symlink_status(target_name, ec);
+  if (fs::exists(state)) {
+    if (!fs::is_directory(state) || !fs::is_empty(target_name, ec) || ec) {
+      return fail(calf::Status(calf::ErrorId::kExportWebFolder,
+                               dir + " exists and is not an empty folder"));
+    }
+  }
+  auto sources = find_web_sources();
+  if (!sources.ok()) return fail(sources.status());
+  const WebSources& src = sources.value();
+
+  // The clip's name in the folder: its file name, characters a URL would have to escape as _.
+  std::string clip_name = file_name(clip);
+  for (char& c : clip_name) {
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '_')) {
+      c = '_';
+    }
+  }
+  auto page = read_text(src.web / "index.html");
+  if (!page.ok()) return fail(page.status());
+  std::string html = std::move(page.value());
+  const size_t imports = replace_all(&html, kWebNpmFrom, kWebNpmTo);
+  const size_t metas =
+      replace_all(&html, kWebClipMeta, "<meta name=\"calf-clip\" content=\"" + clip_name + "\">");
+  if (imports == 0 || metas != 1) {
+    return fail(calf::Status(calf::ErrorId::kExportWebFiles,
+                             (src.web / "index.html").string() +
+                                 " is not the page calf-export knows (no npm imports or no "
+                                 "calf-clip meta tag)"));
+  }
+
+  const fs::path parent = target_name.has_parent_path() ? target_name.parent_path() : ".";
+  TempDir temp(parent / fmt::format(".{}.tmp-{}", target_name.filename().string(), getpid()));
+  const auto write_error = [&](const std::string& what) {
+    return fail(
+        calf::Status(calf::ErrorId::kFileWrite,
+                     fmt::format("cannot write {}: {}", what, ec ? ec.message() : "write failed")));
+  };
+  if (!fs::create_directory(temp.path(), ec) || ec) return write_error(temp.path().string());
+  uint64_t files = 0, bytes = 0;
+  const auto copy = [&](const fs::path& from, const fs::path& to) {
+    fs::create_directories(to.parent_path(), ec);
+    if (!ec) fs::copy_file(from, to, ec);
+    if (ec) return false;
+    ++files;
+    bytes += fs::file_size(to, ec);
+    return !ec;
+  };
+  {
+    std::ofstream out(temp.path() / "index.html", std::ios::binary);
+    out << html;
+    out.close();
+    if (!out) return write_error((temp.path() / "index.html").string());
+    ++files;
+    bytes += html.size();
+  }
+  for (const auto& entry : fs::directory_iterator(src.web / "src", ec)) {
+    if (entry.path().extension() != ".js") continue;
+    if (!copy(entry.path(), temp.path() / "src" / entry.path().filename())) {
+      return write_error(entry.path().string());
+    }
+  }
+  if (ec) return write_error((src.web / "src").string());
+  for (const char* f : kWebNpmFiles) {
+    if (!copy(src.npm / f, temp.path() / kWebNpmTo / f)) return write_error(f);
+  }
+  if (!copy(clip, temp.path() / clip_name)) return write_error(clip);
+  // Into place whole: a new folder, or over an empty one (rename(2) replaces an empty folder).
+  fs::rename(temp.path(), target_name, ec);
+  if (ec) return write_error(dir);
+  temp.release();
+  if (!quiet) {
+    std::printf("%s: the web player and %s (%llu files, %llu bytes); serve it with:\n", dir.c_str(),
+                clip_name.c_str(), static_cast<unsigned long long>(files),
+                static_cast<unsigned long long>(bytes));
+    std::printf(
+        "python3 -m http.server --bind 127.0.0.1 --directory %s 8000  # then open "
+        "http://127.0.0.1:8000/\n",
+        dir.c_str());
+  }
+  return calf::tools::kExitOk;
+}
+
 }  // namespace
 
 static int command_main(int argc, char** argv) {
@@ -183,7 +372,10 @@ static int command_main(int argc, char** argv) {
       "EXT_meshopt_compression (a required extension: the loader needs a meshoptimizer decoder, "
       "e.g. three.js's GLTFLoader.setMeshoptDecoder); the sizes are printed."
       " Each file is written whole or not at all (a temporary file renamed into "
-      "place); an output or side file that is the input clip is refused (CALF-E007).\n" +
+      "place); an output or side file that is the input clip is refused (CALF-E007).\n"
+      "--web DIR writes the web player with a copy of the clip (any clip calf reads) into a new "
+      "or empty folder any static web host serves, and prints the command that serves it "
+      "locally.\n" +
       std::string(calf::tools::kExitStatusHelp)};
   std::string clip, out;
   uint32_t frame = 0;
@@ -192,8 +384,15 @@ static int command_main(int argc, char** argv) {
   bool meshopt = false;
   double alpha_mask = 0;
   std::string subdivide = "auto";
+  std::string web;
   app.add_option("CLIP", clip, "input .calf holding a mesh or tiles track")->required();
-  app.add_option("-o,--output", out, "output .glb, .gltf or .obj")->required();
+  CLI::Option* output = app.add_option("-o,--output", out, "output .glb, .gltf or .obj");
+  CLI::Option* web_option = app.add_option(
+      "--web", web,
+      "instead of -o: write DIR, a folder any static web host serves: the web player (its page, "
+      "scripts and npm modules) and a copy of CLIP, which the page opens; a new or empty folder, "
+      "written whole or not at all (docs/EXPORT.md)");
+  web_option->excludes(output);
   app.add_option("--frame", frame,
                  "the frame whose transforms and vertex states are exported (default 0)")
       ->default_val(0);
@@ -215,6 +414,18 @@ static int command_main(int argc, char** argv) {
   app.add_flag("-q,--quiet", quiet, "print nothing on success");
   if (const int exit = calf::tools::parse_command_line(app, kCommand, argc, argv); exit >= 0) {
     return exit;
+  }
+  if (web_option->count() > 0) {
+    for (const char* option : {"--frame", "--track", "--subdivide", "--alpha-mask", "--meshopt"}) {
+      if (app.get_option(option)->count() > 0) {
+        return calf::tools::usage_error(kCommand,
+                                        std::string(option) + " applies to -o, not to --web");
+      }
+    }
+    return export_web(clip, web, quiet);
+  }
+  if (output->count() == 0) {
+    return calf::tools::usage_error(kCommand, "--output or --web is required");
   }
 
   auto format = calf::exporter::mesh_export_format_from_path(out);

@@ -7,8 +7,9 @@
 // the bytes fetched.
 //
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM
+//   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM --clip CLIP EYE_PATH   (a given clip)
 import { execFileSync } from 'node:child_process';
-import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { copyFileSync, mkdirSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { startRangeServer, launchChromium } from './browser.mjs';
@@ -16,7 +17,11 @@ import { readPng, psnr } from './frames.mjs';
 
 // The floor the brief sets is 40 dB; the measured figures are in docs/WEB.md.
 const MIN_DB = 40;
-const chromium = process.argv[2] ?? '/usr/bin/chromium';
+const chromium = process.argv[2] && !process.argv[2].startsWith('--') ? process.argv[2] : '/usr/bin/chromium';
+// --clip CLIP EYE_PATH: a measurement of a given clip (e.g. tools/demo.sh's) along a given eye
+// path instead of the test's two clips; only calf-play is needed in CALF_BIN.
+const clipAt = process.argv.indexOf('--clip');
+const given = clipAt > 0 ? { clip: process.argv[clipAt + 1], path: process.argv[clipAt + 2] } : null;
 const bin = process.env.CALF_BIN;
 if (!bin) {
   console.log('web.match: CALF_BIN (the directory of calf-capture, calf-encode, calf-play) is not set');
@@ -28,14 +33,20 @@ if (!bin) {
 const dir = mkdtempSync(join(process.env.CALF_WEB_TMP ?? tmpdir(), 'calf-web-match-'));
 const run = (tool, args) => execFileSync(join(bin, tool), args, { encoding: 'utf8', stdio: ['ignore', 'pipe', 'pipe'] });
 const t0 = Date.now();
-run('calf-capture', ['--scene', 'interior', '--face-size', '64', '--frames', '2', '--spp', '1', '--quiet', '--out', join(dir, 'cap')]);
-run('calf-capture', ['--scene', 'interior', '--ground-truth', '--gt-size', '64x48', '--frames', '2', '--spp', '1', '--quiet', '--out', join(dir, 'gt')]);
+if (given) {
+  mkdirSync(join(dir, 'gt'));
+  copyFileSync(given.clip, join(dir, 'given.calf'));
+  copyFileSync(given.path, join(dir, 'gt', 'eye_path.json'));
+} else {
+  run('calf-capture', ['--scene', 'interior', '--face-size', '64', '--frames', '2', '--spp', '1', '--quiet', '--out', join(dir, 'cap')]);
+  run('calf-capture', ['--scene', 'interior', '--ground-truth', '--gt-size', '64x48', '--frames', '2', '--spp', '1', '--quiet', '--out', join(dir, 'gt')]);
+}
 // The same capture twice: rgba16f colour (the page decodes it to RGBA on the CPU) and BC1 (the
 // page uploads the blocks where WEBGL_compressed_texture_s3tc_srgb exists, as SwiftShader has).
-const clips = [['rgba16f', ['--color-format', 'rgba16f']], ['bc1', ['--color-format', 'bc1', '--bc1-fit', 'range', '--colour-rdo', '0']]];
+const clips = given ? [['given', null]] : [['rgba16f', ['--color-format', 'rgba16f']], ['bc1', ['--color-format', 'bc1', '--bc1-fit', 'range', '--colour-rdo', '0']]];
 const native = {};
 for (const [name, args] of clips) {
-  run('calf-encode', [join(dir, 'cap'), '-o', join(dir, `${name}.calf`), '--cell', '16', '--quiet', ...args]);
+  if (args) run('calf-encode', [join(dir, 'cap'), '-o', join(dir, `${name}.calf`), '--cell', '16', '--quiet', ...args]);
   const played = run('calf-play', [join(dir, `${name}.calf`), '--headless', '--eye-path', join(dir, 'gt', 'eye_path.json'), '--out', join(dir, `play-${name}`)]);
   native[name] = [...played.matchAll(/^pose (\d+) frame \d+: (\d+) views, (\d+)\/(\d+) cells, .*render ([0-9.]+) ms/gm)]
     .map((m) => ({ views: Number(m[2]), cells: Number(m[3]), total: Number(m[4]), ms: Number(m[5]) }));

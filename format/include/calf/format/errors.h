@@ -225,6 +225,8 @@ enum class ErrorKind : uint8_t {
   X(kExportWrite, 481, kInternal, "the glTF / OBJ exporter failed")                             \
   X(kExportTilesOption, 482, kInvalidArgument, "a tiles export option is outside its range")  \
   X(kExportTilesEmpty, 483, kInvalidArgument, "a tile set to export has no tile or no atlas")  \
+  X(kExportWebFolder, 484, kInvalidArgument, "a web folder to write exists and is not empty")  \
+  X(kExportWebFiles, 485, kIo, "the web player's files to copy are not found")                 \
   /* end of the list: every line above ends with a backslash */
 // clang-format on
 
