@@ -5,9 +5,11 @@
 // every file is written whole or not at all.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -231,6 +233,19 @@ size_t replace_all(std::string* text, const std::string& from, const std::string
   return count;
 }
 
+// `text` as one POSIX shell word: unchanged when it holds only characters no shell treats
+// specially, else in single quotes (each ' written as '\'').
+std::string shell_word(const std::string& text) {
+  const bool plain = !text.empty() && std::all_of(text.begin(), text.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) ||
+           (c != 0 && std::strchr("/._-+,:@%=", c) != nullptr);
+  });
+  if (plain) return text;
+  std::string quoted = "'";
+  for (char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
+}
+
 // A folder being written, removed unless committed.
 class TempDir {
  public:
@@ -337,7 +352,7 @@ int export_web(const std::string& clip, const std::string& dir, bool quiet) {
     std::printf(
         "python3 -m http.server --bind 127.0.0.1 --directory %s 8000  # then open "
         "http://127.0.0.1:8000/\n",
-        dir.c_str());
+        shell_word(dir).c_str());
   }
   return calf::tools::kExitOk;
 }
