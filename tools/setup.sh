@@ -11,8 +11,8 @@ PACKAGES=(
   libzstd-dev liblzma-dev libxxhash-dev
   # capture sets: images and manifests
   libopenimageio-dev libopenexr-dev libpng-dev nlohmann-json3-dev
-  # command lines and text
-  libcli11-dev libfmt-dev
+  # command lines and text; man pages generated from each command's --help
+  libcli11-dev libfmt-dev help2man man-db
   # threads
   libtbb-dev
   # block codecs

@@ -12,7 +12,6 @@
 
 #include "calf/decoder/kind_table.h"
 #include "calf/format/container.h"
-#include "calf/format/version.h"
 #include "command_line.h"
 
 namespace {
@@ -228,7 +227,6 @@ static int command_main(int argc, char** argv) {
                   "directory; use calf-verify to check every chunk. Control characters in "
                   "metadata are printed escaped (\\xNN) in text mode.\n") +
       calf::tools::kExitStatusHelp};
-  app.set_version_flag("--version", std::string("calf ") + calf::kVersionString);
   std::string path;
   bool json = false, chunks = false;
   app.add_option("FILE", path, "the .calf clip (a regular file)")->required();

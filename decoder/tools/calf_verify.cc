@@ -11,7 +11,6 @@
 
 #include "calf/decoder/kind_table.h"
 #include "calf/format/container.h"
-#include "calf/format/version.h"
 #include "command_line.h"
 
 static int command_main(int argc, char** argv) {
@@ -23,7 +22,6 @@ static int command_main(int argc, char** argv) {
       "id.\nExit status: 0 all files good; 1 a problem was found (or a file could not "
       "be opened); 2 a usage error (bad option or argument), one line with CALF-E006 "
       "on stderr.")};
-  app.set_version_flag("--version", std::string("calf ") + calf::kVersionString);
   std::vector<std::string> files;
   bool quiet = false, container_only = false, decode = false;
   size_t max_problems = 100;

@@ -21,6 +21,7 @@
 
 #include "calf/format/files.h"
 #include "calf/format/status.h"
+#include "calf/format/version.h"
 
 namespace calf::tools {
 
@@ -54,8 +55,10 @@ inline int usage_error(const char* command, const std::string& message) {
 
 // Parses the command line. Returns -1 when the command should go on, else the exit status to
 // return at once: 0 after --help / --version, 2 after a usage error (printed as one line).
+// Every command answers --version with "calf X.Y.Z" (help2man reads it for the man pages).
 inline int parse_command_line(CLI::App& app, const char* command, int argc, char** argv) {
   files::install_temp_file_cleanup();
+  app.set_version_flag("--version", std::string("calf ") + kVersionString);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

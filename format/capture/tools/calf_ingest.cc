@@ -7,7 +7,6 @@
 #include <CLI/CLI.hpp>
 
 #include "calf/capture/ingest.h"
-#include "calf/format/version.h"
 #include "command_line.h"
 
 static int command_main(int argc, char** argv) {
@@ -22,7 +21,6 @@ static int command_main(int argc, char** argv) {
                            "(equirect: per run of frames) from --first-frame on, all made one "
                            "animated capture set; every frame must be the same rig.\n") +
                calf::tools::kExitStatusHelp};
-  app.set_version_flag("--version", std::string("calf ") + calf::kVersionString);
   app.require_subcommand(1);
   app.fallthrough();  // --quiet may follow the subcommand
   calf::capture::IngestOptions options;
