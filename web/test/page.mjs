@@ -5,7 +5,10 @@
 // face table), as the decoder decoded it. Bad input is one line in the overlay with its id: a file
 // that is not a clip (CALF-E040), a clip with no track it plays (CALF-E460), and a chunk whose
 // hash fails (CALF-E058) when a later pose first needs it, the last good frame staying on the
-// canvas and the page still drawing afterwards.
+// canvas and the page still drawing afterwards. Streaming frame after frame from one pose: no
+// chunk requested twice, none beyond what the frame and the two prefetched after it need, the
+// next frame already fetched, and the overlay's bytes per second against the clip's. Inline
+// input: a mouse drag and a finger's drag look, W and D move.
 //
 //   node web/test/page.mjs CHROMIUM
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
