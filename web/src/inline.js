@@ -3,7 +3,8 @@
 // moves the eye by one frame's worth of the held keys and returns the camera's axes.
 const KEYS = { w: 'forward', arrowup: 'forward', s: 'back', arrowdown: 'back', a: 'left', arrowleft: 'left', d: 'right', arrowright: 'right' };
 
-// target: the element that takes pointer drags (the canvas); eye: [x, y, z], moved in place.
+// target: the element that takes pointer drags (the canvas); eye: [x, y, z], moved in place
+// (state.eye: the page sets another when another clip opens).
 export function inlineControls(target, eye, { speed = 0.02, turn = 0.005 } = {}) {
   const state = { eye, yaw: 0, pitch: 0, held: new Set(), pointer: null };
   const look = (dx, dy) => {
@@ -37,7 +38,7 @@ export function inlineControls(target, eye, { speed = 0.02, turn = 0.005 } = {})
     const axes = state.axes(), h = state.held;
     const move = speed * ((h.has('forward') ? 1 : 0) - (h.has('back') ? 1 : 0));
     const strafe = speed * ((h.has('right') ? 1 : 0) - (h.has('left') ? 1 : 0));
-    for (let k = 0; k < 3; ++k) eye[k] += move * axes.forward[k] + strafe * axes.right[k];
+    for (let k = 0; k < 3; ++k) state.eye[k] += move * axes.forward[k] + strafe * axes.right[k];
     return axes;
   };
   return state;

@@ -7,7 +7,7 @@ import { openClip } from './container.js';
 import { openLightfield, decodeFaceFrames, parseTimeline, bcBlocks, STREAM } from './lightfield.js';
 import { readChunk } from './container.js';
 import { E, fail } from './errors.js';
-import { cachedT, chunkFetchCounts, httpSource, planFrame, prefetch, rateMeter, touchChunk, trimCache } from './stream.js';
+import { cachedT, chunkFetchCounts, fetched, httpSource, planFrame, prefetch, rateMeter, touchChunk, trimCache } from './stream.js';
 import { makeCodecs } from './codecs.js';
 import { bcUpload, makeRaymarcher, marchRange, selectViews } from './raymarch.js';
 import { visibleSets } from './culling.js';
@@ -39,11 +39,13 @@ export function canvasRgb(gl, canvas) {
   return rgb;
 }
 
-export async function openMarchPlayer({ canvas, url, deps, status }) {
+// The clip: `url` (read with range requests), or `source` (container.js's bytesSource, e.g. a
+// local file's bytes; nothing is fetched).
+export async function openMarchPlayer({ canvas, url, source: given = null, deps, status }) {
   const gl = canvas.getContext('webgl2', { preserveDrawingBuffer: true, antialias: false });
   if (!gl) throw new Error('WebGL2 is not available');
   const codecs = await makeCodecs(deps);
-  const source = await httpSource(url);
+  const source = given ? { ...given, local: true, stats: { requests: 0, bytes: 0, ranges: [] } } : await httpSource(url);
   if (source.notice) status(source.notice);
   const clip = await openClip(source, codecs);
   const t = clip.tracks.findIndex((x) => x.kind === 1);
@@ -231,8 +233,7 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
     const out = inside(position) ? '' : '; the eye is outside the view volume';
     status(`frame ${prepared.frame}: ${eyes === 2 ? 'two eyes, ' : ''}${prepared.active.length} of ${lf.views.length} views, ${prepared.visibleCells}/${prepared.totalCells} cells, ` +
       `render ${renderMs.toFixed(1)} ms; ${stats.cellsDecoded} cells decoded (${stats.decodeMs.toFixed(0)} ms), ` +
-      `${source.stats.bytes} of ${source.size} bytes fetched (${(100 * source.stats.bytes / source.size).toFixed(1)} %, ` +
-      `${source.stats.requests} requests), ${rate()}${out}`);
+      `${fetched(source, rate)}${out}`);
     return !out;
   }
   // One pose into the canvas. An error (a damaged chunk, say) is one line in the overlay and is

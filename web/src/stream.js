@@ -197,6 +197,14 @@ export function rateMeter(source, seconds) {
   };
 }
 
+// The overlay's part on bytes: fetched, their share of the clip, requests, and rate() (a
+// rateMeter's); for a local file (source.local), its size.
+export function fetched(source, rate) {
+  if (source.local) return `a local file of ${source.size} bytes`;
+  return `${source.stats.bytes} of ${source.size} bytes fetched (${(100 * source.stats.bytes / source.size).toFixed(1)} %, ` +
+    `${source.stats.requests} requests), ${rate()}`;
+}
+
 // tValue for planFrame from the t chunks already in clip.chunkCache (SPEC §11.1.4).
 export function cachedT(lf, n) {
   return (view, face, cell) => {

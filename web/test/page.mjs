@@ -8,14 +8,15 @@
 // canvas and the page still drawing afterwards. Streaming frame after frame from one pose: no
 // chunk requested twice, none beyond what the frame and the two prefetched after it need, the
 // next frame already fetched, and the overlay's bytes per second against the clip's. Inline
-// input: a mouse drag and a finger's drag look, W and D move.
+// input: a mouse drag and a finger's drag look, W and D move. A local file chosen in the page's
+// picker plays.
 //
 //   node web/test/page.mjs CHROMIUM
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { ROOT, loadCodecs } from './node_codecs.mjs';
-import { startRangeServer, launchChromium, openPage } from './browser.mjs';
+import { startRangeServer, launchChromium, openPage, colourCount } from './browser.mjs';
 import { bytesSource, openClip } from '../src/container.js';
 import { openLightfield, STREAM } from '../src/lightfield.js';
 
@@ -209,6 +210,20 @@ try {
       if (!near(s2.pitch - s1.pitch, -0.3) || !near(s2.yaw, s1.yaw)) problems.push(`inline: a touch drag of 60 px down turned pitch by ${s2.pitch - s1.pitch}, yaw by ${s2.yaw - s1.yaw}`);
       if (![0, 1, 2].every((k) => near(s3.eye[k] - s2.eye[k], 0.02 * forward[k]))) problems.push(`inline: W moved the eye from ${s2.eye} to ${s3.eye}, not 0.02 along ${forward}`);
       if (![0, 1, 2].every((k) => near(s4.eye[k] - s3.eye[k], 0.02 * right[k]))) problems.push(`inline: D moved the eye from ${s3.eye} to ${s4.eye}, not 0.02 along ${right}`);
+      // A local file chosen in the page's picker plays from memory.
+      const local = 'tests/conformance/lightfield/bc1_raw16_zstd.calf';
+      await sp.setInputFiles('#file', join(ROOT, local));
+      await sp.waitForFunction(() => window.calfPlayer.source.local, null, { timeout: 60000 }).catch(() => {});
+      const picked = await sp.evaluate(async () => {
+        const p = window.calfPlayer;
+        if (!p.source.local) return { line: document.getElementById('overlay').textContent };
+        await p.renderPose({ position: [0, 0, 0], forward: [0, 0, -1], up: [0, 1, 0], fovY: Math.PI / 3, width: 32, height: 32 }, 0);
+        return { line: document.getElementById('overlay').textContent, rgb: Array.from(p.pixels()), requests: p.source.stats.requests };
+      });
+      const size = readFileSync(join(ROOT, local)).length;
+      console.log(`page: a local file: '${picked.line}', ${picked.rgb ? colourCount(picked.rgb) : 0} colours`);
+      if (!picked.rgb || !picked.line.includes(`a local file of ${size} bytes`)) problems.push(`a local file did not play: '${picked.line}'`);
+      else if (colourCount(picked.rgb) < 3) problems.push(`a local file drew a blank frame (${colourCount(picked.rgb)} colours)`);
     }
     await touch.close();
   }
