@@ -116,12 +116,19 @@ function compile(gl, type, source, what) {
   return s;
 }
 
+// Linked programs by context and source: a second clip opened on the same canvas reuses them
+// (SwiftShader takes seconds to compile the ray march).
+const programs = new WeakMap();
 function program(gl, vs, fs, what) {
+  if (!programs.has(gl)) programs.set(gl, new Map());
+  const known = programs.get(gl), key = `${vs}\n//\n${fs}`;
+  if (known.has(key)) return known.get(key);
   const p = gl.createProgram();
   gl.attachShader(p, compile(gl, gl.VERTEX_SHADER, vs, what));
   gl.attachShader(p, compile(gl, gl.FRAGMENT_SHADER, fs, what));
   gl.linkProgram(p);
   if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error(`${what} program: ${gl.getProgramInfoLog(p).split('\n')[0]}`);
+  known.set(key, p);
   return p;
 }
 
