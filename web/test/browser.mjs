@@ -70,3 +70,18 @@ export async function renderEyePath(page, path, onPose, onError) {
     await onPose(i, got, Uint8Array.from(got.rgb));
   }
 }
+
+// Plays `clip` (a URL path) in the page `held` keeps ({} at first): the first time a new page
+// of `base`'s web/index.html?autoplay=0 (openPage), later the same page's window.calfOpen, so
+// that its shaders compile once. Returns `held`: { page, consoleLines, ready, overlay }.
+export async function playClip(browser, held, base, clip) {
+  if (!held.page) return Object.assign(held, await openPage(browser, `${base}/web/index.html?autoplay=0&clip=${clip}`));
+  return Object.assign(held, await held.page.evaluate(async (url) => {
+    try {
+      await window.calfOpen(url);
+      return { ready: true, overlay: document.getElementById('overlay').textContent };
+    } catch (e) {
+      return { ready: false, overlay: e.message.split('\n')[0] };
+    }
+  }, clip));
+}

@@ -42,7 +42,7 @@ try {
   const page = await browser.newPage();
   const consoleLines = [];
   page.on('pageerror', (e) => consoleLines.push(e.message));
-  await page.goto(`http://127.0.0.1:${port}/`);
+  await page.goto(`http://127.0.0.1:${port}/?autoplay=0`);  // the test draws
   await page.waitForFunction(() => window.calfStatus !== 'loading', null, { timeout: 60000 });
   const overlay = await page.textContent('#overlay');
   console.log(`export: the page at the folder's root: '${overlay}'`);

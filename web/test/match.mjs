@@ -13,7 +13,7 @@ import { execFileSync } from 'node:child_process';
 import { copyFileSync, mkdirSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startRangeServer, launchChromium, openPage, renderEyePath, colourCount } from './browser.mjs';
+import { startRangeServer, launchChromium, playClip, renderEyePath, colourCount } from './browser.mjs';
 import { readPng, psnr } from './frames.mjs';
 
 // The floor the brief sets is 40 dB; the measured figures are in docs/WEB.md.
@@ -59,9 +59,10 @@ const path = JSON.parse(readFileSync(join(dir, 'gt', 'eye_path.json'), 'utf8'));
 const { server, port } = await startRangeServer({ '/clips': dir });
 const problems = [];
 const browser = await launchChromium(chromium);
+const held = {};  // one page plays the clips in turn (the ray march compiles once)
 try {
 for (const [name] of clips) {
-  const { page, consoleLines, ready, overlay } = await openPage(browser, `http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/clips/${name}.calf`);
+  const { page, consoleLines, ready, overlay } = await playClip(browser, held, `http://127.0.0.1:${port}`, `/clips/${name}.calf`);
   if (!ready) {
     problems.push(`${name}: the page did not open the clip: ${overlay} ${consoleLines.join(' | ')}`);
   } else {
@@ -94,7 +95,6 @@ for (const [name] of clips) {
     if (f.twice.length) problems.push(`${name}: chunks fetched twice: ${f.twice.slice(0, 10)}`);
     if (!(f.bytes < f.size)) problems.push(`${name}: the whole clip was fetched (${f.bytes} of ${f.size} bytes)`);
   }
-  await page.close();
 }
 } finally {
   await browser.close();

@@ -12,7 +12,7 @@ import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { loadCodecs } from './node_codecs.mjs';
-import { startRangeServer, launchChromium, openPage, renderEyePath, colourCount } from './browser.mjs';
+import { startRangeServer, launchChromium, playClip, renderEyePath, colourCount } from './browser.mjs';
 import { readPng, psnr } from './frames.mjs';
 import { joinClips } from '../tools/join_clips.mjs';
 
@@ -60,12 +60,12 @@ const path = JSON.parse(readFileSync(join(dir, 'gt', 'eye_path.json'), 'utf8'));
 const { server, port } = await startRangeServer({ '/clips': dir });
 const problems = [];
 const browser = await launchChromium(chromium);
+const held = {};  // one page plays the clips in turn (the programs compile once)
 try {
   for (const name of clips) {
-    const { page, consoleLines, ready, overlay } = await openPage(browser, `http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/clips/${name}.calf`);
+    const { page, consoleLines, ready, overlay } = await playClip(browser, held, `http://127.0.0.1:${port}`, `/clips/${name}.calf`);
     if (!ready) {
       problems.push(`${name}: the page did not open the clip: ${overlay} ${consoleLines.join(' | ')}`);
-      await page.close();
       continue;
     }
     await renderEyePath(page, path, (i, got, rgb) => {
@@ -79,7 +79,6 @@ try {
       if (!(db >= MIN_DB)) writeFileSync(join(dir, `page-${name}-${i}.ppm`), Buffer.concat([Buffer.from(`P6 ${want.width} ${want.height} 255\n`), rgb]));
       if (!(db >= MIN_DB)) problems.push(`${name} pose ${i}: ${db.toFixed(2)} dB against calf-play, below ${MIN_DB}`);
     }, (i, message) => problems.push(`${name} pose ${i}: ${message} ${consoleLines.join(' | ')}`));
-    await page.close();
   }
 } finally {
   await browser.close();

@@ -107,27 +107,6 @@ try {
   const { overlay: meshLine } = await openPage(browser, `${base}/web/index.html?clip=/tests/conformance/container/valid/empty.calf`, { timeout: 30000 });
   console.log(`page: a clip without tracks: '${meshLine}'`);
   if (!meshLine.startsWith('CALF-E460 ') || meshLine.includes('\n')) problems.push(`a clip without tracks gave '${meshLine}'`);
-  // A damaged chunk, first needed by the second pose.
-  const { page: dmg, ready: dmgReady, overlay: dmgLine } = await openPage(browser, `${base}/web/index.html?autoplay=0&clip=/clips/damaged.calf`);
-  if (!dmgReady) {
-    problems.push(`the damaged clip did not open: ${dmgLine}`);
-  } else {
-    const poses = await dmg.evaluate(async () => {
-      const p = window.calfPlayer, cam = (z) => ({ position: [0, 0, 0], forward: [0, 0, z], up: [0, 1, 0], fovY: Math.PI / 3, width: 32, height: 32 });
-      await p.renderPose(cam(-1), 0);
-      const good = Array.from(p.pixels()), goodLine = document.getElementById('overlay').textContent;
-      let thrown = null;
-      try { await p.renderPose(cam(1), 0); } catch (e) { thrown = e.message; }
-      const after = Array.from(p.pixels()), line = document.getElementById('overlay').textContent;
-      await p.renderPose(cam(-1), 1 / 24);  // the page still draws
-      return { good, goodLine, thrown, after, line, again: document.getElementById('overlay').textContent };
-    });
-    console.log(`page: damaged chunk: '${poses.goodLine}', then '${poses.line}', then '${poses.again}'`);
-    if (!poses.line.startsWith('CALF-E058 ') || poses.line.includes('\n')) problems.push(`a damaged chunk gave '${poses.line}'`);
-    if (!poses.thrown) problems.push('a damaged chunk did not fail the pose');
-    if (poses.after.join() !== poses.good.join()) problems.push('the last good frame did not stay after the damaged chunk');
-    if (!poses.again.startsWith('frame 1:')) problems.push(`after the damaged chunk the page did not draw: '${poses.again}'`);
-  }
   // Streaming, frame after frame from one pose (looking down +x, where the clip's cells have a
   // keyframe every frame), two frames of prefetch (the documented default,
   // given): no chunk is requested twice; after frame n (its prefetch done) every chunk fetched
@@ -224,6 +203,29 @@ try {
       console.log(`page: a local file: '${picked.line}', ${picked.rgb ? colourCount(picked.rgb) : 0} colours`);
       if (!picked.rgb || !picked.line.includes(`a local file of ${size} bytes`)) problems.push(`a local file did not play: '${picked.line}'`);
       else if (colourCount(picked.rgb) < 3) problems.push(`a local file drew a blank frame (${colourCount(picked.rgb)} colours)`);
+      // A damaged chunk, first needed by the second pose.
+      // (in the streaming page, whose shaders are compiled by now)
+      const dmg = sp;
+      const dmgLine = await sp.evaluate(async () => { try { await window.calfOpen('/clips/damaged.calf'); return null; } catch (e) { return e.message; } });
+      if (dmgLine) {
+        problems.push(`the damaged clip did not open: ${dmgLine}`);
+      } else {
+        const poses = await dmg.evaluate(async () => {
+          const p = window.calfPlayer, cam = (z) => ({ position: [0, 0, 0], forward: [0, 0, z], up: [0, 1, 0], fovY: Math.PI / 3, width: 32, height: 32 });
+          await p.renderPose(cam(-1), 0);
+          const good = Array.from(p.pixels()), goodLine = document.getElementById('overlay').textContent;
+          let thrown = null;
+          try { await p.renderPose(cam(1), 0); } catch (e) { thrown = e.message; }
+          const after = Array.from(p.pixels()), line = document.getElementById('overlay').textContent;
+          await p.renderPose(cam(-1), 1 / 24);  // the page still draws
+          return { good, goodLine, thrown, after, line, again: document.getElementById('overlay').textContent };
+        });
+        console.log(`page: damaged chunk: '${poses.goodLine}', then '${poses.line}', then '${poses.again}'`);
+        if (!poses.line.startsWith('CALF-E058 ') || poses.line.includes('\n')) problems.push(`a damaged chunk gave '${poses.line}'`);
+        if (!poses.thrown) problems.push('a damaged chunk did not fail the pose');
+        if (poses.after.join() !== poses.good.join()) problems.push('the last good frame did not stay after the damaged chunk');
+        if (!poses.again.startsWith('frame 1:')) problems.push(`after the damaged chunk the page did not draw: '${poses.again}'`);
+      }
     }
     await touch.close();
   }
