@@ -406,12 +406,15 @@ export async function openLightfield(clip, t) {
 // written. Coverage (§11.1.11; mask and near count a texel) is decoded only with
 // `{ coverage: true }` in a track with coverage, else it is null and no coverage chunk is read.
 // Frames are decoded in order, so a region chunk is read once and its P-frames applied as
-// they come.
-export async function decodeFaceFrames(lf, v, face, onFrame, only = null, { coverage: withCoverage = false } = {}) {
+// they come. `{ from, to }` decodes frames from … to − 1 only (onFrame is called for those): a
+// region chunk holding `from` is applied from its own first frame (§11.1.2), and no chunk of an
+// earlier frame is read. `{ material: false }` neither reads nor decodes material (null).
+export async function decodeFaceFrames(lf, v, face, onFrame, only = null,
+  { coverage: withCoverage = false, material: withMaterial = true, from = 0, to = lf.header.frame_count } = {}) {
   const h = lf.header, N = h.face_size, t = lf.track;
   const view = lf.views[v];
   const colour = new Float32Array(3 * N * N), depth = new Uint16Array(N * N);
-  const material = view.hasMaterial ? new Uint8Array(3 * N * N) : null;
+  const material = view.hasMaterial && withMaterial ? new Uint8Array(3 * N * N) : null;
   const coverage = withCoverage && lf.hasCoverage ? new Uint16Array(2 * N * N) : null;
   const find = (stream, region) => lf.byKey.get(`${stream}/${v}/${face}/${region}`) ?? [];
   const read = (c) => readChunk(lf.clip, c.id);
@@ -438,7 +441,7 @@ export async function decodeFaceFrames(lf, v, face, onFrame, only = null, { cove
   const KIND = { [STREAM.depth]: 'depth', [STREAM.material]: 'material', [STREAM.coverage]: 'coverage' };
   const FORMATS = { [STREAM.depth]: h.depth_format, [STREAM.material]: h.material_format, [STREAM.coverage]: 0 };
   const lossless = h.depth_format !== FORMAT.bc5;
-  for (let n = 0; n < h.frame_count; ++n) {
+  for (let n = from; n < to; ++n) {
     for (let r = 0; r < cellState.length; ++r) {
       const cell = cellState[r];
       if (!cell) continue;
@@ -468,7 +471,8 @@ export async function decodeFaceFrames(lf, v, face, onFrame, only = null, { cove
         tile.chunk = c;
         tile.frames = parseRegion(await read(c), kind, FORMATS[tile.stream],
           tile.rect.w, tile.rect.h, c.frameCount, `${where} frames ${c.firstFrame}+${c.frameCount}`);
-        if (n !== c.firstFrame) bad(`${where}: frame ${n} inside a chunk not decoded from its start`);
+        if (n !== c.firstFrame && n !== from) bad(`${where}: frame ${n} inside a chunk not decoded from its start`);
+        for (let j = c.firstFrame; j < n; ++j) applyRegionFrame(tile.frames[j - c.firstFrame], tile.state, tile.rect.w, tile.channels);
       }
       applyRegionFrame(tile.frames[n - tile.chunk.firstFrame], tile.state, tile.rect.w, tile.channels);
       const dst = { depth, material, coverage }[kind], ch = tile.channels, { x: tx, y: ty, w: tw, h: th } = tile.rect;

@@ -1,17 +1,22 @@
 // The page's lightfield player: calf-play's GL render (raymarch.js: the native ray-march shader,
 // its view selection and march range) of a clip opened by URL over range requests. Only the
 // cells and depth tiles the pose's eye can see (culling.js, the native decoder's culling) of the
-// active views are fetched and decoded, every frame of them, when first needed; a frame's faces
-// are uploaded when a pose needs that frame or new cells.
+// active views are fetched and decoded, for the pose's frame; the same cells' chunks of the next
+// frames are prefetched; a face is uploaded when a pose needs another frame or new cells of it.
 import { openClip } from './container.js';
 import { openLightfield, decodeFaceFrames, parseTimeline, bcBlocks, STREAM } from './lightfield.js';
 import { readChunk } from './container.js';
 import { E, fail } from './errors.js';
-import { httpSource, prefetch } from './stream.js';
+import { cachedT, chunkFetchCounts, fetched, httpSource, planFrame, prefetch, rateMeter, touchChunk, trimCache } from './stream.js';
 import { makeCodecs } from './codecs.js';
 import { bcUpload, makeRaymarcher, marchRange, selectViews } from './raymarch.js';
 import { visibleSets } from './culling.js';
 import { openRasterPlayer, rasterTracks } from './raster_player.js';
+
+// How many frames ahead the page fetches (index.html?prefetch=N), and the most raw bytes of
+// chunks it keeps cached.
+export const PREFETCH_FRAMES = 2;
+export const CACHE_BYTES = 256 * 1024 * 1024;
 
 // frame_at_time (format/capture/src/eye_path.cc).
 export function frameAtTime(seconds, fps, frameCount) {
@@ -34,11 +39,13 @@ export function canvasRgb(gl, canvas) {
   return rgb;
 }
 
-export async function openMarchPlayer({ canvas, url, deps, status }) {
+// The clip: `url` (read with range requests), or `source` (container.js's bytesSource, e.g. a
+// local file's bytes; nothing is fetched).
+export async function openMarchPlayer({ canvas, url, source: given = null, deps, status }) {
   const gl = canvas.getContext('webgl2', { preserveDrawingBuffer: true, antialias: false });
   if (!gl) throw new Error('WebGL2 is not available');
   const codecs = await makeCodecs(deps);
-  const source = await httpSource(url);
+  const source = given ? { ...given, local: true, stats: { requests: 0, bytes: 0, ranges: [] } } : await httpSource(url);
   if (source.notice) status(source.notice);
   const clip = await openClip(source, codecs);
   const t = clip.tracks.findIndex((x) => x.kind === 1);
@@ -54,99 +61,96 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
   // bc=0 turns it off), else it is decoded to RGBA on the CPU.
   const bc = deps.noBc ? null : bcUpload(gl, h.colour_format, N);
   const renderer = makeRaymarcher(gl, { views: lf.views, faceSize: N, cellSize: h.cell_size, bc });
+  // Prefetch: after a frame's own chunks, those of the next `prefetchFrames` frames (wrapping, as
+  // the page loops) for the same cells and tiles, in the background; chunks the cache holds
+  // beyond `cacheBytes` raw bytes are dropped, least recently used first.
+  const prefetchFrames = Math.max(0, Math.floor(deps.prefetchFrames ?? PREFETCH_FRAMES));
+  const cacheBytes = deps.cacheBytes ?? CACHE_BYTES;
   const cellInfo = new Map();  // BCn: `view/face/cell` -> { keys, t, slot: [keyframe in slot 0, 1] }
-  const decoded = new Map();  // view -> { frames: [frame] -> { colour: [6], depth: [6] }, have: [6] -> { cells, tiles } }
-  const uploaded = new Int32Array(lf.views.length).fill(-1);
+  // Per view: its faces as uploaded, and per face the cells and tiles decoded at `frame` (the
+  // others keep an earlier frame's texels, which this pose's rays do not reach).
+  const faces = new Map();
   const selection = {};
-  const rateSamples = [];
-  const stats = { decodeMs: 0, cellsDecoded: 0, tilesDecoded: 0 };
-  // Decodes (every frame of) the cells and tiles of view v that `sets` names and that are not
-  // decoded yet; returns whether anything was.
-  async function ensureCells(v, sets) {
-    if (!decoded.has(v)) {
-      decoded.set(v, {
-        frames: Array.from({ length: F }, () => ({
-          colour: Array.from({ length: 6 }, () => new Float32Array(3 * N * N)),
-          depth: Array.from({ length: 6 }, () => new Uint16Array(N * N)),
-        })),
-        have: Array.from({ length: 6 }, () => ({ cells: new Set(), tiles: new Set() })),
-      });
-    }
-    const d = decoded.get(v);
-    // What is missing, fetched first in one request per run of neighbouring chunks.
-    const missing = [], ids = [];
-    const chunks = (stream, face, r) => (lf.byKey.get(`${stream}/${v}/${face}/${r}`) ?? []).map((c) => c.id);
-    for (let face = 0; face < 6; ++face) {
-      const have = d.have[face];
-      const only = { cells: new Set([...sets.cells[face]].filter((r) => !have.cells.has(r))),
-        tiles: new Set([...sets.tiles[face]].filter((r) => !have.tiles.has(r))) };
-      missing.push(only);
-      for (const r of only.cells) ids.push(...chunks(STREAM.t, face, r), ...chunks(STREAM.colour, face, r));
-      for (const r of only.tiles) ids.push(...chunks(STREAM.depth, face, r), ...chunks(STREAM.material, face, r));
-    }
-    const tf = performance.now();
-    await prefetch(lf.clip, ids.sort((a, b) => a - b));
-    stats.decodeMs += performance.now() - tf;
-    let any = false;
-    for (let face = 0; face < 6; ++face) {
-      const have = d.have[face], only = missing[face];
-      if (only.cells.size === 0 && only.tiles.size === 0) continue;
-      any = true;
-      const t0 = performance.now();
-      if (bc) {
-        for (const r of only.cells) {
-          const tc = lf.byKey.get(`${STREAM.t}/${v}/${face}/${r}`)?.[0];
-          const what = `track ${lf.track} view ${v} face ${face} cell ${r} t`;
-          if (!tc) fail(E.lightfieldChunk, `${what}: no t chunk`);
-          cellInfo.set(`${v}/${face}/${r}`, { ...parseTimeline(await readChunk(lf.clip, tc.id), F, what), slot: [-1, -1] });
-          have.cells.add(r);
-        }
-        stats.cellsDecoded += only.cells.size;
-        only.cells = new Set();
-        if (only.tiles.size === 0) continue;
+  const stats = { decodeMs: 0, fetchMs: 0, cellsDecoded: 0, tilesDecoded: 0, prefetched: 0 };
+  const running = new Set();  // prefetches in flight
+  const rate = rateMeter(source, F / fps);
+  const plan = (needed, n) => planFrame(lf, n, needed, cachedT(lf, n), { material: false, cellTiles: false });
+  // Fetches what frame n of the regions `needed` asks for: t chunks first, so that the next
+  // colour keyframe is fetched only where t[n] ≠ 0. Returns the chunk ids of the frame.
+  async function fetchFrame(needed, n) {
+    let got = await prefetch(lf.clip, plan(needed, n).filter((id) => lf.clip.chunks[id].stream === STREAM.t));
+    const ids = plan(needed, n);
+    got = got.concat(await prefetch(lf.clip, ids));
+    return { ids, got };
+  }
+  // BCn: per cell of `cells` (view v, face), keyframe m (the one whose frames hold `frame`) in
+  // slot m % 2 and the next one in the other slot when t ≠ 0 (docs/DECODER.md), and its value in
+  // the cell texture.
+  async function uploadBc(v, face, cells, frame, values) {
+    for (const r of cells) {
+      const key = `${v}/${face}/${r}`;
+      if (!cellInfo.has(key)) {
+        const tc = lf.byKey.get(`${STREAM.t}/${v}/${face}/${r}`)?.[0];
+        const what = `track ${lf.track} view ${v} face ${face} cell ${r} t`;
+        if (!tc) fail(E.lightfieldChunk, `${what}: no t chunk`);
+        cellInfo.set(key, { ...parseTimeline(await readChunk(lf.clip, tc.id), F, what), slot: [-1, -1] });
       }
-      await decodeFaceFrames(lf, v, face, (n, colour, depth) => {
-        const dst = d.frames[n];
-        for (const r of only.cells) {
-          const { x, y, w, h: rh } = lf.cells.rect(r);
-          for (let j = y; j < y + rh; ++j) dst.colour[face].set(colour.subarray(3 * (j * N + x), 3 * (j * N + x + w)), 3 * (j * N + x));
-        }
-        for (const r of only.tiles) {
-          const { x, y, w, h: rh } = lf.tiles.rect(r);
-          for (let j = y; j < y + rh; ++j) dst.depth[face].set(depth.subarray(j * N + x, j * N + x + w), j * N + x);
-        }
-      }, only);
+      const info = cellInfo.get(key), { keys } = info;
+      let m = 0;
+      while (m + 1 < keys.length && keys[m + 1] <= frame) ++m;
+      const w = m + 1 < keys.length ? info.t[frame] : 0;
+      for (const i of w ? [m, m + 1] : [m]) {
+        if (info.slot[i % 2] === keys[i]) continue;
+        const c = (lf.byKey.get(`${STREAM.colour}/${v}/${face}/${r}`) ?? []).find((x) => x.firstFrame === keys[i]);
+        const what = `track ${lf.track} view ${v} face ${face} cell ${r} keyframe ${keys[i]}`;
+        if (!c) fail(E.lightfieldChunk, `${what}: no colour chunk`);
+        const rect = lf.cells.rect(r);
+        renderer.uploadBlocks(v, face, i % 2, rect, bcBlocks(await readChunk(lf.clip, c.id), h.colour_format, rect.w, rect.h, what));
+        info.slot[i % 2] = keys[i];
+      }
+      values[r] = ((m % 2) << 8) | w;
+    }
+    renderer.uploadCells(v, face, values);
+  }
+  // Decodes frame n of the cells and tiles of view v that `sets` names and that are not decoded
+  // at n yet (their chunks fetched), and uploads the faces that changed.
+  async function decodeView(v, sets, n) {
+    if (!faces.has(v)) {
+      const six = (make) => Array.from({ length: 6 }, make);
+      faces.set(v, { frame: -1, colour: six(() => new Float32Array(3 * N * N)), depth: six(() => new Uint16Array(N * N)),
+        cells: six(() => new Set()), tiles: six(() => new Set()), values: six(() => new Uint32Array(lf.cells.count)) });
+    }
+    const d = faces.get(v);
+    if (d.frame !== n) {
+      for (let face = 0; face < 6; ++face) { d.cells[face].clear(); d.tiles[face].clear(); }
+      d.frame = n;
+    }
+    for (let face = 0; face < 6; ++face) {
+      const only = { cells: new Set([...sets.cells[face]].filter((r) => !d.cells[face].has(r))),
+        tiles: new Set([...sets.tiles[face]].filter((r) => !d.tiles[face].has(r))) };
+      if (only.cells.size === 0 && only.tiles.size === 0) continue;
+      const t0 = performance.now();
+      if (bc) await uploadBc(v, face, only.cells, n, d.values[face]);
+      const cpu = { cells: bc ? new Set() : only.cells, tiles: only.tiles };
+      if (cpu.cells.size || cpu.tiles.size) {
+        await decodeFaceFrames(lf, v, face, (m, colour, depth) => {
+          for (const r of cpu.cells) {
+            const { x, y, w, h: rh } = lf.cells.rect(r);
+            for (let j = y; j < y + rh; ++j) d.colour[face].set(colour.subarray(3 * (j * N + x), 3 * (j * N + x + w)), 3 * (j * N + x));
+          }
+          for (const r of cpu.tiles) {
+            const { x, y, w, h: rh } = lf.tiles.rect(r);
+            for (let j = y; j < y + rh; ++j) d.depth[face].set(depth.subarray(j * N + x, j * N + x + w), j * N + x);
+          }
+        }, cpu, { material: false, from: n, to: n + 1 });
+      }
+      if (bc) { if (cpu.tiles.size) renderer.uploadDepth(v, face, d.depth[face]); }
+      else renderer.uploadFace(v, face, d.colour[face], d.depth[face]);
       stats.decodeMs += performance.now() - t0;
       stats.cellsDecoded += only.cells.size;
       stats.tilesDecoded += only.tiles.size;
-      for (const r of only.cells) have.cells.add(r);
-      for (const r of only.tiles) have.tiles.add(r);
-    }
-    return any;
-  }
-  // BCn: per fetched cell of view v, keyframe m (the one whose frames hold `frame`) in slot m % 2
-  // and the next one in the other slot when t ≠ 0 (docs/DECODER.md), and the cell texture.
-  async function uploadBc(v, frame) {
-    const d = decoded.get(v);
-    for (let face = 0; face < 6; ++face) {
-      const values = new Uint32Array(lf.cells.count);
-      for (const r of d.have[face].cells) {
-        const info = cellInfo.get(`${v}/${face}/${r}`), { keys } = info;
-        let m = 0;
-        while (m + 1 < keys.length && keys[m + 1] <= frame) ++m;
-        const w = m + 1 < keys.length ? info.t[frame] : 0;
-        for (const i of w ? [m, m + 1] : [m]) {
-          if (info.slot[i % 2] === keys[i]) continue;
-          const c = (lf.byKey.get(`${STREAM.colour}/${v}/${face}/${r}`) ?? []).find((x) => x.firstFrame === keys[i]);
-          const what = `track ${lf.track} view ${v} face ${face} cell ${r} keyframe ${keys[i]}`;
-          if (!c) fail(E.lightfieldChunk, `${what}: no colour chunk`);
-          const rect = lf.cells.rect(r);
-          renderer.uploadBlocks(v, face, i % 2, rect, bcBlocks(await readChunk(lf.clip, c.id), h.colour_format, rect.w, rect.h, what));
-          info.slot[i % 2] = keys[i];
-        }
-        values[r] = ((m % 2) << 8) | w;
-      }
-      renderer.uploadCells(v, face, values);
+      for (const r of only.cells) d.cells[face].add(r);
+      for (const r of only.tiles) d.tiles[face].add(r);
     }
   }
   // The view volume: the clip's `view_volume` metadata ("x0 y0 z0 x1 y1 z1") where well formed,
@@ -183,21 +187,35 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
     const { near, far } = marchRange(lf.views, camera.position);
     const sets = visibleSets(lf, cullCamera(camera), near, far, active);
     let visibleCells = 0;
+    const needed = [];
     for (const v of active) {
       const vs = sets.get(v);
-      for (let face = 0; face < 6; ++face) visibleCells += vs.cells[face].size;
-      const changed = await ensureCells(v, vs);
-      if (bc) await uploadBc(v, frame);
-      if (uploaded[v] === frame && !changed) continue;
-      const f = decoded.get(v).frames[frame];
       for (let face = 0; face < 6; ++face) {
-        if (bc) renderer.uploadDepth(v, face, f.depth[face]);
-        else renderer.uploadFace(v, face, f.colour[face], f.depth[face]);
+        visibleCells += vs.cells[face].size;
+        for (const cell of vs.cells[face]) needed.push({ view: v, face, cell });
+        for (const tile of vs.tiles[face]) needed.push({ view: v, face, tile });
       }
-      uploaded[v] = frame;
+    }
+    const tf = performance.now();
+    const { ids } = await fetchFrame(needed, frame);
+    stats.fetchMs += performance.now() - tf;
+    for (const id of ids) touchChunk(lf.clip, id);
+    trimCache(lf.clip, cacheBytes, new Set(ids));
+    for (const v of active) await decodeView(v, sets.get(v), frame);
+    const next = [];
+    for (let k = 1; k <= prefetchFrames && k < F; ++k) next.push((frame + k) % F);
+    if (next.length) {
+      const p = (async () => { for (const n of next) stats.prefetched += (await fetchFrame(needed, n)).got.length; })()
+        .catch(() => {})  // a chunk that fails here is fetched again, and reported, when a frame needs it
+        .finally(() => running.delete(p));
+      running.add(p);
     }
     return { frame, active, visibleCells, totalCells: active.length * 6 * lf.cells.count };
   }
+  // Resolves when the prefetches in flight are done.
+  const settled = async () => { while (running.size) await Promise.all([...running]); };
+  // How many requests fetched each chunk (Map id -> count).
+  const fetchCounts = () => chunkFetchCounts(lf.clip, source);
   // Draws a prepared pose (synchronous: a WebXR frame draws inside its callback); target:
   // { framebuffer, viewport: { x, y, width, height } } or the whole canvas.
   function draw(camera, prepared, target) {
@@ -212,16 +230,10 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
   }
   // The overlay line of a drawn pose; position: the viewer's.
   function report(prepared, renderMs, position, eyes = 1) {
-    const now = performance.now();
-    rateSamples.push({ now, bytes: source.stats.bytes });
-    while (rateSamples.length > 2 && now - rateSamples[1].now >= 1000) rateSamples.shift();
-    const span = (now - rateSamples[0].now) / 1000;
-    const rate = span > 0 ? (source.stats.bytes - rateSamples[0].bytes) / span : 0;
     const out = inside(position) ? '' : '; the eye is outside the view volume';
     status(`frame ${prepared.frame}: ${eyes === 2 ? 'two eyes, ' : ''}${prepared.active.length} of ${lf.views.length} views, ${prepared.visibleCells}/${prepared.totalCells} cells, ` +
       `render ${renderMs.toFixed(1)} ms; ${stats.cellsDecoded} cells decoded (${stats.decodeMs.toFixed(0)} ms), ` +
-      `${source.stats.bytes} of ${source.size} bytes fetched (${(100 * source.stats.bytes / source.size).toFixed(1)} %, ` +
-      `${source.stats.requests} requests), ${(rate / 1024).toFixed(1)} KiB/s${out}`);
+      `${fetched(source, rate)}${out}`);
     return !out;
   }
   // One pose into the canvas. An error (a damaged chunk, say) is one line in the overlay and is
@@ -242,5 +254,6 @@ export async function openMarchPlayer({ canvas, url, deps, status }) {
   const pixels = () => canvasRgb(gl, canvas);
   const views = lf.views.filter((v) => v);
   const startEye = [0, 1, 2].map((k) => views.reduce((s, v) => s + v.position[k], 0) / views.length);
-  return { gl, lf, renderPose, prepare, draw, report, pixels, stats, fps, frameCount: F, startEye, volume, inside };
+  return { gl, lf, renderPose, prepare, draw, report, pixels, stats, fps, frameCount: F, startEye, volume, inside,
+    prefetchFrames, settled, fetchCounts, source };
 }

@@ -15,6 +15,7 @@
 //   premultiplied colour (out = src + (1 − src.a) dst); a last depth-tested pass writes the
 //   nearest distance with alpha ≥ 0.5 into the layer's fourth channel (the native MIN blend).
 import { GL_TILES_VERTEX, GL_MESH_FRAGMENT } from './glsl_raster.js';
+import { keptProgram } from './raymarch.js';
 
 const PROLOGUE = '#version 300 es\nprecision highp float;\nprecision highp int;\nprecision highp sampler2D;\nprecision highp sampler2DArray;\n';
 const NEAR = 0.01;  // MeshRenderOptions::near, TilesRenderOptions::near
@@ -117,6 +118,10 @@ void main() { out_colour = vec4(srgb(texelFetch(frame_tex, ivec2(gl_FragCoord.xy
 `;
 
 function program(gl, vs, fs, what) {
+  return keptProgram(gl, vs, fs, () => linkProgram(gl, vs, fs, what));
+}
+
+function linkProgram(gl, vs, fs, what) {
   const p = gl.createProgram();
   for (const [type, src] of [[gl.VERTEX_SHADER, vs], [gl.FRAGMENT_SHADER, fs]]) {
     const s = gl.createShader(type);

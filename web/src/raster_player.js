@@ -5,7 +5,7 @@
 import { openTiles } from './tiles.js';
 import { openMesh } from './mesh.js';
 import { makeRaster, loadMesh, loadTiles } from './raster.js';
-import { prefetch } from './stream.js';
+import { fetched, prefetch, rateMeter } from './stream.js';
 import { canvasRgb, frameAtTime } from './march_player.js';
 
 // The tracks of kind 2 and 4 with a representation (an index chunk), in clip order, every chunk
@@ -28,6 +28,7 @@ export async function openRasterPlayer({ gl, canvas, clip, source, status, track
   // min(frame, its last frame)).
   const F = tracks[0].frameCount, h0 = clip.tracks[tracks[0].track].header;
   const fps = h0.fps_numerator / h0.fps_denominator;
+  const rate = rateMeter(source, F / fps);
   // The view region (the tracks' union): where the eye starts and what the overlay checks.
   const volume = { min: [Infinity, Infinity, Infinity], max: [-Infinity, -Infinity, -Infinity] };
   for (const t of tracks) {
@@ -56,7 +57,7 @@ export async function openRasterPlayer({ gl, canvas, clip, source, status, track
     const what = tracks.map((t, i) => (t.kind === 'mesh' ? `mesh: ${figures[i]?.triangles ?? 0} triangles` : `tiles: ${t.n} tiles`)).join(', ');
     const out = inside(position) ? '' : '; the eye is outside the view volume';
     status(`frame ${prepared.frame}: ${eyes === 2 ? 'two eyes, ' : ''}${what}, render ${renderMs.toFixed(1)} ms; ` +
-      `${source.stats.bytes} of ${source.size} bytes fetched (${source.stats.requests} requests)${out}`);
+      `${fetched(source, rate)}${out}`);
     return !out;
   }
   async function renderPose(camera, time) {

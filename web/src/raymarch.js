@@ -116,7 +116,21 @@ function compile(gl, type, source, what) {
   return s;
 }
 
+// Linked programs by context and source: a second clip opened on the same canvas reuses them
+// (SwiftShader takes seconds to compile the ray march). link() makes one when none is kept.
+const programs = new WeakMap();
+export function keptProgram(gl, vs, fs, link) {
+  if (!programs.has(gl)) programs.set(gl, new Map());
+  const known = programs.get(gl), key = `${vs}\n//\n${fs}`;
+  if (!known.has(key)) known.set(key, link());
+  return known.get(key);
+}
+
 function program(gl, vs, fs, what) {
+  return keptProgram(gl, vs, fs, () => linkProgram(gl, vs, fs, what));
+}
+
+function linkProgram(gl, vs, fs, what) {
   const p = gl.createProgram();
   gl.attachShader(p, compile(gl, gl.VERTEX_SHADER, vs, what));
   gl.attachShader(p, compile(gl, gl.FRAGMENT_SHADER, fs, what));

@@ -1,7 +1,8 @@
 // calf-export --web (docs/EXPORT.md): the folder it writes holds the page, its scripts, the npm
 // modules the page imports and the clip; served as the command prints it (python3's
 // http.server, no range requests) and opened at its root in headless Chromium, the page plays the
-// clip it names by default and draws a frame that is not blank.
+// clip it names by default, says in one line that the server sent the whole clip (no range
+// requests), and draws a frame that is not blank.
 //
 //   CALF_EXPORT=build/.../calf-export node web/test/export.mjs CHROMIUM
 import { execFileSync, spawn } from 'node:child_process';
@@ -41,10 +42,14 @@ try {
   const page = await browser.newPage();
   const consoleLines = [];
   page.on('pageerror', (e) => consoleLines.push(e.message));
-  await page.goto(`http://127.0.0.1:${port}/`);
+  await page.goto(`http://127.0.0.1:${port}/?autoplay=0`);  // the test draws
   await page.waitForFunction(() => window.calfStatus !== 'loading', null, { timeout: 60000 });
   const overlay = await page.textContent('#overlay');
   console.log(`export: the page at the folder's root: '${overlay}'`);
+  // http.server answers a range request with the whole file: one notice line says so.
+  const notice = (await page.evaluate(() => window.calfStatusLines)).filter((l) => l.startsWith('the server ignores range requests'));
+  console.log(`export: the notice: '${notice[0]}'`);
+  if (notice.length !== 1 || notice[0].includes('\n')) problems.push(`no one-line notice of the whole download: ${JSON.stringify(notice)}`);
   if ((await page.evaluate(() => window.calfStatus)) !== 'ready') {
     problems.push(`the page did not play its clip: ${overlay} ${consoleLines.join(' | ')}`);
   } else {

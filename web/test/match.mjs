@@ -4,7 +4,8 @@
 // SwiftShader) renders the same poses with the same shader body; each frame must be within
 // MIN_DB of calf-play's, a blank canvas fails, and the page's active views and visible cells
 // (the only ones it fetches) are calf-play's. Prints the dB per pose, the render ms of both and
-// the bytes fetched.
+// the bytes fetched; along the path the page fetches less than the whole clip and no chunk twice
+// (the page's record of its range requests).
 //
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM --clip CLIP EYE_PATH   (a given clip)
@@ -12,7 +13,7 @@ import { execFileSync } from 'node:child_process';
 import { copyFileSync, mkdirSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startRangeServer, launchChromium } from './browser.mjs';
+import { startRangeServer, launchChromium, playClip, renderEyePath, colourCount } from './browser.mjs';
 import { readPng, psnr } from './frames.mjs';
 
 // The floor the brief sets is 40 dB; the measured figures are in docs/WEB.md.
@@ -58,34 +59,15 @@ const path = JSON.parse(readFileSync(join(dir, 'gt', 'eye_path.json'), 'utf8'));
 const { server, port } = await startRangeServer({ '/clips': dir });
 const problems = [];
 const browser = await launchChromium(chromium);
+const held = {};  // one page plays the clips in turn (the ray march compiles once)
 try {
 for (const [name] of clips) {
-  const page = await browser.newPage();
-  const consoleLines = [];
-  page.on('console', (m) => consoleLines.push(m.text()));
-  page.on('pageerror', (e) => consoleLines.push(e.message));
-  await page.goto(`http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/clips/${name}.calf`);
-  await page.waitForFunction(() => window.calfStatus !== 'loading', null, { timeout: 60000 });
-  if ((await page.evaluate(() => window.calfStatus)) !== 'ready') {
-    problems.push(`${name}: the page did not open the clip: ${await page.textContent('#overlay')} ${consoleLines.join(' | ')}`);
+  const { page, consoleLines, ready, overlay } = await playClip(browser, held, `http://127.0.0.1:${port}`, `/clips/${name}.calf`);
+  if (!ready) {
+    problems.push(`${name}: the page did not open the clip: ${overlay} ${consoleLines.join(' | ')}`);
   } else {
-    for (let i = 0; i < path.poses.length; ++i) {
-      const p = path.poses[i];
-      const camera = { position: p.position, forward: p.forward, up: p.up, fovY: (p.fov_y_degrees * Math.PI) / 180, width: path.width, height: path.height };
-      let got;
-      try {
-        got = await page.evaluate(async ({ camera, time }) => {
-          const r = await window.calfPlayer.renderPose(camera, time);
-          return { ...r, rgb: Array.from(window.calfPlayer.pixels()) };
-        }, { camera, time: p.time });
-      } catch (e) {
-        problems.push(`${name} pose ${i}: ${e.message.split('\n')[0]} ${consoleLines.join(' | ')}`);
-        continue;
-      }
+    await renderEyePath(page, path, (i, got, rgb) => {
       const want = readPng(join(dir, `play-${name}`, `frame_${String(i).padStart(5, '0')}.png`));
-      const rgb = Uint8Array.from(got.rgb);
-      const distinct = new Set();
-      for (let k = 0; k < rgb.length; k += 3) distinct.add((rgb[k] << 16) | (rgb[k + 1] << 8) | rgb[k + 2]);
       const db = psnr(rgb, want.rgb);
       const n = native[name][i] ?? {};
       console.log(`web.match: ${name} pose ${i} frame ${got.frame} (colour ${got.colourUpload}): ${got.active.length} views, ${got.visibleCells}/${got.totalCells} cells ` +
@@ -96,11 +78,23 @@ for (const [name] of clips) {
         problems.push(`${name} pose ${i}: ${got.active.length} views, ${got.visibleCells}/${got.totalCells} cells; calf-play ${n.views}, ${n.cells}/${n.total}`);
       }
       if (name === 'bc1' && !got.colourUpload.startsWith('BC1')) problems.push(`bc1 pose ${i}: colour went up as ${got.colourUpload}, not as BC1 blocks`);
-      if (distinct.size < 16) problems.push(`${name} pose ${i}: the canvas is blank (${distinct.size} colours)`);
+      const colours = colourCount(rgb);
+      if (colours < 16) problems.push(`${name} pose ${i}: the canvas is blank (${colours} colours)`);
       if (!(db >= MIN_DB)) problems.push(`${name} pose ${i}: ${db.toFixed(2)} dB against calf-play, below ${MIN_DB}`);
-    }
+    }, (i, message) => problems.push(`${name} pose ${i}: ${message} ${consoleLines.join(' | ')}`));
+    // Along the path, with the prefetches done: less than the whole clip, no chunk twice.
+    const f = await page.evaluate(async () => {
+      const p = window.calfPlayer;
+      await p.settled();
+      const counts = p.fetchCounts();
+      return { twice: [...counts].filter(([, k]) => k > 1).map(([id]) => id), chunks: counts.size, of: p.lf.clip.chunks.length,
+        bytes: p.source.stats.bytes, size: p.source.size, requests: p.source.stats.requests, prefetched: p.stats.prefetched };
+    });
+    console.log(`web.match: ${name} along the path: ${f.bytes} of ${f.size} bytes fetched (${(100 * f.bytes / f.size).toFixed(1)} %), ` +
+      `${f.chunks} of ${f.of} chunks in ${f.requests} requests, ${f.prefetched} of them prefetched, ${f.twice.length} fetched twice`);
+    if (f.twice.length) problems.push(`${name}: chunks fetched twice: ${f.twice.slice(0, 10)}`);
+    if (!(f.bytes < f.size)) problems.push(`${name}: the whole clip was fetched (${f.bytes} of ${f.size} bytes)`);
   }
-  await page.close();
 }
 } finally {
   await browser.close();

@@ -12,7 +12,7 @@ import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { loadCodecs } from './node_codecs.mjs';
-import { startRangeServer, launchChromium } from './browser.mjs';
+import { startRangeServer, launchChromium, playClip, renderEyePath, colourCount } from './browser.mjs';
 import { readPng, psnr } from './frames.mjs';
 import { joinClips } from '../tools/join_clips.mjs';
 
@@ -60,45 +60,25 @@ const path = JSON.parse(readFileSync(join(dir, 'gt', 'eye_path.json'), 'utf8'));
 const { server, port } = await startRangeServer({ '/clips': dir });
 const problems = [];
 const browser = await launchChromium(chromium);
+const held = {};  // one page plays the clips in turn (the programs compile once)
 try {
   for (const name of clips) {
-    const page = await browser.newPage();
-    const consoleLines = [];
-    page.on('console', (m) => consoleLines.push(m.text()));
-    page.on('pageerror', (e) => consoleLines.push(e.message));
-    await page.goto(`http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/clips/${name}.calf`);
-    await page.waitForFunction(() => window.calfStatus !== 'loading', null, { timeout: 60000 });
-    if ((await page.evaluate(() => window.calfStatus)) !== 'ready') {
-      problems.push(`${name}: the page did not open the clip: ${await page.textContent('#overlay')} ${consoleLines.join(' | ')}`);
-      await page.close();
+    const { page, consoleLines, ready, overlay } = await playClip(browser, held, `http://127.0.0.1:${port}`, `/clips/${name}.calf`);
+    if (!ready) {
+      problems.push(`${name}: the page did not open the clip: ${overlay} ${consoleLines.join(' | ')}`);
       continue;
     }
-    for (let i = 0; i < path.poses.length; ++i) {
-      const p = path.poses[i];
-      const camera = { position: p.position, forward: p.forward, up: p.up, fovY: (p.fov_y_degrees * Math.PI) / 180, width: path.width, height: path.height };
-      let got;
-      try {
-        got = await page.evaluate(async ({ camera, time }) => {
-          const r = await window.calfPlayer.renderPose(camera, time);
-          return { ...r, rgb: Array.from(window.calfPlayer.pixels()) };
-        }, { camera, time: p.time });
-      } catch (e) {
-        problems.push(`${name} pose ${i}: ${e.message.split('\n')[0]} ${consoleLines.join(' | ')}`);
-        continue;
-      }
+    await renderEyePath(page, path, (i, got, rgb) => {
       const want = readPng(join(dir, `play-${name}`, `frame_${String(i).padStart(5, '0')}.png`));
-      const rgb = Uint8Array.from(got.rgb);
-      const distinct = new Set();
-      for (let k = 0; k < rgb.length; k += 3) distinct.add((rgb[k] << 16) | (rgb[k + 1] << 8) | rgb[k + 2]);
       const db = psnr(rgb, want.rgb);
       const what = got.tracks.map((t) => (t.kind === 'mesh' ? `mesh ${t.triangles} triangles` : `tiles ${t.tiles}`)).join(' + ');
       console.log(`web.match_raster: ${name} pose ${i} frame ${got.frame} (${what}): ${db.toFixed(2)} dB against calf-play; ` +
         `render ${got.renderMs.toFixed(1)} ms (SwiftShader) against calf-play's ${native[name][i]?.ms} ms (llvmpipe)`);
-      if (distinct.size < 16) problems.push(`${name} pose ${i}: the canvas is blank (${distinct.size} colours)`);
+      const colours = colourCount(rgb);
+      if (colours < 16) problems.push(`${name} pose ${i}: the canvas is blank (${colours} colours)`);
       if (!(db >= MIN_DB)) writeFileSync(join(dir, `page-${name}-${i}.ppm`), Buffer.concat([Buffer.from(`P6 ${want.width} ${want.height} 255\n`), rgb]));
       if (!(db >= MIN_DB)) problems.push(`${name} pose ${i}: ${db.toFixed(2)} dB against calf-play, below ${MIN_DB}`);
-    }
-    await page.close();
+    }, (i, message) => problems.push(`${name} pose ${i}: ${message} ${consoleLines.join(' | ')}`));
   }
 } finally {
   await browser.close();

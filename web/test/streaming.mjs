@@ -1,8 +1,12 @@
 // The streaming reader (web/src/stream.js) against a local server with range requests
 // (web/test/range_server.py): the clip opens with two requests; per frame the plan for one
 // face's cells fetches only those chunks, never one twice, and they decode to the face's hash
-// lines with no other read (coverage chunks only when the plan asks for coverage); a server
-// without range support gives one notice and the whole clip.
+// lines with no other read (coverage chunks only when the plan asks for coverage), and each
+// frame decoded alone (`{ from: n, to: n + 1 }`, as the page decodes a pose's frame) gives its
+// line too; two prefetches of the same chunks at once request each chunk once (counted in the
+// server's log, and by chunkFetchCounts from the reader's own record); a trimmed cache keeps what
+// it is told to and fetches only what it dropped; a server without range support gives one
+// notice and the whole clip.
 //
 //   node web/test/streaming.mjs
 import { spawn } from 'node:child_process';
@@ -12,14 +16,17 @@ import { createInterface } from 'node:readline';
 import { ROOT, loadCodecs } from './node_codecs.mjs';
 import { openClip } from '../src/container.js';
 import { openLightfield, decodeFaceFrames, faceHash } from '../src/lightfield.js';
-import { httpSource, planFrame, prefetch, cachedT } from '../src/stream.js';
+import { httpSource, planFrame, prefetch, cachedT, chunkFetchCounts, trimCache } from '../src/stream.js';
 
 const DIR = join(ROOT, 'tests/conformance/lightfield');
 const problems = [];
 const check = (ok, what) => { if (!ok) problems.push(what); };
 
+// The server's log: one `GET PATH RANGE BYTES` line a request.
 async function startServer(args) {
-  const child = spawn('/usr/bin/python3', [join(ROOT, 'web/test/range_server.py'), DIR, ...args], { stdio: ['ignore', 'pipe', 'ignore'] });
+  const child = spawn('/usr/bin/python3', [join(ROOT, 'web/test/range_server.py'), DIR, ...args], { stdio: ['ignore', 'pipe', 'pipe'] });
+  child.log = [];
+  createInterface({ input: child.stderr }).on('line', (l) => child.log.push(l));
   const line = await new Promise((resolve, reject) => {
     createInterface({ input: child.stdout }).once('line', resolve);
     child.once('exit', (code) => reject(new Error(`range_server exited with ${code}`)));
@@ -59,6 +66,18 @@ async function streamFace(codecs, base, name, view, face, coverage = false) {
   }
   const want = readFileSync(join(DIR, `${name}.hashes`), 'utf8').split('\n').filter((l) => l.includes(` view ${view} face ${face} `));
   check(lines.join('\n') === want.join('\n'), `${name} view ${view} face ${face}: streamed decode differs from the .hashes lines`);
+  // Each frame alone, from the cache.
+  for (let n = 0; n < lf.header.frame_count; ++n) {
+    const alone = [];
+    try {
+      await decodeFaceFrames(lf, view, face, (m, c, d, mat, cov) => {
+        alone.push(`track ${t} frame ${m} view ${view} face ${face} ${faceHash(codecs, c, d, mat, cov)}`);
+      }, null, { coverage, from: n, to: n + 1 });
+    } catch (e) {
+      problems.push(`${name} frame ${n} alone: ${e.message}`);
+    }
+    check(alone.length === 1 && alone[0] === want[n], `${name} view ${view} face ${face} frame ${n} decoded alone: '${alone}' against '${want[n]}'`);
+  }
   check(openRequests <= 2, `${name}: ${openRequests} requests to open`);
   check(twice === 0, `${name}: ${twice} chunks fetched twice`);
   check(bytes < source.size, `${name}: fetched ${bytes} of ${source.size} bytes`);
@@ -81,6 +100,36 @@ try {
   await streamFace(codecs, ranged.base, 'bc1_raw16_groups', 0, 1);
   await streamFace(codecs, ranged.base, 'bc6h_raw16_lzma2', 0, 0);
   await streamFace(codecs, ranged.base, 'coverage_bc1_pred16m', 1, 2, true);
+  // Two prefetches of overlapping chunk sets at once: each chunk requested once.
+  {
+    const url = `${ranged.base}/crafted_bc7_raw16_mat.calf`, first = ranged.child.log.length;
+    const source = await httpSource(url);
+    const clip = await openClip(source, codecs);
+    const lt = clip.tracks.findIndex((x) => x.kind === 1);
+    const ids = clip.chunks.filter((c) => c.track === lt && c.stream >= 1 && c.stream <= 4 && c.view === 0 && c.face === 2).map((c) => c.id);
+    check(ids.length > 2, `${ids.length} chunks of view 0 face 2`);
+    const half = ids.slice(0, Math.ceil(ids.length / 2));
+    await Promise.all([prefetch(clip, ids), prefetch(clip, half), prefetch(clip, ids)]);
+    await new Promise((r) => setTimeout(r, 200));  // the server's last log lines
+    const fromLog = new Map();
+    for (const line of ranged.child.log.slice(first)) {
+      const m = /^GET \/crafted_bc7_raw16_mat\.calf bytes=(\d+)-(\d+) /.exec(line);
+      if (!m) continue;
+      const start = Number(m[1]), end = Number(m[2]) + 1;
+      for (const c of clip.chunks) if (c.offset >= start && c.offset + c.storedSize <= end) fromLog.set(c.id, (fromLog.get(c.id) ?? 0) + 1);
+    }
+    const counts = chunkFetchCounts(clip, source), requests = source.stats.requests - 2;
+    check(ids.every((id) => fromLog.get(id) === 1), `overlapping prefetches: the server's log counts ${ids.map((id) => fromLog.get(id) ?? 0)} requests per chunk`);
+    check(ids.every((id) => counts.get(id) === 1) && counts.size === ids.length, `overlapping prefetches: chunkFetchCounts ${[...counts]}`);
+    // A trimmed cache: the kept chunk stays, the others are fetched again, once.
+    const keep = ids[ids.length - 1];
+    const dropped = trimCache(clip, 0, new Set([keep]));
+    check(dropped === ids.length - 1 && clip.chunkCache.has(keep), `trimCache dropped ${dropped} of ${ids.length}, kept ${clip.chunkCache.has(keep)}`);
+    const again = await prefetch(clip, ids);
+    check(again.length === ids.length - 1 && !again.includes(keep), `after the trim ${again.length} chunks fetched again`);
+    console.log(`overlapping prefetches: ${ids.length} chunks, ${requests} requests, each chunk once in the server's log; ` +
+      `after trimming the cache to one chunk, ${again.length} fetched again`);
+  }
   // No range support: one download, one notice, the same pictures.
   const source = await httpSource(`${plain.base}/bc1_raw16_zstd.calf`);
   check(source.notice && source.stats.requests === 1 && source.stats.bytes === source.size,

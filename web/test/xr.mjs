@@ -7,7 +7,7 @@
 // so when the head leaves the view volume.
 //
 //   node web/test/xr.mjs CHROMIUM
-import { startRangeServer, launchChromium } from './browser.mjs';
+import { startRangeServer, launchChromium, openPage, colourCount } from './browser.mjs';
 import { psnr } from './frames.mjs';
 
 const chromium = process.argv[2] ?? '/usr/bin/chromium';
@@ -77,14 +77,9 @@ const { server, port } = await startRangeServer();
 const problems = [];
 const browser = await launchChromium(chromium);
 try {
-  const page = await browser.newPage();
-  const consoleLines = [];
-  page.on('console', (m) => consoleLines.push(m.text()));
-  page.on('pageerror', (e) => consoleLines.push(e.message));
-  await page.addInitScript(installFakeXr);
-  await page.goto(`http://127.0.0.1:${port}/web/index.html?autoplay=0&xrtime=0&clip=/tests/conformance/lightfield/bc7_bc5_zstd_mat.calf`);
-  await page.waitForFunction(() => window.calfStatus !== 'loading', null, { timeout: 60000 });
-  if ((await page.evaluate(() => window.calfStatus)) !== 'ready') throw new Error(`the page did not open the clip: ${await page.textContent('#overlay')} ${consoleLines.join(' | ')}`);
+  const { page, consoleLines, ready, overlay } = await openPage(browser,
+    `http://127.0.0.1:${port}/web/index.html?autoplay=0&xrtime=0&clip=/tests/conformance/lightfield/bc7_bc5_zstd_mat.calf`, { init: installFakeXr });
+  if (!ready) throw new Error(`the page did not open the clip: ${overlay} ${consoleLines.join(' | ')}`);
   if (!(await page.isVisible('#vr'))) problems.push('no Enter VR button with navigator.xr offering immersive-vr');
   await page.evaluate(({ offset, eye }) => {
     window.fakeXr.offset = offset;
@@ -137,13 +132,12 @@ try {
     }, { position, forward, up, fovY, width: EYE, height: EYE })));
   }
   const db = (a, b) => psnr(a, b);
-  const colours = new Set();
-  for (let k = 0; k < halves[0].length; k += 3) colours.add((halves[0][k] << 16) | (halves[0][k + 1] << 8) | halves[0][k + 2]);
+  const colours = colourCount(halves[0]);
   const same = [db(halves[0], singles[0]), db(halves[1], singles[1])], crossed = [db(halves[0], singles[1]), db(halves[1], singles[0])];
   const between = db(halves[0], halves[1]);
   console.log(`xr: left half against the single-eye render at the left eye ${same[0].toFixed(2)} dB, at the right eye ${crossed[0].toFixed(2)} dB; ` +
-    `right half ${same[1].toFixed(2)} / ${crossed[1].toFixed(2)} dB; the halves against each other ${between.toFixed(2)} dB; ${colours.size} colours`);
-  if (colours.size < 16) problems.push(`the left eye is blank (${colours.size} colours)`);
+    `right half ${same[1].toFixed(2)} / ${crossed[1].toFixed(2)} dB; the halves against each other ${between.toFixed(2)} dB; ${colours} colours`);
+  if (colours < 16) problems.push(`the left eye is blank (${colours} colours)`);
   for (const k of [0, 1]) {
     if (!(same[k] >= 40)) problems.push(`eye ${k}: ${same[k].toFixed(2)} dB against its single-eye render, below 40`);
     if (!(crossed[k] < same[k])) problems.push(`eye ${k}: no closer to its own pose's render than to the other eye's`);
