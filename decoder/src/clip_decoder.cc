@@ -13,6 +13,7 @@
 
 #include "calf/format/lightfield_layout.h"
 #include "chunk_cache.h"
+#include "colour_av1.h"
 
 namespace calf::decoder {
 
@@ -76,6 +77,11 @@ struct ClipDecoder::Impl {
   struct CellState {
     std::optional<lf::CellTimeline> timeline;
     int64_t slot_keyframe[2] = {-1, -1};  // the keyframe ordinal each slot holds
+    // AV1 colour (SPEC §11.1.12): the cell's dav1d context, created when first visible, the
+    // chunk and frame it has decoded up to, and the frame the renderer's slot 0 holds.
+    std::shared_ptr<Av1CellDecoder> av1;
+    uint32_t av1_chunk = UINT32_MAX;
+    int64_t av1_decoded = -1, av1_uploaded = -1;
   };
   struct TileState {
     int64_t frame = -1;  // the frame the renderer's texels of the tile hold
@@ -177,6 +183,9 @@ struct ClipDecoder::Impl {
   Status open_tables();
   Status update_cell(uint32_t view, uint32_t face, uint32_t cell, uint32_t frame,
                      FrameUpdates* out);
+  Status update_cell_av1(uint32_t view, uint32_t face, uint32_t cell, uint32_t frame,
+                         FrameUpdates* out);
+  bool av1 = false;  // the track's colour is AV1
   // `stream`: kDepth, kMaterial or kCoverage.
   Status update_tile(LightfieldStream stream, uint32_t view, uint32_t face, uint32_t tile,
                      uint32_t frame, FrameUpdates* out);
@@ -284,6 +293,57 @@ Status ClipDecoder::Impl::update_cell(uint32_t view, uint32_t face, uint32_t cel
   return Status::Ok();
 }
 
+// AV1 colour: slot 0 always holds the frame, t = 0. Within the chunk serving the frame, decoding
+// goes on from the frame the cell's context holds when that lies before it (playback: one unit per
+// frame), else restarts at the chunk's key frame (a seek: at most the keyframe interval of units).
+Status ClipDecoder::Impl::update_cell_av1(uint32_t view, uint32_t face, uint32_t cell,
+                                          uint32_t frame, FrameUpdates* out) {
+  CellState& s = cell_state[view][size_t{face} * cells.cell_count() + cell];
+  const PixelRect rect =
+      cells.cell_rect(cell % cells.cells_per_side(), cell / cells.cells_per_side());
+  if (s.av1_uploaded != frame) {
+    CALF_ASSIGN_OR_RETURN(uint32_t id,
+                          chunk_serving(LightfieldStream::kColour, view, face, cell, frame, false));
+    const container::ChunkKeys& keys = reader->chunks()[id].keys;
+    CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out));
+    const std::string what = where(view, face, cell) + " colour";
+    CALF_ASSIGN_OR_RETURN(lf::Av1Gop gop, lf::parse_av1_gop(*raw, keys.frame_count, what));
+    if (!s.av1) {
+      CALF_ASSIGN_OR_RETURN(Av1CellDecoder d, Av1CellDecoder::create());
+      s.av1 = std::make_shared<Av1CellDecoder>(std::move(d));
+    }
+    uint32_t next = 0;
+    if (s.av1_chunk == id && s.av1_decoded >= keys.first_frame && s.av1_decoded <= frame) {
+      next = static_cast<uint32_t>(s.av1_decoded) - keys.first_frame + 1;
+    } else {
+      s.av1->reset();
+      s.av1_chunk = id;
+      s.av1_decoded = -1;
+    }
+    for (uint32_t u = next; u <= frame - keys.first_frame; ++u) {
+      const Status st =
+          s.av1->decode(gop.units[u], what + " frame " + std::to_string(keys.first_frame + u));
+      if (!st.ok()) {
+        s.av1->reset();
+        s.av1_chunk = UINT32_MAX;
+        s.av1_decoded = -1;
+        return st;
+      }
+      s.av1_decoded = keys.first_frame + u;
+    }
+    std::vector<uint8_t> gpu;
+    CALF_RETURN_IF_ERROR(s.av1->rgba8(rect.width, rect.height, gpu, what));
+    emit(out, UpdateTarget::kColour, view, face, 0, rect, PixelFormat::kRgba8, gpu);
+    s.av1_uploaded = frame;
+  }
+  CellParams p;
+  p.view = view;
+  p.face = static_cast<CubeFace>(face);
+  p.cell = cell;
+  out->cells.push_back(p);
+  return Status::Ok();
+}
+
 Status ClipDecoder::Impl::update_tile(LightfieldStream stream, uint32_t view, uint32_t face,
                                       uint32_t tile, uint32_t frame, FrameUpdates* out) {
   const bool depth = stream == LightfieldStream::kDepth;
@@ -357,6 +417,11 @@ Status ClipDecoder::Impl::update_tile(LightfieldStream stream, uint32_t view, ui
 
 void ClipDecoder::Impl::queue_prefetch(bool cell, uint32_t view, uint32_t face, uint32_t index,
                                        uint32_t frame) {
+  if (cell && av1) {
+    auto id = chunk_serving(LightfieldStream::kColour, view, face, index, frame, false);
+    if (id.ok()) prefetch_ids.push_back(*id);
+    return;
+  }
   if (cell) {
     const CellState& s = cell_state[view][size_t{face} * cells.cell_count() + index];
     if (!s.timeline) return;
@@ -409,6 +474,7 @@ Expected<ClipDecoder> ClipDecoder::open(const container::Reader& reader, uint16_
   impl->track = track;
   impl->header = ref.header();
   impl->has_coverage = ref.has_coverage();
+  impl->av1 = impl->header.colour_format == static_cast<uint16_t>(PixelFormat::kAv1);
   impl->options = options;
   for (uint32_t v = 0; v < impl->header.view_count; ++v) {
     impl->views.push_back(ref.view(v));
@@ -437,7 +503,10 @@ void ClipDecoder::set_view_dependent(bool on) {
 void ClipDecoder::reset() {
   Impl& d = *impl_;
   for (auto& view : d.cell_state) {
-    for (auto& c : view) c.slot_keyframe[0] = c.slot_keyframe[1] = -1;
+    for (auto& c : view) {
+      c.slot_keyframe[0] = c.slot_keyframe[1] = -1;
+      c.av1_uploaded = -1;
+    }
   }
   for (auto* states : {&d.depth_state, &d.material_state, &d.coverage_state}) {
     for (auto& view : *states) {
@@ -597,7 +666,11 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
       stats.visible_cells += static_cast<uint32_t>(vis_cells.size());
       stats.visible_tiles += static_cast<uint32_t>(vis_tiles.size());
       for (uint32_t c : vis_cells) {
-        if (Status s = d.update_cell(v, f, c, frame, out); !s.ok()) report(s);
+        if (Status s =
+                d.av1 ? d.update_cell_av1(v, f, c, frame, out) : d.update_cell(v, f, c, frame, out);
+            !s.ok()) {
+          report(s);
+        }
       }
       for (uint32_t t : vis_tiles) {
         out->tiles.push_back(TileRef{v, face, t});

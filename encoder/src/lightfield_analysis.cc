@@ -54,6 +54,16 @@ Status validate_options(const LightfieldEncodeOptions& o) {
   if (static_cast<uint8_t>(o.bc1_fit) > static_cast<uint8_t>(Bc1Fit::kCluster)) {
     return bad("unknown BC1 fit");
   }
+  if (o.colour == ColourCoding::kAv1) {
+    const Av1ColourOptions& a = o.av1;
+    if (a.crf < 1 || a.crf > 63)
+      return bad("--av1-crf " + std::to_string(a.crf) + ": expected [1, 63]");
+    if (a.qp > 63) return bad("--av1-qp " + std::to_string(a.qp) + ": expected [1, 63]");
+    if (a.preset > 13)
+      return bad("--av1-preset " + std::to_string(a.preset) + ": expected [0, 13]");
+    if (a.keyframe_interval < 1) return bad("--av1-keyframe-interval 0: expected >= 1");
+    if (o.segment_frames != 0) return bad("--segment-frames with AV1 colour: not supported");
+  }
   // 256 as calf-capture's: beyond it oneTBB prints warnings of its own (a library never prints).
   if (o.threads > 256) return bad("--threads " + std::to_string(o.threads) + ": expected [0, 256]");
   if (static_cast<uint16_t>(o.supercompression) >= container::kCompressionCount) {
@@ -169,6 +179,12 @@ Expected<LightfieldAnalysis> plan_lightfield(const capture::CaptureManifest& m,
     const bool hdr = std::any_of(views.begin(), views.end(), [](const auto& v) { return v.hdr; });
     a.colour = hdr ? ColourCoding::kBc6h : ColourCoding::kBc1;
   }
+  if (a.colour == ColourCoding::kAv1 &&
+      std::any_of(views.begin(), views.end(), [](const auto& v) { return v.hdr; })) {
+    return Status(ErrorId::kEncoderAv1Input,
+                  "AV1 colour codes 8-bit sRGB, and the capture set has HDR colour (a value above "
+                  "1): use --colour-codec bc");
+  }
   a.hdr = a.colour == ColourCoding::kBc6h || a.colour == ColourCoding::kRgba16f;
   container::LightfieldTrackHeader& h = a.header;
   switch (a.colour) {
@@ -183,6 +199,9 @@ Expected<LightfieldAnalysis> plan_lightfield(const capture::CaptureManifest& m,
       break;
     case ColourCoding::kRgba8:
       h.colour_format = pf(PixelFormat::kRgba8);
+      break;
+    case ColourCoding::kAv1:
+      h.colour_format = pf(PixelFormat::kAv1);
       break;
     default:
       h.colour_format = pf(PixelFormat::kRgba16f);

@@ -28,6 +28,7 @@
 #include "calf/format/lightfield_layout.h"
 #include "calf/format/log_depth.h"
 #include "calf/format/version.h"
+#include "colour_av1.h"
 #include "lightfield_internal.h"
 
 namespace calf {
@@ -178,6 +179,7 @@ struct Context {
   FaceGrid cells, tiles;
   uint32_t first_frame;  // the clip frame of the view data's frame 0
   bool partial;          // a frame range short of the clip: t chunks stay raw for the merge
+  uint32_t fps_numerator = 24, fps_denominator = 1;  // the track's (AV1 colour's timing)
 };
 
 Status add_chunk(const Context& ctx, TaskOut& out, ChunkKeys keys, const std::vector<uint8_t>& raw,
@@ -287,6 +289,7 @@ Status code_colour_frame(ColourCoding coding, Bc1Fit bc1_fit, std::span<const fl
       return Status::Ok();
     }
     case ColourCoding::kAuto:
+    case ColourCoding::kAv1:  // coded by colour_av1_task, never frame by frame
       break;
   }
   return Status(ErrorId::kInternal, "unresolved colour format");
@@ -339,7 +342,52 @@ Status rdo_keyframe(const Context& ctx, uint32_t face, const PixelRect& r, uint3
   return bc::rdo_bc7(rgba.data(), r.width, r.height, bytes.data(), bytes.size(), o);
 }
 
+// AV1 colour (SPEC §11.1.12): the cell's frames as sRGB bytes, one chunk per GOP.
+void colour_av1_task(const Context& ctx, uint32_t face, uint32_t cell, TaskOut& out) {
+  const ViewData& v = *ctx.view;
+  const PixelRect r =
+      ctx.cells.cell_rect(cell % ctx.cells.cells_per_side(), cell / ctx.cells.cells_per_side());
+  const size_t n = static_cast<size_t>(r.width) * r.height;
+  std::vector<uint16_t> half(n * 3);
+  std::vector<float> linear(n * 3);
+  std::vector<uint8_t> rgba(n * 4 * v.frames);
+  for (uint32_t f = 0; f < v.frames; ++f) {
+    gather_cell_halves(v, face, r, f, half.data());
+    for (size_t i = 0; i < n * 3; ++i) linear[i] = bc::half_to_float(half[i]);
+    const std::vector<uint8_t> frame = srgb8_rgba_of(linear);
+    std::copy(frame.begin(), frame.end(), &rgba[f * n * 4]);
+  }
+  auto gops = av1_internal::encode_cell(rgba, r.width, r.height, v.frames, ctx.fps_numerator,
+                                        ctx.fps_denominator, ctx.options->av1);
+  if (!gops.ok()) {
+    out.status = gops.status().with_context("view " + std::to_string(ctx.view_index) + " face " +
+                                            std::to_string(face) + " cell " + std::to_string(cell));
+    return;
+  }
+  TaskStats& s = out.stats;
+  s.colour.raw += n * 4 * v.frames;
+  s.colour.temporal += n * 4 * v.frames;
+  s.keyframes += gops->size();
+  ChunkKeys keys;
+  keys.stream = static_cast<uint16_t>(LightfieldStream::kColour);
+  keys.face = face;
+  keys.region = cell;
+  uint32_t first = 0;
+  std::vector<uint8_t> raw;
+  for (const av1_internal::Gop& gop : *gops) {
+    raw.clear();
+    lf::append_av1_gop(raw, gop);
+    keys.first_frame = ctx.first_frame + first;
+    keys.frame_count = static_cast<uint32_t>(gop.size());
+    first += keys.frame_count;
+    // Entropy-coded already: stored as is.
+    out.status = add_chunk(ctx, out, keys, raw, s.colour, true);
+    if (!out.status.ok()) return;
+  }
+}
+
 void colour_task(const Context& ctx, uint32_t face, uint32_t cell, TaskOut& out) {
+  if (ctx.colour == ColourCoding::kAv1) return colour_av1_task(ctx, face, cell, out);
   const ViewData& v = *ctx.view;
   const PixelRect r =
       ctx.cells.cell_rect(cell % ctx.cells.cells_per_side(), cell / ctx.cells.cells_per_side());
@@ -937,8 +985,17 @@ Expected<LightfieldViewEncoding> encode_lightfield_view_frames(
   tbb::task_arena arena(options.threads == 0 ? tbb::task_arena::automatic
                                              : static_cast<int>(options.threads));
   const uint64_t total = uint64_t{6} * m.viewpoints.size();
-  const Context ctx{&options, &view, v,           analysis.colour, analysis.hdr,
-                    cells,    tiles, first_frame, !whole};
+  const Context ctx{&options,
+                    &view,
+                    v,
+                    analysis.colour,
+                    analysis.hdr,
+                    cells,
+                    tiles,
+                    first_frame,
+                    !whole,
+                    analysis.header.fps_numerator,
+                    analysis.header.fps_denominator};
   for (uint32_t face = 0; face < 6; ++face) {
     // Tasks of one face in file order: cells, depth tiles, material tiles, coverage tiles.
     const uint32_t nc = cells.cell_count(), nt = tiles.cell_count();
@@ -979,6 +1036,10 @@ Expected<LightfieldTrackWriter> LightfieldTrackWriter::begin(container::Writer& 
   CALF_ASSIGN_OR_RETURN(uint16_t track, writer.add_track(analysis.header));
   // A coverage stream is a 1.2 feature (SPEC §11.1.11): the file says so in its minor version.
   if (analysis.coverage) writer.require_minor_version(container::kVersionMinorCoverage);
+  // So is AV1 colour (1.3, SPEC §11.1.12), which earlier decoders refuse as an unknown format.
+  if (analysis.colour == ColourCoding::kAv1) {
+    writer.require_minor_version(container::kVersionMinorAv1);
+  }
   LightfieldEncodeStats stats;
   stats.colour_format = analysis.header.colour_format;
   stats.depth_format = analysis.header.depth_format;

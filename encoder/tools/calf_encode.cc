@@ -286,6 +286,29 @@ static int command_main(int argc, char** argv) {
          "auto (BC1 for LDR input, BC6H for HDR), bc1, bc7, bc6h, rgba8, rgba16f (default auto)")
       ->check(CLI::IsMember({"auto", "bc1", "bc7", "bc6h", "rgba8", "rgba16f"}))
       ->default_val("auto");
+  std::string colour_codec = "bc";
+  app.add_option("--colour-codec", colour_codec,
+                 "bc (colour keyframes in --color-format with interpolation weights) or av1 (per "
+                 "colour cell one AV1 stream, SVT-AV1 8-bit 4:2:0, decoded by dav1d; LDR input; "
+                 "format/SPEC.md 11.1.12, docs/ENCODER.md \"AV1 colour\") (default bc)")
+      ->check(CLI::IsMember({"bc", "av1"}))
+      ->default_val("bc");
+  app.add_option("--av1-crf", o.av1.crf,
+                 "av1: constant rate factor 1..63, lower is better and larger (default 32)")
+      ->check(CLI::Range(1u, 63u))
+      ->default_val(32);
+  app.add_option("--av1-qp", o.av1.qp,
+                 "av1: a fixed quantiser 1..63 instead of --av1-crf (default: none, CRF)")
+      ->check(CLI::Range(1u, 63u));
+  app.add_option("--av1-preset", o.av1.preset,
+                 "av1: SVT-AV1 preset 0..13, higher is faster and larger (default 8)")
+      ->check(CLI::Range(0u, 13u))
+      ->default_val(8);
+  app.add_option("--av1-keyframe-interval", o.av1.keyframe_interval,
+                 "av1: a key frame every K frames, K >= 1: the random-access granularity, a seek "
+                 "decodes at most K frames of each visible cell (default 30)")
+      ->check(CLI::Range(1u, 16777216u))
+      ->default_val(30);
   app.add_option(
          "--depth-format", depth,
          "pred16m (log-16 codes, exact after quantisation, as spatial-prediction residuals; "
@@ -573,11 +596,27 @@ static int command_main(int argc, char** argv) {
   // An option of another mode is a usage error, never silently ignored.
   const auto given = [&](const char* name) { return app.get_option(name)->count() > 0; };
   if (mode != "lightfield") {
-    for (const char* opt :
-         {"--cell", "--psnr", "--color-format", "--depth-format", "--depth-window", "--max-aabbs",
-          "--depth-keyframe-interval", "--segment-frames", "--colour-rdo", "--bc1-fit",
-          "--depth-fixed-groups", "--no-coverage", "--analysis-only", "--analysis", "--views",
-          "--frame-range"}) {
+    for (const char* opt : {"--cell",
+                            "--psnr",
+                            "--color-format",
+                            "--depth-format",
+                            "--depth-window",
+                            "--max-aabbs",
+                            "--depth-keyframe-interval",
+                            "--segment-frames",
+                            "--colour-rdo",
+                            "--bc1-fit",
+                            "--depth-fixed-groups",
+                            "--no-coverage",
+                            "--analysis-only",
+                            "--analysis",
+                            "--views",
+                            "--frame-range",
+                            "--colour-codec",
+                            "--av1-crf",
+                            "--av1-qp",
+                            "--av1-preset",
+                            "--av1-keyframe-interval"}) {
       if (given(opt)) {
         return calf::tools::usage_error("calf-encode",
                                         std::string(opt) + " needs --mode lightfield");
@@ -657,6 +696,26 @@ static int command_main(int argc, char** argv) {
       {"bc7", calf::ColourCoding::kBc7},     {"bc6h", calf::ColourCoding::kBc6h},
       {"rgba8", calf::ColourCoding::kRgba8}, {"rgba16f", calf::ColourCoding::kRgba16f}};
   o.colour = colours.at(colour);
+  if (colour_codec == "av1") {
+    for (const char* opt : {"--color-format", "--colour-rdo", "--bc1-fit", "--segment-frames",
+                            "--analysis-only", "--analysis"}) {
+      if (given(opt)) {
+        return calf::tools::usage_error("calf-encode",
+                                        std::string(opt) + " needs --colour-codec bc");
+      }
+    }
+    if (given("--av1-crf") && given("--av1-qp")) {
+      return calf::tools::usage_error("calf-encode", "--av1-crf and --av1-qp exclude each other");
+    }
+    o.colour = calf::ColourCoding::kAv1;
+  } else {
+    for (const char* opt : {"--av1-crf", "--av1-qp", "--av1-preset", "--av1-keyframe-interval"}) {
+      if (given(opt)) {
+        return calf::tools::usage_error("calf-encode",
+                                        std::string(opt) + " needs --colour-codec av1");
+      }
+    }
+  }
   if (colour_rdo == "auto") {
     o.colour_rdo = calf::kColourRdoAuto;
   } else {

@@ -483,7 +483,7 @@ void region_rect_gpu_bytes(const RegionChunk& chunk, size_t index, std::vector<u
 
 Status check_colour_format(uint16_t colour_format) {
   for (PixelFormat f : {PixelFormat::kBc1, PixelFormat::kBc7, PixelFormat::kBc6h,
-                        PixelFormat::kRgba8, PixelFormat::kRgba16f}) {
+                        PixelFormat::kRgba8, PixelFormat::kRgba16f, PixelFormat::kAv1}) {
     if (is(colour_format, f)) return Status::Ok();
   }
   return Status(ErrorId::kLightfieldFormat, "colour format " + std::to_string(colour_format) +
@@ -533,8 +533,58 @@ Status colour_payload_gpu_bytes(uint16_t colour_format, std::span<const uint8_t>
     }
     return Status::Ok();
   }
-  const Status bad = check_colour_format(colour_format);
-  return Status(bad.id(), what + ": " + bad.message());
+  // AV1 colour has no keyframe payloads: its chunks are GOPs (parse_av1_gop).
+  return Status(ErrorId::kLightfieldFormat,
+                what + ": colour format " + std::to_string(colour_format) + " (" +
+                    container::pixel_format_name(colour_format) + ") has no keyframe payload");
+}
+
+container::PixelFormat colour_gpu_format(uint16_t colour_format) {
+  return is(colour_format, PixelFormat::kAv1) ? PixelFormat::kRgba8
+                                              : static_cast<PixelFormat>(colour_format);
+}
+
+Expected<Av1Gop> parse_av1_gop(std::span<const uint8_t> raw, uint32_t frame_count,
+                               const std::string& what) {
+  auto bad = [&](const std::string& why) { return Status(ErrorId::kAv1Chunk, what + ": " + why); };
+  if (raw.size() < 4) return bad("AV1 chunk of " + std::to_string(raw.size()) + " bytes");
+  uint32_t f = 0;
+  std::memcpy(&f, raw.data(), 4);
+  if (f != frame_count || f == 0) {
+    return bad("AV1 chunk of " + std::to_string(f) + " frames, its keys say " +
+               std::to_string(frame_count));
+  }
+  const uint64_t head = 4 + uint64_t{f} * 4;
+  if (head > raw.size()) {
+    return bad("AV1 chunk of " + std::to_string(raw.size()) +
+               " bytes is shorter than its head of " + std::to_string(head));
+  }
+  Av1Gop gop;
+  gop.units.reserve(f);
+  uint64_t at = head;
+  for (uint32_t i = 0; i < f; ++i) {
+    uint32_t size = 0;
+    std::memcpy(&size, raw.data() + 4 + size_t{i} * 4, 4);
+    if (size == 0 || size > raw.size() - at) {
+      return bad("temporal unit " + std::to_string(i) + " of " + std::to_string(size) +
+                 " bytes at offset " + std::to_string(at) + " of " + std::to_string(raw.size()));
+    }
+    gop.units.push_back(raw.subspan(at, size));
+    at += size;
+  }
+  if (at != raw.size()) {
+    return bad(std::to_string(raw.size() - at) + " bytes after the last temporal unit");
+  }
+  return gop;
+}
+
+void append_av1_gop(std::vector<uint8_t>& out, std::span<const std::vector<uint8_t>> units) {
+  auto put = [&](uint32_t v) {
+    for (int b = 0; b < 4; ++b) out.push_back(static_cast<uint8_t>(v >> (8 * b)));
+  };
+  put(static_cast<uint32_t>(units.size()));
+  for (const auto& u : units) put(static_cast<uint32_t>(u.size()));
+  for (const auto& u : units) out.insert(out.end(), u.begin(), u.end());
 }
 
 }  // namespace calf::lf

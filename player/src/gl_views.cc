@@ -119,7 +119,7 @@ Expected<GlTextureLayout> layout_for_clip(const container::LightfieldTrackHeader
                                  " views, the layout was given " + std::to_string(views.size()));
   }
   GlTextureLayout layout;
-  layout.colour_format = static_cast<PixelFormat>(header.colour_format);
+  layout.colour_format = lf::colour_gpu_format(header.colour_format);
   const auto depth = static_cast<PixelFormat>(header.depth_format);
   layout.depth_format = depth == PixelFormat::kBc5 && keep_bc5_depth ? depth : PixelFormat::kR16;
   // r16p and r16pm (predicted) decode to the same r16 codes on the CPU: the textures never see

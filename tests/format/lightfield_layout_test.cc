@@ -168,3 +168,44 @@ TEST(LightfieldLayout, RegionChunkHead) {
 
 }  // namespace
 }  // namespace calf::lf
+
+namespace calf::lf {
+namespace {
+
+// SPEC §11.1.12: u32 F, F x u32 unit sizes, the units; written here byte by byte.
+TEST(LightfieldLayout, Av1GopChunk) {
+  const Bytes raw = {2, 0, 0, 0, 3, 0, 0, 0, 1, 0, 0, 0, 0x12, 0x00, 0xAA, 0xBB};
+  auto gop = parse_av1_gop(raw, 2, "cell");
+  ASSERT_TRUE(gop.ok()) << gop.status().to_string();
+  ASSERT_EQ(gop->units.size(), 2u);
+  EXPECT_EQ(Bytes(gop->units[0].begin(), gop->units[0].end()), (Bytes{0x12, 0x00, 0xAA}));
+  EXPECT_EQ(Bytes(gop->units[1].begin(), gop->units[1].end()), (Bytes{0xBB}));
+  Bytes out;
+  const std::vector<Bytes> units = {{0x12, 0x00, 0xAA}, {0xBB}};
+  append_av1_gop(out, units);
+  EXPECT_EQ(out, raw);
+  // Another frame count than the keys', a unit of 0 bytes, units past the chunk, a byte left
+  // over, a head cut short: E067.
+  EXPECT_EQ(parse_av1_gop(raw, 3, "c").status().id(), ErrorId::kAv1Chunk);
+  Bytes b = raw;
+  b[8] = 0;
+  EXPECT_EQ(parse_av1_gop(b, 2, "c").status().id(), ErrorId::kAv1Chunk);
+  b = raw;
+  b[8] = 2;
+  EXPECT_EQ(parse_av1_gop(b, 2, "c").status().id(), ErrorId::kAv1Chunk);
+  b = raw;
+  b.push_back(0);
+  EXPECT_EQ(parse_av1_gop(b, 2, "c").status().id(), ErrorId::kAv1Chunk);
+  EXPECT_EQ(parse_av1_gop(Bytes(raw.begin(), raw.begin() + 6), 2, "c").status().id(),
+            ErrorId::kAv1Chunk);
+  EXPECT_EQ(parse_av1_gop(Bytes{0, 0, 0, 0}, 0, "c").status().id(), ErrorId::kAv1Chunk);
+  // AV1 is a colour format without keyframe payloads; the player gets rgba8 updates.
+  EXPECT_TRUE(check_colour_format(static_cast<uint16_t>(container::PixelFormat::kAv1)).ok());
+  Bytes gpu;
+  EXPECT_EQ(colour_payload_gpu_bytes(12, raw, 4, 4, gpu, "c").id(), ErrorId::kLightfieldFormat);
+  EXPECT_EQ(colour_gpu_format(12), container::PixelFormat::kRgba8);
+  EXPECT_EQ(colour_gpu_format(4), container::PixelFormat::kBc1);
+}
+
+}  // namespace
+}  // namespace calf::lf

@@ -55,7 +55,7 @@ std::vector<std::string> clip_names() {
 TEST(LightfieldConformance, SuiteIsComplete) {
   const std::vector<std::string> names = clip_names();
   EXPECT_GE(names.size(), 6u);
-  for (const char* colour : {"bc1", "bc7", "bc6h", "rgba8", "rgba16f"}) {
+  for (const char* colour : {"bc1", "bc7", "bc6h", "rgba8", "rgba16f", "av1"}) {
     bool found = false;
     for (const auto& n : names) found |= n.rfind(std::string(colour) + "_", 0) == 0;
     EXPECT_TRUE(found) << "no clip with colour " << colour;

@@ -61,7 +61,18 @@
 namespace calf {
 
 // Colour format choice; kAuto = BC1 for LDR input (every colour value <= 1), BC6H for HDR.
-enum class ColourCoding : uint8_t { kAuto, kBc1, kBc7, kBc6h, kRgba8, kRgba16f };
+// kAv1: per cell one AV1 stream of 8-bit 4:2:0 pictures (SPEC §11.1.12), LDR input only.
+enum class ColourCoding : uint8_t { kAuto, kBc1, kBc7, kBc6h, kRgba8, kRgba16f, kAv1 };
+
+// AV1 colour (ColourCoding::kAv1): SVT-AV1's settings. Each cell's frames are coded as closed
+// GOPs of `keyframe_interval` frames, one fresh single-threaded encoder each, so the bytes never
+// depend on LightfieldEncodeOptions::threads.
+struct Av1ColourOptions {
+  uint32_t crf = 32;                // constant rate factor 1..63 (lower: better and larger)
+  uint32_t qp = 0;                  // 1..63: a fixed quantiser instead of the CRF; 0 = CRF
+  uint32_t preset = 8;              // SVT-AV1 preset 0..13 (higher: faster, larger)
+  uint32_t keyframe_interval = 30;  // K >= 1: a key frame every K frames, the seek granularity
+};
 // kRaw16: log-16 codes as 16-bit planes (SPEC §11.1.6); kRaw16Predicted: the same codes as
 // spatial-prediction residuals (depth format r16p, SPEC §11.1.8), lossless like kRaw16 and
 // smaller once supercompressed; kBc5: lossy; kRaw16PredictedMasked: as kRaw16Predicted, but a
@@ -113,6 +124,8 @@ struct LightfieldEncodeOptions {
   // RDO at its default it is what keeps LDR content within 0.05 dB of --colour-rdo 0
   // while saving 30 % of its colour bytes.
   Bc1Fit bc1_fit = Bc1Fit::kCluster;
+  // ColourCoding::kAv1 only.
+  Av1ColourOptions av1;
   container::Compression supercompression = container::Compression::kZstd;
   container::CompressionOptions levels;  // zstd level / LZMA preset (fixed per clip)
   uint32_t threads = 1;                  // 0 = all cores; never changes the output

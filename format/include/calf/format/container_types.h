@@ -39,6 +39,9 @@ inline constexpr uint16_t kVersionMinor = 1;
 // 1.2: a lightfield track may hold a coverage stream (stream tag 5, SPEC §11.1.11), which 1.0 and
 // 1.1 readers skip; a writer writes minor 2 only for a file that holds one.
 inline constexpr uint16_t kVersionMinorCoverage = 2;
+// 1.3: a lightfield track may hold AV1 colour (colour format 12, SPEC §11.1.12), which earlier
+// decoders refuse as a colour format they lack; a writer writes minor 3 only for such a file.
+inline constexpr uint16_t kVersionMinorAv1 = 3;
 inline constexpr uint64_t kHeaderSize = 64;
 inline constexpr uint64_t kAlignment = 16;  // chunk offsets and the directory offset
 // Must-understand feature bits (SPEC.md "Header"). Bit 0 (1.1): the directory is its body's size
@@ -88,6 +91,7 @@ enum class PixelFormat : uint16_t {
   kRg8 = 9,
   kR16Predicted = 10,  // depth only: r16 codes as spatial-prediction residuals (SPEC §11.1.8)
   kR16PredictedMasked = 11,  // depth only: r16p, P-frames' changed texels only (SPEC §11.1.9)
+  kAv1 = 12,  // colour only: per cell one AV1 stream in GOP chunks (SPEC §11.1.12); 1.3
 };
 const char* pixel_format_name(uint16_t format);
 

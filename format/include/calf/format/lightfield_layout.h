@@ -275,7 +275,8 @@ struct CoverageRect {
 };
 void append_coverage_payload(std::vector<uint8_t>& out, std::span<const CoverageRect> rects);
 
-// CALF-E203 unless `colour_format` is one §11.1 allows for colour (BC1, BC7, BC6H, rgba8, rgba16f).
+// CALF-E203 unless `colour_format` is one §11.1 allows for colour (BC1, BC7, BC6H, rgba8, rgba16f,
+// av1).
 Status check_colour_format(uint16_t colour_format);
 
 // The GPU-ready bytes of a w x h colour keyframe payload (§11.1.5): BC1 blocks unsplit, BC6H / BC7
@@ -284,5 +285,23 @@ Status check_colour_format(uint16_t colour_format);
 Status colour_payload_gpu_bytes(uint16_t colour_format, std::span<const uint8_t> payload,
                                 uint32_t width, uint32_t height, std::vector<uint8_t>& out,
                                 const std::string& what);
+
+// The pixel format of the colour updates a decoder yields for a track of `colour_format`: the
+// format itself, but rgba8 for AV1 colour (its pictures are converted to sRGB-encoded RGBA8).
+container::PixelFormat colour_gpu_format(uint16_t colour_format);
+
+// ---- AV1 colour (§11.1.12) ----
+
+// An AV1 colour chunk: the temporal units (low-overhead OBU format) of F consecutive frames of one
+// cell, the first a key frame; `units` point into the chunk's bytes, which must outlive them.
+struct Av1Gop {
+  std::vector<std::span<const uint8_t>> units;
+};
+// The head is u32 F (= the chunk's frame_count key), F x u32 unit sizes (each >= 1), then the
+// units back to back, nothing after. Errors: CALF-E067 (kAv1Chunk).
+Expected<Av1Gop> parse_av1_gop(std::span<const uint8_t> raw, uint32_t frame_count,
+                               const std::string& what);
+// Appends an AV1 colour chunk of `units` (each non-empty) as parse_av1_gop reads it.
+void append_av1_gop(std::vector<uint8_t>& out, std::span<const std::vector<uint8_t>> units);
 
 }  // namespace calf::lf

@@ -1,0 +1,217 @@
+#include "colour_av1.h"
+
+#include <EbSvtAv1Enc.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+namespace calf::av1_internal {
+namespace {
+
+Status svt_error(const std::string& call, int64_t code) {
+  return Status(ErrorId::kEncoderAv1, "SVT-AV1 " + call + " failed (" + std::to_string(code) + ")");
+}
+
+uint8_t byte_of(double v) {
+  return static_cast<uint8_t>(std::clamp(std::lround(v), 0L, 255L));
+}
+
+// Reads a LEB128 value (AV1 §4.10.5) at `at`; false when it runs past the end.
+bool leb128(std::span<const uint8_t> b, size_t& at, uint64_t& value) {
+  value = 0;
+  for (int i = 0; i < 8; ++i) {
+    if (at >= b.size()) return false;
+    const uint8_t byte = b[at++];
+    value |= uint64_t{byte & 0x7Fu} << (7 * i);
+    if (!(byte & 0x80)) return true;
+  }
+  return false;
+}
+
+// Splits an OBU stream into temporal units: each starts at a temporal delimiter OBU (type 2).
+Expected<Gop> split_units(std::span<const uint8_t> stream) {
+  Gop units;
+  size_t at = 0;
+  while (at < stream.size()) {
+    const size_t start = at;
+    const uint8_t header = stream[at++];
+    const uint32_t type = (header >> 3) & 15;
+    if (header & 4) ++at;  // extension byte
+    uint64_t size = 0;
+    if (!(header & 2) || !leb128(stream, at, size) ||
+        size > stream.size() - std::min(at, stream.size())) {
+      return svt_error("output (an OBU without a size field or past the stream)", 0);
+    }
+    at += size;
+    if (type == 2) units.emplace_back();
+    if (units.empty()) return svt_error("output (an OBU before the first temporal delimiter)", 0);
+    units.back().insert(units.back().end(), stream.begin() + static_cast<ptrdiff_t>(start),
+                        stream.begin() + static_cast<ptrdiff_t>(at));
+  }
+  return units;
+}
+
+// One GOP by a fresh encoder: every picture W x H 4:2:0, frames `first` .. `first + count - 1`.
+Expected<Gop> encode_gop(const std::vector<uint8_t>& yuv, uint32_t W, uint32_t H, uint32_t count,
+                         uint32_t fps_numerator, uint32_t fps_denominator,
+                         const Av1ColourOptions& o) {
+  EbComponentType* handle = nullptr;
+  EbSvtAv1EncConfiguration cfg;
+  if (EbErrorType e = svt_av1_enc_init_handle(&handle, nullptr, &cfg); e != EB_ErrorNone) {
+    return svt_error("svt_av1_enc_init_handle", e);
+  }
+  struct Closer {
+    EbComponentType* h;
+    bool initialised = false;
+    ~Closer() {
+      if (initialised) svt_av1_enc_deinit(h);
+      svt_av1_enc_deinit_handle(h);
+    }
+  } closer{handle};
+  cfg.enc_mode = static_cast<int8_t>(o.preset);
+  cfg.source_width = W;
+  cfg.source_height = H;
+  cfg.frame_rate_numerator = fps_numerator;
+  cfg.frame_rate_denominator = fps_denominator;
+  cfg.encoder_bit_depth = 8;
+  cfg.encoder_color_format = EB_YUV420;
+  cfg.intra_period_length = -1;  // the GOP's first frame is its only key frame
+  cfg.intra_refresh_type = SVT_AV1_KF_REFRESH;
+  cfg.rate_control_mode = 0;
+  if (o.qp > 0) {
+    cfg.qp = static_cast<uint32_t>(o.qp);
+    cfg.enable_adaptive_quantization = 0;  // fixed QP
+  } else {
+    cfg.qp = static_cast<uint32_t>(o.crf);
+  }
+  cfg.logical_processors = 1;  // one thread: the cells are coded in parallel instead
+  cfg.color_primaries = EB_CICP_CP_BT_709;
+  cfg.transfer_characteristics = EB_CICP_TC_SRGB;
+  cfg.matrix_coefficients = EB_CICP_MC_BT_709;
+  cfg.color_range = EB_CR_FULL_RANGE;
+  if (EbErrorType e = svt_av1_enc_set_parameter(handle, &cfg); e != EB_ErrorNone) {
+    return svt_error("svt_av1_enc_set_parameter", e);
+  }
+  if (EbErrorType e = svt_av1_enc_init(handle); e != EB_ErrorNone) {
+    return svt_error("svt_av1_enc_init", e);
+  }
+  closer.initialised = true;
+  const size_t luma = size_t{W} * H, chroma = luma / 4, picture = luma + 2 * chroma;
+  std::vector<uint8_t> stream;
+  bool done = false;
+  auto drain = [&](bool all_sent) -> Status {
+    for (;;) {
+      EbBufferHeaderType* packet = nullptr;
+      const EbErrorType e = svt_av1_enc_get_packet(handle, &packet, all_sent ? 1 : 0);
+      if (e == EB_NoErrorEmptyQueue) return Status::Ok();
+      if (e != EB_ErrorNone || packet == nullptr) return svt_error("svt_av1_enc_get_packet", e);
+      const bool eos = packet->flags & EB_BUFFERFLAG_EOS;
+      if (packet->flags & EB_BUFFERFLAG_ERROR_MASK) {
+        svt_av1_enc_release_out_buffer(&packet);
+        return svt_error("encoding (packet flags)", 0);
+      }
+      stream.insert(stream.end(), packet->p_buffer, packet->p_buffer + packet->n_filled_len);
+      svt_av1_enc_release_out_buffer(&packet);
+      if (eos) {
+        done = true;
+        return Status::Ok();
+      }
+    }
+  };
+  for (uint32_t i = 0; i < count; ++i) {
+    EbSvtIOFormat io{};
+    io.luma = const_cast<uint8_t*>(yuv.data() + i * picture);
+    io.cb = io.luma + luma;
+    io.cr = io.cb + chroma;
+    io.y_stride = W;
+    io.cb_stride = io.cr_stride = W / 2;
+    io.width = W;
+    io.height = H;
+    io.color_fmt = EB_YUV420;
+    io.bit_depth = EB_EIGHT_BIT;
+    EbBufferHeaderType in{};
+    in.size = sizeof(EbBufferHeaderType);
+    in.p_buffer = reinterpret_cast<uint8_t*>(&io);
+    in.n_filled_len = static_cast<uint32_t>(picture);
+    in.pts = i;
+    in.pic_type = EB_AV1_INVALID_PICTURE;
+    if (EbErrorType e = svt_av1_enc_send_picture(handle, &in); e != EB_ErrorNone) {
+      return svt_error("svt_av1_enc_send_picture", e);
+    }
+    CALF_RETURN_IF_ERROR(drain(false));
+  }
+  EbBufferHeaderType eos{};
+  eos.size = sizeof(EbBufferHeaderType);
+  eos.flags = EB_BUFFERFLAG_EOS;
+  eos.pic_type = EB_AV1_INVALID_PICTURE;
+  if (EbErrorType e = svt_av1_enc_send_picture(handle, &eos); e != EB_ErrorNone) {
+    return svt_error("svt_av1_enc_send_picture (end of stream)", e);
+  }
+  while (!done) CALF_RETURN_IF_ERROR(drain(true));
+  CALF_ASSIGN_OR_RETURN(Gop units, split_units(stream));
+  if (units.size() != count) {
+    return svt_error("output (" + std::to_string(units.size()) + " temporal units for " +
+                         std::to_string(count) + " frames)",
+                     0);
+  }
+  return units;
+}
+
+}  // namespace
+
+void rgba_to_ycbcr420(std::span<const uint8_t> rgba, uint32_t W, uint32_t H, uint8_t* y,
+                      uint8_t* cb, uint8_t* cr) {
+  constexpr double kr = 0.2126, kb = 0.0722, kg = 1 - kr - kb;
+  for (uint32_t j = 0; j < H; j += 2) {
+    for (uint32_t i = 0; i < W; i += 2) {
+      double sb = 0, sr = 0;
+      for (uint32_t dy = 0; dy < 2; ++dy) {
+        for (uint32_t dx = 0; dx < 2; ++dx) {
+          const uint8_t* p = &rgba[((size_t{j} + dy) * W + i + dx) * 4];
+          const double l = kr * p[0] + kg * p[1] + kb * p[2];
+          y[(size_t{j} + dy) * W + i + dx] = byte_of(l);
+          sb += (p[2] - l) / (2 * (1 - kb));
+          sr += (p[0] - l) / (2 * (1 - kr));
+        }
+      }
+      cb[size_t{j / 2} * (W / 2) + i / 2] = byte_of(128 + sb / 4);
+      cr[size_t{j / 2} * (W / 2) + i / 2] = byte_of(128 + sr / 4);
+    }
+  }
+}
+
+Expected<std::vector<Gop>> encode_cell(std::span<const uint8_t> rgba, uint32_t w, uint32_t h,
+                                       uint32_t frames, uint32_t fps_numerator,
+                                       uint32_t fps_denominator, const Av1ColourOptions& options) {
+  // SVT-AV1 prints its banner and settings to stderr unless told otherwise; a library prints
+  // nothing. SVT_LOG is read when its first encoder starts (an explicit setting is kept).
+  setenv("SVT_LOG", "0", 0);
+  const uint32_t W = std::max(64u, (w + 7) / 8 * 8), H = std::max(64u, (h + 7) / 8 * 8);
+  const size_t luma = size_t{W} * H, picture = luma + luma / 2;
+  std::vector<uint8_t> padded(luma * 4);
+  std::vector<Gop> gops;
+  for (uint32_t g0 = 0; g0 < frames; g0 += options.keyframe_interval) {
+    const uint32_t count = std::min(options.keyframe_interval, frames - g0);
+    std::vector<uint8_t> yuv(picture * count);
+    for (uint32_t i = 0; i < count; ++i) {
+      const uint8_t* src = &rgba[size_t{g0 + i} * w * h * 4];
+      for (uint32_t y = 0; y < H; ++y) {
+        const uint32_t sy = std::min(y, h - 1);
+        for (uint32_t x = 0; x < W; ++x) {
+          const uint32_t sx = std::min(x, w - 1);
+          std::copy_n(src + (size_t{sy} * w + sx) * 4, 4, &padded[(size_t{y} * W + x) * 4]);
+        }
+      }
+      uint8_t* out = &yuv[i * picture];
+      rgba_to_ycbcr420(padded, W, H, out, out + luma, out + luma + luma / 4);
+    }
+    CALF_ASSIGN_OR_RETURN(Gop gop,
+                          encode_gop(yuv, W, H, count, fps_numerator, fps_denominator, options));
+    gops.push_back(std::move(gop));
+  }
+  return gops;
+}
+
+}  // namespace calf::av1_internal

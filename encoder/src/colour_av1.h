@@ -1,0 +1,33 @@
+// AV1 colour (format/SPEC.md §11.1.12): one cell's frames, as sRGB-encoded RGBA8, encoded with
+// SVT-AV1 into closed GOPs of temporal units. Private to the light-field encoder.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "calf/encoder/lightfield_encode.h"
+#include "calf/format/status.h"
+
+namespace calf::av1_internal {
+
+// The temporal units of one GOP: unit i shows frame i of the GOP; unit 0 is a key frame with its
+// sequence header.
+using Gop = std::vector<std::vector<uint8_t>>;
+
+// Encodes `frames` frames of a w x h cell (`rgba`: frame after frame, row-major, 4 bytes a texel,
+// alpha ignored) as GOPs of options.keyframe_interval frames (the last may be shorter), each by a
+// fresh single-threaded SVT-AV1 encoder, so that the bytes depend on the pictures and the options
+// only. Pictures narrower or lower than 64 texels (SVT-AV1's least) or not a multiple of 8 are
+// padded by repeating the last column and row. Errors: CALF-E256 (kEncoderAv1).
+Expected<std::vector<Gop>> encode_cell(std::span<const uint8_t> rgba, uint32_t w, uint32_t h,
+                                       uint32_t frames, uint32_t fps_numerator,
+                                       uint32_t fps_denominator, const Av1ColourOptions& options);
+
+// The encoder's colour conversion (BT.709, full range, chroma as the mean of each 2 x 2 block):
+// the inverse, up to rounding, of the decoder's (§11.1.12). `y` is W x H, `cb` and `cr`
+// W / 2 x H / 2; W and H even. `rgba` is W x H.
+void rgba_to_ycbcr420(std::span<const uint8_t> rgba, uint32_t W, uint32_t H, uint8_t* y,
+                      uint8_t* cb, uint8_t* cr);
+
+}  // namespace calf::av1_internal
