@@ -46,8 +46,9 @@ Status validate(const NoiseEstimateOptions& o) {
     return Status(ErrorId::kEncoderOption,
                   "noise block " + std::to_string(o.block) + ": expected [4, 64]");
   }
-  if (o.min_blocks < 1 || o.max_pairs < 1) {
-    return Status(ErrorId::kEncoderOption, "noise estimate: min_blocks and max_pairs must be >= 1");
+  if (o.min_blocks < 1 || o.max_pairs < 1 || !(o.min_share >= 0 && o.min_share <= 1)) {
+    return Status(ErrorId::kEncoderOption,
+                  "noise estimate: min_blocks and max_pairs must be >= 1, min_share in [0, 1]");
   }
   return Status::Ok();
 }
@@ -89,6 +90,7 @@ void NoiseSamples::add_pair(const capture::ViewFrame& a, const capture::ViewFram
       for (uint32_t bx = 0; bx < n; bx += block) {
         const uint32_t x1 = std::min(n, bx + block), y1 = std::min(n, by + block);
         const uint64_t area = uint64_t{x1 - bx} * (y1 - by);
+        ++examined_;
         uint64_t count = 0;
         bool changed = false;
         for (uint32_t y = by; y < y1; ++y) {
@@ -133,12 +135,16 @@ void NoiseSamples::add_pair(const capture::ViewFrame& a, const capture::ViewFram
 void NoiseSamples::merge(const NoiseSamples& other) {
   for (size_t i = 0; i < kBins; ++i) bins_[i] += other.bins_[i];
   count_ += other.count_;
+  examined_ += other.examined_;
 }
 
-NoiseEstimate NoiseSamples::estimate(uint64_t min_blocks) const {
+NoiseEstimate NoiseSamples::estimate(uint64_t min_blocks, double min_share) const {
   NoiseEstimate e;
   e.samples = count_;
-  if (count_ == 0 || count_ < min_blocks) return e;
+  if (count_ == 0 || count_ < min_blocks ||
+      static_cast<double>(count_) < min_share * static_cast<double>(examined_)) {
+    return e;
+  }
   // The lower median of the samples' PSNR (the median block energy).
   const uint64_t rank = (count_ + 1) / 2;
   uint64_t seen = 0;
@@ -159,7 +165,7 @@ NoiseEstimate estimate_view_noise(std::span<const capture::ViewFrame> frames, No
   NoiseSamples s;
   for (size_t f = 1; f < frames.size(); ++f)
     s.add_pair(frames[f - 1], frames[f], metric, options.block);
-  return s.estimate(options.min_blocks);
+  return s.estimate(options.min_blocks, options.min_share);
 }
 
 Expected<CaptureNoise> estimate_capture_noise(const capture::CaptureSetReader& input,
@@ -230,10 +236,10 @@ Expected<CaptureNoise> estimate_capture_noise(const capture::CaptureSetReader& i
   NoiseSamples all;
   for (const ViewResult& r : results) {
     const NoiseSamples& s = hdr ? r.log2 : r.srgb;
-    out.views.push_back(s.estimate(options.min_blocks));
+    out.views.push_back(s.estimate(options.min_blocks, options.min_share));
     all.merge(s);
   }
-  out.set = all.estimate(options.min_blocks);
+  out.set = all.estimate(options.min_blocks, options.min_share);
   return out;
 }
 

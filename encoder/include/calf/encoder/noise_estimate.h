@@ -21,7 +21,9 @@
 //
 // Noise that is the same in every frame (a renderer with a fixed seed on static content) does not
 // change from frame to frame and costs no keyframes: it is not measured. A set of one frame, or
-// one where fewer than min_blocks blocks changed on static geometry, has no estimate.
+// one where fewer than min_blocks samples, or fewer than min_share of all the blocks examined,
+// changed on static geometry, has no estimate: a few changing blocks (shading beside a moving
+// part of converged content) say more about that content than about noise.
 #pragma once
 
 #include <cstdint>
@@ -42,6 +44,7 @@ enum class NoiseMetric : uint8_t { kSrgb, kLog2 };
 struct NoiseEstimateOptions {
   uint32_t block = 8;        // B, the block side in texels, 4..64
   uint64_t min_blocks = 16;  // fewer samples than this: no estimate, >= 1
+  double min_share = 0.02;   // fewer samples than this share of the blocks examined: none
   uint32_t max_pairs = 8;    // consecutive frame pairs measured per view, evenly spread, >= 1
   uint32_t threads = 1;      // views read at once; 0 = all cores; never changes the result
   uint64_t max_image_pixels = capture::kDefaultMaxImagePixels;  // CaptureSetReader::open's
@@ -71,12 +74,13 @@ class NoiseSamples {
   void add_pair(const capture::ViewFrame& a, const capture::ViewFrame& b, NoiseMetric metric,
                 uint32_t block);
   void merge(const NoiseSamples& other);
-  NoiseEstimate estimate(uint64_t min_blocks) const;
+  NoiseEstimate estimate(uint64_t min_blocks, double min_share) const;
   uint64_t count() const { return count_; }
 
  private:
   std::vector<uint64_t> bins_;  // by a sample's own PSNR, kNoiseBinDb wide
-  uint64_t count_ = 0;
+  uint64_t count_ = 0;          // samples
+  uint64_t examined_ = 0;       // blocks examined, samples or not
 };
 
 // The estimate of one view's frames (in frame order) in `metric`, over every consecutive pair
@@ -98,7 +102,7 @@ Expected<CaptureNoise> estimate_capture_noise(const capture::CaptureSetReader& i
 inline constexpr double kAutoPsnrCapDb = 50;
 inline constexpr double kAutoPsnrFloorDb = 10;
 // The margin calf-encode uses unless told (docs/ENCODER.md "Keyframes and render noise").
-inline constexpr double kDefaultPsnrNoiseMargin = 4;
+inline constexpr double kDefaultPsnrNoiseMargin = 3;
 double auto_psnr_db(const NoiseEstimate& estimate, double margin, double cap = kAutoPsnrCapDb);
 
 }  // namespace calf
