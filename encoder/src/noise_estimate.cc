@@ -243,6 +243,10 @@ Expected<CaptureNoise> estimate_capture_noise(const capture::CaptureSetReader& i
   return out;
 }
 
+Status check_lightfield_options(const LightfieldEncodeOptions& options) {
+  return lightfield_internal::validate_options(options);
+}
+
 double auto_psnr_db(const NoiseEstimate& estimate, double margin, double cap) {
   if (!estimate.psnr_db) return cap;
   return std::clamp(*estimate.psnr_db - margin, std::min(kAutoPsnrFloorDb, cap), cap);

@@ -223,6 +223,7 @@ int encode_surfels(const std::string& input, const std::string& candidates, cons
 // Returns 0, or the exit status of the error it printed.
 int resolve_auto_psnr(const std::filesystem::path& dir, double margin, bool quiet,
                       calf::LightfieldEncodeOptions* o) {
+  if (calf::Status s = calf::check_lightfield_options(*o); !s.ok()) return fail(s);
   const auto t0 = std::chrono::steady_clock::now();
   auto input = calf::capture::CaptureSetReader::open(dir, o->max_image_pixels);
   if (!input.ok()) return fail(input.status());

@@ -97,6 +97,10 @@ Expected<CaptureNoise> estimate_capture_noise(const capture::CaptureSetReader& i
                                               ColourCoding colour,
                                               const NoiseEstimateOptions& options);
 
+// The light-field encoder's own option check (kEncoderOption naming the flag), for a caller that
+// estimates the noise before it encodes: a bad option is reported before any image is read.
+Status check_lightfield_options(const LightfieldEncodeOptions& options);
+
 // --psnr auto: Q = min(cap, estimate - margin), never below kAutoPsnrFloorDb; `cap` (50, the
 // encoder's default Q) without an estimate.
 inline constexpr double kAutoPsnrCapDb = 50;
