@@ -25,6 +25,7 @@
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/encoder/lightfield_shard.h"
 #include "calf/encoder/mesh_encode.h"
+#include "calf/encoder/noise_estimate.h"
 #include "calf/encoder/surfels_build.h"
 #include "calf/encoder/visible_set.h"
 #include "calf_encode/tiles_mode.h"
@@ -217,6 +218,50 @@ int encode_surfels(const std::string& input, const std::string& candidates, cons
   return 0;
 }
 
+// --psnr auto: estimates the render noise of the capture set at `dir` (calf/encoder/
+// noise_estimate.h) and sets o->min_psnr_db from it; prints the estimate and Q unless `quiet`.
+// Returns 0, or the exit status of the error it printed.
+int resolve_auto_psnr(const std::filesystem::path& dir, double margin, bool quiet,
+                      calf::LightfieldEncodeOptions* o) {
+  if (calf::Status s = calf::check_lightfield_options(*o); !s.ok()) return fail(s);
+  const auto t0 = std::chrono::steady_clock::now();
+  auto input = calf::capture::CaptureSetReader::open(dir, o->max_image_pixels);
+  if (!input.ok()) return fail(input.status());
+  calf::NoiseEstimateOptions no;
+  no.threads = o->threads;
+  no.max_image_pixels = o->max_image_pixels;
+  auto noise = calf::estimate_capture_noise(*input, o->colour, no);
+  if (!noise.ok()) return fail(noise.status());
+  o->min_psnr_db = calf::auto_psnr_db(noise->set, margin);
+  if (quiet) return 0;
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const char* metric = noise->metric == calf::NoiseMetric::kLog2 ? "log2-PSNR" : "sRGB PSNR";
+  if (!noise->set.psnr_db) {
+    std::fprintf(stderr,
+                 "calf-encode: colour noise: no estimate (%llu samples of frame-to-frame change on "
+                 "static geometry, %.2f s); --psnr auto: Q = %.2f dB\n",
+                 static_cast<unsigned long long>(noise->set.samples), seconds, o->min_psnr_db);
+    return 0;
+  }
+  double lo = 1e9, hi = -1e9;
+  for (const calf::NoiseEstimate& v : noise->views) {
+    if (!v.psnr_db) continue;
+    lo = std::min(lo, *v.psnr_db);
+    hi = std::max(hi, *v.psnr_db);
+  }
+  const std::string views =
+      lo <= hi ? fmt::format("views {:.2f}-{:.2f}; ", lo, hi) : std::string("no view alone; ");
+  std::fprintf(stderr,
+               "calf-encode: colour noise %.2f dB %s (%s%llu samples of frame-to-frame change on "
+               "static geometry, %.2f s); --psnr auto: Q = %.2f dB (min(50, estimate - margin "
+               "%g))\n",
+               *noise->set.psnr_db, metric, views.c_str(),
+               static_cast<unsigned long long>(noise->set.samples), seconds, o->min_psnr_db,
+               margin);
+  return 0;
+}
+
 static int command_main(int argc, char** argv) {
   CLI::App app{
       "calf-encode: encode a capture set (format/CAPTURE.md) into a .calf lightfield track "
@@ -276,11 +321,20 @@ static int command_main(int argc, char** argv) {
       ->check(CLI::Range(uint64_t{1}, calf::capture::kMaxImagePixelsLimit));
   app.add_option("--cell", o.cell_size, "colour cell side in px, multiple of 4 (default 64)")
       ->default_val(64);
+  std::string psnr = "auto";
   app.add_option(
-         "--psnr", o.min_psnr_db,
+         "--psnr", psnr,
          "Q: min dB of every interpolated frame vs. the frame as the spatial codec shows it; "
-         "sRGB PSNR for LDR, log2-PSNR (8-stop peak) for HDR (default 50)")
-      ->default_val(50.0);
+         "sRGB PSNR for LDR, log2-PSNR (8-stop peak) for HDR; a number in (0, 200] or auto: "
+         "Q = min(50, the capture's render-noise estimate - --psnr-noise-margin), 50 when there "
+         "is no estimate (one frame, or no colour change on static geometry); the estimate "
+         "and Q are printed (docs/ENCODER.md \"Keyframes and render noise\") (default auto)")
+      ->default_val("auto");
+  double noise_margin = calf::kDefaultPsnrNoiseMargin;
+  app.add_option("--psnr-noise-margin", noise_margin,
+                 "with --psnr auto: dB Q stays below the render-noise estimate, 0..50 (default " +
+                     fmt::format("{:g}", calf::kDefaultPsnrNoiseMargin) + ")")
+      ->check(CLI::Range(0.0, 50.0));
   app.add_option(
          "--color-format", colour,
          "auto (BC1 for LDR input, BC6H for HDR), bc1, bc7, bc6h, rgba8, rgba16f (default auto)")
@@ -598,6 +652,7 @@ static int command_main(int argc, char** argv) {
   if (mode != "lightfield") {
     for (const char* opt : {"--cell",
                             "--psnr",
+                            "--psnr-noise-margin",
                             "--color-format",
                             "--depth-format",
                             "--depth-window",
@@ -726,6 +781,18 @@ static int command_main(int argc, char** argv) {
           "calf-encode", "--colour-rdo " + colour_rdo + ": expected a number in [0, 1e6] or auto");
     }
   }
+  const bool psnr_auto = psnr == "auto";
+  if (!psnr_auto) {
+    char* end = nullptr;
+    o.min_psnr_db = std::strtod(psnr.c_str(), &end);
+    if (psnr.empty() || *end != '\0' || !std::isfinite(o.min_psnr_db)) {
+      return calf::tools::usage_error("calf-encode",
+                                      "--psnr " + psnr + ": expected a number of dB or auto");
+    }
+    if (given("--psnr-noise-margin")) {
+      return calf::tools::usage_error("calf-encode", "--psnr-noise-margin needs --psnr auto");
+    }
+  }
   o.bc1_fit = bc1_fit == "range"     ? calf::Bc1Fit::kRange
               : bc1_fit == "refined" ? calf::Bc1Fit::kRefined
                                      : calf::Bc1Fit::kCluster;
@@ -757,6 +824,12 @@ static int command_main(int argc, char** argv) {
     return calf::tools::usage_error(
         "calf-encode", "--plain-directory with --analysis-only: sharded encodes write 1.1 files");
   }
+  if (psnr_auto && analysis_path.empty()) {
+    // Q from the capture's render noise, decided before pass 1 so that an analysis file records
+    // the number and its shards code with it.
+    o.max_image_pixels = max_image_pixels;
+    if (int rc = resolve_auto_psnr(dir, noise_margin, quiet, &o); rc != 0) return rc;
+  }
   if (analysis_only) {
     const auto t0 = std::chrono::steady_clock::now();
     o.max_image_pixels = max_image_pixels;
@@ -772,9 +845,10 @@ static int command_main(int argc, char** argv) {
   }
   if (!analysis_path.empty()) {
     for (const char* opt :
-         {"--cell", "--psnr", "--color-format", "--depth-format", "--depth-window", "--max-aabbs",
-          "--depth-keyframe-interval", "--supercompression", "--segment-frames", "--colour-rdo",
-          "--bc1-fit", "--depth-fixed-groups", "--no-coverage", "--plain-directory"}) {
+         {"--cell", "--psnr", "--psnr-noise-margin", "--color-format", "--depth-format",
+          "--depth-window", "--max-aabbs", "--depth-keyframe-interval", "--supercompression",
+          "--segment-frames", "--colour-rdo", "--bc1-fit", "--depth-fixed-groups", "--no-coverage",
+          "--plain-directory"}) {
       if (app.get_option(opt)->count() > 0) {
         return calf::tools::usage_error(
             "calf-encode",

@@ -1,0 +1,164 @@
+// Keyframes and render noise (docs/ENCODER.md "Keyframes and render noise"): encodes a capture
+// set with the colour keyframe threshold Q at 50 dB (calf-encode --psnr 50) and at --psnr auto
+// for each margin given (calf/encoder/noise_estimate.h), and prints per encode the colour stream's
+// stored bytes, its keyframes and the PSNR of the decoded colour (every face of every view and
+// frame, 8-bit sRGB as calf-bench's peers measure it, one MSE over everything) against the input
+// and against a reference capture of the same viewpoints (--reference: the scene rendered
+// converged, ground truth at the capture's own texels). Prints markdown.
+//
+//   bench-noise_keyframes --capture NOISY [--reference CONVERGED] [--margin 4 --margin 6 ...]
+//       [--threads N]
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include "calf/capture/capture_set.h"
+#include "calf/decoder/lightfield_reference.h"
+#include "calf/encoder/lightfield_encode.h"
+#include "calf/encoder/noise_estimate.h"
+#include "calf/format/colour.h"
+#include "calf/format/container.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace calf;
+
+// Every face of every view and frame of a capture set as sRGB bytes, view-major.
+Expected<std::vector<uint8_t>> capture_srgb(const fs::path& dir) {
+  CALF_ASSIGN_OR_RETURN(capture::CaptureSetReader in, capture::CaptureSetReader::open(dir));
+  const auto& m = in.manifest();
+  std::vector<uint8_t> out;
+  capture::ViewFrame vf;
+  for (uint32_t v = 0; v < m.viewpoints.size(); ++v) {
+    for (uint32_t f = 0; f < m.frame_count; ++f) {
+      CALF_RETURN_IF_ERROR(in.read(v, f, &vf));
+      for (const float c : vf.color) out.push_back(srgb8_from_linear(c));
+    }
+  }
+  return out;
+}
+
+// The clip's decoded colour in the same layout.
+Expected<std::vector<uint8_t>> clip_srgb(const fs::path& clip) {
+  CALF_ASSIGN_OR_RETURN(container::Reader reader, container::Reader::open(clip.string()));
+  CALF_ASSIGN_OR_RETURN(decoder::LightfieldReference ref,
+                        decoder::LightfieldReference::open(reader, 0));
+  const auto& h = ref.header();
+  std::vector<uint8_t> out;
+  decoder::LightfieldFace face;
+  for (uint32_t v = 0; v < h.view_count; ++v) {
+    for (uint32_t f = 0; f < h.frame_count; ++f) {
+      for (uint32_t i = 0; i < 6; ++i) {
+        CALF_RETURN_IF_ERROR(ref.decode_face(v, i, f, &face));
+        for (const float c : face.colour) out.push_back(srgb8_from_linear(c));
+      }
+    }
+  }
+  return out;
+}
+
+double psnr(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
+  if (a.size() != b.size() || a.empty()) return NAN;
+  double sum = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    const double d = static_cast<double>(a[i]) - static_cast<double>(b[i]);
+    sum += d * d;
+  }
+  return sum == 0 ? INFINITY : 10.0 * std::log10(255.0 * 255.0 * a.size() / sum);
+}
+
+int fail(const Status& s) {
+  std::fprintf(stderr, "bench-noise_keyframes: %s\n", s.to_string().c_str());
+  return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"bench-noise_keyframes: colour bytes and PSNR at --psnr 50 and --psnr auto"};
+  std::string capture_dir, reference_dir;
+  std::vector<double> margins;
+  uint32_t threads = 0;
+  app.add_option("--capture", capture_dir, "the capture set encoded")->required();
+  app.add_option("--reference", reference_dir,
+                 "a converged capture of the same viewpoints, frames and face size");
+  app.add_option("--margin", margins,
+                 "--psnr-noise-margin values (repeatable; default: the "
+                 "default margin)");
+  app.add_option("--threads", threads, "encoder threads, 0 = all cores (default 0)");
+  CLI11_PARSE(app, argc, argv);
+  if (margins.empty()) margins.push_back(kDefaultPsnrNoiseMargin);
+
+  auto input = capture::CaptureSetReader::open(capture_dir);
+  if (!input.ok()) return fail(input.status());
+  NoiseEstimateOptions no;
+  no.threads = threads;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto noise = estimate_capture_noise(*input, ColourCoding::kAuto, no);
+  if (!noise.ok()) return fail(noise.status());
+  const double estimate_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  auto in_rgb = capture_srgb(capture_dir);
+  if (!in_rgb.ok()) return fail(in_rgb.status());
+  std::optional<std::vector<uint8_t>> ref_rgb;
+  if (!reference_dir.empty()) {
+    auto r = capture_srgb(reference_dir);
+    if (!r.ok()) return fail(r.status());
+    ref_rgb = std::move(*r);
+  }
+
+  std::printf("capture %s: noise estimate %s (%s, %llu samples, %.2f s)%s\n\n", capture_dir.c_str(),
+              noise->set.psnr_db ? fmt::format("{:.2f} dB", *noise->set.psnr_db).c_str() : "none",
+              noise->metric == NoiseMetric::kLog2 ? "log2-PSNR" : "sRGB PSNR",
+              static_cast<unsigned long long>(noise->set.samples), estimate_s,
+              ref_rgb
+                  ? fmt::format("; input vs reference {:.2f} dB", psnr(*in_rgb, *ref_rgb)).c_str()
+                  : "");
+  std::printf("| --psnr | Q (dB) | colour bytes | × Q 50 | keyframes | vs input (dB) |%s\n",
+              ref_rgb ? " vs reference (dB) | Δ vs Q 50 (dB) |" : "");
+  std::printf("|---|---:|---:|---:|---:|---:|%s\n", ref_rgb ? "---:|---:|" : "");
+  const fs::path clip = fs::temp_directory_path() /
+                        fmt::format("bench-noise_keyframes-{}.calf", static_cast<long>(getpid()));
+  std::vector<std::pair<std::string, double>> runs = {{"50", 50.0}};
+  for (const double m : margins) {
+    runs.emplace_back(fmt::format("auto, margin {:g}", m), auto_psnr_db(noise->set, m));
+  }
+  uint64_t base_bytes = 0;
+  double base_ref = 0;
+  for (const auto& [label, q] : runs) {
+    LightfieldEncodeOptions o;
+    o.threads = threads;
+    o.min_psnr_db = q;
+    auto stats = encode_lightfield_file(capture_dir, clip.string(), o);
+    if (!stats.ok()) return fail(stats.status());
+    auto out_rgb = clip_srgb(clip);
+    if (!out_rgb.ok()) return fail(out_rgb.status());
+    const uint64_t bytes = stats->colour.stored;
+    if (base_bytes == 0) base_bytes = bytes;
+    const double vs_ref = ref_rgb ? psnr(*ref_rgb, *out_rgb) : NAN;
+    if (label == "50") base_ref = vs_ref;
+    std::printf(
+        "| %s | %.2f | %llu | %.3f | %llu of %llu | %.2f |", label.c_str(), q,
+        static_cast<unsigned long long>(bytes),
+        static_cast<double>(bytes) / static_cast<double>(base_bytes),
+        static_cast<unsigned long long>(stats->colour_keyframes),
+        static_cast<unsigned long long>(stats->colour_cells * input->manifest().frame_count),
+        psnr(*in_rgb, *out_rgb));
+    if (ref_rgb) std::printf(" %.2f | %+.2f |", vs_ref, vs_ref - base_ref);
+    std::printf("\n");
+    std::fflush(stdout);
+  }
+  std::error_code ec;
+  fs::remove(clip, ec);
+  return 0;
+}
