@@ -209,11 +209,13 @@ Status validate_impl(const SceneFile& s, ErrorId size_id) {
     return Status(ErrorId::kSceneFileLimit,
                   "frame_count " + std::to_string(s.frame_count) + " exceeds 1000000");
   }
+  const Box3& box = s.view_volume;
+  const double lo[3] = {box.min.x, box.min.y, box.min.z}, hi[3] = {box.max.x, box.max.y, box.max.z};
   for (int a = 0; a < 3; ++a) {
-    if (!std::isfinite(s.view_region_min[a]) || !std::isfinite(s.view_region_max[a])) {
+    if (!std::isfinite(lo[a]) || !std::isfinite(hi[a])) {
       return Status(ErrorId::kSceneFileValue, "view_region is not finite");
     }
-    if (s.view_region_min[a] > s.view_region_max[a]) {
+    if (lo[a] > hi[a]) {
       return Status(ErrorId::kSceneFileField,
                     "view_region: min exceeds max on axis " + std::string(1, "xyz"[a]));
     }
@@ -564,10 +566,8 @@ Expected<SceneFile> Decoder::decode(
     }
     FieldReader rr = reader(*region, "view_region");
     CALF_RETURN_IF_ERROR(rr.check_keys({"min", "max"}));
-    CALF_ASSIGN_OR_RETURN(const Vec3 lo, rr.point("min"));
-    CALF_ASSIGN_OR_RETURN(const Vec3 hi, rr.point("max"));
-    s.view_region_min = {lo.x, lo.y, lo.z};
-    s.view_region_max = {hi.x, hi.y, hi.z};
+    CALF_ASSIGN_OR_RETURN(s.view_volume.min, rr.point("min"));
+    CALF_ASSIGN_OR_RETURN(s.view_volume.max, rr.point("max"));
   }
   if (top.has("environment")) {
     CALF_ASSIGN_OR_RETURN(const Json* env, top.get("environment"));
@@ -958,8 +958,8 @@ Expected<EncodedScene> encode_scene_file(const SceneFile& s) {
   json["fps"] = s.fps;
   json["frame_count"] = s.frame_count;
   json["view_region"] = {
-      {"min", OJson::array({s.view_region_min[0], s.view_region_min[1], s.view_region_min[2]})},
-      {"max", OJson::array({s.view_region_max[0], s.view_region_max[1], s.view_region_max[2]})}};
+      {"min", OJson::array({s.view_volume.min.x, s.view_volume.min.y, s.view_volume.min.z})},
+      {"max", OJson::array({s.view_volume.max.x, s.view_volume.max.y, s.view_volume.max.z})}};
   json["environment"] = {{"zenith", float3_json(e.zenith)},
                          {"horizon", float3_json(e.horizon)},
                          {"ground", float3_json(e.ground)},
