@@ -5,12 +5,18 @@ namespace calf::decoder {
 namespace {
 
 // In the order calf-verify's "ok" line names what it decoded.
+#define CALF_DECODER_KIND_POINTER(Name, number, name, section) &k##Name##DecoderKind,
+// One line per kind (clang-format would pack them).
+// clang-format off
 constexpr const DecoderKind* kKinds[] = {
     &kLightfieldDecoderKind,
     &kMeshDecoderKind,
     &kSurfelsDecoderKind,
     &kTilesDecoderKind,
+    CALF_EXTRA_TRACK_KINDS(CALF_DECODER_KIND_POINTER)  // a build's own kinds (track_kinds.h)
 };
+// clang-format on
+#undef CALF_DECODER_KIND_POINTER
 
 }  // namespace
 

@@ -22,6 +22,7 @@
 #include "calf/encoder/color_keyframes.h"
 #include "calf/encoder/depth_aabb.h"
 #include "calf/format/bc.h"
+#include "calf/format/clip_metadata.h"
 #include "calf/format/depth_predict.h"
 #include "calf/format/files.h"
 #include "calf/format/grid.h"
@@ -1111,11 +1112,9 @@ Expected<LightfieldEncodeStats> encode_lightfield_file(const std::filesystem::pa
     CALF_RETURN_IF_ERROR(writer.set_metadata("source_scene", input.manifest().scene));
   }
   // The box the eye may move in (format/CAPTURE.md view_volume): the player warns outside it.
-  const Box3& box = input.manifest().view_volume;
-  char volume[160];
-  std::snprintf(volume, sizeof volume, "%.17g %.17g %.17g %.17g %.17g %.17g", box.min.x, box.min.y,
-                box.min.z, box.max.x, box.max.y, box.max.z);
-  CALF_RETURN_IF_ERROR(writer.set_metadata("view_volume", volume));
+  CALF_RETURN_IF_ERROR(
+      writer.set_metadata(std::string(container::kViewVolumeKey),
+                          container::format_view_volume(input.manifest().view_volume)));
   CALF_RETURN_IF_ERROR(writer.finish());
   return stats;
 }

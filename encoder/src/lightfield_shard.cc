@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "calf/capture/capture_shard.h"
+#include "calf/format/clip_metadata.h"
 #include "calf/format/container.h"
 #include "calf/format/container_codec.h"
 #include "calf/format/container_fields.h"
@@ -235,11 +236,8 @@ std::vector<std::pair<std::string, std::string>> clip_metadata(const capture::Ca
   std::vector<std::pair<std::string, std::string>> md;
   md.emplace_back("encoder", std::string("calf-encode ") + kVersionString);
   if (!m.scene.empty()) md.emplace_back("source_scene", m.scene);
-  const Box3& box = m.view_volume;
-  char volume[160];
-  std::snprintf(volume, sizeof volume, "%.17g %.17g %.17g %.17g %.17g %.17g", box.min.x, box.min.y,
-                box.min.z, box.max.x, box.max.y, box.max.z);
-  md.emplace_back("view_volume", volume);
+  md.emplace_back(std::string(container::kViewVolumeKey),
+                  container::format_view_volume(m.view_volume));
   return md;
 }
 

@@ -13,6 +13,7 @@
 #include <tbb/task_arena.h>
 
 #include "calf/encoder/sphere_mesh.h"
+#include "calf/format/clip_metadata.h"
 #include "calf/format/coordinates.h"
 #include "calf/format/files.h"
 #include "calf/format/version.h"
@@ -68,10 +69,9 @@ Expected<Plan> make_plan(const capture::SceneFile& scene,
   h.segment_count = options.segment_count;
   h.flags = visible ? mesh::kHeaderVisibleSet : 0;
   auto& x = plan.index;
-  for (int c = 0; c < 3; ++c) {
-    x.view_min[c] = scene.view_region_min[c];
-    x.view_max[c] = scene.view_region_max[c];
-  }
+  const Box3& box = scene.view_volume;
+  x.view_min[0] = box.min.x, x.view_min[1] = box.min.y, x.view_min[2] = box.min.z;
+  x.view_max[0] = box.max.x, x.view_max[1] = box.max.y, x.view_max[2] = box.max.z;
   for (const auto& m : scene.materials) {
     mesh::MaterialRecord r;
     for (int c = 0; c < 3; ++c) {
@@ -467,11 +467,8 @@ Expected<MeshEncodeStats> encode_mesh_file(
   CALF_RETURN_IF_ERROR(
       writer.set_metadata("encoder", std::string("calf-encode ") + kVersionString));
   if (!scene.name.empty()) CALF_RETURN_IF_ERROR(writer.set_metadata("source_scene", scene.name));
-  char volume[160];
-  std::snprintf(volume, sizeof volume, "%.17g %.17g %.17g %.17g %.17g %.17g",
-                scene.view_region_min[0], scene.view_region_min[1], scene.view_region_min[2],
-                scene.view_region_max[0], scene.view_region_max[1], scene.view_region_max[2]);
-  CALF_RETURN_IF_ERROR(writer.set_metadata("view_volume", volume));
+  CALF_RETURN_IF_ERROR(writer.set_metadata(std::string(container::kViewVolumeKey),
+                                           container::format_view_volume(scene.view_volume)));
   for (const auto& [key, value] : extra_metadata)
     CALF_RETURN_IF_ERROR(writer.set_metadata(key, value));
   CALF_RETURN_IF_ERROR(writer.finish());

@@ -62,11 +62,8 @@ calf::Expected<calf::encoder::VisibleSet> visible_set_of(const calf::capture::Sc
                                                          const VisibleSetFlags& flags,
                                                          uint32_t* segment_count,
                                                          std::string* summary) {
-  const calf::Box3 region{
-      {scene.view_region_min[0], scene.view_region_min[1], scene.view_region_min[2]},
-      {scene.view_region_max[0], scene.view_region_max[1], scene.view_region_max[2]}};
-  const double eye_height =
-      flags.eye_height.value_or(0.5 * (scene.view_region_min[1] + scene.view_region_max[1]));
+  const calf::Box3& region = scene.view_volume;
+  const double eye_height = flags.eye_height.value_or(0.5 * (region.min.y + region.max.y));
   const auto segments =
       calf::encoder::perimeter_segments(region, eye_height, flags.segments_per_edge);
   double perimeter = 0;

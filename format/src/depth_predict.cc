@@ -15,8 +15,6 @@ static_assert(std::endian::native == std::endian::little,
 
 namespace {
 
-constexpr uint16_t kSkyCode = 65535;
-
 uint16_t load_code(const uint8_t* p) {
   uint16_t v;
   std::memcpy(&v, p, 2);  // little-endian host: asserted above
@@ -97,14 +95,14 @@ void reconstruct_run(const uint8_t* hi, const uint8_t* lo, const uint8_t* up, si
   }
   size_t i = 0;
 #if defined(__SSE2__)
-  const __m128i sky = _mm_set1_epi16(-1);
+  const __m128i sky = _mm_set1_epi16(static_cast<int16_t>(kLog16Sky));
   for (; i + 8 <= n; i += 8) {
     const size_t x = x0 + i;
     const __m128i above = _mm_loadu_si128(reinterpret_cast<const __m128i*>(up + 2 * x));
     const int above_sky = _mm_movemask_epi8(_mm_cmpeq_epi16(above, sky));  // 2 bits a texel
     // The predictions of x .. x + 7 read up(x - 1 .. x + 7), code(x - 1) and codes x .. x + 6.
-    const bool left_sky = x > 0 && load_code(row + 2 * (x - 1)) == kSkyCode;
-    const bool up_left_sky = x > 0 && load_code(up + 2 * (x - 1)) == kSkyCode;
+    const bool left_sky = x > 0 && load_code(row + 2 * (x - 1)) == kLog16Sky;
+    const bool up_left_sky = x > 0 && load_code(up + 2 * (x - 1)) == kLog16Sky;
     const __m128i d = residuals8(hi + i, lo + i);
     if (above_sky == 0 && !left_sky && !up_left_sky) {
       const uint16_t carry =

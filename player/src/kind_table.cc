@@ -4,12 +4,18 @@
 namespace calf::player {
 namespace {
 
+#define CALF_PLAYER_KIND_POINTER(Name, number, name, section) &k##Name##PlayerKind,
+// One line per kind (clang-format would pack them).
+// clang-format off
 constexpr const PlayerKind* kKinds[] = {
     &kLightfieldPlayerKind,
     &kTilesPlayerKind,
     &kSurfelsPlayerKind,
     &kMeshPlayerKind,
+    CALF_EXTRA_TRACK_KINDS(CALF_PLAYER_KIND_POINTER)  // a build's own kinds (track_kinds.h)
 };
+// clang-format on
+#undef CALF_PLAYER_KIND_POINTER
 
 }  // namespace
 

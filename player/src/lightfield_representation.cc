@@ -6,9 +6,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <sstream>
 
 #include "calf/decoder/cpu_textures.h"
+#include "calf/format/clip_metadata.h"
 #include "calf/format/lightfield_layout.h"
 #include "calf/player/gl_renderer.h"
 #include "calf/player/gl_views.h"
@@ -18,18 +18,6 @@ namespace {
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-// The view volume from the clip's metadata ("x0 y0 z0 x1 y1 z1"), if present and well formed.
-std::optional<Box3> parse_volume(const std::string* text) {
-  if (text == nullptr) return std::nullopt;
-  std::istringstream in(*text);
-  double v[6];
-  for (double& x : v) {
-    if (!(in >> x) || !std::isfinite(x)) return std::nullopt;
-  }
-  if (v[0] > v[3] || v[1] > v[4] || v[2] > v[5]) return std::nullopt;
-  return Box3{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
 }
 
 std::string format(const char* fmt, auto... args) {
@@ -124,7 +112,8 @@ Expected<std::unique_ptr<LightfieldRepresentation>> LightfieldRepresentation::op
     bounds = box_union(bounds, p);
     impl->has_material = impl->has_material || info.has_material;
   }
-  impl->volume = parse_volume(reader.find_metadata("view_volume")).value_or(bounds);
+  impl->volume = container::parse_view_volume(reader.find_metadata(container::kViewVolumeKey))
+                     .value_or(bounds);
   CALF_ASSIGN_OR_RETURN(ViewSelector sel, ViewSelector::make(impl->viewpoints, options.selection));
   impl->selector.emplace(std::move(sel));
   for (uint32_t v = 0; v < h.view_count; ++v) {

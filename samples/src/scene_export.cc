@@ -53,9 +53,7 @@ Expected<capture::SceneFile> export_scene(const Scene& scene, uint32_t frames) {
   out.generator = "calf-capture";
   out.fps = scene.fps;
   out.frame_count = frames;
-  const Box3& region = scene.default_rig.view_volume;
-  out.view_region_min = {region.min.x, region.min.y, region.min.z};
-  out.view_region_max = {region.max.x, region.max.y, region.max.z};
+  out.view_volume = scene.default_rig.view_volume;
   capture::SceneEnvironment& e = out.environment;
   e.zenith = float3(scene.sky.zenith);
   e.horizon = float3(scene.sky.horizon);

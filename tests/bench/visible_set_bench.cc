@@ -161,9 +161,7 @@ int run_scene_file(const std::string& dir, const std::vector<int>& frame_counts,
     fmt::print("error: {}\n", scene.status().to_string());
     return 1;
   }
-  const Box3 region{
-      {scene->view_region_min[0], scene->view_region_min[1], scene->view_region_min[2]},
-      {scene->view_region_max[0], scene->view_region_max[1], scene->view_region_max[2]}};
+  const Box3 region = scene->view_volume;
   std::vector<ViewSegment> segs = perimeter_segments(region, 0.5 * (region.min.y + region.max.y),
                                                      static_cast<uint32_t>(segments_per_edge));
   if (segment >= 0) {

@@ -28,8 +28,7 @@ SceneFile sample_scene() {
   s.generator = "scene_file_test";
   s.fps = 23.976;
   s.frame_count = 3;
-  s.view_region_min = {-0.5, 1.25, 1.0 / 3};
-  s.view_region_max = {0.5, 1.75, 1};
+  s.view_volume = {{-0.5, 1.25, 1.0 / 3}, {0.5, 1.75, 1}};
   s.environment.sun_irradiance = {2, 1.5f, 1};
   s.environment.ambient = {0.1f, 0.2f, 0.3f};
   s.textures.push_back({"textures/checker.png",
@@ -271,8 +270,7 @@ TEST_F(SceneFileTest, HandWrittenMinimalFile) {
   EXPECT_EQ(s->name, "minimal");
   EXPECT_EQ(s->fps, 24);
   EXPECT_EQ(s->frame_count, 2u);
-  EXPECT_EQ(s->view_region_min, (std::array<double, 3>{0, 1, 0}));
-  EXPECT_EQ(s->view_region_max, (std::array<double, 3>{1, 2, 1}));
+  EXPECT_EQ(s->view_volume, (Box3{{0, 1, 0}, {1, 2, 1}}));
   ASSERT_EQ(s->materials.size(), 1u);
   EXPECT_EQ(s->materials[0].base_color, (SceneFloat3{0.5f, 0.25f, 1}));
   EXPECT_EQ(s->materials[0].ior, 1.25f);

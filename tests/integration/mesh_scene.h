@@ -18,8 +18,7 @@ inline capture::SceneFile make_mesh_test_scene(uint32_t frame_count = 3, bool sp
   s.name = "mesh-test";
   s.fps = 24;
   s.frame_count = frame_count;
-  s.view_region_min = {-1, 1.5, -1};
-  s.view_region_max = {1, 1.7, 1};
+  s.view_volume = {{-1, 1.5, -1}, {1, 1.7, 1}};
   s.materials.push_back({"grey", {0.5f, 0.5f, 0.5f}, capture::kNoTexture, {0, 0, 0}, 0, 0, 1.5f});
   s.materials.push_back({"lamp", {1, 0.75f, 0.25f}, capture::kNoTexture, {4, 3, 2}, 0, 0, 1.5f});
   s.materials.push_back(
@@ -106,8 +105,7 @@ inline capture::SceneFile make_textured_mesh_test_scene() {
   s.name = "mesh-textured";
   s.fps = 24;
   s.frame_count = 2;
-  s.view_region_min = {-1, 1.5, -1};
-  s.view_region_max = {1, 1.7, 1};
+  s.view_volume = {{-1, 1.5, -1}, {1, 1.7, 1}};
   const auto texture = [](const char* path, uint32_t w, uint32_t h, uint32_t seed) {
     capture::SceneTexture t;
     t.path = path;

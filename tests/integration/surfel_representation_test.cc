@@ -33,8 +33,7 @@ capture::SceneFile plates() {
   capture::SceneFile s;
   s.name = "plates";
   s.frame_count = 1;
-  s.view_region_min = {-0.1, -0.1, -0.1};
-  s.view_region_max = {0.1, 0.1, 0.1};
+  s.view_volume = {{-0.1, -0.1, -0.1}, {0.1, 0.1, 0.1}};
   s.materials.push_back({"grey", {0.5f, 0.5f, 0.5f}, capture::kNoTexture, {0, 0, 0}, 0, 0, 1.5f});
   capture::SceneMesh plate;
   plate.name = "plate";

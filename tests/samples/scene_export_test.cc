@@ -62,8 +62,8 @@ void expect_same_counts(const Scene& scene, const capture::SceneFile& file, uint
   }
   EXPECT_EQ(file.triangle_count(), triangles);
   EXPECT_EQ(file.triangle_count(), scene.triangle_count());
-  EXPECT_EQ(file.view_region_min[0], scene.default_rig.view_volume.min.x);
-  EXPECT_EQ(file.view_region_max[1], scene.default_rig.view_volume.max.y);
+  EXPECT_EQ(file.view_volume.min.x, scene.default_rig.view_volume.min.x);
+  EXPECT_EQ(file.view_volume.max.y, scene.default_rig.view_volume.max.y);
 }
 
 TEST(SceneExport, BuiltinScenesKeepTheirContent) {

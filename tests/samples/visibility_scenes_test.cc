@@ -160,7 +160,7 @@ TEST_P(VisibilityScene, ExportAndReadBackWithSharedMeshesStoredOnce) {
   }
   const capture::SceneEnvironment& e = back->environment;
   EXPECT_GT(e.sun_irradiance[0], 0) << "a sun";
-  EXPECT_EQ(back->view_region_min[1], scene->default_rig.view_volume.min.y);
+  EXPECT_EQ(back->view_volume.min.y, scene->default_rig.view_volume.min.y);
   fs::remove_all(dir);
 }
 

@@ -1,6 +1,7 @@
 #include "json_fields.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cstdio>
 #include <vector>
 
@@ -42,8 +43,9 @@ std::string dump_json(const Json& json) {
   return json.dump(2, ' ', false, Json::error_handler_t::replace);
 }
 
-Status FieldReader::error(const std::string& field_path, const std::string& what) const {
-  return Status(id_, std::string(source_) + ": field '" + field_path + "': " + what);
+Status FieldReader::error(ErrorId id, const std::string& field_path,
+                          const std::string& what) const {
+  return Status(id, std::string(source_) + ": field '" + field_path + "': " + what);
 }
 
 Status FieldReader::check_keys(std::initializer_list<const char*> allowed) const {
@@ -67,8 +69,59 @@ Expected<double> FieldReader::number(const char* key) const {
   CALF_ASSIGN_OR_RETURN(const Json* v, get(key));
   if (!v->is_number()) return error(field(key), "expected a number, got " + describe(*v));
   double d = v->get<double>();
-  if (!std::isfinite(d)) return error(field(key), "expected a finite number");
+  if (!std::isfinite(d)) return error(value_id_, field(key), "expected a finite number");
   return d;
+}
+
+Expected<uint64_t> FieldReader::count(const char* key, uint64_t max) const {
+  CALF_ASSIGN_OR_RETURN(const Json* v, get(key));
+  const bool negative = v->is_number_integer() && !v->is_number_unsigned() && v->get<int64_t>() < 0;
+  if (!v->is_number_integer() || negative)
+    return error(field(key), "expected an integer >= 0, got " + describe(*v));
+  const uint64_t u = v->get<uint64_t>();
+  if (u > max) {
+    return error(limit_id_, field(key),
+                 std::to_string(u) + " exceeds the limit of " + std::to_string(max));
+  }
+  return u;
+}
+
+// JSON numbers go through double; a value beyond float's range would become inf, so it is refused
+// as not finite.
+Expected<float> FieldReader::f32(const char* key) const {
+  CALF_ASSIGN_OR_RETURN(const Json* v, get(key));
+  if (!v->is_number()) return error(field(key), "expected a number, got " + describe(*v));
+  const double d = v->get<double>();
+  if (!std::isfinite(d) || std::fabs(d) > FLT_MAX)
+    return error(value_id_, field(key), "is not a finite 32-bit float");
+  return static_cast<float>(d);
+}
+
+Expected<std::array<float, 3>> FieldReader::float3(const char* key) const {
+  CALF_ASSIGN_OR_RETURN(const Json* v, get(key));
+  if (!v->is_array() || v->size() != 3)
+    return error(field(key), "expected [x, y, z], got " + describe(*v));
+  std::array<float, 3> out{};
+  for (size_t i = 0; i < 3; ++i) {
+    const Json& e = (*v)[i];
+    const std::string at = field(key) + "[" + std::to_string(i) + "]";
+    if (!e.is_number()) return error(at, "expected a number, got " + describe(e));
+    const double d = e.get<double>();
+    if (!std::isfinite(d) || std::fabs(d) > FLT_MAX)
+      return error(value_id_, at, "is not a finite 32-bit float");
+    out[i] = static_cast<float>(d);
+  }
+  return out;
+}
+
+Expected<const Json*> FieldReader::array(const char* key, size_t max) const {
+  CALF_ASSIGN_OR_RETURN(const Json* v, get(key));
+  if (!v->is_array()) return error(field(key), "expected an array, got " + describe(*v));
+  if (v->size() > max) {
+    return error(limit_id_, field(key),
+                 std::to_string(v->size()) + " entries exceed the limit of " + std::to_string(max));
+  }
+  return v;
 }
 
 Expected<uint32_t> FieldReader::uint(const char* key, uint32_t min, uint32_t max) const {
@@ -106,10 +159,10 @@ Expected<Vec3> FieldReader::point(const char* key) const {
   double c[3];
   for (size_t i = 0; i < 3; ++i) {
     const Json& e = (*v)[i];
-    if (!e.is_number() || !std::isfinite(e.get<double>())) {
-      return error(field(key) + "[" + std::to_string(i) + "]",
-                   "expected a finite number, got " + describe(e));
-    }
+    const std::string at = field(key) + "[" + std::to_string(i) + "]";
+    if (!e.is_number()) return error(at, "expected a finite number, got " + describe(e));
+    if (!std::isfinite(e.get<double>()))
+      return error(value_id_, at, "expected a finite number, got " + describe(e));
     c[i] = e.get<double>();
   }
   return Vec3{c[0], c[1], c[2]};
@@ -125,6 +178,19 @@ Expected<std::string> FieldReader::string_or(const char* key, std::string fallba
 
 Expected<bool> FieldReader::boolean_or(const char* key, bool fallback) const {
   return has(key) ? boolean(key) : Expected<bool>(fallback);
+}
+
+Expected<float> FieldReader::f32_or(const char* key, float fallback) const {
+  return has(key) ? f32(key) : Expected<float>(fallback);
+}
+
+Expected<std::array<float, 3>> FieldReader::float3_or(const char* key,
+                                                      std::array<float, 3> fallback) const {
+  return has(key) ? float3(key) : Expected<std::array<float, 3>>(fallback);
+}
+
+Expected<const Json*> FieldReader::array_or_null(const char* key, size_t max) const {
+  return has(key) ? array(key, max) : Expected<const Json*>(nullptr);
 }
 
 namespace {

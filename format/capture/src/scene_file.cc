@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <bit>
-#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -210,11 +209,13 @@ Status validate_impl(const SceneFile& s, ErrorId size_id) {
     return Status(ErrorId::kSceneFileLimit,
                   "frame_count " + std::to_string(s.frame_count) + " exceeds 1000000");
   }
+  const Box3& box = s.view_volume;
+  const double lo[3] = {box.min.x, box.min.y, box.min.z}, hi[3] = {box.max.x, box.max.y, box.max.z};
   for (int a = 0; a < 3; ++a) {
-    if (!std::isfinite(s.view_region_min[a]) || !std::isfinite(s.view_region_max[a])) {
+    if (!std::isfinite(lo[a]) || !std::isfinite(hi[a])) {
       return Status(ErrorId::kSceneFileValue, "view_region is not finite");
     }
-    if (s.view_region_min[a] > s.view_region_max[a]) {
+    if (lo[a] > hi[a]) {
       return Status(ErrorId::kSceneFileField,
                     "view_region: min exceeds max on axis " + std::string(1, "xyz"[a]));
     }
@@ -426,16 +427,10 @@ class Decoder {
     return Status(id, std::string(source_) + ": field '" + field + "': " + what);
   }
   FieldReader reader(const Json& object, const std::string& path) const {
-    return FieldReader(object, path, source_, ErrorId::kSceneFileField);
+    return FieldReader(object, path, source_, ErrorId::kSceneFileField, ErrorId::kSceneFileLimit,
+                       ErrorId::kSceneFileValue);
   }
 
-  // An optional array (nullptr when absent) of at most `max` entries (E160 beyond).
-  Expected<const Json*> array(const FieldReader& r, const char* key, size_t max,
-                              bool required) const;
-  Expected<uint64_t> u64(const FieldReader& r, const char* key, uint64_t max) const;
-  Expected<float> f32(const FieldReader& r, const char* key, float fallback) const;
-  Expected<SceneFloat3> float3(const FieldReader& r, const char* key, SceneFloat3 fallback) const;
-  Expected<std::array<double, 3>> double3(const FieldReader& r, const char* key) const;
   Expected<std::string> name(const FieldReader& r, const char* key) const;
 
   // Declares a view read from `key` (absent: nothing), each element `element_size` bytes, going
@@ -451,87 +446,6 @@ class Decoder {
   std::vector<Buffer> buffers_;
   std::vector<PendingView> views_;
 };
-
-Expected<const Json*> Decoder::array(const FieldReader& r, const char* key, size_t max,
-                                     bool required) const {
-  if (!r.has(key)) {
-    if (required) return error(ErrorId::kSceneFileField, r.field(key), "missing");
-    return static_cast<const Json*>(nullptr);
-  }
-  CALF_ASSIGN_OR_RETURN(const Json* v, r.get(key));
-  if (!v->is_array()) return error(ErrorId::kSceneFileField, r.field(key), "expected an array");
-  if (v->size() > max) {
-    return error(ErrorId::kSceneFileLimit, r.field(key),
-                 std::to_string(v->size()) + " entries exceed the limit of " + std::to_string(max));
-  }
-  return v;
-}
-
-Expected<uint64_t> Decoder::u64(const FieldReader& r, const char* key, uint64_t max) const {
-  CALF_ASSIGN_OR_RETURN(const Json* v, r.get(key));
-  bool negative = v->is_number_integer() && !v->is_number_unsigned() && v->get<int64_t>() < 0;
-  if (!v->is_number_integer() || negative) {
-    return error(ErrorId::kSceneFileField, r.field(key), "expected an integer >= 0");
-  }
-  uint64_t u = v->get<uint64_t>();
-  if (u > max) {
-    return error(ErrorId::kSceneFileLimit, r.field(key),
-                 std::to_string(u) + " exceeds the limit of " + std::to_string(max));
-  }
-  return u;
-}
-
-// JSON numbers go through double; a value beyond float's range would become inf, so it is
-// refused as non-finite (E157) like a NaN in a buffer.
-Expected<float> Decoder::f32(const FieldReader& r, const char* key, float fallback) const {
-  if (!r.has(key)) return fallback;
-  CALF_ASSIGN_OR_RETURN(const Json* v, r.get(key));
-  if (!v->is_number()) return error(ErrorId::kSceneFileField, r.field(key), "expected a number");
-  double d = v->get<double>();
-  if (!std::isfinite(d) || std::fabs(d) > FLT_MAX) {
-    return error(ErrorId::kSceneFileValue, r.field(key), "is not a finite 32-bit float");
-  }
-  return static_cast<float>(d);
-}
-
-Expected<SceneFloat3> Decoder::float3(const FieldReader& r, const char* key,
-                                      SceneFloat3 fallback) const {
-  if (!r.has(key)) return fallback;
-  CALF_ASSIGN_OR_RETURN(const Json* v, r.get(key));
-  if (!v->is_array() || v->size() != 3) {
-    return error(ErrorId::kSceneFileField, r.field(key), "expected [x, y, z]");
-  }
-  SceneFloat3 out;
-  for (size_t i = 0; i < 3; ++i) {
-    const Json& e = (*v)[i];
-    if (!e.is_number()) return error(ErrorId::kSceneFileField, r.field(key), "expected numbers");
-    double d = e.get<double>();
-    if (!std::isfinite(d) || std::fabs(d) > FLT_MAX) {
-      return error(ErrorId::kSceneFileValue, r.field(key) + "[" + std::to_string(i) + "]",
-                   "is not a finite 32-bit float");
-    }
-    out[i] = static_cast<float>(d);
-  }
-  return out;
-}
-
-Expected<std::array<double, 3>> Decoder::double3(const FieldReader& r, const char* key) const {
-  CALF_ASSIGN_OR_RETURN(const Json* v, r.get(key));
-  if (!v->is_array() || v->size() != 3) {
-    return error(ErrorId::kSceneFileField, r.field(key), "expected [x, y, z]");
-  }
-  std::array<double, 3> out{};
-  for (size_t i = 0; i < 3; ++i) {
-    const Json& e = (*v)[i];
-    if (!e.is_number()) return error(ErrorId::kSceneFileField, r.field(key), "expected numbers");
-    out[i] = e.get<double>();
-    if (!std::isfinite(out[i])) {
-      return error(ErrorId::kSceneFileValue, r.field(key) + "[" + std::to_string(i) + "]",
-                   "is not finite");
-    }
-  }
-  return out;
-}
 
 Expected<std::string> Decoder::name(const FieldReader& r, const char* key) const {
   CALF_ASSIGN_OR_RETURN(std::string s, r.string_or(key, ""));
@@ -551,9 +465,9 @@ Status Decoder::view_raw(const FieldReader& r, const char* key, size_t element_s
   }
   FieldReader v = reader(*j, field);
   CALF_RETURN_IF_ERROR(v.check_keys({"buffer", "offset", "count"}));
-  CALF_ASSIGN_OR_RETURN(uint64_t buffer, u64(v, "buffer", kSceneMaxBuffers));
-  CALF_ASSIGN_OR_RETURN(uint64_t offset, u64(v, "offset", kMaxByteLength));
-  CALF_ASSIGN_OR_RETURN(uint64_t count, u64(v, "count", kMaxViewCount));
+  CALF_ASSIGN_OR_RETURN(uint64_t buffer, v.count("buffer", kSceneMaxBuffers));
+  CALF_ASSIGN_OR_RETURN(uint64_t offset, v.count("offset", kMaxByteLength));
+  CALF_ASSIGN_OR_RETURN(uint64_t count, v.count("count", kMaxViewCount));
   if (buffer >= buffers_.size()) {
     return error(
         ErrorId::kSceneFileView, field,
@@ -643,7 +557,7 @@ Expected<SceneFile> Decoder::decode(
   CALF_ASSIGN_OR_RETURN(s.description, name(top, "description"));
   CALF_ASSIGN_OR_RETURN(s.generator, name(top, "generator"));
   CALF_ASSIGN_OR_RETURN(s.fps, top.number("fps"));
-  CALF_ASSIGN_OR_RETURN(uint64_t frames, u64(top, "frame_count", kSceneMaxFrames));
+  CALF_ASSIGN_OR_RETURN(uint64_t frames, top.count("frame_count", kSceneMaxFrames));
   s.frame_count = static_cast<uint32_t>(frames);
   {
     CALF_ASSIGN_OR_RETURN(const Json* region, top.get("view_region"));
@@ -652,8 +566,8 @@ Expected<SceneFile> Decoder::decode(
     }
     FieldReader rr = reader(*region, "view_region");
     CALF_RETURN_IF_ERROR(rr.check_keys({"min", "max"}));
-    CALF_ASSIGN_OR_RETURN(s.view_region_min, double3(rr, "min"));
-    CALF_ASSIGN_OR_RETURN(s.view_region_max, double3(rr, "max"));
+    CALF_ASSIGN_OR_RETURN(s.view_volume.min, rr.point("min"));
+    CALF_ASSIGN_OR_RETURN(s.view_volume.max, rr.point("max"));
   }
   if (top.has("environment")) {
     CALF_ASSIGN_OR_RETURN(const Json* env, top.get("environment"));
@@ -665,19 +579,19 @@ Expected<SceneFile> Decoder::decode(
                        "sun_disc_radiance", "sun_cos_radius", "ambient", "ao_distance"}));
     SceneEnvironment& e = s.environment;
     const SceneEnvironment d;
-    CALF_ASSIGN_OR_RETURN(e.zenith, float3(er, "zenith", d.zenith));
-    CALF_ASSIGN_OR_RETURN(e.horizon, float3(er, "horizon", d.horizon));
-    CALF_ASSIGN_OR_RETURN(e.ground, float3(er, "ground", d.ground));
-    CALF_ASSIGN_OR_RETURN(e.sun_direction, float3(er, "sun_direction", d.sun_direction));
-    CALF_ASSIGN_OR_RETURN(e.sun_irradiance, float3(er, "sun_irradiance", d.sun_irradiance));
-    CALF_ASSIGN_OR_RETURN(e.sun_disc_radiance, f32(er, "sun_disc_radiance", d.sun_disc_radiance));
-    CALF_ASSIGN_OR_RETURN(e.sun_cos_radius, f32(er, "sun_cos_radius", d.sun_cos_radius));
-    CALF_ASSIGN_OR_RETURN(e.ambient, float3(er, "ambient", d.ambient));
-    CALF_ASSIGN_OR_RETURN(e.ao_distance, f32(er, "ao_distance", d.ao_distance));
+    CALF_ASSIGN_OR_RETURN(e.zenith, er.float3_or("zenith", d.zenith));
+    CALF_ASSIGN_OR_RETURN(e.horizon, er.float3_or("horizon", d.horizon));
+    CALF_ASSIGN_OR_RETURN(e.ground, er.float3_or("ground", d.ground));
+    CALF_ASSIGN_OR_RETURN(e.sun_direction, er.float3_or("sun_direction", d.sun_direction));
+    CALF_ASSIGN_OR_RETURN(e.sun_irradiance, er.float3_or("sun_irradiance", d.sun_irradiance));
+    CALF_ASSIGN_OR_RETURN(e.sun_disc_radiance, er.f32_or("sun_disc_radiance", d.sun_disc_radiance));
+    CALF_ASSIGN_OR_RETURN(e.sun_cos_radius, er.f32_or("sun_cos_radius", d.sun_cos_radius));
+    CALF_ASSIGN_OR_RETURN(e.ambient, er.float3_or("ambient", d.ambient));
+    CALF_ASSIGN_OR_RETURN(e.ao_distance, er.f32_or("ao_distance", d.ao_distance));
   }
   // Buffers and textures: paths confined to the folder, distinct.
   std::set<std::string> uris;
-  CALF_ASSIGN_OR_RETURN(const Json* buffers, array(top, "buffers", kSceneMaxBuffers, true));
+  CALF_ASSIGN_OR_RETURN(const Json* buffers, top.array("buffers", kSceneMaxBuffers));
   for (size_t i = 0; i < buffers->size(); ++i) {
     const std::string at = "buffers[" + std::to_string(i) + "]";
     const Json& b = (*buffers)[i];
@@ -686,7 +600,7 @@ Expected<SceneFile> Decoder::decode(
     CALF_RETURN_IF_ERROR(br.check_keys({"uri", "byte_length"}));
     Buffer buffer;
     CALF_ASSIGN_OR_RETURN(buffer.uri, br.string("uri"));
-    CALF_ASSIGN_OR_RETURN(buffer.byte_length, u64(br, "byte_length", kMaxByteLength));
+    CALF_ASSIGN_OR_RETURN(buffer.byte_length, br.count("byte_length", kMaxByteLength));
     if (std::string p = path_problem(buffer.uri); !p.empty()) {
       return error(ErrorId::kSceneFilePath, br.field("uri"), "'" + buffer.uri + "' " + p);
     }
@@ -695,7 +609,7 @@ Expected<SceneFile> Decoder::decode(
     }
     buffers_.push_back(std::move(buffer));
   }
-  CALF_ASSIGN_OR_RETURN(const Json* textures, array(top, "textures", kSceneMaxTextures, false));
+  CALF_ASSIGN_OR_RETURN(const Json* textures, top.array_or_null("textures", kSceneMaxTextures));
   for (size_t i = 0; textures && i < textures->size(); ++i) {
     const std::string at = "textures[" + std::to_string(i) + "]";
     const Json& t = (*textures)[i];
@@ -713,7 +627,7 @@ Expected<SceneFile> Decoder::decode(
     }
     s.textures.push_back(std::move(texture));
   }
-  CALF_ASSIGN_OR_RETURN(const Json* materials, array(top, "materials", kSceneMaxMaterials, false));
+  CALF_ASSIGN_OR_RETURN(const Json* materials, top.array_or_null("materials", kSceneMaxMaterials));
   for (size_t i = 0; materials && i < materials->size(); ++i) {
     const std::string at = "materials[" + std::to_string(i) + "]";
     const Json& mj = (*materials)[i];
@@ -723,21 +637,21 @@ Expected<SceneFile> Decoder::decode(
         {"name", "base_color", "base_color_texture", "emission", "reflect", "refract", "ior"}));
     SceneMaterial m;
     CALF_ASSIGN_OR_RETURN(m.name, name(mr, "name"));
-    CALF_ASSIGN_OR_RETURN(m.base_color, float3(mr, "base_color", m.base_color));
+    CALF_ASSIGN_OR_RETURN(m.base_color, mr.float3_or("base_color", m.base_color));
     if (mr.has("base_color_texture")) {
-      CALF_ASSIGN_OR_RETURN(uint64_t t, u64(mr, "base_color_texture", kSceneMaxTextures));
+      CALF_ASSIGN_OR_RETURN(uint64_t t, mr.count("base_color_texture", kSceneMaxTextures));
       m.base_color_texture = static_cast<uint32_t>(t);
     }
-    CALF_ASSIGN_OR_RETURN(m.emission, float3(mr, "emission", m.emission));
-    CALF_ASSIGN_OR_RETURN(m.reflect, f32(mr, "reflect", m.reflect));
-    CALF_ASSIGN_OR_RETURN(m.refract, f32(mr, "refract", m.refract));
-    CALF_ASSIGN_OR_RETURN(m.ior, f32(mr, "ior", m.ior));
+    CALF_ASSIGN_OR_RETURN(m.emission, mr.float3_or("emission", m.emission));
+    CALF_ASSIGN_OR_RETURN(m.reflect, mr.f32_or("reflect", m.reflect));
+    CALF_ASSIGN_OR_RETURN(m.refract, mr.f32_or("refract", m.refract));
+    CALF_ASSIGN_OR_RETURN(m.ior, mr.f32_or("ior", m.ior));
     s.materials.push_back(std::move(m));
   }
   // Meshes, objects and lights are sized first so that the view targets keep valid addresses.
-  CALF_ASSIGN_OR_RETURN(const Json* meshes, array(top, "meshes", kSceneMaxMeshes, false));
-  CALF_ASSIGN_OR_RETURN(const Json* objects, array(top, "objects", kSceneMaxObjects, false));
-  CALF_ASSIGN_OR_RETURN(const Json* lights, array(top, "lights", kSceneMaxLights, false));
+  CALF_ASSIGN_OR_RETURN(const Json* meshes, top.array_or_null("meshes", kSceneMaxMeshes));
+  CALF_ASSIGN_OR_RETURN(const Json* objects, top.array_or_null("objects", kSceneMaxObjects));
+  CALF_ASSIGN_OR_RETURN(const Json* lights, top.array_or_null("lights", kSceneMaxLights));
   s.meshes.resize(meshes ? meshes->size() : 0);
   s.objects.resize(objects ? objects->size() : 0);
   s.lights.resize(lights ? lights->size() : 0);
@@ -1044,8 +958,8 @@ Expected<EncodedScene> encode_scene_file(const SceneFile& s) {
   json["fps"] = s.fps;
   json["frame_count"] = s.frame_count;
   json["view_region"] = {
-      {"min", OJson::array({s.view_region_min[0], s.view_region_min[1], s.view_region_min[2]})},
-      {"max", OJson::array({s.view_region_max[0], s.view_region_max[1], s.view_region_max[2]})}};
+      {"min", OJson::array({s.view_volume.min.x, s.view_volume.min.y, s.view_volume.min.z})},
+      {"max", OJson::array({s.view_volume.max.x, s.view_volume.max.y, s.view_volume.max.z})}};
   json["environment"] = {{"zenith", float3_json(e.zenith)},
                          {"horizon", float3_json(e.horizon)},
                          {"ground", float3_json(e.ground)},

@@ -22,10 +22,6 @@ using container::Length;
 using container::Range;
 
 constexpr uint64_t kHashBytes = 8;
-// record_size, mesh, mesh_hash, candidate_count, colour_set_count, box_min, box_max.
-constexpr uint64_t kRecordHeadBytes = 8 + 4 + 8 + 4 + 4 + 24;
-constexpr uint64_t kViewBytes = 20;
-constexpr uint64_t kMinRecordBytes = kRecordHeadBytes + kHashBytes;
 
 // The file header as stored, before its hash.
 struct FileHead {
@@ -46,6 +42,25 @@ struct FileHead {
   }
 };
 
+// What every record starts with: its size and counts. The walk over a file reads this much of
+// each record; decode_record reads it as the start of the record, with the limits that bound the
+// counts (not stored; a walk reads without them).
+struct RecordHead {
+  uint64_t record_size = 0;
+  uint32_t mesh = 0;
+  uint64_t mesh_hash = 0;
+  uint32_t candidate_count = 0, colour_set_count = 0;
+  uint64_t max_candidates = UINT64_MAX, max_colour_sets = UINT64_MAX;
+  template <class Self, class V>
+  static constexpr void fields(Self& s, V& v) {
+    v(s.record_size, "record_size");
+    v(s.mesh, "mesh");
+    v(s.mesh_hash, "mesh_hash");
+    v(s.candidate_count, "candidate_count", Range{0, s.max_candidates});
+    v(s.colour_set_count, "colour_set_count", Range{0, s.max_colour_sets});
+  }
+};
+
 struct ViewFields {
   SurfelCandidateView* view;
   uint32_t max_count;
@@ -57,29 +72,32 @@ struct ViewFields {
   }
 };
 
-// One record as stored, before its hash. The counts and the limits that bound them come first,
-// then the arrays whose lengths they give: a reader allocates nothing a count has not bounded.
+// The start of one record as stored: its head, then its box. The views, materials and arrays
+// whose lengths the head's counts give follow: a reader allocates nothing a count has not bounded.
 struct RecordFields {
   SurfelCandidates* p;
-  uint64_t record_size = 0;
-  uint32_t candidate_count = 0, colour_set_count = 0;
-  uint32_t direction_count = 0, resolution = 0;  // from the file header, not stored here
-
-  uint64_t max_candidates() const { return uint64_t{direction_count} * resolution * resolution; }
+  RecordHead head;
   template <class Self, class V>
   static constexpr void fields(Self& s, V& v) {
-    v(s.record_size, "record_size");
-    v(s.p->mesh, "mesh");
-    v(s.p->mesh_hash, "mesh_hash");
-    v(s.candidate_count, "candidate_count", Range{0, s.max_candidates()});
-    v(s.colour_set_count, "colour_set_count", Range{0, kSurfelMaxColourSets});
+    v(s.head, "head");
     v(s.p->box_min, "box_min", FloatRule::kFinite);
     v(s.p->box_max, "box_max", FloatRule::kFinite);
   }
+  // The limits of a file with `direction_count` directions at `resolution`.
+  void bound(uint32_t direction_count, uint32_t resolution) {
+    head.max_candidates = uint64_t{direction_count} * resolution * resolution;
+    head.max_colour_sets = kSurfelMaxColourSets;
+  }
 };
 
+constexpr uint64_t kRecordHeadBytes = container::fixed_size<RecordHead>();
+constexpr uint64_t kRecordStartBytes = kRecordHeadBytes + 24;  // the head and the box
+constexpr uint64_t kViewBytes = 20;
+// A record without views, materials or candidates: its start and its hash.
+constexpr uint64_t kMinRecordBytes = kRecordStartBytes + kHashBytes;
+
 uint64_t record_bytes(uint64_t direction_count, uint64_t candidates, uint64_t sets) {
-  return kRecordHeadBytes + kViewBytes * direction_count + 4 * sets + 24 * candidates +
+  return kRecordStartBytes + kViewBytes * direction_count + 4 * sets + 24 * candidates +
          3 * sets * candidates + kHashBytes;
 }
 
@@ -153,14 +171,15 @@ Expected<std::vector<uint8_t>> encode_record(const SurfelCandidateHeader& h, uin
     return Status(s.id(), cat("writing: ", s.message()));
   }
   const uint64_t n = p.candidate_count(), sets = p.colour_sets.size();
-  RecordFields r{const_cast<SurfelCandidates*>(&p)};
-  r.record_size = record_bytes(h.direction_count, n, sets);
-  r.candidate_count = static_cast<uint32_t>(n);
-  r.colour_set_count = static_cast<uint32_t>(sets);
-  r.direction_count = h.direction_count;
-  r.resolution = h.resolution;
+  RecordFields r{const_cast<SurfelCandidates*>(&p), {}};
+  r.head.record_size = record_bytes(h.direction_count, n, sets);
+  r.head.mesh = p.mesh;
+  r.head.mesh_hash = p.mesh_hash;
+  r.head.candidate_count = static_cast<uint32_t>(n);
+  r.head.colour_set_count = static_cast<uint32_t>(sets);
+  r.bound(h.direction_count, h.resolution);
   std::vector<uint8_t> out;
-  out.reserve(r.record_size);
+  out.reserve(r.head.record_size);
   FieldWriter w(out, record_name("surfel-candidate writer", index));
   RecordFields::fields(r, w);
   for (SurfelCandidateView view : p.views) {
@@ -176,9 +195,9 @@ Expected<std::vector<uint8_t>> encode_record(const SurfelCandidateHeader& h, uin
   const size_t at = out.size();
   out.resize(at + kHashBytes);
   container::store_le(out.data() + at, hash, kHashBytes);
-  if (out.size() != r.record_size) {
+  if (out.size() != r.head.record_size) {
     return Status(ErrorId::kInternal,
-                  cat("record ", index, " size ", out.size(), " is not ", r.record_size));
+                  cat("record ", index, " size ", out.size(), " is not ", r.head.record_size));
   }
   return out;
 }
@@ -196,18 +215,19 @@ Expected<SurfelCandidates> decode_record(std::span<const uint8_t> bytes,
         cat(where, ": hash ", stored, " does not match the record's bytes (", actual, ")"));
   }
   SurfelCandidates p;
-  RecordFields r{&p};
-  r.direction_count = h.direction_count;
-  r.resolution = h.resolution;
+  RecordFields r{&p, {}};
+  r.bound(h.direction_count, h.resolution);
   FieldReader reader(bytes.first(bytes.size() - kHashBytes), ErrorId::kSurfelFileField,
                      ErrorId::kSurfelFileValue, where, ErrorId::kSurfelFileLimit);
   RecordFields::fields(r, reader);
   if (!reader.ok()) return reader.status();
-  if (r.record_size != bytes.size()) {
+  if (r.head.record_size != bytes.size()) {
     return Status(ErrorId::kSurfelFileField,
-                  cat(where, ": record_size ", r.record_size, " is not ", bytes.size()));
+                  cat(where, ": record_size ", r.head.record_size, " is not ", bytes.size()));
   }
-  const uint64_t n = r.candidate_count, sets = r.colour_set_count;
+  p.mesh = r.head.mesh;
+  p.mesh_hash = r.head.mesh_hash;
+  const uint64_t n = r.head.candidate_count, sets = r.head.colour_set_count;
   // The counts must account for every byte before any array is allocated.
   if (record_bytes(h.direction_count, n, sets) != bytes.size()) {
     return Status(
@@ -241,7 +261,8 @@ struct Walk {
 Expected<Walk> walk(const container::ByteSource& src, std::string_view source) {
   const uint64_t size = src.size();
   // The header: at most 32 fixed bytes, the name and the hash.
-  std::vector<uint8_t> head(std::min<uint64_t>(size, 32 + 4 + kSurfelMaxSceneName + kHashBytes));
+  std::vector<uint8_t> head(
+      std::min<uint64_t>(size, container::min_size<FileHead>() + kSurfelMaxSceneName + kHashBytes));
   CALF_RETURN_IF_ERROR(src.read_at(0, head));
   if (head.size() < 8 ||
       !std::equal(kSurfelCandidatesMagic.begin(), kSurfelCandidatesMagic.end(), head.begin())) {
@@ -282,18 +303,23 @@ Expected<Walk> walk(const container::ByteSource& src, std::string_view source) {
   w.entries.reserve(f.prototype_count);
   for (uint32_t i = 0; i < f.prototype_count; ++i) {
     const std::string where = record_name(source, i);
-    if (size - offset < kRecordHeadBytes) {
+    if (size - offset < kRecordStartBytes) {
       return Status(ErrorId::kSurfelFileTruncated,
                     cat(where, ": the file ends at byte ", size, " inside its head"));
     }
-    uint8_t bytes[kRecordHeadBytes - 24];
+    uint8_t bytes[kRecordHeadBytes];
     CALF_RETURN_IF_ERROR(src.read_at(offset, bytes));
+    RecordHead record;  // without limits: reading the head's bytes cannot fail
+    FieldReader record_reader(bytes, ErrorId::kSurfelFileTruncated, ErrorId::kSurfelFileField,
+                              where);
+    RecordHead::fields(record, record_reader);
+    if (!record_reader.ok()) return record_reader.status();
     SurfelCandidateEntry e;
-    const uint64_t record_size = container::load_le(bytes, 8);
-    e.mesh = static_cast<uint32_t>(container::load_le(bytes + 8, 4));
-    e.mesh_hash = container::load_le(bytes + 12, 8);
-    e.candidate_count = static_cast<uint32_t>(container::load_le(bytes + 20, 4));
-    e.colour_set_count = static_cast<uint32_t>(container::load_le(bytes + 24, 4));
+    const uint64_t record_size = record.record_size;
+    e.mesh = record.mesh;
+    e.mesh_hash = record.mesh_hash;
+    e.candidate_count = record.candidate_count;
+    e.colour_set_count = record.colour_set_count;
     e.offset = offset;
     e.size = record_size;
     if (record_size < kMinRecordBytes) {
@@ -308,7 +334,7 @@ Expected<Walk> walk(const container::ByteSource& src, std::string_view source) {
     // The last material, for check_surfel_candidates_match; a record too short to hold its
     // materials is read() 's E183.
     const uint64_t materials_end =
-        kRecordHeadBytes + kViewBytes * f.direction_count + 4 * uint64_t{e.colour_set_count};
+        kRecordStartBytes + kViewBytes * f.direction_count + 4 * uint64_t{e.colour_set_count};
     if (e.colour_set_count > 0 && materials_end + kHashBytes <= record_size) {
       uint8_t last[4];
       CALF_RETURN_IF_ERROR(src.read_at(offset + materials_end - 4, last));
@@ -476,7 +502,7 @@ Status check_surfel_candidates_match(std::span<const SurfelCandidateEntry> entri
 
 std::vector<SurfelCandidateEntry> surfel_candidate_entries(const SurfelCandidateFile& file) {
   std::vector<SurfelCandidateEntry> out;
-  uint64_t offset = 32 + 4 + file.header.scene.size() + kHashBytes;
+  uint64_t offset = container::min_size<FileHead>() + file.header.scene.size() + kHashBytes;
   for (const SurfelCandidates& p : file.prototypes) {
     SurfelCandidateEntry e;
     e.mesh = p.mesh;

@@ -30,6 +30,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "calf/format/log_depth.h"
+
 namespace calf::lf {
 
 // LOCO-I's median edge detector from the left (a), upper (b) and upper-left (c) neighbours.
@@ -42,8 +44,7 @@ inline uint16_t med_predict(uint16_t a, uint16_t b, uint16_t c) {
 
 // The prediction of an inner texel (x > 0 and y > 0), as the table above says.
 inline uint16_t depth_predict_inner(uint16_t a, uint16_t b, uint16_t c) {
-  constexpr uint16_t kSky = 65535;
-  if (a == kSky || b == kSky || c == kSky) return med_predict(a, b, c);
+  if (a == kLog16Sky || b == kLog16Sky || c == kLog16Sky) return med_predict(a, b, c);
   return static_cast<uint16_t>(a + b - c);
 }
 

@@ -1,12 +1,12 @@
-// The one list of calf's track kinds (format/SPEC.md §6.1, §11). Like the error list in
-// errors.h, every per-kind table derives from it: the TrackKind enum and kind names here, the
-// header types, stream names, header decoding and printing in track_registry.h, and the checks
-// of tests/format/track_registry_test.cc (every kind has a SPEC section, a name, a round trip).
-//
-// Adding a kind: a line below, then its slice: format/<kind>_layout.h declaring
-// `<Name>TrackHeader` (with `kKind`, `fields()`, `kStreamNames`) and `<Name>Stream`, included
-// by track_registry.h; a SPEC §11 section; encoder/<kind>_encode and decoder/<kind>_decoder.
-// Nothing else in the container changes: the reader, calf-info and calf-verify walk the list.
+// The one list of calf's track kinds (format/SPEC.md §6.1, §11). Like errors.h's error list, every
+// per-kind table derives from it: the enum and names here, header types, stream names, header
+// coding and printing in track_registry.h, the checks of tests/format/track_registry_test.cc.
+// Adding a kind: docs/ARCHITECTURE.md, "Checklist: adding a track kind".
+#ifdef CALF_EXTRA_TRACK_KINDS_HEADER    // a build's own kinds (tests/test_kind/), listed first
+#include CALF_EXTRA_TRACK_KINDS_HEADER  // defines CALF_EXTRA_TRACK_KINDS(X)
+#else
+#define CALF_EXTRA_TRACK_KINDS(X)
+#endif
 #pragma once
 
 #include <cstdint>
@@ -16,12 +16,12 @@ namespace calf::container {
 // X(Name, number, "name", "SPEC section"). `Name` gives the enumerator k<Name>, the header type
 // <Name>TrackHeader and the stream enum <Name>Stream. Numbers are stable forever; 0 is invalid.
 #define CALF_TRACK_KINDS(X)              \
+  CALF_EXTRA_TRACK_KINDS(X)              \
   X(Lightfield, 1, "lightfield", "11.1") \
   X(Tiles, 2, "tiles", "11.2")           \
   X(Surfels, 3, "surfels", "11.3")       \
   X(Mesh, 4, "mesh", "11.4")             \
   /* end of the list: every line above ends with a backslash */
-
 // Track kinds (SPEC.md §6.1). A reader that meets another kind skips the track, unless the
 // track is marked must-understand (kTrackRequired), then it refuses the file (CALF-E050).
 enum class TrackKind : uint16_t {

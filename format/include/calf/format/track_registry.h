@@ -1,11 +1,11 @@
-// The per-kind tables of the track registry (track_kinds.h holds the list): the header type of
-// every kind, its stream names, and header decoding, encoding and printing by kind number. The
-// container reader, calf-info and the registry test use these instead of a switch per kind, so a
-// new kind touches the list and its own layout header only.
-//
+// The per-kind tables of the track registry (track_kinds.h holds the list): each kind's header
+// type and stream names, header coding and printing by kind number, instead of a switch per kind.
 //   CALF_ASSIGN_OR_RETURN(TrackHeader h, read_track_header(record.kind, record.header, "track 2"));
 //   if (const auto* lf = std::get_if<LightfieldTrackHeader>(&h)) ...
 //   for (const auto& e : print_track_header(h)) ...   // calf-info's lines
+#ifdef CALF_EXTRA_TRACK_LAYOUT  // a build's own kind's layout (docs/ARCHITECTURE.md)
+#include CALF_EXTRA_TRACK_LAYOUT
+#endif
 #pragma once
 
 #include <cstdint>

@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "calf/capture/image_budget.h"
+#include "calf/format/geometry.h"
 #include "calf/format/status.h"
 
 namespace calf::capture {
@@ -168,9 +169,9 @@ struct SceneFile {
   std::string generator;     // informative: the program that wrote it
   double fps = 30;           // (0, 1000]
   uint32_t frame_count = 1;  // 1 .. kSceneMaxFrames
-  // The box the eye may move in (min <= max componentwise), e.g. a capture rig's view volume.
-  std::array<double, 3> view_region_min{0, 0, 0};
-  std::array<double, 3> view_region_max{0, 0, 0};
+  // The box the eye may move in (min <= max componentwise), e.g. a capture rig's view volume;
+  // the file's "view_region" (SCENE.md).
+  Box3 view_volume;
   SceneEnvironment environment;
   std::vector<SceneMaterial> materials;
   std::vector<SceneTexture> textures;
