@@ -82,7 +82,7 @@ Status validate_render_options(const RenderOptions& o, size_t view_count) {
   if (!(o.mixed_texel_bend_texels >= 0) || !std::isfinite(o.mixed_texel_bend_texels)) {
     return option_error("mixed_texel_bend_texels must be finite and >= 0");
   }
-  if (o.coverage > 3) return option_error("coverage is not 0, 1, 2 or 3");
+  if (o.coverage > 4) return option_error("coverage is not 0, 1, 2, 3 or 4");
   if (!(o.coverage_threshold >= 0 && o.coverage_threshold <= 1)) {
     return option_error("coverage_threshold must be in [0, 1]");
   }
@@ -193,6 +193,26 @@ double coverage_margin(const View& v, const Vec3& x, double r, double margin, ui
     double o = 0;
     for (int k = 0; k < 4; ++k) {
       o += taps.weight[k] * (front[k] ? 1.0 - cov[k].far : cov[k].near);
+    }
+    covered = o >= threshold;
+  } else if (mode == 4) {
+    // Every tap's cell nearest the direction (the direction's own cell in the texel it falls
+    // in), front shares for a tap across a face seam, blended bilinearly against the threshold.
+    const double x0 = std::floor(fc.u - 0.5), y0 = std::floor(fc.v - 0.5);
+    double o = 0;
+    for (int k = 0; k < 4; ++k) {
+      const double tx = x0 + (k & 1), ty = y0 + (k >> 1);
+      const Texel& t = taps.texel[k];
+      double share;
+      if (t.face == fc.face && t.x == tx && t.y == ty) {
+        const int i = std::clamp(static_cast<int>(std::floor((fc.u - tx) * 4)), 0, 3);
+        const int j = std::clamp(static_cast<int>(std::floor((fc.v - ty) * 4)), 0, 3);
+        const bool own = (cov[k].mask >> (4 * j + i)) & 1u;
+        share = own == front[k] ? 1.0 : 0.0;
+      } else {
+        share = front[k] ? 1.0 - cov[k].far : cov[k].near;
+      }
+      o += taps.weight[k] * share;
     }
     covered = o >= threshold;
   } else {

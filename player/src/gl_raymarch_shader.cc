@@ -26,6 +26,7 @@ struct CalfView {
   uint cell_size;
   uint layer;        // 6 * view index
   int material_layer;  // -1: no material
+  int coverage_layer;  // -1: no coverage
 };
 // A uniform block, not a storage buffer: llvmpipe loads it as uniform data (measured 20 % faster
 // than the same records in an SSBO). Sized by CALF_MAX_VIEWS, defined by the host.
@@ -39,6 +40,7 @@ layout(binding = 1) uniform usampler2DArray depth_tex;
 #endif
 layout(binding = 2) uniform usampler2DArray cell_tex;
 layout(binding = 3) uniform sampler2DArray material_tex;
+layout(binding = 4) uniform usampler2DArray coverage_tex;
 
 uniform uint view_count;         // active views, in views[]
 uniform uint colour_slots;       // 2 keyframe slots per face, or 1
@@ -54,6 +56,10 @@ uniform float cam_decay;
 uniform float color_depth_tolerance;
 uniform float mixed_penalty_factor;  // exp(-mixed_texel_penalty); 1 = off
 uniform float mixed_texel_bend_texels;  // in texel angles, 2 / face size radians
+uniform uint coverage_mode;      // RenderOptions::coverage (read with CALF_COVERAGE only)
+uniform float coverage_threshold;
+uniform float coverage_cluster;
+uniform uint coverage_agreement;
 uniform bool tight_march_start;
 uniform bool bilinear_color;
 uniform bool depth_aware_color;
@@ -196,22 +202,110 @@ float code_margin(CalfView v, vec3 x, float r) {
   return code == CALF_LOG16_SKY ? INF : float(code) - rcode;
 }
 
+#ifdef CALF_COVERAGE
+// ---- coverage_margin (cpu_renderer.cc): where code_margin's `margin` puts the point at or behind
+// the footprint's surface, the view's coverage says whether that surface covers the direction
+// inside the texel; where it does not, the margin is measured against the surface behind it ----
+float coverage_margin(CalfView v, vec3 x, float r, float margin) {
+  if (margin > 0.0 || coverage_mode == 0u || v.coverage_layer < 0) return margin;
+  int face = face_of(x);
+  vec2 uv = texel_coord(x, face, v.face_size);
+  Taps taps = bilinear_taps(face, uv, v.face_size);
+  float rcode = calf_code_from_log_depth(log(r), log_range(v));
+  float front_code = rcode + margin;  // the footprint's surface
+  float cluster_codes = coverage_cluster * v.inv_step;
+  bool front[4];
+  bool edge = false;
+  uvec4 cov[4];
+  int nearest = 0;
+  float back = -1.0;  // the farthest tap outside the front cluster (CALF_LOG16_SKY: sky)
+  for (int t = 0; t < 4; ++t) {
+    uint c = depth_code(v, taps.texel[t]);
+    // mask low byte, mask high byte, near count, far count (of 16 cells)
+    cov[t] = texelFetch(coverage_tex, ivec3(taps.texel[t].xy, v.coverage_layer + taps.texel[t].z),
+                        0);
+    front[t] = c != CALF_LOG16_SKY && float(c) - front_code <= cluster_codes;
+    if (!front[t]) back = max(back, float(c));
+    if (cov[t].x != 255u || cov[t].y != 255u || cov[t].z > 0u || cov[t].w > 0u || !front[t]) {
+      edge = true;
+    }
+    if (taps.weight[t] > taps.weight[nearest]) nearest = t;
+  }
+  if (!edge) return margin;
+  bool covered = false;
+  if (coverage_mode == 1u) {
+    float o = 0.0;
+    for (int t = 0; t < 4; ++t) {
+      o += taps.weight[t] * (front[t] ? 1.0 - float(cov[t].w) / 16.0 : float(cov[t].z) / 16.0);
+    }
+    covered = o >= coverage_threshold;
+  } else if (coverage_mode == 4u) {
+    // Every tap's cell nearest the direction; front shares for a tap across a face seam.
+    vec2 base = floor(uv - 0.5);
+    float o = 0.0;
+    for (int t = 0; t < 4; ++t) {
+      vec2 txy = base + vec2(float(t & 1), float(t >> 1));
+      float share;
+      if (taps.texel[t].z == face && vec2(taps.texel[t].xy) == txy) {
+        ivec2 c = clamp(ivec2(floor((uv - txy) * 4.0)), ivec2(0), ivec2(3));
+        bool own = ((uint(cov[t].x | cov[t].y << 8) >> uint(4 * c.y + c.x)) & 1u) != 0u;
+        share = own == front[t] ? 1.0 : 0.0;
+      } else {
+        share = front[t] ? 1.0 - float(cov[t].w) / 16.0 : float(cov[t].z) / 16.0;
+      }
+      o += taps.weight[t] * share;
+    }
+    covered = o >= coverage_threshold;
+  } else {
+    // The cell of the nearest texel that the direction falls in (clamped coordinates ignored).
+    ivec2 cell = clamp(ivec2(floor((uv - floor(uv)) * 4.0)), ivec2(0), ivec2(3));
+    uint mask = cov[nearest].x | cov[nearest].y << 8;
+    if (!front[nearest]) mask = ~mask;
+    int grow = coverage_mode == 3u ? 1 : 0;  // mode 3: the front grown by one cell
+    for (int j = max(cell.y - grow, 0); j <= min(cell.y + grow, 3); ++j) {
+      for (int i = max(cell.x - grow, 0); i <= min(cell.x + grow, 3); ++i) {
+        covered = covered || ((mask >> uint(4 * j + i)) & 1u) != 0u;
+      }
+    }
+  }
+  if (covered || back < 0.0) return margin;
+  return back == float(CALF_LOG16_SKY) ? INF : back - rcode;
+}
+#endif
+
 // ---- CpuRenderer::empty_at / empty_beyond: BetweenViewpointAndGeometry over the active views,
 // true as soon as one view that is not too near sees p in front of its surface by more than
-// `margin_texels` of its own texels (relative depth margin_texels x 2 / face size) ----
+// `margin_texels` of its own texels (relative depth margin_texels x 2 / face size); with
+// coverage, votes that only the coverage gives count once coverage_agreement views agree ----
 bool empty_beyond(vec3 p, float margin_texels, uint vetoes_ignored) {
   bool consulted = false;
   uint vetoes = 0u;
+#ifdef CALF_COVERAGE
+  uint coverage_votes = 0u;
+#endif
   for (uint k = 0u; k < view_count; ++k) {
     CalfView v = views[k];
     vec3 x = p - v.position;
     float r = length(x);
     if (r <= min_view_distance) continue;
     consulted = true;
+#ifdef CALF_COVERAGE
+    float plain = code_margin(v, x, r);
+    float threshold = texel_angles_in_codes(v, margin_texels);
+    if (!(coverage_margin(v, x, r, plain) > threshold)) continue;
+    if (plain > threshold) {
+      ++vetoes;
+    } else {
+      ++coverage_votes;
+    }
+    uint counted = vetoes + (coverage_votes >= coverage_agreement ? coverage_votes : 0u);
+    if (counted > vetoes_ignored) return true;
+#else
     if (code_margin(v, x, r) > texel_angles_in_codes(v, margin_texels) &&
         ++vetoes > vetoes_ignored) {
       return true;
     }
+#endif
   }
   return !consulted;
 }

@@ -8,10 +8,12 @@ extern const char* const kGlFullscreenVertex;
 
 // Alg. 4 as the CPU reference implements it (cpu_renderer.cc, cpu_renderer_rr.cc), one function
 // per CPU function. Pasted after "#version 450 core", "#define CALF_MAX_VIEWS <kGlMaxActiveViews>",
-// an optional "#define CALF_DEPTH_BC5" and kGlslConventions.
+// an optional "#define CALF_DEPTH_BC5", "#define CALF_HINTS <n>", an optional
+// "#define CALF_COVERAGE" (some view has coverage faces) and kGlslConventions.
 extern const char* const kGlRaymarchFragment;
 
-// The most views one frame can use (the uniform block holds this many records).
+// The most views one frame can use (the uniform block holds this many records: 16 KiB, the
+// smallest GL_MAX_UNIFORM_BLOCK_SIZE GL 4.5 allows).
 inline constexpr unsigned kGlMaxActiveViews = 256;
 
 // std140 layout of one active view in the shader's view block (struct CalfView there).
@@ -25,7 +27,9 @@ struct GlViewRecord {
   unsigned cell_size;
   unsigned layer;      // 6 * view index: depth / cells layer of face 0
   int material_layer;  // 6 * material index, -1 without material
+  int coverage_layer;  // 6 * coverage index, -1 without coverage
+  int padding[3];      // std140 rounds the struct up to 16 bytes
 };
-static_assert(sizeof(GlViewRecord) == 48, "must match the std140 struct in the shader");
+static_assert(sizeof(GlViewRecord) == 64, "must match the std140 struct in the shader");
 
 }  // namespace calf::player::internal

@@ -102,6 +102,9 @@ Status GlRenderer::build_program() {
       "#define CALF_MAX_VIEWS " + std::to_string(internal::kGlMaxActiveViews) + "\n";
   if (views_->depth_is_bc5()) defines += "#define CALF_DEPTH_BC5\n";
   defines += "#define CALF_HINTS " + std::to_string(options_.surface_hints) + "\n";
+  // The coverage test is compiled only where some view has coverage faces: the shader of a view
+  // set without coverage is the one it always was.
+  if (views_->has_coverage()) defines += "#define CALF_COVERAGE\n";
   const Expected<GLuint> program = internal::build_gl_program(
       gl,
       {{GL_VERTEX_SHADER, internal::kGlFullscreenVertex, "vertex"},
@@ -142,7 +145,9 @@ Status GlRenderer::draw(const Camera& camera) {
          info.face_size,
          info.cell_size,
          6 * v,
-         views_->material_base(v)});
+         views_->material_base(v),
+         views_->coverage_base(v),
+         {0, 0, 0}});
   }
   // The whole block is backed, also past the active views (GL leaves a short buffer undefined).
   const size_t active_count = records.size();
@@ -153,8 +158,8 @@ Status GlRenderer::draw(const Camera& camera) {
   gl.BindBufferBase(GL_UNIFORM_BUFFER, 0, view_buffer_);
 
   const GlViews::Textures& tex = views_->textures();
-  const GLuint units[4] = {tex.colour, tex.depth, tex.cells, tex.material};
-  for (GLenum unit = 0; unit < 4; ++unit) {
+  const GLuint units[5] = {tex.colour, tex.depth, tex.cells, tex.material, tex.coverage};
+  for (GLenum unit = 0; unit < 5; ++unit) {
     gl.ActiveTexture(GL_TEXTURE0 + unit);
     gl.BindTexture(GL_TEXTURE_2D_ARRAY, units[unit]);
   }
@@ -177,6 +182,10 @@ Status GlRenderer::draw(const Camera& camera) {
   gl.Uniform1f(loc("color_depth_tolerance"), f(o.color_depth_tolerance));
   gl.Uniform1f(loc("mixed_penalty_factor"), f(std::exp(-o.mixed_texel_penalty)));
   gl.Uniform1f(loc("mixed_texel_bend_texels"), f(o.mixed_texel_bend_texels));
+  gl.Uniform1ui(loc("coverage_mode"), o.coverage);
+  gl.Uniform1f(loc("coverage_threshold"), f(o.coverage_threshold));
+  gl.Uniform1f(loc("coverage_cluster"), f(o.coverage_cluster));
+  gl.Uniform1ui(loc("coverage_agreement"), o.coverage_agreement);
   gl.Uniform1i(loc("tight_march_start"), o.tight_march_start ? 1 : 0);
   gl.Uniform1i(loc("bilinear_color"), o.bilinear_color ? 1 : 0);
   gl.Uniform1i(loc("depth_aware_color"), o.depth_aware_color ? 1 : 0);

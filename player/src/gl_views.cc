@@ -9,6 +9,7 @@
 #include "calf/decoder/cpu_textures.h"
 #include "calf/format/bc.h"
 #include "calf/format/grid.h"
+#include "calf/format/lightfield_layout.h"
 #include "gl_errors.h"
 
 // S3TC names come from an extension, not from the core header.
@@ -83,6 +84,9 @@ GlFormat material_format(PixelFormat f) {
   }
 }
 
+// Coverage texels: the decoder's kCoverage bytes (lf::coverage_to_gpu) as unsigned integers.
+constexpr GlFormat kCoverageFormat = {GL_RGBA8UI, false, 0, GL_RGBA_INTEGER, GL_UNSIGNED_BYTE, 4};
+
 std::string format_name(PixelFormat f) {
   return container::pixel_format_name(static_cast<uint16_t>(f));
 }
@@ -109,11 +113,16 @@ uint8_t ior_code(float ior) {
   return unit_code(static_cast<float>((double{ior} - 1.0) / 2.0));
 }
 
+// A share of a texel's 16 cells as a count.
+uint8_t cell_count(float share) {
+  return static_cast<uint8_t>(std::lround(16.0 * std::clamp(double{share}, 0.0, 1.0)));
+}
+
 }  // namespace
 
 Expected<GlTextureLayout> layout_for_clip(const container::LightfieldTrackHeader& header,
                                           std::span<const decoder::LightfieldViewInfo> views,
-                                          bool keep_bc5_depth) {
+                                          bool keep_bc5_depth, bool coverage) {
   if (views.size() != header.view_count) {
     return Status(kGlLayout, "the clip has " + std::to_string(header.view_count) +
                                  " views, the layout was given " + std::to_string(views.size()));
@@ -139,6 +148,7 @@ Expected<GlTextureLayout> layout_for_clip(const container::LightfieldTrackHeader
     v.face_size = header.face_size;
     v.cell_size = header.cell_size;
     v.has_material = info.has_material && material != PixelFormat::kNone;
+    v.has_coverage = coverage;
     layout.views.push_back(v);
   }
   return layout;
@@ -161,7 +171,7 @@ Expected<ViewSetUpload> updates_from_view_set(const ViewSet& set) {
   for (uint32_t vi = 0; vi < set.views.size(); ++vi) {
     const View& v = set.views[vi];
     const uint32_t n = v.face_size();
-    up.layout.views.push_back({v.position(), v.range(), n, n, v.has_material()});
+    up.layout.views.push_back({v.position(), v.range(), n, n, v.has_material(), v.has_coverage()});
     const size_t texels = size_t{n} * n;
     for (int f = 0; f < kCubeFaceCount; ++f) {
       const CubeFace face = cube_face_from_index(f);
@@ -190,6 +200,21 @@ Expected<ViewSetUpload> updates_from_view_set(const ViewSet& set) {
         up.bytes.push_back(std::move(codes));
         pending.push_back({UpdateTarget::kMaterial, vi, f, PixelFormat::kRgba8});
       }
+      if (v.has_coverage()) {
+        std::vector<uint8_t> texels_gpu(texels * lf::kCoverageGpuBytes);
+        for (uint32_t y = 0; y < n; ++y) {
+          for (uint32_t x = 0; x < n; ++x) {
+            const Coverage cov = v.coverage_at(face, x, y);
+            uint8_t* p = &texels_gpu[(size_t{y} * n + x) * lf::kCoverageGpuBytes];
+            p[0] = static_cast<uint8_t>(cov.mask);
+            p[1] = static_cast<uint8_t>(cov.mask >> 8);
+            p[2] = cell_count(cov.near);
+            p[3] = cell_count(cov.far);
+          }
+        }
+        up.bytes.push_back(std::move(texels_gpu));
+        pending.push_back({UpdateTarget::kCoverage, vi, f, PixelFormat::kRgba8});
+      }
       up.frame.cells.push_back({vi, face, 0, 0, 0});
     }
   }
@@ -213,7 +238,7 @@ GlViews::GlViews(const GlFunctions& gl, GlTextureLayout layout)
     : gl_(gl), layout_(std::move(layout)) {}
 
 GlViews::~GlViews() {
-  const GLuint names[] = {tex_.colour, tex_.depth, tex_.cells, tex_.material};
+  const GLuint names[] = {tex_.colour, tex_.depth, tex_.cells, tex_.material, tex_.coverage};
   for (GLuint t : names) {
     if (t != 0) gl_.DeleteTextures(1, &t);
   }
@@ -271,6 +296,14 @@ Expected<std::unique_ptr<GlViews>> GlViews::make(const GlFunctions& gl, GlTextur
   if (layout.colour_format == PixelFormat::kBc1 && !gl.s3tc_srgb) {
     return Status(kGlMissing, "sRGB BC1 colour needs GL_EXT_texture_sRGB");
   }
+  const uint64_t coverage_layers =
+      6 * static_cast<uint64_t>(std::count_if(layout.views.begin(), layout.views.end(),
+                                              [](const GlViewInfo& v) { return v.has_coverage; }));
+  if (coverage_layers > static_cast<uint64_t>(gl.max_array_layers)) {
+    return Status(kGlMissing, std::to_string(coverage_layers) +
+                                  " coverage layers, the context allows " +
+                                  std::to_string(gl.max_array_layers));
+  }
   const uint64_t slots = layout.colour_two_slots ? 2 : 1;
   const uint64_t colour_layers = layout.views.size() * 6 * slots;
   if (colour_layers > static_cast<uint64_t>(gl.max_array_layers)) {
@@ -288,6 +321,8 @@ Expected<std::unique_ptr<GlViews>> GlViews::make(const GlFunctions& gl, GlTextur
   views->size_ = size;
   int next_material = 0;
   for (const GlViewInfo& v : views->layout_.views) {
+    views->coverage_base_.push_back(v.has_coverage ? views->coverage_layers_ : -1);
+    if (v.has_coverage) views->coverage_layers_ += 6;
     // The cell grid convention (calf/format/grid.h); the shader's x / cell_size agrees with it,
     // a cell larger than the face included.
     views->cells_per_side_.push_back(
@@ -325,12 +360,16 @@ Status GlViews::allocate() {
   // A 1-texel placeholder when no view has material, so that the sampler is always complete.
   make(&tex_.material, material_layers > 0 ? material.internal : GL_RGBA8,
        material_layers > 0 ? n : 1, std::max(material_layers, 1));
+  // Coverage likewise (the shader reads it only for views with coverage).
+  make(&tex_.coverage, kCoverageFormat.internal, coverage_layers_ > 0 ? n : 1,
+       std::max(coverage_layers_, 1));
   CALF_RETURN_IF_ERROR(check_gl_error(gl_, "allocating the view textures"));
 
   // Initial contents: what a fresh View holds. Uncompressed textures are cleared; compressed ones
   // get blocks that decode to the same values (all-zero BC1 / BC6H / BC7 blocks are black; a BC5
   // block of channel endpoints 255, 255 and zero indices is 255 in both channels: sky).
   const uint16_t sky = kLog16Sky, zero16 = 0;
+  const uint8_t plain_coverage[4] = {255, 255, 0, 0};  // every cell its own surface
   const uint8_t black[4] = {0, 0, 0, 255};
   const float zero[4] = {0, 0, 0, 0};
   const PixelRect face{0, 0, size_, size_};
@@ -363,6 +402,7 @@ Status GlViews::allocate() {
   } else {
     gl_.ClearTexImage(tex_.material, 0, GL_RGBA, GL_UNSIGNED_BYTE, black);
   }
+  gl_.ClearTexImage(tex_.coverage, 0, GL_RGBA_INTEGER, GL_UNSIGNED_BYTE, plain_coverage);
   cells_.assign(size_t{cell_side_} * cell_side_ * layout_.views.size() * 6, 0);
   cells_dirty_.assign(layout_.views.size() * 6, 0);
   return check_gl_error(gl_, "initialising the view textures");
@@ -454,6 +494,15 @@ Status GlViews::apply_update(const TextureUpdate& u) {
       }
       texture = tex_.material;
       layer = material_base_[u.view] + face;
+      break;
+    case UpdateTarget::kCoverage:
+      if (coverage_base_[u.view] < 0) return fail("the view has no coverage");
+      if (u.format != PixelFormat::kRgba8) {
+        return fail("format " + format_name(u.format) + " is not rgba8");
+      }
+      in = storage = kCoverageFormat;
+      texture = tex_.coverage;
+      layer = coverage_base_[u.view] + face;
       break;
     default:
       return fail("unknown target");

@@ -93,10 +93,11 @@ Expected<std::unique_ptr<LightfieldRepresentation>> LightfieldRepresentation::op
   impl->track = track;
   impl->backend = backend;
   impl->options = options;
-  // The CPU reference reads a clip's coverage (SPEC §11.1.11) into its views as it reads a capture
-  // set's; the GL renderer has no coverage textures, so its decoder never reads the stream.
+  // Both renderers read a clip's coverage (SPEC §11.1.11), the CPU reference into its views as it
+  // reads a capture set's, the GL renderer into its coverage textures; it is decoded whatever
+  // RenderOptions::coverage says, so that coverage can be turned on while playing.
   decoder::ClipDecoderOptions decoder_options = options.decoder;
-  decoder_options.coverage = backend == RenderBackend::kCpu;
+  decoder_options.coverage = true;
   CALF_ASSIGN_OR_RETURN(decoder::ClipDecoder d,
                         decoder::ClipDecoder::open(reader, track, decoder_options));
   impl->decoder.emplace(std::move(d));
@@ -125,8 +126,8 @@ Expected<std::unique_ptr<LightfieldRepresentation>> LightfieldRepresentation::op
     if (gl == nullptr) {
       return Status(ErrorId::kPlayerGl, "the GL renderer needs a current OpenGL 4.5 context");
     }
-    CALF_ASSIGN_OR_RETURN(GlTextureLayout layout,
-                          layout_for_clip(h, views, options.keep_bc5_depth));
+    CALF_ASSIGN_OR_RETURN(GlTextureLayout layout, layout_for_clip(h, views, options.keep_bc5_depth,
+                                                                  impl->decoder->has_coverage()));
     CALF_ASSIGN_OR_RETURN(impl->gl_views, GlViews::make(*gl, std::move(layout)));
     // A view set with no active view is refused by the option check: validate with all views.
     RenderOptions probe = options.render;
@@ -170,6 +171,9 @@ const Box3& LightfieldRepresentation::view_volume() const {
 }
 bool LightfieldRepresentation::has_material() const {
   return impl_->has_material;
+}
+bool LightfieldRepresentation::has_coverage() const {
+  return impl_->decoder->has_coverage();
 }
 const ViewSet* LightfieldRepresentation::cpu_views() const {
   return impl_->cpu_textures ? &impl_->view_set : nullptr;
@@ -433,6 +437,11 @@ RepresentationStats LightfieldRepresentation::stats() const {
   out.entries.push_back({"render", format("%.1f ms", d.render_ms)});
   out.entries.push_back(
       {"RR", d.options.render.rr ? (d.has_material ? "on" : "on (no material)") : "off"});
+  // The coverage rule in use (the window's C key turns it on and off).
+  std::string coverage = "off";
+  if (d.options.render.coverage != 0) coverage = format("mode %u", d.options.render.coverage);
+  if (!d.decoder->has_coverage()) coverage += " (none in the clip)";
+  out.entries.push_back({"coverage", coverage});
   if (st.errors) out.entries.push_back({"damaged chunks", st.first_error, true});
   return out;
 }

@@ -401,8 +401,9 @@ static int command_main(int argc, char** argv) {
       "reconstruction from the nearest viewpoints' colour + depth cube maps, decoded "
       "view-dependently; mesh tracks (paper 004: a full scene or its visible set) by "
       "rasterising their triangles; composited by depth.\n"
-      "Window: drag to look, WASD/QE to fly, O orbit, R reflections/refractions (RR), V priority, "
-      "+/- active views, Shift+S stereo, space pause, H HUD, Esc quit.\n"
+      "Window: drag to look, WASD/QE to fly, O orbit, R reflections/refractions (RR), C coverage "
+      "on/off (--coverage's mode, else 3), V priority, +/- active views, Shift+S stereo, space "
+      "pause, H HUD, Esc quit.\n"
       "Headless (--headless): renders an eye path (calf-capture writes one with --ground-truth) "
       "through OSMesa, writes frames to --out and, with --compare, prints PSNR / SSIM per pose "
       "and a final 'mean PSNR <x> dB, mean SSIM <y>' line; with --compare-clip FULL.calf it "
@@ -542,11 +543,17 @@ static int command_main(int argc, char** argv) {
                  "docs/RENDERING.md \"Mixed texels\")")
       ->check(CLI::Range(0.0, 50.0));
   app.add_option("--coverage", o.render.coverage,
-                 "light field, --renderer cpu: how the CPU reference uses a clip's coverage "
-                 "stream (SPEC 11.1.11), as bench-player_quality --coverage uses a capture set's: "
-                 "0 off, 1 bilinear front shares, 2 cell mask, 3 grown cell mask; clips without "
-                 "coverage play as with 0 (default 0)")
-      ->check(CLI::Range(0u, 3u));
+                 "light field: how the renderer (GL or CPU) uses a clip's coverage stream (SPEC "
+                 "11.1.11) in its emptiness test, as bench-player_quality --coverage uses a "
+                 "capture set's: 0 off, 1 bilinear front shares, 2 cell mask, 3 grown cell mask, 4 "
+                 "every tap's cell; "
+                 "clips without coverage play as with 0; the window's C key toggles it "
+                 "(default 0)")
+      ->check(CLI::Range(0u, 4u));
+  app.add_option("--coverage-agreement", o.render.coverage_agreement,
+                 "light field, with --coverage: a point that a view calls empty only through its "
+                 "coverage is empty once this many views say so (default 1)")
+      ->check(CLI::Range(1u, 65536u));
   app.add_option("--supersample", o.render.supersample,
                  "light field: N x N eye rays per pixel on an even grid, colour their mean (a box "
                  "filter, as the ground truth's), depth the nearest; anti-aliases silhouettes and "

@@ -498,7 +498,8 @@ int main(int argc, char** argv) {
   app.add_option("--mixed-bend", base.mixed_texel_bend_texels, "mixed_texel_bend_texels")
       ->capture_default_str();
   app.add_option("--coverage", base.coverage,
-                 "coverage: 0 off, 1 bilinear front shares, 2 cell mask (views with coverage)")
+                 "coverage: 0 off, 1 bilinear front shares, 2 cell mask, 3 grown cell mask, 4 "
+                 "every tap's cell (views with coverage)")
       ->capture_default_str();
   app.add_option("--coverage-threshold", base.coverage_threshold, "coverage_threshold")
       ->capture_default_str();

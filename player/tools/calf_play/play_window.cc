@@ -122,6 +122,9 @@ Status run_window(const std::string& clip_path, const PlaybackOptions& options,
   std::string warning;
   uint64_t frames = 0;
   bool key_down[GLFW_KEY_LAST + 1] = {};
+  // The coverage mode the C key turns on: --coverage's, or the grown cell mask.
+  const uint32_t coverage_on =
+      lf != nullptr && lf->options().render.coverage != 0 ? lf->options().render.coverage : 3;
   while (!glfwWindowShouldClose(window)) {
     glfwPollEvents();
     const auto now = std::chrono::steady_clock::now();
@@ -146,6 +149,14 @@ Status run_window(const std::string& clip_path, const PlaybackOptions& options,
         RenderOptions r = lf->options().render;
         r.rr = !r.rr;
         if (r.rr && !lf->has_material()) warning = "the clip has no material: RR does nothing";
+        (void)lf->set_render_options(r);
+      }
+      if (pressed(GLFW_KEY_C) && lf != nullptr) {
+        RenderOptions r = lf->options().render;
+        r.coverage = r.coverage == 0 ? coverage_on : 0;
+        if (r.coverage != 0 && !lf->has_coverage()) {
+          warning = "the clip has no coverage stream: coverage does nothing";
+        }
         (void)lf->set_render_options(r);
       }
       const bool key_v = pressed(GLFW_KEY_V);

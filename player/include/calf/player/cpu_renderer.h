@@ -140,10 +140,13 @@ struct RenderOptions {
   // the surface behind (the farthest of the bilinear taps outside the front cluster). 0: off;
   // 1: the bilinear blend of the taps' front shares (1 - far for a front tap, near for a tap
   // behind) against `coverage_threshold`; 2: the nearest texel's 4 x 4 cell mask; 3: that mask
-  // grown by one cell. The front cluster: taps within a relative depth `coverage_cluster` of the
-  // footprint's surface. Off by default: it lifts the spider's silhouettes but carves thin parts
-  // of turntable at 128² faces unless coverage_agreement asks for 2 or 3 views, which in turn
-  // gives back part of the spider's gain (docs/RENDERING.md "Coverage").
+  // grown by one cell; 4: each bilinear tap's cell nearest the direction (the direction's own
+  // cell in the texel it falls in; a tap across a face seam gives its front share), their
+  // covered bits blended bilinearly against `coverage_threshold`. The front cluster: taps within a
+  // relative depth `coverage_cluster` of the footprint's surface. Off by default: it lifts the
+  // spider's silhouettes but carves thin parts of turntable at 128² faces unless coverage_agreement
+  // asks for 2 or 3 views, which in turn gives back part of the spider's gain (docs/RENDERING.md
+  // "Coverage").
   uint32_t coverage = 0;
   double coverage_threshold = 0.5;
   double coverage_cluster = 0.05;

@@ -1,13 +1,15 @@
 // The OpenGL 4.5 ray-march renderer of paper 002 Alg. 4 (and its RR variant, Sec. 6.1): the
 // player's product renderer. It implements exactly the algorithm of the scalar CPU reference
 // (calf/player/cpu_renderer.h, docs/RENDERING.md): the same RenderOptions, the same Camera model,
-// the same texel taps, footprint test, refinement, weights, sky and RR rules — one GLSL function
-// per CPU function — and is tested against it (tests/integration/gl_renderer_test.cc: PSNR between
-// the two images of the same frame >= 45 dB).
+// the same texel taps, footprint test, coverage test, refinement, weights, sky and RR rules — one
+// GLSL function per CPU function — and is tested against it (tests/integration/gl_renderer_test.cc:
+// PSNR between the two images of the same frame >= 45 dB).
 //
 // It reads the viewpoint textures of a GlViews (calf/player/gl_views.h), which the decoder's
 // FrameUpdates (or updates_from_view_set()) fill; a cell's colour is the keyframe blend
-// mix(slot a, slot 1 - a, t / 255) done per texel in the shader.
+// mix(slot a, slot 1 - a, t / 255) done per texel in the shader. Views with coverage faces
+// answer RenderOptions::coverage and coverage_agreement as the CPU's do; the coverage test is
+// compiled into the shader only when some view of the GlViews has coverage.
 //
 // A frame is one full-screen fragment pass into a framebuffer object holding RGBA32F: rgb the
 // linear colour (HDR kept), alpha the radial distance from the eye to the surface (+inf for sky),

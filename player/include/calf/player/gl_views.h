@@ -19,9 +19,13 @@
 //   material  layer 6 m + f for the m-th view with material: RGBA8 codes (reflect, refract, ior
 //             code; kBc1 updates decoded on the CPU) or COMPRESSED_RGB_S3TC_DXT1 (kBc1 storage);
 //             reflect = R, refract = G, ior = 1 + 2 B (format/SPEC.md §11.1.6)
+//   coverage  layer 6 c + f for the c-th view with coverage (format/CAPTURE.md "Coverage", SPEC
+//             §11.1.11): RGBA8UI, the decoder's kCoverage bytes as they are (mask low byte, mask
+//             high byte, near count, far count of the texel's 16 cells); a 1-texel placeholder
+//             when no view has coverage
 //
 // Initial state matches a fresh calf::player::View: colour black, depth sky, t = 0 / slot 0,
-// material (0, 0, 1).
+// material (0, 0, 1), coverage plain (every cell the texel's own surface).
 //
 // Why BC5 depth defaults to R16 storage: the BC5 interpolants are rounded differently by
 // different decoders (llvmpipe's differs from the reference by up to 2 LSB, docs/BLOCK_CODECS.md),
@@ -54,6 +58,7 @@ struct GlViewInfo {
   uint32_t face_size = 1;                            // texels per face side
   uint32_t cell_size = 1;                            // colour cell side (texels) of the t table
   bool has_material = false;                         // material faces exist for the view
+  bool has_coverage = false;                         // coverage faces exist for the view
 };
 
 struct GlTextureLayout {
@@ -70,15 +75,19 @@ struct GlTextureLayout {
 // position, range and material flag from `views` (ClipDecoder::view(v) for v < view_count), the
 // track's formats; depth kept as R16 unless `keep_bc5_depth`. Errors: CALF-E410 for a view count
 // other than the header's or a depth format other than r16 / BC5 (the other formats are checked
-// by GlViews::make), CALF-E020 for a view's invalid z_near / z_far.
+// by GlViews::make), CALF-E020 for a view's invalid z_near / z_far. `coverage`: every view gets
+// coverage faces (a track with a coverage stream decoded with ClipDecoderOptions::coverage).
 Expected<GlTextureLayout> layout_for_clip(const container::LightfieldTrackHeader& header,
                                           std::span<const decoder::LightfieldViewInfo> views,
-                                          bool keep_bc5_depth = false);
+                                          bool keep_bc5_depth = false, bool coverage = false);
 
 // A ViewSet as updates: the layout (rgba16f colour, one slot; r16 depth; rgba8 material codes:
-// reflect and refract round(255 x), ior round(255 clamp((ior - 1) / 2, 0, 1))) and one update
-// per face and stream plus one CellParams (t = 0) per face, so that the GL renderer draws exactly
-// the views the CPU renderer draws (colour rounded to half floats, material to its 8-bit codes).
+// reflect and refract round(255 x), ior round(255 clamp((ior - 1) / 2, 0, 1)); coverage for the
+// views that have it: shares as counts round(16 x) of the 16 cells, the decoder's kCoverage
+// bytes) and one update per face and stream plus one CellParams (t = 0) per face, so that the GL
+// renderer draws exactly the views the CPU renderer draws (colour rounded to half floats,
+// material to its 8-bit codes; coverage is exact for shares in sixteenths, which every producer
+// writes, format/CAPTURE.md).
 // Not copyable: the updates point into `bytes`.
 struct ViewSetUpload {
   GlTextureLayout layout;
@@ -109,9 +118,9 @@ class GlViews {
   // update (those before it stay applied). Errors: as apply_update / set_cells.
   Status apply(const decoder::FrameUpdates& frame);
   // One update. Errors (CALF-E411, nothing is written): view, face or slot out of range, material
-  // for a view without it, an empty rect or one leaving the face, a format the storage does not
-  // take, block rects not 4-aligned (width / height may be short only at the face's edge), a
-  // byte count other than the rect needs; CALF-E412 when GL reports an error.
+  // or coverage for a view without it, an empty rect or one leaving the face, a format the storage
+  // does not take, block rects not 4-aligned (width / height may be short only at the face's edge),
+  // a byte count other than the rect needs; CALF-E412 when GL reports an error.
   Status apply_update(const decoder::TextureUpdate& update);
   // Sets (t, a_slot) of the given cells. Errors (CALF-E411): a view, face or cell index out of
   // range, a_slot > 1 (or a_slot 1 / t > 0 with one slot).
@@ -122,11 +131,15 @@ class GlViews {
 
   // For the renderer: GL texture names and the layer bases.
   struct Textures {
-    GLuint colour = 0, depth = 0, cells = 0, material = 0;
+    GLuint colour = 0, depth = 0, cells = 0, material = 0, coverage = 0;
   };
   const Textures& textures() const { return tex_; }
   // The first material layer of view v (6 m for the m-th view with material), -1 without.
   int material_base(uint32_t v) const { return material_base_[v]; }
+  // The first coverage layer of view v (6 c for the c-th view with coverage), -1 without.
+  int coverage_base(uint32_t v) const { return coverage_base_[v]; }
+  // Whether any view has coverage faces.
+  bool has_coverage() const { return coverage_layers_ > 0; }
   uint32_t cells_per_side(uint32_t v) const;
   // Colour slots per face (2 or 1).
   uint32_t colour_slots() const { return layout_.colour_two_slots ? 2 : 1; }
@@ -146,6 +159,8 @@ class GlViews {
   uint32_t size_ = 1;       // texture width = height: the largest face
   uint32_t cell_side_ = 1;  // cells texture width = height
   std::vector<int> material_base_;
+  std::vector<int> coverage_base_;
+  int coverage_layers_ = 0;
   std::vector<uint32_t> cells_per_side_;
   std::vector<uint16_t> cells_;       // CPU copy of the cells texture, layer-major
   std::vector<uint8_t> cells_dirty_;  // per layer

@@ -76,6 +76,8 @@ class LightfieldRepresentation final : public Representation {
 
   // Whether any view carries material (the RR variant needs it).
   bool has_material() const;
+  // Whether the track has a coverage stream (RenderOptions::coverage needs it; SPEC §11.1.11).
+  bool has_coverage() const;
   // The CPU backend's views after the last prepare(), indexed like the clip (a view never active
   // yet is a one-texel placeholder), with the clip's coverage where it has a coverage stream;
   // nullptr for the GL backend. For tests and tools.
