@@ -56,8 +56,8 @@ def doc_files(root):
     return files
 
 
-def prose_lines(text):
-    """Yields (line number, line) outside fenced code blocks, inline code removed."""
+def unfenced_lines(text):
+    """Yields (line number, line) outside fenced code blocks."""
     fence = None
     for number, line in enumerate(text.split("\n"), 1):
         stripped = line.lstrip()
@@ -68,6 +68,12 @@ def prose_lines(text):
             if stripped.startswith(fence):
                 fence = None
             continue
+        yield number, line
+
+
+def prose_lines(text):
+    """Yields (line number, line) outside fenced code blocks, inline code removed."""
+    for number, line in unfenced_lines(text):
         yield number, re.sub(r"`[^`]*`", "``", line)
 
 
@@ -84,24 +90,16 @@ def anchors(path, cache):
         found = set()
         counts = {}
         with open(path, encoding="utf-8") as f:
-            fence = None
-            for line in f:
-                stripped = line.strip()
-                if fence is None and (stripped.startswith("```") or stripped.startswith("~~~")):
-                    fence = stripped[:3]
-                    continue
-                if fence is not None:
-                    if stripped.startswith(fence):
-                        fence = None
-                    continue
-                m = re.match(r"^#{1,6}\s+(.*?)\s*#*\s*$", line)
-                if m:
-                    base = slug(m.group(1))
-                    n = counts.get(base, 0)
-                    counts[base] = n + 1
-                    found.add(base if n == 0 else f"{base}-{n}")
-                for explicit in re.findall(r"<a\s+(?:name|id)=\"([^\"]+)\"", line):
-                    found.add(explicit)
+            text = f.read()
+        for _, line in unfenced_lines(text):
+            m = re.match(r"^#{1,6}\s+(.*?)\s*#*\s*$", line)
+            if m:
+                base = slug(m.group(1))
+                n = counts.get(base, 0)
+                counts[base] = n + 1
+                found.add(base if n == 0 else f"{base}-{n}")
+            for explicit in re.findall(r"<a\s+(?:name|id)=\"([^\"]+)\"", line):
+                found.add(explicit)
         cache[path] = found
     return cache[path]
 

@@ -185,9 +185,6 @@ void rgba_to_ycbcr420(std::span<const uint8_t> rgba, uint32_t W, uint32_t H, uin
 Expected<std::vector<Gop>> encode_cell(std::span<const uint8_t> rgba, uint32_t w, uint32_t h,
                                        uint32_t frames, uint32_t fps_numerator,
                                        uint32_t fps_denominator, const Av1ColourOptions& options) {
-  // SVT-AV1 prints its banner and settings to stderr unless told otherwise; a library prints
-  // nothing. SVT_LOG is read when its first encoder starts (an explicit setting is kept).
-  setenv("SVT_LOG", "0", 0);
   const uint32_t W = std::max(64u, (w + 7) / 8 * 8), H = std::max(64u, (h + 7) / 8 * 8);
   const size_t luma = size_t{W} * H, picture = luma + luma / 2;
   std::vector<uint8_t> padded(luma * 4);

@@ -951,5 +951,8 @@ static int command_main(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
+  // SVT-AV1 (--colour-codec av1) prints its banner and settings to stderr unless SVT_LOG says
+  // otherwise; set before any thread starts, and a user's own setting is kept.
+  setenv("SVT_LOG", "0", 0);
   return calf::tools::run_command("calf-encode", [&] { return command_main(argc, argv); });
 }

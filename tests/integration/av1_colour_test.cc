@@ -25,7 +25,11 @@
 #include "calf/format/colour.h"
 #include "calf/format/container.h"
 #include "calf/format/lightfield_layout.h"
+#include "clip_edit.h"
 #include "synthetic_capture.h"
+
+// SVT-AV1 logs to stderr unless SVT_LOG says otherwise (calf-encode sets it in main).
+[[maybe_unused]] static const int kQuietSvt = setenv("SVT_LOG", "0", 0);
 
 namespace calf {
 namespace {
@@ -198,26 +202,13 @@ TEST_F(Av1Colour, DecodersAgreeInOrderAndSeekingAndFollowTheInput) {
 // The file with the first colour chunk of (view, face, cell 0) edited; other chunks as they are.
 std::vector<uint8_t> with_colour_chunk(const container::Reader& r, uint32_t view, uint32_t face,
                                        const std::function<void(std::vector<uint8_t>&)>& edit) {
-  std::vector<uint8_t> out;
-  auto w = container::Writer::create(container::memory_sink(&out));
-  EXPECT_TRUE(w.ok());
-  EXPECT_TRUE(w->add_track(std::get<container::LightfieldTrackHeader>(r.tracks()[0].header)).ok());
-  w->require_minor_version(r.header().version_minor);
-  bool edited = false;
-  for (uint32_t id = 0; id < r.chunks().size(); ++id) {
-    const container::ChunkKeys& k = r.chunks()[id].keys;
-    auto raw = r.read_chunk(id);
-    EXPECT_TRUE(raw.ok());
-    if (k.stream == static_cast<uint16_t>(LightfieldStream::kColour) && k.view == view &&
-        k.face == face && !edited) {
-      edit(*raw);
-      edited = true;
-    }
-    EXPECT_TRUE(w->add_chunk(k, *raw, container::Compression::kNone).ok());
-  }
-  EXPECT_TRUE(edited);
-  EXPECT_TRUE(w->finish().ok());
-  return out;
+  return testing_support::with_chunk_edited(
+      r,
+      [&](const container::ChunkKeys& k) {
+        return k.stream == static_cast<uint16_t>(LightfieldStream::kColour) && k.view == view &&
+               k.face == face;
+      },
+      edit);
 }
 
 TEST_F(Av1Colour, DamagedChunksAreRefusedWithTheirIds) {

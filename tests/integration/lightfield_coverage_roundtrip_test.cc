@@ -25,6 +25,7 @@
 #include "calf/format/container.h"
 #include "calf/format/lightfield_layout.h"
 #include "calf/player/lightfield_representation.h"
+#include "clip_edit.h"
 #include "synthetic_capture.h"
 
 namespace calf {
@@ -268,26 +269,13 @@ TEST_F(LightfieldCoverage, CoverageTheStreamCannotHoldIsRefusedWithE255) {
 std::vector<uint8_t> with_coverage_chunk(const container::Reader& r, uint32_t view, uint32_t face,
                                          uint32_t tile,
                                          const std::function<void(std::vector<uint8_t>&)>& edit) {
-  std::vector<uint8_t> out;
-  auto w = container::Writer::create(container::memory_sink(&out));
-  EXPECT_TRUE(w.ok());
-  EXPECT_TRUE(w->add_track(std::get<container::LightfieldTrackHeader>(r.tracks()[0].header)).ok());
-  w->require_minor_version(r.header().version_minor);
-  bool edited = false;
-  for (uint32_t id = 0; id < r.chunks().size(); ++id) {
-    const container::ChunkKeys& k = r.chunks()[id].keys;
-    auto raw = r.read_chunk(id);
-    EXPECT_TRUE(raw.ok());
-    if (k.stream == static_cast<uint16_t>(LightfieldStream::kCoverage) && k.view == view &&
-        k.face == face && k.region == tile && !edited) {
-      edit(*raw);
-      edited = true;
-    }
-    EXPECT_TRUE(w->add_chunk(k, *raw, container::Compression::kNone).ok());
-  }
-  EXPECT_TRUE(edited);
-  EXPECT_TRUE(w->finish().ok());
-  return out;
+  return testing_support::with_chunk_edited(
+      r,
+      [&](const container::ChunkKeys& k) {
+        return k.stream == static_cast<uint16_t>(LightfieldStream::kCoverage) && k.view == view &&
+               k.face == face && k.region == tile;
+      },
+      edit);
 }
 
 // Rewrites a coverage chunk's keyframe so that tile texel 0 is the edge texel (mask, near).

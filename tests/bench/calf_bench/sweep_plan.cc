@@ -83,6 +83,8 @@ const char* colour_coding_name(ColourCoding c) {
       return "rgba8";
     case ColourCoding::kRgba16f:
       return "rgba16f";
+    case ColourCoding::kAv1:
+      return "av1";
   }
   return "?";
 }
