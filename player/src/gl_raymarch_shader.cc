@@ -18,7 +18,7 @@ const char* const kGlRaymarchFragment = R"glsl(
 struct CalfView {
   vec3 position;  // relative to the eye
   float log_near;  // the CalfLogRange of the view (glsl_conventions.h), spread over the record
-  float step;      // so that the record packs into 48 bytes
+  float step;      // so that the record packs into 64 bytes (std140)
   float inv_step;
   float z_near;
   float z_far;

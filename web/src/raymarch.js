@@ -237,13 +237,15 @@ export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER
     const P = camera.projection;
     const rayForward = P ? [0, 1, 2].map((k) => fwd[k] + (P[8] / P[0]) * right[k] + (P[9] / P[5]) * up[k]) : fwd;
     const rayRight = P ? scale(right, 1 / P[0]) : scale(right, h * aspect), rayUp = P ? scale(up, 1 / P[5]) : scale(up, h);
-    const records = new ArrayBuffer(MAX_ACTIVE_VIEWS * 48);
+    // The std140 records of CalfView: 13 scalars padded to 64 bytes each.
+    const records = new ArrayBuffer(MAX_ACTIVE_VIEWS * 64);
     const f32 = new Float32Array(records), u32 = new Uint32Array(records), i32 = new Int32Array(records);
     active.forEach((v, k) => {
-      const info = views[v], r = logRange(info), b = 12 * k;
+      const info = views[v], r = logRange(info), b = 16 * k;
       f32.set([info.position[0] - camera.position[0], info.position[1] - camera.position[1], info.position[2] - camera.position[2],
         r.log_near, r.step, r.inv_step, info.zNear, info.zFar], b);
-      u32[b + 8] = N; u32[b + 9] = cellSize; u32[b + 10] = 6 * v; i32[b + 11] = -1;
+      // No material and no coverage layer: the page draws neither.
+      u32[b + 8] = N; u32[b + 9] = cellSize; u32[b + 10] = 6 * v; i32[b + 11] = -1; i32[b + 12] = -1;
     });
     gl.bindBuffer(gl.UNIFORM_BUFFER, viewBuffer);
     gl.bufferData(gl.UNIFORM_BUFFER, records, gl.STREAM_DRAW);
