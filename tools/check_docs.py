@@ -3,8 +3,8 @@
 
   (a) every relative link and image in README.md, docs/**/*.md and format/*.md resolves to a file
       inside the repository, and a link's #anchor names a heading of the page it points to;
-  (b) no development-history wording ("stop 38", "issue 17", "third round") outside docs/history/,
-      CHANGELOG.md and the change-log sections at the end of format/SPEC.md, format/CAPTURE.md and
+  (b) no development-history wording ("stop N", "issue N", "third round") outside the
+      change-log sections at the end of format/SPEC.md, format/CAPTURE.md and
       format/SCENE.md, nor in any command's --help;
   (c) with --command NAME=PATH (repeated): every long option of that command's --help (and of each
       of its subcommands' --help) appears as `--option` in the command's reference page, the page
@@ -20,7 +20,7 @@ import re
 import subprocess
 import sys
 
-# "stop 38", "Stop 40:", "stops 42-43", "the stop-40 figures", "issue 17", "Issue 16's"; and the
+# "stop N", "Stop N:", "stops N-M", "the stop-N figures", "issue N", "Issue N's"; and the
 # titles of tuning rounds ("Third round (...)"), capitalised so that an algorithm's first round
 # of samples is not one.
 HISTORY = re.compile(
@@ -132,21 +132,15 @@ def check_links(root, rel, text, problems, anchor_cache):
                                     f"{os.path.relpath(resolved, root)}")
 
 
-def history_exempt(rel):
-    return rel.startswith("docs/history/") or rel == "CHANGELOG.md"
-
-
 def check_history(rel, text, problems):
-    if history_exempt(rel):
-        return
     log = CHANGE_LOG_HEADING.get(rel)
     for number, line in enumerate(text.split("\n"), 1):
         if log is not None and log.match(line):
             return
         m = HISTORY.search(line)
         if m:
-            problems.append(f"{rel}:{number}: development history '{m.group(0)}' (move it to "
-                            "docs/history/ or say what holds now)")
+            problems.append(f"{rel}:{number}: development history '{m.group(0)}' (say what holds "
+                            "now; the history belongs in git)")
 
 
 def command_pages(root):

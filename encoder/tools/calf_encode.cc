@@ -406,15 +406,16 @@ static int command_main(int argc, char** argv) {
          "made them; rgba8 / rgba16f ignore it; auto = 0.5 for BC6H / BC7 (31-69 % fewer "
          "BC6H colour bytes on the built-in scenes for <= 0.02 dB against ground truth) and "
          "12 for BC1 (32-46 % with the default --bc1-fit, within 0.02 dB) "
-         "(docs/ENCODER.md; the measurements: docs/history/ENCODER.md) (default auto)")
+         "(docs/ENCODER.md; the measurements: git log -p docs/ENCODER.md) (default auto)")
       ->default_val("auto");
   std::string bc1_fit = "cluster";
-  app.add_option("--bc1-fit", bc1_fit,
-                 "how BC1 colour blocks are fitted: range (libsquish's range fit, the fastest; "
-                 "the least accurate), refined (range fit, then least-squares endpoints "
-                 "for its indices: +0.1 dB for ~1.3x the BC1 encode time) or cluster (libsquish's "
-                 "cluster fit: +0.2-0.3 dB for 1.1-2.6x the encode time) (docs/history/ENCODER.md "
-                 "\"BC1 fit\") (default cluster)")
+  app.add_option(
+         "--bc1-fit", bc1_fit,
+         "how BC1 colour blocks are fitted: range (libsquish's range fit, the fastest; "
+         "the least accurate), refined (range fit, then least-squares endpoints "
+         "for its indices: +0.1 dB for ~1.3x the BC1 encode time) or cluster (libsquish's "
+         "cluster fit: +0.2-0.3 dB for 1.1-2.6x the encode time) (git log -p docs/ENCODER.md "
+         "\"BC1 fit\") (default cluster)")
       ->check(CLI::IsMember({"range", "refined", "cluster"}))
       ->default_val("cluster");
   app.add_option("--supercompression", super,
@@ -425,7 +426,7 @@ static int command_main(int argc, char** argv) {
   app.add_flag("--plain-directory", plain_directory,
                "every mode: write a container 1.0 file (plain 64-byte chunk index entries) that "
                "calf 1.0 readers open, instead of 1.1's directory compressed as one zstd frame "
-               "(format/SPEC.md 4.1: 2-43 % smaller lightfield clips, docs/history/ENCODER.md "
+               "(format/SPEC.md 4.1: 2-43 % smaller lightfield clips, git log -p docs/ENCODER.md "
                "\"Compressed directory\"); sharded encodes always write 1.1");
   app.add_flag("-q,--quiet", quiet, "no progress line");
   bool analysis_only = false;
