@@ -18,9 +18,9 @@ TrackVerification verify(const container::Reader& reader, uint16_t track, bool w
   return out;
 }
 
-// Named even when the file has no lightfield track: "0 faces decoded".
+// Named when a lightfield track was decoded, even one of no faces.
 std::string verified_summary(const VerifiedTotals& totals) {
-  return fmt::format(", {} faces decoded", totals.decoded[0]);
+  return totals.tracks ? fmt::format(", {} faces decoded", totals.decoded[0]) : "";
 }
 
 }  // namespace
