@@ -12,5 +12,5 @@ if command -v ccache >/dev/null; then
 fi
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG=-O0 \
   -DCALF_WERROR=ON -DCALF_TEST_KIND=ON "${launcher[@]}" >/dev/null
-cmake --build "$build" -j"${CALF_JOBS:-2}" --target calf-info calf-verify swatch_kind_test
-ctest --test-dir "$build" -R 'swatch' --output-on-failure "$@"
+cmake --build "$build" -j"${CALF_JOBS:-2}" --target calf-info calf-verify swatch_kind_test track_registry_test
+ctest --test-dir "$build" -R 'swatch|track_registry' --output-on-failure "$@"
