@@ -1,8 +1,9 @@
 #!/bin/bash
 # Builds calf with the test-only track kind (tests/test_kind/, CMake option CALF_TEST_KIND) in
 # build/test-kind and runs what exercises it: its own tests (the decoder and player tables'
-# entries, calf-info's and calf-verify's lines) and the conformance runner's entries for its
-# clips. Extra arguments go to ctest. docs/ARCHITECTURE.md, "The test-only kind".
+# entries, calf-info's and calf-verify's lines), the conformance runner's entries for its clips,
+# and the track registry test with the kind registered. Extra arguments go to ctest.
+# docs/ARCHITECTURE.md, "The test-only kind".
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=build/test-kind
