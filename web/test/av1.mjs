@@ -2,6 +2,7 @@
 // decoder: web.conformance checks that the clip is refused there). In headless Chromium:
 // - the page's decoder reproduces every hash line of tests/conformance/lightfield/av1_pred16m
 //   (web/src/hash_lines.js, as web.conformance runs it under node);
+// - the AV1 clip of the decoder's fuzz corpus decodes without a problem;
 // - a temporal unit made garbage (its chunk's bytes changed in the decoder's cache) gives
 //   CALF-E301, as calf-verify gives;
 // - the page plays the clip along a 4-pose eye path (one per frame), each frame >= MIN_DB against
@@ -29,6 +30,8 @@ if (!bin) {
 }
 const clipPath = 'tests/conformance/lightfield/av1_pred16m.calf';
 const want = readFileSync(join(ROOT, clipPath.replace(/\.calf$/, '.hashes')), 'utf8').split('\n').filter(Boolean);
+// The AV1 clip of the decoder's fuzz corpus, which must decode without a problem.
+const fuzzClip = 'tests/fuzz/corpus/clip_decoder_fuzz/valid_av1_f16_5fr.calf';
 const dir = mkdtempSync(join(process.env.CALF_WEB_TMP ?? tmpdir(), 'calf-web-av1-'));
 
 // The eye path: from the views' centre, looking along four directions, at frames 0 … 3 (a
@@ -61,7 +64,7 @@ try {
   if (!ready) throw new Error(`the page did not open ${clipPath}: ${overlay} ${consoleLines.join(' | ')}`);
   // The page's decoder, with the page's codecs (WebCodecs for AV1), on the whole clip; then with
   // one unit of the first colour chunk made garbage (every byte 0xff, its size kept).
-  const got = await page.evaluate(async (url) => {
+  const got = await page.evaluate(async ({ url, fuzzUrl }) => {
     const { decodeLines } = await import('/web/src/hash_lines.js');
     const codecs = window.calfPlayer.lf.clip.codecs;
     const bytes = new Uint8Array(await (await fetch(url)).arrayBuffer());
@@ -79,8 +82,9 @@ try {
     } catch (e) {
       damaged = { lines: [], problems: [e.message] };
     }
-    return { clean, ms, damaged: damaged.problems[0] ?? null };
-  }, `/${clipPath}`);
+    const fuzz = await decodeLines(new Uint8Array(await (await fetch(fuzzUrl)).arrayBuffer()), codecs);
+    return { clean, ms, damaged: damaged.problems[0] ?? null, fuzz: { lines: fuzz.lines.length, problem: fuzz.problems[0] ?? null } };
+  }, { url: `/${clipPath}`, fuzzUrl: `/${fuzzClip}` });
   const diffs = [];
   for (let i = 0; i < Math.max(want.length, got.clean.lines.length); ++i) {
     if (want[i] !== got.clean.lines[i]) diffs.push(`line ${i + 1}: expected '${want[i] ?? ''}', got '${got.clean.lines[i] ?? ''}'`);
@@ -89,6 +93,8 @@ try {
     `${got.ms.toFixed(0)} ms${got.clean.problems.length ? ` (${got.clean.problems[0]})` : ''}`);
   for (const d of diffs.slice(0, 5)) problems.push(`conformance: ${d}`);
   if (got.clean.problems.length) problems.push(`conformance: ${got.clean.problems[0]}`);
+  console.log(`web.av1: ${fuzzClip}: ${got.fuzz.lines} lines, ${got.fuzz.problem ?? 'no problem'}`);
+  if (got.fuzz.problem || got.fuzz.lines === 0) problems.push(`${fuzzClip}: ${got.fuzz.lines} lines, ${got.fuzz.problem ?? 'no problem'}`);
   console.log(`web.av1: a garbage temporal unit: ${got.damaged ?? 'no problem'}`);
   if (!got.damaged?.startsWith('CALF-E301 ')) problems.push(`a garbage temporal unit gave ${got.damaged ?? 'no problem'}, not CALF-E301`);
 
