@@ -408,6 +408,8 @@ export function applyRegionFrame(rects, state, tw, channels) {
   }
 }
 
+let openings = 0;
+
 // Opens lightfield track t of an opened clip: formats, chunk keys, view index chunks.
 // Returns the track, with `views[v]` null and `viewProblems[v]` set for a dropped view, and
 // `hasCoverage` when it holds any coverage chunk (§11.1.11).
@@ -456,7 +458,8 @@ export async function openLightfield(clip, t) {
   if (views.every((x) => x === null)) throw viewProblems[0];
   const hasCoverage = clip.chunks.some((c) => c.track === t && c.stream === STREAM.coverage);
   const av1 = h.colour_format === FORMAT.av1;
-  return { clip, track: t, header: h, cells, tiles, byKey, views, viewProblems, hasCoverage, av1 };
+  // `opened` names this opening in the AV1 decoders' cell keys (codecs.av1 may serve several).
+  return { clip, track: t, header: h, cells, tiles, byKey, views, viewProblems, hasCoverage, av1, opened: ++openings };
 }
 
 // Decodes every frame of one face of one view in order; calls onFrame(n, colour, depth,
@@ -486,7 +489,7 @@ export async function decodeFaceFrames(lf, v, face, onFrame, only = null,
     }
     const where = `track ${t} view ${v} face ${face} cell ${r}`;
     if (lf.av1) {  // §11.1.12: no t chunks; each frame decoded from the GOP chunk holding it
-      cellState.push({ rect: lf.cells.rect(r), where, key: `${t}/${v}/${face}/${r}`, chunk: null, units: null });
+      cellState.push({ rect: lf.cells.rect(r), where, key: `${lf.opened}/${t}/${v}/${face}/${r}`, chunk: null, units: null });
       continue;
     }
     const tc = find(STREAM.t, r);
