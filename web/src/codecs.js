@@ -3,7 +3,9 @@
 // as a one-block .xz stream built around the chunk's raw LZMA2 stream). The caller passes the
 // packages' modules in, so that node (web/test) and the page (an import map) load them their way.
 import { E, fail } from './errors.js';
+import { webCodecsAv1 } from './av1.js';
 
+// `av1` (AV1 colour, SPEC §11.1.12) is the browser's WebCodecs decoder (av1.js), null under node.
 export async function makeCodecs({ hashWasm, fzstd, xz }) {
   const h3 = await hashWasm.createXXHash3();
   const h64 = await hashWasm.createXXHash64();
@@ -17,6 +19,7 @@ export async function makeCodecs({ hashWasm, fzstd, xz }) {
     xxh64: (bytes) => digest(h64, bytes),
     zstd: (bytes, rawSize) => fzstd.decompress(bytes, new Uint8Array(rawSize)),
     lzma2: (xzBytes) => new Response(new xz.XzReadableStream(new Blob([xzBytes]).stream())).arrayBuffer(),
+    av1: await webCodecsAv1(),
   };
 }
 

@@ -5,7 +5,7 @@ import { E, CalfError, fail } from './errors.js';
 import { readChunk } from './container.js';
 import { decodeBc1, decodeBc4, decodeBc6h, decodeBc7 } from './bc.js';
 
-export const FORMAT = { none: 0, rgba8: 1, rgba16f: 2, r16: 3, bc1: 4, bc4: 5, bc5: 6, bc6h: 7, bc7: 8, rg8: 9, r16p: 10, r16pm: 11 };
+export const FORMAT = { none: 0, rgba8: 1, rgba16f: 2, r16: 3, bc1: 4, bc4: 5, bc5: 6, bc6h: 7, bc7: 8, rg8: 9, r16p: 10, r16pm: 11, av1: 12 };
 export const STREAM = { index: 0, colour: 1, depth: 2, material: 3, t: 4, coverage: 5 };
 const COLOUR_FORMATS = [FORMAT.bc1, FORMAT.bc7, FORMAT.bc6h, FORMAT.rgba8, FORMAT.rgba16f];
 const DEPTH_FORMATS = [FORMAT.r16, FORMAT.r16p, FORMAT.r16pm, FORMAT.bc5];
@@ -132,6 +132,59 @@ export function bcBlocks(raw, format, w, h, what) {
   for (let k = 0; k < B; ++k) {
     out.set(raw.subarray(4 * k, 4 * k + 4), 8 * k);
     out.set(raw.subarray(4 * B + 4 * k, 4 * B + 4 * k + 4), 8 * k + 4);
+  }
+  return out;
+}
+
+// §11.1.12: an AV1 colour (GOP) chunk of `frameCount` frames → its temporal units; a head that
+// contradicts the chunk's size or keys is CALF-E067 (as lf::parse_av1_gop).
+export function parseAv1Gop(raw, frameCount, what) {
+  const bad67 = (why) => fail(E.av1Chunk, `${what}: ${why}`);
+  if (raw.length < 4) bad67(`AV1 chunk of ${raw.length} bytes`);
+  const v = new DataView(raw.buffer, raw.byteOffset, raw.length);
+  const F = v.getUint32(0, true);
+  if (F !== frameCount || F === 0) bad67(`AV1 chunk of ${F} frames, its keys say ${frameCount}`);
+  const head = 4 + 4 * F;
+  if (head > raw.length) bad67(`AV1 chunk of ${raw.length} bytes is shorter than its head of ${head}`);
+  const units = [];
+  let at = head;
+  for (let i = 0; i < F; ++i) {
+    const size = v.getUint32(4 + 4 * i, true);
+    if (size === 0 || size > raw.length - at) bad67(`temporal unit ${i} of ${size} bytes at offset ${at} of ${raw.length}`);
+    units.push(raw.subarray(at, at + size));
+    at += size;
+  }
+  if (at !== raw.length) bad67(`${raw.length - at} bytes after the last temporal unit`);
+  return units;
+}
+
+// §11.1.12's normative conversion of one texel: luma y, chroma cb and cr → sRGB-encoded bytes
+// (BT.709 full range in 16 fractional bits; >> of a negative value is floor division).
+export function av1YcbcrToRgb(y, cb, cr, out, o = 0) {
+  const u = cb - 128, v = cr - 128;
+  const c = (x) => (x < 0 ? 0 : x > 255 ? 255 : x);
+  out[o] = c(y + ((103206 * v + 32768) >> 16));
+  out[o + 1] = c(y - ((12276 * u + 30679 * v + 32768) >> 16));
+  out[o + 2] = c(y + ((121609 * u + 32768) >> 16));
+}
+
+// §11.1.12: the w × h cell of a decoded AV1 picture ({ format, width, height, planes: [Y, U, V],
+// strides }, av1.js) → linear binary32 RGB, texel-interleaved, through the sRGB bytes exactly as
+// rgba8 (§11.1.5). A picture that is not 8-bit 4:2:0 ('I420') or is smaller than the cell is
+// CALF-E302.
+export function av1Colour(picture, w, h, what) {
+  if (picture.format !== 'I420' || !picture.planes || picture.width < w || picture.height < h) {
+    fail(E.av1Picture, `${what}: a ${picture.width} x ${picture.height} picture of format ${picture.format} for a ${w} x ${h} cell (8-bit 4:2:0 expected)`);
+  }
+  const [ys, us, vs] = picture.planes, [ly, lc] = picture.strides;
+  const out = new Float32Array(3 * w * h), rgb = new Uint8Array(3);
+  for (let y = 0; y < h; ++y) {
+    for (let x = 0; x < w; ++x) {
+      const c = (y >> 1) * lc + (x >> 1);
+      av1YcbcrToRgb(ys[y * ly + x], us[c], vs[c], rgb);
+      const d = 3 * (y * w + x);
+      out[d] = SRGB[rgb[0]]; out[d + 1] = SRGB[rgb[1]]; out[d + 2] = SRGB[rgb[2]];
+    }
   }
   return out;
 }
@@ -355,12 +408,19 @@ export function applyRegionFrame(rects, state, tw, channels) {
   }
 }
 
+let openings = 0;
+
 // Opens lightfield track t of an opened clip: formats, chunk keys, view index chunks.
 // Returns the track, with `views[v]` null and `viewProblems[v]` set for a dropped view, and
 // `hasCoverage` when it holds any coverage chunk (§11.1.11).
 export async function openLightfield(clip, t) {
   const h = clip.tracks[t].header;
-  if (!COLOUR_FORMATS.includes(h.colour_format)) fail(E.lightfieldFormat, `track ${t}: colour format ${h.colour_format}`);
+  // AV1 colour (§11.1.12) needs an AV1 decoder (codecs.av1: WebCodecs, in a browser); without
+  // one the track is refused as by any reader that lacks the format.
+  if (h.colour_format === FORMAT.av1 && !clip.codecs.av1) {
+    fail(E.lightfieldFormat, `track ${t}: colour format ${h.colour_format} (av1): no AV1 decoder here (the page decodes it with WebCodecs in a browser)`);
+  }
+  if (!COLOUR_FORMATS.includes(h.colour_format) && h.colour_format !== FORMAT.av1) fail(E.lightfieldFormat, `track ${t}: colour format ${h.colour_format}`);
   if (!DEPTH_FORMATS.includes(h.depth_format)) fail(E.lightfieldFormat, `track ${t}: depth format ${h.depth_format}`);
   if (h.material_format !== 0 && !MATERIAL_FORMATS.includes(h.material_format)) fail(E.lightfieldFormat, `track ${t}: material format ${h.material_format}`);
   const cells = faceGrid(h.face_size, h.cell_size), tiles = faceGrid(h.face_size, h.depth_tile_size);
@@ -397,7 +457,9 @@ export async function openLightfield(clip, t) {
   }
   if (views.every((x) => x === null)) throw viewProblems[0];
   const hasCoverage = clip.chunks.some((c) => c.track === t && c.stream === STREAM.coverage);
-  return { clip, track: t, header: h, cells, tiles, byKey, views, viewProblems, hasCoverage };
+  const av1 = h.colour_format === FORMAT.av1;
+  // `opened` names this opening in the AV1 decoders' cell keys (codecs.av1 may serve several).
+  return { clip, track: t, header: h, cells, tiles, byKey, views, viewProblems, hasCoverage, av1, opened: ++openings };
 }
 
 // Decodes every frame of one face of one view in order; calls onFrame(n, colour, depth,
@@ -426,6 +488,10 @@ export async function decodeFaceFrames(lf, v, face, onFrame, only = null,
       continue;
     }
     const where = `track ${t} view ${v} face ${face} cell ${r}`;
+    if (lf.av1) {  // §11.1.12: no t chunks; each frame decoded from the GOP chunk holding it
+      cellState.push({ rect: lf.cells.rect(r), where, key: `${lf.opened}/${t}/${v}/${face}/${r}`, chunk: null, units: null });
+      continue;
+    }
     const tc = find(STREAM.t, r);
     if (tc.length !== 1) bad(`${where}: ${tc.length} t chunks`);
     if (tc[0].frameCount !== h.frame_count) bad(`${where}: t chunk of ${tc[0].frameCount} frames`);
@@ -445,6 +511,10 @@ export async function decodeFaceFrames(lf, v, face, onFrame, only = null,
     for (let r = 0; r < cellState.length; ++r) {
       const cell = cellState[r];
       if (!cell) continue;
+      if (lf.av1) {
+        await av1Cell(lf, cell, find(STREAM.colour, r), n, colour, N);
+        continue;
+      }
       const { keys, t: tv } = cell.timeline;
       let m = 0;
       while (m + 1 < keys.length && keys[m + 1] <= n) ++m;
@@ -492,6 +562,23 @@ export async function decodeFaceFrames(lf, v, face, onFrame, only = null,
     }
     await onFrame(n, colour, depth, material, coverage);
   }
+}
+
+// Frame n of an AV1 colour cell into the face's colour: the GOP chunk holding n parsed, its unit
+// decoded by codecs.av1 (one decoder per cell, kept across calls, so that frame after frame
+// decodes one unit each), converted by av1Colour.
+async function av1Cell(lf, cell, chunks, n, colour, N) {
+  if (!cell.chunk || n < cell.chunk.firstFrame || n >= cell.chunk.firstFrame + cell.chunk.frameCount) {
+    const c = chunks.find((x) => x.firstFrame <= n && n < x.firstFrame + x.frameCount);
+    if (!c) bad(`${cell.where}: no colour chunk for frame ${n}`);
+    const what = `${cell.where} colour`;
+    cell.units = parseAv1Gop(await readChunk(lf.clip, c.id), c.frameCount, what);
+    cell.chunk = c;
+  }
+  const what = `${cell.where} colour`, { x: cx, y: cy, w: cw, h: ch } = cell.rect;
+  const picture = await lf.clip.codecs.av1.picture(cell.key, cell.chunk, cell.units, n - cell.chunk.firstFrame, what);
+  const values = av1Colour(picture, cw, ch, what);
+  for (let y = 0; y < ch; ++y) colour.set(values.subarray(3 * y * cw, 3 * (y + 1) * cw), 3 * ((cy + y) * N + cx));
 }
 
 // §14: the conformance hash of one decoded face (coverage: a track with coverage's, as

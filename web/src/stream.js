@@ -78,7 +78,8 @@ export function planFrame(lf, n, needed, tValue = () => undefined, { coverage = 
     const key = holding(colour);
     if (key) {
       ids.add(key.id);
-      const t = tValue(view, face, cell);
+      // AV1 colour (§11.1.12): the GOP chunk holding n is all a frame needs.
+      const t = lf.av1 ? 0 : tValue(view, face, cell);
       const next = colour.find((c) => c.firstFrame === key.firstFrame + key.frameCount);
       if (next && t !== 0) ids.add(next.id);
     }

@@ -1,6 +1,6 @@
 #!/bin/bash
 # Runs one of the web player's node tests for ctest (web.conformance, web.streaming, web.page,
-# web.xr, web.match, web.match_raster).
+# web.xr, web.match, web.match_raster, web.av1).
 # Skipped (77, one line) without node, build/npm's packages or a further TOOL (a command, or
 # npm:PACKAGE), failed instead with CI=true (tools/setup.sh installs them all). With chromium
 # among the TOOLs, the script gets its path as its argument.

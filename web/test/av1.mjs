@@ -1,0 +1,144 @@
+// AV1 colour (format/SPEC.md §11.1.12) in the page, where WebCodecs decodes it (node has no AV1
+// decoder: web.conformance checks that the clip is refused there). In headless Chromium:
+// - the page's decoder reproduces every hash line of tests/conformance/lightfield/av1_pred16m
+//   (web/src/hash_lines.js, as web.conformance runs it under node);
+// - the AV1 clip of the decoder's fuzz corpus decodes without a problem;
+// - a temporal unit made garbage (its chunk's bytes changed in the decoder's cache) gives
+//   CALF-E301, as calf-verify gives;
+// - the page plays the clip along a 4-pose eye path (one per frame), each frame >= MIN_DB against
+//   calf-play's GL frame of the same pose (CALF_BIN), with calf-play's active views and cells;
+// - garbage units met while playing give one line in the overlay (CALF-E301) and the last good
+//   frame stays on the canvas.
+//
+//   CALF_BIN=BUILD_DIR node web/test/av1.mjs CHROMIUM
+import { execFileSync } from 'node:child_process';
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { ROOT, loadCodecs } from './node_codecs.mjs';
+import { startRangeServer, launchChromium, playClip, renderEyePath } from './browser.mjs';
+import { readPng, psnr } from './frames.mjs';
+import { bytesSource, openClip, readChunk } from '../src/container.js';
+import { parseViewIndex } from '../src/lightfield.js';
+
+const MIN_DB = 40;
+const chromium = process.argv[2] ?? '/usr/bin/chromium';
+const bin = process.env.CALF_BIN;
+if (!bin) {
+  console.log('web.av1: CALF_BIN (the directory of calf-play) is not set');
+  process.exit(1);
+}
+const clipPath = 'tests/conformance/lightfield/av1_pred16m.calf';
+const want = readFileSync(join(ROOT, clipPath.replace(/\.calf$/, '.hashes')), 'utf8').split('\n').filter(Boolean);
+// The AV1 clip of the decoder's fuzz corpus, which must decode without a problem.
+const fuzzClip = 'tests/fuzz/corpus/clip_decoder_fuzz/valid_av1_f16_5fr.calf';
+const dir = mkdtempSync(join(process.env.CALF_WEB_TMP ?? tmpdir(), 'calf-web-av1-'));
+
+// The eye path: from the views' centre, looking along four directions, at frames 0 … 3 (a
+// frame's start time plus a quarter frame).
+const { codecs } = await loadCodecs();
+const clip = await openClip(bytesSource(new Uint8Array(readFileSync(join(ROOT, clipPath)))), codecs);
+const h = clip.tracks[0].header, fps = h.fps_numerator / h.fps_denominator;
+const positions = [];
+for (const c of clip.chunks) {
+  if (c.track === 0 && c.stream === 0) positions.push(parseViewIndex(await readChunk(clip, c.id), 'index', h.material_format).position);
+}
+const centre = [0, 1, 2].map((k) => positions.reduce((s, p) => s + p[k], 0) / positions.length);
+const looks = [[1, 0, 0.3], [-0.2, 0.1, 1], [-1, -0.3, 0], [0.3, 0.2, -1]];
+const path = { format: 'calf-eye-path', version: 1, width: 64, height: 48, fov_y_degrees: 70,
+  poses: looks.map((f, i) => ({ time: (i + 0.25) / fps, fov_y_degrees: 70, position: centre, forward: f, up: [0, 1, 0] })) };
+writeFileSync(join(dir, 'eye_path.json'), JSON.stringify(path));
+const played = execFileSync(join(bin, 'calf-play'), [join(ROOT, clipPath), '--headless', '--eye-path', join(dir, 'eye_path.json'), '--out', join(dir, 'play')],
+  { encoding: 'utf8', stdio: ['ignore', 'pipe', 'pipe'] });
+const native = [...played.matchAll(/^pose (\d+) frame \d+: (\d+) views, (\d+)\/(\d+) cells, .*render ([0-9.]+) ms/gm)]
+  .map((m) => ({ views: Number(m[2]), cells: Number(m[3]), total: Number(m[4]), ms: Number(m[5]) }));
+if (native.length !== path.poses.length) throw new Error(`calf-play gave ${native.length} pose lines: ${played}`);
+
+const { server, port } = await startRangeServer();
+const problems = [];
+const browser = await launchChromium(chromium);
+const t0 = Date.now();
+try {
+  const held = {};
+  const { page, consoleLines, ready, overlay } = await playClip(browser, held, `http://127.0.0.1:${port}`, `/${clipPath}`);
+  if (!ready) throw new Error(`the page did not open ${clipPath}: ${overlay} ${consoleLines.join(' | ')}`);
+  // The page's decoder, with the page's codecs (WebCodecs for AV1), on the whole clip; then with
+  // one unit of the first colour chunk made garbage (every byte 0xff, its size kept).
+  const got = await page.evaluate(async ({ url, fuzzUrl }) => {
+    const { decodeLines } = await import('/web/src/hash_lines.js');
+    const codecs = window.calfPlayer.lf.clip.codecs;
+    const bytes = new Uint8Array(await (await fetch(url)).arrayBuffer());
+    const t = performance.now();
+    const clean = await decodeLines(bytes, codecs);
+    const ms = performance.now() - t;
+    let damaged;
+    try {
+      damaged = await decodeLines(bytes, codecs, (clip) => {
+        const c = clip.chunks.find((x) => x.stream === 1 && x.frameCount > 1);
+        const raw = clip.chunkCache.get(c.id), v = new DataView(raw.buffer, raw.byteOffset, raw.length);
+        const at = 4 + 4 * v.getUint32(0, true) + v.getUint32(4, true);  // unit 1
+        raw.fill(0xff, at, at + v.getUint32(8, true));
+      });
+    } catch (e) {
+      damaged = { lines: [], problems: [e.message] };
+    }
+    const fuzz = await decodeLines(new Uint8Array(await (await fetch(fuzzUrl)).arrayBuffer()), codecs);
+    return { clean, ms, damaged: damaged.problems[0] ?? null, fuzz: { lines: fuzz.lines.length, problem: fuzz.problems[0] ?? null } };
+  }, { url: `/${clipPath}`, fuzzUrl: `/${fuzzClip}` });
+  const diffs = [];
+  for (let i = 0; i < Math.max(want.length, got.clean.lines.length); ++i) {
+    if (want[i] !== got.clean.lines[i]) diffs.push(`line ${i + 1}: expected '${want[i] ?? ''}', got '${got.clean.lines[i] ?? ''}'`);
+  }
+  console.log(`web.av1: av1_pred16m in the page's decoder (WebCodecs): ${want.length - diffs.length} of ${want.length} hash lines reproduced, ` +
+    `${got.ms.toFixed(0)} ms${got.clean.problems.length ? ` (${got.clean.problems[0]})` : ''}`);
+  for (const d of diffs.slice(0, 5)) problems.push(`conformance: ${d}`);
+  if (got.clean.problems.length) problems.push(`conformance: ${got.clean.problems[0]}`);
+  console.log(`web.av1: ${fuzzClip}: ${got.fuzz.lines} lines, ${got.fuzz.problem ?? 'no problem'}`);
+  if (got.fuzz.problem || got.fuzz.lines === 0) problems.push(`${fuzzClip}: ${got.fuzz.lines} lines, ${got.fuzz.problem ?? 'no problem'}`);
+  console.log(`web.av1: a garbage temporal unit: ${got.damaged ?? 'no problem'}`);
+  if (!got.damaged?.startsWith('CALF-E301 ')) problems.push(`a garbage temporal unit gave ${got.damaged ?? 'no problem'}, not CALF-E301`);
+
+  // Playback against calf-play.
+  const frames = [];
+  await renderEyePath(page, path, (i, r, rgb) => {
+    const png = readPng(join(dir, 'play', `frame_${String(i).padStart(5, '0')}.png`));
+    const db = psnr(rgb, png.rgb), n = native[i];
+    frames.push(rgb);
+    console.log(`web.av1: pose ${i} frame ${r.frame}: ${r.active.length} views, ${r.visibleCells}/${r.totalCells} cells (calf-play ${n.views}, ${n.cells}/${n.total}), ` +
+      `${db.toFixed(2)} dB against calf-play; render ${r.renderMs.toFixed(1)} ms (SwiftShader) against calf-play's ${n.ms} ms (llvmpipe)`);
+    if (r.frame !== i) problems.push(`pose ${i}: frame ${r.frame}`);
+    if (r.active.length !== n.views || r.visibleCells !== n.cells || r.totalCells !== n.total) problems.push(`pose ${i}: views or cells differ from calf-play's`);
+    if (!(db >= MIN_DB)) problems.push(`pose ${i}: ${db.toFixed(2)} dB against calf-play, below ${MIN_DB}`);
+    if (new Set(rgb).size < 4) problems.push(`pose ${i}: the canvas is blank`);
+  }, (i, message) => problems.push(`pose ${i}: ${message}`));
+
+  // Garbage units while playing: every colour chunk's units after the first made garbage in the
+  // cache, then the first pose at frame 1 (its cells' decoders go on from frame 0 … 3, so they
+  // restart at a key frame; frame 1's unit is garbage).
+  const bad = await page.evaluate(async (camera) => {
+    const p = window.calfPlayer, cache = p.lf.clip.chunkCache;
+    for (const c of p.lf.clip.chunks) {
+      if (c.stream !== 1 || c.frameCount < 2 || !cache.has(c.id)) continue;
+      const raw = cache.get(c.id).slice(), v = new DataView(raw.buffer);
+      const at = 4 + 4 * v.getUint32(0, true) + v.getUint32(4, true);
+      raw.fill(0xff, at);
+      cache.set(c.id, raw);
+    }
+    const before = Array.from(p.pixels());
+    let thrown = null;
+    try { await p.renderPose(camera, 1.25 / p.fps); } catch (e) { thrown = e.message; }
+    const after = Array.from(p.pixels());
+    return { thrown, overlay: document.getElementById('overlay').textContent, same: before.every((x, i) => x === after[i]) };
+  }, { position: path.poses[0].position, forward: path.poses[0].forward, up: [0, 1, 0], fovY: (70 * Math.PI) / 180, width: 64, height: 48 });
+  console.log(`web.av1: garbage units while playing: overlay '${bad.overlay}', the last frame ${bad.same ? 'stays' : 'changed'}`);
+  if (!bad.overlay.startsWith('CALF-E301 ') || bad.overlay.includes('\n')) problems.push(`garbage units while playing: overlay '${bad.overlay}'`);
+  if (!bad.same) problems.push('garbage units while playing: the canvas changed');
+} finally {
+  await browser.close();
+  server.kill();
+}
+console.log(`web.av1: ${((Date.now() - t0) / 1000).toFixed(1)} s in Chromium`);
+for (const p of problems) console.log(`web.av1: FAIL ${p}`);
+if (problems.length === 0) rmSync(dir, { recursive: true, force: true });
+else console.log(`web.av1: its files are kept in ${dir}`);
+process.exit(problems.length ? 1 : 0);
