@@ -33,6 +33,7 @@ import shlex
 import statistics
 import subprocess
 import sys
+import textwrap
 import time
 
 ROOT = os.path.realpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
@@ -198,8 +199,12 @@ class Context:
     def __init__(self, build, out):
         self.build, self.out = build, out
         self.demo = os.path.join(ROOT, "build/demo")
-        self.commit, self.machine = commit(), machine()
-        self.date = datetime.date.today().isoformat()
+        if REUSE and "commit" in STATE:
+            self.commit, self.machine, self.date = STATE["commit"], STATE["machine"], STATE["date"]
+        else:
+            self.commit, self.machine = commit(), machine()
+            self.date = datetime.date.today().isoformat()
+            STATE.update(commit=self.commit, machine=self.machine, date=self.date)
         self.loads, self.seconds, self.done = {}, {}, set()
 
     def stamp(self, name, what):
@@ -388,6 +393,12 @@ BC_BENCH_ARGS = ["--quick", "--repeats", "1"]
 
 # ---------------------------------------------------------------------------------------------
 # Writing blocks.
+def para(*sentences):
+    """One paragraph of prose, wrapped at 100 columns like the pages around it."""
+    return textwrap.fill(" ".join(sentences), width=100, break_long_words=False,
+                         break_on_hyphens=False)
+
+
 def n(value):
     return f"{value:,}"
 
@@ -442,11 +453,11 @@ def write_encoder(ctx):
                     f"{e['seconds']:.2f} ({s['encode_wall']:.1f}) | {e['rss']:.0f} | "
                     f"{p['psnr']:.2f} / {p['ssim']:.4f} ({p['floor']:.2f}) |")
     return "\n".join([
-        ctx.stamp("encoder", "scenes"),
-        f"Built-in scenes captured at {FACE}² faces over {FRAMES} frames with their default rigs, "
-        "encoded at calf-encode's defaults; \"encode s\" is calf-encode's own figure (the wall "
-        "time with reading the EXR set in brackets); PSNR / SSIM is calf-play's mean over the "
-        f"{FRAMES} ground-truth poses at {GT}.", "", *rows, "", scenes_command()])
+        para(ctx.stamp("encoder", "scenes"),
+             f"Built-in scenes captured at {FACE}² faces over {FRAMES} frames with their default rigs, "
+             "encoded at calf-encode's defaults; \"encode s\" is calf-encode's own figure (the wall "
+             "time with reading the EXR set in brackets); PSNR / SSIM is calf-play's mean over the "
+             f"{FRAMES} ground-truth poses at {GT}."), "", *rows, "", scenes_command()])
 
 
 def write_decoder(ctx):
@@ -458,10 +469,10 @@ def write_decoder(ctx):
         rows.append(f"| {scene} | {n(s['bytes'])} | {s['verify']:.2f} | {p['decode']:.2f} / "
                     f"{p['decode_median']:.2f} | {p['mbps']:.2f} |")
     return "\n".join([
-        ctx.stamp("decoder", "scenes"),
-        f"The clips of ENCODER.md's table ({FACE}² faces, {FRAMES} frames); decode time is "
-        "calf-play's view-dependent decoder along the ground-truth path, one thread, its first "
-        "frame (everything visible uploaded) included in the mean.", "", *rows, "",
+        para(ctx.stamp("decoder", "scenes"),
+             f"The clips of ENCODER.md's table ({FACE}² faces, {FRAMES} frames); decode time is "
+             "calf-play's view-dependent decoder along the ground-truth path, one thread, its first "
+             "frame (everything visible uploaded) included in the mean."), "", *rows, "",
         scenes_command()])
 
 
@@ -475,11 +486,11 @@ def write_player(ctx):
             rows.append(f"| {scene}{label} | {p['psnr']:.2f} / {p['ssim']:.4f} | {p['floor']:.2f} "
                         f"| {p['first']:.0f} / {p['render']:.0f} | {n(s['bytes'])} |")
     return "\n".join([
-        ctx.stamp("player", "scenes"),
-        f"calf-play's defaults (64 steps, one ray a pixel), GL on llvmpipe, against ground truth "
-        f"at {GT} along each scene's {FRAMES}-pose eye path; the noise floor is the ground truth "
-        f"against another seed. Captures at {FACE}² faces, {FRAMES} frames, the default rigs.",
-        "", *rows, "", scenes_command()])
+        para(ctx.stamp("player", "scenes"),
+             f"calf-play's defaults (64 steps, one ray a pixel), GL on llvmpipe, against ground truth "
+             f"at {GT} along each scene's {FRAMES}-pose eye path; the noise floor is the ground truth "
+             f"against another seed. Captures at {FACE}² faces, {FRAMES} frames, the default rigs."),
+             "", *rows, "", scenes_command()])
 
 
 def write_rendering(ctx):
@@ -489,11 +500,11 @@ def write_rendering(ctx):
     if len(keep) < 2:
         raise SystemExit("docs_figures: no table in bench-gl_render's output")
     return "\n".join([
-        ctx.stamp("rendering", "gl_render"),
-        "bench-gl_render's synthetic room (the eye between the views), the GL renderer at "
-        "RenderOptions' defaults; median of the frames (draw + read-back) after the first; "
-        "`cpu-time` is the process's CPU time a frame over llvmpipe's threads; the peer is the "
-        "CPU reference on the same frame with 2 threads. " + " ".join(head), "",
+        para(ctx.stamp("rendering", "gl_render"),
+             "bench-gl_render's synthetic room (the eye between the views), the GL renderer at "
+             "RenderOptions' defaults; median of the frames (draw + read-back) after the first; "
+             "`cpu-time` is the process's CPU time a frame over llvmpipe's threads; the peer is the "
+             "CPU reference on the same frame with 2 threads. " + " ".join(head)), "",
         "```", *keep, "```", "",
         "```", "build/release/tests/bench-gl_render " + shlex.join(GL_RENDER_ARGS), "```"])
 
@@ -518,11 +529,11 @@ def write_tiles(ctx):
             f"| light field (all {FRAMES} frames) | {n(lf_bytes)} | {lf['psnr']:.2f} / "
             f"{lf['ssim']:.4f} | {lf['floor']:.2f} | {lf['render']:.1f} |"]
     return "\n".join([
-        ctx.stamp("tiles", "demo"),
-        f"The demo's tiles part: frame 0 of its interior capture ({FACE}² faces, 9 views), "
-        "calf-encode --mode tiles at its defaults (budget 72,000 triangles), played with "
-        f"calf-play's defaults (GL on llvmpipe) along the scene's eye path at {GT} with the scene "
-        "held at frame 0, beside the light field on the same poses.", "", *rows, "", "```",
+        para(ctx.stamp("tiles", "demo"),
+             f"The demo's tiles part: frame 0 of its interior capture ({FACE}² faces, 9 views), "
+             "calf-encode --mode tiles at its defaults (budget 72,000 triangles), played with "
+             f"calf-play's defaults (GL on llvmpipe) along the scene's eye path at {GT} with the scene "
+             "held at frame 0, beside the light field on the same poses."), "", *rows, "", "```",
         f"calf-capture --scene interior --out cap --face-size {FACE} --frames {FRAMES}",
         "calf-encode --mode tiles cap -o tiles.calf --tiles-triangles 72000",
         "calf-encode cap -o lightfield.calf",
@@ -552,25 +563,25 @@ def write_visibility(ctx):
     frame = grab(r"^frame time \(([^)]*)\): (.*)$", play, "frame time", str)
     line = against_full(play, "vs-play.log")
     return "\n".join([
-        ctx.stamp("visibility", "demo"),
-        "The demo's visible-set part: the built-in `city`, its view region's perimeter "
-        "(the builder's cube faces 200², 6 frames), played with calf-play's defaults (GL on "
-        "llvmpipe, 320 × 240) along the scene's walk inside the region against the full scene.",
-        "", "| figure | value |", "|---|---|",
-        f"| triangles kept | {n(int(kept))} of {n(int(total_tris))} ({pct} %), from {segments} "
-        "segments |",
-        f"| calf-encode --visible-set wall s | {build_s:.1f} |",
-        f"| mesh clip bytes | {n(vis)} (the full scene: {n(full)}) |",
-        f"| frame time ({frame[0]}) | {frame[1]} |",
-        f"| {line.split(':', 1)[0]} | {line.split(':', 1)[1].strip() if ':' in line else ''} |",
-        "", "```",
-        "calf-capture --scene city --export-scene scene --frames 6",
-        "calf-encode --mode mesh scene -o full.calf",
-        "calf-encode --mode mesh scene -o visible.calf --visible-set --visibility-face-size 200",
-        "calf-capture --scene city --out walk --ground-truth --gt-size 320x240 --ao-samples 0 \\",
-        "  --max-bounces 0 --spp 1 --no-noise-floor --frames 6",
-        "calf-play visible.calf --headless --eye-path walk/eye_path.json --compare-clip full.calf",
-        "```"])
+        para(ctx.stamp("visibility", "demo"),
+             "The demo's visible-set part: the built-in `city`, its view region's perimeter "
+             "(the builder's cube faces 200², 6 frames), played with calf-play's defaults (GL on "
+             "llvmpipe, 320 × 240) along the scene's walk inside the region against the full scene."),
+             "", "| figure | value |", "|---|---|",
+             f"| triangles kept | {n(int(kept))} of {n(int(total_tris))} ({pct} %), from {segments} "
+             "segments |",
+             f"| calf-encode --visible-set wall s | {build_s:.1f} |",
+             f"| mesh clip bytes | {n(vis)} (the full scene: {n(full)}) |",
+             f"| frame time ({frame[0]}) | {frame[1]} |",
+             f"| {line.split(':', 1)[0]} | {line.split(':', 1)[1].strip() if ':' in line else ''} |",
+             "", "```",
+             "calf-capture --scene city --export-scene scene --frames 6",
+             "calf-encode --mode mesh scene -o full.calf",
+             "calf-encode --mode mesh scene -o visible.calf --visible-set --visibility-face-size 200",
+             "calf-capture --scene city --out walk --ground-truth --gt-size 320x240 --ao-samples 0 \\",
+             "  --max-bounces 0 --spp 1 --no-noise-floor --frames 6",
+             "calf-play visible.calf --headless --eye-path walk/eye_path.json --compare-clip full.calf",
+             "```"])
 
 
 def write_surfels(ctx):
@@ -586,11 +597,11 @@ def write_surfels(ctx):
     frame = grab(r"^frame time \(([^)]*)\): (.*)$", play, "frame time", str)
     line = against_full(play, "sf-play.log")
     return "\n".join([
-        ctx.stamp("surfels", "demo"),
-        "The demo's surfel part: the built-in `factory` (28 M triangles counting instances), "
-        "candidates ray-cast at a 128² G-buffer, at most 8,192 surfels a prototype, played with "
-        "calf-play's defaults (GL on llvmpipe, 320 × 240) along its ground-level walk (2 poses) "
-        "against the full mesh.", "", "| figure | value |", "|---|---|",
+        para(ctx.stamp("surfels", "demo"),
+             "The demo's surfel part: the built-in `factory` (28 M triangles counting instances), "
+             "candidates ray-cast at a 128² G-buffer, at most 8,192 surfels a prototype, played with "
+             "calf-play's defaults (GL on llvmpipe, 320 × 240) along its ground-level walk (2 poses) "
+             "against the full mesh."), "", "| figure | value |", "|---|---|",
         f"| surfels | {n(surfels)} of {n(cands)} candidates, {per} bytes a surfel |",
         f"| build wall s | {cand_s + build_s:.1f} (candidates {cand_s:.1f} + surfels "
         f"{build_s:.1f}) |",
@@ -618,12 +629,12 @@ def write_block_codecs(ctx):
     if len(rows) < 4:
         raise SystemExit("docs_figures: no MEAN/synthetic rows in bench-bc_bench's output")
     return "\n".join([
-        ctx.stamp("block_codecs", "bc_bench"),
-        "bench-bc_bench's synthetic set (512² images: gradient, value-noise texture, hard edges, "
-        "white noise, procedural render; BC4 / BC5 on R / RG of the same images; BC6H on its HDR "
-        "set: a 24-stop ramp, a sunlit render, log-uniform noise), one thread, means over the "
-        "set (an exact image counts as 99 dB), `--quick` (BC1 q2, BC7 q2 and BC6H q2 left out). "
-        + " ".join(g.strip() + "." for g in gains), "", *rows, "",
+        para(ctx.stamp("block_codecs", "bc_bench"),
+             "bench-bc_bench's synthetic set (512² images: gradient, value-noise texture, hard edges, "
+             "white noise, procedural render; BC4 / BC5 on R / RG of the same images; BC6H on its HDR "
+             "set: a 24-stop ramp, a sunlit render, log-uniform noise), one thread, means over the "
+             "set (an exact image counts as 99 dB), `--quick` (BC1 q2, BC7 q2 and BC6H q2 left out). "
+             + " ".join(g.strip() + "." for g in gains)), "", *rows, "",
         "```", "build/release/tests/bench-bc_bench " + shlex.join(BC_BENCH_ARGS), "```"])
 
 
