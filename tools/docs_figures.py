@@ -199,19 +199,22 @@ class Context:
     def __init__(self, build, out):
         self.build, self.out = build, out
         self.demo = os.path.join(ROOT, "build/demo")
-        if REUSE and "commit" in STATE:
-            self.commit, self.machine, self.date = STATE["commit"], STATE["machine"], STATE["date"]
-        else:
-            self.commit, self.machine = commit(), machine()
-            self.date = datetime.date.today().isoformat()
-            STATE.update(commit=self.commit, machine=self.machine, date=self.date)
+        self.commit, self.machine = commit(), machine()
+        self.date = datetime.date.today().isoformat()
         self.loads, self.seconds, self.done = {}, {}, set()
+
+    def where(self, what):
+        """(commit, date, machine) of measurement WHAT: now, or as --reuse found it noted."""
+        run = STATE.get("runs", {}).get(what, {})
+        return (run.get("commit", self.commit), run.get("date", self.date),
+                run.get("machine", self.machine))
 
     def stamp(self, name, what):
         """The block's first line: who measured it, where and when."""
-        return (f"Measured by `tools/docs_figures.sh --only {name}` at commit {self.commit} "
-                f"({self.date}), Release build, on {self.machine} (load average "
-                f"{self.loads[what]} when it started; GL is Mesa's llvmpipe on the CPU).")
+        at, date, host = self.where(what)
+        return (f"Measured by `tools/docs_figures.sh --only {name}` at commit {at} ({date}), "
+                f"Release build, on {host} (load average {self.loads[what]} when it started; GL "
+                "is Mesa's llvmpipe on the CPU).")
 
 
 def log(message):
@@ -249,6 +252,8 @@ def mark(ctx, what):
         ctx.loads[what] = STATE["loads"].get(what, "unknown")
     else:
         ctx.loads[what] = STATE["loads"][what] = load_average()
+        STATE.setdefault("runs", {})[what] = dict(commit=ctx.commit, date=ctx.date,
+                                                  machine=ctx.machine)
 
 
 def read(path):
@@ -428,14 +433,16 @@ def write_demo(ctx):
                 else "installing the missing packages")
     build = ("the Release build made from scratch" if STATE.get("demo_fresh_build")
              else "the Release build already there")
-    text = (f"The demo took **{total:.1f} s** wall on {ctx.machine} (load average "
-            f"{ctx.loads['demo']} when it started; {packages}, {build}; commit {ctx.commit}, "
-            f"{ctx.date}); its light field played at {psnr:.2f} dB PSNR, {ssim:.4f} SSIM against "
+    at, date, host = ctx.where("demo")
+    text = (f"The demo took **{total:.1f} s** wall on {host} (load average "
+            f"{ctx.loads['demo']} when it started; {packages}, {build}; commit {at}, "
+            f"{date}); its light field played at {psnr:.2f} dB PSNR, {ssim:.4f} SSIM against "
             f"ground truth (noise floor {floor:.2f} dB), from a {clip:.2f} MB clip.")
     if STATE.get("full_run_s"):
         text += (f" `tools/docs_figures.sh` re-measured it and every figures block of docs/ "
-                 f"(`--list` names them) in {STATE['full_run_s']:.0f} s wall.")
-    return text
+                 f"(`--list` names them) in {STATE['full_run_s']:.0f} s wall (load average "
+                 f"{STATE['full_run_load']} at the end).")
+    return para(text)
 
 
 def write_encoder(ctx):
@@ -700,6 +707,9 @@ def main():
     if not REUSE:
         if not args.only:
             STATE["full_run_s"] = time.monotonic() - t_start
+            STATE["full_run_load"] = load_average()
+        elif "demo" in names:
+            STATE.pop("full_run_s", None)  # the demo's figure no longer comes from a full run
         with open(state_path + ".tmp", "w") as f:
             json.dump(STATE, f, indent=1, sort_keys=True)
         os.replace(state_path + ".tmp", state_path)
