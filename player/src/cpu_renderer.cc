@@ -92,6 +92,8 @@ Status validate_render_options(const RenderOptions& o, size_t view_count) {
   if (o.coverage_agreement < 1 || o.coverage_agreement > 65536) {
     return option_error("coverage_agreement is outside [1, 65536]");
   }
+  if (o.coverage_layers > 8) return option_error("coverage_layers is above 8");
+  if (o.coverage_alpha > 2) return option_error("coverage_alpha is not 0, 1 or 2");
   if (!std::isfinite(o.min_view_distance)) return option_error("min_view_distance is not finite");
   if (o.threads < 1 || o.threads > 256) return option_error("threads is outside [1, 256]");
   if (o.supersample < 1 || o.supersample > 8) return option_error("supersample is outside [1, 8]");
@@ -131,13 +133,20 @@ namespace {
 // in the view's log-16 code units: > 0 in front (empty for this view), <= 0 at or behind the
 // surface; +inf where the view sees sky. The depth compared with is depth_footprint's rule
 // (see RenderOptions), or the interpolated depth where the taps form one smooth surface.
+// Excluded depth codes (RenderOptions::coverage_layers): taps with codes in [lo, hi] are absent
+// (read as sky). An empty band (lo > hi) excludes nothing.
+struct Band {
+  double lo = 1, hi = 0;
+  uint16_t apply(uint16_t code) const { return code >= lo && code <= hi ? kLog16Sky : code; }
+};
+
 double code_margin(const View& v, const Vec3& x, double r, double footprint,
-                   double smooth_log_ratio) {
+                   double smooth_log_ratio, const Band& band = {}) {
   const internal::BilinearTaps taps =
       internal::bilinear_taps(texel_coord_from_direction(x, v.face_size()), v.face_size());
   uint16_t c[4], lo = kLog16Sky, hi = 0;
   for (int k = 0; k < 4; ++k) {
-    c[k] = v.depth_code_at(taps.texel[k].face, taps.texel[k].x, taps.texel[k].y);
+    c[k] = band.apply(v.depth_code_at(taps.texel[k].face, taps.texel[k].x, taps.texel[k].y));
     lo = std::min(lo, c[k]);
     hi = std::max(hi, c[k]);
   }
@@ -239,6 +248,56 @@ double coverage_margin(const View& v, const Vec3& x, double r, double margin, ui
   return back == kLog16Sky ? kInf : back - rcode;
 }
 
+// The band of v's depth codes around the point q (RenderOptions::coverage_layers): within a
+// relative depth `cluster` of |q - P_v|.
+Band exclusion_band(const View& v, const Vec3& q, double cluster) {
+  const double code = v.range().normalized_from_depth(length(q - v.position())) * kLog16MaxFinite;
+  const double half = cluster / v.range().relative_step();
+  return {code - half, code + half};
+}
+
+// The share of direction x (at distance r) that view v's surface at distance r covers, read from
+// its coverage masks bilinearly between cell centres (RenderOptions::coverage_layers); cells of
+// texels nearer than r (the view does not see the point there) do not count, and -1 where no
+// cell counts.
+double coverage_alpha_of_view(const View& v, const Vec3& x, double r, double cluster) {
+  const uint32_t n = v.face_size();
+  const FaceTexelCoord fc = texel_coord_from_direction(x, n);
+  const double rcode = v.range().normalized_from_depth(r) * kLog16MaxFinite;
+  const double half = cluster / v.range().relative_step();
+  const double qx = 4 * fc.u - 0.5, qy = 4 * fc.v - 0.5;
+  const double fx0 = std::floor(qx), fy0 = std::floor(qy);
+  const double wx = qx - fx0, wy = qy - fy0;
+  double alpha = 0, wsum = 0;
+  for (int k = 0; k < 4; ++k) {
+    const int64_t cx = static_cast<int64_t>(fx0) + (k & 1),
+                  cy = static_cast<int64_t>(fy0) + (k >> 1);
+    const double w = ((k & 1) ? wx : 1 - wx) * ((k >> 1) ? wy : 1 - wy);
+    if (w == 0) continue;
+    const int64_t tx = cx >= 0 ? cx / 4 : -((-cx + 3) / 4),
+                  ty = cy >= 0 ? cy / 4 : -((-cy + 3) / 4);
+    const bool inside = tx >= 0 && ty >= 0 && tx < n && ty < n;
+    const Texel t = internal::texel_beyond_face(fc.face, tx, ty, n);
+    const uint16_t code = v.depth_code_at(t.face, t.x, t.y);
+    const Coverage cov = v.coverage_at(t.face, t.x, t.y);
+    const bool front = code != kLog16Sky && std::fabs(code - rcode) <= half;
+    const bool behind = code == kLog16Sky || code > rcode + half;
+    if (!front && !behind) continue;  // a nearer surface hides the point from the view here
+    double value;
+    if (inside) {
+      const int i = static_cast<int>(cx - 4 * tx), j = static_cast<int>(cy - 4 * ty);
+      const bool own = (cov.mask >> (4 * j + i)) & 1u;
+      const double other = cov.near + cov.far;
+      value = front ? (own ? 1.0 : 0.0) : behind && !own && other > 0 ? cov.near / other : 0.0;
+    } else {
+      value = front ? 1.0 - cov.near - cov.far : behind ? cov.near : 0.0;
+    }
+    alpha += w * value;
+    wsum += w;
+  }
+  return wsum > 0 ? std::clamp(alpha / wsum, 0.0, 1.0) : -1.0;
+}
+
 // `texels` texel angles of v (2 / face size radians each, a texel's width at the face centre) as
 // a relative depth, in v's log-16 code units: the scale of the hint margin and the mixed-texel
 // bend.
@@ -278,11 +337,12 @@ double CpuRenderer::tap_purity(const View& v, const Texel& t) const {
 // is not too near sees p in front of its stored surface (or sees sky there) by more than
 // `margin_texels` of its own texels, as relative depth margin_texels x 2 / face size (0 for the
 // plain test).
-bool CpuRenderer::empty_at(const Vec3& p) const {
-  return empty_beyond(p, 0, 0);
+bool CpuRenderer::empty_at(const Vec3& p, const Vec3* exclude) const {
+  return empty_beyond(p, 0, 0, exclude);
 }
 
-bool CpuRenderer::empty_beyond(const Vec3& p, double margin_texels, uint32_t vetoes_ignored) const {
+bool CpuRenderer::empty_beyond(const Vec3& p, double margin_texels, uint32_t vetoes_ignored,
+                               const Vec3* exclude) const {
   bool consulted = false;
   // Votes of views whose footprint test alone sees p as empty, and of those whose coverage does
   // where the footprint test does not: the latter count once coverage_agreement of them agree.
@@ -292,9 +352,14 @@ bool CpuRenderer::empty_beyond(const Vec3& p, double margin_texels, uint32_t vet
     const double r = length(x);
     if (r <= min_view_distance_) continue;
     consulted = true;
-    const double plain = code_margin(*v, x, r, options_.depth_footprint, smooth_log_ratio_);
-    const double m = coverage_margin(*v, x, r, plain, options_.coverage,
-                                     options_.coverage_threshold, options_.coverage_cluster);
+    // Behind an earlier layer the view's texels at that layer's depth are absent, and coverage
+    // has no more to say: the layer's own cells were composited already.
+    const Band band = exclude ? exclusion_band(*v, *exclude, options_.coverage_cluster) : Band{};
+    const double plain = code_margin(*v, x, r, options_.depth_footprint, smooth_log_ratio_, band);
+    const double m = exclude
+                         ? plain
+                         : coverage_margin(*v, x, r, plain, options_.coverage,
+                                           options_.coverage_threshold, options_.coverage_cluster);
     const double threshold = texel_angles_in_codes(*v, margin_texels);
     if (!(m > threshold)) continue;
     ++(plain > threshold ? vetoes : coverage_votes);
@@ -306,7 +371,8 @@ bool CpuRenderer::empty_beyond(const Vec3& p, double margin_texels, uint32_t vet
 }
 
 // RayIntersection: constant steps in the march's normalised log depth from `start` to far.
-bool CpuRenderer::intersect(const Vec3& o, const Vec3& d, double start, Hit* hit) const {
+bool CpuRenderer::intersect(const Vec3& o, const Vec3& d, double start, Hit* hit,
+                            const Vec3* exclude) const {
   const double log_ratio = std::log(options_.far / options_.near);
   const auto lin = [&](double x) { return options_.near * std::exp(x * log_ratio); };
   if (options_.tight_march_start) {
@@ -353,25 +419,27 @@ bool CpuRenderer::intersect(const Vec3& o, const Vec3& d, double start, Hit* hit
     // (the conservative footprint minimum would put the crossing in front of slanted surfaces,
     // where the other views then rightly see empty space). One fetch, also on the GPU.
     const Texel t = texel_from_direction(rel, v->face_size());
-    const uint16_t code = v->depth_code_at(t.face, t.x, t.y);
+    const Band band = exclude ? exclusion_band(*v, *exclude, options_.coverage_cluster) : Band{};
+    const uint16_t code = band.apply(v->depth_code_at(t.face, t.x, t.y));
     if (code == kLog16Sky) return 1;
     return code > v->range().normalized_from_depth(r) * kLog16MaxFinite ? 1 : 0;
   };
   int prev[kMaxHints] = {};
   for (uint32_t i = 0; i <= options_.steps; ++i) {
     const double x = i == options_.steps ? 1.0 : x0 + i * step;
-    if (!empty_at(o + d * lin(x))) {
+    if (!empty_at(o + d * lin(x), exclude)) {
       double lo = x - step, hi = x;
       if (i == 0) {
         lo = hi;  // already behind a surface at the first sample: nothing to refine
       } else {
         for (uint32_t k = 0; k < options_.refine_steps; ++k) {
           const double mid = 0.5 * (lo + hi);
-          (empty_at(o + d * lin(mid)) ? lo : hi) = mid;
+          (empty_at(o + d * lin(mid), exclude) ? lo : hi) = mid;
         }
       }
       hit->z = lin(0.5 * (lo + hi));
       hit->p = o + d * hit->z;
+      hit->hinted = false;
       return true;
     }
     // The hint views are followed at `surface_hint_substeps` points per step (one fetch each),
@@ -394,7 +462,7 @@ bool CpuRenderer::intersect(const Vec3& o, const Vec3& d, double start, Hit* hit
           }
           const double xc = 0.5 * (lo + hi);
           if (xc < found && !empty_beyond(o + d * lin(xc), options_.surface_hint_margin_texels,
-                                          options_.surface_hint_vetoes)) {
+                                          options_.surface_hint_vetoes, exclude)) {
             found = xc;
           }
         }
@@ -404,6 +472,7 @@ bool CpuRenderer::intersect(const Vec3& o, const Vec3& d, double start, Hit* hit
     if (found < kInf) {
       hit->z = lin(found);
       hit->p = o + d * hit->z;
+      hit->hinted = true;
       return true;
     }
   }
@@ -413,12 +482,13 @@ bool CpuRenderer::intersect(const Vec3& o, const Vec3& d, double start, Hit* hit
 // SampleColor over the active views and their blend (CalculateColor). Weights are kept as
 // logarithms and normalised by the largest, so no view's weight underflows to zero.
 void CpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* rgb, int* best_view,
-                                double* best_rgb) const {
+                                double* best_rgb, double* alpha) const {
   const double hit_distance = std::max(length(p - o), 1e-12);
   double sum[3] = {0, 0, 0}, wsum = 0, best = -kInf;
   struct Contribution {
-    double log_w, c[3];
+    double log_w, c[3], alpha;
   };
+  double min_alpha = 1, max_alpha = -1;
   // Views are few (the paper uses up to 16); a small fixed buffer would do, a vector is clearer.
   std::vector<Contribution> contributions;
   contributions.reserve(active_.size());
@@ -431,9 +501,16 @@ void CpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* rgb, int* 
     const FaceTexelCoord c = texel_coord_from_direction(x, v.face_size());
     const Texel nearest = texel_from_direction(x, v.face_size());
     const uint16_t ncode = v.depth_code_at(nearest.face, nearest.x, nearest.y);
+    const double view_alpha = alpha && v.has_coverage()
+                                  ? coverage_alpha_of_view(v, x, r, options_.coverage_cluster)
+                                  : 1.0;
+    if (view_alpha >= 0) {
+      min_alpha = std::min(min_alpha, view_alpha);
+      max_alpha = std::max(max_alpha, view_alpha);
+    }
     if (ncode == kLog16Sky) continue;  // this view sees past p: it has no colour for it
     const double ndiff = std::fabs(std::log(v.range().decode(ncode) / r));
-    Contribution k{-options_.depth_decay * ndiff, {0, 0, 0}};
+    Contribution k{-options_.depth_decay * ndiff, {0, 0, 0}, view_alpha};
     if (!options_.bilinear_color) {
       const float* col = v.color_at(nearest.face, nearest.x, nearest.y);
       for (int ch = 0; ch < 3; ++ch) k.c[ch] = col[ch];
@@ -471,12 +548,20 @@ void CpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* rgb, int* 
     }
     contributions.push_back(k);
   }
+  double asum = 0, awsum = 0;
   for (const Contribution& k : contributions) {
     const double w = std::exp(k.log_w - best);
     for (int ch = 0; ch < 3; ++ch) sum[ch] += w * k.c[ch];
     wsum += w;
+    if (k.alpha >= 0) asum += w * k.alpha, awsum += w;
   }
   for (int ch = 0; ch < 3; ++ch) rgb[ch] = wsum > 0 ? sum[ch] / wsum : 0.0;
+  if (alpha) {
+    *alpha = options_.coverage_alpha == 0   ? min_alpha
+             : options_.coverage_alpha == 2 ? (max_alpha >= 0 ? max_alpha : 1.0)
+             : awsum > 0                    ? asum / awsum
+                                            : 1.0;
+  }
 }
 
 // Sky has no parallax: every view sees it in the ray's own direction. Views whose depth there is
@@ -524,9 +609,46 @@ void CpuRenderer::shade_sky(const Vec3& /*origin*/, const Vec3& d, double* rgb) 
 }
 
 RaySample CpuRenderer::trace(const Vec3& origin, const Vec3& direction) const {
+  if (options_.coverage_layers > 0 && !options_.rr) return trace_layers(origin, direction);
   Hit hit;
   return shade_hit(origin, direction,
                    intersect(origin, direction, options_.near, &hit) ? &hit : nullptr);
+}
+
+// RenderOptions::coverage_layers: partly covered surfaces laid front to back over what the ray
+// meets behind them.
+RaySample CpuRenderer::trace_layers(const Vec3& o, const Vec3& d) const {
+  RaySample s;
+  s.depth = kInf;
+  double transmit = 1;
+  double start = options_.near;
+  Hit hit, previous;
+  for (uint32_t layer = 0;; ++layer) {
+    const bool found = intersect(o, d, start, &hit, layer > 0 ? &previous.p : nullptr);
+    double rgb[3] = {0, 0, 0}, alpha = 1;
+    if (found) {
+      int best;
+      shade_surface(
+          o, hit.p, rgb, &best, nullptr,
+          layer < options_.coverage_layers && (hit.hinted || !options_.coverage_layers_hints_only)
+              ? &alpha
+              : nullptr);
+      if (alpha > 1 - 1e-6) alpha = 1;
+    } else {
+      shade_sky(o, d, rgb);
+    }
+    for (int ch = 0; ch < 3; ++ch) s.rgb[ch] += transmit * alpha * rgb[ch];
+    // The pixel's depth: the layer that brings the accumulated opacity to 1/2.
+    if (transmit > 0.5 && transmit * (1 - alpha) <= 0.5) {
+      s.hit = found;
+      s.depth = found ? hit.z : kInf;
+    }
+    transmit *= 1 - alpha;
+    if (!found || alpha == 1) break;
+    previous = hit;
+    start = std::nextafter(hit.z, kInf);
+  }
+  return s;
 }
 
 RaySample CpuRenderer::shade_at(const Vec3& origin, const Vec3& direction, double depth) const {

@@ -27,6 +27,7 @@ Status option_error(const std::string& what) {
 // The CPU renderer's checks (both renderers accept the same options), plus the GL limits.
 Status check_options(const RenderOptions& o, size_t view_count) {
   CALF_RETURN_IF_ERROR(validate_render_options(o, view_count));
+  if (o.coverage_layers > 0) return option_error("coverage_layers is the CPU reference's only");
   const size_t active = o.active_views.empty() ? view_count : o.active_views.size();
   if (active > internal::kGlMaxActiveViews) {
     return option_error(std::to_string(active) + " active views, the GL renderer takes at most " +

@@ -227,7 +227,10 @@ RenderedImage box_down(const RenderedImage& in, uint32_t k) {
 uint32_t g_supersample = 1;
 bool g_breakdown = false;
 // --gt-depth: which eye rays are shaded at the reference's depth instead of where the march ends.
-enum class GtDepth { kNone, kAll, kSky };
+// kSurface: only where both the reference and the march end on a surface (the march's
+// sky-or-surface decision kept, its depth replaced); kDecision: only where they disagree about
+// sky (the decision replaced, the march's depth kept elsewhere).
+enum class GtDepth { kNone, kAll, kSky, kSurface, kDecision };
 GtDepth g_gt_depth = GtDepth::kNone;
 
 // Re-shades the rays of `img` (rendered by `renderer` from `cam`, one ray per pixel) that
@@ -240,7 +243,10 @@ void shade_at_reference_depth(const CpuRenderer& renderer, const Camera& cam,
     for (uint32_t i = 0; i < cam.width; ++i) {
       const size_t k = size_t{j} * cam.width + i;
       const double z = reference.depth[k];
-      if (g_gt_depth == GtDepth::kSky && !(std::isinf(z) && std::isfinite(img->depth[k]))) continue;
+      const bool ref_sky = std::isinf(z), img_sky = std::isinf(img->depth[k]);
+      if (g_gt_depth == GtDepth::kSky && !(ref_sky && !img_sky)) continue;
+      if (g_gt_depth == GtDepth::kSurface && (ref_sky || img_sky)) continue;
+      if (g_gt_depth == GtDepth::kDecision && ref_sky == img_sky) continue;
       const RaySample s = renderer.shade_at(cam.position, camera_ray(cam, frame, i, j), z);
       for (int ch = 0; ch < 3; ++ch) img->color[3 * k + ch] = static_cast<float>(s.rgb[ch]);
       img->depth[k] = static_cast<float>(s.depth);
@@ -446,6 +452,91 @@ std::vector<Score> measure(const char* section, std::vector<Pose>& poses, FrameC
   return mean;
 }
 
+// --montage: the worst silhouette region of one pose, ground truth beside renders with other
+// coverage settings. Each entry of `settings` is "M" (coverage mode M) or "M+L" (and
+// coverage_layers L); the window (`window` pixels square, scaled `scale` times, nearest) is the
+// one with the largest squared error of the first entry's render over the pixels that the
+// ground truth or that render shows as sky or next to a depth edge (the breakdown's grown, hole
+// and edge classes), searched on a grid of window / 4.
+void write_silhouette_montage(const fs::path& file, const Pose& p, const ViewSet& views,
+                              const RenderOptions& base, const std::vector<std::string>& settings,
+                              uint32_t window, uint32_t scale) {
+  const Camera cam = capture::camera_from_pose(p.pose, p.reference.width, p.reference.height);
+  const RenderedImage& ref = p.reference;
+  const uint32_t w = ref.width, h = ref.height;
+  window = std::min({window, w, h});
+  std::vector<RenderedImage> renders;
+  for (const std::string& setting : settings) {
+    RenderOptions o = base;
+    const size_t plus = setting.find('+');
+    o.coverage = static_cast<uint32_t>(std::stoul(setting.substr(0, plus)));
+    o.coverage_layers =
+        plus == std::string::npos ? 0 : static_cast<uint32_t>(std::stoul(setting.substr(plus + 1)));
+    o = need(march_range_for(views, cam.position, o));
+    const CpuRenderer renderer = need(CpuRenderer::make(views, o));
+    RenderedImage img;
+    if (Status s = renderer.render(cam, &img); !s.ok()) die(s);
+    renders.push_back(std::move(img));
+  }
+  const auto encoded = [](float linear) {
+    return srgb_from_linear(std::clamp(linear, 0.0f, 1.0f));
+  };
+  std::vector<double> se(size_t{w} * h, 0.0);
+  for (uint32_t j = 0; j < h; ++j) {
+    for (uint32_t i = 0; i < w; ++i) {
+      const size_t k = size_t{j} * w + i;
+      bool silhouette = false;
+      for (int dj = -1; dj <= 1; ++dj) {
+        for (int di = -1; di <= 1; ++di) {
+          const int64_t x = int64_t{i} + di, y = int64_t{j} + dj;
+          if (x < 0 || y < 0 || x >= w || y >= h) continue;
+          const float zn = ref.depth[size_t(y) * w + size_t(x)];
+          silhouette = silhouette || std::isinf(zn) || std::isinf(renders[0].depth[k]) ||
+                       std::fabs(zn / ref.depth[k] - 1) > 0.05f;
+        }
+      }
+      if (!silhouette) continue;
+      for (int c = 0; c < 3; ++c) {
+        const double d = encoded(renders[0].color[3 * k + c]) - encoded(ref.color[3 * k + c]);
+        se[k] += d * d;
+      }
+    }
+  }
+  uint32_t bx = 0, by = 0;
+  double worst = -1;
+  const uint32_t stride = std::max(window / 4, 1u);
+  for (uint32_t y0 = 0; y0 + window <= h; y0 += stride) {
+    for (uint32_t x0 = 0; x0 + window <= w; x0 += stride) {
+      double sum = 0;
+      for (uint32_t y = y0; y < y0 + window; ++y) {
+        for (uint32_t x = x0; x < x0 + window; ++x) sum += se[size_t{y} * w + x];
+      }
+      if (sum > worst) worst = sum, bx = x0, by = y0;
+    }
+  }
+  const uint32_t panels = 1 + static_cast<uint32_t>(renders.size()), side = window * scale;
+  const uint32_t gap = scale;  // a dark column between panels
+  const uint32_t out_w = panels * side + (panels - 1) * gap;
+  std::vector<float> out(size_t{3} * out_w * side, 0.0f);
+  for (uint32_t panel = 0; panel < panels; ++panel) {
+    const RenderedImage& img = panel == 0 ? ref : renders[panel - 1];
+    for (uint32_t y = 0; y < side; ++y) {
+      for (uint32_t x = 0; x < side; ++x) {
+        const size_t src = size_t{by + y / scale} * w + bx + x / scale;
+        const size_t dst = 3 * (size_t{y} * out_w + panel * (side + gap) + x);
+        for (int c = 0; c < 3; ++c) out[dst + c] = img.color[3 * src + c];
+      }
+    }
+  }
+  if (Status s = write_png(file, {out_w, side, out}); !s.ok()) die(s);
+  std::printf("montage %s: window %ux%u at (%u, %u), ground truth", file.string().c_str(), window,
+              window, bx, by);
+  for (size_t k = 0; k < settings.size(); ++k) {
+    std::printf(" | coverage %s", settings[k].c_str());
+  }
+  std::printf("\n");
+}
+
 std::vector<uint32_t> parse_list(const std::string& text) {
   std::vector<uint32_t> out;
   size_t at = 0;
@@ -507,6 +598,16 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--coverage-agreement", base.coverage_agreement, "coverage_agreement")
       ->capture_default_str();
+  app.add_option("--coverage-layers", base.coverage_layers,
+                 "coverage_layers: composite at most this many partly covered surfaces per ray "
+                 "(0 off)")
+      ->capture_default_str();
+  app.add_option("--coverage-alpha", base.coverage_alpha,
+                 "coverage_alpha: 0 the views' minimum, 1 their colour-weighted mean")
+      ->capture_default_str();
+  app.add_option("--coverage-layers-hints", base.coverage_layers_hints_only,
+                 "coverage_layers_hints_only (0/1): composite only surface hints' hits")
+      ->capture_default_str();
   double unmix = -1;
   app.add_option("--coverage-unmix-jump", g_unmix_jump,
                  "unmix only across depth steps above this relative depth")
@@ -544,19 +645,37 @@ int main(int argc, char** argv) {
                "print where the squared error sits: sky, grown, hole, edge, wrong depth, surface, "
                "mirror, glass pixels (not with --supersample)");
   app.add_option("--out", out_dir, "write renders, references and heat maps (PNG) here");
+  std::string montage_file, montage_arg = "0,3";
+  uint32_t montage_window = 48, montage_scale = 4;
+  app.add_option("--montage", montage_file,
+                 "write a PNG of the first picked pose's worst silhouette region: ground truth | "
+                 "one render per --montage-coverage entry (the window is the first entry's worst)");
+  app.add_option("--montage-coverage", montage_arg,
+                 "comma-separated: M (coverage mode) or M+L (and coverage_layers L)")
+      ->capture_default_str();
+  app.add_option("--montage-window", montage_window, "window side in pixels")
+      ->capture_default_str();
+  app.add_option("--montage-scale", montage_scale, "pixel scale of the montage")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
   std::string gt_depth_arg = "none";
   app.add_option("--gt-depth", gt_depth_arg,
                  "none; all: shade every eye ray at the reference's depth instead of where the "
                  "march ends (the error the shading leaves when the geometry is exact); sky: only "
                  "the rays that the reference sends to the sky and the march ends on a surface "
                  "(with --render-supersample 1; use --supersample K for anti-aliased figures; "
-                 "the ms column then includes the re-shading)")
-      ->check(CLI::IsMember({"none", "all", "sky"}))
+                 "the ms column then includes the re-shading); surface: only where both the "
+                 "reference and the march end on a surface (the march's silhouettes, exact "
+                 "depth); decision: only where they disagree about sky (exact silhouettes, the "
+                 "march's depth)")
+      ->check(CLI::IsMember({"none", "all", "sky", "surface", "decision"}))
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
-  g_gt_depth = gt_depth_arg == "all"   ? GtDepth::kAll
-               : gt_depth_arg == "sky" ? GtDepth::kSky
-                                       : GtDepth::kNone;
+  g_gt_depth = gt_depth_arg == "all"        ? GtDepth::kAll
+               : gt_depth_arg == "sky"      ? GtDepth::kSky
+               : gt_depth_arg == "surface"  ? GtDepth::kSurface
+               : gt_depth_arg == "decision" ? GtDepth::kDecision
+                                            : GtDepth::kNone;
   if (g_gt_depth != GtDepth::kNone && base.supersample != 1) {
     die(Status(ErrorId::kInvalidArgument,
                "--gt-depth needs --render-supersample 1: the reference has one depth per pixel"));
@@ -634,16 +753,35 @@ int main(int argc, char** argv) {
       "texels), tight start %d, "
       "hints %u (margin %.3f texels, vetoes %u, substeps %u), rr_start %.3f, rr replace %d, "
       "supersample %u (renderer %u), threads %u; coverage %u (threshold %.2f, cluster %.3f, "
-      "agreement %u, unmix %.2f)\n",
+      "agreement %u, unmix %.2f, layers %u, alpha rule %u)\n",
       m.scene.c_str(), m.viewpoints.size(), m.face_size, m.frame_count, base.steps,
       base.refine_steps, base.depth_footprint, base.smooth_depth_ratio, base.depth_decay,
       base.cam_decay, base.color_depth_tolerance, base.mixed_texel_penalty,
       base.mixed_texel_bend_texels, base.tight_march_start, base.surface_hints,
       base.surface_hint_margin_texels, base.surface_hint_vetoes, base.surface_hint_substeps,
       base.rr_start, base.rr_replace_view_reflection, g_supersample, base.supersample, base.threads,
-      base.coverage, base.coverage_threshold, base.coverage_cluster, base.coverage_agreement,
-      unmix);
+      base.coverage, base.coverage_threshold, base.coverage_cluster, base.coverage_agreement, unmix,
+      base.coverage_layers, base.coverage_alpha);
   FrameCache frames(reader, unmix);
+  if (!montage_file.empty()) {
+    if (between.empty()) die(Status(ErrorId::kInvalidArgument, "--montage needs --eye-path"));
+    std::vector<std::string> settings;
+    for (size_t at = 0; at < montage_arg.size();) {
+      size_t comma = montage_arg.find(',', at);
+      if (comma == std::string::npos) comma = montage_arg.size();
+      const std::string item = montage_arg.substr(at, comma - at);
+      if (item.empty() || item.find_first_not_of("0123456789+") != std::string::npos ||
+          item.front() == '+' || item.back() == '+') {
+        die(Status(ErrorId::kInvalidArgument, "--montage-coverage: bad entry '" + item + "'"));
+      }
+      settings.push_back(item);
+      at = comma + 1;
+    }
+    const Pose& p = between.front();
+    write_silhouette_montage(montage_file, p, frames.at(capture_frame_at(m, p.pose.time)), base,
+                             settings, montage_window, montage_scale);
+    return 0;
+  }
   if (!between.empty()) measure("between", between, frames, m, variants, out_dir, false);
   if (!vp_gt_file.empty()) {
     const capture::EyePath vp = need(capture::read_eye_path(vp_gt_file));

@@ -517,6 +517,83 @@ TEST(CpuRenderer, CoverageAgreementKeepsThinParts) {
   EXPECT_GT(agreed, 0.94 * off);
 }
 
+// Compositing partly covered surfaces (RenderOptions::coverage_layers): the sphere of
+// CoveragePlacesSilhouettesInsideTexels between four coarse anti-aliased views. Where the march
+// ends on the sphere but the eye ray misses it (the footprint rule grows the silhouette by up to
+// a texel), the views' cell masks say the point is uncovered and the ray goes on to the sky
+// behind; rays well inside the silhouette keep nearly their colour. Counted: the squared colour
+// error against the ground truth of the pixels the march grows onto the sphere, and of those
+// well inside it.
+TEST(CpuRenderer, CoverageLayersShowTheSkyBehindGrownSilhouettes) {
+  Scene scene;
+  scene.room = false;
+  scene.uniform_sky = true;
+  scene.spheres = {{{0.05, -0.03, -2.0}, 0.3}};
+  const std::vector<Vec3> pos = {
+      {-0.3, 0.1, 0.2}, {0.3, -0.1, 0.2}, {0.1, 0.3, 0.1}, {-0.1, -0.3, 0.1}};
+  ViewSet views = make_views(scene, pos, 32, false, 4);
+  for (View& v : views.views) testing::add_coverage(scene, &v);
+  const Vec3 eye = {0.04, 0.03, 0.1};
+  Camera cam;
+  cam.position = eye;
+  cam.forward = testing::unit(testing::sub(scene.spheres[0].centre, eye));
+  cam.fov_y = 24 * kPi / 180;
+  cam.width = cam.height = 96;
+  const RenderedImage gt = ground_truth(scene, cam);
+  RenderOptions o;
+  o.steps = 128;
+  const RenderedImage off = render(views, cam, o);
+  o.coverage_layers = 2;
+  o.coverage_alpha = 1;
+  const RenderedImage layered = render(views, cam, o);
+  o.coverage_layers_hints_only = true;
+  const RenderedImage hinted = render(views, cam, o);
+  double grown_off = 0, grown_layered = 0, grown_hinted = 0;
+  double inside_off = 0, inside_layered = 0, inside_hinted = 0;
+  size_t grown = 0, inside = 0;
+  const auto se = [&](const RenderedImage& img, size_t k) {
+    double e = 0;
+    for (int c = 0; c < 3; ++c) e += std::pow(img.color[3 * k + c] - gt.color[3 * k + c], 2);
+    return e;
+  };
+  for (size_t k = 0; k < gt.depth.size(); ++k) {
+    if (!std::isfinite(gt.depth[k]) && std::isfinite(off.depth[k])) {
+      ++grown;
+      grown_off += se(off, k);
+      grown_layered += se(layered, k);
+      grown_hinted += se(hinted, k);
+    }
+    // Well inside: the ground truth's sphere covers the pixels within 12 of it (a texel of the
+    // views is about 11 eye pixels).
+    constexpr int kBorder = 12;
+    const int i = static_cast<int>(k % cam.width), j = static_cast<int>(k / cam.width);
+    const int w = static_cast<int>(cam.width), h = static_cast<int>(cam.height);
+    if (i < kBorder || j < kBorder || i + kBorder >= w || j + kBorder >= h) continue;
+    bool all = true;
+    for (int dj = -kBorder; dj <= kBorder && all; ++dj) {
+      for (int di = -kBorder; di <= kBorder && all; ++di) {
+        all = std::isfinite(gt.depth[size_t(j + dj) * cam.width + size_t(i + di)]);
+      }
+    }
+    if (!all) continue;
+    ++inside;
+    inside_off += se(off, k);
+    inside_layered += se(layered, k);
+    inside_hinted += se(hinted, k);
+  }
+  std::printf(
+      "%zu grown pixels, squared error %.3f without layers, %.3f with, %.3f hints only; %zu inner "
+      "pixels: %.3f without, %.3f with, %.3f hints only\n",
+      grown, grown_off, grown_layered, grown_hinted, inside, inside_off, inside_layered,
+      inside_hinted);
+  EXPECT_GE(grown, 20u);
+  EXPECT_LT(grown_layered, 0.7 * grown_off);
+  EXPECT_LE(grown_hinted, grown_off);
+  EXPECT_GE(inside, 500u);
+  EXPECT_LT(inside_layered, 1.1 * inside_off + 1e-3 * inside);
+  EXPECT_LT(inside_hinted, 1.1 * inside_off + 1e-3 * inside);
+}
+
 // Views without coverage render exactly as before whatever the coverage option says.
 TEST(CpuRenderer, ViewsWithoutCoverageRenderAsBefore) {
   const ViewSet views = make_views(room_with_spheres(), corner_views({0, 0, 0.5}, 1.0), 24);
@@ -527,6 +604,11 @@ TEST(CpuRenderer, ViewsWithoutCoverageRenderAsBefore) {
   const RenderedImage a = render(views, cam, off), b = render(views, cam, on);
   EXPECT_EQ(a.color, b.color);
   EXPECT_EQ(a.depth, b.depth);
+  on.coverage_layers = 2;
+  on.coverage_alpha = 1;
+  const RenderedImage c = render(views, cam, on);
+  EXPECT_EQ(a.color, c.color);
+  EXPECT_EQ(a.depth, c.depth);
 }
 
 TEST(CpuRenderer, ImageDoesNotDependOnThreadCount) {
@@ -730,6 +812,14 @@ TEST(CpuRenderer, RejectsBadOptionsAndCameras) {
     o.mixed_texel_bend_texels = bad;
     EXPECT_EQ(code(o), ErrorId::kPlayerOptions) << bad;
   }
+  o = {};
+  o.coverage_layers = 9;
+  EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
+  o.coverage_layers = 8;
+  o.coverage_alpha = 3;
+  EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
+  o.coverage_alpha = 2;
+  EXPECT_TRUE(CpuRenderer::make(views, o).ok());
   EXPECT_EQ(CpuRenderer::make(ViewSet{}, {}).status().id(), ErrorId::kPlayerOptions);
   const CpuRenderer r = *CpuRenderer::make(views, {});
   RenderedImage img;

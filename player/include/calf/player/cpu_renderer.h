@@ -156,6 +156,26 @@ struct RenderOptions {
   // straddle a part thinner than a texel as easily as its texels do; the views that see the part
   // as covered keep it. 1: every coverage vote counts.
   uint32_t coverage_agreement = 1;
+  // Compositing partly covered surfaces (the CPU reference only: the GL renderer refuses it;
+  // plain variant, not RR): 0 off, else at most this many partly covered layers per ray (1..8),
+  // the next one opaque. Where the march ends on a surface point p, each view with coverage gives
+  // the share alpha_j of p's direction that its front surface covers: its 4 x 4 cell masks read
+  // bilinearly between cell centres at p's sub-texel position (a cell of a texel at p's depth,
+  // within coverage_cluster, counts 1 where the mask shows its own surface; a cell of a texel
+  // behind p or of sky counts its texel's near share of the cells its mask leaves; cells of
+  // texels nearer than p, which hide it, do not count; across a face seam a texel counts its
+  // front share). alpha is `coverage_alpha` over the views: 0 their minimum, 1 their mean
+  // weighted as their colours are, 2 their maximum. Where alpha < 1 the surface's colour is laid
+  // over what the ray meets behind it, front to back: the march goes on from p with each view's
+  // texels at p's depth (within coverage_cluster) taken as absent. The pixel's depth is the
+  // layer's at which the accumulated opacity reaches 1/2 (sky if none). Off by default: it lifts
+  // the spider but loses on CesiumMilkTruck, turntable and interior (docs/RENDERING.md
+  // "Coverage").
+  uint32_t coverage_layers = 0;
+  uint32_t coverage_alpha = 0;
+  // Composite only the hits that surface hints found (a crossing of a hint view's surface that
+  // the other views did not refute), the march's own hits being opaque.
+  bool coverage_layers_hints_only = false;
   // Start each march where the first surface can be: no point nearer to view j's centre than
   // z_near_j can be behind its surface, so the march starts at max_j (z_near_j - |o - P_j|)
   // (over the active views, at least the ray's own start) and spends its steps beyond.
@@ -270,16 +290,24 @@ class CpuRenderer {
  private:
   CpuRenderer(const ViewSet& views, const RenderOptions& options);
   struct Hit {
-    Vec3 p;        // the surface point
-    double z = 0;  // its distance from the ray origin
+    Vec3 p;               // the surface point
+    double z = 0;         // its distance from the ray origin
+    bool hinted = false;  // found by a surface hint
   };
   RaySample shade_hit(const Vec3& origin, const Vec3& direction, const Hit* hit) const;
   double tap_purity(const View& v, const Texel& t) const;
-  bool empty_at(const Vec3& p) const;
-  bool empty_beyond(const Vec3& p, double margin_texels, uint32_t vetoes_ignored) const;
-  bool intersect(const Vec3& origin, const Vec3& dir, double start, Hit* hit) const;
+  // `exclude` (nullptr: none): a surface point of an earlier layer; each view treats its texels
+  // at that point's depth (within coverage_cluster) as absent (RenderOptions::coverage_layers).
+  bool empty_at(const Vec3& p, const Vec3* exclude = nullptr) const;
+  bool empty_beyond(const Vec3& p, double margin_texels, uint32_t vetoes_ignored,
+                    const Vec3* exclude = nullptr) const;
+  bool intersect(const Vec3& origin, const Vec3& dir, double start, Hit* hit,
+                 const Vec3* exclude = nullptr) const;
+  // `alpha` (optional): the share of p's direction the views' front surfaces cover
+  // (RenderOptions::coverage_layers), 1 where no view has coverage.
   void shade_surface(const Vec3& origin, const Vec3& p, double* rgb, int* best_view,
-                     double* best_rgb = nullptr) const;
+                     double* best_rgb = nullptr, double* alpha = nullptr) const;
+  RaySample trace_layers(const Vec3& origin, const Vec3& direction) const;
   void secondary(const Vec3& p, const Vec3& dir_in, const Vec3& normal, bool refraction, double ior,
                  uint32_t depth, double* rgb) const;
   void shade_sky(const Vec3& origin, const Vec3& dir, double* rgb) const;
