@@ -664,6 +664,9 @@ TEST(GlRenderer, RejectsBadOptionsAndCameras) {
   o = {};
   o.active_views.assign(257, 0);  // more than the shader's view block holds
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
+  o = {};
+  o.coverage_layers = 2;  // the CPU reference's compositing only: refused, never ignored
+  EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
   std::unique_ptr<GlRenderer> r = *GlRenderer::make(*gv, {});
   o = {};
   o.depth_footprint = 2;
