@@ -1,6 +1,7 @@
 // Private to the player: compiling and linking a GLSL 4.50 program from its stages, shared by the
-// light-field ray-marcher (gl_renderer.cc), the mesh rasteriser (mesh_gl_renderer.cc) and the
-// surfel splatter (surfel_gl_renderer.cc).
+// light-field ray-marcher (gl_renderer.cc), the mesh rasteriser (mesh_gl_renderer.cc), the
+// surfel splatter (surfel_gl_renderer.cc) and the tiles rasteriser (tiles_gl_renderer.cc); and
+// the upload of the rasterisers' camera.
 #pragma once
 
 #include <initializer_list>
@@ -9,6 +10,7 @@
 
 #include "calf/format/status.h"
 #include "calf/player/gl_context.h"
+#include "calf/player/glsl_conventions.h"
 #include "gl_errors.h"
 
 namespace calf::player::internal {
@@ -62,6 +64,20 @@ inline Expected<GLuint> build_gl_program(const GlFunctions& gl,
     return Status(kGlMissing, program + " does not link: " + log.data());
   }
   return id;
+}
+
+// Sets the uniform `uniform CalfRasterCamera calf_camera;` (glsl_conventions.h) of `program`,
+// which must be in use, to glsl_raster_camera(camera, near).
+inline void upload_raster_camera(const GlFunctions& gl, GLuint program, const Camera& camera,
+                                 double near) {
+  const GlslRasterCamera c = glsl_raster_camera(camera, near);
+  const auto loc = [&](const char* name) { return gl.GetUniformLocation(program, name); };
+  gl.Uniform3f(loc("calf_camera.right"), c.right[0], c.right[1], c.right[2]);
+  gl.Uniform3f(loc("calf_camera.up"), c.up[0], c.up[1], c.up[2]);
+  gl.Uniform3f(loc("calf_camera.forward"), c.forward[0], c.forward[1], c.forward[2]);
+  gl.Uniform1f(loc("calf_camera.scale_x"), c.scale_x);
+  gl.Uniform1f(loc("calf_camera.scale_y"), c.scale_y);
+  gl.Uniform1f(loc("calf_camera.near_distance"), c.near_distance);
 }
 
 }  // namespace calf::player::internal

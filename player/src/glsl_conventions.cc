@@ -4,6 +4,18 @@
 
 namespace calf::player {
 
+GlslRasterCamera glsl_raster_camera(const Camera& camera, double near) {
+  const CameraFrame frame = camera_frame(camera);
+  const double h = std::tan(camera.fov_y / 2);
+  const auto f = [](double x) { return static_cast<float>(x); };
+  return {{f(frame.right.x), f(frame.right.y), f(frame.right.z)},
+          {f(frame.up.x), f(frame.up.y), f(frame.up.z)},
+          {f(frame.forward.x), f(frame.forward.y), f(frame.forward.z)},
+          f(h * camera.width / camera.height),
+          f(h),
+          f(near)};
+}
+
 GlslLogRange glsl_log_range(const LogDepthRange& range) {
   // The same double expressions as LogDepthRange's constructor, rounded to float once.
   const double step = range.relative_step();
@@ -12,7 +24,8 @@ GlslLogRange glsl_log_range(const LogDepthRange& range) {
           static_cast<float>(step), static_cast<float>(1.0 / step)};
 }
 
-// Mirrors format/src/cube.cc (kFaceAxes: OpenGL 4.5 core Table 8.19) and format/src/log_depth.cc.
+// Mirrors format/src/cube.cc (kFaceAxes: OpenGL 4.5 core Table 8.19), format/src/log_depth.cc and
+// format/src/camera.cc (the pinhole the rasterisers project with).
 // Keep the two in step: the integration test fails when they drift.
 const char* const kGlslConventions = R"glsl(
 const uint CALF_LOG16_SKY = 65535u;
@@ -81,6 +94,20 @@ float calf_depth_from_code(uint code, CalfLogRange r) {
 
 float calf_code_from_log_depth(float log_z, CalfLogRange r) {
   return (log_z - r.log_near) * r.inv_step;
+}
+
+struct CalfRasterCamera {
+  vec3 right;
+  vec3 up;
+  vec3 forward;
+  float scale_x;
+  float scale_y;
+  float near_distance;
+};
+
+vec4 calf_raster_position(vec3 rel, CalfRasterCamera c) {
+  return vec4(dot(rel, c.right) / c.scale_x, dot(rel, c.up) / c.scale_y, c.near_distance,
+              dot(rel, c.forward));
 }
 )glsl";
 

@@ -28,9 +28,7 @@ layout(location = 3) in vec2 uv;
 uniform vec3 model_x, model_y, model_z, model_t;
 // The normal matrix (inverse transpose of the 3 x 3 part), by columns.
 uniform vec3 normal_x, normal_y, normal_z;
-// Camera: unit right, up, forward; tan(fov_y / 2) * aspect and tan(fov_y / 2); near distance.
-uniform vec3 cam_right, cam_up, cam_forward;
-uniform float scale_x, scale_y, near_distance;
+uniform CalfRasterCamera calf_camera;  // glsl_conventions.h
 out vec3 v_rel;
 out vec3 v_normal;
 out vec3 v_colour;
@@ -40,10 +38,7 @@ void main() {
   v_normal = normal_x * normal.x + normal_y * normal.y + normal_z * normal.z;
   v_colour = colour;
   v_uv = uv;
-  float z = dot(v_rel, cam_forward);
-  // Reversed Z, infinite far, zero-to-one clip range: depth = near / z, clipped where z < near.
-  gl_Position =
-      vec4(dot(v_rel, cam_right) / scale_x, dot(v_rel, cam_up) / scale_y, near_distance, z);
+  gl_Position = calf_raster_position(v_rel, calf_camera);
 }
 )";
 
@@ -154,12 +149,12 @@ GlMeshRenderer::~GlMeshRenderer() {
 
 Status GlMeshRenderer::build_program() {
   const GlFunctions& gl = *gl_;
-  const Expected<GLuint> program =
-      internal::build_gl_program(gl,
-                                 {{GL_VERTEX_SHADER, kVertexShader, "vertex"},
-                                  {GL_GEOMETRY_SHADER, kGeometryShader, "geometry"},
-                                  {GL_FRAGMENT_SHADER, kFragmentShader, "fragment"}},
-                                 "the mesh program");
+  const Expected<GLuint> program = internal::build_gl_program(
+      gl,
+      {{GL_VERTEX_SHADER, std::string(kGlslConventions) + kVertexShader, "vertex"},
+       {GL_GEOMETRY_SHADER, kGeometryShader, "geometry"},
+       {GL_FRAGMENT_SHADER, kFragmentShader, "fragment"}},
+      "the mesh program");
   if (!program.ok()) return program.status();
   program_ = *program;
   const auto loc = [&](const char* name) { return gl.GetUniformLocation(program_, name); };
@@ -381,17 +376,7 @@ Status GlMeshRenderer::render(const MeshDrawList& list, const Camera& camera,
   gl.UseProgram(program_);
   const auto loc = [&](const char* name) { return gl.GetUniformLocation(program_, name); };
   const auto f = [](double x) { return static_cast<float>(x); };
-  const auto vec3 = [&](const char* name, const Vec3& v) {
-    gl.Uniform3f(loc(name), f(v.x), f(v.y), f(v.z));
-  };
-  const CameraFrame frame = camera_frame(camera);
-  const double h = std::tan(camera.fov_y / 2);
-  vec3("cam_right", frame.right);
-  vec3("cam_up", frame.up);
-  vec3("cam_forward", frame.forward);
-  gl.Uniform1f(loc("scale_x"), f(h * camera.width / camera.height));
-  gl.Uniform1f(loc("scale_y"), f(h));
-  gl.Uniform1f(loc("near_distance"), f(options.near));
+  internal::upload_raster_camera(gl, program_, camera, options.near);
   gl.Uniform3f(loc("light"), kMeshKeyLight[0], kMeshKeyLight[1], kMeshKeyLight[2]);
   gl.Uniform1f(loc("ambient"), kMeshAmbient);
   gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, materials_);

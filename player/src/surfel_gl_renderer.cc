@@ -40,8 +40,7 @@ in vec3 v_colour[];
 uniform vec3 model_x, model_y, model_z, model_t;
 uniform float radius;
 uniform vec3 tint;
-uniform vec3 cam_right, cam_up, cam_forward;
-uniform float scale_x, scale_y, near_distance;
+uniform CalfRasterCamera calf_camera;  // glsl_conventions.h
 uniform vec3 light;
 uniform float ambient;
 out vec3 g_rel;
@@ -75,9 +74,7 @@ void main() {
     g_rel = rel;
     g_disc = corners[i];
     g_colour = shaded;
-    // Reversed Z, infinite far, zero-to-one clip range: depth = near / z, clipped where z < near.
-    gl_Position = vec4(dot(rel, cam_right) / scale_x, dot(rel, cam_up) / scale_y, near_distance,
-                       dot(rel, cam_forward));
+    gl_Position = calf_raster_position(rel, calf_camera);
     EmitVertex();
   }
   EndPrimitive();
@@ -114,12 +111,12 @@ GlSurfelRenderer::GlSurfelRenderer(const GlFunctions& gl) : gl_(&gl) {}
 Expected<std::unique_ptr<GlSurfelRenderer>> GlSurfelRenderer::make(const GlFunctions& gl) {
   std::unique_ptr<GlSurfelRenderer> r(new GlSurfelRenderer(gl));
   r->target_ = std::make_unique<internal::GlRasterTarget>(gl, /*with_depth=*/true);
-  const Expected<GLuint> program =
-      internal::build_gl_program(gl,
-                                 {{GL_VERTEX_SHADER, kVertexShader, "vertex"},
-                                  {GL_GEOMETRY_SHADER, kGeometryShader, "geometry"},
-                                  {GL_FRAGMENT_SHADER, kFragmentShader, "fragment"}},
-                                 "the surfel program");
+  const Expected<GLuint> program = internal::build_gl_program(
+      gl,
+      {{GL_VERTEX_SHADER, kVertexShader, "vertex"},
+       {GL_GEOMETRY_SHADER, std::string(kGlslConventions) + kGeometryShader, "geometry"},
+       {GL_FRAGMENT_SHADER, kFragmentShader, "fragment"}},
+      "the surfel program");
   if (!program.ok()) return program.status();
   r->program_ = *program;
   CALF_RETURN_IF_ERROR(check_gl_error(gl, "building the surfel program"));
@@ -196,14 +193,7 @@ Status GlSurfelRenderer::render(const SurfelDrawList& list, const Camera& camera
   const auto vec3 = [&](GLint location, const Vec3& v) {
     gl.Uniform3f(location, f(v.x), f(v.y), f(v.z));
   };
-  const CameraFrame frame = camera_frame(camera);
-  const double h = std::tan(camera.fov_y / 2);
-  vec3(loc("cam_right"), frame.right);
-  vec3(loc("cam_up"), frame.up);
-  vec3(loc("cam_forward"), frame.forward);
-  gl.Uniform1f(loc("scale_x"), f(h * camera.width / camera.height));
-  gl.Uniform1f(loc("scale_y"), f(h));
-  gl.Uniform1f(loc("near_distance"), f(options.near));
+  internal::upload_raster_camera(gl, program_, camera, options.near);
   gl.Uniform3f(loc("light"), kMeshKeyLight[0], kMeshKeyLight[1], kMeshKeyLight[2]);
   gl.Uniform1f(loc("ambient"), kMeshAmbient);
   const GLint model_x = loc("model_x"), model_y = loc("model_y"), model_z = loc("model_z"),

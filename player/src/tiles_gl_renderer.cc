@@ -21,18 +21,13 @@ constexpr const char* kVertexShader = R"(
 layout(location = 0) in vec3 position;  // relative to the view region's centre
 layout(location = 1) in vec3 uvw;       // (u w, v w, w)
 uniform vec3 eye_offset;                // the eye minus the view region's centre
-// Camera: unit right, up, forward; tan(fov_y / 2) * aspect and tan(fov_y / 2); near distance.
-uniform vec3 cam_right, cam_up, cam_forward;
-uniform float scale_x, scale_y, near_distance;
+uniform CalfRasterCamera calf_camera;  // glsl_conventions.h
 out vec3 v_rel;
 out vec3 v_uvw;
 void main() {
   v_rel = position - eye_offset;
   v_uvw = uvw;
-  float z = dot(v_rel, cam_forward);
-  // Reversed Z, infinite far, zero-to-one clip range: depth = near / z, clipped where z < near.
-  gl_Position =
-      vec4(dot(v_rel, cam_right) / scale_x, dot(v_rel, cam_up) / scale_y, near_distance, z);
+  gl_Position = calf_raster_position(v_rel, calf_camera);
 }
 )";
 
@@ -119,11 +114,11 @@ void GlTilesRenderer::release() {
 
 Expected<std::unique_ptr<GlTilesRenderer>> GlTilesRenderer::make(const GlFunctions& gl) {
   std::unique_ptr<GlTilesRenderer> r(new GlTilesRenderer(gl));
-  Expected<GLuint> program =
-      internal::build_gl_program(gl,
-                                 {{GL_VERTEX_SHADER, kVertexShader, "vertex"},
-                                  {GL_FRAGMENT_SHADER, kFragmentShader, "fragment"}},
-                                 "the tiles program");
+  Expected<GLuint> program = internal::build_gl_program(
+      gl,
+      {{GL_VERTEX_SHADER, std::string(kGlslConventions) + kVertexShader, "vertex"},
+       {GL_FRAGMENT_SHADER, kFragmentShader, "fragment"}},
+      "the tiles program");
   if (!program.ok()) return program.status();
   r->program_ = *program;
   CALF_RETURN_IF_ERROR(check_gl_error(gl, "building the tiles program"));
@@ -231,15 +226,8 @@ Status GlTilesRenderer::render(const TileSet& set, const Camera& camera,
   const auto vec3 = [&](const char* name, const Vec3& v) {
     gl.Uniform3f(loc(name), f(v.x), f(v.y), f(v.z));
   };
-  const CameraFrame frame = camera_frame(camera);
-  const double h = std::tan(camera.fov_y / 2);
   vec3("eye_offset", camera.position - origin_);
-  vec3("cam_right", frame.right);
-  vec3("cam_up", frame.up);
-  vec3("cam_forward", frame.forward);
-  gl.Uniform1f(loc("scale_x"), f(h * camera.width / camera.height));
-  gl.Uniform1f(loc("scale_y"), f(h));
-  gl.Uniform1f(loc("near_distance"), f(options.near));
+  internal::upload_raster_camera(gl, program_, camera, options.near);
   gl.Uniform1i(loc("alpha_test"), sorted ? 0 : 1);
   gl.Uniform1i(loc("count_fragments"), count ? 1 : 0);
   gl.Uniform1f(loc("occlusion_alpha"), f(options.occlusion_alpha));

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <initializer_list>
 #include <memory>
 #include <optional>
 #include <string>
@@ -22,6 +23,7 @@
 #include "calf/player/playback.h"
 #include "calf_play/play_window.h"
 #include "command_line.h"
+#include "enum_option.h"
 
 namespace {
 
@@ -393,6 +395,14 @@ int run_headless(Playback& play, Playback* full, Playback* lossless, const Headl
   return 0;
 }
 
+// The names of the enum options: one table each (the first entry is no default: the options
+// structs hold the defaults).
+constexpr tools::EnumTable<bool, 2> kRenderers = {{{"gl", true}, {"cpu", false}}};
+constexpr tools::EnumTable<ViewPriority, 2> kViewPriorities = {
+    {{"distance", ViewPriority::kDistance}, {"angle", ViewPriority::kAngle}}};
+constexpr tools::EnumTable<SurfelClock, 2> kSurfelClocks = {
+    {{"wall", SurfelClock::kWall}, {"cpu", SurfelClock::kCpu}}};
+
 }  // namespace
 
 static int command_main(int argc, char** argv) {
@@ -415,11 +425,12 @@ static int command_main(int argc, char** argv) {
   std::string clip;
   HeadlessArgs h;
   bool headless = false;
-  std::string renderer = "gl", priority = "distance";
   PlaybackOptions play_options;
   LightfieldOptions& o =
       play_options.of<LightfieldOptions>();  // the knobs below are the light field's
   WindowOptions w;
+  // Every default --help shows is the value the options structs hold.
+  app.option_defaults()->always_capture_default();
   app.add_option("CLIP", clip,
                  "the .calf file: every lightfield and mesh track is played, composited by depth")
       ->required();
@@ -434,7 +445,7 @@ static int command_main(int argc, char** argv) {
                  "heat maps (heat_NNNNN.png)");
   app.add_option("--format", h.format,
                  "frame files: png (8-bit sRGB), exr (half RGB + float Z, "
-                 "the ground-truth layout) or both (default png)")
+                 "the ground-truth layout) or both")
       ->check(CLI::IsMember({"png", "exr", "both"}));
   app.add_option("--compare", h.compare,
                  "ground-truth directory written by calf-capture "
@@ -470,57 +481,55 @@ static int command_main(int argc, char** argv) {
                  "pose: ground truth | calf | error heat map");
   app.add_option("--sheet-rows", h.sheet_rows,
                  "poses on the contact sheet, spread evenly along "
-                 "the path, first and last included (default 8)")
+                 "the path, first and last included")
       ->check(CLI::Range(1, 256));
   SurfelOptions& so = play_options.of<SurfelOptions>();
   app.add_option("--surfel-point-size", so.point_size,
                  "surfels: disc diameter in pixels the prefixes are chosen for (the start value "
-                 "with --surfel-target-ms), 1..64 (default 1.5)")
+                 "with --surfel-target-ms), 1..64")
       ->check(CLI::Range(1.0, 64.0));
   app.add_option("--surfel-target-ms", so.target_frame_ms,
                  "surfels: frame-time target in ms, > 0 and <= 10000; the point size follows it "
                  "between 1 and 16 px (headless: each pose's render time counts as its frame "
-                 "time) (default: none, a fixed point size)");
-  std::string surfel_clock = "wall";
-  app.add_option("--surfel-clock", surfel_clock,
-                 "surfels: the time --surfel-target-ms holds: wall (the frame time) or cpu (the "
-                 "process CPU time of the renders, all threads; steadier on a loaded machine) "
-                 "(default wall)")
-      ->check(CLI::IsMember({"wall", "cpu"}));
+                 "time); left out: a fixed point size")
+      ->default_str("");
+  tools::add_enum_option(app, "--surfel-clock", so.controller_clock, kSurfelClocks,
+                         "surfels: the time --surfel-target-ms holds: wall (the frame time) or "
+                         "cpu (the process CPU time of the renders, all threads; steadier on a "
+                         "loaded machine)");
   app.add_option("--surfel-blend", so.blend_share,
                  "surfels: an object whose prefix needs more than this share of its surfels is "
-                 "drawn from the mesh as well (0..1; 1: no blend zone) (default 0.5)")
+                 "drawn from the mesh as well (0..1; 1: no blend zone)")
       ->check(CLI::Range(0.0, 1.0));
   std::vector<double> foveation;
   app.add_option("--surfel-foveation", foveation,
                  "surfels: fixed foveated rendering (paper 001 Sec. 4.4) as INNER,OUTER,SCALE: "
                  "an object whose centre lies within INNER of the image centre (in units of the "
                  "half-diagonal: 1 at the corners) keeps the point size, beyond OUTER it is "
-                 "SCALE times larger (a shorter prefix), linear between; e.g. 0.35,0.75,2 "
-                 "(default off)")
+                 "SCALE times larger (a shorter prefix), linear between; e.g. 0.35,0.75,2; left "
+                 "out: off")
+      ->default_str("")
       ->expected(3)
       ->delimiter(',');
   std::string tiles_blend = "sort";
   app.add_option("--tiles-blend", tiles_blend,
                  "tiles: sort (back to front by distance from the eye each frame, premultiplied "
                  "over; paper 000) or alpha-test (depth test, texels below 50 % alpha dropped, "
-                 "any order; hard silhouettes) (default sort)")
+                 "any order; hard silhouettes)")
       ->check(CLI::IsMember({"sort", "alpha-test"}));
   TilesRenderOptions& tr = play_options.of<TilesOptions>().render;
   app.add_option("--tiles-occlusion-alpha", tr.occlusion_alpha,
                  "tiles, sort: an occlusion pre-pass keeps each pixel's nearest fragment at least "
                  "this opaque, and the sorted pass drops fragments behind it (what one sort "
                  "distance per tile gets wrong where tiles cross or abut at an angle); 0.5..1, "
-                 "or 0 for none (Seurat's plain sort; about half the render time) (default 0.9)");
+                 "or 0 for none (Seurat's plain sort; about half the render time)");
   app.add_option("--tiles-occlusion-epsilon", tr.occlusion_epsilon,
                  "tiles, sort: how much farther (relative) than that fragment another must be to "
-                 "be dropped, so overlapping tiles of one surface never hide each other; (0, 1] "
-                 "(default 0.001)");
-  app.add_option("--renderer", renderer,
-                 "gl (OpenGL 4.5 ray-march, the product) or cpu (the scalar "
-                 "reference; headless only) (default gl)")
-      ->check(CLI::IsMember({"gl", "cpu"}));
-  app.add_option("--steps", o.render.steps, "ray-march steps in log depth (default 64)")
+                 "be dropped, so overlapping tiles of one surface never hide each other; (0, 1]");
+  tools::add_enum_option(app, "--renderer", play_options.use_gl, kRenderers,
+                         "gl (OpenGL 4.5 ray-march, the product) or cpu (the scalar reference; "
+                         "headless only)");
+  app.add_option("--steps", o.render.steps, "ray-march steps in log depth")
       ->check(CLI::Range(1, 65536));
   app.add_flag("--rr", o.render.rr,
                "reflection / refraction rays from the material stream "
@@ -531,56 +540,67 @@ static int command_main(int argc, char** argv) {
                "the eye's (docs/RENDERING.md)");
   app.add_option("--hints", o.render.surface_hints,
                  "surface hint views followed along the march "
-                 "(0 = the paper's march alone; default 1)")
+                 "(0 = the paper's march alone)")
       ->check(CLI::Range(0, 4));
-  app.add_option("--hint-substeps", o.render.surface_hint_substeps,
-                 "hint tests per march step (default 4)")
+  app.add_option("--hint-substeps", o.render.surface_hint_substeps, "hint tests per march step")
       ->check(CLI::Range(1, 64));
   app.add_option("--mixed-texel-penalty", o.render.mixed_texel_penalty,
                  "light field: colour taps on a depth edge of their view (an anti-aliased "
                  "capture mixes both sides' colours there) keep e^-P of their weight, so colour "
-                 "comes from texels wholly on one surface; 0..50, 0 = off (default 3; "
-                 "docs/RENDERING.md \"Mixed texels\")")
+                 "comes from texels wholly on one surface; 0..50, 0 = off (docs/RENDERING.md "
+                 "\"Mixed texels\")")
       ->check(CLI::Range(0.0, 50.0));
   app.add_option("--coverage", o.render.coverage,
                  "light field: how the renderer (GL or CPU) uses a clip's coverage stream (SPEC "
                  "11.1.11) in its emptiness test, as bench-player_quality --coverage uses a "
                  "capture set's: 0 off, 1 bilinear front shares, 2 cell mask, 3 grown cell mask, 4 "
                  "every tap's cell; "
-                 "clips without coverage play as with 0; the window's C key toggles it "
-                 "(default 0)")
+                 "clips without coverage play as with 0; the window's C key toggles it")
       ->check(CLI::Range(0u, 4u));
   app.add_option("--coverage-agreement", o.render.coverage_agreement,
                  "light field, with --coverage: a point that a view calls empty only through its "
-                 "coverage is empty once this many views say so (default 1)")
+                 "coverage is empty once this many views say so")
       ->check(CLI::Range(1u, 65536u));
   app.add_option("--supersample", o.render.supersample,
                  "light field: N x N eye rays per pixel on an even grid, colour their mean (a box "
                  "filter, as the ground truth's), depth the nearest; anti-aliases silhouettes and "
-                 "texture edges for N^2 the render time (default 1: the pixel centre's ray)")
+                 "texture edges for N^2 the render time (1: the pixel centre's ray)")
       ->check(CLI::Range(1, 8));
-  app.add_option("--views", o.selection.max_active, "most active viewpoints per frame (default 9)")
+  app.add_option("--views", o.selection.max_active, "most active viewpoints per frame")
       ->check(CLI::Range(1, 65536));
-  app.add_option("--priority", priority, "view priority: distance or angle (default distance)")
-      ->check(CLI::IsMember({"distance", "angle"}));
+  tools::add_enum_option(app, "--priority", o.selection.priority, kViewPriorities,
+                         "view priority: distance or angle");
   app.add_option("--frame-ms", o.selection.budget.target_frame_ms,
                  "frame-time target of performance "
-                 "culling in ms, 0 = off (default 11.1; headless default 0: quality first)");
+                 "culling in ms, 0 = off (headless: 0 unless given, quality first)");
   app.add_flag(
       "--no-view-dependent", [&](int64_t) { o.decoder.view_dependent = false; },
       "decode every cell of the active views, not only the visible ones");
-  app.add_option("--width", w.width, "window width (default 1280)");
-  app.add_option("--height", w.height, "window height (default 720)");
-  app.add_option("--fov", w.fov_y_degrees, "window: vertical field of view in degrees (default 75)")
+  app.add_option("--width", w.width, "window width");
+  app.add_option("--height", w.height, "window height");
+  app.add_option("--fov", w.fov_y_degrees, "window: vertical field of view in degrees")
       ->check(CLI::Range(10.0, 170.0));
   app.add_flag("--stereo", w.stereo, "window: side-by-side stereo (toggle with Shift+S)");
-  app.add_option("--ipd", w.ipd,
-                 "window: distance between the eyes in scene units (default 0.064)");
+  app.add_option("--ipd", w.ipd, "window: distance between the eyes in scene units");
   app.add_option("--frames", w.max_frames, "window: quit after this many frames (0 = never)");
+  // --help groups the options by what they act on.
+  const auto group = [&app](const char* name, std::initializer_list<const char*> options) {
+    for (const char* option : options) app.get_option(option)->group(name);
+  };
+  group(
+      "Headless evaluation (--headless)",
+      {"--eye-path", "--out", "--format", "--compare", "--no-heat-maps", "--noise-floor",
+       "--compare-clip", "--breakdown", "--breakdown-lossless", "--contact-sheet", "--sheet-rows"});
+  group("Light field renderer", {"--steps", "--rr", "--no-rr-replace", "--hints", "--hint-substeps",
+                                 "--mixed-texel-penalty", "--supersample", "--views", "--priority",
+                                 "--frame-ms", "--no-view-dependent"});
+  group("Light field coverage", {"--coverage", "--coverage-agreement"});
+  group("Surfels", {"--surfel-point-size", "--surfel-target-ms", "--surfel-clock", "--surfel-blend",
+                    "--surfel-foveation"});
+  group("Tiles", {"--tiles-blend", "--tiles-occlusion-alpha", "--tiles-occlusion-epsilon"});
+  group("Window", {"--width", "--height", "--fov", "--stereo", "--ipd", "--frames"});
   if (int rc = tools::parse_command_line(app, "calf-play", argc, argv); rc >= 0) return rc;
 
-  play_options.use_gl = renderer == "gl";
-  so.controller_clock = surfel_clock == "cpu" ? SurfelClock::kCpu : SurfelClock::kWall;
   tr.blend = *tiles_blend_from_name(tiles_blend);  // checked above
   if (Status st = validate_tiles_render_options(tr); !st.ok()) {
     return tools::print_error("calf-play", st, tools::kExitUsage);  // CALF-E478, exit 2
@@ -600,7 +620,6 @@ static int command_main(int argc, char** argv) {
       return tools::print_error("calf-play", s, tools::kExitUsage);
     }
   }
-  o.selection.priority = priority == "angle" ? ViewPriority::kAngle : ViewPriority::kDistance;
   if (headless && app.count("--frame-ms") == 0) o.selection.budget.target_frame_ms = 0;
   if (headless) {
     if (h.eye_path.empty() && h.compare.empty()) {

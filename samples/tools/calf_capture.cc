@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <initializer_list>
 #include <string>
 #include <thread>
 
@@ -256,6 +257,19 @@ static int command_main(int argc, char** argv) {
                "markers; nothing is rendered");
   app.add_flag("--list-scenes", list, "print the built-in scenes and exit");
   app.add_flag("--quiet", quiet, "no progress or summary lines on stderr");
+  // --help groups the options by what they act on.
+  const auto group = [&app](const char* name, std::initializer_list<const char*> options) {
+    for (const char* option : options) app.get_option(option)->group(name);
+  };
+  group("Rig", {"--rig", "--rig-only", "--face-size"});
+  group("Rendering", {"--seed", "--spp", "--min-spp", "--tolerance", "--ao-samples",
+                      "--max-bounces", "--noise"});
+  group("Coverage", {"--coverage"});
+  group("Ground truth", {"--ground-truth", "--eye-path", "--gt-size", "--no-noise-floor"});
+  group("Scene file and surfel candidates",
+        {"--export-scene", "--surfel-candidates", "--surfel-resolution", "--surfel-directions",
+         "--surfel-corners"});
+  group("Capture shards (docs/FARM.md)", {"--views", "--frame-range", "--join"});
   if (int rc = calf::tools::parse_command_line(app, "calf-capture", argc, argv); rc >= 0) return rc;
 
   if (list) {

@@ -1,7 +1,8 @@
 // The GLSL mirror of the conventions (calf/player/glsl_conventions.h) against the C++ ones, run
 // as a compute shader in an OSMesa GL 4.5 core context: cube-face lookups on thousands of
-// directions including exact seams and corners, the inverse mapping, and every log-16 code of
-// the depth functions the ray-march shader calls.
+// directions including exact seams and corners, the inverse mapping, every log-16 code of the
+// depth functions the ray-march shader calls, and the rasterisers' camera against
+// format/camera.h's pixel rays.
 #include <GL/gl.h>
 #include <GL/glext.h>
 #include <GL/osmesa.h>
@@ -14,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "calf/format/camera.h"
 #include "calf/format/cube.h"
 #include "calf/format/log_depth.h"
 #include "calf/player/glsl_conventions.h"
@@ -45,6 +47,7 @@ struct Gl {
   PFNGLGETUNIFORMLOCATIONPROC GetUniformLocation;
   PFNGLUNIFORM1UIPROC Uniform1ui;
   PFNGLUNIFORM1FPROC Uniform1f;
+  PFNGLUNIFORM3FPROC Uniform3f;
 };
 
 class Context {
@@ -87,6 +90,7 @@ class Context {
     CALF_GL(GetUniformLocation);
     CALF_GL(Uniform1ui);
     CALF_GL(Uniform1f);
+    CALF_GL(Uniform3f);
 #undef CALF_GL
     ok_ = true;
   }
@@ -343,6 +347,108 @@ void main() {
     }
     EXPECT_LE(worst_code / 65534,
               4e-6 + 8 * ulp * (std::fabs(std::log(double{zf})) + 1) / log_ratio);
+  }
+}
+
+// calf_raster_position() against format/camera.h: a point on the ray camera_ray_at(x, y) at any
+// distance lands at window position (x, height - y) (GL's rows run bottom-up) with window depth
+// near / z, z its distance along forward, for cameras of several orientations, fields of view and
+// aspects; points nearer than `near` have a window depth above 1 (clipped).
+TEST(GlslConventions, RasterCameraMatchesCameraRays) {
+  REQUIRE_GL();
+  std::string log;
+  const GLuint prog = compute_program(R"(
+layout(local_size_x = 64) in;
+layout(std430, binding = 0) readonly buffer In { vec4 rel[]; };
+layout(std430, binding = 1) writeonly buffer Out { vec4 clip[]; };
+uniform uint count;
+uniform CalfRasterCamera calf_camera;
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= count) return;
+  clip[i] = calf_raster_position(rel[i].xyz, calf_camera);
+}
+)",
+                                      &log);
+  ASSERT_NE(prog, 0u) << log;
+  Gl& gl = context().gl;
+  std::mt19937 rng(47);
+  std::uniform_real_distribution<double> u(0, 1);
+  struct Case {
+    Vec3 forward, up;
+    double fov_y;
+    uint32_t width, height;
+    double near;
+  };
+  for (const Case& k : {Case{{0, 0, -1}, {0, 1, 0}, 1.5707963267948966, 64, 64, 0.05},
+                        Case{{1, 0.2, 0.3}, {0, 1, 0}, 1.2, 1280, 720, 0.01},
+                        Case{{-0.3, -0.9, 0.1}, {0, 0, 1}, 0.4, 300, 900, 0.5},
+                        Case{{0.5, 0.5, 0.5}, {1, 0, 0}, 2.5, 4096, 2048, 1e-3}}) {
+    Camera camera;
+    camera.position = {1.5, -2, 3};  // the shader sees points relative to the eye
+    camera.forward = k.forward;
+    camera.up = k.up;
+    camera.fov_y = k.fov_y;
+    camera.width = k.width;
+    camera.height = k.height;
+    ASSERT_TRUE(validate_camera(camera).ok());
+    const CameraFrame frame = camera_frame(camera);
+    const size_t n = 4096;
+    std::vector<float> rel(4 * n);
+    std::vector<double> xs(n), ys(n), zs(n);
+    for (size_t i = 0; i < n; ++i) {
+      xs[i] = u(rng) * camera.width;
+      ys[i] = u(rng) * camera.height;
+      const Vec3 d = camera_ray_at(camera, frame, xs[i], ys[i]);
+      const double t = k.near * std::exp(u(rng) * 12 - 1);  // some nearer than `near`
+      const Vec3 p = d * t;
+      rel[4 * i] = static_cast<float>(p.x);
+      rel[4 * i + 1] = static_cast<float>(p.y);
+      rel[4 * i + 2] = static_cast<float>(p.z);
+      const Vec3 pf{rel[4 * i], rel[4 * i + 1], rel[4 * i + 2]};
+      zs[i] = pf.x * frame.forward.x + pf.y * frame.forward.y + pf.z * frame.forward.z;
+    }
+    ssbo(0, n * 16, rel.data());
+    const GLuint out = ssbo(1, n * 16, nullptr);
+    gl.UseProgram(prog);
+    gl.Uniform1ui(gl.GetUniformLocation(prog, "count"), static_cast<GLuint>(n));
+    const GlslRasterCamera c = glsl_raster_camera(camera, k.near);
+    const auto loc = [&](const char* name) {
+      const GLint l = gl.GetUniformLocation(prog, name);
+      EXPECT_GE(l, 0) << name;
+      return l;
+    };
+    gl.Uniform3f(loc("calf_camera.right"), c.right[0], c.right[1], c.right[2]);
+    gl.Uniform3f(loc("calf_camera.up"), c.up[0], c.up[1], c.up[2]);
+    gl.Uniform3f(loc("calf_camera.forward"), c.forward[0], c.forward[1], c.forward[2]);
+    gl.Uniform1f(loc("calf_camera.scale_x"), c.scale_x);
+    gl.Uniform1f(loc("calf_camera.scale_y"), c.scale_y);
+    gl.Uniform1f(loc("calf_camera.near_distance"), c.near_distance);
+    gl.DispatchCompute(static_cast<GLuint>(n / 64), 1, 1);
+    gl.MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    const std::vector<float> clip = read_back<float>(out, 4 * n);
+    double worst_px = 0, worst_depth = 0;
+    size_t clipped = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const double w = clip[4 * i + 3];
+      ASSERT_GT(w, 0);
+      const double wx = (clip[4 * i] / w + 1) / 2 * camera.width;
+      const double wy = (clip[4 * i + 1] / w + 1) / 2 * camera.height;
+      const double depth = clip[4 * i + 2] / w;
+      worst_px =
+          std::max({worst_px, std::fabs(wx - xs[i]), std::fabs(wy - (camera.height - ys[i]))});
+      worst_depth = std::max(worst_depth, std::fabs(depth * zs[i] / k.near - 1));
+      clipped += depth > 1;
+      EXPECT_EQ(depth > 1, zs[i] < k.near * (1 - 1e-6)) << i;
+    }
+    std::printf(
+        "camera %u x %u, fov %.2f: max window position diff %.3g px, max rel depth diff "
+        "%.3g, %zu of %zu nearer than near\n",
+        camera.width, camera.height, k.fov_y, worst_px, worst_depth, clipped, n);
+    // Float rounding of the point and the axes: a few ulps of the image side.
+    EXPECT_LT(worst_px, 2e-6 * std::max(camera.width, camera.height) + 1e-4);
+    EXPECT_LT(worst_depth, 1e-5);
+    EXPECT_GT(clipped, 0u);
   }
 }
 

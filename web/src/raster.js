@@ -15,6 +15,7 @@
 //   premultiplied colour (out = src + (1 − src.a) dst); a last depth-tested pass writes the
 //   nearest distance with alpha ≥ 0.5 into the layer's fourth channel (the native MIN blend).
 import { GL_TILES_VERTEX, GL_MESH_FRAGMENT } from './glsl_raster.js';
+import { GLSL_CONVENTIONS } from './glsl_conventions.js';
 import { keptProgram } from './raymarch.js';
 
 const PROLOGUE = '#version 300 es\nprecision highp float;\nprecision highp int;\nprecision highp sampler2D;\nprecision highp sampler2DArray;\n';
@@ -34,8 +35,7 @@ layout(location = 5) in vec3 emission;
 layout(location = 6) in float textured;
 // Object -> eye-relative world: columns of the 3 x 3 part and the translation minus the eye.
 uniform vec3 model_x, model_y, model_z, model_t;
-uniform vec3 cam_right, cam_up, cam_forward;
-uniform float scale_x, scale_y, near_distance;
+uniform CalfRasterCamera calf_camera;  // the GLSL conventions (glsl_conventions.js)
 out vec3 g_rel;
 out vec3 g_normal;
 out vec3 g_colour;
@@ -47,8 +47,7 @@ void main() {
   g_rel = model_x * position.x + model_y * position.y + model_z * position.z + model_t;
   g_normal = normal; g_colour = colour; g_uv = uv;
   g_base = base; g_emission = emission; g_textured = int(textured);
-  float z = dot(g_rel, cam_forward);
-  gl_Position = vec4(dot(g_rel, cam_right) / scale_x, dot(g_rel, cam_up) / scale_y, near_distance, z);
+  gl_Position = calf_raster_position(g_rel, calf_camera);
 }
 `;
 
@@ -145,12 +144,12 @@ function setCamera(gl, p, camera) {
   const forward = normalize(camera.forward), right = normalize(cross(forward, camera.up)), up = cross(right, forward);
   const h = Math.tan(camera.fovY / 2);
   const U = (n) => gl.getUniformLocation(p, n);
-  gl.uniform3fv(U('cam_right'), right);
-  gl.uniform3fv(U('cam_up'), up);
-  gl.uniform3fv(U('cam_forward'), forward);
-  gl.uniform1f(U('scale_x'), (h * camera.width) / camera.height);
-  gl.uniform1f(U('scale_y'), h);
-  gl.uniform1f(U('near_distance'), NEAR);
+  gl.uniform3fv(U('calf_camera.right'), right);
+  gl.uniform3fv(U('calf_camera.up'), up);
+  gl.uniform3fv(U('calf_camera.forward'), forward);
+  gl.uniform1f(U('calf_camera.scale_x'), (h * camera.width) / camera.height);
+  gl.uniform1f(U('calf_camera.scale_y'), h);
+  gl.uniform1f(U('calf_camera.near_distance'), NEAR);
 }
 
 // linear_from_srgb (format/src/colour.cc), in double, rounded to binary32.
@@ -283,8 +282,8 @@ export async function loadTiles(tl) {
 export function makeRaster(gl) {
   if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('WebGL2 without EXT_color_buffer_float: no float render target');
   const floatBlend = !!gl.getExtension('EXT_float_blend');
-  const meshProgram = program(gl, MESH_VERTEX, GL_MESH_FRAGMENT, 'the mesh program');
-  const tilesProgram = program(gl, GL_TILES_VERTEX, TILES_FRAGMENT, 'the tiles program');
+  const meshProgram = program(gl, GLSL_CONVENTIONS + MESH_VERTEX, GL_MESH_FRAGMENT, 'the mesh program');
+  const tilesProgram = program(gl, GLSL_CONVENTIONS + GL_TILES_VERTEX, TILES_FRAGMENT, 'the tiles program');
   const compositeProgram = program(gl, FULLSCREEN, COMPOSITE, 'the composite program');
   const presentProgram = program(gl, FULLSCREEN, PRESENT, 'the present program');
   const mergeProgram = program(gl, FULLSCREEN, MERGE, 'the tiles merge program');

@@ -2,7 +2,8 @@
 // tie-break of calf/format/cube.h, and the log-16 depth mapping of calf/format/log_depth.h, with
 // the same formulas in the same order. This is the one GLSL copy: the ray-march shader
 // (gl_raymarch_shader.cc) is compiled after it and calls these functions for every cube-face
-// lookup and every depth code, and tests/integration/glsl_conventions_test.cc runs the same source
+// lookup and every depth code, the rasterisers (mesh, surfels, tiles) for their camera, and
+// tests/integration/glsl_conventions_test.cc runs the same source
 // under OSMesa on thousands of directions (seams and corners included) and on every depth code,
 // and compares with the C++ functions.
 //
@@ -24,6 +25,17 @@
 //                                                   (neither rounded nor clamped):
 //                                                   normalized_from_depth(z) * 65534
 //   const uint CALF_LOG16_SKY = 65535u, CALF_LOG16_MAX_FINITE = 65534u
+//   struct CalfRasterCamera { vec3 right, up, forward; float scale_x, scale_y, near_distance; }
+//                                                   calf/format/camera.h's camera for the
+//                                                   rasterisers; fill it from glsl_raster_camera()
+//   vec4  calf_raster_position(vec3 rel, CalfRasterCamera c)   the clip position of `rel` (a
+//                                                   point minus the eye): reversed Z with an
+//                                                   infinite far plane in GL's zero-to-one clip
+//                                                   range (glClipControl(GL_LOWER_LEFT,
+//                                                   GL_ZERO_TO_ONE), depth test GL_GREATER):
+//                                                   window x, y those of camera.h's pixel rays,
+//                                                   depth near / z (z along forward), clipped
+//                                                   where z < near
 //
 // Precision: GLSL computes in float where C++ uses double; the range constants are computed in
 // double on the host and rounded once. Face choice is identical for the same float direction
@@ -32,6 +44,7 @@
 // checks these bounds.
 #pragma once
 
+#include "calf/format/camera.h"
 #include "calf/format/log_depth.h"
 
 namespace calf::player {
@@ -44,5 +57,14 @@ struct GlslLogRange {
   float z_near, z_far, log_near, step, inv_step;
 };
 GlslLogRange glsl_log_range(const LogDepthRange& range);
+
+// The CalfRasterCamera a rasteriser receives for `camera` (valid: validate_camera) and the near
+// plane at distance `near`: camera_frame()'s unit axes, tan(fov_y / 2) times the aspect and
+// tan(fov_y / 2), computed in double and rounded to float once.
+struct GlslRasterCamera {
+  float right[3], up[3], forward[3];
+  float scale_x, scale_y, near_distance;
+};
+GlslRasterCamera glsl_raster_camera(const Camera& camera, double near);
 
 }  // namespace calf::player
