@@ -340,7 +340,8 @@ static int command_main(int argc, char** argv) {
   std::string colour_codec = "bc";
   app.add_option("--colour-codec", colour_codec,
                  "bc (colour keyframes in --color-format with interpolation weights) or av1 (per "
-                 "colour cell one AV1 stream, SVT-AV1 8-bit 4:2:0, decoded by dav1d; LDR input; "
+                 "colour cell one AV1 stream, SVT-AV1 4:2:0, decoded by dav1d: 8-bit sRGB, or for "
+                 "HDR input 10-bit codes of half floats; "
                  "format/SPEC.md 11.1.12, docs/ENCODER.md \"AV1 colour\") (default bc)")
       ->check(CLI::IsMember({"bc", "av1"}))
       ->default_val("bc");
