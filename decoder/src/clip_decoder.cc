@@ -307,7 +307,9 @@ Status ClipDecoder::Impl::update_cell_av1(uint32_t view, uint32_t face, uint32_t
     const container::ChunkKeys& keys = reader->chunks()[id].keys;
     CALF_ASSIGN_OR_RETURN(ChunkBytes raw, fetch(id, out));
     const std::string what = where(view, face, cell) + " colour";
-    CALF_ASSIGN_OR_RETURN(lf::Av1Gop gop, lf::parse_av1_gop(*raw, keys.frame_count, what));
+    lf::Av1HdrCurve curve;
+    CALF_ASSIGN_OR_RETURN(lf::Av1Gop gop, lf::parse_av1_chunk(*raw, keys.frame_count,
+                                                              header.colour_format, &curve, what));
     if (!s.av1) {
       CALF_ASSIGN_OR_RETURN(Av1CellDecoder d, Av1CellDecoder::create());
       s.av1 = std::make_shared<Av1CellDecoder>(std::move(d));
@@ -332,8 +334,10 @@ Status ClipDecoder::Impl::update_cell_av1(uint32_t view, uint32_t face, uint32_t
       s.av1_decoded = keys.first_frame + u;
     }
     std::vector<uint8_t> gpu;
-    CALF_RETURN_IF_ERROR(s.av1->rgba8(rect.width, rect.height, gpu, what));
-    emit(out, UpdateTarget::kColour, view, face, 0, rect, PixelFormat::kRgba8, gpu);
+    CALF_RETURN_IF_ERROR(
+        s.av1->gpu_bytes(header.colour_format, rect.width, rect.height, curve, gpu, what));
+    emit(out, UpdateTarget::kColour, view, face, 0, rect,
+         lf::colour_gpu_format(header.colour_format), gpu);
     s.av1_uploaded = frame;
   }
   CellParams p;
@@ -474,7 +478,7 @@ Expected<ClipDecoder> ClipDecoder::open(const container::Reader& reader, uint16_
   impl->track = track;
   impl->header = ref.header();
   impl->has_coverage = ref.has_coverage();
-  impl->av1 = impl->header.colour_format == static_cast<uint16_t>(PixelFormat::kAv1);
+  impl->av1 = lf::is_av1_colour(impl->header.colour_format);
   impl->options = options;
   for (uint32_t v = 0; v < impl->header.view_count; ++v) {
     impl->views.push_back(ref.view(v));

@@ -29,6 +29,14 @@ void av1_ycbcr_to_rgb(uint8_t y, uint8_t cb, uint8_t cr, uint8_t rgb[3]) {
   rgb[2] = clamp8(y + ((121609 * u + 32768) >> 16));
 }
 
+void av1_ycbcr10_to_rgb(uint16_t y, uint16_t cb, uint16_t cr, uint16_t rgb[3]) {
+  const int32_t u = int32_t{cb} - 512, v = int32_t{cr} - 512;
+  auto clamp10 = [](int32_t c) { return static_cast<uint16_t>(std::clamp(c, 0, 1023)); };
+  rgb[0] = clamp10(y + ((103206 * v + 32768) >> 16));
+  rgb[1] = clamp10(y - ((12276 * u + 30679 * v + 32768) >> 16));
+  rgb[2] = clamp10(y + ((121609 * u + 32768) >> 16));
+}
+
 struct Av1CellDecoder::Impl {
   Dav1dContext* context = nullptr;
   Dav1dPicture picture{};
@@ -141,6 +149,60 @@ Status Av1CellDecoder::rgba8(uint32_t w, uint32_t h, std::vector<uint8_t>& out,
     }
   }
   return Status::Ok();
+}
+
+Status Av1CellDecoder::rgba16f(uint32_t w, uint32_t h, lf::Av1HdrCurve curve,
+                               std::vector<uint8_t>& out, const std::string& what) const {
+  const Impl& d = *impl_;
+  if (!d.has_picture) return Status(ErrorId::kAv1Picture, what + ": no decoded picture");
+  const Dav1dPictureParameters& p = d.picture.p;
+  if (p.bpc != 10 || p.layout != DAV1D_PIXEL_LAYOUT_I420 || p.w < 0 || p.h < 0 ||
+      static_cast<uint32_t>(p.w) < w || static_cast<uint32_t>(p.h) < h) {
+    return Status(ErrorId::kAv1Picture,
+                  what + ": a " + std::to_string(p.w) + " x " + std::to_string(p.h) +
+                      " picture of " + std::to_string(p.bpc) + " bits, layout " +
+                      std::to_string(p.layout) + ", for a " + std::to_string(w) + " x " +
+                      std::to_string(h) + " HDR cell (10-bit 4:2:0 expected)");
+  }
+  // The half float bits of every code, once per picture.
+  uint16_t half[1024];
+  for (uint32_t c = 0; c < 1024; ++c) half[c] = lf::av1_hdr_half_bits(curve, c);
+  out.resize(size_t{w} * h * 8);
+  // dav1d's high-bit-depth planes hold one uint16_t a sample; strides are in bytes.
+  const auto* ys = static_cast<const uint8_t*>(d.picture.data[0]);
+  const auto* us = static_cast<const uint8_t*>(d.picture.data[1]);
+  const auto* vs = static_cast<const uint8_t*>(d.picture.data[2]);
+  const ptrdiff_t ly = d.picture.stride[0], lc = d.picture.stride[1];
+  auto sample = [](const uint8_t* row, uint32_t x) {
+    uint16_t v;
+    std::memcpy(&v, row + 2 * size_t{x}, 2);
+    return static_cast<uint16_t>(v & 1023);
+  };
+  for (uint32_t y = 0; y < h; ++y) {
+    const uint8_t* yr = ys + y * ly;
+    const uint8_t* ur = us + (y >> 1) * lc;
+    const uint8_t* vr = vs + (y >> 1) * lc;
+    uint8_t* o = &out[size_t{y} * w * 8];
+    for (uint32_t x = 0; x < w; ++x) {
+      uint16_t rgb[3];
+      av1_ycbcr10_to_rgb(sample(yr, x), sample(ur, x >> 1), sample(vr, x >> 1), rgb);
+      const uint16_t texel[4] = {half[rgb[0]], half[rgb[1]], half[rgb[2]], 0x3C00};
+      for (int c = 0; c < 4; ++c) {
+        o[8 * x + 2 * c] = static_cast<uint8_t>(texel[c]);
+        o[8 * x + 2 * c + 1] = static_cast<uint8_t>(texel[c] >> 8);
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+Status Av1CellDecoder::gpu_bytes(uint16_t colour_format, uint32_t w, uint32_t h,
+                                 lf::Av1HdrCurve curve, std::vector<uint8_t>& out,
+                                 const std::string& what) const {
+  if (colour_format == static_cast<uint16_t>(container::kPixelFormatAv1Hdr)) {
+    return rgba16f(w, h, curve, out, what);
+  }
+  return rgba8(w, h, out, what);
 }
 
 }  // namespace calf::decoder

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "calf/format/av1_hdr_colour.h"
 #include "calf/format/status.h"
 
 namespace calf::decoder {
@@ -31,6 +32,15 @@ class Av1CellDecoder {
   // alpha 255), row-major. Errors: CALF-E302 for no picture, a picture that is not 8-bit 4:2:0 or
   // is smaller than w x h.
   Status rgba8(uint32_t w, uint32_t h, std::vector<uint8_t>& out, const std::string& what) const;
+  // HDR AV1 colour (format 13): the top-left w x h texels of the last picture as RGBA16F
+  // (§11.1.12: the 10-bit conversion, each code through `curve`, alpha 1.0), little-endian
+  // halves, row-major. Errors: CALF-E302 for no picture, a picture that is not 10-bit 4:2:0 or is
+  // smaller than w x h.
+  Status rgba16f(uint32_t w, uint32_t h, lf::Av1HdrCurve curve, std::vector<uint8_t>& out,
+                 const std::string& what) const;
+  // The last picture as the colour format's GPU bytes: rgba8 for av1, rgba16f for av1hdr.
+  Status gpu_bytes(uint16_t colour_format, uint32_t w, uint32_t h, lf::Av1HdrCurve curve,
+                   std::vector<uint8_t>& out, const std::string& what) const;
 
  private:
   struct Impl;
@@ -40,5 +50,7 @@ class Av1CellDecoder {
 
 // §11.1.12's conversion of one 8-bit Y, Cb, Cr sample triple to sRGB-encoded R, G, B.
 void av1_ycbcr_to_rgb(uint8_t y, uint8_t cb, uint8_t cr, uint8_t rgb[3]);
+// The same conversion of one 10-bit triple (0 … 1023, chroma centred on 512) to R, G, B codes.
+void av1_ycbcr10_to_rgb(uint16_t y, uint16_t cb, uint16_t cr, uint16_t rgb[3]);
 
 }  // namespace calf::decoder

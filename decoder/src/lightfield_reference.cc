@@ -181,21 +181,24 @@ Status LightfieldReference::decode_face(uint32_t view, uint32_t face, uint32_t f
     const PixelRect r =
         cells.cell_rect(cell % cells.cells_per_side(), cell / cells.cells_per_side());
     const std::string what = where(view, face, cell) + " colour";
-    if (h.colour_format == static_cast<uint16_t>(PixelFormat::kAv1)) {
+    if (lf::is_av1_colour(h.colour_format)) {
       // §11.1.12: the units of the chunk serving the frame, from its key frame to the frame.
       CALF_ASSIGN_OR_RETURN(uint32_t id, find_one(*reader_, track_, LightfieldStream::kColour, view,
                                                   face, cell, frame, -1));
       const container::ChunkKeys& keys = reader_->chunks()[id].keys;
       CALF_ASSIGN_OR_RETURN(std::vector<uint8_t> raw, reader_->read_chunk(id));
-      CALF_ASSIGN_OR_RETURN(lf::Av1Gop gop, lf::parse_av1_gop(raw, keys.frame_count, what));
+      lf::Av1HdrCurve curve;
+      CALF_ASSIGN_OR_RETURN(lf::Av1Gop gop, lf::parse_av1_chunk(raw, keys.frame_count,
+                                                                h.colour_format, &curve, what));
       CALF_ASSIGN_OR_RETURN(Av1CellDecoder av1, Av1CellDecoder::create());
       for (uint32_t u = 0; u <= frame - keys.first_frame; ++u) {
         CALF_RETURN_IF_ERROR(
             av1.decode(gop.units[u], what + " frame " + std::to_string(keys.first_frame + u)));
       }
-      CALF_RETURN_IF_ERROR(av1.rgba8(r.width, r.height, gpu, what));
+      CALF_RETURN_IF_ERROR(av1.gpu_bytes(h.colour_format, r.width, r.height, curve, gpu, what));
       a.resize(size_t{r.width} * r.height * 3);
-      CALF_RETURN_IF_ERROR(decode_gpu_colour(PixelFormat::kRgba8, gpu, r.width, r.height, a));
+      CALF_RETURN_IF_ERROR(
+          decode_gpu_colour(lf::colour_gpu_format(h.colour_format), gpu, r.width, r.height, a));
       for (uint32_t y = 0; y < r.height; ++y) {
         std::memcpy(&out->colour[((size_t{r.y} + y) * n + r.x) * 3], &a[size_t{y} * r.width * 3],
                     size_t{r.width} * 3 * sizeof(float));

@@ -54,7 +54,8 @@ Expected<Gop> split_units(std::span<const uint8_t> stream) {
 }
 
 // One GOP by a fresh encoder: every picture W x H 4:2:0, frames `first` .. `first + count - 1`.
-Expected<Gop> encode_gop(const std::vector<uint8_t>& yuv, uint32_t W, uint32_t H, uint32_t count,
+// `yuv` holds `count` pictures of `bits` (8: a byte a sample, 10: a uint16_t a sample).
+Expected<Gop> encode_gop(const uint8_t* yuv, uint32_t bits, uint32_t W, uint32_t H, uint32_t count,
                          uint32_t fps_numerator, uint32_t fps_denominator,
                          const Av1ColourOptions& o) {
   EbComponentType* handle = nullptr;
@@ -75,7 +76,7 @@ Expected<Gop> encode_gop(const std::vector<uint8_t>& yuv, uint32_t W, uint32_t H
   cfg.source_height = H;
   cfg.frame_rate_numerator = fps_numerator;
   cfg.frame_rate_denominator = fps_denominator;
-  cfg.encoder_bit_depth = 8;
+  cfg.encoder_bit_depth = bits;
   cfg.encoder_color_format = EB_YUV420;
   cfg.intra_period_length = -1;  // the GOP's first frame is its only key frame
   cfg.intra_refresh_type = SVT_AV1_KF_REFRESH;
@@ -88,7 +89,8 @@ Expected<Gop> encode_gop(const std::vector<uint8_t>& yuv, uint32_t W, uint32_t H
   }
   cfg.logical_processors = 1;  // one thread: the cells are coded in parallel instead
   cfg.color_primaries = EB_CICP_CP_BT_709;
-  cfg.transfer_characteristics = EB_CICP_TC_SRGB;
+  // The 10-bit codes are calf's own curve of half-float bits (§11.1.12), which CICP cannot name.
+  cfg.transfer_characteristics = bits == 8 ? EB_CICP_TC_SRGB : EB_CICP_TC_UNSPECIFIED;
   cfg.matrix_coefficients = EB_CICP_MC_BT_709;
   cfg.color_range = EB_CR_FULL_RANGE;
   if (EbErrorType e = svt_av1_enc_set_parameter(handle, &cfg); e != EB_ErrorNone) {
@@ -98,7 +100,8 @@ Expected<Gop> encode_gop(const std::vector<uint8_t>& yuv, uint32_t W, uint32_t H
     return svt_error("svt_av1_enc_init", e);
   }
   closer.initialised = true;
-  const size_t luma = size_t{W} * H, chroma = luma / 4, picture = luma + 2 * chroma;
+  const size_t sample = bits == 8 ? 1 : 2;
+  const size_t luma = size_t{W} * H * sample, chroma = luma / 4, picture = luma + 2 * chroma;
   std::vector<uint8_t> stream;
   bool done = false;
   auto drain = [&](bool all_sent) -> Status {
@@ -122,7 +125,7 @@ Expected<Gop> encode_gop(const std::vector<uint8_t>& yuv, uint32_t W, uint32_t H
   };
   for (uint32_t i = 0; i < count; ++i) {
     EbSvtIOFormat io{};
-    io.luma = const_cast<uint8_t*>(yuv.data() + i * picture);
+    io.luma = const_cast<uint8_t*>(yuv + i * picture);
     io.cb = io.luma + luma;
     io.cr = io.cb + chroma;
     io.y_stride = W;
@@ -130,7 +133,7 @@ Expected<Gop> encode_gop(const std::vector<uint8_t>& yuv, uint32_t W, uint32_t H
     io.width = W;
     io.height = H;
     io.color_fmt = EB_YUV420;
-    io.bit_depth = EB_EIGHT_BIT;
+    io.bit_depth = bits == 8 ? EB_EIGHT_BIT : EB_TEN_BIT;  // strides count samples
     EbBufferHeaderType in{};
     in.size = sizeof(EbBufferHeaderType);
     in.p_buffer = reinterpret_cast<uint8_t*>(&io);
@@ -182,6 +185,89 @@ void rgba_to_ycbcr420(std::span<const uint8_t> rgba, uint32_t W, uint32_t H, uin
   }
 }
 
+void rgb10_to_ycbcr420(std::span<const uint16_t> rgb, uint32_t W, uint32_t H, uint16_t* y,
+                       uint16_t* cb, uint16_t* cr) {
+  constexpr double kr = 0.2126, kb = 0.0722, kg = 1 - kr - kb;
+  auto code = [](double v) { return static_cast<uint16_t>(std::clamp(std::lround(v), 0L, 1023L)); };
+  for (uint32_t j = 0; j < H; j += 2) {
+    for (uint32_t i = 0; i < W; i += 2) {
+      double sb = 0, sr = 0;
+      for (uint32_t dy = 0; dy < 2; ++dy) {
+        for (uint32_t dx = 0; dx < 2; ++dx) {
+          const uint16_t* p = &rgb[((size_t{j} + dy) * W + i + dx) * 3];
+          const double l = kr * p[0] + kg * p[1] + kb * p[2];
+          y[(size_t{j} + dy) * W + i + dx] = code(l);
+          sb += (p[2] - l) / (2 * (1 - kb));
+          sr += (p[0] - l) / (2 * (1 - kr));
+        }
+      }
+      cb[size_t{j / 2} * (W / 2) + i / 2] = code(512 + sb / 4);
+      cr[size_t{j / 2} * (W / 2) + i / 2] = code(512 + sr / 4);
+    }
+  }
+}
+
+namespace {
+uint16_t clamped_half(uint16_t h) {
+  if (h & 0x8000) return 0;                   // negative (and -0, -NaN): 0
+  return h >= 0x7C00 ? uint16_t{0x7BFF} : h;  // infinity, NaN: the greatest finite half
+}
+}  // namespace
+
+lf::Av1HdrCurve hdr_curve(std::span<const uint16_t> half) {
+  uint16_t lo = 0x7BFF, hi = 0;
+  for (const uint16_t v : half) {
+    const uint16_t c = clamped_half(v);
+    lo = std::min(lo, c);
+    hi = std::max(hi, c);
+  }
+  lf::Av1HdrCurve curve;
+  curve.base = std::max<uint16_t>(lo, 0x0400);
+  curve.shift = 0;
+  while (curve.shift < 5 && uint32_t{curve.base} + (1023u << curve.shift) < hi) ++curve.shift;
+  return curve;
+}
+
+uint16_t hdr_code(lf::Av1HdrCurve curve, uint16_t h) {
+  const uint32_t c = clamped_half(h);
+  if (c <= curve.base) return 0;
+  const uint32_t code = (c - curve.base + ((1u << curve.shift) >> 1)) >> curve.shift;
+  return static_cast<uint16_t>(std::min(code, 1023u));
+}
+
+Expected<HdrCell> encode_cell_hdr(std::span<const uint16_t> half, uint32_t w, uint32_t h,
+                                  uint32_t frames, uint32_t fps_numerator, uint32_t fps_denominator,
+                                  const Av1ColourOptions& options) {
+  const uint32_t W = std::max(64u, (w + 7) / 8 * 8), H = std::max(64u, (h + 7) / 8 * 8);
+  const size_t luma = size_t{W} * H, picture = luma + luma / 2;
+  HdrCell cell;
+  cell.curve = hdr_curve(half);
+  std::vector<uint16_t> padded(luma * 3);
+  for (uint32_t g0 = 0; g0 < frames; g0 += options.keyframe_interval) {
+    const uint32_t count = std::min(options.keyframe_interval, frames - g0);
+    std::vector<uint16_t> yuv(picture * count);
+    for (uint32_t i = 0; i < count; ++i) {
+      const uint16_t* src = &half[size_t{g0 + i} * w * h * 3];
+      for (uint32_t y = 0; y < H; ++y) {
+        const uint32_t sy = std::min(y, h - 1);
+        for (uint32_t x = 0; x < W; ++x) {
+          const uint32_t sx = std::min(x, w - 1);
+          for (int c = 0; c < 3; ++c) {
+            padded[(size_t{y} * W + x) * 3 + c] =
+                hdr_code(cell.curve, src[(size_t{sy} * w + sx) * 3 + c]);
+          }
+        }
+      }
+      uint16_t* out = &yuv[i * picture];
+      rgb10_to_ycbcr420(padded, W, H, out, out + luma, out + luma + luma / 4);
+    }
+    CALF_ASSIGN_OR_RETURN(Gop gop, encode_gop(reinterpret_cast<const uint8_t*>(yuv.data()), 10, W,
+                                              H, count, fps_numerator, fps_denominator, options));
+    cell.gops.push_back(std::move(gop));
+  }
+  return cell;
+}
+
 Expected<std::vector<Gop>> encode_cell(std::span<const uint8_t> rgba, uint32_t w, uint32_t h,
                                        uint32_t frames, uint32_t fps_numerator,
                                        uint32_t fps_denominator, const Av1ColourOptions& options) {
@@ -204,8 +290,8 @@ Expected<std::vector<Gop>> encode_cell(std::span<const uint8_t> rgba, uint32_t w
       uint8_t* out = &yuv[i * picture];
       rgba_to_ycbcr420(padded, W, H, out, out + luma, out + luma + luma / 4);
     }
-    CALF_ASSIGN_OR_RETURN(Gop gop,
-                          encode_gop(yuv, W, H, count, fps_numerator, fps_denominator, options));
+    CALF_ASSIGN_OR_RETURN(
+        Gop gop, encode_gop(yuv.data(), 8, W, H, count, fps_numerator, fps_denominator, options));
     gops.push_back(std::move(gop));
   }
   return gops;

@@ -14,6 +14,7 @@
 #include <tbb/task_arena.h>
 
 #include "calf/encoder/lightfield_encode.h"
+#include "calf/format/av1_hdr_colour.h"
 #include "calf/format/grid.h"
 #include "calf/format/lightfield_layout.h"
 #include "lightfield_internal.h"
@@ -179,13 +180,10 @@ Expected<LightfieldAnalysis> plan_lightfield(const capture::CaptureManifest& m,
     const bool hdr = std::any_of(views.begin(), views.end(), [](const auto& v) { return v.hdr; });
     a.colour = hdr ? ColourCoding::kBc6h : ColourCoding::kBc1;
   }
-  if (a.colour == ColourCoding::kAv1 &&
-      std::any_of(views.begin(), views.end(), [](const auto& v) { return v.hdr; })) {
-    return Status(ErrorId::kEncoderAv1Input,
-                  "AV1 colour codes 8-bit sRGB, and the capture set has HDR colour (a value above "
-                  "1): use --colour-codec bc");
-  }
-  a.hdr = a.colour == ColourCoding::kBc6h || a.colour == ColourCoding::kRgba16f;
+  // AV1 colour of a set with HDR colour is the HDR AV1 format (10-bit codes of half floats).
+  const bool av1_hdr = a.colour == ColourCoding::kAv1 &&
+                       std::any_of(views.begin(), views.end(), [](const auto& v) { return v.hdr; });
+  a.hdr = a.colour == ColourCoding::kBc6h || a.colour == ColourCoding::kRgba16f || av1_hdr;
   container::LightfieldTrackHeader& h = a.header;
   switch (a.colour) {
     case ColourCoding::kBc1:
@@ -201,7 +199,7 @@ Expected<LightfieldAnalysis> plan_lightfield(const capture::CaptureManifest& m,
       h.colour_format = pf(PixelFormat::kRgba8);
       break;
     case ColourCoding::kAv1:
-      h.colour_format = pf(PixelFormat::kAv1);
+      h.colour_format = pf(av1_hdr ? container::kPixelFormatAv1Hdr : PixelFormat::kAv1);
       break;
     default:
       h.colour_format = pf(PixelFormat::kRgba16f);

@@ -165,40 +165,55 @@ Status rdo_keyframe(const Context& ctx, uint32_t face, const PixelRect& r, uint3
   return bc::rdo_bc7(rgba.data(), r.width, r.height, bytes.data(), bytes.size(), o);
 }
 
-// AV1 colour (SPEC §11.1.12): the cell's frames as sRGB bytes, one chunk per GOP.
+// AV1 colour (SPEC §11.1.12): the cell's frames as sRGB bytes, or for HDR as their half floats
+// (format av1hdr, each chunk headed by the cell's curve), one chunk per GOP.
 void colour_av1_task(const Context& ctx, uint32_t face, uint32_t cell, TaskOut& out) {
   const ViewData& v = *ctx.view;
   const PixelRect r =
       ctx.cells.cell_rect(cell % ctx.cells.cells_per_side(), cell / ctx.cells.cells_per_side());
   const size_t n = static_cast<size_t>(r.width) * r.height;
-  std::vector<uint16_t> half(n * 3);
-  std::vector<float> linear(n * 3);
-  std::vector<uint8_t> rgba(n * 4 * v.frames);
-  for (uint32_t f = 0; f < v.frames; ++f) {
-    gather_cell_halves(v, face, r, f, half.data());
-    for (size_t i = 0; i < n * 3; ++i) linear[i] = bc::half_to_float(half[i]);
-    const std::vector<uint8_t> frame = srgb8_rgba_of(linear);
-    std::copy(frame.begin(), frame.end(), &rgba[f * n * 4]);
+  std::vector<uint16_t> half(n * 3 * v.frames);
+  for (uint32_t f = 0; f < v.frames; ++f) gather_cell_halves(v, face, r, f, &half[f * n * 3]);
+  Expected<av1_internal::HdrCell> coded = av1_internal::HdrCell{};
+  if (ctx.hdr) {
+    coded = av1_internal::encode_cell_hdr(half, r.width, r.height, v.frames, ctx.fps_numerator,
+                                          ctx.fps_denominator, ctx.options->av1);
+  } else {
+    std::vector<float> linear(n * 3);
+    std::vector<uint8_t> rgba(n * 4 * v.frames);
+    for (uint32_t f = 0; f < v.frames; ++f) {
+      for (size_t i = 0; i < n * 3; ++i) linear[i] = bc::half_to_float(half[f * n * 3 + i]);
+      const std::vector<uint8_t> frame = srgb8_rgba_of(linear);
+      std::copy(frame.begin(), frame.end(), &rgba[f * n * 4]);
+    }
+    auto gops = av1_internal::encode_cell(rgba, r.width, r.height, v.frames, ctx.fps_numerator,
+                                          ctx.fps_denominator, ctx.options->av1);
+    if (gops.ok()) {
+      coded->gops = std::move(*gops);
+    } else {
+      coded = gops.status();
+    }
   }
-  auto gops = av1_internal::encode_cell(rgba, r.width, r.height, v.frames, ctx.fps_numerator,
-                                        ctx.fps_denominator, ctx.options->av1);
-  if (!gops.ok()) {
-    out.status = gops.status().with_context("view " + std::to_string(ctx.view_index) + " face " +
-                                            std::to_string(face) + " cell " + std::to_string(cell));
+  if (!coded.ok()) {
+    out.status =
+        coded.status().with_context("view " + std::to_string(ctx.view_index) + " face " +
+                                    std::to_string(face) + " cell " + std::to_string(cell));
     return;
   }
   TaskStats& s = out.stats;
-  s.colour.raw += n * 4 * v.frames;
-  s.colour.temporal += n * 4 * v.frames;
-  s.keyframes += gops->size();
+  const uint64_t raw_texel = ctx.hdr ? 8 : 4;
+  s.colour.raw += n * raw_texel * v.frames;
+  s.colour.temporal += n * raw_texel * v.frames;
+  s.keyframes += coded->gops.size();
   ChunkKeys keys;
   keys.stream = static_cast<uint16_t>(LightfieldStream::kColour);
   keys.face = face;
   keys.region = cell;
   uint32_t first = 0;
   std::vector<uint8_t> raw;
-  for (const av1_internal::Gop& gop : *gops) {
+  for (const av1_internal::Gop& gop : coded->gops) {
     raw.clear();
+    if (ctx.hdr) lf::append_av1_hdr_curve(raw, coded->curve);
     lf::append_av1_gop(raw, gop);
     keys.first_frame = ctx.first_frame + first;
     keys.frame_count = static_cast<uint32_t>(gop.size());

@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "calf/encoder/lightfield_encode.h"
+#include "calf/format/av1_hdr_colour.h"
 #include "calf/format/clip_metadata.h"
 #include "calf/format/files.h"
 #include "calf/format/version.h"
@@ -22,7 +23,8 @@ Expected<LightfieldTrackWriter> LightfieldTrackWriter::begin(container::Writer& 
   if (analysis.coverage) writer.require_minor_version(container::kVersionMinorCoverage);
   // So is AV1 colour (1.3, SPEC §11.1.12), which earlier decoders refuse as an unknown format.
   if (analysis.colour == ColourCoding::kAv1) {
-    writer.require_minor_version(container::kVersionMinorAv1);
+    writer.require_minor_version(analysis.hdr ? container::kVersionMinorAv1Hdr
+                                              : container::kVersionMinorAv1);
   }
   LightfieldEncodeStats stats;
   stats.colour_format = analysis.header.colour_format;

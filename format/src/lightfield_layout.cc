@@ -4,6 +4,7 @@
 #include <bit>
 #include <cstdio>
 
+#include "calf/format/av1_hdr_colour.h"
 #include "calf/format/bc.h"
 #include "calf/format/depth_predict.h"
 
@@ -482,8 +483,9 @@ void region_rect_gpu_bytes(const RegionChunk& chunk, size_t index, std::vector<u
 // ---- Colour keyframes ----
 
 Status check_colour_format(uint16_t colour_format) {
-  for (PixelFormat f : {PixelFormat::kBc1, PixelFormat::kBc7, PixelFormat::kBc6h,
-                        PixelFormat::kRgba8, PixelFormat::kRgba16f, PixelFormat::kAv1}) {
+  for (PixelFormat f :
+       {PixelFormat::kBc1, PixelFormat::kBc7, PixelFormat::kBc6h, PixelFormat::kRgba8,
+        PixelFormat::kRgba16f, PixelFormat::kAv1, container::kPixelFormatAv1Hdr}) {
     if (is(colour_format, f)) return Status::Ok();
   }
   return Status(ErrorId::kLightfieldFormat, "colour format " + std::to_string(colour_format) +
@@ -540,8 +542,9 @@ Status colour_payload_gpu_bytes(uint16_t colour_format, std::span<const uint8_t>
 }
 
 container::PixelFormat colour_gpu_format(uint16_t colour_format) {
-  return is(colour_format, PixelFormat::kAv1) ? PixelFormat::kRgba8
-                                              : static_cast<PixelFormat>(colour_format);
+  if (is(colour_format, PixelFormat::kAv1)) return PixelFormat::kRgba8;
+  if (is(colour_format, container::kPixelFormatAv1Hdr)) return PixelFormat::kRgba16f;
+  return static_cast<PixelFormat>(colour_format);
 }
 
 Expected<Av1Gop> parse_av1_gop(std::span<const uint8_t> raw, uint32_t frame_count,

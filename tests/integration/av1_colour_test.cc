@@ -2,7 +2,9 @@
 // library with ColourCoding::kAv1, its layout (GOP chunks, no t chunks, version 1.3), encodes
 // independent of the thread count, the reference decoder and the view-dependent decoder (in order
 // and seeking) giving the same colour, that colour close to the input, and damaged chunks refused
-// with their ids. With CALF_CONFORMANCE_OUT set it writes the conformance clip av1_pred16m there.
+// with their ids; the same for a HDR capture set (format av1hdr: 10-bit codes of half floats, a
+// curve per cell). With CALF_CONFORMANCE_OUT set it writes the conformance clips av1_pred16m and
+// av1_hdr_pred16m there.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -22,6 +24,7 @@
 #include "calf/decoder/lightfield_reference.h"
 #include "calf/decoder/lightfield_verify.h"
 #include "calf/encoder/lightfield_encode.h"
+#include "calf/format/av1_hdr_colour.h"
 #include "calf/format/colour.h"
 #include "calf/format/container.h"
 #include "calf/format/lightfield_layout.h"
@@ -61,9 +64,14 @@ class Av1Colour : public ::testing::Test {
     return o;
   }
 
-  std::vector<uint8_t> encode(const LightfieldEncodeOptions& o) {
+  std::vector<uint8_t> encode(const LightfieldEncodeOptions& o, bool hdr = false) {
     std::vector<uint8_t> bytes;
-    auto in = capture::CaptureSetReader::open(root_ / "set");
+    if (hdr && !fs::exists(root_ / "hdr")) {
+      SceneSpec spec = spec_;
+      spec.hdr = true;
+      EXPECT_TRUE(testing_support::write_synthetic_capture(root_ / "hdr", spec).ok());
+    }
+    auto in = capture::CaptureSetReader::open(root_ / (hdr ? "hdr" : "set"));
     EXPECT_TRUE(in.ok()) << in.status().to_string();
     auto writer = container::Writer::create(container::memory_sink(&bytes));
     EXPECT_TRUE(writer.ok());
@@ -79,6 +87,8 @@ class Av1Colour : public ::testing::Test {
     return std::move(*r);
   }
 
+  void decoders_agree(bool hdr);
+
   fs::path root_;
   SceneSpec spec_{.face = 16, .frames = 5, .views = 2};
 };
@@ -92,6 +102,17 @@ double psnr_srgb8(const std::vector<float>& a, const std::vector<float>& b) {
   }
   const double mse = se / static_cast<double>(a.size());
   return mse == 0 ? 99 : 10 * std::log10(255.0 * 255.0 / mse);
+}
+
+// log2-PSNR (SPEC §11.1.4, HDR): over log2(max(v, 2^-14)) of every channel, peak 8.
+double psnr_log2(const std::vector<float>& a, const std::vector<float>& b) {
+  double se = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    const double d = std::log2(std::max(a[i], 0x1p-14f)) - std::log2(std::max(b[i], 0x1p-14f));
+    se += d * d;
+  }
+  const double mse = se / static_cast<double>(a.size());
+  return mse == 0 ? 99 : 10 * std::log10(64.0 / mse);
 }
 
 TEST_F(Av1Colour, LayoutIsGopChunksWithoutTChunksInA13File) {
@@ -127,12 +148,54 @@ TEST_F(Av1Colour, LayoutIsGopChunksWithoutTChunksInA13File) {
   EXPECT_EQ(colour, spec_.views * 6 * 3);
 }
 
+TEST_F(Av1Colour, HdrLayoutIsCurveHeadedGopChunksInA14File) {
+  const std::vector<uint8_t> bytes = encode(options(), true);
+  const container::Reader r = open(bytes);
+  EXPECT_EQ(r.header().version_minor, container::kVersionMinorAv1Hdr);
+  const auto& h = std::get<container::LightfieldTrackHeader>(r.tracks()[0].header);
+  EXPECT_EQ(h.colour_format, static_cast<uint16_t>(container::kPixelFormatAv1Hdr));
+  EXPECT_EQ(h.flags, 1);
+  uint32_t colour = 0, wide = 0;
+  for (uint32_t id = 0; id < r.chunks().size(); ++id) {
+    const container::ChunkKeys& k = r.chunks()[id].keys;
+    EXPECT_NE(k.stream, static_cast<uint16_t>(LightfieldStream::kTParams));
+    if (k.stream != static_cast<uint16_t>(LightfieldStream::kColour)) continue;
+    ++colour;
+    auto raw = r.read_chunk(id);
+    ASSERT_TRUE(raw.ok());
+    lf::Av1HdrCurve curve;
+    auto gop = lf::parse_av1_chunk(*raw, k.frame_count, h.colour_format, &curve, "chunk");
+    ASSERT_TRUE(gop.ok()) << gop.status().to_string();
+    ASSERT_EQ(gop->units.size(), k.frame_count);
+    // The synthetic scene's LDR faces lie within [2^-14, 1] (a span of 0x3800 bits, which shift 4
+    // covers); its face 4 goes up to 40 (SceneSpec), which its top code must reach.
+    EXPECT_GE(curve.base, 0x0400);
+    EXPECT_LE(curve.shift, k.face == 4 ? 5 : 4);
+    if (k.face == 4) wide += lf::av1_hdr_half_bits(curve, 1023) > 0x4900;  // above 10
+    // Unit 0: a temporal delimiter, then the sequence header.
+    EXPECT_EQ(gop->units[0][0], 0x12);
+    EXPECT_EQ((gop->units[0][2] >> 3) & 15, 1);
+  }
+  EXPECT_EQ(colour, spec_.views * 6 * 3);
+  EXPECT_EQ(wide, spec_.views * 3);
+}
+
 TEST_F(Av1Colour, EncodeDoesNotDependOnTheThreadCount) {
   EXPECT_EQ(encode(options(1)), encode(options(2)));
+  EXPECT_EQ(encode(options(1), true), encode(options(2), true));
 }
 
 TEST_F(Av1Colour, DecodersAgreeInOrderAndSeekingAndFollowTheInput) {
-  const std::vector<uint8_t> bytes = encode(options());
+  for (const bool hdr : {false, true}) {
+    SCOPED_TRACE(hdr ? "HDR (av1hdr)" : "LDR (av1)");
+    decoders_agree(hdr);
+  }
+}
+
+void Av1Colour::decoders_agree(bool hdr) {
+  SceneSpec spec = spec_;
+  spec.hdr = hdr;
+  const std::vector<uint8_t> bytes = encode(options(), hdr);
   const container::Reader r = open(bytes);
   auto ref = decoder::LightfieldReference::open(r, 0);
   ASSERT_TRUE(ref.ok()) << ref.status().to_string();
@@ -153,13 +216,13 @@ TEST_F(Av1Colour, DecodersAgreeInOrderAndSeekingAndFollowTheInput) {
     EXPECT_EQ(updates.stats.errors, 0u) << updates.stats.first_error;
     for (const decoder::TextureUpdate& u : updates.updates) {
       if (u.target != decoder::UpdateTarget::kColour) continue;
-      EXPECT_EQ(u.format, container::PixelFormat::kRgba8);
+      EXPECT_EQ(u.format, hdr ? container::PixelFormat::kRgba16f : container::PixelFormat::kRgba8);
       EXPECT_EQ(u.slot, 0u);
     }
     for (const decoder::CellParams& c : updates.cells) EXPECT_EQ(c.t, 0);
     ASSERT_TRUE(tex.apply(updates).ok());
     for (uint32_t v = 0; v < spec_.views; ++v) {
-      const capture::ViewFrame input = testing_support::make_frame(spec_, v, frame);
+      const capture::ViewFrame input = testing_support::make_frame(spec, v, frame);
       for (uint32_t f = 0; f < 6; ++f) {
         ASSERT_TRUE(ref->decode_face(v, f, frame, &face).ok());
         ASSERT_EQ(tex.colour(v, static_cast<CubeFace>(f)), face.colour)
@@ -171,7 +234,7 @@ TEST_F(Av1Colour, DecodersAgreeInOrderAndSeekingAndFollowTheInput) {
             for (int c = 0; c < 3; ++c) want.push_back(input.color[3 * i + c]);
           }
         }
-        const double psnr = psnr_srgb8(want, face.colour);
+        const double psnr = hdr ? psnr_log2(want, face.colour) : psnr_srgb8(want, face.colour);
         worst = std::min(worst, psnr);
         sum += psnr;
         ++faces;
@@ -179,12 +242,13 @@ TEST_F(Av1Colour, DecodersAgreeInOrderAndSeekingAndFollowTheInput) {
     }
   }
   // The synthetic scene is smooth gradients and a square with hard edges moving across a 16-texel
-  // face: 4:2:0 chroma blurs those edges. Measured with SVT-AV1 1.4.1 (preset 10, CRF 32): mean
-  // 36.44 dB, worst face-frame 25.39 dB. The upper bounds say when the coding got lossless by
-  // accident (or the test compares the decoder with itself).
+  // face: 4:2:0 chroma blurs those edges. Measured with SVT-AV1 1.4.1 (preset 10, CRF 32): LDR
+  // (PSNR of sRGB bytes) mean 36.44 dB, worst face-frame 25.39 dB; HDR (log2-PSNR) mean 40.73 dB,
+  // worst 25.33 dB. The upper bounds say when the coding got lossless by accident (or the test
+  // compares the decoder with itself).
   const double mean = sum / faces;
-  std::printf("AV1 colour vs input: mean %.2f dB, worst %.2f dB over %d face-frames\n", mean, worst,
-              faces);
+  std::printf("AV1 colour (%s) vs input: mean %.2f dB, worst %.2f dB over %d face-frames\n",
+              hdr ? "HDR, log2-PSNR" : "LDR, sRGB PSNR", mean, worst, faces);
   EXPECT_GT(mean, 30.0);
   EXPECT_LT(mean, 60.0);
   EXPECT_GT(worst, 20.0);
@@ -193,7 +257,8 @@ TEST_F(Av1Colour, DecodersAgreeInOrderAndSeekingAndFollowTheInput) {
   EXPECT_TRUE(verified.problems.empty())
       << (verified.problems.empty() ? "" : verified.problems[0].to_string());
   if (const char* out_dir = std::getenv("CALF_CONFORMANCE_OUT")) {
-    std::ofstream(fs::path(out_dir) / "av1_pred16m.calf", std::ios::binary)
+    std::ofstream(fs::path(out_dir) / (hdr ? "av1_hdr_pred16m.calf" : "av1_pred16m.calf"),
+                  std::ios::binary)
         .write(reinterpret_cast<const char*>(bytes.data()),
                static_cast<std::streamsize>(bytes.size()));
   }
@@ -249,16 +314,36 @@ TEST_F(Av1Colour, DamagedChunksAreRefusedWithTheirIds) {
   }
 }
 
-TEST_F(Av1Colour, HdrInputAndBadOptionsAreRefused) {
-  SceneSpec hdr = spec_;
-  hdr.hdr = true;
-  ASSERT_TRUE(testing_support::write_synthetic_capture(root_ / "hdr", hdr).ok());
-  auto in = capture::CaptureSetReader::open(root_ / "hdr");
+TEST_F(Av1Colour, HdrCurveOutOfRangeIsRefused) {
+  const std::vector<uint8_t> bytes = encode(options(), true);
+  const container::Reader r = open(bytes);
+  // A shift of 6 (at most 5), a base of 0x7C00 (infinity; at most 0x7BFF), a chunk shorter than
+  // its curve: E067.
+  const auto bad_shift = with_colour_chunk(r, 1, 2, [](std::vector<uint8_t>& raw) { raw[2] = 6; });
+  const auto bad_base = with_colour_chunk(r, 1, 2, [](std::vector<uint8_t>& raw) {
+    raw[0] = 0x00;
+    raw[1] = 0x7C;
+  });
+  const auto short_chunk =
+      with_colour_chunk(r, 1, 2, [](std::vector<uint8_t>& raw) { raw.resize(3); });
+  struct Case {
+    const std::vector<uint8_t>* file;
+    ErrorId id;
+  };
+  for (const Case& c : {Case{&bad_shift, ErrorId::kAv1Chunk}, Case{&bad_base, ErrorId::kAv1Chunk},
+                        Case{&short_chunk, ErrorId::kAv1Chunk}}) {
+    const container::Reader damaged = open(*c.file);
+    const decoder::LightfieldVerifyResult v = decoder::verify_lightfield_track(damaged, 0, true, 4);
+    ASSERT_FALSE(v.problems.empty());
+    EXPECT_EQ(v.problems[0].id(), c.id) << v.problems[0].to_string();
+    EXPECT_NE(v.problems[0].message().find("view 1 face 2"), std::string::npos)
+        << v.problems[0].message();
+  }
+}
+
+TEST_F(Av1Colour, BadOptionsAreRefused) {
+  auto in = capture::CaptureSetReader::open(root_ / "set");
   ASSERT_TRUE(in.ok());
-  std::vector<uint8_t> bytes;
-  auto writer = container::Writer::create(container::memory_sink(&bytes));
-  ASSERT_TRUE(writer.ok());
-  EXPECT_EQ(encode_lightfield(*in, *writer, options()).status().id(), ErrorId::kEncoderAv1Input);
   LightfieldEncodeOptions o = options();
   o.av1.keyframe_interval = 0;
   EXPECT_EQ(analyse_lightfield(*in, o).status().id(), ErrorId::kEncoderOption);

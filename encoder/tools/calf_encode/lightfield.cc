@@ -91,7 +91,8 @@ bool given(const CLI::App& app, const char* name) {
 void add_av1_options(CLI::App& app, LightfieldOptions& o) {
   add_enum_option(app, "--colour-codec", o.colour_codec, kColourCodecs,
                   "bc (colour keyframes in --color-format with interpolation weights) or av1 (per "
-                  "colour cell one AV1 stream, SVT-AV1 8-bit 4:2:0, decoded by dav1d; LDR input; "
+                  "colour cell one AV1 stream, SVT-AV1 4:2:0, decoded by dav1d: 8-bit sRGB, or for "
+                  "HDR input 10-bit codes of half floats; "
                   "format/SPEC.md 11.1.12, docs/ENCODER.md \"AV1 colour\")")
       ->group(kAv1Group);
   Av1ColourOptions& av1 = o.encode.av1;
