@@ -509,7 +509,7 @@ def write_rendering(ctx):
     return "\n".join([
         para(ctx.stamp("rendering", "gl_render"),
              "bench-gl_render's synthetic room (the eye between the views), the GL renderer at "
-             "RenderOptions' defaults; median of the frames (draw + read-back) after the first; "
+             "LightfieldRenderOptions' defaults; median of the frames (draw + read-back) after the first; "
              "`cpu-time` is the process's CPU time a frame over llvmpipe's threads; the peer is the "
              "CPU reference on the same frame with 2 threads. " + " ".join(head)), "",
         "```", *keep, "```", "",

@@ -1,6 +1,6 @@
 // AV1 colour (format/SPEC.md §11.1.12): one cell's AV1 stream decoded with dav1d, a temporal unit
 // at a time, and its pictures converted to the sRGB-encoded RGBA8 texels the rgba8 colour path
-// yields. Private to the decoder: ClipDecoder and LightfieldReference both decode through it.
+// yields. Private to the decoder: LightfieldDecoder and LightfieldReference both decode through it.
 #pragma once
 
 #include <cstdint>

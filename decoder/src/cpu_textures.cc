@@ -148,7 +148,7 @@ CpuTextures::CpuTextures(const container::LightfieldTrackHeader& header,
   }
 }
 
-Status CpuTextures::apply(const FrameUpdates& frame) {
+Status CpuTextures::apply(const LightfieldFrameUpdates& frame) {
   std::vector<float> rgb;
   std::vector<uint16_t> codes;
   std::vector<uint8_t> mat;

@@ -138,7 +138,7 @@ Expected<LightfieldReference::CellTimeline> LightfieldReference::cell_timeline(
 Expected<std::vector<uint32_t>> LightfieldReference::depth_rect_counts(uint32_t view, uint32_t face,
                                                                        uint32_t tile) const {
   CALF_ASSIGN_OR_RETURN(FaceGrid tiles,
-                        FaceGrid::with_cell_size(header_.face_size, header_.depth_tile_size));
+                        FaceGrid::with_cell_size(header_.face_size, header_.depth_region_size));
   CALF_ASSIGN_OR_RETURN(PixelRect r, tiles.cell_rect(tile));
   CALF_ASSIGN_OR_RETURN(lf::RegionCoding coding, lf::depth_coding(header_.depth_format));
   std::vector<uint32_t> counts;
@@ -168,7 +168,7 @@ Status LightfieldReference::decode_face(uint32_t view, uint32_t face, uint32_t f
   if (!view_problems_[view].ok()) return view_problems_[view];
   const uint32_t n = h.face_size;
   CALF_ASSIGN_OR_RETURN(FaceGrid cells, FaceGrid::with_cell_size(n, h.cell_size));
-  CALF_ASSIGN_OR_RETURN(FaceGrid tiles, FaceGrid::with_cell_size(n, h.depth_tile_size));
+  CALF_ASSIGN_OR_RETURN(FaceGrid tiles, FaceGrid::with_cell_size(n, h.depth_region_size));
   out->colour.assign(size_t{n} * n * 3, 0.0f);
   out->depth.assign(size_t{n} * n, 0);
   out->material.clear();

@@ -34,7 +34,7 @@ const tiles::IndexChunk& TilesTrack::index() const {
   return index_ ? index_->chunk : kEmpty;
 }
 
-Box3 TilesTrack::view_region() const {
+Box3 TilesTrack::view_volume() const {
   const tiles::IndexChunk& x = index();
   return Box3{{x.view_min[0], x.view_min[1], x.view_min[2]},
               {x.view_max[0], x.view_max[1], x.view_max[2]}};
@@ -138,7 +138,7 @@ Status TilesTrack::atlas(std::vector<uint8_t>* out) const {
 
 Status TilesTrack::decode(TileSet* out) const {
   TileSet s;
-  s.view_region = view_region();
+  s.view_volume = view_volume();
   s.atlas_width = header_.atlas_width;
   s.atlas_height = header_.atlas_height;
   CALF_RETURN_IF_ERROR(quads(&s.tiles));

@@ -19,8 +19,8 @@ uint64_t tiles_quads_hash(const TileSet& s) {
   std::vector<uint8_t> b;
   b.reserve(52 + 96 * s.tiles.size());
   put(b, s.tiles.size(), 4);
-  for (double d : {s.view_region.min.x, s.view_region.min.y, s.view_region.min.z,
-                   s.view_region.max.x, s.view_region.max.y, s.view_region.max.z})
+  for (double d : {s.view_volume.min.x, s.view_volume.min.y, s.view_volume.min.z,
+                   s.view_volume.max.x, s.view_volume.max.y, s.view_volume.max.z})
     put(b, std::bit_cast<uint64_t>(d), 8);
   for (const Tile& t : s.tiles) {
     for (const TileCorner& c : t.corners) {

@@ -209,7 +209,7 @@ float partition_estimate(const int (*px)[4], int subsets, int partition, int cha
 
 // Mode descriptions the generic path handles (modes 0, 1, 2, 3, 6, 7).
 struct ModeSpec {
-  int mode, subsets, partition_bits, color_bits, alpha_bits, pbits, index_bits;
+  int mode, subsets, partition_bits, colour_bits, alpha_bits, pbits, index_bits;
 };
 constexpr ModeSpec kMode0{0, 3, 4, 4, 0, 1, 3}, kMode1{1, 2, 6, 6, 0, 2, 3},
     kMode2{2, 3, 6, 5, 0, 0, 2}, kMode3{3, 2, 6, 7, 0, 1, 2}, kMode6{6, 1, 0, 7, 7, 1, 4},
@@ -223,7 +223,7 @@ struct Candidate {
 // Fits, orients (anchor indices < half) and packs one block in `m` with shape `partition`.
 void try_mode(const ModeSpec& m, int partition, const int (*px)[4], int refinements,
               Candidate& best) {
-  const FitSpec spec{0, m.alpha_bits ? 4 : 3, m.color_bits, m.pbits, m.index_bits};
+  const FitSpec spec{0, m.alpha_bits ? 4 : 3, m.colour_bits, m.pbits, m.index_bits};
   SubsetFit fit[3];
   long err = 0;
   for (int sub = 0; sub < m.subsets; ++sub) {
@@ -259,7 +259,7 @@ void try_mode(const ModeSpec& m, int partition, const int (*px)[4], int refineme
   bw.write(static_cast<uint32_t>(partition), m.partition_bits);
   for (int ch = 0; ch < 3; ++ch)
     for (int sub = 0; sub < m.subsets; ++sub)
-      for (int j = 0; j < 2; ++j) bw.write(static_cast<uint32_t>(fit[sub].q[j][ch]), m.color_bits);
+      for (int j = 0; j < 2; ++j) bw.write(static_cast<uint32_t>(fit[sub].q[j][ch]), m.colour_bits);
   if (m.alpha_bits) {
     for (int sub = 0; sub < m.subsets; ++sub)
       for (int j = 0; j < 2; ++j) bw.write(static_cast<uint32_t>(fit[sub].q[j][3]), m.alpha_bits);

@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <string>
 
-namespace calf::av1_internal {
+namespace calf::encoder::av1_internal {
 namespace {
 
 Status svt_error(const std::string& call, int64_t code) {
@@ -297,4 +297,4 @@ Expected<std::vector<Gop>> encode_cell(std::span<const uint8_t> rgba, uint32_t w
   return gops;
 }
 
-}  // namespace calf::av1_internal
+}  // namespace calf::encoder::av1_internal

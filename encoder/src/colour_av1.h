@@ -10,7 +10,7 @@
 #include "calf/format/av1_hdr_colour.h"
 #include "calf/format/status.h"
 
-namespace calf::av1_internal {
+namespace calf::encoder::av1_internal {
 
 // The temporal units of one GOP: unit i shows frame i of the GOP; unit 0 is a key frame with its
 // sequence header.
@@ -53,4 +53,4 @@ void rgba_to_ycbcr420(std::span<const uint8_t> rgba, uint32_t W, uint32_t H, uin
 void rgb10_to_ycbcr420(std::span<const uint16_t> rgb, uint32_t W, uint32_t H, uint16_t* y,
                        uint16_t* cb, uint16_t* cr);
 
-}  // namespace calf::av1_internal
+}  // namespace calf::encoder::av1_internal

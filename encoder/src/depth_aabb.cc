@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <string>
 
-namespace calf {
+namespace calf::encoder {
 namespace {
 
 // A half-open box on the (possibly coarsened) mask grid.
@@ -182,4 +182,4 @@ uint64_t covered_texels(std::span<const PixelRect> boxes) {
   return total;
 }
 
-}  // namespace calf
+}  // namespace calf::encoder

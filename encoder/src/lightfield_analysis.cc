@@ -19,7 +19,7 @@
 #include "calf/format/lightfield_layout.h"
 #include "lightfield_internal.h"
 
-namespace calf {
+namespace calf::encoder {
 namespace lightfield_internal {
 
 Status validate_options(const LightfieldEncodeOptions& o) {
@@ -31,8 +31,8 @@ Status validate_options(const LightfieldEncodeOptions& o) {
   if (!(o.min_psnr_db > 0 && o.min_psnr_db <= 200)) {
     return bad("--psnr " + std::to_string(o.min_psnr_db) + ": expected (0, 200] dB");
   }
-  if (o.depth_tiles_per_side < 1 || o.depth_tiles_per_side > 64) {
-    return bad("depth tiles per side " + std::to_string(o.depth_tiles_per_side) +
+  if (o.depth_regions_per_side < 1 || o.depth_regions_per_side > 64) {
+    return bad("depth regions per side " + std::to_string(o.depth_regions_per_side) +
                ": expected [1, 64]");
   }
   if (o.depth_window < 1 || o.depth_window > 65535) {
@@ -169,8 +169,8 @@ Expected<LightfieldAnalysis> plan_lightfield(const capture::CaptureManifest& m,
                                               std::to_string(m.viewpoints.size()));
   }
   CALF_ASSIGN_OR_RETURN(FaceGrid cells, FaceGrid::with_cell_size(m.face_size, options.cell_size));
-  CALF_ASSIGN_OR_RETURN(FaceGrid tiles,
-                        FaceGrid::with_tiles_per_side(m.face_size, options.depth_tiles_per_side));
+  CALF_ASSIGN_OR_RETURN(
+      FaceGrid tiles, FaceGrid::with_regions_per_side(m.face_size, options.depth_regions_per_side));
   LightfieldAnalysis a;
   a.views.assign(views.begin(), views.end());
   // HDR or LDR: decided over the whole set unless the format is given. LDR input never pays for
@@ -220,7 +220,7 @@ Expected<LightfieldAnalysis> plan_lightfield(const capture::CaptureManifest& m,
   h.view_count = static_cast<uint32_t>(m.viewpoints.size());
   h.face_size = m.face_size;
   h.cell_size = cells.cell_size();
-  h.depth_tile_size = tiles.cell_size();
+  h.depth_region_size = tiles.cell_size();
   h.flags = a.hdr ? 1 : 0;
   a.coverage = m.coverage && options.coverage;
   return a;
@@ -234,7 +234,7 @@ Expected<LightfieldAnalysis> analyse_lightfield(const capture::CaptureSetReader&
   // The grids first: a bad cell size fails before any image is read.
   CALF_RETURN_IF_ERROR(FaceGrid::with_cell_size(m.face_size, options.cell_size).status());
   CALF_RETURN_IF_ERROR(
-      FaceGrid::with_tiles_per_side(m.face_size, options.depth_tiles_per_side).status());
+      FaceGrid::with_regions_per_side(m.face_size, options.depth_regions_per_side).status());
 
   // Views are read in parallel; the error reported is the first failing view's, as a serial
   // read would report it. Views after a known failure are skipped.
@@ -265,4 +265,4 @@ Expected<LightfieldAnalysis> analyse_lightfield(const capture::CaptureSetReader&
   return plan_lightfield(m, facts, options);
 }
 
-}  // namespace calf
+}  // namespace calf::encoder

@@ -7,14 +7,14 @@
 
 #include "calf/encoder/bc_encode.h"
 #include "calf/encoder/bc_rdo.h"
-#include "calf/encoder/color_keyframes.h"
+#include "calf/encoder/colour_keyframes.h"
 #include "calf/format/bc.h"
 #include "calf/format/colour.h"
 #include "calf/format/lightfield_layout.h"
 #include "colour_av1.h"
 #include "lightfield_view_pass.h"
 
-namespace calf {
+namespace calf::encoder {
 namespace lightfield_internal {
 namespace {
 
@@ -346,4 +346,4 @@ Status spatial_colour_reference(ColourCoding coding, Bc1Fit bc1_fit, std::span<c
   return Status::Ok();
 }
 
-}  // namespace calf
+}  // namespace calf::encoder

@@ -14,7 +14,7 @@
 #include "lightfield_internal.h"
 #include "lightfield_view_pass.h"
 
-namespace calf {
+namespace calf::encoder {
 namespace lightfield_internal {
 namespace {
 
@@ -71,7 +71,7 @@ void add_figures(LightfieldEncodeStats& total, const LightfieldEncodeStats& part
   total.index_bytes += part.index_bytes;
   total.colour_cells += part.colour_cells;
   total.colour_keyframes += part.colour_keyframes;
-  total.depth_tiles += part.depth_tiles;
+  total.depth_regions += part.depth_regions;
   total.depth_keyframes += part.depth_keyframes;
   total.depth_pframes += part.depth_pframes;
   total.depth_empty_pframes += part.depth_empty_pframes;
@@ -101,8 +101,8 @@ using lightfield_internal::figures_of;
 using lightfield_internal::kInf;
 using lightfield_internal::Pending;
 using lightfield_internal::read_view;
+using lightfield_internal::RegionStream;
 using lightfield_internal::TaskOut;
-using lightfield_internal::TileStream;
 using lightfield_internal::ViewData;
 
 }  // namespace
@@ -164,8 +164,8 @@ Expected<LightfieldViewEncoding> encode_lightfield_view_frames(
                   "the analysis was made for another capture set or other options");
   }
   CALF_ASSIGN_OR_RETURN(FaceGrid cells, FaceGrid::with_cell_size(m.face_size, options.cell_size));
-  CALF_ASSIGN_OR_RETURN(FaceGrid tiles,
-                        FaceGrid::with_tiles_per_side(m.face_size, options.depth_tiles_per_side));
+  CALF_ASSIGN_OR_RETURN(
+      FaceGrid tiles, FaceGrid::with_regions_per_side(m.face_size, options.depth_regions_per_side));
 
   LightfieldViewEncoding out;
   out.view = v;
@@ -216,7 +216,7 @@ Expected<LightfieldViewEncoding> encode_lightfield_view_frames(
                     analysis.header.fps_numerator,
                     analysis.header.fps_denominator};
   for (uint32_t face = 0; face < 6; ++face) {
-    // Tasks of one face in file order: cells, depth tiles, material tiles, coverage tiles.
+    // Tasks of one face in file order: cells, depth regions, material tiles, coverage tiles.
     const uint32_t nc = cells.cell_count(), nt = tiles.cell_count();
     const uint32_t nm = view.has_material ? nt : 0;
     const uint32_t nv = analysis.coverage ? nt : 0;
@@ -228,11 +228,11 @@ Expected<LightfieldViewEncoding> encode_lightfield_view_frames(
                             if (i < nc) {
                               colour_task(ctx, face, i, outs[i]);
                             } else if (i < nc + nt) {
-                              region_task(ctx, face, i - nc, TileStream::kDepth, outs[i]);
+                              region_task(ctx, face, i - nc, RegionStream::kDepth, outs[i]);
                             } else if (i < nc + nt + nm) {
-                              region_task(ctx, face, i - nc - nt, TileStream::kMaterial, outs[i]);
+                              region_task(ctx, face, i - nc - nt, RegionStream::kMaterial, outs[i]);
                             } else {
-                              region_task(ctx, face, i - nc - nt - nm, TileStream::kCoverage,
+                              region_task(ctx, face, i - nc - nt - nm, RegionStream::kCoverage,
                                           outs[i]);
                             }
                           }
@@ -244,10 +244,10 @@ Expected<LightfieldViewEncoding> encode_lightfield_view_frames(
       add_figures(stats, figures_of(o.stats));
     }
     stats.colour_cells += nc;
-    stats.depth_tiles += nt;
+    stats.depth_regions += nt;
     if (options.progress) options.progress(uint64_t{6} * v + face + 1, total);
   }
   return out;
 }
 
-}  // namespace calf
+}  // namespace calf::encoder

@@ -9,7 +9,7 @@
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/format/status.h"
 
-namespace calf::lightfield_internal {
+namespace calf::encoder::lightfield_internal {
 
 // kEncoderOption for an option outside its range (the message names the command-line flag).
 Status validate_options(const LightfieldEncodeOptions& options);
@@ -38,4 +38,4 @@ class ViewFactsBuilder {
 // Whether two views' facts agree (ranges compared by their z_near and z_far).
 bool same_facts(const LightfieldViewFacts& a, const LightfieldViewFacts& b);
 
-}  // namespace calf::lightfield_internal
+}  // namespace calf::encoder::lightfield_internal

@@ -10,7 +10,7 @@
 #include "calf/format/log_depth.h"
 #include "lightfield_view_pass.h"
 
-namespace calf::lightfield_internal {
+namespace calf::encoder::lightfield_internal {
 namespace {
 
 using container::ChunkKeys;
@@ -18,7 +18,7 @@ using container::LightfieldStream;
 
 // A tile's frames as interleaved bytes: depth [hi, lo] per texel, material [reflect, refract,
 // ior] per texel.
-struct TileFrames {
+struct RegionFrames {
   uint32_t width = 0, height = 0, bytes_per_texel = 0, frames = 0;
   std::vector<uint8_t> data;  // [frame][y][x][byte]
   const uint8_t* texel(uint32_t f, uint32_t x, uint32_t y) const {
@@ -26,7 +26,7 @@ struct TileFrames {
   }
 };
 
-ChangeMask material_change_mask(const TileFrames& t, uint32_t first, uint32_t current,
+ChangeMask material_change_mask(const RegionFrames& t, uint32_t first, uint32_t current,
                                 uint32_t window) {
   ChangeMask mask;
   mask.width = t.width;
@@ -61,7 +61,7 @@ enum class RegionCoding : uint8_t {
 
 // Codes frames [first, first + count) of a tile into one chunk (SPEC §11.1 "Region chunk").
 // `decoded` is the decoder's tile state (bytes_per_texel == 2 only), for the BC5 error report.
-Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
+Status code_region_group(const Context& ctx, const RegionFrames& t, bool is_depth,
                          RegionCoding coding, uint32_t first, uint32_t count,
                          std::vector<uint8_t>& raw, TaskStats& s, StreamBytes& bytes,
                          std::vector<uint16_t>* decoded) {
@@ -259,7 +259,7 @@ Status code_region_group(const Context& ctx, const TileFrames& t, bool is_depth,
 // empty but for the first W - 1, which re-send what changed in the W frames before the group. A
 // seek anywhere in the span reads this one chunk, as it read one chunk before, and static content
 // costs one keyframe instead of one every K frames.
-uint32_t static_group_span(const Context& ctx, const TileFrames& t, uint32_t first,
+uint32_t static_group_span(const Context& ctx, const RegionFrames& t, uint32_t first,
                            uint32_t count) {
   const uint32_t k = ctx.options->depth_keyframe_interval;
   const uint32_t segment = ctx.options->segment_frames;
@@ -281,14 +281,14 @@ uint32_t static_group_span(const Context& ctx, const TileFrames& t, uint32_t fir
 
 }  // namespace
 
-void region_task(const Context& ctx, uint32_t face, uint32_t tile, TileStream stream,
+void region_task(const Context& ctx, uint32_t face, uint32_t tile, RegionStream stream,
                  TaskOut& out) {
   const ViewData& v = *ctx.view;
-  const bool is_depth = stream == TileStream::kDepth;
-  const bool is_coverage = stream == TileStream::kCoverage;
+  const bool is_depth = stream == RegionStream::kDepth;
+  const bool is_coverage = stream == RegionStream::kCoverage;
   const PixelRect r =
       ctx.tiles.cell_rect(tile % ctx.tiles.cells_per_side(), tile / ctx.tiles.cells_per_side());
-  TileFrames t;
+  RegionFrames t;
   t.width = r.width;
   t.height = r.height;
   t.bytes_per_texel = is_depth ? 2 : 3;
@@ -347,4 +347,4 @@ void region_task(const Context& ctx, uint32_t face, uint32_t tile, TileStream st
   }
 }
 
-}  // namespace calf::lightfield_internal
+}  // namespace calf::encoder::lightfield_internal

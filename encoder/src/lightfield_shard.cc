@@ -27,7 +27,7 @@
 #include "calf/format/version.h"
 #include "lightfield_internal.h"
 
-namespace calf {
+namespace calf::encoder {
 namespace {
 
 // Metadata keys of the intermediate files. Their record is text: one fact per line, floats as
@@ -53,7 +53,7 @@ std::string analysis_record(const LightfieldAnalysis& a, const LightfieldEncodeO
   s << kRecordMagic << "\n";
   s << "cell " << o.cell_size << "\npsnr " << hex_double(o.min_psnr_db) << "\ncolour "
     << static_cast<int>(o.colour) << "\ndepth " << static_cast<int>(o.depth) << "\ntiles "
-    << o.depth_tiles_per_side << "\nwindow " << o.depth_window << "\naabbs " << o.max_aabbs
+    << o.depth_regions_per_side << "\nwindow " << o.depth_window << "\naabbs " << o.max_aabbs
     << "\nkeyframe_interval " << o.depth_keyframe_interval << "\nsupercompression "
     << static_cast<int>(o.supercompression) << "\nzstd_level " << o.levels.zstd_level
     << "\nlzma_preset " << o.levels.lzma_preset << "\nsegment_frames " << o.segment_frames
@@ -140,7 +140,7 @@ Status parse_record(const std::string& path, const std::string& text, Lightfield
     return bad_record(path, "depth");
   o->depth = static_cast<DepthCoding>(x);
   if (!field("tiles", 64)) return bad_record(path, "tiles");
-  o->depth_tiles_per_side = static_cast<uint32_t>(x);
+  o->depth_regions_per_side = static_cast<uint32_t>(x);
   if (!field("window", 65535)) return bad_record(path, "window");
   o->depth_window = static_cast<uint32_t>(x);
   if (!field("aabbs", 64)) return bad_record(path, "aabbs");
@@ -470,7 +470,7 @@ Expected<LightfieldEncodeStats> encode_lightfield_shard(
     total.material.stored += enc.stats.material.stored;
     total.coverage.stored += enc.stats.coverage.stored;
     total.colour_cells += enc.stats.colour_cells;
-    total.depth_tiles += enc.stats.depth_tiles;
+    total.depth_regions += enc.stats.depth_regions;
     total.min_colour_quality_db =
         std::min(total.min_colour_quality_db, enc.stats.min_colour_quality_db);
   }
@@ -557,7 +557,7 @@ Status merge_lightfield_shards(const LightfieldAnalysisFile& analysis,
   }
   // The clip: the same calls, in the same order, as encode_lightfield_file() makes. A view's
   // chunks from its shards go in the encoder's file order (index; per face: colour cells with
-  // their t chunk then keyframes, depth tiles, material tiles; each by frame); the partial t
+  // their t chunk then keyframes, depth regions, material tiles; each by frame); the partial t
   // chunks of one cell are joined and compressed as one encode does.
   CALF_ASSIGN_OR_RETURN(container::Writer writer,
                         container::Writer::create(out_path, analysis.options.levels));
@@ -649,4 +649,4 @@ Status merge_lightfield_shards(const LightfieldAnalysisFile& analysis,
   return writer.finish();
 }
 
-}  // namespace calf
+}  // namespace calf::encoder

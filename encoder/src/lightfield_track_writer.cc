@@ -10,7 +10,7 @@
 #include "lightfield_internal.h"
 #include "lightfield_view_pass.h"
 
-namespace calf {
+namespace calf::encoder {
 
 using container::ChunkKeys;
 using lightfield_internal::add_figures;
@@ -104,4 +104,4 @@ Expected<LightfieldEncodeStats> encode_lightfield_file(const std::filesystem::pa
   return stats;
 }
 
-}  // namespace calf
+}  // namespace calf::encoder

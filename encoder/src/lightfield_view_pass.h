@@ -17,7 +17,7 @@
 #include "calf/format/log_depth.h"
 #include "calf/format/status.h"
 
-namespace calf::lightfield_internal {
+namespace calf::encoder::lightfield_internal {
 
 inline constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -92,10 +92,11 @@ Status add_chunk(const Context& ctx, TaskOut& out, container::ChunkKeys keys,
 void colour_task(const Context& ctx, uint32_t face, uint32_t cell, TaskOut& out);
 
 // The region streams a tile is coded in.
-enum class TileStream : uint8_t { kDepth, kMaterial, kCoverage };
+enum class RegionStream : uint8_t { kDepth, kMaterial, kCoverage };
 
 // Codes tile `tile` of `face` in `stream` (lightfield_regions.cc).
-void region_task(const Context& ctx, uint32_t face, uint32_t tile, TileStream stream, TaskOut& out);
+void region_task(const Context& ctx, uint32_t face, uint32_t tile, RegionStream stream,
+                 TaskOut& out);
 
 // A task's figures in the track's terms, so that one merge (add_figures) serves tasks and views.
 LightfieldEncodeStats figures_of(const TaskStats& task);
@@ -103,4 +104,4 @@ LightfieldEncodeStats figures_of(const TaskStats& task);
 // Adds the counts and bytes of `part` to `total` (formats and hdr are the track's, not summed).
 void add_figures(LightfieldEncodeStats& total, const LightfieldEncodeStats& part);
 
-}  // namespace calf::lightfield_internal
+}  // namespace calf::encoder::lightfield_internal

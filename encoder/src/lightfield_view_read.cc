@@ -9,7 +9,7 @@
 #include "lightfield_internal.h"
 #include "lightfield_view_pass.h"
 
-namespace calf::lightfield_internal {
+namespace calf::encoder::lightfield_internal {
 namespace {
 
 // The coverage of view-frame `vf` as the stream codes it (SPEC §11.1.11): near and far shares
@@ -95,4 +95,4 @@ Status read_view(const capture::CaptureSetReader& input, uint32_t view,
   return Status::Ok();
 }
 
-}  // namespace calf::lightfield_internal
+}  // namespace calf::encoder::lightfield_internal

@@ -13,7 +13,7 @@
 #include "calf/format/colour.h"
 #include "lightfield_internal.h"
 
-namespace calf {
+namespace calf::encoder {
 namespace {
 
 constexpr double kTopDb = 200;  // samples at or above this PSNR (or without energy) share a bin
@@ -252,4 +252,4 @@ double auto_psnr_db(const NoiseEstimate& estimate, double margin, double cap) {
   return std::clamp(*estimate.psnr_db - margin, std::min(kAutoPsnrFloorDb, cap), cap);
 }
 
-}  // namespace calf
+}  // namespace calf::encoder

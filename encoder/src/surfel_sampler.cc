@@ -11,7 +11,7 @@
 #include "calf/format/coordinates.h"
 #include "surfel_sampler_internal.h"
 
-namespace calf {
+namespace calf::encoder {
 namespace {
 
 using surfel_internal::P3;
@@ -126,4 +126,4 @@ Expected<SurfelOrder> order_surfels(std::span<const Vec3> candidates, uint32_t n
   return result;
 }
 
-}  // namespace calf
+}  // namespace calf::encoder

@@ -15,7 +15,7 @@
 
 #include "surfel_sampler_internal.h"
 
-namespace calf::surfel_internal {
+namespace calf::encoder::surfel_internal {
 namespace {
 
 constexpr size_t kChunk = 1 << 14;
@@ -86,4 +86,4 @@ std::vector<uint32_t> order_exact_greedy(std::span<const Vec3> candidates, uint3
   return order;
 }
 
-}  // namespace calf::surfel_internal
+}  // namespace calf::encoder::surfel_internal

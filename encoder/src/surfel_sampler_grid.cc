@@ -7,7 +7,7 @@
 
 #include "surfel_sampler_internal.h"
 
-namespace calf::surfel_internal {
+namespace calf::encoder::surfel_internal {
 namespace {
 
 constexpr uint64_t kEmpty = ~uint64_t{0};
@@ -169,4 +169,4 @@ float PointGrid::nearest2(const P3& q, uint32_t skip, float stop2, bool* exact) 
   return best;
 }
 
-}  // namespace calf::surfel_internal
+}  // namespace calf::encoder::surfel_internal

@@ -9,7 +9,7 @@
 
 #include "calf/encoder/surfel_sampler.h"
 
-namespace calf::surfel_internal {
+namespace calf::encoder::surfel_internal {
 
 struct P3 {
   float x, y, z;
@@ -113,4 +113,4 @@ std::vector<uint32_t> order_exact_greedy(std::span<const Vec3> candidates, uint3
 std::vector<uint32_t> order_greedy_tree(std::span<const Vec3> candidates, uint32_t n,
                                         const SurfelSamplerOptions& options);
 
-}  // namespace calf::surfel_internal
+}  // namespace calf::encoder::surfel_internal

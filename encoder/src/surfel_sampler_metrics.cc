@@ -12,7 +12,7 @@
 #include "calf/format/coordinates.h"
 #include "surfel_sampler_internal.h"
 
-namespace calf {
+namespace calf::encoder {
 namespace surfel_internal {
 
 std::vector<float> nearest_neighbour_distances(std::span<const P3> points, uint32_t threads) {
@@ -77,4 +77,4 @@ Expected<PrefixSpacing> prefix_spacing(std::span<const Vec3> candidates,
   return s;
 }
 
-}  // namespace calf
+}  // namespace calf::encoder

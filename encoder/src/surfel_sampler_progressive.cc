@@ -6,7 +6,7 @@
 
 #include "surfel_sampler_internal.h"
 
-namespace calf::surfel_internal {
+namespace calf::encoder::surfel_internal {
 
 std::vector<uint32_t> order_progressive(std::span<const Vec3> candidates, uint32_t n,
                                         const SurfelSamplerOptions& options) {
@@ -184,4 +184,4 @@ std::vector<uint32_t> order_progressive(std::span<const Vec3> candidates, uint32
   return order;
 }
 
-}  // namespace calf::surfel_internal
+}  // namespace calf::encoder::surfel_internal

@@ -33,7 +33,7 @@
 #include <emmintrin.h>
 #endif
 
-namespace calf::surfel_internal {
+namespace calf::encoder::surfel_internal {
 namespace {
 
 // Candidates per leaf: small enough that a leaf's box is tight, large enough that the tree's
@@ -286,4 +286,4 @@ std::vector<uint32_t> order_greedy_tree(std::span<const Vec3> candidates, uint32
   return order;
 }
 
-}  // namespace calf::surfel_internal
+}  // namespace calf::encoder::surfel_internal

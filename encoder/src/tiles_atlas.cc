@@ -49,12 +49,12 @@ bool pack_atlas(const std::vector<uint32_t>& sides, uint32_t max_size,
   return false;
 }
 
-TileSet write_tile_set(const Frame& f, const Box3& view_region, const Selection& selection,
+TileSet write_tile_set(const Frame& f, const Box3& view_volume, const Selection& selection,
                        const std::vector<TileTexture>& textures,
                        const std::vector<AtlasPlacement>& placements, uint32_t width,
                        uint32_t height, double dilation) {
   TileSet set;
-  set.view_region = view_region;
+  set.view_volume = view_volume;
   set.atlas_width = width;
   set.atlas_height = height;
   set.atlas_rgba.assign(size_t{width} * height * 4, 0);

@@ -57,7 +57,7 @@ Status validate_tile_set(const TileSet& t) {
                              ") RGBA (", int{p[0]}, ", ", int{p[1]}, ", ", int{p[2]}, ", ",
                              int{p[3]}, ") has colour above alpha (the atlas is premultiplied)"));
   }
-  const Box3& v = t.view_region;
+  const Box3& v = t.view_volume;
   const double lo[3] = {v.min.x, v.min.y, v.min.z}, hi[3] = {v.max.x, v.max.y, v.max.z};
   for (int c = 0; c < 3; ++c) {
     if (!coordinate_ok(lo[c]) || !coordinate_ok(hi[c]) || !(lo[c] <= hi[c]))
@@ -112,7 +112,7 @@ Status encode_tiles_track(const TileSet& input, const TilesEncodeOptions& option
   header.atlas_format = bc7 ? tiles::kAtlasBc7 : tiles::kAtlasRgba8;
   CALF_RETURN_IF_ERROR(tiles::check_header(header));
   tiles::IndexChunk index;
-  const Box3& v = input.view_region;
+  const Box3& v = input.view_volume;
   index.view_min[0] = v.min.x, index.view_min[1] = v.min.y, index.view_min[2] = v.min.z;
   index.view_max[0] = v.max.x, index.view_max[1] = v.max.y, index.view_max[2] = v.max.z;
   index.band_rows = options.band_rows;

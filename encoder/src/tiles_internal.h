@@ -175,7 +175,7 @@ struct AtlasPlacement {
 bool pack_atlas(const std::vector<uint32_t>& sides, uint32_t max_size,
                 std::vector<AtlasPlacement>* placements, uint32_t* width, uint32_t* height);
 // Writes the tile set: corners, projective coordinates and the RGBA8 atlas.
-TileSet write_tile_set(const Frame& f, const Box3& view_region, const Selection& selection,
+TileSet write_tile_set(const Frame& f, const Box3& view_volume, const Selection& selection,
                        const std::vector<TileTexture>& textures,
                        const std::vector<AtlasPlacement>& placements, uint32_t width,
                        uint32_t height, double dilation);

@@ -42,9 +42,9 @@ static int command_main(int argc, char** argv) {
   if (int rc = calf::tools::parse_command_line(app, "calf-merge", argc, argv); rc >= 0) return rc;
 
   const auto start = std::chrono::steady_clock::now();
-  auto analysis = calf::read_lightfield_analysis(analysis_path);
+  auto analysis = calf::encoder::read_lightfield_analysis(analysis_path);
   if (!analysis.ok()) return calf::tools::print_error("calf-merge", analysis.status());
-  if (calf::Status s = calf::merge_lightfield_shards(*analysis, shards, out); !s.ok()) {
+  if (calf::Status s = calf::encoder::merge_lightfield_shards(*analysis, shards, out); !s.ok()) {
     return calf::tools::print_error("calf-merge", s);
   }
   if (!quiet) {

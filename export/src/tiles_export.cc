@@ -232,7 +232,7 @@ Expected<std::vector<ExportedFile>> export_tile_set(const TileSet& set, MeshExpo
   std::vector<aiVector3D> positions, uvs;
   std::vector<std::array<unsigned, 3>> faces;
   double worst = 0;
-  const Box3& region = set.view_region;
+  const Box3& region = set.view_volume;
   const std::array<double, 3> centre = {(double(region.min.x) + region.max.x) / 2,
                                         (double(region.min.y) + region.max.y) / 2,
                                         (double(region.min.z) + region.max.z) / 2};

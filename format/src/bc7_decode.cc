@@ -13,7 +13,7 @@ namespace {
 
 // Table.M of the specification, one row per mode.
 struct Bc7Mode {
-  int subsets, partition_bits, rotation_bits, index_select_bits, color_bits, alpha_bits;
+  int subsets, partition_bits, rotation_bits, index_select_bits, colour_bits, alpha_bits;
   int endpoint_pbits, shared_pbits, index_bits, index2_bits;
 };
 constexpr Bc7Mode kModes[8] = {
@@ -47,7 +47,7 @@ void decode_bc7_block(const uint8_t* block, uint8_t* rgba) {
   const int ns = m.subsets, ne = 2 * ns;
   int ep[6][4];  // endpoint e = 2 * subset + {0, 1}; channels RGBA
   for (int c = 0; c < 3; ++c)
-    for (int e = 0; e < ne; ++e) ep[e][c] = static_cast<int>(br.read(m.color_bits));
+    for (int e = 0; e < ne; ++e) ep[e][c] = static_cast<int>(br.read(m.colour_bits));
   for (int e = 0; e < ne; ++e)
     ep[e][3] = m.alpha_bits ? static_cast<int>(br.read(m.alpha_bits)) : 255;
 
@@ -60,8 +60,8 @@ void decode_bc7_block(const uint8_t* block, uint8_t* rgba) {
   const bool has_pbit = m.endpoint_pbits || m.shared_pbits;
   for (int e = 0; e < ne; ++e) {
     for (int c = 0; c < 3; ++c) {
-      ep[e][c] = has_pbit ? unquantize(ep[e][c] << 1 | pbit[e], m.color_bits + 1)
-                          : unquantize(ep[e][c], m.color_bits);
+      ep[e][c] = has_pbit ? unquantize(ep[e][c] << 1 | pbit[e], m.colour_bits + 1)
+                          : unquantize(ep[e][c], m.colour_bits);
     }
     if (m.alpha_bits) {
       ep[e][3] = has_pbit ? unquantize(ep[e][3] << 1 | pbit[e], m.alpha_bits + 1)
@@ -80,9 +80,9 @@ void decode_bc7_block(const uint8_t* block, uint8_t* rgba) {
 
   // Which index set drives colour and which alpha (index selection only in mode 4).
   const bool swap = m.index2_bits && index_select;
-  const int color_bits = swap ? m.index2_bits : m.index_bits;
+  const int colour_bits = swap ? m.index2_bits : m.index_bits;
   const int alpha_bits = m.index2_bits ? (swap ? m.index_bits : m.index2_bits) : m.index_bits;
-  const uint8_t* wc = weights_for_bits(color_bits);
+  const uint8_t* wc = weights_for_bits(colour_bits);
   const uint8_t* wa = weights_for_bits(alpha_bits);
   for (int i = 0; i < 16; ++i) {
     const int s = subset_of(ns, partition, i);

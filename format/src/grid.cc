@@ -30,7 +30,7 @@ Expected<FaceGrid> FaceGrid::with_cell_size(uint32_t face_size, uint32_t cell_si
   return FaceGrid(face_size, cell_size);
 }
 
-Expected<FaceGrid> FaceGrid::with_tiles_per_side(uint32_t face_size, uint32_t tiles_per_side) {
+Expected<FaceGrid> FaceGrid::with_regions_per_side(uint32_t face_size, uint32_t tiles_per_side) {
   CALF_RETURN_IF_ERROR(check_grid_size("tiles per side", tiles_per_side));
   // Checked here too so that a zero face is reported as such, not as a zero cell size.
   CALF_RETURN_IF_ERROR(check_grid_size("face size", face_size));

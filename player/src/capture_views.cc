@@ -65,7 +65,7 @@ Expected<View> view_from_capture_frame(const capture::ViewFrame& frame, const Ve
       codes[i] = range->encode_unchecked(frame.depth[first + i]);
     Status s = view.write_depth_rect(face, whole, codes);
     if (s.ok()) {
-      s = view.write_color_rect(
+      s = view.write_colour_rect(
           face, whole, std::span<const float>(frame.color).subspan(3 * first, 3 * face_texels));
     }
     if (s.ok() && frame.has_material) {
@@ -124,7 +124,7 @@ RenderedImage reproject_view(const View& view, const Camera& camera) {
       const size_t k = size_t{j} * camera.width + i;
       double c[3] = {0, 0, 0};
       for (int t = 0; t < 4; ++t) {
-        const float* col = view.color_at(taps.texel[t].face, taps.texel[t].x, taps.texel[t].y);
+        const float* col = view.colour_at(taps.texel[t].face, taps.texel[t].x, taps.texel[t].y);
         for (int ch = 0; ch < 3; ++ch) c[ch] += taps.weight[t] * col[ch];
       }
       for (int ch = 0; ch < 3; ++ch) out.color[3 * k + ch] = static_cast<float>(c[ch]);

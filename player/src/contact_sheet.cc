@@ -67,7 +67,7 @@ Expected<Rgb8Image> compose_contact_sheet(std::span<const ContactSheetRow> rows,
     const uint32_t w = rows[r].ground_truth.width, h = rows[r].ground_truth.height;
     std::vector<uint8_t> heat(size_t{3} * w * h);
     for (size_t i = 0; i < errors[r].size(); ++i) {
-      const std::array<uint8_t, 3> c = heat_color(errors[r][i] / options.heat_full_scale);
+      const std::array<uint8_t, 3> c = heat_colour(errors[r][i] / options.heat_full_scale);
       std::copy(c.begin(), c.end(), heat.begin() + 3 * i);
     }
     blit(sheet, options.gap, y, w, h, srgb8_tile(rows[r].ground_truth));

@@ -38,7 +38,7 @@ void unmix_coverage_colour(View* view, double min_share, double min_jump) {
   std::array<std::vector<float>, kCubeFaceCount> out;
   for (int f = 0; f < kCubeFaceCount; ++f) {
     const CubeFace face = cube_face_from_index(f);
-    const std::span<const float> in = view->color_face(face);
+    const std::span<const float> in = view->colour_face(face);
     out[f].assign(in.begin(), in.end());
     for (uint32_t y = 0; y < n; ++y) {
       for (uint32_t x = 0; x < n; ++x) {
@@ -74,7 +74,7 @@ void unmix_coverage_colour(View* view, double min_share, double min_jump) {
             if (view->coverage_at(t.face, t.x, t.y).mask == 0xFFFF) score += 10;
             if (score > best[s]) {
               best[s] = score;
-              pick[s] = view->color_at(t.face, t.x, t.y);
+              pick[s] = view->colour_at(t.face, t.x, t.y);
             }
           }
         }
@@ -105,7 +105,7 @@ void unmix_coverage_colour(View* view, double min_share, double min_jump) {
   const PixelRect whole{0, 0, n, n};
   for (int f = 0; f < kCubeFaceCount; ++f) {
     // The rect is the whole face and `out` holds it: the write cannot fail.
-    (void)view->write_color_rect(cube_face_from_index(f), whole, out[f]);
+    (void)view->write_colour_rect(cube_face_from_index(f), whole, out[f]);
   }
 }
 

@@ -1,6 +1,7 @@
 // Private to the player: reading a rendered frame back from the bound framebuffer, shared by the
-// light-field ray-marcher (gl_renderer.cc) and the mesh rasteriser (mesh_gl_renderer.cc). Both draw
-// into an RGBA32F colour attachment 0 holding linear RGB and radial depth.
+// light-field ray-marcher (lightfield_gl_renderer.cc) and the mesh rasteriser
+// (mesh_gl_renderer.cc). Both draw into an RGBA32F colour attachment 0 holding linear RGB and
+// radial depth.
 #pragma once
 
 #include <cstddef>

@@ -1,6 +1,6 @@
 // Private to the player: compiling and linking a GLSL 4.50 program from its stages, shared by the
-// light-field ray-marcher (gl_renderer.cc), the mesh rasteriser (mesh_gl_renderer.cc), the
-// surfel splatter (surfel_gl_renderer.cc) and the tiles rasteriser (tiles_gl_renderer.cc); and
+// light-field ray-marcher (lightfield_gl_renderer.cc), the mesh rasteriser (mesh_gl_renderer.cc),
+// the surfel splatter (surfel_gl_renderer.cc) and the tiles rasteriser (tiles_gl_renderer.cc); and
 // the upload of the rasterisers' camera.
 #pragma once
 

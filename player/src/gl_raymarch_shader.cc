@@ -46,23 +46,23 @@ uniform uint view_count;         // active views, in views[]
 uniform uint colour_slots;       // 2 keyframe slots per face, or 1
 uniform uint steps;              // N_step
 uniform uint refine_steps;
-uniform float march_near;        // RenderOptions::near
+uniform float march_near;        // LightfieldRenderOptions::near
 uniform float march_log_ratio;   // ln(far / near)
 uniform float min_view_distance;
 uniform float footprint_limit;   // depth_footprint - 1e-9
 uniform float smooth_log_ratio;  // ln(1 + smooth_depth_ratio)
 uniform float depth_decay;
 uniform float cam_decay;
-uniform float color_depth_tolerance;
+uniform float colour_depth_tolerance;
 uniform float mixed_penalty_factor;  // exp(-mixed_texel_penalty); 1 = off
 uniform float mixed_texel_bend_texels;  // in texel angles, 2 / face size radians
-uniform uint coverage_mode;      // RenderOptions::coverage (read with CALF_COVERAGE only)
+uniform uint coverage_mode;      // LightfieldRenderOptions::coverage (read with CALF_COVERAGE only)
 uniform float coverage_threshold;
 uniform float coverage_cluster;
 uniform uint coverage_agreement;
 uniform bool tight_march_start;
-uniform bool bilinear_color;
-uniform bool depth_aware_color;
+uniform bool bilinear_colour;
+uniform bool depth_aware_colour;
 uniform float surface_hint_margin_texels;  // of its own texels a vetoing view must see beyond
 uniform uint surface_hint_vetoes;   // vetoes a hint crossing survives
 uniform uint surface_hint_substeps; // hint tests per step
@@ -174,7 +174,7 @@ vec3 colour_at(CalfView v, ivec3 t) {
   return mix(ca, cb, float(w) / 255.0);
 }
 
-// ---- code_margin (cpu_renderer.cc): how far in front of its surface view v sees the point at
+// ---- code_margin (lightfield_cpu_renderer.cc): how far in front of its surface view v sees the point at
 // offset x (r = |x|), in code units: > 0 in front, <= 0 at or behind, +inf where v sees sky ----
 float code_margin(CalfView v, vec3 x, float r) {
   int face = face_of(x);
@@ -203,7 +203,7 @@ float code_margin(CalfView v, vec3 x, float r) {
 }
 
 #ifdef CALF_COVERAGE
-// ---- coverage_margin (cpu_renderer.cc): where code_margin's `margin` puts the point at or behind
+// ---- coverage_margin (lightfield_cpu_renderer.cc): where code_margin's `margin` puts the point at or behind
 // the footprint's surface, the view's coverage says whether that surface covers the direction
 // inside the texel; where it does not, the margin is measured against the surface behind it ----
 float coverage_margin(CalfView v, vec3 x, float r, float margin) {
@@ -273,7 +273,7 @@ float coverage_margin(CalfView v, vec3 x, float r, float margin) {
 }
 #endif
 
-// ---- CpuRenderer::empty_at / empty_beyond: BetweenViewpointAndGeometry over the active views,
+// ---- LightfieldCpuRenderer::empty_at / empty_beyond: BetweenViewpointAndGeometry over the active views,
 // true as soon as one view that is not too near sees p in front of its surface by more than
 // `margin_texels` of its own texels (relative depth margin_texels x 2 / face size); with
 // coverage, votes that only the coverage gives count once coverage_agreement views agree ----
@@ -310,7 +310,7 @@ bool empty_beyond(vec3 p, float margin_texels, uint vetoes_ignored) {
   return !consulted;
 }
 
-// ---- CpuRenderer::intersect: RayIntersection ----
+// ---- LightfieldCpuRenderer::intersect: RayIntersection ----
 float lin(float x) { return march_near * exp(x * march_log_ratio); }
 
 // The hint test of intersect()'s `side`: -1 view h does not vote at the sample (too near its
@@ -341,7 +341,7 @@ bool intersect(vec3 o, vec3 d, float start, out float z_hit) {
   float step = (1.0 - x0) / float(steps);
 #if CALF_HINTS > 0
   // Surface hints: the views nearest the ray origin, nearest first (ties: lower index). Their
-  // count is compiled in (CALF_HINTS = RenderOptions::surface_hints), so that the per-hint state
+  // count is compiled in (CALF_HINTS = LightfieldRenderOptions::surface_hints), so that the per-hint state
   // lives in registers: llvmpipe spills dynamically indexed arrays to memory.
   uint hints = min(uint(CALF_HINTS), view_count);
   uint hint[CALF_HINTS];
@@ -462,7 +462,7 @@ bool intersect(vec3 o, vec3 d, float start, out float z_hit) {
   return true;
 }
 
-// ---- mixed_texel / CpuRenderer::tap_purity ----
+// ---- mixed_texel / LightfieldCpuRenderer::tap_purity ----
 bool mixed_texel(CalfView v, ivec3 t) {
   uint code = depth_code(v, t);
   const ivec2 kStep[4] = ivec2[4](ivec2(-1, 0), ivec2(1, 0), ivec2(0, -1), ivec2(0, 1));
@@ -482,7 +482,7 @@ float tap_purity(CalfView v, ivec3 t) {
   return mixed_texel(v, t) ? mixed_penalty_factor : 1.0;
 }
 
-// ---- CpuRenderer::shade_surface: SampleColor + CalculateColor ----
+// ---- LightfieldCpuRenderer::shade_surface: SampleColor + CalculateColor ----
 // The weighted mean is accumulated online, rescaled whenever a larger log weight arrives: the
 // same exp(log_w - best) normalisation as the CPU's two passes, without an array of views.
 // best_colour: the colour of the best-weighted view (rr_replace_view_reflection starts from it).
@@ -505,7 +505,7 @@ vec3 shade_surface(vec3 o, vec3 p, out int best_view, out vec3 best_colour) {
     float log_r = log(r);
     float log_w = -depth_decay * log_disagreement(v, ncode, log_r);
     vec3 c = vec3(0.0);
-    if (!bilinear_color) {
+    if (!bilinear_colour) {
       c = colour_at(v, nearest);
     } else {
       Taps taps = bilinear_taps(face, uv, v.face_size);
@@ -520,15 +520,15 @@ vec3 shade_surface(vec3 o, vec3 p, out int best_view, out vec3 best_colour) {
       float asum = 0.0;
       for (int t = 0; t < 4; ++t) {
         a[t] = taps.weight[t] > 0.0 ? taps.weight[t] * tap_purity(v, taps.texel[t]) : 0.0;
-        if (depth_aware_color) {
+        if (depth_aware_colour) {
           a[t] *= diff[t] == INF
                       ? 0.0
-                      : exp(-depth_decay * max(0.0, diff[t] - dmin - color_depth_tolerance));
+                      : exp(-depth_decay * max(0.0, diff[t] - dmin - colour_depth_tolerance));
         }
         asum += a[t];
       }
       for (int t = 0; t < 4; ++t) c += a[t] / asum * colour_at(v, taps.texel[t]);
-      if (depth_aware_color) log_w = -depth_decay * dmin + log(asum);
+      if (depth_aware_colour) log_w = -depth_decay * dmin + log(asum);
     }
     log_w -= cam_decay * length(o - v.position) / hit_distance;
     if (log_w > best) {
@@ -546,7 +546,7 @@ vec3 shade_surface(vec3 o, vec3 p, out int best_view, out vec3 best_colour) {
   return wsum > 0.0 ? sum / wsum : vec3(0.0);
 }
 
-// ---- CpuRenderer::shade_sky ----
+// ---- LightfieldCpuRenderer::shade_sky ----
 vec3 shade_sky(vec3 d) {
   for (int pass = 0; pass < 2; ++pass) {
     vec3 sum = vec3(0.0);
@@ -560,7 +560,7 @@ vec3 shade_sky(vec3 d) {
       if (pass == 0 && !sky) continue;
       vec3 c = vec3(0.0);
       float w = 1.0;  // the view's weight
-      if (!bilinear_color) {
+      if (!bilinear_colour) {
         c = colour_at(v, nearest);
       } else {
         Taps taps = bilinear_taps(face, uv, v.face_size);
@@ -568,7 +568,7 @@ vec3 shade_sky(vec3 d) {
         float asum = 0.0, unpenalised = 0.0;
         for (int t = 0; t < 4; ++t) {
           bool tap_sky = depth_code(v, taps.texel[t]) == CALF_LOG16_SKY;
-          a[t] = taps.weight[t] * (pass == 0 && depth_aware_color && !tap_sky ? 0.0 : 1.0);
+          a[t] = taps.weight[t] * (pass == 0 && depth_aware_colour && !tap_sky ? 0.0 : 1.0);
           unpenalised += a[t];
           if (a[t] > 0.0) a[t] *= tap_purity(v, taps.texel[t]);
           asum += a[t];
@@ -584,7 +584,7 @@ vec3 shade_sky(vec3 d) {
   return vec3(0.0);
 }
 
-// ---- cpu_renderer_rr.cc ----
+// ---- lightfield_cpu_renderer_rr.cc ----
 
 // texel_point: the scene point (eye-relative) a texel of v stands for; false for sky.
 bool texel_point(CalfView v, ivec3 t, out vec3 q) {
@@ -624,7 +624,7 @@ struct RrRay {
   float weight;  // product of the (signed) weights on the way here
 };
 
-// The direction CpuRenderer::secondary() gives a ray arriving along unit d_in at a surface with
+// The direction LightfieldCpuRenderer::secondary() gives a ray arriving along unit d_in at a surface with
 // unit normal n (either orientation): the reflection, or with `refraction` GLSL refract() with
 // eta = 1 / ior where there is no total internal reflection.
 vec3 secondary_direction(vec3 d_in, vec3 n, bool refraction, float ior) {
@@ -639,7 +639,7 @@ vec3 secondary_direction(vec3 d_in, vec3 n, bool refraction, float ior) {
   return dir;
 }
 
-// CpuRenderer::trace and shade_rr without recursion. A ray's colour is linear in its children's:
+// LightfieldCpuRenderer::trace and shade_rr without recursion. A ray's colour is linear in its children's:
 //   Alg. 4:       c = w_rfl c_rfl + w_rfr c_rfr + (1 - w_rfl - w_rfr) c_diffuse
 //   replacement:  c = c_view + w_rfl (c_rfl - c_rfl,view) + w_rfr (c_rfr - c_rfr,view)
 // so each ray adds its own term times the product of the weights above it and pushes its
@@ -704,14 +704,14 @@ float trace(vec3 o, vec3 d, out vec3 rgb) {
                            ray.depth + 1u, ray.weight * w);
     }
   }
-  if (rr && rr_replace_view_reflection) rgb = max(rgb, vec3(0.0));  // as CpuRenderer::trace
+  if (rr && rr_replace_view_reflection) rgb = max(rgb, vec3(0.0));  // as LightfieldCpuRenderer::trace
   return eye_z;
 }
 
 void main() {
   uint i = uint(gl_FragCoord.x);
   uint j = image_size.y - 1u - uint(gl_FragCoord.y);  // row 0 at the top, like the CPU image
-  // CpuRenderer::render: supersample^2 rays through an even grid over the pixel, row-major, the
+  // LightfieldCpuRenderer::render: supersample^2 rays through an even grid over the pixel, row-major, the
   // colour their mean and the depth the nearest hit; 1 = the ray through the centre.
   float n = float(supersample);
   vec3 sum = vec3(0.0);

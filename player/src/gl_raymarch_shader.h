@@ -6,9 +6,10 @@ namespace calf::player::internal {
 // A full-screen triangle from gl_VertexID (no vertex buffers).
 extern const char* const kGlFullscreenVertex;
 
-// Alg. 4 as the CPU reference implements it (cpu_renderer.cc, cpu_renderer_rr.cc), one function
-// per CPU function. Pasted after "#version 450 core", "#define CALF_MAX_VIEWS <kGlMaxActiveViews>",
-// an optional "#define CALF_DEPTH_BC5", "#define CALF_HINTS <n>", an optional
+// Alg. 4 as the CPU reference implements it (lightfield_cpu_renderer.cc,
+// lightfield_cpu_renderer_rr.cc), one function per CPU function. Pasted after "#version 450 core",
+// "#define CALF_MAX_VIEWS <kGlMaxActiveViews>", an optional "#define CALF_DEPTH_BC5", "#define
+// CALF_HINTS <n>", an optional
 // "#define CALF_COVERAGE" (some view has coverage faces) and kGlslConventions.
 extern const char* const kGlRaymarchFragment;
 

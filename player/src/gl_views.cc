@@ -132,7 +132,8 @@ Expected<GlTextureLayout> layout_for_clip(const container::LightfieldTrackHeader
   const auto depth = static_cast<PixelFormat>(header.depth_format);
   layout.depth_format = depth == PixelFormat::kBc5 && keep_bc5_depth ? depth : PixelFormat::kR16;
   // r16p and r16pm (predicted) decode to the same r16 codes on the CPU: the textures never see
-  // them (the ClipDecoder fills an r16pm rectangle's unchanged texels from its own tile state).
+  // them (the LightfieldDecoder fills an r16pm rectangle's unchanged texels from its own tile
+  // state).
   if (depth != PixelFormat::kR16 && depth != PixelFormat::kR16Predicted &&
       depth != PixelFormat::kR16PredictedMasked && depth != PixelFormat::kBc5) {
     return Status(kGlLayout,
@@ -176,7 +177,7 @@ Expected<ViewSetUpload> updates_from_view_set(const ViewSet& set) {
     for (int f = 0; f < kCubeFaceCount; ++f) {
       const CubeFace face = cube_face_from_index(f);
       std::vector<uint8_t> colour(texels * 8);
-      const std::span<const float> c = v.color_face(face);
+      const std::span<const float> c = v.colour_face(face);
       for (size_t i = 0; i < texels; ++i) {
         const uint16_t h[4] = {bc::float_to_half(c[3 * i]), bc::float_to_half(c[3 * i + 1]),
                                bc::float_to_half(c[3 * i + 2]), bc::float_to_half(1.0f)};
@@ -430,7 +431,7 @@ Status GlViews::upload(GLuint texture, GLenum storage, bool compressed, GLenum f
   return check_gl_error(gl_, "uploading a texture rect");
 }
 
-Status GlViews::apply(const decoder::FrameUpdates& frame) {
+Status GlViews::apply(const decoder::LightfieldFrameUpdates& frame) {
   for (size_t i = 0; i < frame.updates.size(); ++i) {
     const Status s = apply_update(frame.updates[i]);
     if (!s.ok()) return s.with_context("update " + std::to_string(i));

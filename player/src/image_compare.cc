@@ -164,7 +164,7 @@ Expected<MissingGeometry> missing_geometry(const RenderedImage& test,
   return m;
 }
 
-std::array<uint8_t, 3> heat_color(double t) {
+std::array<uint8_t, 3> heat_colour(double t) {
   // Stops at t = 0, 1/4, 1/2, 3/4, 1: black, blue, cyan, yellow, red.
   static constexpr double kStops[5][3] = {{0, 0, 0}, {0, 0, 1}, {0, 1, 1}, {1, 1, 0}, {1, 0, 0}};
   if (std::isnan(t)) t = 1;

@@ -84,7 +84,7 @@ Status write_heat_map_png(const std::filesystem::path& path, const RgbImageRef& 
   if (!errors.ok()) return std::move(errors).status().with_context(path.string());
   std::vector<uint8_t> pixels(3 * errors->size());
   for (size_t i = 0; i < errors->size(); ++i) {
-    const std::array<uint8_t, 3> c = heat_color((*errors)[i] / full_scale);
+    const std::array<uint8_t, 3> c = heat_colour((*errors)[i] / full_scale);
     for (int ch = 0; ch < 3; ++ch) pixels[3 * i + ch] = c[ch];
   }
   return write_rgb8_png_file(path, a.width, a.height, pixels);

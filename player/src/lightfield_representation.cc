@@ -10,8 +10,8 @@
 #include "calf/decoder/cpu_textures.h"
 #include "calf/format/clip_metadata.h"
 #include "calf/format/lightfield_layout.h"
-#include "calf/player/gl_renderer.h"
 #include "calf/player/gl_views.h"
+#include "calf/player/lightfield_gl_renderer.h"
 
 namespace calf::player {
 namespace {
@@ -32,7 +32,7 @@ struct LightfieldRepresentation::Impl {
   const container::Reader* reader = nullptr;
   uint16_t track = 0;
   RenderBackend backend = RenderBackend::kGl;
-  std::optional<decoder::ClipDecoder> decoder;
+  std::optional<decoder::LightfieldDecoder> decoder;
   LightfieldOptions options;
   std::optional<ViewSelector> selector;
   std::vector<Vec3> viewpoints;
@@ -41,7 +41,7 @@ struct LightfieldRepresentation::Impl {
 
   // GL path.
   std::unique_ptr<GlViews> gl_views;
-  std::unique_ptr<GlRenderer> gl_renderer;
+  std::unique_ptr<LightfieldGlRenderer> lightfield_gl_renderer;
   // CPU path. The CPU renderer reads linear float views: one View per clip view, indexed like the
   // clip, so that a view which stays active is never rebuilt; after each frame only what the
   // updates changed is converted again from the texture state: the rects of depth and material
@@ -57,14 +57,14 @@ struct LightfieldRepresentation::Impl {
   std::vector<CellRef> stale_cells;  // colour cells of built views to mix again, no duplicates
   std::vector<uint8_t> cell_stale;   // per (view, face, cell): listed in stale_cells
   std::vector<float> scratch;
-  decoder::FrameUpdates updates;
+  decoder::LightfieldFrameUpdates updates;
   ViewSelection selection;
   double render_ms = 0, upload_ms = 0;
 
   // Whether the decoder culls by the eyes' frusta for these options: not with RR on a clip with
   // material, whose reflection / refraction rays leave the frusta and read any texel of the
   // active views (with culling, stale cells cost ~0.8 dB on mirror-box).
-  bool view_dependent_for(const RenderOptions& r) const {
+  bool view_dependent_for(const LightfieldRenderOptions& r) const {
     return options.decoder.view_dependent && !(r.rr && has_material);
   }
   void mark_stale_cell(uint32_t view, CubeFace face, uint32_t cell);
@@ -73,7 +73,7 @@ struct LightfieldRepresentation::Impl {
   Status build_view(uint32_t v);
   Status convert_material(uint32_t v, CubeFace face, const PixelRect& rect);
   Status convert_coverage(uint32_t v, CubeFace face, const PixelRect& rect);
-  RenderOptions frame_options(const Vec3& eye) const;
+  LightfieldRenderOptions frame_options(const Vec3& eye) const;
 };
 
 LightfieldRepresentation::LightfieldRepresentation(std::unique_ptr<Impl> impl)
@@ -95,11 +95,11 @@ Expected<std::unique_ptr<LightfieldRepresentation>> LightfieldRepresentation::op
   impl->options = options;
   // Both renderers read a clip's coverage (SPEC §11.1.11), the CPU reference into its views as it
   // reads a capture set's, the GL renderer into its coverage textures; it is decoded whatever
-  // RenderOptions::coverage says, so that coverage can be turned on while playing.
-  decoder::ClipDecoderOptions decoder_options = options.decoder;
+  // LightfieldRenderOptions::coverage says, so that coverage can be turned on while playing.
+  decoder::LightfieldDecoderOptions decoder_options = options.decoder;
   decoder_options.coverage = true;
-  CALF_ASSIGN_OR_RETURN(decoder::ClipDecoder d,
-                        decoder::ClipDecoder::open(reader, track, decoder_options));
+  CALF_ASSIGN_OR_RETURN(decoder::LightfieldDecoder d,
+                        decoder::LightfieldDecoder::open(reader, track, decoder_options));
   impl->decoder.emplace(std::move(d));
   const auto& h = impl->decoder->header();
   std::vector<decoder::LightfieldViewInfo> views;
@@ -130,9 +130,10 @@ Expected<std::unique_ptr<LightfieldRepresentation>> LightfieldRepresentation::op
                                                                   impl->decoder->has_coverage()));
     CALF_ASSIGN_OR_RETURN(impl->gl_views, GlViews::make(*gl, std::move(layout)));
     // A view set with no active view is refused by the option check: validate with all views.
-    RenderOptions probe = options.render;
+    LightfieldRenderOptions probe = options.render;
     probe.active_views.clear();
-    CALF_ASSIGN_OR_RETURN(impl->gl_renderer, GlRenderer::make(*impl->gl_views, probe));
+    CALF_ASSIGN_OR_RETURN(impl->lightfield_gl_renderer,
+                          LightfieldGlRenderer::make(*impl->gl_views, probe));
   } else {
     impl->cpu_textures.emplace(h, views);
     const LogDepthRange placeholder_range = *LogDepthRange::make(1, 2);
@@ -213,10 +214,11 @@ Status LightfieldRepresentation::report_frame_time(double frame_ms) {
   return impl_->selector->report_frame_time(frame_ms);
 }
 
-Status LightfieldRepresentation::set_render_options(const RenderOptions& options) {
-  RenderOptions probe = options;
+Status LightfieldRepresentation::set_render_options(const LightfieldRenderOptions& options) {
+  LightfieldRenderOptions probe = options;
   probe.active_views.clear();
-  if (impl_->gl_renderer) CALF_RETURN_IF_ERROR(impl_->gl_renderer->set_options(probe));
+  if (impl_->lightfield_gl_renderer)
+    CALF_RETURN_IF_ERROR(impl_->lightfield_gl_renderer->set_options(probe));
   impl_->options.render = options;
   impl_->decoder->set_view_dependent(impl_->view_dependent_for(options));
   return Status::Ok();
@@ -234,7 +236,7 @@ Status LightfieldRepresentation::prepare(uint32_t frame, std::span<const Camera>
   // The viewers' frusta, out to the march range's far end: nothing farther is ever sampled.
   std::vector<EyeView> frusta;
   for (const Camera& e : eyes) {
-    const RenderOptions r = d.frame_options(e.position);
+    const LightfieldRenderOptions r = d.frame_options(e.position);
     frusta.push_back(eye_view(e, r.near, r.far));
   }
   CALF_RETURN_IF_ERROR(d.decoder->advance(frame, frusta, d.selection.active, &d.updates));
@@ -327,7 +329,7 @@ Status LightfieldRepresentation::Impl::build_view(uint32_t v) {
   for (int f = 0; f < kCubeFaceCount; ++f) {
     const CubeFace face = static_cast<CubeFace>(f);
     View& out = view_set.views[v];
-    CALF_RETURN_IF_ERROR(out.write_color_rect(face, whole, cpu_textures->colour(v, face)));
+    CALF_RETURN_IF_ERROR(out.write_colour_rect(face, whole, cpu_textures->colour(v, face)));
     CALF_RETURN_IF_ERROR(out.write_depth_rect(face, whole, cpu_textures->depth(v, face)));
     if (out.has_material()) CALF_RETURN_IF_ERROR(convert_material(v, face, whole));
     CALF_RETURN_IF_ERROR(convert_coverage(v, face, whole));
@@ -375,7 +377,7 @@ Status LightfieldRepresentation::Impl::refresh_cpu_views() {
   for (const CellRef& c : stale_cells) {
     const CubeFace face = static_cast<CubeFace>(c.face);
     cpu_textures->colour_cell(c.view, face, c.cell, &scratch);
-    CALF_RETURN_IF_ERROR(view_set.views[c.view].write_color_rect(
+    CALF_RETURN_IF_ERROR(view_set.views[c.view].write_colour_rect(
         face, grid.cell_rect(c.cell % per_side, c.cell / per_side), scratch));
     cell_stale[(size_t{c.view} * kCubeFaceCount + c.face) * grid.cell_count() + c.cell] = 0;
   }
@@ -386,7 +388,7 @@ Status LightfieldRepresentation::Impl::refresh_cpu_views() {
   return Status::Ok();
 }
 
-RenderOptions LightfieldRepresentation::Impl::frame_options(const Vec3& eye) const {
+LightfieldRenderOptions LightfieldRepresentation::Impl::frame_options(const Vec3& eye) const {
   if (options.fixed_march_range) return options.render;
   // march_range_for's rule over every view of the clip, so the range does not jump when the
   // active set changes.
@@ -401,14 +403,14 @@ RenderOptions LightfieldRepresentation::Impl::frame_options(const Vec3& eye) con
 Status LightfieldRepresentation::render(const Camera& camera, RenderedImage* out) {
   Impl& d = *impl_;
   const auto t0 = std::chrono::steady_clock::now();
-  RenderOptions r = d.frame_options(camera.position);
+  LightfieldRenderOptions r = d.frame_options(camera.position);
   r.active_views = d.selection.active;
-  if (d.gl_renderer) {
-    CALF_RETURN_IF_ERROR(d.gl_renderer->set_options(r));
-    CALF_RETURN_IF_ERROR(d.gl_renderer->render(camera, out));
+  if (d.lightfield_gl_renderer) {
+    CALF_RETURN_IF_ERROR(d.lightfield_gl_renderer->set_options(r));
+    CALF_RETURN_IF_ERROR(d.lightfield_gl_renderer->render(camera, out));
   } else {
     // The view set is indexed like the clip; the active views in selection order, as the GL path.
-    CALF_ASSIGN_OR_RETURN(CpuRenderer cpu, CpuRenderer::make(d.view_set, r));
+    CALF_ASSIGN_OR_RETURN(LightfieldCpuRenderer cpu, LightfieldCpuRenderer::make(d.view_set, r));
     CALF_RETURN_IF_ERROR(cpu.render(camera, out));
   }
   d.render_ms = ms_since(t0);
@@ -430,7 +432,7 @@ RepresentationStats LightfieldRepresentation::stats() const {
                                                 sel.culled_by_performance)});
   out.entries.push_back(
       {"cells visible", format("%u / %u, tiles %u / %u", st.visible_cells, st.total_cells,
-                               st.visible_tiles, st.total_tiles)});
+                               st.visible_regions, st.total_regions)});
   out.entries.push_back({"updates", format("%.2f Mbps @24 fps", st.mbps_at_24fps())});
   out.entries.push_back({"decode", format("%.2f ms", st.decode_ms)});
   out.entries.push_back({"upload", format("%.2f ms", d.upload_ms)});

@@ -35,7 +35,7 @@ Status validate_tile_set(const TileSet& set) {
                      " bytes, not 4 x " + std::to_string(set.atlas_width) + " x " +
                      std::to_string(set.atlas_height));
   }
-  for (const Vec3& v : {set.view_region.min, set.view_region.max}) {
+  for (const Vec3& v : {set.view_volume.min, set.view_volume.max}) {
     if (!(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z))) {
       return set_error("the tile set's view region is not finite");
     }

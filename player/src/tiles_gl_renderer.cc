@@ -138,7 +138,7 @@ Status GlTilesRenderer::upload(const TileSet& set, const TilesLinearAtlas& atlas
                      std::to_string(gl.max_texture_size));
   }
   release();
-  origin_ = (set.view_region.min + set.view_region.max) / 2;
+  origin_ = (set.view_volume.min + set.view_volume.max) / 2;
   std::vector<float> vertices;
   vertices.reserve(24 * set.tiles.size());
   for (const Tile& t : set.tiles) {

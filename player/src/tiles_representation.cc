@@ -93,7 +93,7 @@ double TilesRepresentation::fps() const {
   return impl_->fps;
 }
 const Box3& TilesRepresentation::view_volume() const {
-  return impl_->set.view_region;
+  return impl_->set.view_volume;
 }
 const TileSet& TilesRepresentation::tile_set() const {
   return impl_->set;

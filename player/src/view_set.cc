@@ -45,7 +45,7 @@ Expected<View> View::make(const Vec3& position, const LogDepthRange& range, uint
   v.face_size_ = face_size;
   const size_t texels = size_t{face_size} * face_size;
   for (int f = 0; f < kCubeFaceCount; ++f) {
-    v.color_[f].assign(3 * texels, 0.0f);
+    v.colour_[f].assign(3 * texels, 0.0f);
     v.depth_[f].assign(texels, kLog16Sky);
     if (with_material) {
       v.material_[f].resize(3 * texels);
@@ -96,10 +96,10 @@ Status View::check_rect(CubeFace face, const PixelRect& rect, size_t src_size, s
   return Status::Ok();
 }
 
-Status View::write_color_rect(CubeFace face, const PixelRect& rect, std::span<const float> src,
-                              size_t src_stride) {
+Status View::write_colour_rect(CubeFace face, const PixelRect& rect, std::span<const float> src,
+                               size_t src_stride) {
   CALF_RETURN_IF_ERROR(check_rect(face, rect, src.size(), 3, &src_stride));
-  copy_rect(color_[cube_face_index(face)], face_size_, rect, 3, src, src_stride);
+  copy_rect(colour_[cube_face_index(face)], face_size_, rect, 3, src, src_stride);
   return Status::Ok();
 }
 

@@ -38,7 +38,7 @@ Status check_request(const CaptureRequest& r) {
 }  // namespace
 
 Status check_viewpoints(const Scene& scene, const Rig& rig, uint32_t frames, double fps,
-                        const RenderOptions& options) {
+                        const LightfieldRenderOptions& options) {
   for (uint32_t f = 0; f < frames; ++f) {
     CALF_ASSIGN_OR_RETURN(auto tracer, FrameTracer::create(scene, f / fps, options));
     for (size_t v = 0; v < rig.viewpoints.size(); ++v) {
@@ -149,7 +149,7 @@ Expected<RenderStats> render_capture_set(const Scene& scene, const CaptureReques
 }
 
 Expected<RenderStats> render_ground_truth(const Scene& scene, const capture::EyePath& path_in,
-                                          const RenderOptions& options,
+                                          const LightfieldRenderOptions& options,
                                           const std::filesystem::path& directory,
                                           const ProgressFn& progress) {
   CALF_RETURN_IF_ERROR(validate_render_options(options));

@@ -314,7 +314,7 @@ Expected<PlacementResult> place_cameras(const Scene& scene, const PlacementOptio
   // k is per the scene's length scale, so a model's rig does not depend on its file's unit.
   const double k = options.k / scene.length_scale;
   const uint32_t frames = std::max(1u, capture_frames);
-  RenderOptions render;
+  LightfieldRenderOptions render;
   render.threads = options.threads;
   tbb::task_arena arena(options.threads == 0 ? tbb::task_arena::automatic
                                              : static_cast<int>(options.threads));

@@ -161,7 +161,7 @@ struct FrameTracer::Impl {
   glm::vec3 sun_dir{0, 1, 0};
   glm::vec3 ambient{0};
   float ao_distance = 1;
-  RenderOptions options;
+  LightfieldRenderOptions options;
 
   ~Impl() {
     if (rtc) rtcReleaseScene(rtc);
@@ -376,8 +376,8 @@ struct FrameTracer::Impl {
     return color;
   }
 
-  // The colour of a pixel as the mean of its samples (RenderOptions: rounds doubling the count
-  // until the sRGB-encoded standard error is at most `tolerance` or spp samples are taken).
+  // The colour of a pixel as the mean of its samples (LightfieldRenderOptions: rounds doubling the
+  // count until the sRGB-encoded standard error is at most `tolerance` or spp samples are taken).
   // `dir_at(x, y)` is the ray through position (x, y) in [0, 1)^2 of the pixel's square. The
   // samples themselves box-filter the pixel, so each filters textures only over its share of the
   // pixel: the footprint of the first round's stratum, `spread` (the pixel's angular width,
@@ -385,8 +385,8 @@ struct FrameTracer::Impl {
   // count the pixel ends at. (A whole pixel's footprint per sample blurs textures twice: the box
   // of the samples over the pixel, then a mip filter as wide again.)
   template <typename DirFn>
-  glm::vec3 converged_color(const glm::vec3& o, const DirFn& dir_at, float spread, uint64_t key,
-                            uint64_t* rays, uint64_t* samples) const {
+  glm::vec3 converged_colour(const glm::vec3& o, const DirFn& dir_at, float spread, uint64_t key,
+                             uint64_t* rays, uint64_t* samples) const {
     const uint64_t scramble = mix64(key ^ 0x3C6EF372FE94F82Bull);
     const uint32_t sx = static_cast<uint32_t>(scramble), sy = static_cast<uint32_t>(scramble >> 32);
     const uint32_t max_n = options.spp;
@@ -423,7 +423,7 @@ struct FrameTracer::Impl {
     return glm::vec3(sum / static_cast<double>(n));
   }
 
-  // One pixel: colour (one centre sample when spp is 1, else converged_color), and the depth and
+  // One pixel: colour (one centre sample when spp is 1, else converged_colour), and the depth and
   // material of the primary hit of the ray through the pixel centre, `centre`. `spread` is the
   // pixel's angular width (pixel_spread), which sets the texture filter's footprint.
   template <typename DirFn>
@@ -439,7 +439,7 @@ struct FrameTracer::Impl {
       ++*samples;
     } else {
       hit = intersect(o, centre, 0, INFINITY, &h, rays);
-      c = converged_color(o, dir_at, spread, key, rays, samples);
+      c = converged_colour(o, dir_at, spread, key, rays, samples);
     }
     if (options.noise > 0) {
       Rng n(noise_key);
@@ -484,7 +484,7 @@ float coverage_tolerance(uint32_t face_size) {
   return std::min(0.05f, 4.0f / static_cast<float>(std::max(face_size, 1u)));
 }
 
-Status validate_render_options(const RenderOptions& o) {
+Status validate_render_options(const LightfieldRenderOptions& o) {
   auto bad = [](const std::string& what) { return Status(ErrorId::kCaptureOption, what); };
   if (o.threads > 256) return bad("threads " + std::to_string(o.threads) + " is outside 0..256");
   if (o.ao_samples > 256) {
@@ -510,7 +510,7 @@ FrameTracer::FrameTracer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 FrameTracer::~FrameTracer() = default;
 
 Expected<std::unique_ptr<FrameTracer>> FrameTracer::create(const Scene& scene, double time,
-                                                           const RenderOptions& options) {
+                                                           const LightfieldRenderOptions& options) {
   CALF_RETURN_IF_ERROR(validate_render_options(options));
   CALF_RETURN_IF_ERROR(validate_scene(scene));
   auto impl = std::make_unique<Impl>();

@@ -141,8 +141,8 @@ static int command_main(int argc, char** argv) {
       "calf-capture"};
   std::string scene_arg, out_dir, rig_arg = "default", eye_path_file, export_dir;
   uint32_t face_size = 256, frames = 0, threads = 0;
-  // Rendering defaults are RenderOptions' (calf/samples/render.h), one place.
-  samples::RenderOptions render;
+  // Rendering defaults are LightfieldRenderOptions' (calf/samples/render.h), one place.
+  samples::LightfieldRenderOptions render;
   bool noise_floor = true;
   std::string gt_size = "256x256";
   bool list = false, ground_truth = false, quiet = false;
@@ -372,7 +372,7 @@ static int command_main(int argc, char** argv) {
     // same poses with the next seed, what calf-play --compare measures the ground truth against
     // itself with.
     if (noise_floor) {
-      samples::RenderOptions other = render;
+      samples::LightfieldRenderOptions other = render;
       other.seed = render.seed + 1;
       Progress progress("noise-floor pose", quiet);
       auto result = samples::render_ground_truth(

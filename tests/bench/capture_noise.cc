@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
   CLI::App app{"bench-capture_noise: calf-capture's noise floor (two seeds) and cost"};
   std::string scene_name = "interior", gt_size;
   uint32_t face_size = 64, views = 0, poses = 4, frame = 0;
-  samples::RenderOptions render;
+  samples::LightfieldRenderOptions render;
   uint64_t other_seed = 2;
   app.add_option("--scene", scene_name, "built-in scene")->capture_default_str();
   app.add_option("--face-size", face_size, "cube face size")->capture_default_str();
@@ -58,11 +58,12 @@ int main(int argc, char** argv) {
   app.add_option("--threads", render.threads, "render threads (0: all)");
   app.add_option("--seed", render.seed, "first seed")->capture_default_str();
   app.add_option("--other-seed", other_seed, "second seed")->capture_default_str();
-  app.add_option("--spp", render.spp, "RenderOptions::spp")->capture_default_str();
-  app.add_option("--min-spp", render.min_spp, "RenderOptions::min_spp")->capture_default_str();
-  app.add_option("--tolerance", render.tolerance, "RenderOptions::tolerance")
+  app.add_option("--spp", render.spp, "LightfieldRenderOptions::spp")->capture_default_str();
+  app.add_option("--min-spp", render.min_spp, "LightfieldRenderOptions::min_spp")
       ->capture_default_str();
-  app.add_option("--ao-samples", render.ao_samples, "RenderOptions::ao_samples")
+  app.add_option("--tolerance", render.tolerance, "LightfieldRenderOptions::tolerance")
+      ->capture_default_str();
+  app.add_option("--ao-samples", render.ao_samples, "LightfieldRenderOptions::ao_samples")
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   if (Status s = samples::validate_render_options(render); !s.ok()) {
@@ -74,7 +75,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", scene.status().to_string().c_str());
     return 1;
   }
-  samples::RenderOptions second = render;
+  samples::LightfieldRenderOptions second = render;
   second.seed = other_seed;
   const double time = frame / scene->fps;
   auto ta = samples::FrameTracer::create(*scene, time, render);

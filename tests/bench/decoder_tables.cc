@@ -1,9 +1,9 @@
 // Paper 002 Tables 3 and 4 for calf's view-dependent decoder (decoder/include/calf/decoder/
-// clip_decoder.h), on encoded clips:
+// lightfield_decoder.h), on encoded clips:
 //
 // Table 3 — per active-view count (5, 9, all) and with / without view-dependent decoding: the
 //   bitrate of the texture updates at 24 fps (colour; depth + material), the decode time per
-//   frame (ClipDecoder::advance: culling, chunk fetch from the cache / file, zstd or LZMA2
+//   frame (LightfieldDecoder::advance: culling, chunk fetch from the cache / file, zstd or LZMA2
 //   decompression, layout undoing), the time a memcpy of the same update bytes takes and the ratio.
 //   The eye sits at the centroid of the viewpoints (inside the view volume) and looks in
 //   `--directions` horizontal directions in turn; for each it plays the whole clip `--repeats`
@@ -22,9 +22,9 @@
 //   decode them per frame (process start-up included and reported apart).
 //
 // The limit beside every decode figure: the time to read and decompress just the chunks
-//   the frame used (FrameUpdates::chunks, each time it was used) plus a memcpy of the frame's
-//   update bytes. The decoder runs on one thread by default (no background prefetch), so its time
-//   holds every decompression it does.
+//   the frame used (LightfieldFrameUpdates::chunks, each time it was used) plus a memcpy of the
+//   frame's update bytes. The decoder runs on one thread by default (no background prefetch), so
+//   its time holds every decompression it does.
 // --synthetic N: a 9-view clip of N x N faces made by this program (make_synthetic_clip), e.g. the
 //   issue's 1024 x 9 views case.
 //
@@ -46,8 +46,8 @@
 
 #include "../integration/synthetic_capture.h"
 #include "bench_clock.h"
-#include "calf/decoder/clip_decoder.h"
 #include "calf/decoder/culling.h"
+#include "calf/decoder/lightfield_decoder.h"
 #include "calf/decoder/lightfield_reference.h"
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/format/container.h"
@@ -69,7 +69,7 @@ struct Poses {
   std::vector<EyeView> eyes;  // one per direction
 };
 
-Poses make_poses(const ClipDecoder& d, uint32_t directions) {
+Poses make_poses(const LightfieldDecoder& d, uint32_t directions) {
   Poses p;
   const uint32_t n = d.header().view_count;
   double far = 1;
@@ -93,7 +93,7 @@ Poses make_poses(const ClipDecoder& d, uint32_t directions) {
   return p;
 }
 
-std::vector<uint32_t> nearest_views(const ClipDecoder& d, const Vec3& eye, uint32_t count) {
+std::vector<uint32_t> nearest_views(const LightfieldDecoder& d, const Vec3& eye, uint32_t count) {
   std::vector<uint32_t> order(d.header().view_count);
   for (uint32_t v = 0; v < order.size(); ++v) order[v] = v;
   auto dist = [&](uint32_t v) {
@@ -134,30 +134,30 @@ std::array<Table3Row, 3> run_table3(const container::Reader& reader, const Poses
                                     const std::vector<uint32_t>& active, uint32_t repeats,
                                     bool background) {
   std::array<Table3Row, 3> rows;
-  std::array<ClipDecoderOptions, 3> options;
+  std::array<LightfieldDecoderOptions, 3> options;
   for (size_t m = 0; m < 3; ++m) {
     rows[m].vd = kTable3Modes[m].vd;
     rows[m].views = static_cast<uint32_t>(active.size());
     options[m].view_dependent = kTable3Modes[m].vd;
     options[m].background_thread = background;
   }
-  auto d0 = ClipDecoder::open(reader, 0, options[0]);
-  auto d1 = ClipDecoder::open(reader, 0, options[1]);
-  auto d2 = ClipDecoder::open(reader, 0, options[2]);
+  auto d0 = LightfieldDecoder::open(reader, 0, options[0]);
+  auto d1 = LightfieldDecoder::open(reader, 0, options[1]);
+  auto d2 = LightfieldDecoder::open(reader, 0, options[2]);
   for (const auto* d : {&d0, &d1, &d2}) {
     if (!d->ok()) {
       std::fprintf(stderr, "%s\n", d->status().to_string().c_str());
       std::exit(1);
     }
   }
-  const std::array<ClipDecoder*, 3> decoders = {&*d0, &*d1, &*d2};
+  const std::array<LightfieldDecoder*, 3> decoders = {&*d0, &*d1, &*d2};
   const uint32_t frames = decoders[0]->header().frame_count;
   std::vector<uint8_t> sink, chunk, scratch;
-  FrameUpdates fu;
+  LightfieldFrameUpdates fu;
   std::array<double, 3> colour{}, depth{}, visible{};
   for (const EyeView& held : poses.eyes) {
     for (size_t m = 0; m < 3; ++m) {
-      ClipDecoder& d = *decoders[m];
+      LightfieldDecoder& d = *decoders[m];
       Table3Row& row = rows[m];
       const bool moving = kTable3Modes[m].moving;
       d.reset();
@@ -241,11 +241,11 @@ struct Table4Row {
   double visible_pct = 0, regular = 0, hierarchical = 0;
 };
 
-Table4Row run_table4(const ClipDecoder& d, const Poses& poses, const std::vector<uint32_t>& active,
-                     uint32_t level) {
+Table4Row run_table4(const LightfieldDecoder& d, const Poses& poses,
+                     const std::vector<uint32_t>& active, uint32_t level) {
   Table4Row row;
   row.level = level;
-  auto grid = FaceGrid::with_tiles_per_side(d.header().face_size, 1u << level);
+  auto grid = FaceGrid::with_regions_per_side(d.header().face_size, 1u << level);
   if (!grid.ok()) return row;
   double visible = 0, total = 0;
   for (const EyeView& eye : poses.eyes) {
@@ -255,7 +255,8 @@ Table4Row run_table4(const ClipDecoder& d, const Poses& poses, const std::vector
     for (uint32_t v : active) {
       const LightfieldViewInfo& info = d.view(v);
       const Vec3 p = info.position;
-      // The decoder's far cap (clip_decoder.cc): past the viewer's far plane from this viewpoint.
+      // The decoder's far cap (lightfield_decoder.cc): past the viewer's far plane from this
+      // viewpoint.
       const double z_far = std::max<double>(
           info.z_far,
           std::hypot(eye.position.x - p.x, eye.position.y - p.y, eye.position.z - p.z) + eye.far);
@@ -323,10 +324,10 @@ void run_peers(const container::Reader& reader, const std::vector<uint32_t>& act
 // A 9-view clip of face x face texels per cube face made here (no ray tracing): the synthetic
 // scene of the integration tests (tests/integration/synthetic_capture.h: smooth colour, a small
 // moving square on face 0, a fade on face 2, sky on half of face 3), viewpoints 0.1 apart on a
-// line, encoded with the default options (cell 64, 2 x 2 depth tiles, raw16 depth, BC1 colour)
+// line, encoded with the default options (cell 64, 2 x 2 depth regions, raw16 depth, BC1 colour)
 // but for the depth coding `depth`. The capture set is written to a temporary directory and
 // removed after encoding.
-bool make_synthetic_clip(uint32_t face, uint32_t frames, DepthCoding depth,
+bool make_synthetic_clip(uint32_t face, uint32_t frames, encoder::DepthCoding depth,
                          const std::string& out) {
   namespace fs = std::filesystem;
   const fs::path dir =
@@ -341,10 +342,10 @@ bool make_synthetic_clip(uint32_t face, uint32_t frames, DepthCoding depth,
   const double t0 = now_ms();
   Status s = testing_support::write_synthetic_capture(dir, scene);
   if (s.ok()) {
-    LightfieldEncodeOptions o;
+    encoder::LightfieldEncodeOptions o;
     o.threads = 0;
     o.depth = depth;
-    auto stats = encode_lightfield_file(dir, out, o);
+    auto stats = encoder::encode_lightfield_file(dir, out, o);
     if (!stats.ok()) s = stats.status();
   }
   fs::remove_all(dir);
@@ -392,9 +393,10 @@ int main(int argc, char** argv) {
       ->check(CLI::NonexistentPath);
   CLI11_PARSE(app, argc, argv);
   if (synthetic != 0) {
-    const DepthCoding depth = synthetic_depth == "pred16"    ? DepthCoding::kRaw16Predicted
-                              : synthetic_depth == "pred16m" ? DepthCoding::kRaw16PredictedMasked
-                                                             : DepthCoding::kRaw16;
+    const encoder::DepthCoding depth =
+        synthetic_depth == "pred16"    ? encoder::DepthCoding::kRaw16Predicted
+        : synthetic_depth == "pred16m" ? encoder::DepthCoding::kRaw16PredictedMasked
+                                       : encoder::DepthCoding::kRaw16;
     if (!make_synthetic_clip(synthetic, synthetic_frames, depth, synthetic_out)) return 1;
     clips.push_back(synthetic_out);
   }
@@ -409,7 +411,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "%s\n", reader.status().to_string().c_str());
       return 1;
     }
-    auto probe = ClipDecoder::open(*reader, 0);
+    auto probe = LightfieldDecoder::open(*reader, 0);
     if (!probe.ok()) {
       std::fprintf(stderr, "%s: %s\n", path.c_str(), probe.status().to_string().c_str());
       return 1;
@@ -417,9 +419,9 @@ int main(int argc, char** argv) {
     const auto& h = probe->header();
     const Poses poses = make_poses(*probe, directions);
     std::printf(
-        "\n## %s\n\n%u views, face %u, cell %u, depth tile %u, %u frames; eye at the "
+        "\n## %s\n\n%u views, face %u, cell %u, depth region %u, %u frames; eye at the "
         "viewpoints' centroid, fov 90°, %u directions x %u plays\n\n",
-        path.c_str(), h.view_count, h.face_size, h.cell_size, h.depth_tile_size, h.frame_count,
+        path.c_str(), h.view_count, h.face_size, h.cell_size, h.depth_region_size, h.frame_count,
         directions, repeats);
     std::printf(
         "Table 3 (decoder %s; limit = reading and decompressing the chunks the frame used + a "

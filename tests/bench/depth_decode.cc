@@ -60,7 +60,7 @@ int run(const std::string& path, int repeat) {
     return 1;
   }
   auto coding = lf::depth_coding(h->depth_format);
-  auto grid = FaceGrid::with_cell_size(h->face_size, h->depth_tile_size);
+  auto grid = FaceGrid::with_cell_size(h->face_size, h->depth_region_size);
   if (!coding.ok() || !grid.ok()) {
     fmt::print(stderr, "{}: {}\n", path,
                (coding.ok() ? grid.status() : coding.status()).to_string());

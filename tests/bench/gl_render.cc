@@ -1,5 +1,5 @@
-// bench-gl_render: frame time of the GL ray-march renderer (calf/player/gl_renderer.h) under
-// OSMesa (llvmpipe on a machine without a GPU driver), plain and RR, for image sizes and view
+// bench-gl_render: frame time of the GL ray-march renderer (calf/player/lightfield_gl_renderer.h)
+// under OSMesa (llvmpipe on a machine without a GPU driver), plain and RR, for image sizes and view
 // counts, with the scalar CPU reference renderer on the same frame as the peer.
 //
 // Scene: the synthetic room of the player tests (tests/player/synthetic_scene.h: a box room with
@@ -22,10 +22,10 @@
 
 #include "../player/synthetic_scene.h"
 #include "bench_clock.h"
-#include "calf/player/cpu_renderer.h"
 #include "calf/player/gl_context.h"
-#include "calf/player/gl_renderer.h"
 #include "calf/player/gl_views.h"
+#include "calf/player/lightfield_cpu_renderer.h"
+#include "calf/player/lightfield_gl_renderer.h"
 
 namespace {
 
@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
   CLI::App app{"GL ray-march renderer frame time under OSMesa, with the CPU reference as peer"};
   std::vector<uint32_t> sizes = {256, 512}, view_counts = {4, 9};
   uint32_t face = 256, steps = 64, repeats = 5, cpu_threads = 2, cpu_max_size = 256;
-  RenderOptions defaults;
+  LightfieldRenderOptions defaults;
   uint32_t hints = defaults.surface_hints, hint_substeps = defaults.surface_hint_substeps;
   bool rr_replace = defaults.rr_replace_view_reflection;
   app.add_option("--sizes", sizes, "square image sizes")->capture_default_str();
@@ -75,10 +75,11 @@ int main(int argc, char** argv) {
   app.add_option("--cpu-threads", cpu_threads, "threads of the CPU peer")->capture_default_str();
   app.add_option("--cpu-max-size", cpu_max_size, "largest size the CPU peer renders (0: none)")
       ->capture_default_str();
-  app.add_option("--hints", hints, "RenderOptions::surface_hints")->capture_default_str();
-  app.add_option("--hint-substeps", hint_substeps, "RenderOptions::surface_hint_substeps")
+  app.add_option("--hints", hints, "LightfieldRenderOptions::surface_hints")->capture_default_str();
+  app.add_option("--hint-substeps", hint_substeps, "LightfieldRenderOptions::surface_hint_substeps")
       ->capture_default_str();
-  app.add_option("--rr-replace", rr_replace, "RenderOptions::rr_replace_view_reflection (0/1)")
+  app.add_option("--rr-replace", rr_replace,
+                 "LightfieldRenderOptions::rr_replace_view_reflection (0/1)")
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
@@ -113,14 +114,14 @@ int main(int argc, char** argv) {
         cam.forward = {-0.1, -0.15, -1};
         cam.fov_y = 70 * 3.141592653589793 / 180;
         cam.width = cam.height = size;
-        RenderOptions o;
+        LightfieldRenderOptions o;
         o.steps = steps;
         o.rr = rr;
         o.surface_hints = hints;
         o.surface_hint_substeps = hint_substeps;
         o.rr_replace_view_reflection = rr_replace;
         o = *march_range_for(up->layout, cam.position, o);
-        Expected<std::unique_ptr<GlRenderer>> r = GlRenderer::make(**gv, o);
+        Expected<std::unique_ptr<LightfieldGlRenderer>> r = LightfieldGlRenderer::make(**gv, o);
         if (!r.ok()) {
           fmt::print("{}\n", r.status().to_string());
           return 1;
@@ -142,7 +143,7 @@ int main(int argc, char** argv) {
         std::string cpu = "-", ratio = "-";
         if (size <= cpu_max_size) {
           o.threads = cpu_threads;
-          const Expected<CpuRenderer> c = CpuRenderer::make(views, o);
+          const Expected<LightfieldCpuRenderer> c = LightfieldCpuRenderer::make(views, o);
           t0 = now_ms();
           if (!c.ok() || !c->render(cam, &img).ok()) return 1;
           const double cpu_ms = now_ms() - t0;

@@ -1,10 +1,11 @@
 // Paper 002 Table 1 for the lightfield track: for each capture set, the bytes of the colour and
 // depth streams at each stage of the encoder (raw, temporal, +spatial (BCn), +zstd, +LZMA2) and
-// their ratios to raw, taken from the encoder's own per-stream accounting (LightfieldEncodeStats),
-// plus, in the same run, general-purpose peers on the raw streams: `xz -9` and `zstd -19` of the
-// raw colour stream (RGBA8 sRGB for LDR input, RGBA16F for HDR, as StreamBytes::raw counts it) and
-// of the raw log-16 depth stream (per-view z_near / z_far from the data, as the encoder quantises).
-// Also encode seconds and peak RSS (getrusage). Prints markdown.
+// their ratios to raw, taken from the encoder's own per-stream accounting
+// (encoder::LightfieldEncodeStats), plus, in the same run, general-purpose peers on the raw
+// streams: `xz -9` and `zstd -19` of the raw colour stream (RGBA8 sRGB for LDR input, RGBA16F for
+// HDR, as encoder::StreamBytes::raw counts it) and of the raw log-16 depth stream (per-view z_near
+// / z_far from the data, as the encoder quantises). Also encode seconds and peak RSS (getrusage).
+// Prints markdown.
 //
 // With --depth-format pred16 (pred16m) the depth column is the predicted coding (format r16p,
 // r16pm). Unless the
@@ -157,16 +158,16 @@ Peer run_peer(const std::string& tool_args, const fs::path& file) {
 }
 
 struct EncodeRun {
-  LightfieldEncodeStats stats;
+  encoder::LightfieldEncodeStats stats;
   double seconds = 0;
   uint64_t file_bytes = 0;
 };
 // The clip is removed afterwards unless `keep`.
 Expected<EncodeRun> encode(const fs::path& capture, const fs::path& out,
-                           const LightfieldEncodeOptions& o, bool keep = false) {
+                           const encoder::LightfieldEncodeOptions& o, bool keep = false) {
   EncodeRun r;
   const double t0 = now_s();
-  CALF_ASSIGN_OR_RETURN(r.stats, encode_lightfield_file(capture, out.string(), o));
+  CALF_ASSIGN_OR_RETURN(r.stats, encoder::encode_lightfield_file(capture, out.string(), o));
   r.seconds = now_s() - t0;
   r.file_bytes = fs::file_size(out);
   if (!keep) fs::remove(out);
@@ -201,9 +202,9 @@ const char* format_name(uint16_t f) {
 
 struct Run {
   uint32_t threads = 0;
-  double min_psnr_db = LightfieldEncodeOptions{}.min_psnr_db;  // calf-encode's --psnr
+  double min_psnr_db = encoder::LightfieldEncodeOptions{}.min_psnr_db;  // calf-encode's --psnr
   bool have_xz = false, have_zstd = false, colour_peers = true;
-  DepthCoding depth = DepthCoding::kRaw16;
+  encoder::DepthCoding depth = encoder::DepthCoding::kRaw16;
   bool fixed_groups = false, lzma2 = true;
   bool video_peers = false;
   bench::PeerSettings peers;
@@ -223,8 +224,9 @@ int run_one(const fs::path& dir, const Run& run) {
   const fs::path zstd_clip = tmp / "zstd.calf";
   const bool merge = !run.fixed_groups;
   // The options of one encode: the run's, with this supercompression and depth layout.
-  auto options = [&](container::Compression sc, DepthCoding depth, bool merge_static_groups) {
-    LightfieldEncodeOptions o;
+  auto options = [&](container::Compression sc, encoder::DepthCoding depth,
+                     bool merge_static_groups) {
+    encoder::LightfieldEncodeOptions o;
     o.threads = threads;
     o.min_psnr_db = run.min_psnr_db;
     o.depth = depth;
@@ -245,9 +247,9 @@ int run_one(const fs::path& dir, const Run& run) {
   }
   // The depth bytes without predicted depth or static groups (raw16, one chunk per K frames).
   std::optional<EncodeRun> before;
-  if (failed.ok() && (run.depth != DepthCoding::kRaw16 || merge)) {
+  if (failed.ok() && (run.depth != encoder::DepthCoding::kRaw16 || merge)) {
     auto r = encode(dir, tmp / "before.calf",
-                    options(container::Compression::kZstd, DepthCoding::kRaw16, false));
+                    options(container::Compression::kZstd, encoder::DepthCoding::kRaw16, false));
     failed = r.status();
     if (r.ok()) before = *r;
   }
@@ -257,9 +259,9 @@ int run_one(const fs::path& dir, const Run& run) {
     fs::remove_all(tmp);
     return 1;
   }
-  const LightfieldEncodeStats& s = z->stats;
-  const LightfieldEncodeStats none;
-  const LightfieldEncodeStats& sx = x ? x->stats : none;
+  const encoder::LightfieldEncodeStats& s = z->stats;
+  const encoder::LightfieldEncodeStats none;
+  const encoder::LightfieldEncodeStats& sx = x ? x->stats : none;
   auto lz = [&](uint64_t v) { return x ? std::optional<uint64_t>(v) : std::nullopt; };
 
   // Peers on the raw streams.
@@ -371,7 +373,7 @@ int run_one(const fs::path& dir, const Run& run) {
       "- colour: {} cells, {} keyframes of {} cell-frames, min temporal quality {:.1f} dB; "
       "depth: {} tiles, {} keyframes, {} P-frames ({} empty); index {} bytes\n",
       s.colour_cells, s.colour_keyframes, s.colour_cells * m.frame_count, s.min_colour_quality_db,
-      s.depth_tiles, s.depth_keyframes, s.depth_pframes, s.depth_empty_pframes,
+      s.depth_regions, s.depth_keyframes, s.depth_pframes, s.depth_empty_pframes,
       bytes(s.index_bytes));
   // What no stream column counts: the file's header, directory and padding (SPEC §4, §7), per
   // chunk; container 1.1 compresses the directory (docs/ENCODER.md "Compressed directory").
@@ -440,9 +442,9 @@ int main(int argc, char** argv) {
                  "further x265 parameters of the colour peer, key=value:key=value (default none); "
                  "keyint=1 makes it intra-only, each frame decodable alone as each calf frame is");
   CLI11_PARSE(app, argc, argv);
-  run.depth = depth == "pred16"    ? DepthCoding::kRaw16Predicted
-              : depth == "pred16m" ? DepthCoding::kRaw16PredictedMasked
-                                   : DepthCoding::kRaw16;
+  run.depth = depth == "pred16"    ? encoder::DepthCoding::kRaw16Predicted
+              : depth == "pred16m" ? encoder::DepthCoding::kRaw16PredictedMasked
+                                   : encoder::DepthCoding::kRaw16;
   run.colour_peers = !no_colour_peers;
   run.lzma2 = !no_lzma2;
   run.have_xz = have_tool("xz");

@@ -97,14 +97,14 @@ int main(int argc, char** argv) {
                  "default margin)");
   app.add_option("--threads", threads, "encoder threads, 0 = all cores (default 0)");
   CLI11_PARSE(app, argc, argv);
-  if (margins.empty()) margins.push_back(kDefaultPsnrNoiseMargin);
+  if (margins.empty()) margins.push_back(encoder::kDefaultPsnrNoiseMargin);
 
   auto input = capture::CaptureSetReader::open(capture_dir);
   if (!input.ok()) return fail(input.status());
-  NoiseEstimateOptions no;
+  encoder::NoiseEstimateOptions no;
   no.threads = threads;
   const auto t0 = std::chrono::steady_clock::now();
-  auto noise = estimate_capture_noise(*input, ColourCoding::kAuto, no);
+  auto noise = encoder::estimate_capture_noise(*input, encoder::ColourCoding::kAuto, no);
   if (!noise.ok()) return fail(noise.status());
   const double estimate_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -119,7 +119,7 @@ int main(int argc, char** argv) {
 
   std::printf("capture %s: noise estimate %s (%s, %llu samples, %.2f s)%s\n\n", capture_dir.c_str(),
               noise->set.psnr_db ? fmt::format("{:.2f} dB", *noise->set.psnr_db).c_str() : "none",
-              noise->metric == NoiseMetric::kLog2 ? "log2-PSNR" : "sRGB PSNR",
+              noise->metric == encoder::NoiseMetric::kLog2 ? "log2-PSNR" : "sRGB PSNR",
               static_cast<unsigned long long>(noise->set.samples), estimate_s,
               ref_rgb
                   ? fmt::format("; input vs reference {:.2f} dB", psnr(*in_rgb, *ref_rgb)).c_str()
@@ -131,15 +131,15 @@ int main(int argc, char** argv) {
                         fmt::format("bench-noise_keyframes-{}.calf", static_cast<long>(getpid()));
   std::vector<std::pair<std::string, double>> runs = {{"50", 50.0}};
   for (const double m : margins) {
-    runs.emplace_back(fmt::format("auto, margin {:g}", m), auto_psnr_db(noise->set, m));
+    runs.emplace_back(fmt::format("auto, margin {:g}", m), encoder::auto_psnr_db(noise->set, m));
   }
   uint64_t base_bytes = 0;
   double base_ref = 0;
   for (const auto& [label, q] : runs) {
-    LightfieldEncodeOptions o;
+    encoder::LightfieldEncodeOptions o;
     o.threads = threads;
     o.min_psnr_db = q;
-    auto stats = encode_lightfield_file(capture_dir, clip.string(), o);
+    auto stats = encoder::encode_lightfield_file(capture_dir, clip.string(), o);
     if (!stats.ok()) return fail(stats.status());
     auto out_rgb = clip_srgb(clip);
     if (!out_rgb.ok()) return fail(out_rgb.status());

@@ -22,7 +22,7 @@
 //
 //   bench-player_quality --capture DIR --eye-path GT/eye_path.json [--viewpoint-gt FILE]
 //                        [--steps N] [--threads N] [--variants plain,rr] [--out DIR] ...
-// Every RenderOptions knob has an option (--help). PSNR / SSIM are image_compare.h's
+// Every LightfieldRenderOptions knob has an option (--help). PSNR / SSIM are image_compare.h's
 // (sRGB-encoded, clamped; SSIM on luma); per pose, then mean and worst pose. "depth ok" is the
 // share of pixels whose depth is within 2 % of the reference's (or sky in both). --breakdown
 // splits the squared error by what the ground truth shows at each pixel (sky, grown, hole, edge,
@@ -46,8 +46,8 @@
 #include "calf/format/camera.h"
 #include "calf/format/colour.h"
 #include "calf/player/capture_views.h"
-#include "calf/player/cpu_renderer.h"
 #include "calf/player/image_compare.h"
+#include "calf/player/lightfield_cpu_renderer.h"
 
 namespace {
 
@@ -190,7 +190,7 @@ Status write_montage(const fs::path& file, const RenderedImage& ref, const Rende
       for (int c = 0; c < 3; ++c) {
         out[dst + c] = panel == 0   ? ref.color[3 * src + c]
                        : panel == 1 ? img.color[3 * src + c]
-                                    : linear_from_srgb8(heat_color(err[src] / 0.1)[c]);
+                                    : linear_from_srgb8(heat_colour(err[src] / 0.1)[c]);
       }
     }
   }
@@ -236,7 +236,7 @@ GtDepth g_gt_depth = GtDepth::kNone;
 // Re-shades the rays of `img` (rendered by `renderer` from `cam`, one ray per pixel) that
 // g_gt_depth names at `reference`'s depth: all of them, or those the reference sends to the sky
 // while the renderer hit something. What is left is the error of the shading alone.
-void shade_at_reference_depth(const CpuRenderer& renderer, const Camera& cam,
+void shade_at_reference_depth(const LightfieldCpuRenderer& renderer, const Camera& cam,
                               const RenderedImage& reference, RenderedImage* img) {
   const CameraFrame frame = camera_frame(cam);
   for (uint32_t j = 0; j < cam.height; ++j) {
@@ -354,7 +354,7 @@ void print_breakdown(const std::string& name, const Breakdown& b) {
 
 struct Variant {
   std::string name;
-  RenderOptions options;
+  LightfieldRenderOptions options;
 };
 
 // Renders every pose with every variant, prints a row per pose and the means; returns the means.
@@ -392,8 +392,9 @@ std::vector<Score> measure(const char* section, std::vector<Pose>& poses, FrameC
       mean_360.ssim += t / poses.size();
     }
     for (size_t vi = 0; vi < variants.size(); ++vi) {
-      const RenderOptions o = need(march_range_for(views, cam.position, variants[vi].options));
-      const CpuRenderer renderer = need(CpuRenderer::make(views, o));
+      const LightfieldRenderOptions o =
+          need(march_range_for(views, cam.position, variants[vi].options));
+      const LightfieldCpuRenderer renderer = need(LightfieldCpuRenderer::make(views, o));
       RenderedImage img;
       const double t0 = now_s();
       if (Status s = renderer.render(cam, &img); !s.ok()) die(s);
@@ -459,21 +460,22 @@ std::vector<Score> measure(const char* section, std::vector<Pose>& poses, FrameC
 // ground truth or that render shows as sky or next to a depth edge (the breakdown's grown, hole
 // and edge classes), searched on a grid of window / 4.
 void write_silhouette_montage(const fs::path& file, const Pose& p, const ViewSet& views,
-                              const RenderOptions& base, const std::vector<std::string>& settings,
-                              uint32_t window, uint32_t scale) {
+                              const LightfieldRenderOptions& base,
+                              const std::vector<std::string>& settings, uint32_t window,
+                              uint32_t scale) {
   const Camera cam = capture::camera_from_pose(p.pose, p.reference.width, p.reference.height);
   const RenderedImage& ref = p.reference;
   const uint32_t w = ref.width, h = ref.height;
   window = std::min({window, w, h});
   std::vector<RenderedImage> renders;
   for (const std::string& setting : settings) {
-    RenderOptions o = base;
+    LightfieldRenderOptions o = base;
     const size_t plus = setting.find('+');
     o.coverage = static_cast<uint32_t>(std::stoul(setting.substr(0, plus)));
     o.coverage_layers =
         plus == std::string::npos ? 0 : static_cast<uint32_t>(std::stoul(setting.substr(plus + 1)));
     o = need(march_range_for(views, cam.position, o));
-    const CpuRenderer renderer = need(CpuRenderer::make(views, o));
+    const LightfieldCpuRenderer renderer = need(LightfieldCpuRenderer::make(views, o));
     RenderedImage img;
     if (Status s = renderer.render(cam, &img); !s.ok()) die(s);
     renders.push_back(std::move(img));
@@ -562,8 +564,8 @@ int main(int argc, char** argv) {
                "bench-player_quality"};
   std::string capture_dir, eye_path_file, vp_gt_file, write_vp_file, out_dir, poses_arg;
   std::string variants_arg = "plain,rr", active_arg;
-  // RenderOptions' defaults: the tuned configuration of docs/RENDERING.md "Quality".
-  RenderOptions base;
+  // LightfieldRenderOptions' defaults: the tuned configuration of docs/RENDERING.md "Quality".
+  LightfieldRenderOptions base;
   bool no_reproject = false;
   app.add_option("--capture", capture_dir, "capture set directory (manifest.json)")->required();
   app.add_option("--eye-path", eye_path_file,
@@ -579,7 +581,7 @@ int main(int argc, char** argv) {
   app.add_option("--smooth", base.smooth_depth_ratio, "smooth_depth_ratio")->capture_default_str();
   app.add_option("--depth-decay", base.depth_decay, "w_depth decay")->capture_default_str();
   app.add_option("--cam-decay", base.cam_decay, "w_cam decay")->capture_default_str();
-  app.add_option("--color-tolerance", base.color_depth_tolerance, "color_depth_tolerance")
+  app.add_option("--color-tolerance", base.colour_depth_tolerance, "colour_depth_tolerance")
       ->capture_default_str();
   app.add_option("--tight-start", base.tight_march_start, "tight_march_start (0/1)")
       ->capture_default_str();
@@ -623,7 +625,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--hint-substeps", base.surface_hint_substeps, "surface_hint_substeps")
       ->capture_default_str();
-  app.add_option("--bilinear", base.bilinear_color, "bilinear_color (0/1)")->capture_default_str();
+  app.add_option("--bilinear", base.bilinear_colour, "bilinear_colour (0/1)")
+      ->capture_default_str();
   app.add_option("--rr-replace", base.rr_replace_view_reflection, "rr_replace_view_reflection")
       ->capture_default_str();
   app.add_option("--rr-start", base.rr_start, "z_e of secondary rays")->capture_default_str();
@@ -636,9 +639,10 @@ int main(int argc, char** argv) {
                  "compare k x k box-filtered images: ground truth rendered k times the size, "
                  "reconstructions rendered at that size (1..8)")
       ->capture_default_str();
-  app.add_option("--render-supersample", base.supersample,
-                 "RenderOptions::supersample: the renderer's own n x n eye rays per pixel, box-"
-                 "filtered, against the ground truth at its size (calf-play --supersample; 1..8)")
+  app.add_option(
+         "--render-supersample", base.supersample,
+         "LightfieldRenderOptions::supersample: the renderer's own n x n eye rays per pixel, box-"
+         "filtered, against the ground truth at its size (calf-play --supersample; 1..8)")
       ->capture_default_str();
   app.add_flag("--no-reproject", no_reproject, "skip the vp-reproj measurement");
   app.add_flag("--breakdown", g_breakdown,
@@ -756,7 +760,7 @@ int main(int argc, char** argv) {
       "agreement %u, unmix %.2f, layers %u, alpha rule %u)\n",
       m.scene.c_str(), m.viewpoints.size(), m.face_size, m.frame_count, base.steps,
       base.refine_steps, base.depth_footprint, base.smooth_depth_ratio, base.depth_decay,
-      base.cam_decay, base.color_depth_tolerance, base.mixed_texel_penalty,
+      base.cam_decay, base.colour_depth_tolerance, base.mixed_texel_penalty,
       base.mixed_texel_bend_texels, base.tight_march_start, base.surface_hints,
       base.surface_hint_margin_texels, base.surface_hint_vetoes, base.surface_hint_substeps,
       base.rr_start, base.rr_replace_view_reflection, g_supersample, base.supersample, base.threads,

@@ -13,7 +13,7 @@
 
 #include "calf/capture/capture_set.h"
 #include "calf/decoder/lightfield_reference.h"
-#include "calf/encoder/color_keyframes.h"
+#include "calf/encoder/colour_keyframes.h"
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/format/container.h"
 
@@ -26,12 +26,12 @@ struct Result {
 };
 
 bool encode_and_decode(const calf::capture::CaptureSetReader& input,
-                       calf::LightfieldEncodeOptions o, Result* r) {
+                       calf::encoder::LightfieldEncodeOptions o, Result* r) {
   std::vector<uint8_t> bytes;
   auto writer = calf::container::Writer::create(calf::container::memory_sink(&bytes));
   if (!writer.ok()) return false;
   const auto t0 = std::chrono::steady_clock::now();
-  auto stats = calf::encode_lightfield(input, *writer, o);
+  auto stats = calf::encoder::encode_lightfield(input, *writer, o);
   if (!stats.ok() || !writer->finish().ok()) {
     std::fprintf(stderr, "encode: %s\n", stats.status().to_string().c_str());
     return false;
@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
       x.insert(x.end(), a[i].begin(), a[i].end());
       y.insert(y.end(), b[i].begin(), b[i].end());
     }
-    return hdr ? calf::psnr_log2(x, y) : calf::psnr_srgb(x, y);
+    return hdr ? calf::encoder::psnr_log2(x, y) : calf::encoder::psnr_srgb(x, y);
   };
   std::printf("capture %s: %zu views x %u frames, face %u, %s, depth K %u\n\n", capture_dir.c_str(),
               m.viewpoints.size(), m.frame_count, m.face_size,
@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
   Result none;
   bool have_none = false;
   while (std::getline(list, item, ',')) {
-    calf::LightfieldEncodeOptions o;
+    calf::encoder::LightfieldEncodeOptions o;
     o.threads = threads;
     o.depth_keyframe_interval = k;
     o.segment_frames = static_cast<uint32_t>(std::stoul(item));

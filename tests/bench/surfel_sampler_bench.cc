@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
   uint32_t exact_max = 100000;
   uint32_t threads = 1;
   int repeats = 3;
-  calf::SurfelSamplerOptions base;
+  calf::encoder::SurfelSamplerOptions base;
   app.add_option("--surface", surface, "bumpy | plane")->capture_default_str();
   app.add_option("--candidates", candidates, "candidate count")->capture_default_str();
   app.add_option("--sizes", sizes, "surfel counts")->capture_default_str();
@@ -104,9 +104,9 @@ int main(int argc, char** argv) {
       surface, points.size(), threads, base.round_samples, base.growth_period, base.max_accept,
       base.vicinity);
 
-  const calf::SurfelOrderMethod methods[] = {
-      calf::SurfelOrderMethod::kGreedyTree, calf::SurfelOrderMethod::kProgressive,
-      calf::SurfelOrderMethod::kExactGreedy, calf::SurfelOrderMethod::kRandom};
+  const calf::encoder::SurfelOrderMethod methods[] = {
+      calf::encoder::SurfelOrderMethod::kGreedyTree, calf::encoder::SurfelOrderMethod::kProgressive,
+      calf::encoder::SurfelOrderMethod::kExactGreedy, calf::encoder::SurfelOrderMethod::kRandom};
   constexpr int kMethods = 4, kExact = 2;
   fmt::print(
       "milliseconds, wall / CPU (median of runs); limit: exact / sampler >= 50 at 10k (CPU)\n");
@@ -117,16 +117,17 @@ int main(int argc, char** argv) {
     if (n > points.size()) continue;
     double ms[kMethods] = {NAN, NAN, NAN, NAN}, cpu[kMethods] = {NAN, NAN, NAN, NAN};
     for (int m = 0; m < kMethods; ++m) {
-      if (methods[m] == calf::SurfelOrderMethod::kProgressive && skip_progressive) continue;
-      if (methods[m] == calf::SurfelOrderMethod::kExactGreedy && n > exact_max) continue;
-      calf::SurfelSamplerOptions o = base;
+      if (methods[m] == calf::encoder::SurfelOrderMethod::kProgressive && skip_progressive)
+        continue;
+      if (methods[m] == calf::encoder::SurfelOrderMethod::kExactGreedy && n > exact_max) continue;
+      calf::encoder::SurfelSamplerOptions o = base;
       o.method = methods[m];
       std::vector<double> runs, cpus;
-      const int reps = methods[m] == calf::SurfelOrderMethod::kExactGreedy ? 1 : repeats;
+      const int reps = methods[m] == calf::encoder::SurfelOrderMethod::kExactGreedy ? 1 : repeats;
       for (int r = 0; r < reps; ++r) {
         const auto t0 = std::chrono::steady_clock::now();
         const double c0 = cpu_seconds();
-        auto order = calf::order_surfels(points, n, o);
+        auto order = calf::encoder::order_surfels(points, n, o);
         cpus.push_back((cpu_seconds() - c0) * 1e3);
         runs.push_back(
             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() * 1e3);
@@ -171,7 +172,7 @@ int main(int argc, char** argv) {
     double exact_rho = NAN;
     for (int m : {kExact, 0, 1, 3}) {
       if (longest[m].size() < p) continue;
-      auto s = calf::prefix_spacing(points, longest[m], p, threads);
+      auto s = calf::encoder::prefix_spacing(points, longest[m], p, threads);
       if (!s.ok()) {
         fmt::print(stderr, "{}\n", s.status().to_string());
         return 1;
@@ -179,8 +180,8 @@ int main(int argc, char** argv) {
       const double rho = s->r_min / s->r_max;
       if (m == kExact) exact_rho = rho;
       fmt::print("{:>8} {:>12} {:>10.5f} {:>10.5f} {:>10.5f} {:>10.3f} {:>11.1f}%\n", p,
-                 calf::surfel_order_method_name(methods[m]), s->r_min, s->r_median, s->r_max, rho,
-                 100.0 * (rho / exact_rho - 1.0));
+                 calf::encoder::surfel_order_method_name(methods[m]), s->r_min, s->r_median,
+                 s->r_max, rho, 100.0 * (rho / exact_rho - 1.0));
     }
   }
   return 0;

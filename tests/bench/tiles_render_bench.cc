@@ -27,7 +27,7 @@ namespace {
 
 TileSet synthesize(uint32_t gu, uint32_t gv, uint32_t atlas_size) {
   TileSet set;
-  set.view_region = {{-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5}};
+  set.view_volume = {{-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5}};
   set.atlas_width = set.atlas_height = atlas_size;
   set.atlas_rgba.resize(size_t{4} * atlas_size * atlas_size);
   uint32_t state = 12345;

@@ -177,7 +177,7 @@ TEST_F(CaptureSetTest, WriterRefusals) {
   EXPECT_NE(s.message().find("face +X texel (3, 1)"), std::string::npos) << s.to_string();
   ViewFrame hot = frame_data(0, 0, false);
   hot.color[0] = 70000;  // would overflow half to +inf
-  EXPECT_EQ(w->write(0, 0, hot).id(), ErrorId::kCaptureColorPixel);
+  EXPECT_EQ(w->write(0, 0, hot).id(), ErrorId::kCaptureColourPixel);
   EXPECT_FALSE(fs::exists(image(0, 0)));
   ASSERT_TRUE(w->write(0, 0, frame_data(0, 0, false)).ok());
   EXPECT_EQ(w->write(0, 0, frame_data(0, 0, false)).id(), ErrorId::kCaptureWriterMisuse);
@@ -364,7 +364,7 @@ TEST_F(CaptureSetTest, BadColourPixels) {
     fs::remove_all(dir_);
     write_set(false);
     write_raw(image(1, 0), 4, 24, {"R", "G", "B", "Z"}, 1.0f, 1, 0, 23, bad);
-    expect_read_error(ErrorId::kCaptureColorPixel, "face -Z texel (0, 3): colour channel G");
+    expect_read_error(ErrorId::kCaptureColourPixel, "face -Z texel (0, 3): colour channel G");
   }
 }
 

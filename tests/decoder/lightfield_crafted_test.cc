@@ -122,7 +122,7 @@ TEST(LightfieldCrafted, ClipsHoldWhatTheyAreFor) {
     const auto& h =
         std::get<container::LightfieldTrackHeader>(r.tracks()[lightfield_track(r)].header);
     EXPECT_NE(h.face_size % h.cell_size, 0u) << s.name;
-    EXPECT_NE(h.face_size % h.depth_tile_size, 0u) << s.name;
+    EXPECT_NE(h.face_size % h.depth_region_size, 0u) << s.name;
     EXPECT_NE(h.face_size % 4, 0u) << s.name;
     size_t interpolated = 0;
     for (const auto& [k, raw] : chunks_of(r, LightfieldStream::kTParams)) {

@@ -8,22 +8,23 @@
 namespace calf {
 namespace {
 
-ChangeMask make_mask(uint32_t w, uint32_t h) {
-  return ChangeMask{w, h, std::vector<uint8_t>(static_cast<size_t>(w) * h, 0)};
+encoder::ChangeMask make_mask(uint32_t w, uint32_t h) {
+  return encoder::ChangeMask{w, h, std::vector<uint8_t>(static_cast<size_t>(w) * h, 0)};
 }
-void set_rect(ChangeMask& m, uint32_t x, uint32_t y, uint32_t w, uint32_t h) {
+void set_rect(encoder::ChangeMask& m, uint32_t x, uint32_t y, uint32_t w, uint32_t h) {
   for (uint32_t j = y; j < y + h; ++j)
     for (uint32_t i = x; i < x + w; ++i) m.bits[j * m.width + i] = 1;
 }
 
-std::vector<PixelRect> fit(const ChangeMask& m, uint32_t max_boxes, uint32_t alignment = 1) {
-  auto r = fit_change_boxes(m, {max_boxes, alignment});
+std::vector<PixelRect> fit(const encoder::ChangeMask& m, uint32_t max_boxes,
+                           uint32_t alignment = 1) {
+  auto r = encoder::fit_change_boxes(m, {max_boxes, alignment});
   EXPECT_TRUE(r.ok()) << r.status().to_string();
   return *r;
 }
 
 // Every set texel covered, boxes inside the tile, pairwise disjoint, at most max_boxes.
-void expect_valid_cover(const ChangeMask& m, const std::vector<PixelRect>& boxes,
+void expect_valid_cover(const encoder::ChangeMask& m, const std::vector<PixelRect>& boxes,
                         uint32_t max_boxes) {
   ASSERT_LE(boxes.size(), max_boxes);
   std::vector<int> owner(m.bits.size(), -1);
@@ -50,13 +51,13 @@ TEST(DepthAabbTest, EmptyMaskNeedsNoBox) {
 }
 
 TEST(DepthAabbTest, OneBlobGivesItsTightBox) {
-  ChangeMask m = make_mask(32, 16);
+  encoder::ChangeMask m = make_mask(32, 16);
   set_rect(m, 5, 3, 7, 4);
   EXPECT_EQ(fit(m, 4), (std::vector<PixelRect>{{5, 3, 7, 4}}));
 }
 
 TEST(DepthAabbTest, TwoBlobsGiveTwoTightBoxesInOrder) {
-  ChangeMask m = make_mask(64, 64);
+  encoder::ChangeMask m = make_mask(64, 64);
   set_rect(m, 40, 2, 10, 5);  // top right
   set_rect(m, 3, 30, 6, 20);  // bottom left
   EXPECT_EQ(fit(m, 2), (std::vector<PixelRect>{{40, 2, 10, 5}, {3, 30, 6, 20}}));
@@ -67,14 +68,14 @@ TEST(DepthAabbTest, TwoBlobsGiveTwoTightBoxesInOrder) {
 TEST(DepthAabbTest, MoreBoxesNeverCoverMoreTexels) {
   std::mt19937 rng(7);
   for (int trial = 0; trial < 50; ++trial) {
-    ChangeMask m = make_mask(40, 30);
+    encoder::ChangeMask m = make_mask(40, 30);
     for (int blob = 0; blob < 5; ++blob)
       set_rect(m, rng() % 35, rng() % 25, 1 + rng() % 5, 1 + rng() % 5);
     uint64_t previous = UINT64_MAX;
     for (uint32_t a = 1; a <= 8; ++a) {
       const auto boxes = fit(m, a);
       expect_valid_cover(m, boxes, a);
-      const uint64_t area = covered_texels(boxes);
+      const uint64_t area = encoder::covered_texels(boxes);
       EXPECT_LE(area, previous);
       previous = area;
     }
@@ -84,7 +85,7 @@ TEST(DepthAabbTest, MoreBoxesNeverCoverMoreTexels) {
 // Naive reference: for A = 2 the greedy search is exhaustive over single guillotine cuts, so its
 // area must equal the best cut found by brute force with naive tightening.
 TEST(DepthAabbTest, TwoBoxesMatchBruteForceBestCut) {
-  const auto tight_area = [](const ChangeMask& m, uint32_t x0, uint32_t y0, uint32_t x1,
+  const auto tight_area = [](const encoder::ChangeMask& m, uint32_t x0, uint32_t y0, uint32_t x1,
                              uint32_t y1) -> uint64_t {
     uint32_t a = UINT32_MAX, b = UINT32_MAX, c = 0, d = 0;
     for (uint32_t y = y0; y < y1; ++y)
@@ -99,7 +100,7 @@ TEST(DepthAabbTest, TwoBoxesMatchBruteForceBestCut) {
   };
   std::mt19937 rng(11);
   for (int trial = 0; trial < 100; ++trial) {
-    ChangeMask m = make_mask(12, 10);
+    encoder::ChangeMask m = make_mask(12, 10);
     for (auto& bit : m.bits) bit = (rng() % 9) == 0;
     uint64_t best = tight_area(m, 0, 0, 12, 10);
     for (uint32_t s = 1; s < 12; ++s)
@@ -108,14 +109,14 @@ TEST(DepthAabbTest, TwoBoxesMatchBruteForceBestCut) {
       best = std::min(best, tight_area(m, 0, 0, 12, s) + tight_area(m, 0, s, 12, 10));
     const auto boxes = fit(m, 2);
     expect_valid_cover(m, boxes, 2);
-    EXPECT_EQ(covered_texels(boxes), best) << "trial " << trial;
+    EXPECT_EQ(encoder::covered_texels(boxes), best) << "trial " << trial;
   }
 }
 
 TEST(DepthAabbTest, AlignedBoxesSnapToBlocksAndClipToTheTile) {
   std::mt19937 rng(3);
   for (int trial = 0; trial < 50; ++trial) {
-    ChangeMask m = make_mask(30, 22);  // not a multiple of 4: edge boxes are clipped
+    encoder::ChangeMask m = make_mask(30, 22);  // not a multiple of 4: edge boxes are clipped
     for (int blob = 0; blob < 4; ++blob)
       set_rect(m, rng() % 28, rng() % 20, 1 + rng() % 3, 1 + rng() % 3);
     const auto boxes = fit(m, 3, 4);
@@ -133,28 +134,30 @@ TEST(DepthAabbTest, ChangeMaskUsesTheWholeWindow) {
   // Texel 0 changes between frames 0 and 1 and goes back at frame 2; texel 1 changes at frame 2.
   const std::vector<uint16_t> f0 = {10, 20, 30, 40}, f1 = {11, 20, 30, 40}, f2 = {10, 25, 30, 40};
   const std::vector<std::span<const uint16_t>> frames = {f0, f1, f2};
-  auto w1 = depth_change_mask(frames, 2, 2, 2, 1);
+  auto w1 = encoder::depth_change_mask(frames, 2, 2, 2, 1);
   ASSERT_TRUE(w1.ok());
   EXPECT_EQ(w1->bits, (std::vector<uint8_t>{1, 1, 0, 0}));  // differs from frame 1 at texel 0
-  auto w2 = depth_change_mask(frames, 2, 2, 2, 2);
+  auto w2 = encoder::depth_change_mask(frames, 2, 2, 2, 2);
   EXPECT_EQ(w2->bits, (std::vector<uint8_t>{1, 1, 0, 0}));
   // A texel equal to frame i-1 but not to frame i-2 is still marked with W = 2.
   const std::vector<uint16_t> g0 = {1, 1}, g1 = {2, 1}, g2 = {2, 1};
   const std::vector<std::span<const uint16_t>> g = {g0, g1, g2};
-  EXPECT_EQ(depth_change_mask(g, 2, 1, 2, 1)->bits, (std::vector<uint8_t>{0, 0}));
-  EXPECT_EQ(depth_change_mask(g, 2, 1, 2, 2)->bits, (std::vector<uint8_t>{1, 0}));
+  EXPECT_EQ(encoder::depth_change_mask(g, 2, 1, 2, 1)->bits, (std::vector<uint8_t>{0, 0}));
+  EXPECT_EQ(encoder::depth_change_mask(g, 2, 1, 2, 2)->bits, (std::vector<uint8_t>{1, 0}));
   // Epsilon tolerates small code differences.
-  EXPECT_EQ(depth_change_mask(frames, 2, 2, 1, 1, 1)->bits, (std::vector<uint8_t>{0, 0, 0, 0}));
+  EXPECT_EQ(encoder::depth_change_mask(frames, 2, 2, 1, 1, 1)->bits,
+            (std::vector<uint8_t>{0, 0, 0, 0}));
 }
 
 TEST(DepthAabbTest, BadArgumentsAreErrors) {
   const std::vector<uint16_t> f0(4), f1(3);
   const std::vector<std::span<const uint16_t>> frames = {f0, f1};
-  EXPECT_EQ(depth_change_mask(frames, 2, 2, 1, 1).status().id(), ErrorId::kInvalidArgument);
-  EXPECT_FALSE(depth_change_mask(frames, 2, 2, 0, 1).ok());
-  EXPECT_FALSE(depth_change_mask(frames, 2, 2, 2, 1).ok());
-  EXPECT_FALSE(fit_change_boxes(make_mask(4, 4), {0, 1}).ok());
-  EXPECT_FALSE(fit_change_boxes(make_mask(4, 4), {2, 0}).ok());
+  EXPECT_EQ(encoder::depth_change_mask(frames, 2, 2, 1, 1).status().id(),
+            ErrorId::kInvalidArgument);
+  EXPECT_FALSE(encoder::depth_change_mask(frames, 2, 2, 0, 1).ok());
+  EXPECT_FALSE(encoder::depth_change_mask(frames, 2, 2, 2, 1).ok());
+  EXPECT_FALSE(encoder::fit_change_boxes(make_mask(4, 4), {0, 1}).ok());
+  EXPECT_FALSE(encoder::fit_change_boxes(make_mask(4, 4), {2, 0}).ok());
 }
 
 }  // namespace

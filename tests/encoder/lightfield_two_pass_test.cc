@@ -1,7 +1,8 @@
 // The light-field encoder's two passes (encoder/include/calf/encoder/lightfield_encode.h "Two
 // passes"): the analysis decides every header field before a view is coded, views coded apart
-// (in another order, with other thread counts) assemble into the very bytes of encode_lightfield(),
-// and misuse of the passes (wrong order, other options, images changed in between) is refused.
+// (in another order, with other thread counts) assemble into the very bytes of
+// encoder::encode_lightfield(), and misuse of the passes (wrong order, other options, images
+// changed in between) is refused.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -77,22 +78,22 @@ class LightfieldTwoPass : public ::testing::Test {
     return dir;
   }
 
-  static LightfieldEncodeOptions options(uint32_t threads) {
-    LightfieldEncodeOptions o;
+  static encoder::LightfieldEncodeOptions options(uint32_t threads) {
+    encoder::LightfieldEncodeOptions o;
     o.cell_size = 4;
-    o.depth_tiles_per_side = 2;
+    o.depth_regions_per_side = 2;
     o.depth_keyframe_interval = 3;
     o.threads = threads;
     return o;
   }
 
-  // encode_lightfield() into memory.
+  // encoder::encode_lightfield() into memory.
   static std::vector<uint8_t> encode_whole(const capture::CaptureSetReader& input,
-                                           const LightfieldEncodeOptions& o) {
+                                           const encoder::LightfieldEncodeOptions& o) {
     std::vector<uint8_t> bytes;
     auto writer = container::Writer::create(container::memory_sink(&bytes), o.levels);
     EXPECT_TRUE(writer.ok());
-    auto stats = encode_lightfield(input, *writer, o);
+    auto stats = encoder::encode_lightfield(input, *writer, o);
     EXPECT_TRUE(stats.ok()) << stats.status().to_string();
     const Status st = writer->finish();
     EXPECT_TRUE(st.ok()) << st.to_string();
@@ -106,15 +107,15 @@ TEST_F(LightfieldTwoPass, AnalysisDecidesTheWholeHeader) {
   const fs::path dir = make_capture("set", /*hdr_view=*/2);
   auto input = capture::CaptureSetReader::open(dir);
   ASSERT_TRUE(input.ok());
-  auto a = analyse_lightfield(*input, options(2));
+  auto a = encoder::analyse_lightfield(*input, options(2));
   ASSERT_TRUE(a.ok()) << a.status().to_string();
 
   // HDR appears in the last view only, and in its last frame: still a HDR track.
   EXPECT_TRUE(a->hdr);
-  EXPECT_EQ(a->colour, ColourCoding::kBc6h);
+  EXPECT_EQ(a->colour, encoder::ColourCoding::kBc6h);
   EXPECT_EQ(a->header.colour_format, static_cast<uint16_t>(container::PixelFormat::kBc6h));
   EXPECT_EQ(a->header.flags, 1);
-  // The default depth coding (LightfieldEncodeOptions::depth): r16pm.
+  // The default depth coding (encoder::LightfieldEncodeOptions::depth): r16pm.
   EXPECT_EQ(a->header.depth_format,
             static_cast<uint16_t>(container::PixelFormat::kR16PredictedMasked));
   EXPECT_EQ(a->header.material_format, static_cast<uint16_t>(container::PixelFormat::kRgba8));
@@ -122,7 +123,7 @@ TEST_F(LightfieldTwoPass, AnalysisDecidesTheWholeHeader) {
   EXPECT_EQ(a->header.frame_count, kFrames);
   EXPECT_EQ(a->header.face_size, kFace);
   EXPECT_EQ(a->header.cell_size, 4u);
-  EXPECT_EQ(a->header.depth_tile_size, 4u);
+  EXPECT_EQ(a->header.depth_region_size, 4u);
   EXPECT_EQ(a->header.fps_numerator, 24u);
   EXPECT_EQ(a->header.fps_denominator, 1u);
 
@@ -154,9 +155,9 @@ TEST_F(LightfieldTwoPass, LdrSetWithoutMaterialPlansBc1AndNoMaterialStream) {
   const fs::path dir = make_capture("set", /*hdr_view=*/-1);
   auto input = capture::CaptureSetReader::open(dir);
   ASSERT_TRUE(input.ok());
-  LightfieldEncodeOptions o = options(1);
-  o.depth = DepthCoding::kBc5;
-  auto a = analyse_lightfield(*input, o);
+  encoder::LightfieldEncodeOptions o = options(1);
+  o.depth = encoder::DepthCoding::kBc5;
+  auto a = encoder::analyse_lightfield(*input, o);
   ASSERT_TRUE(a.ok()) << a.status().to_string();
   EXPECT_FALSE(a->hdr);
   EXPECT_EQ(a->header.colour_format, static_cast<uint16_t>(container::PixelFormat::kBc1));
@@ -164,29 +165,30 @@ TEST_F(LightfieldTwoPass, LdrSetWithoutMaterialPlansBc1AndNoMaterialStream) {
   EXPECT_EQ(a->header.material_format, static_cast<uint16_t>(container::PixelFormat::kBc1));
   EXPECT_EQ(a->header.flags, 0);
   // Facts without material anywhere: no material stream, whatever the manifest promises.
-  std::vector<LightfieldViewFacts> facts = a->views;
+  std::vector<encoder::LightfieldViewFacts> facts = a->views;
   facts[0].has_material = false;
-  auto plain = plan_lightfield(input->manifest(), facts, o);
+  auto plain = encoder::plan_lightfield(input->manifest(), facts, o);
   ASSERT_TRUE(plain.ok()) << plain.status().to_string();
   EXPECT_EQ(plain->header.material_format, 0);
   // A given colour format is kept even for HDR facts.
   facts[1].hdr = true;
-  o.colour = ColourCoding::kBc7;
-  auto bc7 = plan_lightfield(input->manifest(), facts, o);
+  o.colour = encoder::ColourCoding::kBc7;
+  auto bc7 = encoder::plan_lightfield(input->manifest(), facts, o);
   ASSERT_TRUE(bc7.ok());
-  EXPECT_EQ(bc7->colour, ColourCoding::kBc7);
+  EXPECT_EQ(bc7->colour, encoder::ColourCoding::kBc7);
   EXPECT_FALSE(bc7->hdr);
-  o.colour = ColourCoding::kAuto;
-  auto hdr = plan_lightfield(input->manifest(), facts, o);
+  o.colour = encoder::ColourCoding::kAuto;
+  auto hdr = encoder::plan_lightfield(input->manifest(), facts, o);
   ASSERT_TRUE(hdr.ok());
-  EXPECT_EQ(hdr->colour, ColourCoding::kBc6h);
+  EXPECT_EQ(hdr->colour, encoder::ColourCoding::kBc6h);
   // One fact per viewpoint.
   facts.pop_back();
-  EXPECT_EQ(plan_lightfield(input->manifest(), facts, o).status().id(), ErrorId::kEncoderInput);
+  EXPECT_EQ(encoder::plan_lightfield(input->manifest(), facts, o).status().id(),
+            ErrorId::kEncoderInput);
 }
 
 // Views analysed one by one and coded in reverse order with other thread counts, then assembled:
-// the bytes of one encode_lightfield() run.
+// the bytes of one encoder::encode_lightfield() run.
 TEST_F(LightfieldTwoPass, ViewsCodedApartAssembleIntoTheSameBytes) {
   for (const int hdr_view : {-1, 1}) {
     const fs::path dir = make_capture("set" + std::to_string(hdr_view + 1), hdr_view);
@@ -195,23 +197,23 @@ TEST_F(LightfieldTwoPass, ViewsCodedApartAssembleIntoTheSameBytes) {
     const std::vector<uint8_t> whole = encode_whole(*input, options(1));
     ASSERT_FALSE(whole.empty());
 
-    std::vector<LightfieldViewFacts> facts(kViews);
+    std::vector<encoder::LightfieldViewFacts> facts(kViews);
     for (uint32_t v = kViews; v-- > 0;) {
-      auto f = analyse_lightfield_view(*input, v);
+      auto f = encoder::analyse_lightfield_view(*input, v);
       ASSERT_TRUE(f.ok()) << f.status().to_string();
       facts[v] = *f;
     }
-    auto a = plan_lightfield(input->manifest(), facts, options(1));
+    auto a = encoder::plan_lightfield(input->manifest(), facts, options(1));
     ASSERT_TRUE(a.ok()) << a.status().to_string();
-    std::vector<LightfieldViewEncoding> views(kViews);
+    std::vector<encoder::LightfieldViewEncoding> views(kViews);
     std::vector<uint64_t> progress;
     for (uint32_t v = kViews; v-- > 0;) {
-      LightfieldEncodeOptions o = options(v + 1);
+      encoder::LightfieldEncodeOptions o = options(v + 1);
       o.progress = [&](uint64_t done, uint64_t total) {
         EXPECT_EQ(total, 6u * kViews);
         progress.push_back(done);
       };
-      auto e = encode_lightfield_view(*input, *a, v, o);
+      auto e = encoder::encode_lightfield_view(*input, *a, v, o);
       ASSERT_TRUE(e.ok()) << e.status().to_string();
       EXPECT_EQ(e->view, v);
       views[v] = std::move(*e);
@@ -222,11 +224,11 @@ TEST_F(LightfieldTwoPass, ViewsCodedApartAssembleIntoTheSameBytes) {
     std::vector<uint8_t> apart;
     auto writer = container::Writer::create(container::memory_sink(&apart));
     ASSERT_TRUE(writer.ok());
-    auto track = LightfieldTrackWriter::begin(*writer, *a);
+    auto track = encoder::LightfieldTrackWriter::begin(*writer, *a);
     ASSERT_TRUE(track.ok()) << track.status().to_string();
     EXPECT_EQ(track->finish().status().id(), ErrorId::kEncoderInput);  // no view yet
     EXPECT_EQ(track->append(views[1]).id(), ErrorId::kEncoderInput);   // view 0 comes first
-    for (const LightfieldViewEncoding& v : views) ASSERT_TRUE(track->append(v).ok());
+    for (const encoder::LightfieldViewEncoding& v : views) ASSERT_TRUE(track->append(v).ok());
     EXPECT_EQ(track->append(views[0]).id(), ErrorId::kEncoderInput);  // one view too many
     auto stats = track->finish();
     ASSERT_TRUE(stats.ok()) << stats.status().to_string();
@@ -236,10 +238,10 @@ TEST_F(LightfieldTwoPass, ViewsCodedApartAssembleIntoTheSameBytes) {
     // The merged figures count each view once.
     EXPECT_EQ(stats->material_views, 1u);
     EXPECT_EQ(stats->colour_cells, uint64_t{kViews} * 6 * 4);
-    EXPECT_EQ(stats->depth_tiles, uint64_t{kViews} * 6 * 4);
+    EXPECT_EQ(stats->depth_regions, uint64_t{kViews} * 6 * 4);
     EXPECT_EQ(stats->hdr, hdr_view >= 0);
     uint64_t chunks = 0;
-    for (const LightfieldViewEncoding& v : views) chunks += v.chunks.size();
+    for (const encoder::LightfieldViewEncoding& v : views) chunks += v.chunks.size();
     EXPECT_EQ(stats->colour.chunks + stats->depth.chunks + stats->material.chunks + kViews, chunks);
   }
 }
@@ -248,26 +250,29 @@ TEST_F(LightfieldTwoPass, ViewPassRefusesAnotherPlanOrChangedImages) {
   const fs::path dir = make_capture("set", /*hdr_view=*/-1);
   auto input = capture::CaptureSetReader::open(dir);
   ASSERT_TRUE(input.ok());
-  auto a = analyse_lightfield(*input, options(1));
+  auto a = encoder::analyse_lightfield(*input, options(1));
   ASSERT_TRUE(a.ok()) << a.status().to_string();
-  ASSERT_TRUE(encode_lightfield_view(*input, *a, 1, options(1)).ok());
+  ASSERT_TRUE(encoder::encode_lightfield_view(*input, *a, 1, options(1)).ok());
 
-  EXPECT_EQ(encode_lightfield_view(*input, *a, kViews, options(1)).status().id(),
+  EXPECT_EQ(encoder::encode_lightfield_view(*input, *a, kViews, options(1)).status().id(),
             ErrorId::kEncoderInput);
-  LightfieldEncodeOptions other = options(1);
+  encoder::LightfieldEncodeOptions other = options(1);
   other.cell_size = 8;  // another grid than the header's
-  EXPECT_EQ(encode_lightfield_view(*input, *a, 0, other).status().id(), ErrorId::kEncoderInput);
+  EXPECT_EQ(encoder::encode_lightfield_view(*input, *a, 0, other).status().id(),
+            ErrorId::kEncoderInput);
   other = options(1);
-  other.colour = ColourCoding::kBc7;
-  EXPECT_EQ(encode_lightfield_view(*input, *a, 0, other).status().id(), ErrorId::kEncoderInput);
-  LightfieldAnalysis edited = *a;
+  other.colour = encoder::ColourCoding::kBc7;
+  EXPECT_EQ(encoder::encode_lightfield_view(*input, *a, 0, other).status().id(),
+            ErrorId::kEncoderInput);
+  encoder::LightfieldAnalysis edited = *a;
   edited.header.material_format = 0;
-  EXPECT_EQ(encode_lightfield_view(*input, edited, 0, options(1)).status().id(),
+  EXPECT_EQ(encoder::encode_lightfield_view(*input, edited, 0, options(1)).status().id(),
             ErrorId::kEncoderInput);
   // Options the view pass refuses whatever the analysis.
   other = options(1);
   other.max_aabbs = 0;
-  EXPECT_EQ(encode_lightfield_view(*input, *a, 0, other).status().id(), ErrorId::kEncoderOption);
+  EXPECT_EQ(encoder::encode_lightfield_view(*input, *a, 0, other).status().id(),
+            ErrorId::kEncoderOption);
 
   // View 1's depth range grows after the analysis: its depth codes would no longer mean what
   // the index chunk says.
@@ -281,9 +286,9 @@ TEST_F(LightfieldTwoPass, ViewPassRefusesAnotherPlanOrChangedImages) {
     fs::copy_file(root_ / "scratch" / capture::capture_file_name(m, 1, 2),
                   dir / capture::capture_file_name(m, 1, 2), fs::copy_options::overwrite_existing);
   }
-  auto changed = encode_lightfield_view(*input, *a, 1, options(1));
+  auto changed = encoder::encode_lightfield_view(*input, *a, 1, options(1));
   EXPECT_EQ(changed.status().id(), ErrorId::kEncoderInput) << changed.status().to_string();
-  EXPECT_TRUE(encode_lightfield_view(*input, *a, 0, options(1)).ok());
+  EXPECT_TRUE(encoder::encode_lightfield_view(*input, *a, 0, options(1)).ok());
 }
 
 // A bad image in a later view: the analysis reports the first failing view, whatever the thread
@@ -296,7 +301,7 @@ TEST_F(LightfieldTwoPass, AnalysisReportsTheFirstFailingView) {
   for (const uint32_t v : {2u, 1u}) {  // corrupt view 2, then also view 1
     std::ofstream(dir / capture::capture_file_name(m, v, 3), std::ios::binary) << "not an image";
     for (const uint32_t threads : {1u, 3u}) {
-      auto a = analyse_lightfield(*input, options(threads));
+      auto a = encoder::analyse_lightfield(*input, options(threads));
       ASSERT_FALSE(a.ok());
       EXPECT_NE(a.status().message().find(capture::capture_file_name(m, v, 3)), std::string::npos)
           << a.status().to_string();

@@ -25,8 +25,9 @@ double base_value(uint32_t face, uint32_t x, uint32_t y, int c, double shift) {
 // `frames` frames of one view: static geometry (depth 2 everywhere) except a square whose depth
 // changes every frame (a moving object, its colour random), plus Gaussian noise of sigma in the
 // metric's domain, drawn anew every frame. `lighting` brightens every frame by that much more.
-std::vector<capture::ViewFrame> make_frames(uint32_t frames, double sigma, NoiseMetric metric,
-                                            double lighting, uint32_t seed) {
+std::vector<capture::ViewFrame> make_frames(uint32_t frames, double sigma,
+                                            encoder::NoiseMetric metric, double lighting,
+                                            uint32_t seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, 1.0);
   std::uniform_real_distribution<float> any(0.0f, 1.0f);
@@ -46,7 +47,7 @@ std::vector<capture::ViewFrame> make_frames(uint32_t frames, double sigma, Noise
               continue;
             }
             const double m = base_value(face, x, y, c, lighting * f) + sigma * noise(rng);
-            v.color[3 * i + c] = metric == NoiseMetric::kLog2
+            v.color[3 * i + c] = metric == encoder::NoiseMetric::kLog2
                                      ? static_cast<float>(std::exp2(m * 8.0 - 6.0))
                                      : linear_from_srgb(static_cast<float>(m));
           }
@@ -59,8 +60,9 @@ std::vector<capture::ViewFrame> make_frames(uint32_t frames, double sigma, Noise
 
 TEST(NoiseEstimateTest, GaussianNoiseInSrgbGivesItsPsnr) {
   for (const double sigma : {0.02, 0.007, 0.003}) {
-    const auto frames = make_frames(4, sigma, NoiseMetric::kSrgb, 0.0, 7);
-    const NoiseEstimate e = estimate_view_noise(frames, NoiseMetric::kSrgb, {});
+    const auto frames = make_frames(4, sigma, encoder::NoiseMetric::kSrgb, 0.0, 7);
+    const encoder::NoiseEstimate e =
+        encoder::estimate_view_noise(frames, encoder::NoiseMetric::kSrgb, {});
     ASSERT_TRUE(e.psnr_db.has_value()) << sigma;
     // PSNR of a frame against its noise-free self, peak 1: -20 log10(sigma).
     EXPECT_NEAR(*e.psnr_db, -20.0 * std::log10(sigma), 0.4) << sigma;
@@ -71,18 +73,20 @@ TEST(NoiseEstimateTest, GaussianNoiseInSrgbGivesItsPsnr) {
 TEST(NoiseEstimateTest, SmoothLightingChangeIsNotNoise) {
   // Every frame 2 % brighter: the temporal difference is smooth, the high-pass removes it.
   const double sigma = 0.005;
-  const auto frames = make_frames(4, sigma, NoiseMetric::kSrgb, 0.02, 11);
-  const NoiseEstimate e = estimate_view_noise(frames, NoiseMetric::kSrgb, {});
+  const auto frames = make_frames(4, sigma, encoder::NoiseMetric::kSrgb, 0.02, 11);
+  const encoder::NoiseEstimate e =
+      encoder::estimate_view_noise(frames, encoder::NoiseMetric::kSrgb, {});
   ASSERT_TRUE(e.psnr_db.has_value());
   EXPECT_NEAR(*e.psnr_db, -20.0 * std::log10(sigma), 0.4);
 }
 
 TEST(NoiseEstimateTest, GaussianNoiseInLog2GivesItsPsnr) {
   // Noise of sigma in log2 units (the base's log2 is m * 8 - 6, so sigma_log2 = 8 sigma), PSNR
-  // with the 8-stop peak of psnr_log2: 10 log10(64 / sigma_log2^2).
+  // with the 8-stop peak of encoder::psnr_log2: 10 log10(64 / sigma_log2^2).
   const double sigma = 0.004;
-  const auto frames = make_frames(4, sigma, NoiseMetric::kLog2, 0.0, 13);
-  const NoiseEstimate e = estimate_view_noise(frames, NoiseMetric::kLog2, {});
+  const auto frames = make_frames(4, sigma, encoder::NoiseMetric::kLog2, 0.0, 13);
+  const encoder::NoiseEstimate e =
+      encoder::estimate_view_noise(frames, encoder::NoiseMetric::kLog2, {});
   ASSERT_TRUE(e.psnr_db.has_value());
   const double sigma_log2 = 8.0 * sigma;
   EXPECT_NEAR(*e.psnr_db, 10.0 * std::log10(64.0 / (sigma_log2 * sigma_log2)), 0.4);
@@ -90,20 +94,23 @@ TEST(NoiseEstimateTest, GaussianNoiseInLog2GivesItsPsnr) {
 
 TEST(NoiseEstimateTest, NoiseFreeFramesHaveNoEstimateAndKeepQ50) {
   // Identical static content: nothing changes, no sample.
-  const auto still = make_frames(4, 0.0, NoiseMetric::kSrgb, 0.0, 1);
-  const NoiseEstimate a = estimate_view_noise(still, NoiseMetric::kSrgb, {});
+  const auto still = make_frames(4, 0.0, encoder::NoiseMetric::kSrgb, 0.0, 1);
+  const encoder::NoiseEstimate a =
+      encoder::estimate_view_noise(still, encoder::NoiseMetric::kSrgb, {});
   EXPECT_FALSE(a.psnr_db.has_value());
-  EXPECT_EQ(auto_psnr_db(a, kDefaultPsnrNoiseMargin), 50.0);
+  EXPECT_EQ(encoder::auto_psnr_db(a, encoder::kDefaultPsnrNoiseMargin), 50.0);
   // A noise-free lighting change: samples, but far above 50 dB + the margin.
-  const auto lit = make_frames(4, 0.0, NoiseMetric::kSrgb, 0.02, 1);
-  const NoiseEstimate b = estimate_view_noise(lit, NoiseMetric::kSrgb, {});
+  const auto lit = make_frames(4, 0.0, encoder::NoiseMetric::kSrgb, 0.02, 1);
+  const encoder::NoiseEstimate b =
+      encoder::estimate_view_noise(lit, encoder::NoiseMetric::kSrgb, {});
   EXPECT_GT(b.samples, 500u);
   if (b.psnr_db) {
-    EXPECT_GT(*b.psnr_db, 50.0 + kDefaultPsnrNoiseMargin);
+    EXPECT_GT(*b.psnr_db, 50.0 + encoder::kDefaultPsnrNoiseMargin);
   }
-  EXPECT_EQ(auto_psnr_db(b, kDefaultPsnrNoiseMargin), 50.0);
+  EXPECT_EQ(encoder::auto_psnr_db(b, encoder::kDefaultPsnrNoiseMargin), 50.0);
   // One frame: no pair, no estimate.
-  const NoiseEstimate c = estimate_view_noise(std::span(still).first(1), NoiseMetric::kSrgb, {});
+  const encoder::NoiseEstimate c =
+      encoder::estimate_view_noise(std::span(still).first(1), encoder::NoiseMetric::kSrgb, {});
   EXPECT_FALSE(c.psnr_db.has_value());
   EXPECT_EQ(c.samples, 0u);
 }
@@ -111,7 +118,7 @@ TEST(NoiseEstimateTest, NoiseFreeFramesHaveNoEstimateAndKeepQ50) {
 TEST(NoiseEstimateTest, AFewChangingBlocksAreNoEstimate) {
   // Still content but for one 8 x 8 block of one face that changes noisily every frame: 1 of
   // 216 blocks (< 2 %), what converged content shows beside a moving part.
-  auto frames = make_frames(4, 0.0, NoiseMetric::kSrgb, 0.0, 3);
+  auto frames = make_frames(4, 0.0, encoder::NoiseMetric::kSrgb, 0.0, 3);
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> any(0.2f, 0.8f);
   for (capture::ViewFrame& v : frames) {
@@ -122,23 +129,25 @@ TEST(NoiseEstimateTest, AFewChangingBlocksAreNoEstimate) {
       }
     }
   }
-  NoiseEstimateOptions o;
+  encoder::NoiseEstimateOptions o;
   o.min_blocks = 1;
-  const NoiseEstimate e = estimate_view_noise(frames, NoiseMetric::kSrgb, o);
+  const encoder::NoiseEstimate e =
+      encoder::estimate_view_noise(frames, encoder::NoiseMetric::kSrgb, o);
   EXPECT_GT(e.samples, 0u);
   EXPECT_FALSE(e.psnr_db.has_value());
   o.min_share = 0;
-  EXPECT_TRUE(estimate_view_noise(frames, NoiseMetric::kSrgb, o).psnr_db.has_value());
+  EXPECT_TRUE(
+      encoder::estimate_view_noise(frames, encoder::NoiseMetric::kSrgb, o).psnr_db.has_value());
 }
 
 TEST(NoiseEstimateTest, AutoPsnrIsTheEstimateLessTheMarginCappedAt50) {
-  NoiseEstimate e;
+  encoder::NoiseEstimate e;
   e.psnr_db = 43.0;
-  EXPECT_DOUBLE_EQ(auto_psnr_db(e, 4.0), 39.0);
+  EXPECT_DOUBLE_EQ(encoder::auto_psnr_db(e, 4.0), 39.0);
   e.psnr_db = 60.0;
-  EXPECT_DOUBLE_EQ(auto_psnr_db(e, 4.0), 50.0);
+  EXPECT_DOUBLE_EQ(encoder::auto_psnr_db(e, 4.0), 50.0);
   e.psnr_db = 5.0;
-  EXPECT_DOUBLE_EQ(auto_psnr_db(e, 4.0), kAutoPsnrFloorDb);
+  EXPECT_DOUBLE_EQ(encoder::auto_psnr_db(e, 4.0), encoder::kAutoPsnrFloorDb);
 }
 
 }  // namespace

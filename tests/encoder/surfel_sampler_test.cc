@@ -16,9 +16,9 @@
 namespace calf {
 namespace {
 
-constexpr SurfelOrderMethod kMethods[] = {
-    SurfelOrderMethod::kGreedyTree, SurfelOrderMethod::kProgressive,
-    SurfelOrderMethod::kExactGreedy, SurfelOrderMethod::kRandom};
+constexpr encoder::SurfelOrderMethod kMethods[] = {
+    encoder::SurfelOrderMethod::kGreedyTree, encoder::SurfelOrderMethod::kProgressive,
+    encoder::SurfelOrderMethod::kExactGreedy, encoder::SurfelOrderMethod::kRandom};
 
 // side x side grid on the unit square (z = 0): a flat surface whose ideal spacing is known.
 std::vector<Vec3> plane_grid(int side) {
@@ -39,14 +39,15 @@ std::vector<Vec3> sphere(int count) {
   return p;
 }
 
-SurfelOrder order(std::span<const Vec3> c, uint32_t n, SurfelSamplerOptions o) {
-  auto r = order_surfels(c, n, o);
+encoder::SurfelOrder order(std::span<const Vec3> c, uint32_t n, encoder::SurfelSamplerOptions o) {
+  auto r = encoder::order_surfels(c, n, o);
   EXPECT_TRUE(r.ok()) << r.status().to_string();
-  return r.ok() ? *r : SurfelOrder{};
+  return r.ok() ? *r : encoder::SurfelOrder{};
 }
 
-SurfelSamplerOptions with(SurfelOrderMethod m, uint32_t threads = 1, uint64_t seed = 7) {
-  SurfelSamplerOptions o;
+encoder::SurfelSamplerOptions with(encoder::SurfelOrderMethod m, uint32_t threads = 1,
+                                   uint64_t seed = 7) {
+  encoder::SurfelSamplerOptions o;
   o.method = m;
   o.threads = threads;
   o.seed = seed;
@@ -67,15 +68,15 @@ double dist(const Vec3& a, const Vec3& b) {
 // reserve (samples set aside come back when the input set runs dry).
 TEST(SurfelSamplerTest, OrdersArePermutationsAndPrefixesNest) {
   const std::vector<Vec3> c = sphere(1500);
-  for (SurfelOrderMethod m : kMethods) {
-    SCOPED_TRACE(surfel_order_method_name(m));
-    const SurfelOrder all = order(c, 1500, with(m));
+  for (encoder::SurfelOrderMethod m : kMethods) {
+    SCOPED_TRACE(encoder::surfel_order_method_name(m));
+    const encoder::SurfelOrder all = order(c, 1500, with(m));
     ASSERT_EQ(all.order.size(), 1500u);
     std::set<uint32_t> seen(all.order.begin(), all.order.end());
     EXPECT_EQ(seen.size(), 1500u);
     EXPECT_LT(*seen.rbegin(), 1500u);
     for (uint32_t n : {1u, 2u, 300u, 1200u}) {
-      const SurfelOrder part = order(c, n, with(m));
+      const encoder::SurfelOrder part = order(c, n, with(m));
       ASSERT_EQ(part.order.size(), n);
       EXPECT_TRUE(std::equal(part.order.begin(), part.order.end(), all.order.begin())) << n;
     }
@@ -90,7 +91,7 @@ TEST(SurfelSamplerTest, ExactGreedySatisfiesItsDefinition) {
   std::vector<Vec3> c;
   for (int i = 0; i < 250; ++i) c.push_back({u(rng), u(rng), u(rng)});      // a volume
   for (int i = 0; i < 150; ++i) c.push_back({u(rng), 0.25 * u(rng), 2.0});  // a far slab
-  const SurfelOrder o = order(c, 400, with(SurfelOrderMethod::kExactGreedy));
+  const encoder::SurfelOrder o = order(c, 400, with(encoder::SurfelOrderMethod::kExactGreedy));
   ASSERT_EQ(o.order.size(), 400u);
   std::vector<double> d(c.size(), std::numeric_limits<double>::infinity());
   std::vector<bool> chosen(c.size(), false);
@@ -152,8 +153,10 @@ TEST(SurfelSamplerTest, GreedyTreeIsTheExactGreedyPermutation) {
     SCOPED_TRACE(name);
     const auto n = static_cast<uint32_t>(c.size());
     for (uint64_t seed : {7u, 8u}) {
-      const SurfelOrder tree = order(c, n, with(SurfelOrderMethod::kGreedyTree, 1, seed));
-      const SurfelOrder exact = order(c, n, with(SurfelOrderMethod::kExactGreedy, 2, seed));
+      const encoder::SurfelOrder tree =
+          order(c, n, with(encoder::SurfelOrderMethod::kGreedyTree, 1, seed));
+      const encoder::SurfelOrder exact =
+          order(c, n, with(encoder::SurfelOrderMethod::kExactGreedy, 2, seed));
       EXPECT_EQ(tree.order, exact.order) << "seed " << seed;
       EXPECT_EQ(tree.r_m, exact.r_m);
     }
@@ -175,13 +178,14 @@ TEST(SurfelSamplerTest, ProgressiveSpreadsFarBetterThanRandom) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::vector<Vec3> c(40000);
   for (Vec3& p : c) p = {u(rng), u(rng), 0.0};
-  const SurfelOrder prog = order(c, 2000, with(SurfelOrderMethod::kProgressive));
-  const SurfelOrder exact = order(c, 2000, with(SurfelOrderMethod::kExactGreedy));
-  const SurfelOrder rand = order(c, 2000, with(SurfelOrderMethod::kRandom));
+  const encoder::SurfelOrder prog = order(c, 2000, with(encoder::SurfelOrderMethod::kProgressive));
+  const encoder::SurfelOrder exact = order(c, 2000, with(encoder::SurfelOrderMethod::kExactGreedy));
+  const encoder::SurfelOrder rand = order(c, 2000, with(encoder::SurfelOrderMethod::kRandom));
   for (uint32_t p : {500u, 2000u}) {
     SCOPED_TRACE(p);
-    auto sp = prefix_spacing(c, prog.order, p), se = prefix_spacing(c, exact.order, p),
-         sr = prefix_spacing(c, rand.order, p);
+    auto sp = encoder::prefix_spacing(c, prog.order, p),
+         se = encoder::prefix_spacing(c, exact.order, p),
+         sr = encoder::prefix_spacing(c, rand.order, p);
     ASSERT_TRUE(sp.ok() && se.ok() && sr.ok());
     const double rho_p = sp->r_min / sp->r_max, rho_e = se->r_min / se->r_max,
                  rho_r = sr->r_min / sr->r_max;
@@ -205,18 +209,18 @@ TEST(SurfelSamplerTest, ProgressiveSpreadsFarBetterThanRandom) {
 // seed gives another order.
 TEST(SurfelSamplerTest, DeterministicOverThreadsAndSeeds) {
   const std::vector<Vec3> c = sphere(3000);
-  for (SurfelOrderMethod m : kMethods) {
-    SCOPED_TRACE(surfel_order_method_name(m));
-    const SurfelOrder one = order(c, 300, with(m, 1));
+  for (encoder::SurfelOrderMethod m : kMethods) {
+    SCOPED_TRACE(encoder::surfel_order_method_name(m));
+    const encoder::SurfelOrder one = order(c, 300, with(m, 1));
     for (uint32_t threads : {2u, 4u, 0u}) {
-      const SurfelOrder other = order(c, 300, with(m, threads));
+      const encoder::SurfelOrder other = order(c, 300, with(m, threads));
       EXPECT_EQ(one.order, other.order) << threads;
       EXPECT_EQ(one.r_m, other.r_m) << threads;
       EXPECT_EQ(one.p_m, other.p_m);
     }
-    const SurfelOrder again = order(c, 300, with(m, 1));
+    const encoder::SurfelOrder again = order(c, 300, with(m, 1));
     EXPECT_EQ(one.order, again.order);
-    const SurfelOrder seeded = order(c, 300, with(m, 1, 8));
+    const encoder::SurfelOrder seeded = order(c, 300, with(m, 1, 8));
     EXPECT_NE(one.order, seeded.order);
   }
 }
@@ -226,11 +230,11 @@ TEST(SurfelSamplerTest, DeterministicOverThreadsAndSeeds) {
 // the order.
 TEST(SurfelSamplerTest, RmAndPrefixSpacingOnHandComputedValues) {
   const std::vector<Vec3> c = {{0, 0, 0}, {1, 0, 0}, {3, 0, 0}, {7, 0, 0}};
-  for (SurfelOrderMethod m : kMethods) {
-    const SurfelOrder o = order(c, 4, with(m));
+  for (encoder::SurfelOrderMethod m : kMethods) {
+    const encoder::SurfelOrder o = order(c, 4, with(m));
     EXPECT_EQ(o.p_m, 4u);
     EXPECT_EQ(o.r_m, 1.0f);
-    auto s = prefix_spacing(c, o.order, 4);
+    auto s = encoder::prefix_spacing(c, o.order, 4);
     ASSERT_TRUE(s.ok());
     EXPECT_EQ(s->r_min, 1.0);
     EXPECT_EQ(s->r_median, 1.0);
@@ -238,26 +242,26 @@ TEST(SurfelSamplerTest, RmAndPrefixSpacingOnHandComputedValues) {
   }
   // Exact greedy from any start: the order's first two points are the two ends of the farthest
   // pair reachable from the start; r_m over p_m = 2 is their distance.
-  SurfelSamplerOptions o = with(SurfelOrderMethod::kExactGreedy);
+  encoder::SurfelSamplerOptions o = with(encoder::SurfelOrderMethod::kExactGreedy);
   o.p_m = 2;
-  const SurfelOrder two = order(c, 4, o);
+  const encoder::SurfelOrder two = order(c, 4, o);
   EXPECT_EQ(two.p_m, 2u);
   const double d01 = std::fabs(c[two.order[0]].x - c[two.order[1]].x);
   EXPECT_EQ(two.r_m, static_cast<float>(d01));
   EXPECT_GE(d01, 4.0);  // from any start the farthest point is at least 4 away
   // One surfel: no neighbour, r_m = 0.
-  const SurfelOrder single = order(c, 1, with(SurfelOrderMethod::kProgressive));
+  const encoder::SurfelOrder single = order(c, 1, with(encoder::SurfelOrderMethod::kProgressive));
   EXPECT_EQ(single.p_m, 1u);
   EXPECT_EQ(single.r_m, 0.0f);
   // Coincident candidates: any order, r_m = 0.
   const std::vector<Vec3> same(50, Vec3{1, 2, 3});
-  const SurfelOrder dup = order(same, 50, with(SurfelOrderMethod::kProgressive));
+  const encoder::SurfelOrder dup = order(same, 50, with(encoder::SurfelOrderMethod::kProgressive));
   EXPECT_EQ(dup.order.size(), 50u);
   EXPECT_EQ(dup.r_m, 0.0f);
 }
 
-// prefix_spacing (a hashed grid) against brute force, on points clustered at three scales (a
-// dense blob, a sparse slab, two far outliers) so that queries cross many empty cells.
+// encoder::prefix_spacing (a hashed grid) against brute force, on points clustered at three scales
+// (a dense blob, a sparse slab, two far outliers) so that queries cross many empty cells.
 TEST(SurfelSamplerTest, PrefixSpacingMatchesBruteForce) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -274,7 +278,7 @@ TEST(SurfelSamplerTest, PrefixSpacingMatchesBruteForce) {
       for (uint32_t j = 0; j < prefix; ++j)
         if (i != j) nn[i] = std::min(nn[i], dist(c[ord[i]], c[ord[j]]));
     std::sort(nn.begin(), nn.end());
-    auto s = prefix_spacing(c, ord, prefix, 2);
+    auto s = encoder::prefix_spacing(c, ord, prefix, 2);
     ASSERT_TRUE(s.ok()) << s.status().to_string();
     EXPECT_NEAR(s->r_min, nn.front(), 1e-6 * nn.front()) << prefix;
     EXPECT_NEAR(s->r_median, nn[(prefix - 1) / 2], 1e-6 * nn[(prefix - 1) / 2]) << prefix;
@@ -282,8 +286,8 @@ TEST(SurfelSamplerTest, PrefixSpacingMatchesBruteForce) {
   }
 }
 
-ErrorId error_of(std::span<const Vec3> c, uint32_t n, const SurfelSamplerOptions& o) {
-  auto r = order_surfels(c, n, o);
+ErrorId error_of(std::span<const Vec3> c, uint32_t n, const encoder::SurfelSamplerOptions& o) {
+  auto r = encoder::order_surfels(c, n, o);
   return r.ok() ? ErrorId::kOk : r.status().id();
 }
 
@@ -296,7 +300,7 @@ TEST(SurfelSamplerTest, Errors) {
 
   std::vector<Vec3> bad = c;
   bad[3].y = std::nan("");
-  auto r = order_surfels(bad, 10, {});
+  auto r = encoder::order_surfels(bad, 10, {});
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().id(), ErrorId::kSurfelPosition);
   EXPECT_NE(r.status().to_string().find("candidate 3 coordinate y"), std::string::npos)
@@ -308,12 +312,12 @@ TEST(SurfelSamplerTest, Errors) {
   EXPECT_EQ(error_of(bad, 10, {}), ErrorId::kSurfelPosition);
 
   auto option = [&](auto change) {
-    SurfelSamplerOptions o;
+    encoder::SurfelSamplerOptions o;
     change(o);
     return error_of(c, 10, o);
   };
   EXPECT_EQ(option([](auto& o) { o.round_samples = 0; }), ErrorId::kSurfelSamplerOption);
-  EXPECT_EQ(option([](auto& o) { o.round_samples = kSurfelMaxRoundSamples + 1; }),
+  EXPECT_EQ(option([](auto& o) { o.round_samples = encoder::kSurfelMaxRoundSamples + 1; }),
             ErrorId::kSurfelSamplerOption);
   EXPECT_EQ(option([](auto& o) { o.growth_period = 0; }), ErrorId::kSurfelSamplerOption);
   EXPECT_EQ(option([](auto& o) { o.max_accept = 201; }), ErrorId::kSurfelSamplerOption);
@@ -323,9 +327,9 @@ TEST(SurfelSamplerTest, Errors) {
   EXPECT_EQ(option([](auto& o) { o.extend_below = 1.0; }), ErrorId::kSurfelSamplerOption);
   EXPECT_EQ(option([](auto& o) { o.extend_below = -0.5; }), ErrorId::kSurfelSamplerOption);
   EXPECT_EQ(option([](auto& o) { o.p_m = 0; }), ErrorId::kSurfelSamplerOption);
-  EXPECT_EQ(option([](auto& o) { o.threads = kSurfelMaxThreads + 1; }),
+  EXPECT_EQ(option([](auto& o) { o.threads = encoder::kSurfelMaxThreads + 1; }),
             ErrorId::kSurfelSamplerOption);
-  EXPECT_EQ(option([](auto& o) { o.method = static_cast<SurfelOrderMethod>(7); }),
+  EXPECT_EQ(option([](auto& o) { o.method = static_cast<encoder::SurfelOrderMethod>(7); }),
             ErrorId::kSurfelSamplerOption);
   // Edges of the ranges are accepted.
   EXPECT_EQ(option([](auto& o) { o.round_samples = 1; }), ErrorId::kOk);
@@ -333,11 +337,11 @@ TEST(SurfelSamplerTest, Errors) {
   EXPECT_EQ(option([](auto& o) { o.vicinity = 0.0; }), ErrorId::kOk);
 
   const std::vector<uint32_t> ord = {0, 1, 2};
-  EXPECT_EQ(prefix_spacing(c, ord, 0).status().id(), ErrorId::kSurfelCount);
-  EXPECT_EQ(prefix_spacing(c, ord, 4).status().id(), ErrorId::kSurfelCount);
+  EXPECT_EQ(encoder::prefix_spacing(c, ord, 0).status().id(), ErrorId::kSurfelCount);
+  EXPECT_EQ(encoder::prefix_spacing(c, ord, 4).status().id(), ErrorId::kSurfelCount);
   const std::vector<uint32_t> outside = {0, 100};
-  EXPECT_EQ(prefix_spacing(c, outside, 2).status().id(), ErrorId::kSurfelCount);
-  EXPECT_EQ(prefix_spacing(c, ord, 2, kSurfelMaxThreads + 1).status().id(),
+  EXPECT_EQ(encoder::prefix_spacing(c, outside, 2).status().id(), ErrorId::kSurfelCount);
+  EXPECT_EQ(encoder::prefix_spacing(c, ord, 2, encoder::kSurfelMaxThreads + 1).status().id(),
             ErrorId::kSurfelSamplerOption);
 }
 

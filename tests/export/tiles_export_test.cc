@@ -180,7 +180,7 @@ TEST(TilesExport, SubdivisionBoundsTheAffineError) {
 // vertices), so an engine drawing the mesh in index order composites back to front there.
 TEST(TilesExport, TilesAreWrittenBackToFrontFromTheViewRegionCentre) {
   const TileSet set = small_set();
-  const Box3& r = set.view_region;
+  const Box3& r = set.view_volume;
   const aiVector3D centre((r.min.x + r.max.x) / 2, (r.min.y + r.max.y) / 2,
                           (r.min.z + r.max.z) / 2);
   const auto distance_of = [&](const std::array<aiVector3D, 4>& corners) {

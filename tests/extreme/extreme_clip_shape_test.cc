@@ -121,7 +121,7 @@ TEST(OneFrame, EncodesDecodesSeeksAndPlays) {
   ASSERT_TRUE(rects.ok());
   EXPECT_EQ(*rects, std::vector<uint32_t>{1});
   // Frame 1 does not exist: a clear error naming the frame and the count.
-  decoder::FrameUpdates fu;
+  decoder::LightfieldFrameUpdates fu;
   const Status past = decoded->decoder->advance(1, {}, {}, &fu);
   EXPECT_EQ(past.id(), ErrorId::kDecoderArgument);
   EXPECT_NE(past.message().find("1"), std::string::npos) << past.message();
@@ -144,7 +144,7 @@ TEST(OneFrame, EncodesDecodesSeeksAndPlays) {
 
 // ---- W >= frame count, A = 1 ----
 
-// 16-texel faces (depth tiles of 8), 7 frames. On +X, in tile 0, a 2 x 2 block moves one texel
+// 16-texel faces (depth regions of 8), 7 frames. On +X, in tile 0, a 2 x 2 block moves one texel
 // per frame along the diagonal and texel (6, 6) toggles between 2.5 and 3.5 every odd frame; the
 // rest of the face is at 3 and the other faces at 4, -Y half sky.
 float moving_depth(uint32_t frame, int face, uint32_t x, uint32_t y) {
@@ -360,7 +360,7 @@ TEST(FaceSize, FourTexelFaces) {
   check_face_size(4, 4, last_texel_ray(4));
 }
 TEST(FaceSize, TwentyTexelFacesWithCellsOf16) {
-  // 20 = 16 + 4: the second cell column and row are 4 texels wide; depth tiles are 12 and 8.
+  // 20 = 16 + 4: the second cell column and row are 4 texels wide; depth regions are 12 and 8.
   auto cells = FaceGrid::with_cell_size(20, 16);
   ASSERT_TRUE(cells.ok());
   EXPECT_EQ(cells->cells_per_side(), 2u);
@@ -395,7 +395,7 @@ TEST(FaceSize, Faces2048) {
   auto stats = encode_lightfield_file(tmp.path() / "cap", clip, eo);
   ASSERT_TRUE(stats.ok()) << stats.status().to_string();
   EXPECT_EQ(stats->colour_cells, 6u * 8 * 8);
-  EXPECT_EQ(stats->depth_tiles, 6u * 2 * 2);
+  EXPECT_EQ(stats->depth_regions, 6u * 2 * 2);
   const auto t1 = std::chrono::steady_clock::now();
 
   auto reader = container::Reader::open(clip);
@@ -403,7 +403,7 @@ TEST(FaceSize, Faces2048) {
   auto ref = decoder::LightfieldReference::open(*reader, 0);
   ASSERT_TRUE(ref.ok());
   EXPECT_EQ(ref->header().face_size, kN);
-  EXPECT_EQ(ref->header().depth_tile_size, 1024u);
+  EXPECT_EQ(ref->header().depth_region_size, 1024u);
   for (int f : {0, 5}) {
     decoder::LightfieldFace face;
     ASSERT_TRUE(ref->decode_face(0, f, 0, &face).ok());
@@ -415,14 +415,14 @@ TEST(FaceSize, Faces2048) {
     }
   }
   // A narrow eye at the viewpoint looking at +X: only a few of the 384 cells are decoded.
-  auto d = decoder::ClipDecoder::open(*reader, 0);
+  auto d = decoder::LightfieldDecoder::open(*reader, 0);
   ASSERT_TRUE(d.ok());
   EyeView eye;
   eye.forward = {1, 0, 0};
   eye.fov_y = 0.1;
   eye.near = 0.5;
   eye.far = 10;
-  decoder::FrameUpdates fu;
+  decoder::LightfieldFrameUpdates fu;
   ASSERT_TRUE(d->advance(0, std::span<const EyeView>(&eye, 1), {}, &fu).ok());
   EXPECT_EQ(fu.stats.errors, 0u);
   EXPECT_EQ(fu.stats.total_cells, 384u);

@@ -12,10 +12,10 @@
 #include <vector>
 
 #include "calf/decoder/lightfield_reference.h"
-#include "calf/encoder/color_keyframes.h"
+#include "calf/encoder/colour_keyframes.h"
 #include "calf/format/lightfield_layout.h"
-#include "calf/player/cpu_renderer.h"
 #include "calf/player/image_compare.h"
+#include "calf/player/lightfield_cpu_renderer.h"
 #include "calf/player/playback.h"
 #include "extreme_common.h"
 
@@ -76,13 +76,14 @@ int half_ulps(float a, float b) {
 TEST(HdrColour, HalfExtremesComeBackExactlyThroughRgba16fAndWithinBc6hError) {
   TempDir tmp("hdr");
   ASSERT_TRUE(write_hdr_capture(tmp.path() / "cap").ok());
-  for (ColourCoding coding : {ColourCoding::kRgba16f, ColourCoding::kBc6h}) {
-    const bool bc6h = coding == ColourCoding::kBc6h;
-    LightfieldEncodeOptions eo;
+  for (encoder::ColourCoding coding :
+       {encoder::ColourCoding::kRgba16f, encoder::ColourCoding::kBc6h}) {
+    const bool bc6h = coding == encoder::ColourCoding::kBc6h;
+    encoder::LightfieldEncodeOptions eo;
     eo.cell_size = 8;
     eo.colour = coding;
     const std::string clip = tmp.file(bc6h ? "bc6h.calf" : "rgba16f.calf");
-    auto stats = encode_lightfield_file(tmp.path() / "cap", clip, eo);
+    auto stats = encoder::encode_lightfield_file(tmp.path() / "cap", clip, eo);
     ASSERT_TRUE(stats.ok()) << stats.status().to_string();
     EXPECT_TRUE(stats->hdr);
     EXPECT_FALSE(std::isnan(stats->min_colour_quality_db));
@@ -137,7 +138,8 @@ TEST(HdrColour, HalfExtremesComeBackExactlyThroughRgba16fAndWithinBc6hError) {
     ASSERT_TRUE(decoded);
     auto views = view_set_of(*decoded);
     ASSERT_TRUE(views.ok());
-    auto cpu = player::CpuRenderer::make(*views, *player::march_range_for(*views, {0, 0, 0}, {}));
+    auto cpu = player::LightfieldCpuRenderer::make(*views,
+                                                   *player::march_range_for(*views, {0, 0, 0}, {}));
     ASSERT_TRUE(cpu.ok());
     const double n = std::sqrt(1 + 2 * 0.625 * 0.625);
     const player::RaySample s = cpu->trace({0, 0, 0}, {1 / n, 0.625 / n, 0.625 / n});
@@ -187,7 +189,7 @@ TEST(HdrColour, ValuesAboveTheLargestHalfAreRefusedNamingThePixel) {
     vf.color[3 * vf.texel_index(CubeFace::kPosY, 3, 2) + 1] = bad;
     const Status s = w->write(0, 0, vf);
     ASSERT_FALSE(s.ok()) << bad;
-    EXPECT_EQ(s.id(), ErrorId::kCaptureColorPixel);
+    EXPECT_EQ(s.id(), ErrorId::kCaptureColourPixel);
     EXPECT_NE(s.message().find("face +Y texel (3, 2): colour channel G"), std::string::npos)
         << s.message();
     w->abandon();
@@ -209,14 +211,16 @@ TEST(ConstantCells, InfinitePsnrKeepsTheKeyframeSearchFinite) {
       frames[(f * kTexels + i) * 3 + 2] = 0.6f;
     }
   }
-  const ShownKeyframeFn shown = [&](uint32_t f) -> Expected<std::span<const float>> {
+  const encoder::ShownKeyframeFn shown = [&](uint32_t f) -> Expected<std::span<const float>> {
     return std::span<const float>(frames).subspan(f * kTexels * 3, kTexels * 3);
   };
-  for (const CellQualityFn& quality : {CellQualityFn(psnr_srgb), CellQualityFn(psnr_log2)}) {
-    for (KeyframeSearch search : {KeyframeSearch::kGalloping, KeyframeSearch::kExhaustive}) {
-      KeyframeOptions o;
+  for (const encoder::CellQualityFn& quality :
+       {encoder::CellQualityFn(encoder::psnr_srgb), encoder::CellQualityFn(encoder::psnr_log2)}) {
+    for (encoder::KeyframeSearch search :
+         {encoder::KeyframeSearch::kGalloping, encoder::KeyframeSearch::kExhaustive}) {
+      encoder::KeyframeOptions o;
       o.search = search;
-      auto k = select_cell_keyframes(frames, kFrames, kTexels, shown, quality, o);
+      auto k = encoder::select_cell_keyframes(frames, kFrames, kTexels, shown, quality, o);
       ASSERT_TRUE(k.ok()) << k.status().to_string();
       EXPECT_EQ(k->keyframes, (std::vector<uint32_t>{0, 7}));
       EXPECT_EQ(k->t, (std::vector<uint8_t>{0, 0, 0, 0, 255, 255, 255, 0}));
@@ -225,16 +229,17 @@ TEST(ConstantCells, InfinitePsnrKeepsTheKeyframeSearchFinite) {
   }
   // A cell black in every frame: one keyframe, quality +inf, never NaN.
   const std::vector<float> black(kTexels * 3 * kFrames, 0.0f);
-  const ShownKeyframeFn shown_black = [&](uint32_t f) -> Expected<std::span<const float>> {
+  const encoder::ShownKeyframeFn shown_black = [&](uint32_t f) -> Expected<std::span<const float>> {
     return std::span<const float>(black).subspan(f * kTexels * 3, kTexels * 3);
   };
-  auto k = select_cell_keyframes(black, kFrames, kTexels, shown_black, psnr_log2, {});
+  auto k =
+      encoder::select_cell_keyframes(black, kFrames, kTexels, shown_black, encoder::psnr_log2, {});
   ASSERT_TRUE(k.ok());
   EXPECT_EQ(k->keyframes, std::vector<uint32_t>{0});
   EXPECT_EQ(k->min_quality_db, std::numeric_limits<double>::infinity());
-  EXPECT_EQ(
-      psnr_srgb(std::span<const float>(black).first(48), std::span<const float>(black).first(48)),
-      std::numeric_limits<double>::infinity());
+  EXPECT_EQ(encoder::psnr_srgb(std::span<const float>(black).first(48),
+                               std::span<const float>(black).first(48)),
+            std::numeric_limits<double>::infinity());
 }
 
 // The player's metrics on exact reconstructions (calf-play's per-frame statistics): MSE 0 gives
@@ -285,13 +290,14 @@ TEST(ConstantCells, BlackAndConstantCellsCostNextToNothingAndDecodeExactly) {
     const fs::path cap = tmp.path() / (hdr ? "cap_hdr" : "cap_ldr");
     ASSERT_TRUE(write_constant_capture(cap, hdr).ok());
     // LDR: auto (BC1) and rgba16f; HDR: auto (BC6H).
-    for (ColourCoding coding : {ColourCoding::kAuto, ColourCoding::kRgba16f}) {
-      if (hdr && coding != ColourCoding::kAuto) continue;
-      LightfieldEncodeOptions eo;
+    for (encoder::ColourCoding coding :
+         {encoder::ColourCoding::kAuto, encoder::ColourCoding::kRgba16f}) {
+      if (hdr && coding != encoder::ColourCoding::kAuto) continue;
+      encoder::LightfieldEncodeOptions eo;
       eo.cell_size = 8;
       eo.colour = coding;
       const std::string clip = tmp.file("c.calf");
-      auto stats = encode_lightfield_file(cap, clip, eo);
+      auto stats = encoder::encode_lightfield_file(cap, clip, eo);
       ASSERT_TRUE(stats.ok()) << stats.status().to_string();
       const auto& s = *stats;
       // No NaN anywhere in the statistics; exact reconstructions count as +inf dB.
@@ -308,7 +314,7 @@ TEST(ConstantCells, BlackAndConstantCellsCostNextToNothingAndDecodeExactly) {
       const uint64_t payload = s.colour.stored + s.depth.stored;
       const uint64_t file = fs::file_size(clip);
       std::printf("%s %s: raw %llu bytes, chunks %llu, stored payload %llu, file %llu\n",
-                  hdr ? "HDR" : "LDR", coding == ColourCoding::kAuto ? "auto" : "rgba16f",
+                  hdr ? "HDR" : "LDR", coding == encoder::ColourCoding::kAuto ? "auto" : "rgba16f",
                   static_cast<unsigned long long>(s.colour.raw + s.depth.raw),
                   static_cast<unsigned long long>(chunks), static_cast<unsigned long long>(payload),
                   static_cast<unsigned long long>(file));
@@ -332,7 +338,7 @@ TEST(ConstantCells, BlackAndConstantCellsCostNextToNothingAndDecodeExactly) {
                   ASSERT_EQ(rgb[i + c], 0.0f) << "black texel " << x << "," << y << " face " << f;
                 }
               } else if (cell == 1) {
-                const double tol = coding == ColourCoding::kRgba16f ? 0 : 0.02;
+                const double tol = coding == encoder::ColourCoding::kRgba16f ? 0 : 0.02;
                 for (int c = 0; c < 3; ++c) ASSERT_NEAR(rgb[i + c], 0.5, tol);
               }
             }

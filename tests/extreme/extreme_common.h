@@ -22,13 +22,13 @@
 
 #include "../gl_test_context.h"
 #include "calf/capture/capture_set.h"
-#include "calf/decoder/clip_decoder.h"
 #include "calf/decoder/cpu_textures.h"
+#include "calf/decoder/lightfield_decoder.h"
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/format/container.h"
 #include "calf/format/log_depth.h"
-#include "calf/player/cpu_renderer.h"
 #include "calf/player/gl_context.h"
+#include "calf/player/lightfield_cpu_renderer.h"
 #include "calf/player/view_set.h"
 
 namespace calf::extreme {
@@ -137,13 +137,13 @@ inline void fill_face(capture::ViewFrame& vf, CubeFace face, const float rgb[3],
 // view kept current (view-dependent decoding off): what a GPU holds.
 struct DecodedClip {
   std::unique_ptr<container::Reader> reader;
-  std::optional<decoder::ClipDecoder> decoder;
+  std::optional<decoder::LightfieldDecoder> decoder;
   std::optional<decoder::CpuTextures> textures;
-  decoder::FrameUpdates last;  // the updates of the last advance()
+  decoder::LightfieldFrameUpdates last;  // the updates of the last advance()
 
   const container::LightfieldTrackHeader& header() const { return decoder->header(); }
   uint32_t view_count() const { return header().view_count; }
-  // Brings every view to `frame`; errors as ClipDecoder::advance and CpuTextures::apply.
+  // Brings every view to `frame`; errors as LightfieldDecoder::advance and CpuTextures::apply.
   Status advance(uint32_t frame) {
     CALF_RETURN_IF_ERROR(decoder->advance(frame, {}, {}, &last));
     if (last.stats.errors != 0) {
@@ -160,10 +160,10 @@ inline std::unique_ptr<DecodedClip> decode_clip(const std::string& path, uint32_
   EXPECT_TRUE(reader.ok()) << reader.status().to_string();
   if (!reader.ok()) return nullptr;
   out->reader = std::make_unique<container::Reader>(std::move(*reader));
-  decoder::ClipDecoderOptions o;
+  decoder::LightfieldDecoderOptions o;
   o.view_dependent = false;
   o.background_thread = false;
-  auto d = decoder::ClipDecoder::open(*out->reader, 0, o);
+  auto d = decoder::LightfieldDecoder::open(*out->reader, 0, o);
   EXPECT_TRUE(d.ok()) << d.status().to_string();
   if (!d.ok()) return nullptr;
   out->decoder.emplace(std::move(*d));
@@ -188,7 +188,7 @@ inline Expected<player::ViewSet> view_set_of(const DecodedClip& clip) {
     const PixelRect whole{0, 0, n, n};
     for (int f = 0; f < kCubeFaceCount; ++f) {
       const CubeFace face = cube_face_from_index(f);
-      CALF_RETURN_IF_ERROR(view.write_color_rect(face, whole, clip.textures->colour(v, face)));
+      CALF_RETURN_IF_ERROR(view.write_colour_rect(face, whole, clip.textures->colour(v, face)));
       CALF_RETURN_IF_ERROR(view.write_depth_rect(face, whole, clip.textures->depth(v, face)));
     }
     set.views.push_back(std::move(view));

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "calf/format/log_depth.h"
-#include "calf/player/cpu_renderer.h"
+#include "calf/player/lightfield_cpu_renderer.h"
 #include "calf/player/playback.h"
 #include "extreme_common.h"
 
@@ -241,7 +241,7 @@ TEST(DepthRange1e4To1e6, CaptureEncodeDecodeRenderRoundTrip) {
   auto gpu = Playback::open(clip, po, &gl->gl());
   ASSERT_TRUE(gpu.ok()) << gpu.status().to_string();
   for (bool data_range : {true, false}) {
-    player::RenderOptions ro = po.of<player::LightfieldOptions>().render;
+    player::LightfieldRenderOptions ro = po.of<player::LightfieldOptions>().render;
     if (!data_range) {
       ro.near = default_near;
       ro.far = 1e6;
@@ -287,7 +287,7 @@ TEST(FlatDepth, EveryDepthEqualEncodesDecodesAndRendersExactly) {
     ASSERT_TRUE(views.ok()) << views.status().to_string();
     auto range = player::march_range_for(*views, {0, 0, 0}, {});
     ASSERT_TRUE(range.ok());
-    auto cpu = player::CpuRenderer::make(*views, *range);
+    auto cpu = player::LightfieldCpuRenderer::make(*views, *range);
     ASSERT_TRUE(cpu.ok());
     for (int f = 0; f < 6; ++f) {
       RenderedImage img;
@@ -299,7 +299,7 @@ TEST(FlatDepth, EveryDepthEqualEncodesDecodesAndRendersExactly) {
     const Vec3 eye{0.4, -0.3, 0.2};
     auto off = player::march_range_for(*views, eye, {});
     ASSERT_TRUE(off.ok());
-    auto cpu_off = player::CpuRenderer::make(*views, *off);
+    auto cpu_off = player::LightfieldCpuRenderer::make(*views, *off);
     ASSERT_TRUE(cpu_off.ok());
     size_t checked = 0;
     for (int f = 0; f < 6; ++f) {

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "calf/player/cpu_renderer.h"
+#include "calf/player/lightfield_cpu_renderer.h"
 #include "calf/player/playback.h"
 #include "extreme_common.h"
 
@@ -223,11 +223,11 @@ TEST(NothingToSee, EveryViewAbstainingIsEmptySpaceShowingTheViewsColour) {
   // view votes anywhere, every sample counts as empty and no ray hits. With no view seeing sky
   // in the ray's direction either, the sky rule falls back to all views' colours there: the wall
   // colour towards +X, the sky colour elsewhere.
-  player::RenderOptions o;
+  player::LightfieldRenderOptions o;
   o.near = 0.01;
   o.far = 10;
   o.min_view_distance = 100;
-  auto cpu = player::CpuRenderer::make(*views, o);
+  auto cpu = player::LightfieldCpuRenderer::make(*views, o);
   ASSERT_TRUE(cpu.ok());
   RenderedImage toward, away;
   Camera cam = camera({0, 0.25, 0}, {1, 0, 0});
@@ -245,12 +245,12 @@ TEST(NothingToSee, NothingDecodedRendersTheInitialBlackSky) {
   ASSERT_TRUE(encode(tmp.path() / "cap", clip, ColourCoding::kRgba16f).ok());
   auto reader = container::Reader::open(clip);
   ASSERT_TRUE(reader.ok());
-  auto d = decoder::ClipDecoder::open(*reader, 0);  // view-dependent
+  auto d = decoder::LightfieldDecoder::open(*reader, 0);  // view-dependent
   ASSERT_TRUE(d.ok());
   std::vector<decoder::LightfieldViewInfo> infos = {d->view(0), d->view(1)};
   decoder::CpuTextures textures(d->header(), infos);
   // No viewer: nothing is visible, nothing is decoded.
-  decoder::FrameUpdates fu;
+  decoder::LightfieldFrameUpdates fu;
   ASSERT_TRUE(d->advance(0, {}, {}, &fu).ok());
   EXPECT_EQ(fu.updates.size(), 0u);
   EXPECT_EQ(fu.stats.visible_cells, 0u);
@@ -266,12 +266,13 @@ TEST(NothingToSee, NothingDecodedRendersTheInitialBlackSky) {
     ASSERT_TRUE(view.ok());
     for (int f = 0; f < 6; ++f) {
       const CubeFace face = cube_face_from_index(f);
-      ASSERT_TRUE(view->write_color_rect(face, {0, 0, 16, 16}, textures.colour(v, face)).ok());
+      ASSERT_TRUE(view->write_colour_rect(face, {0, 0, 16, 16}, textures.colour(v, face)).ok());
       ASSERT_TRUE(view->write_depth_rect(face, {0, 0, 16, 16}, textures.depth(v, face)).ok());
     }
     views.views.push_back(std::move(*view));
   }
-  auto cpu = player::CpuRenderer::make(views, *player::march_range_for(views, {0, 0.2, 0}, {}));
+  auto cpu =
+      player::LightfieldCpuRenderer::make(views, *player::march_range_for(views, {0, 0.2, 0}, {}));
   ASSERT_TRUE(cpu.ok());
   RenderedImage img;
   ASSERT_TRUE(cpu->render(camera({0, 0.2, 0}, {1, 0.1, 0}), &img).ok());

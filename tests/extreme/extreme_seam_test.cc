@@ -16,16 +16,16 @@
 #include <vector>
 
 #include "calf/player/capture_views.h"
-#include "calf/player/cpu_renderer.h"
-#include "calf/player/gl_renderer.h"
 #include "calf/player/gl_views.h"
+#include "calf/player/lightfield_cpu_renderer.h"
+#include "calf/player/lightfield_gl_renderer.h"
 #include "extreme_common.h"
 
 namespace calf::extreme {
 namespace {
 
+using player::LightfieldRenderOptions;
 using player::RenderedImage;
-using player::RenderOptions;
 
 constexpr uint32_t kN = 8;
 
@@ -141,9 +141,9 @@ std::string texel_text(const TexelColour& t) {
 
 TEST(SeamRays, CpuNearestColourFollowsTheTieBreakRule) {
   const player::ViewSet views = seam_views();
-  RenderOptions o = *player::march_range_for(views, {0, 0, 0}, {});
-  o.bilinear_color = false;
-  auto cpu = player::CpuRenderer::make(views, o);
+  LightfieldRenderOptions o = *player::march_range_for(views, {0, 0, 0}, {});
+  o.bilinear_colour = false;
+  auto cpu = player::LightfieldCpuRenderer::make(views, o);
   ASSERT_TRUE(cpu.ok()) << cpu.status().to_string();
   int strict = 0, ulp_cases = 0;
   for (const SeamRay& ray : seam_rays()) {
@@ -186,8 +186,8 @@ const std::vector<std::pair<double, TexelColour>> kCornerTaps = {
 
 TEST(SeamRays, CpuBilinearColourMixesBothSidesOfTheSeam) {
   const player::ViewSet views = seam_views();
-  const RenderOptions o = *player::march_range_for(views, {0, 0, 0}, {});
-  auto cpu = player::CpuRenderer::make(views, o);
+  const LightfieldRenderOptions o = *player::march_range_for(views, {0, 0, 0}, {});
+  auto cpu = player::LightfieldCpuRenderer::make(views, o);
   ASSERT_TRUE(cpu.ok());
   const player::RaySample seam = cpu->trace({0, 0, 0}, unit(1, 1, 0.3));
   const player::RaySample corner = cpu->trace({0, 0, 0}, unit(1, 1, 1));
@@ -219,9 +219,9 @@ TEST(SeamRays, GlRendererAgreesAtSeamsAndCorners) {
   auto gv = player::GlViews::make(gl->gl(), up_views->layout);
   ASSERT_TRUE(gv.ok()) << gv.status().to_string();
   ASSERT_TRUE((*gv)->apply(up_views->frame).ok());
-  RenderOptions o = *player::march_range_for(views, {0, 0, 0}, {});
-  o.bilinear_color = false;
-  auto renderer = player::GlRenderer::make(**gv, o);
+  LightfieldRenderOptions o = *player::march_range_for(views, {0, 0, 0}, {});
+  o.bilinear_colour = false;
+  auto renderer = player::LightfieldGlRenderer::make(**gv, o);
   ASSERT_TRUE(renderer.ok()) << renderer.status().to_string();
 
   // A 1 x 1 camera: its only ray is exactly normalize(forward) (a = b = 0), in float.
@@ -260,7 +260,7 @@ TEST(SeamRays, GlRendererAgreesAtSeamsAndCorners) {
   std::printf("GL: %d of %d one-float-ulp rays kept their side of the seam\n", strict, ulp_cases);
 
   // Bilinear: the same mixes as the CPU reference.
-  o.bilinear_color = true;
+  o.bilinear_colour = true;
   ASSERT_TRUE((*renderer)->set_options(o).ok());
   RenderedImage seam, corner;
   render_ray({1, 1, 0.3}, &seam);

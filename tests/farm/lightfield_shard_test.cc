@@ -78,16 +78,16 @@ TEST_P(LightfieldShardScenes, MergedViewShardsEqualOneMachineEncode) {
   ASSERT_TRUE(fs::exists(dir / capture::kManifestFileName));
   const fs::path work = scratch() / ("work-" + name);
   fs::create_directories(work);
-  LightfieldEncodeOptions o;
+  encoder::LightfieldEncodeOptions o;
   o.threads = 2;
   const std::string one = (work / "one.calf").string();
-  ASSERT_TRUE(encode_lightfield_file(dir, one, o).ok());
+  ASSERT_TRUE(encoder::encode_lightfield_file(dir, one, o).ok());
   const std::string expected = bytes_of(one);
   ASSERT_GT(expected.size(), 0u);
 
-  auto written = write_lightfield_analysis(dir, (work / "analysis.calf").string(), o);
+  auto written = encoder::write_lightfield_analysis(dir, (work / "analysis.calf").string(), o);
   ASSERT_TRUE(written.ok()) << written.status().to_string();
-  auto analysis = read_lightfield_analysis((work / "analysis.calf").string());
+  auto analysis = encoder::read_lightfield_analysis((work / "analysis.calf").string());
   ASSERT_TRUE(analysis.ok()) << analysis.status().to_string();
   EXPECT_EQ(analysis->id, written->id);
   const uint32_t views = analysis->analysis.header.view_count;
@@ -100,12 +100,13 @@ TEST_P(LightfieldShardScenes, MergedViewShardsEqualOneMachineEncode) {
       const std::string path =
           (work / ("shard" + std::to_string(k) + "-" + std::to_string(i) + ".calf")).string();
       // Thread counts differ per shard: never part of the bytes.
-      auto s = encode_lightfield_shard(dir, *analysis, groups[i], 0, frames, 1 + i % 2, path);
+      auto s =
+          encoder::encode_lightfield_shard(dir, *analysis, groups[i], 0, frames, 1 + i % 2, path);
       ASSERT_TRUE(s.ok()) << s.status().to_string();
       shards.insert(shards.begin(), path);  // merged in reverse order: order is not significant
     }
     const std::string merged = (work / ("merged" + std::to_string(k) + ".calf")).string();
-    const Status m = merge_lightfield_shards(*analysis, shards, merged);
+    const Status m = encoder::merge_lightfield_shards(*analysis, shards, merged);
     ASSERT_TRUE(m.ok()) << m.to_string();
     EXPECT_TRUE(bytes_of(merged) == expected) << "merged clip differs from the one-machine encode";
   }
@@ -135,15 +136,15 @@ TEST(LightfieldShardFrames, FrameRangeShardsEqualSegmentedEncode) {
   ASSERT_TRUE(fs::exists(dir / capture::kManifestFileName));
   const fs::path work = scratch() / "frames-work";
   fs::create_directories(work);
-  LightfieldEncodeOptions o;
+  encoder::LightfieldEncodeOptions o;
   o.threads = 2;
   o.segment_frames = 2;
   o.depth_keyframe_interval = 1;
-  // Masked predicted depth (r16pm, the last DepthCoding): the analysis file records it and the
-  // shards code its chunks as one encode does (view shards of raw16 above).
-  o.depth = DepthCoding::kRaw16PredictedMasked;
+  // Masked predicted depth (r16pm, the last encoder::DepthCoding): the analysis file records it and
+  // the shards code its chunks as one encode does (view shards of raw16 above).
+  o.depth = encoder::DepthCoding::kRaw16PredictedMasked;
   const std::string one = (work / "one.calf").string();
-  auto stats = encode_lightfield_file(dir, one, o);
+  auto stats = encoder::encode_lightfield_file(dir, one, o);
   ASSERT_TRUE(stats.ok()) << stats.status().to_string();
   {
     auto r = container::Reader::open(one);
@@ -161,11 +162,11 @@ TEST(LightfieldShardFrames, FrameRangeShardsEqualSegmentedEncode) {
   // Closed segments: every cell has a keyframe at frames 0 and 2.
   EXPECT_GE(stats->colour_keyframes, 2 * stats->colour_cells);
 
-  ASSERT_TRUE(write_lightfield_analysis(dir, (work / "a.calf").string(), o).ok());
-  auto a = read_lightfield_analysis((work / "a.calf").string());
+  ASSERT_TRUE(encoder::write_lightfield_analysis(dir, (work / "a.calf").string(), o).ok());
+  auto a = encoder::read_lightfield_analysis((work / "a.calf").string());
   ASSERT_TRUE(a.ok()) << a.status().to_string();
   EXPECT_EQ(a->options.segment_frames, 2u);
-  EXPECT_EQ(a->options.depth, DepthCoding::kRaw16PredictedMasked);
+  EXPECT_EQ(a->options.depth, encoder::DepthCoding::kRaw16PredictedMasked);
   const auto groups = split(a->analysis.header.view_count, 2);
   std::vector<std::string> shards;
   for (uint32_t g = 0; g < 2; ++g) {
@@ -176,29 +177,30 @@ TEST(LightfieldShardFrames, FrameRangeShardsEqualSegmentedEncode) {
       name += std::to_string(first);
       name += ".calf";
       const std::string path = (work / name).string();
-      auto s = encode_lightfield_shard(dir, *a, groups[g], first, 2, 2, path);
+      auto s = encoder::encode_lightfield_shard(dir, *a, groups[g], first, 2, 2, path);
       ASSERT_TRUE(s.ok()) << s.status().to_string();
       shards.push_back(path);
     }
   }
   const std::string merged = (work / "merged.calf").string();
-  const Status m = merge_lightfield_shards(*a, shards, merged);
+  const Status m = encoder::merge_lightfield_shards(*a, shards, merged);
   ASSERT_TRUE(m.ok()) << m.to_string();
   EXPECT_TRUE(bytes_of(merged) == bytes_of(one));
 
   // A range that is not whole segments is refused.
-  auto odd = encode_lightfield_shard(dir, *a, groups[0], 1, 2, 1, (work / "odd.calf").string());
+  auto odd =
+      encoder::encode_lightfield_shard(dir, *a, groups[0], 1, 2, 1, (work / "odd.calf").string());
   ASSERT_FALSE(odd.ok());
   expect_one_line(odd.status(), ErrorId::kEncoderInput);
   // Overlapping frame ranges of one view, and a gap.
   const std::string whole0 = (work / "whole0.calf").string();
-  ASSERT_TRUE(encode_lightfield_shard(dir, *a, groups[0], 0, 4, 1, whole0).ok());
+  ASSERT_TRUE(encoder::encode_lightfield_shard(dir, *a, groups[0], 0, 4, 1, whole0).ok());
   std::vector<std::string> overlap = shards;
   overlap.push_back(whole0);
-  expect_one_line(merge_lightfield_shards(*a, overlap, (work / "x.calf").string()),
+  expect_one_line(encoder::merge_lightfield_shards(*a, overlap, (work / "x.calf").string()),
                   ErrorId::kShardOverlap);
   std::vector<std::string> gap = {shards[0], shards[2], shards[3]};  // view group 0 lacks 0-1
-  expect_one_line(merge_lightfield_shards(*a, gap, (work / "x.calf").string()),
+  expect_one_line(encoder::merge_lightfield_shards(*a, gap, (work / "x.calf").string()),
                   ErrorId::kShardMissing);
   EXPECT_FALSE(fs::exists(work / "x.calf"));
 }
@@ -208,46 +210,47 @@ TEST(LightfieldShardErrors, MergeRefusesMissingForeignAndOverlappingShards) {
   ASSERT_TRUE(fs::exists(dir / capture::kManifestFileName));
   const fs::path work = scratch() / "errors";
   fs::create_directories(work);
-  LightfieldEncodeOptions o;
+  encoder::LightfieldEncodeOptions o;
   o.threads = 2;
-  ASSERT_TRUE(write_lightfield_analysis(dir, (work / "a.calf").string(), o).ok());
-  LightfieldEncodeOptions other = o;
+  ASSERT_TRUE(encoder::write_lightfield_analysis(dir, (work / "a.calf").string(), o).ok());
+  encoder::LightfieldEncodeOptions other = o;
   other.min_psnr_db = 40;  // another analysis of the same capture set
-  ASSERT_TRUE(write_lightfield_analysis(dir, (work / "b.calf").string(), other).ok());
-  auto a = read_lightfield_analysis((work / "a.calf").string());
-  auto b = read_lightfield_analysis((work / "b.calf").string());
+  ASSERT_TRUE(encoder::write_lightfield_analysis(dir, (work / "b.calf").string(), other).ok());
+  auto a = encoder::read_lightfield_analysis((work / "a.calf").string());
+  auto b = encoder::read_lightfield_analysis((work / "b.calf").string());
   ASSERT_TRUE(a.ok() && b.ok());
   EXPECT_NE(a->id, b->id);
   const uint32_t n = a->analysis.header.view_count, frames = a->analysis.header.frame_count;
   const auto groups = split(n, 2);
   const std::string s0 = (work / "s0.calf").string(), s1 = (work / "s1.calf").string();
   const std::string b1 = (work / "b1.calf").string(), all = (work / "all.calf").string();
-  ASSERT_TRUE(encode_lightfield_shard(dir, *a, groups[0], 0, frames, 1, s0).ok());
-  ASSERT_TRUE(encode_lightfield_shard(dir, *a, groups[1], 0, frames, 1, s1).ok());
-  ASSERT_TRUE(encode_lightfield_shard(dir, *b, groups[1], 0, frames, 1, b1).ok());
+  ASSERT_TRUE(encoder::encode_lightfield_shard(dir, *a, groups[0], 0, frames, 1, s0).ok());
+  ASSERT_TRUE(encoder::encode_lightfield_shard(dir, *a, groups[1], 0, frames, 1, s1).ok());
+  ASSERT_TRUE(encoder::encode_lightfield_shard(dir, *b, groups[1], 0, frames, 1, b1).ok());
   std::vector<uint32_t> every(n);
   for (uint32_t v = 0; v < n; ++v) every[v] = v;
-  ASSERT_TRUE(encode_lightfield_shard(dir, *a, every, 0, frames, 1, all).ok());
+  ASSERT_TRUE(encoder::encode_lightfield_shard(dir, *a, every, 0, frames, 1, all).ok());
   const std::string out = (work / "out.calf").string();
 
-  expect_one_line(merge_lightfield_shards(*a, std::vector<std::string>{s0}, out),
+  expect_one_line(encoder::merge_lightfield_shards(*a, std::vector<std::string>{s0}, out),
                   ErrorId::kShardMissing);
-  expect_one_line(merge_lightfield_shards(*a, std::vector<std::string>{s0, b1}, out),
+  expect_one_line(encoder::merge_lightfield_shards(*a, std::vector<std::string>{s0, b1}, out),
                   ErrorId::kShardMismatch);
-  expect_one_line(merge_lightfield_shards(*a, std::vector<std::string>{s0, s1, all}, out),
+  expect_one_line(encoder::merge_lightfield_shards(*a, std::vector<std::string>{s0, s1, all}, out),
                   ErrorId::kShardOverlap);
   // A clip or the analysis file is not a shard; a shard is not an analysis file.
-  expect_one_line(
-      merge_lightfield_shards(*a, std::vector<std::string>{s0, (work / "a.calf").string()}, out),
-      ErrorId::kShardFile);
-  expect_one_line(read_lightfield_analysis(s0).status(), ErrorId::kShardFile);
+  expect_one_line(encoder::merge_lightfield_shards(
+                      *a, std::vector<std::string>{s0, (work / "a.calf").string()}, out),
+                  ErrorId::kShardFile);
+  expect_one_line(encoder::read_lightfield_analysis(s0).status(), ErrorId::kShardFile);
   EXPECT_FALSE(fs::exists(out));
   // The analysis file is an input of a shard and of a merge: neither may write over it.
   const std::string a_path = (work / "a.calf").string();
   const std::string a_bytes = bytes_of(a_path);
-  expect_one_line(encode_lightfield_shard(dir, *a, groups[0], 0, frames, 1, a_path).status(),
-                  ErrorId::kOutputIsInput);
-  expect_one_line(merge_lightfield_shards(*a, std::vector<std::string>{s0, s1}, a_path),
+  expect_one_line(
+      encoder::encode_lightfield_shard(dir, *a, groups[0], 0, frames, 1, a_path).status(),
+      ErrorId::kOutputIsInput);
+  expect_one_line(encoder::merge_lightfield_shards(*a, std::vector<std::string>{s0, s1}, a_path),
                   ErrorId::kOutputIsInput);
   EXPECT_EQ(bytes_of(a_path), a_bytes);
   // The shard list and view lists.
@@ -258,7 +261,7 @@ TEST(LightfieldShardErrors, MergeRefusesMissingForeignAndOverlappingShards) {
   ASSERT_TRUE(list.ok());
   EXPECT_EQ(*list, (std::vector<uint32_t>{0, 1, 2, 5, 7, 8}));
   EXPECT_EQ(capture::index_list_text(*list), "0-2,5,7-8");
-  ASSERT_TRUE(merge_lightfield_shards(*a, std::vector<std::string>{s1, s0}, out).ok());
+  ASSERT_TRUE(encoder::merge_lightfield_shards(*a, std::vector<std::string>{s1, s0}, out).ok());
 }
 
 // Two captures of one manifest whose pixels differ (one colour texel of view 0, frame 0: the
@@ -289,28 +292,28 @@ TEST(LightfieldShardErrors, AnalysisIdentifiesThePixels) {
   }
   EXPECT_EQ(bytes_of(other / capture::kManifestFileName),
             bytes_of(dir / capture::kManifestFileName));
-  LightfieldEncodeOptions o;
+  encoder::LightfieldEncodeOptions o;
   o.threads = 2;
   const std::string a_path = (work / "a.calf").string(), b_path = (work / "b.calf").string();
-  ASSERT_TRUE(write_lightfield_analysis(dir, a_path, o).ok());
-  ASSERT_TRUE(write_lightfield_analysis(other, b_path, o).ok());
-  auto a = read_lightfield_analysis(a_path);
-  auto b = read_lightfield_analysis(b_path);
+  ASSERT_TRUE(encoder::write_lightfield_analysis(dir, a_path, o).ok());
+  ASSERT_TRUE(encoder::write_lightfield_analysis(other, b_path, o).ok());
+  auto a = encoder::read_lightfield_analysis(a_path);
+  auto b = encoder::read_lightfield_analysis(b_path);
   ASSERT_TRUE(a.ok() && b.ok());
   EXPECT_NE(a->id, b->id);
   const uint32_t n = a->analysis.header.view_count, frames = a->analysis.header.frame_count;
   const auto groups = split(n, 2);
   const std::string s0 = (work / "s0.calf").string(), s1 = (work / "s1-other.calf").string();
-  ASSERT_TRUE(encode_lightfield_shard(dir, *a, groups[0], 0, frames, 1, s0).ok());
-  ASSERT_TRUE(encode_lightfield_shard(other, *b, groups[1], 0, frames, 1, s1).ok());
+  ASSERT_TRUE(encoder::encode_lightfield_shard(dir, *a, groups[0], 0, frames, 1, s0).ok());
+  ASSERT_TRUE(encoder::encode_lightfield_shard(other, *b, groups[1], 0, frames, 1, s1).ok());
   const std::string out = (work / "mixed.calf").string();
-  expect_one_line(merge_lightfield_shards(*a, std::vector<std::string>{s0, s1}, out),
+  expect_one_line(encoder::merge_lightfield_shards(*a, std::vector<std::string>{s0, s1}, out),
                   ErrorId::kShardMismatch);
   EXPECT_FALSE(fs::exists(out));
   // View 0 of the other capture, coded with the first analysis.
-  const Status s =
-      encode_lightfield_shard(other, *a, groups[0], 0, frames, 1, (work / "s0-other.calf").string())
-          .status();
+  const Status s = encoder::encode_lightfield_shard(other, *a, groups[0], 0, frames, 1,
+                                                    (work / "s0-other.calf").string())
+                       .status();
   expect_one_line(s, ErrorId::kShardMismatch);
   EXPECT_NE(s.message().find("view 0 frames 0-1 are not the images analysed"), std::string::npos)
       << s.to_string();
@@ -320,8 +323,8 @@ TEST(LightfieldShardErrors, AnalysisIdentifiesThePixels) {
   ASSERT_TRUE(reader.ok());
   const std::string last = reader->image_path(n - 1, 0).filename().string();
   if (bytes_of(dir / last) == bytes_of(other / last)) {
-    EXPECT_TRUE(encode_lightfield_shard(other, *a, groups[1], 0, frames, 1,
-                                        (work / "s1-same.calf").string())
+    EXPECT_TRUE(encoder::encode_lightfield_shard(other, *a, groups[1], 0, frames, 1,
+                                                 (work / "s1-same.calf").string())
                     .ok());
   }
 }

@@ -45,7 +45,7 @@ Clip make_clip(uint64_t seed, int n, const CompressionOptions& opt = {1, 0, true
   lf.view_count = 4;
   lf.face_size = 256;
   lf.cell_size = 64;
-  lf.depth_tile_size = 128;
+  lf.depth_region_size = 128;
   lf.colour_format = static_cast<uint16_t>(PixelFormat::kBc7);
   EXPECT_TRUE(w->add_track(lf).ok());
   EXPECT_TRUE(w->add_track(999, 0, Bytes{1, 2, 3}).ok());  // an unknown optional track

@@ -77,7 +77,7 @@ TEST(GridTest, BadSizesAndIndicesAreErrors) {
   EXPECT_EQ(FaceGrid::with_cell_size(0, 64).status().id(), ErrorId::kGridSize);
   EXPECT_EQ(FaceGrid::with_cell_size(64, 0).status().id(), ErrorId::kGridSize);
   EXPECT_EQ(FaceGrid::with_cell_size(kMaxFaceSize + 1, 64).status().id(), ErrorId::kGridSize);
-  EXPECT_EQ(FaceGrid::with_tiles_per_side(64, 0).status().id(), ErrorId::kGridSize);
+  EXPECT_EQ(FaceGrid::with_regions_per_side(64, 0).status().id(), ErrorId::kGridSize);
   const FaceGrid g = must(FaceGrid::with_cell_size(128, 64));
   auto bad = g.cell_rect(4u);
   ASSERT_FALSE(bad.ok());
@@ -86,18 +86,18 @@ TEST(GridTest, BadSizesAndIndicesAreErrors) {
 }
 
 TEST(GridTest, TilesAreFourAligned) {
-  const FaceGrid two = must(FaceGrid::with_tiles_per_side(1024, 2));
+  const FaceGrid two = must(FaceGrid::with_regions_per_side(1024, 2));
   EXPECT_EQ(two.cells_per_side(), 2u);
   EXPECT_EQ(*two.cell_rect(3), (PixelRect{512, 512, 512, 512}));
-  const FaceGrid odd = must(FaceGrid::with_tiles_per_side(30, 2));  // 15 -> 16
+  const FaceGrid odd = must(FaceGrid::with_regions_per_side(30, 2));  // 15 -> 16
   EXPECT_EQ(odd.cell_size(), 16u);
   EXPECT_EQ(*odd.cell_rect(1), (PixelRect{16, 0, 14, 16}));
-  const FaceGrid tiny = must(FaceGrid::with_tiles_per_side(6, 4));  // documented example
+  const FaceGrid tiny = must(FaceGrid::with_regions_per_side(6, 4));  // documented example
   EXPECT_EQ(tiny.cells_per_side(), 2u);
   EXPECT_EQ(*tiny.cell_rect(3), (PixelRect{4, 4, 2, 2}));
   for (uint32_t face : {1u, 2u, 7u, 33u, 1000u}) {
     for (uint32_t tiles : {1u, 2u, 3u, 8u}) {
-      const FaceGrid g = must(FaceGrid::with_tiles_per_side(face, tiles));
+      const FaceGrid g = must(FaceGrid::with_regions_per_side(face, tiles));
       EXPECT_LE(g.cells_per_side(), tiles);
       for (uint32_t i = 0; i + 1 < g.cells_per_side(); ++i)
         EXPECT_EQ(g.cell_rect(i, 0).width % 4, 0u);

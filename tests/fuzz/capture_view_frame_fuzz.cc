@@ -41,7 +41,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       case calf::ErrorId::kCaptureFileMissing:
       case calf::ErrorId::kCaptureImageFormat:
       case calf::ErrorId::kCaptureDepthPixel:
-      case calf::ErrorId::kCaptureColorPixel:
+      case calf::ErrorId::kCaptureColourPixel:
       case calf::ErrorId::kCaptureMaterialPixel:
         return 0;
       default:

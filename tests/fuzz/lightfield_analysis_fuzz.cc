@@ -23,7 +23,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::ofstream out(file, std::ios::binary | std::ios::trunc);
     out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
   }
-  calf::Expected<calf::LightfieldAnalysisFile> a = calf::read_lightfield_analysis(file.string());
+  calf::Expected<calf::encoder::LightfieldAnalysisFile> a =
+      calf::encoder::read_lightfield_analysis(file.string());
   if (a.ok()) {
     if (a->analysis.views.size() != a->analysis.header.view_count) std::abort();
   } else if (a.status().id() == calf::ErrorId::kOk) {

@@ -1,7 +1,7 @@
 // Fuzz target: the reference lightfield decoder
 // (decoder/include/calf/decoder/lightfield_reference.h) on arbitrary bytes. Opens them as a .calf
 // file from memory, opens every lightfield track and decodes every view / face / frame it claims,
-// plus every cell timeline and depth tile's rectangle counts. Any crash, sanitizer report or hang
+// plus every cell timeline and depth region's rectangle counts. Any crash, sanitizer report or hang
 // is a bug; errors are expected. Seeded with tiny valid encoded files (face 8, 2-3 frames) and
 // files whose chunks were rewritten with corrupt contents but valid hashes (so mutations reach the
 // decoder's chunk parser, not just the container's checks).
@@ -30,7 +30,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (face_texels == 0 || face_texels > budget || faces > budget / face_texels) continue;
     budget -= faces * face_texels;
     auto cells = FaceGrid::with_cell_size(h.face_size, h.cell_size);
-    auto tiles = FaceGrid::with_cell_size(h.face_size, h.depth_tile_size);
+    auto tiles = FaceGrid::with_cell_size(h.face_size, h.depth_region_size);
     decoder::LightfieldFace out;
     for (uint32_t v = 0; v < h.view_count; ++v) {
       for (uint32_t f = 0; f < 6; ++f) {

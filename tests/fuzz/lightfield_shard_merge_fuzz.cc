@@ -35,13 +35,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   write(analysis_path, data + 4, split);
   write(shard, data + 4 + split, size - 4 - split);
   std::filesystem::remove(out);
-  auto analysis = calf::read_lightfield_analysis(analysis_path.string());
+  auto analysis = calf::encoder::read_lightfield_analysis(analysis_path.string());
   if (!analysis.ok()) {
     if (analysis.status().id() == calf::ErrorId::kOk) std::abort();
     return 0;
   }
   const std::vector<std::string> shards = {shard.string()};
-  const calf::Status s = calf::merge_lightfield_shards(*analysis, shards, out.string());
+  const calf::Status s = calf::encoder::merge_lightfield_shards(*analysis, shards, out.string());
   if (!s.ok()) {
     if (s.id() == calf::ErrorId::kOk || s.to_string().find('\n') != std::string::npos) std::abort();
     if (std::filesystem::exists(out)) std::abort();

@@ -1,10 +1,10 @@
 // AV1 colour end to end (format/SPEC.md §11.1.12): a synthetic capture set encoded by calf-encode's
-// library with ColourCoding::kAv1, its layout (GOP chunks, no t chunks, version 1.3), encodes
-// independent of the thread count, the reference decoder and the view-dependent decoder (in order
-// and seeking) giving the same colour, that colour close to the input, and damaged chunks refused
-// with their ids; the same for a HDR capture set (format av1hdr: 10-bit codes of half floats, a
-// curve per cell). With CALF_CONFORMANCE_OUT set it writes the conformance clips av1_pred16m and
-// av1_hdr_pred16m there.
+// library with encoder::ColourCoding::kAv1, its layout (GOP chunks, no t chunks, version 1.3),
+// encodes independent of the thread count, the reference decoder and the view-dependent decoder (in
+// order and seeking) giving the same colour, that colour close to the input, and damaged chunks
+// refused with their ids; the same for a HDR capture set (format av1hdr: 10-bit codes of half
+// floats, a curve per cell). With CALF_CONFORMANCE_OUT set it writes the conformance clips
+// av1_pred16m and av1_hdr_pred16m there.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -19,8 +19,8 @@
 #include <vector>
 
 #include "calf/capture/capture_set.h"
-#include "calf/decoder/clip_decoder.h"
 #include "calf/decoder/cpu_textures.h"
+#include "calf/decoder/lightfield_decoder.h"
 #include "calf/decoder/lightfield_reference.h"
 #include "calf/decoder/lightfield_verify.h"
 #include "calf/encoder/lightfield_encode.h"
@@ -54,9 +54,9 @@ class Av1Colour : public ::testing::Test {
   void TearDown() override { fs::remove_all(root_); }
 
   // The conformance clip's options: one stream per 16-texel face, a key frame every 2 frames.
-  static LightfieldEncodeOptions options(uint32_t threads = 1) {
-    LightfieldEncodeOptions o;
-    o.colour = ColourCoding::kAv1;
+  static encoder::LightfieldEncodeOptions options(uint32_t threads = 1) {
+    encoder::LightfieldEncodeOptions o;
+    o.colour = encoder::ColourCoding::kAv1;
     o.cell_size = 16;
     o.av1.keyframe_interval = 2;
     o.av1.preset = 10;
@@ -64,7 +64,7 @@ class Av1Colour : public ::testing::Test {
     return o;
   }
 
-  std::vector<uint8_t> encode(const LightfieldEncodeOptions& o, bool hdr = false) {
+  std::vector<uint8_t> encode(const encoder::LightfieldEncodeOptions& o, bool hdr = false) {
     std::vector<uint8_t> bytes;
     if (hdr && !fs::exists(root_ / "hdr")) {
       SceneSpec spec = spec_;
@@ -75,7 +75,7 @@ class Av1Colour : public ::testing::Test {
     EXPECT_TRUE(in.ok()) << in.status().to_string();
     auto writer = container::Writer::create(container::memory_sink(&bytes));
     EXPECT_TRUE(writer.ok());
-    auto s = encode_lightfield(*in, *writer, o);
+    auto s = encoder::encode_lightfield(*in, *writer, o);
     EXPECT_TRUE(s.ok()) << s.status().to_string();
     EXPECT_TRUE(writer->finish().ok());
     return bytes;
@@ -105,7 +105,7 @@ double psnr_srgb8(const std::vector<float>& a, const std::vector<float>& b) {
 }
 
 // log2-PSNR (SPEC §11.1.4, HDR): over log2(max(v, 2^-14)) of every channel, peak 8.
-double psnr_log2(const std::vector<float>& a, const std::vector<float>& b) {
+double encoder::psnr_log2(const std::vector<float>& a, const std::vector<float>& b) {
   double se = 0;
   for (size_t i = 0; i < a.size(); ++i) {
     const double d = std::log2(std::max(a[i], 0x1p-14f)) - std::log2(std::max(b[i], 0x1p-14f));
@@ -199,14 +199,14 @@ void Av1Colour::decoders_agree(bool hdr) {
   const container::Reader r = open(bytes);
   auto ref = decoder::LightfieldReference::open(r, 0);
   ASSERT_TRUE(ref.ok()) << ref.status().to_string();
-  decoder::ClipDecoderOptions dopt;
+  decoder::LightfieldDecoderOptions dopt;
   dopt.view_dependent = false;
   dopt.background_thread = false;
-  auto dec = decoder::ClipDecoder::open(r, 0, dopt);
+  auto dec = decoder::LightfieldDecoder::open(r, 0, dopt);
   ASSERT_TRUE(dec.ok()) << dec.status().to_string();
   std::vector<decoder::LightfieldViewInfo> infos = {dec->view(0), dec->view(1)};
   decoder::CpuTextures tex(dec->header(), infos);
-  decoder::FrameUpdates updates;
+  decoder::LightfieldFrameUpdates updates;
   decoder::LightfieldFace face;
   double worst = 1e9, sum = 0;
   int faces = 0;
@@ -234,7 +234,8 @@ void Av1Colour::decoders_agree(bool hdr) {
             for (int c = 0; c < 3; ++c) want.push_back(input.color[3 * i + c]);
           }
         }
-        const double psnr = hdr ? psnr_log2(want, face.colour) : psnr_srgb8(want, face.colour);
+        const double psnr =
+            hdr ? encoder::psnr_log2(want, face.colour) : psnr_srgb8(want, face.colour);
         worst = std::min(worst, psnr);
         sum += psnr;
         ++faces;
@@ -299,12 +300,12 @@ TEST_F(Av1Colour, DamagedChunksAreRefusedWithTheirIds) {
     EXPECT_EQ(v.problems[0].id(), c.id) << v.problems[0].to_string();
     EXPECT_NE(v.problems[0].message().find("view 1 face 2"), std::string::npos)
         << v.problems[0].message();
-    decoder::ClipDecoderOptions dopt;
+    decoder::LightfieldDecoderOptions dopt;
     dopt.view_dependent = false;
     dopt.background_thread = false;
-    auto dec = decoder::ClipDecoder::open(damaged, 0, dopt);
+    auto dec = decoder::LightfieldDecoder::open(damaged, 0, dopt);
     ASSERT_TRUE(dec.ok());
-    decoder::FrameUpdates updates;
+    decoder::LightfieldFrameUpdates updates;
     ASSERT_TRUE(dec->advance(0, {}, {}, &updates).ok());
     EXPECT_EQ(updates.stats.errors, 1u);
     EXPECT_EQ(updates.stats.first_error.rfind(
@@ -344,12 +345,12 @@ TEST_F(Av1Colour, HdrCurveOutOfRangeIsRefused) {
 TEST_F(Av1Colour, BadOptionsAreRefused) {
   auto in = capture::CaptureSetReader::open(root_ / "set");
   ASSERT_TRUE(in.ok());
-  LightfieldEncodeOptions o = options();
+  encoder::LightfieldEncodeOptions o = options();
   o.av1.keyframe_interval = 0;
-  EXPECT_EQ(analyse_lightfield(*in, o).status().id(), ErrorId::kEncoderOption);
+  EXPECT_EQ(encoder::analyse_lightfield(*in, o).status().id(), ErrorId::kEncoderOption);
   o = options();
   o.av1.crf = 64;
-  EXPECT_EQ(analyse_lightfield(*in, o).status().id(), ErrorId::kEncoderOption);
+  EXPECT_EQ(encoder::analyse_lightfield(*in, o).status().id(), ErrorId::kEncoderOption);
 }
 
 }  // namespace

@@ -1,9 +1,9 @@
 // The whole playback path on a real clip: an animated synthetic room (a sphere moving over a
 // mirror floor) captured from three viewpoints, encoded by calf's encoder (BC7 / BC1 colour
 // keyframes with per-cell t, raw16 or BC5 depth, material), decoded view-dependently by the
-// ClipDecoder for the eye's frustum, its updates applied to the GL textures (GlViews) and to the
-// decoder's CPU image of them (CpuTextures). Each frame the GL renderer's image must match the CPU
-// renderer's on the CPU image (>= 45 dB, same depths); both are also compared with the exact
+// LightfieldDecoder for the eye's frustum, its updates applied to the GL textures (GlViews) and to
+// the decoder's CPU image of them (CpuTextures). Each frame the GL renderer's image must match the
+// CPU renderer's on the CPU image (>= 45 dB, same depths); both are also compared with the exact
 // ground truth, as a sanity bound.
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -16,15 +16,15 @@
 #include "../gl_test_context.h"
 #include "../player/synthetic_scene.h"
 #include "calf/capture/capture_set.h"
-#include "calf/decoder/clip_decoder.h"
 #include "calf/decoder/cpu_textures.h"
+#include "calf/decoder/lightfield_decoder.h"
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/format/container.h"
 #include "calf/format/container_io.h"
-#include "calf/player/cpu_renderer.h"
 #include "calf/player/gl_context.h"
-#include "calf/player/gl_renderer.h"
 #include "calf/player/gl_views.h"
+#include "calf/player/lightfield_cpu_renderer.h"
+#include "calf/player/lightfield_gl_renderer.h"
 
 namespace calf::player {
 namespace {
@@ -72,7 +72,7 @@ struct Clip {
   std::unique_ptr<container::Reader> reader;
 };
 
-Clip encode_clip(const LightfieldEncodeOptions& options) {
+Clip encode_clip(const encoder::LightfieldEncodeOptions& options) {
   std::string name = "calf_gl_clip_";
   name.append(std::to_string(::getpid()));
   const fs::path dir = fs::temp_directory_path() / name;
@@ -103,7 +103,7 @@ Clip encode_clip(const LightfieldEncodeOptions& options) {
     EXPECT_TRUE(in.ok()) << in.status().to_string();
     auto writer = container::Writer::create(container::memory_sink(&clip.bytes));
     EXPECT_TRUE(writer.ok());
-    auto stats = encode_lightfield(*in, *writer, options);
+    auto stats = encoder::encode_lightfield(*in, *writer, options);
     EXPECT_TRUE(stats.ok()) << stats.status().to_string();
     EXPECT_TRUE(writer->finish().ok());
   }
@@ -115,7 +115,7 @@ Clip encode_clip(const LightfieldEncodeOptions& options) {
 }
 
 // The CPU renderer's views: the decoder's CPU image of the textures.
-ViewSet view_set_from(const decoder::ClipDecoder& d, const decoder::CpuTextures& tex) {
+ViewSet view_set_from(const decoder::LightfieldDecoder& d, const decoder::CpuTextures& tex) {
   ViewSet set;
   for (uint32_t v = 0; v < d.header().view_count; ++v) {
     const decoder::LightfieldViewInfo& info = d.view(v);
@@ -125,7 +125,7 @@ ViewSet view_set_from(const decoder::ClipDecoder& d, const decoder::CpuTextures&
     const uint32_t n = tex.face_size();
     for (int f = 0; f < kCubeFaceCount; ++f) {
       const CubeFace face = cube_face_from_index(f);
-      EXPECT_TRUE(view.write_color_rect(face, {0, 0, n, n}, tex.colour(v, face)).ok());
+      EXPECT_TRUE(view.write_colour_rect(face, {0, 0, n, n}, tex.colour(v, face)).ok());
       EXPECT_TRUE(view.write_depth_rect(face, {0, 0, n, n}, tex.depth(v, face)).ok());
       if (material) {
         const std::span<const uint8_t> codes = tex.material(v, face);
@@ -152,10 +152,11 @@ double psnr(const std::vector<float>& ref, const std::vector<float>& test) {
 
 // `min_db`: besides the 45 dB acceptance bound, what float rounding alone gives (llvmpipe
 // decodes BC7 exactly, BC1 with its own rounding of the interpolants).
-void play(const char* name, const LightfieldEncodeOptions& options, bool keep_bc5, double min_db) {
+void play(const char* name, const encoder::LightfieldEncodeOptions& options, bool keep_bc5,
+          double min_db) {
   const Clip clip = encode_clip(options);
   ASSERT_TRUE(clip.reader);
-  auto d = decoder::ClipDecoder::open(*clip.reader, 0);
+  auto d = decoder::LightfieldDecoder::open(*clip.reader, 0);
   ASSERT_TRUE(d.ok()) << d.status().to_string();
   std::vector<decoder::LightfieldViewInfo> infos;
   for (uint32_t v = 0; v < d->header().view_count; ++v) infos.push_back(d->view(v));
@@ -178,11 +179,11 @@ void play(const char* name, const LightfieldEncodeOptions& options, bool keep_bc
   eye.aspect = 1;
   eye.near = 0.01;
   eye.far = 20;
-  RenderOptions o;
+  LightfieldRenderOptions o;
   o.rr = true;
   o.threads = 2;
   for (uint32_t frame = 0; frame < kFrames; ++frame) {
-    decoder::FrameUpdates fu;
+    decoder::LightfieldFrameUpdates fu;
     const Status advanced = d->advance(frame, {&eye, 1}, {}, &fu);
     ASSERT_TRUE(advanced.ok()) << advanced.to_string();
     ASSERT_EQ(fu.stats.errors, 0u) << fu.stats.first_error;
@@ -193,10 +194,10 @@ void play(const char* name, const LightfieldEncodeOptions& options, bool keep_bc
     EXPECT_LT(fu.stats.visible_cells, fu.stats.total_cells);  // the decoder culled something
 
     const ViewSet views = view_set_from(*d, tex);
-    const RenderOptions ro = *march_range_for(views, cam.position, o);
+    const LightfieldRenderOptions ro = *march_range_for(views, cam.position, o);
     RenderedImage want, got;
-    ASSERT_TRUE(CpuRenderer::make(views, ro)->render(cam, &want).ok());
-    std::unique_ptr<GlRenderer> r = *GlRenderer::make(**gv, ro);
+    ASSERT_TRUE(LightfieldCpuRenderer::make(views, ro)->render(cam, &want).ok());
+    std::unique_ptr<LightfieldGlRenderer> r = *LightfieldGlRenderer::make(**gv, ro);
     ASSERT_TRUE(r->render(cam, &got).ok());
     const RenderedImage truth = testing::ground_truth(scene_at(frame), cam);
     size_t same_depth = 0;
@@ -221,21 +222,21 @@ void play(const char* name, const LightfieldEncodeOptions& options, bool keep_bc
 
 TEST(GlClip, DecodedBc7ClipWithRawDepthMatchesTheCpuRenderer) {
   CALF_REQUIRE_GL();
-  LightfieldEncodeOptions o;
+  encoder::LightfieldEncodeOptions o;
   o.cell_size = 8;
   o.min_psnr_db = 40;
-  o.colour = ColourCoding::kBc7;
-  o.depth = DepthCoding::kRaw16;
+  o.colour = encoder::ColourCoding::kBc7;
+  o.depth = encoder::DepthCoding::kRaw16;
   play("BC7 + raw16", o, false, 70);
 }
 
 TEST(GlClip, DecodedBc1ClipWithBc5DepthMatchesTheCpuRenderer) {
   CALF_REQUIRE_GL();
-  LightfieldEncodeOptions o;
+  encoder::LightfieldEncodeOptions o;
   o.cell_size = 8;
   o.min_psnr_db = 40;
-  o.colour = ColourCoding::kBc1;
-  o.depth = DepthCoding::kBc5;
+  o.colour = encoder::ColourCoding::kBc1;
+  o.depth = encoder::DepthCoding::kBc5;
   play("BC1 + BC5 (CPU-decoded)", o, false, 55);
   play("BC1 + BC5 (GPU-decoded)", o, true, 0);
 }

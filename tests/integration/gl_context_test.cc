@@ -11,8 +11,8 @@
 #include <string>
 
 #include "../gl_test_context.h"
-#include "calf/player/gl_renderer.h"
 #include "calf/player/gl_views.h"
+#include "calf/player/lightfield_gl_renderer.h"
 
 namespace calf::player {
 namespace {
@@ -119,7 +119,7 @@ TEST(GlContext, ShaderFailuresAndGlErrorsAreReported) {
   const Expected<GlFunctions> gl = load_gl_functions(&failing_compiler);
   ASSERT_TRUE(gl.ok());
   std::unique_ptr<GlViews> views = *GlViews::make(*gl, one_view(container::PixelFormat::kRgba8));
-  const Status compile = GlRenderer::make(*views, {}).status();
+  const Status compile = LightfieldGlRenderer::make(*views, {}).status();
   EXPECT_EQ(compile.number(), 404);
   EXPECT_NE(compile.message().find("does not compile"), std::string::npos) << compile.to_string();
 

@@ -19,17 +19,17 @@
 #include "calf/format/bc.h"
 #include "calf/format/colour.h"
 #include "calf/format/grid.h"
-#include "calf/player/cpu_renderer.h"
 #include "calf/player/gl_context.h"
-#include "calf/player/gl_renderer.h"
 #include "calf/player/gl_views.h"
+#include "calf/player/lightfield_cpu_renderer.h"
+#include "calf/player/lightfield_gl_renderer.h"
 
 namespace calf::player {
 namespace {
 
 using container::PixelFormat;
 using decoder::CellParams;
-using decoder::FrameUpdates;
+using decoder::LightfieldFrameUpdates;
 using decoder::TextureUpdate;
 using decoder::UpdateTarget;
 
@@ -85,7 +85,7 @@ class HandDecoder {
   }
 
   GlTextureLayout& layout() { return layout_; }
-  FrameUpdates& frame() { return frame_; }
+  LightfieldFrameUpdates& frame() { return frame_; }
 
   // Colour keyframe `linear` (a whole face, 3 floats per texel) into `slot`, rect `r`.
   void colour(uint32_t view, int face, uint32_t slot, const PixelRect& r,
@@ -208,7 +208,7 @@ class HandDecoder {
           }
         }
         const CubeFace face = cube_face_from_index(f);
-        EXPECT_TRUE(view.write_color_rect(face, {0, 0, n, n}, c).ok());
+        EXPECT_TRUE(view.write_colour_rect(face, {0, 0, n, n}, c).ok());
         EXPECT_TRUE(view.write_depth_rect(face, {0, 0, n, n}, s.depth).ok());
         if (info.has_material) {
           EXPECT_TRUE(view.write_material_rect(face, {0, 0, n, n}, s.material).ok());
@@ -253,7 +253,7 @@ class HandDecoder {
   };
   PixelFormat colour_, depth_, material_;
   GlTextureLayout layout_;
-  FrameUpdates frame_;
+  LightfieldFrameUpdates frame_;
   std::list<std::vector<uint8_t>> storage_;  // stable addresses for the update spans
   std::vector<State> state_;
 };
@@ -280,7 +280,7 @@ Captured capture(const testing::Scene& s, const Vec3& position, uint32_t n, uint
   c.info = {position, v.range(), n, cell, with_material};
   for (int f = 0; f < 6; ++f) {
     const CubeFace face = cube_face_from_index(f);
-    c.colour[f].assign(v.color_face(face).begin(), v.color_face(face).end());
+    c.colour[f].assign(v.colour_face(face).begin(), v.colour_face(face).end());
     c.depth[f].assign(v.depth_face(face).begin(), v.depth_face(face).end());
     for (float m : v.material_face(face)) {
       c.material[f].push_back(static_cast<uint8_t>(std::lround(255 * std::clamp(m, 0.0f, 1.0f))));
@@ -378,12 +378,12 @@ TEST(GlUpdates, BlockFormatsKeyframeSlotsAndCellsMatchTheCpuRenderer) {
     cam.forward = {0.1, -0.5, -1};
     cam.width = cam.height = 64;
     for (bool rr : {false, true}) {
-      RenderOptions o = *march_range_for(cpu_views, cam.position, {});
+      LightfieldRenderOptions o = *march_range_for(cpu_views, cam.position, {});
       o.rr = rr;
       o.threads = 2;
       RenderedImage want, got;
-      ASSERT_TRUE(CpuRenderer::make(cpu_views, o)->render(cam, &want).ok());
-      std::unique_ptr<GlRenderer> r = *GlRenderer::make(**gv, o);
+      ASSERT_TRUE(LightfieldCpuRenderer::make(cpu_views, o)->render(cam, &want).ok());
+      std::unique_ptr<LightfieldGlRenderer> r = *LightfieldGlRenderer::make(**gv, o);
       ASSERT_TRUE(r->render(cam, &got).ok());
       const double p = psnr_vs(want.color, got.color);
       size_t same_depth = 0;
@@ -424,8 +424,8 @@ TEST(GlUpdates, CellParametersSelectAndBlendTheSlots) {
   Camera cam;
   cam.position = {0.01, 0.02, 0.0};
   cam.width = cam.height = 8;
-  std::unique_ptr<GlRenderer> r =
-      *GlRenderer::make(*gv, *march_range_for(gv->layout(), cam.position, {}));
+  std::unique_ptr<LightfieldGlRenderer> r =
+      *LightfieldGlRenderer::make(*gv, *march_range_for(gv->layout(), cam.position, {}));
   const struct {
     uint8_t t, a;
     float red, blue;
@@ -546,8 +546,9 @@ TEST(GlUpdates, RefusesLayoutsTheGpuCannotHold) {
   h.depth_format = static_cast<uint16_t>(PixelFormat::kR16Predicted);
   EXPECT_EQ(layout_for_clip(h, infos)->depth_format, PixelFormat::kR16);
   EXPECT_EQ(layout_for_clip(h, infos, true)->depth_format, PixelFormat::kR16);
-  // So is r16pm: the ClipDecoder sends whole rectangles of r16 codes, their unchanged texels
-  // from its copy of the tile (ClipDecoder.MaskedDepthDecodesToRaw16CodesFromAnyFrameOfTheWindow).
+  // So is r16pm: the LightfieldDecoder sends whole rectangles of r16 codes, their unchanged texels
+  // from its copy of the tile
+  // (LightfieldDecoder.MaskedDepthDecodesToRaw16CodesFromAnyFrameOfTheWindow).
   h.depth_format = static_cast<uint16_t>(PixelFormat::kR16PredictedMasked);
   EXPECT_EQ(layout_for_clip(h, infos)->depth_format, PixelFormat::kR16);
   EXPECT_EQ(layout_for_clip(h, infos, true)->depth_format, PixelFormat::kR16);

@@ -1,7 +1,7 @@
 // The lightfield conformance clips (tests/conformance/lightfield/): frozen files of today's
 // bitstream with the hash of every decoded face at every frame (SPEC §14). Both decoders must
 // reproduce every line: the reference decoder through verify_lightfield_track (what
-// `calf-verify --decode` prints) and the view-dependent ClipDecoder with everything visible,
+// `calf-verify --decode` prints) and the view-dependent LightfieldDecoder with everything visible,
 // read back from its CPU textures. The files were written by encode_pin_test
 // (CALF_CONFORMANCE_OUT), the crafted_* clips by tests/conformance/lightfield_crafted.h, and
 // hashed by calf-verify --decode when they were frozen; nothing here regenerates them.
@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "calf/decoder/clip_decoder.h"
 #include "calf/decoder/cpu_textures.h"
+#include "calf/decoder/lightfield_decoder.h"
 #include "calf/decoder/lightfield_reference.h"
 #include "calf/decoder/lightfield_verify.h"
 #include "calf/format/container.h"
@@ -128,7 +128,7 @@ TEST(LightfieldConformance, MaskedDepthClipsSkipTexels) {
     const container::Reader reader = open_clip(n);
     auto ref = LightfieldReference::open(reader, 0);
     ASSERT_TRUE(ref.ok()) << n;
-    auto grid = FaceGrid::with_cell_size(ref->header().face_size, ref->header().depth_tile_size);
+    auto grid = FaceGrid::with_cell_size(ref->header().face_size, ref->header().depth_region_size);
     ASSERT_TRUE(grid.ok()) << n;
     uint64_t skipped = 0, p_rects = 0, skipping_rects = 0;
     for (uint32_t id = 0; id < reader.chunks().size(); ++id) {
@@ -215,18 +215,18 @@ TEST(LightfieldConformance, ViewDependentDecoderReproducesEveryHash) {
     const container::Reader reader = open_clip(name);
     const std::vector<std::string> want = read_lines(suite_dir() / (name + ".hashes"));
     const uint16_t track = lightfield_track(reader);
-    ClipDecoderOptions o;
+    LightfieldDecoderOptions o;
     o.view_dependent = false;
     o.background_thread = false;
     o.coverage = true;  // the hash of a track with coverage holds it (SPEC §14 item 4)
-    auto d = ClipDecoder::open(reader, track, o);
+    auto d = LightfieldDecoder::open(reader, track, o);
     ASSERT_TRUE(d.ok()) << name << ": " << d.status().to_string();
     std::vector<LightfieldViewInfo> views;
     for (uint32_t v = 0; v < d->header().view_count; ++v) views.push_back(d->view(v));
     CpuTextures tex(d->header(), views);
     size_t line = 0;
     for (uint32_t frame = 0; frame < d->header().frame_count; ++frame) {
-      FrameUpdates fu;
+      LightfieldFrameUpdates fu;
       ASSERT_TRUE(d->advance(frame, {}, {}, &fu).ok()) << name;
       ASSERT_EQ(fu.stats.errors, 0u) << name << ": " << fu.stats.first_error;
       ASSERT_TRUE(tex.apply(fu).ok()) << name;

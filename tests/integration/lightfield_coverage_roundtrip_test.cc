@@ -17,8 +17,8 @@
 
 #include "../gl_test_context.h"
 #include "calf/capture/capture_set.h"
-#include "calf/decoder/clip_decoder.h"
 #include "calf/decoder/cpu_textures.h"
+#include "calf/decoder/lightfield_decoder.h"
 #include "calf/decoder/lightfield_reference.h"
 #include "calf/decoder/lightfield_verify.h"
 #include "calf/encoder/lightfield_encode.h"
@@ -61,14 +61,14 @@ class LightfieldCoverage : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(root_); }
 
-  std::vector<uint8_t> encode(const fs::path& set, const LightfieldEncodeOptions& o,
-                              LightfieldEncodeStats* stats = nullptr) {
+  std::vector<uint8_t> encode(const fs::path& set, const encoder::LightfieldEncodeOptions& o,
+                              encoder::LightfieldEncodeStats* stats = nullptr) {
     std::vector<uint8_t> bytes;
     auto in = capture::CaptureSetReader::open(set);
     EXPECT_TRUE(in.ok()) << in.status().to_string();
     auto writer = container::Writer::create(container::memory_sink(&bytes));
     EXPECT_TRUE(writer.ok());
-    auto s = encode_lightfield(*in, *writer, o);
+    auto s = encoder::encode_lightfield(*in, *writer, o);
     EXPECT_TRUE(s.ok()) << s.status().to_string();
     if (stats != nullptr && s.ok()) *stats = *s;
     EXPECT_TRUE(writer->finish().ok());
@@ -100,12 +100,13 @@ class LightfieldCoverage : public ::testing::Test {
 };
 
 TEST_F(LightfieldCoverage, ReferenceDecoderGivesBackTheSetsCoverageExactly) {
-  for (const DepthCoding depth : {DepthCoding::kRaw16PredictedMasked, DepthCoding::kRaw16}) {
-    LightfieldEncodeOptions o;
+  for (const encoder::DepthCoding depth :
+       {encoder::DepthCoding::kRaw16PredictedMasked, encoder::DepthCoding::kRaw16}) {
+    encoder::LightfieldEncodeOptions o;
     o.cell_size = 8;
     o.depth = depth;
     o.depth_keyframe_interval = 2;  // groups, static runs and P-frames with coverage
-    LightfieldEncodeStats stats;
+    encoder::LightfieldEncodeStats stats;
     const std::vector<uint8_t> bytes = encode(root_ / "cov", o, &stats);
     const container::Reader r = open(bytes);
     EXPECT_EQ(r.header().version_minor, container::kVersionMinorCoverage);
@@ -132,21 +133,21 @@ TEST_F(LightfieldCoverage, ReferenceDecoderGivesBackTheSetsCoverageExactly) {
 }
 
 TEST_F(LightfieldCoverage, ViewDependentDecoderAndCpuPlayerSeeTheSameCoverage) {
-  LightfieldEncodeOptions o;
+  encoder::LightfieldEncodeOptions o;
   o.cell_size = 8;
   o.depth_keyframe_interval = 2;
   const std::vector<uint8_t> bytes = encode(root_ / "cov", o);
   const container::Reader r = open(bytes);
-  decoder::ClipDecoderOptions dopt;
+  decoder::LightfieldDecoderOptions dopt;
   dopt.view_dependent = false;
   dopt.background_thread = false;
   dopt.coverage = true;
-  auto dec = decoder::ClipDecoder::open(r, 0, dopt);
+  auto dec = decoder::LightfieldDecoder::open(r, 0, dopt);
   ASSERT_TRUE(dec.ok()) << dec.status().to_string();
   EXPECT_TRUE(dec->has_coverage());
   std::vector<decoder::LightfieldViewInfo> infos = {dec->view(0), dec->view(1)};
   decoder::CpuTextures tex(dec->header(), infos);
-  decoder::FrameUpdates updates;
+  decoder::LightfieldFrameUpdates updates;
   // Frames in an order that seeks backwards and across groups.
   for (const uint32_t frame : {0u, 1u, 4u, 2u, 3u, 0u}) {
     ASSERT_TRUE(dec->advance(frame, {}, {}, &updates).ok());
@@ -163,7 +164,7 @@ TEST_F(LightfieldCoverage, ViewDependentDecoderAndCpuPlayerSeeTheSameCoverage) {
   }
   // Off (the default, and the GL player's): no coverage update at all.
   dopt.coverage = false;
-  auto plain = decoder::ClipDecoder::open(r, 0, dopt);
+  auto plain = decoder::LightfieldDecoder::open(r, 0, dopt);
   ASSERT_TRUE(plain.ok());
   ASSERT_TRUE(plain->advance(0, {}, {}, &updates).ok());
   for (const auto& u : updates.updates) EXPECT_NE(u.target, decoder::UpdateTarget::kCoverage);
@@ -206,7 +207,7 @@ TEST_F(LightfieldCoverage, ViewDependentDecoderAndCpuPlayerSeeTheSameCoverage) {
 
 TEST_F(LightfieldCoverage, DroppedOrAbsentCoverageLeavesTheClipAsWithout) {
   ASSERT_TRUE(write_coverage_capture(root_ / "plain", spec_, false).ok());
-  LightfieldEncodeOptions o;
+  encoder::LightfieldEncodeOptions o;
   o.cell_size = 8;
   const std::vector<uint8_t> without = encode(root_ / "plain", o);
   o.coverage = false;
@@ -251,8 +252,8 @@ TEST_F(LightfieldCoverage, CoverageTheStreamCannotHoldIsRefusedWithE255) {
     ASSERT_TRUE(w->write(0, 0, vf).ok());
     ASSERT_TRUE(w->finish().ok());
     const fs::path out = root_ / "bad.calf";
-    LightfieldEncodeOptions o;
-    auto stats = encode_lightfield_file(dir, out.string(), o);
+    encoder::LightfieldEncodeOptions o;
+    auto stats = encoder::encode_lightfield_file(dir, out.string(), o);
     ASSERT_FALSE(stats.ok());
     EXPECT_EQ(stats.status().id(), ErrorId::kEncoderCoverage) << stats.status().to_string();
     EXPECT_NE(stats.status().message().find(sky ? "face 3 texel (2, 2)" : "face 2 texel (2, 3)"),
@@ -260,7 +261,7 @@ TEST_F(LightfieldCoverage, CoverageTheStreamCannotHoldIsRefusedWithE255) {
         << stats.status().message();
     EXPECT_FALSE(fs::exists(out));  // nothing written
     o.coverage = false;
-    EXPECT_TRUE(encode_lightfield_file(dir, out.string(), o).ok());
+    EXPECT_TRUE(encoder::encode_lightfield_file(dir, out.string(), o).ok());
     fs::remove(out);
   }
 }
@@ -299,7 +300,7 @@ void first_texel_edge(std::vector<uint8_t>& raw, uint32_t tile_side, uint16_t ma
 }
 
 TEST_F(LightfieldCoverage, DamagedCoverageChunksAreE065AndContradictionsE066) {
-  LightfieldEncodeOptions o;
+  encoder::LightfieldEncodeOptions o;
   o.cell_size = 8;
   const std::vector<uint8_t> bytes = encode(root_ / "cov", o);
   const container::Reader r = open(bytes);
@@ -330,25 +331,25 @@ TEST_F(LightfieldCoverage, DamagedCoverageChunksAreE065AndContradictionsE066) {
   EXPECT_TRUE(ok.problems.empty()) << ok.problems[0].to_string();
   // The view-dependent decoder reports the damaged chunk as a frame error, with its id.
   const container::Reader damaged = open(counts_over_16);
-  decoder::ClipDecoderOptions dopt;
+  decoder::LightfieldDecoderOptions dopt;
   dopt.view_dependent = false;
   dopt.background_thread = false;
   dopt.coverage = true;
-  auto dec = decoder::ClipDecoder::open(damaged, 0, dopt);
+  auto dec = decoder::LightfieldDecoder::open(damaged, 0, dopt);
   ASSERT_TRUE(dec.ok());
-  decoder::FrameUpdates updates;
+  decoder::LightfieldFrameUpdates updates;
   ASSERT_TRUE(dec->advance(0, {}, {}, &updates).ok());
   EXPECT_EQ(updates.stats.errors, 1u);
   EXPECT_EQ(updates.stats.first_error.rfind("CALF-E065", 0), 0u) << updates.stats.first_error;
 }
 
 // The GL player uploads a clip's coverage (kCoverage updates into its coverage textures) and
-// answers RenderOptions::coverage as the CPU player does, frame after frame (the coverage of face
-// 0's moving square changes with it), with the coverage test on (modes 4 and 3) and off. The C key
-// of calf-play's window switches between the two.
+// answers LightfieldRenderOptions::coverage as the CPU player does, frame after frame (the coverage
+// of face 0's moving square changes with it), with the coverage test on (modes 4 and 3) and off.
+// The C key of calf-play's window switches between the two.
 TEST_F(LightfieldCoverage, GlPlayerUsesTheClipsCoverageAsTheCpuPlayer) {
   CALF_REQUIRE_GL();
-  LightfieldEncodeOptions o;
+  encoder::LightfieldEncodeOptions o;
   o.cell_size = 8;
   o.depth_keyframe_interval = 2;
   const std::vector<uint8_t> bytes = encode(root_ / "cov", o);
@@ -369,7 +370,7 @@ TEST_F(LightfieldCoverage, GlPlayerUsesTheClipsCoverageAsTheCpuPlayer) {
   cam.fov_y = 1.2;
   cam.width = cam.height = 40;
   for (const uint32_t coverage : {4u, 3u, 0u}) {
-    player::RenderOptions ro = lo.render;
+    player::LightfieldRenderOptions ro = lo.render;
     ro.coverage = coverage;
     ASSERT_TRUE((*gl)->set_render_options(ro).ok());
     ASSERT_TRUE((*cpu)->set_render_options(ro).ok());
@@ -392,7 +393,7 @@ TEST_F(LightfieldCoverage, GlPlayerUsesTheClipsCoverageAsTheCpuPlayer) {
           "coverage %u, frame %u: GL vs CPU player %.2f dB, %zu of %zu pixels agree on sky\n",
           coverage, frame, p, same_side, a.depth.size());
       // With coverage on, hits land on the cell edges of this set's made-up masks, where float
-      // and double can shade from different texels (gl_renderer_test.cc,
+      // and double can shade from different texels (lightfield_gl_renderer_test.cc,
       // MatchesCpuWithCoverage): 53.8-55.6 dB on frames 0, 1, 3, 35.7-38.0 dB on frames 2, 4.
       EXPECT_GE(p, coverage == 0 ? 45.0 : 35.0) << "coverage " << coverage << " frame " << frame;
       EXPECT_GE(same_side + 1, a.depth.size());  // an isolated float / double flip at most

@@ -13,7 +13,7 @@
 
 #include "calf/capture/capture_set.h"
 #include "calf/decoder/lightfield_reference.h"
-#include "calf/encoder/color_keyframes.h"
+#include "calf/encoder/colour_keyframes.h"
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/format/container.h"
 #include "calf/format/grid.h"
@@ -46,11 +46,11 @@ class LightfieldRoundTrip : public ::testing::Test {
     return dir;
   }
 
-  LightfieldEncodeStats encode(const fs::path& capture, const fs::path& out,
-                               LightfieldEncodeOptions o) {
-    auto stats = encode_lightfield_file(capture, out.string(), o);
+  encoder::LightfieldEncodeStats encode(const fs::path& capture, const fs::path& out,
+                                        encoder::LightfieldEncodeOptions o) {
+    auto stats = encoder::encode_lightfield_file(capture, out.string(), o);
     EXPECT_TRUE(stats.ok()) << stats.status().to_string();
-    return stats.ok() ? *stats : LightfieldEncodeStats{};
+    return stats.ok() ? *stats : encoder::LightfieldEncodeStats{};
   }
 
   static std::string slurp(const fs::path& p) {
@@ -61,9 +61,9 @@ class LightfieldRoundTrip : public ::testing::Test {
   // Decodes every view, face and frame of `file` and checks colour against Q (on the spatial
   // reference), depth against the quantised input (exactly, or within `max_rel` for BC5), and
   // material codes exactly (raw). BC1 is fitted with `bc1_fit`, as the file was encoded.
-  void check_file(const fs::path& capture_dir, const fs::path& file, ColourCoding coding, double q,
-                  bool exact_depth, double max_rel = 0, bool exact_material = true,
-                  Bc1Fit bc1_fit = LightfieldEncodeOptions{}.bc1_fit) {
+  void check_file(const fs::path& capture_dir, const fs::path& file, encoder::ColourCoding coding,
+                  double q, bool exact_depth, double max_rel = 0, bool exact_material = true,
+                  encoder::Bc1Fit bc1_fit = encoder::LightfieldEncodeOptions{}.bc1_fit) {
     auto reader = container::Reader::open(file.string());
     ASSERT_TRUE(reader.ok()) << reader.status().to_string();
     EXPECT_TRUE(reader->verify().empty());
@@ -103,10 +103,11 @@ class LightfieldRoundTrip : public ::testing::Test {
               }
             }
             std::vector<float> reference;
-            ASSERT_TRUE(
-                spatial_colour_reference(coding, bc1_fit, orig, r.width, r.height, &reference)
-                    .ok());
-            const double quality = hdr ? psnr_log2(reference, got) : psnr_srgb(reference, got);
+            ASSERT_TRUE(encoder::spatial_colour_reference(coding, bc1_fit, orig, r.width, r.height,
+                                                          &reference)
+                            .ok());
+            const double quality =
+                hdr ? encoder::psnr_log2(reference, got) : encoder::psnr_srgb(reference, got);
             worst = std::min(worst, quality);
             EXPECT_GE(quality, q) << "view " << v << " face " << face << " frame " << f << " cell "
                                   << c;
@@ -146,7 +147,7 @@ class LightfieldRoundTrip : public ::testing::Test {
 TEST_F(LightfieldRoundTrip, Bc1ColourMeetsQAndRaw16DepthIsExact) {
   const fs::path cap = make_capture({}, "ldr");
   const fs::path cap32 = make_capture({.face = 32}, "ldr32");
-  LightfieldEncodeOptions o;
+  encoder::LightfieldEncodeOptions o;
   o.cell_size = 8;
   o.threads = 2;
   // Q bounds the temporal loss against the frames as the BC1 encoder alone makes them; the colour
@@ -162,19 +163,19 @@ TEST_F(LightfieldRoundTrip, Bc1ColourMeetsQAndRaw16DepthIsExact) {
   EXPECT_GT(stats.colour_keyframes, stats.colour_cells);
   EXPECT_LT(stats.colour_keyframes, stats.colour_cells * 5);
   EXPECT_GT(stats.depth_empty_pframes, 0u);
-  check_file(cap, root_ / "ldr.calf", ColourCoding::kBc1, 50.0, true);
+  check_file(cap, root_ / "ldr.calf", encoder::ColourCoding::kBc1, 50.0, true);
   // The default RDO (lambda 0.5) makes the colour smaller; its error per block is at most
   // lambda * 60 squared 8-bit units (bc_rdo.h), 0.625 per RGB sample, on top of Q's 0.65 (50 dB):
   // a cell's MSE is then at most 2 (0.65 + 0.625) (the two errors in the same direction), 44.1 dB.
   // Cells of 32 (64 blocks a chunk): in 8² cells a chunk is 4 blocks, too few for zstd to find
   // the copies.
-  LightfieldEncodeOptions off = o, rdo = o;
+  encoder::LightfieldEncodeOptions off = o, rdo = o;
   off.cell_size = rdo.cell_size = 32;
   rdo.colour_rdo = 0.5;
   const auto without = encode(cap32, root_ / "ldr32.calf", off);
   const auto with_rdo = encode(cap32, root_ / "ldr32-rdo.calf", rdo);
   EXPECT_LT(with_rdo.colour.stored, without.colour.stored);
-  check_file(cap32, root_ / "ldr32-rdo.calf", ColourCoding::kBc1, 44.0, true);
+  check_file(cap32, root_ / "ldr32-rdo.calf", encoder::ColourCoding::kBc1, 44.0, true);
 }
 
 // Every BC1 fit meets Q against its own spatial coding; the refined and cluster fits show the
@@ -183,14 +184,15 @@ TEST_F(LightfieldRoundTrip, Bc1ColourMeetsQAndRaw16DepthIsExact) {
 TEST_F(LightfieldRoundTrip, EveryBc1FitMeetsQAndTheBetterFitsShowTheSourceCloser) {
   const fs::path cap = make_capture({.face = 16, .frames = 3}, "fits");
   double source_psnr[3] = {};
-  for (Bc1Fit fit : {Bc1Fit::kRange, Bc1Fit::kRefined, Bc1Fit::kCluster}) {
-    LightfieldEncodeOptions o;
+  for (encoder::Bc1Fit fit :
+       {encoder::Bc1Fit::kRange, encoder::Bc1Fit::kRefined, encoder::Bc1Fit::kCluster}) {
+    encoder::LightfieldEncodeOptions o;
     o.cell_size = 8;
     o.colour_rdo = 0;  // Q is checked: see Bc1ColourMeetsQAndRaw16DepthIsExact
     o.bc1_fit = fit;
     const fs::path file = root_ / ("fit" + std::to_string(static_cast<int>(fit)) + ".calf");
     encode(cap, file, o);
-    check_file(cap, file, ColourCoding::kBc1, 50.0, true, 0, true, fit);
+    check_file(cap, file, encoder::ColourCoding::kBc1, 50.0, true, 0, true, fit);
     // Against the source: sRGB PSNR over every face of every frame.
     auto reader = container::Reader::open(file.string());
     ASSERT_TRUE(reader.ok());
@@ -219,30 +221,30 @@ TEST_F(LightfieldRoundTrip, EveryBc1FitMeetsQAndTheBetterFitsShowTheSourceCloser
         }
       }
     }
-    source_psnr[static_cast<int>(fit)] = psnr_srgb(src, got);
+    source_psnr[static_cast<int>(fit)] = encoder::psnr_srgb(src, got);
   }
   RecordProperty("range_db", std::to_string(source_psnr[0]));
   RecordProperty("refined_db", std::to_string(source_psnr[1]));
   RecordProperty("cluster_db", std::to_string(source_psnr[2]));
   EXPECT_GT(source_psnr[1], source_psnr[0]);
   EXPECT_GT(source_psnr[2], source_psnr[0]);
-  LightfieldEncodeOptions o;
-  EXPECT_EQ(colour_rdo_lambda(o, ColourCoding::kBc1), 12.0);
-  EXPECT_EQ(colour_rdo_lambda(o, ColourCoding::kBc6h), 0.5);
-  EXPECT_EQ(colour_rdo_lambda(o, ColourCoding::kBc7), 0.5);
+  encoder::LightfieldEncodeOptions o;
+  EXPECT_EQ(encoder::colour_rdo_lambda(o, encoder::ColourCoding::kBc1), 12.0);
+  EXPECT_EQ(encoder::colour_rdo_lambda(o, encoder::ColourCoding::kBc6h), 0.5);
+  EXPECT_EQ(encoder::colour_rdo_lambda(o, encoder::ColourCoding::kBc7), 0.5);
   o.colour_rdo = 3;
-  EXPECT_EQ(colour_rdo_lambda(o, ColourCoding::kBc1), 3.0);
+  EXPECT_EQ(encoder::colour_rdo_lambda(o, encoder::ColourCoding::kBc1), 3.0);
 }
 
 TEST_F(LightfieldRoundTrip, EveryColourFormatAndSchemeRoundTrips) {
   const fs::path cap = make_capture({.face = 12, .frames = 4, .views = 1}, "formats");
-  const std::pair<ColourCoding, container::Compression> cases[] = {
-      {ColourCoding::kBc7, container::Compression::kLzma2},
-      {ColourCoding::kRgba8, container::Compression::kNone},
-      {ColourCoding::kRgba16f, container::Compression::kZstd},
-      {ColourCoding::kBc6h, container::Compression::kZstd}};
+  const std::pair<encoder::ColourCoding, container::Compression> cases[] = {
+      {encoder::ColourCoding::kBc7, container::Compression::kLzma2},
+      {encoder::ColourCoding::kRgba8, container::Compression::kNone},
+      {encoder::ColourCoding::kRgba16f, container::Compression::kZstd},
+      {encoder::ColourCoding::kBc6h, container::Compression::kZstd}};
   for (const auto& [coding, scheme] : cases) {
-    LightfieldEncodeOptions o;
+    encoder::LightfieldEncodeOptions o;
     o.cell_size = 8;  // 12 = one 8-cell and one 4-cell per side: edge cells included
     o.colour = coding;
     o.supercompression = scheme;
@@ -259,7 +261,7 @@ TEST_F(LightfieldRoundTrip, EveryColourFormatAndSchemeRoundTrips) {
 TEST_F(LightfieldRoundTrip, HdrInputChoosesBc6hAndLdrNeverPaysForHdr) {
   const fs::path hdr = make_capture({.face = 8, .frames = 3, .views = 1, .hdr = true}, "hdr");
   const fs::path ldr = make_capture({.face = 8, .frames = 3, .views = 1}, "ldr");
-  LightfieldEncodeOptions o;
+  encoder::LightfieldEncodeOptions o;
   o.cell_size = 8;
   const auto sh = encode(hdr, root_ / "hdr.calf", o);
   const auto sl = encode(ldr, root_ / "ldr.calf", o);
@@ -268,12 +270,12 @@ TEST_F(LightfieldRoundTrip, HdrInputChoosesBc6hAndLdrNeverPaysForHdr) {
   EXPECT_EQ(sl.colour_format, static_cast<uint16_t>(container::PixelFormat::kBc1));
   // BC1 keyframes are half the bytes of BC6H ones.
   EXPECT_LT(sl.colour.spatial, sh.colour.spatial);
-  check_file(hdr, root_ / "hdr.calf", ColourCoding::kBc6h, 50.0, true);
+  check_file(hdr, root_ / "hdr.calf", encoder::ColourCoding::kBc6h, 50.0, true);
 }
 
 TEST_F(LightfieldRoundTrip, OneAndTwoThreadsGiveIdenticalBytes) {
   const fs::path cap = make_capture({.material = true}, "threads");
-  LightfieldEncodeOptions o;
+  encoder::LightfieldEncodeOptions o;
   o.cell_size = 8;
   o.threads = 1;
   encode(cap, root_ / "t1.calf", o);
@@ -282,7 +284,7 @@ TEST_F(LightfieldRoundTrip, OneAndTwoThreadsGiveIdenticalBytes) {
   const std::string a = slurp(root_ / "t1.calf"), b = slurp(root_ / "t2.calf");
   ASSERT_FALSE(a.empty());
   EXPECT_TRUE(a == b) << "thread count changed the output";
-  o.depth = DepthCoding::kBc5;
+  o.depth = encoder::DepthCoding::kBc5;
   o.threads = 1;
   encode(cap, root_ / "b1.calf", o);
   o.threads = 2;
@@ -292,7 +294,7 @@ TEST_F(LightfieldRoundTrip, OneAndTwoThreadsGiveIdenticalBytes) {
 
 TEST_F(LightfieldRoundTrip, StaticSceneIsOneKeyframePerCellAndEmptyPFrames) {
   const fs::path cap = make_capture({.frames = 6, .animated = false}, "static");
-  LightfieldEncodeOptions o;
+  encoder::LightfieldEncodeOptions o;
   o.cell_size = 8;
   o.colour_rdo = 0;  // Q is checked: see Bc1ColourMeetsQAndRaw16DepthIsExact
   const auto stats = encode(cap, root_ / "static.calf", o);
@@ -318,15 +320,15 @@ TEST_F(LightfieldRoundTrip, StaticSceneIsOneKeyframePerCellAndEmptyPFrames) {
   }
   // Static content costs almost nothing: far below one keyframe per frame.
   EXPECT_LT(stats.colour.stored * 3, stats.colour.raw / 6);
-  check_file(cap, root_ / "static.calf", ColourCoding::kBc1, 50.0, true);
+  check_file(cap, root_ / "static.calf", encoder::ColourCoding::kBc1, 50.0, true);
 }
 
 TEST_F(LightfieldRoundTrip, Bc5DepthReportsItsErrorAndDecodesWithinIt) {
   const fs::path cap = make_capture({.material = true}, "bc5");
-  LightfieldEncodeOptions o;
+  encoder::LightfieldEncodeOptions o;
   o.cell_size = 8;
   o.colour_rdo = 0;  // Q is checked: see Bc1ColourMeetsQAndRaw16DepthIsExact
-  o.depth = DepthCoding::kBc5;
+  o.depth = encoder::DepthCoding::kBc5;
   const auto stats = encode(cap, root_ / "bc5.calf", o);
   EXPECT_EQ(stats.depth_format, static_cast<uint16_t>(container::PixelFormat::kBc5));
   EXPECT_EQ(stats.material_format, static_cast<uint16_t>(container::PixelFormat::kBc1));
@@ -334,19 +336,19 @@ TEST_F(LightfieldRoundTrip, Bc5DepthReportsItsErrorAndDecodesWithinIt) {
   EXPECT_LT(stats.depth_max_rel_error, 1.0);
   RecordProperty("bc5_max_rel", std::to_string(stats.depth_max_rel_error));
   RecordProperty("bc5_mean_rel", std::to_string(stats.depth_mean_rel_error));
-  check_file(cap, root_ / "bc5.calf", ColourCoding::kBc1, 50.0, false, stats.depth_max_rel_error,
-             false);
+  check_file(cap, root_ / "bc5.calf", encoder::ColourCoding::kBc1, 50.0, false,
+             stats.depth_max_rel_error, false);
 }
 
 TEST_F(LightfieldRoundTrip, MaterialOnlyWhereAViewSeesIt) {
   const fs::path cap = make_capture({.material = true}, "material");
-  LightfieldEncodeOptions o;
+  encoder::LightfieldEncodeOptions o;
   o.cell_size = 8;
   o.colour_rdo = 0;  // Q is checked: see Bc1ColourMeetsQAndRaw16DepthIsExact
   const auto stats = encode(cap, root_ / "m.calf", o);
   EXPECT_EQ(stats.material_views, 2u);
   EXPECT_EQ(stats.material_format, static_cast<uint16_t>(container::PixelFormat::kRgba8));
-  check_file(cap, root_ / "m.calf", ColourCoding::kBc1, 50.0, true);
+  check_file(cap, root_ / "m.calf", encoder::ColourCoding::kBc1, 50.0, true);
   // A set with material channels but no reflective texel gets no material stream.
   const fs::path plain = make_capture({.face = 8, .frames = 2, .views = 1}, "plain");
   const auto s2 = encode(plain, root_ / "p.calf", o);
@@ -356,7 +358,7 @@ TEST_F(LightfieldRoundTrip, MaterialOnlyWhereAViewSeesIt) {
 
 TEST_F(LightfieldRoundTrip, BadInputNamesTheFileAndWritesNothing) {
   const fs::path cap = make_capture({.face = 8, .frames = 3}, "bad");
-  LightfieldEncodeOptions o;
+  encoder::LightfieldEncodeOptions o;
   o.cell_size = 8;
   // A missing image (NaN / negative depth pixels are rejected by the capture reader with the
   // file, face and texel named: tests/capture/capture_set_test.cc).
@@ -367,16 +369,16 @@ TEST_F(LightfieldRoundTrip, BadInputNamesTheFileAndWritesNothing) {
     fs::copy(cap, bad);
     fs::path victim = bad / capture::capture_file_name(in->manifest(), 1, 2);
     fs::remove(victim);
-    auto r = encode_lightfield_file(bad, (root_ / "nan.calf").string(), o);
+    auto r = encoder::encode_lightfield_file(bad, (root_ / "nan.calf").string(), o);
     ASSERT_FALSE(r.ok());
     EXPECT_NE(r.status().message().find("view001_frame00002"), std::string::npos)
         << r.status().to_string();
     EXPECT_FALSE(fs::exists(root_ / "nan.calf"));
   }
   {
-    LightfieldEncodeOptions bad_options = o;
+    encoder::LightfieldEncodeOptions bad_options = o;
     bad_options.cell_size = 6;
-    auto r = encode_lightfield_file(cap, (root_ / "opt.calf").string(), bad_options);
+    auto r = encoder::encode_lightfield_file(cap, (root_ / "opt.calf").string(), bad_options);
     ASSERT_FALSE(r.ok());
     EXPECT_EQ(r.status().id(), ErrorId::kEncoderOption);
     EXPECT_FALSE(fs::exists(root_ / "opt.calf"));

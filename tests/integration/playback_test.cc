@@ -33,9 +33,9 @@ const std::string& clip_path() {
     std::string cmd = CALF_CAPTURE_EXE;
     cmd.append(" --scene interior --face-size 16 --frames 3 --quiet --out ").append(capture);
     EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
-    LightfieldEncodeOptions o;
+    encoder::LightfieldEncodeOptions o;
     o.cell_size = 8;
-    auto stats = encode_lightfield_file(capture, clip, o);
+    auto stats = encoder::encode_lightfield_file(capture, clip, o);
     EXPECT_TRUE(stats.ok()) << stats.status().to_string();
     return clip;
   }();

@@ -151,12 +151,13 @@ void check_prefixes_nest(const Candidates& c, const std::vector<uint32_t>& order
 
 TEST(SurfelPrefixProperty, EveryPrefixRendersAndPrefixesNest) {
   const Candidates c = sphere_on_a_floor(2500, 40);
-  for (SurfelOrderMethod m : {SurfelOrderMethod::kGreedyTree, SurfelOrderMethod::kProgressive,
-                              SurfelOrderMethod::kRandom}) {
-    SCOPED_TRACE(surfel_order_method_name(m));
-    SurfelSamplerOptions o;
+  for (encoder::SurfelOrderMethod m :
+       {encoder::SurfelOrderMethod::kGreedyTree, encoder::SurfelOrderMethod::kProgressive,
+        encoder::SurfelOrderMethod::kRandom}) {
+    SCOPED_TRACE(encoder::surfel_order_method_name(m));
+    encoder::SurfelSamplerOptions o;
     o.method = m;
-    auto built = order_surfels(c.position, 900, o);
+    auto built = encoder::order_surfels(c.position, 900, o);
     ASSERT_TRUE(built.ok()) << built.status().to_string();
     check_prefixes_nest(c, built->order, 0.0f, [](const player::SurfelDrawList& l, auto* im) {
       const Status s = player::render_surfels_cpu(l, camera(), {}, im);
@@ -173,7 +174,7 @@ TEST(SurfelPrefixProperty, EveryPrefixRendersAndPrefixesNestOnGl) {
   Expected<std::unique_ptr<player::OsMesaContext>> context = player::OsMesaContext::make();
   if (!context.ok()) GTEST_SKIP() << "no OSMesa GL 4.5 core context";
   const Candidates c = sphere_on_a_floor(2500, 40);
-  auto built = order_surfels(c.position, 900, {});
+  auto built = encoder::order_surfels(c.position, 900, {});
   ASSERT_TRUE(built.ok()) << built.status().to_string();
   auto gl = player::GlSurfelRenderer::make((*context)->gl());
   ASSERT_TRUE(gl.ok()) << gl.status().message();
@@ -193,9 +194,9 @@ TEST(SurfelPrefixProperty, EveryPrefixRendersAndPrefixesNestOnGl) {
 // meets the sphere at least 2 pixels inside its silhouette (the rim is seen edge-on).
 TEST(SurfelPrefixProperty, PrefixForARadiusCoversTheSphere) {
   const Candidates c = sphere_on_a_floor(6000, 0);
-  SurfelSamplerOptions o;  // the default: the greedy permutation
+  encoder::SurfelSamplerOptions o;  // the default: the greedy permutation
   o.p_m = 200;
-  auto built = order_surfels(c.position, 3000, o);
+  auto built = encoder::order_surfels(c.position, 3000, o);
   ASSERT_TRUE(built.ok()) << built.status().to_string();
   const Camera cam = camera();
   for (double r : {0.25, 0.15, 0.1}) {

@@ -34,7 +34,7 @@ inline TileSet make_synthetic_tile_set(uint32_t cells, uint32_t s, uint32_t atla
                                        uint64_t seed) {
   TilesRng rng{seed};
   TileSet set;
-  set.view_region = Box3{{-0.25, -0.1, -0.25}, {0.25, 0.1, 0.25}};
+  set.view_volume = Box3{{-0.25, -0.1, -0.25}, {0.25, 0.1, 0.25}};
   const uint32_t per_row = atlas_width / s, count = 6 * cells * cells;
   set.atlas_width = atlas_width;
   set.atlas_height = (count + per_row - 1) / per_row * s;

@@ -69,7 +69,7 @@ double psnr(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
 
 // Bit-for-bit equality of the tiles and the view region.
 void expect_same_tiles(const TileSet& got, const TileSet& want) {
-  EXPECT_EQ(got.view_region, want.view_region);
+  EXPECT_EQ(got.view_volume, want.view_volume);
   ASSERT_EQ(got.tiles.size(), want.tiles.size());
   for (size_t t = 0; t < want.tiles.size(); ++t) {
     for (int k = 0; k < 4; ++k) {
@@ -214,8 +214,8 @@ TEST(TilesTrack, BadInputIsRefused) {
        [](auto& s) { s.tiles[4].corners[0].uvw[0] = 2 * s.tiles[4].corners[0].uvw[2]; }},
       {"V negative", [](auto& s) { s.tiles[4].corners[0].uvw[1] = -1e-9f; }},
       {"U NaN", [](auto& s) { s.tiles[4].corners[0].uvw[0] = NAN; }},
-      {"view region inverted", [](auto& s) { s.view_region.min.x = 1; }},
-      {"view region NaN", [](auto& s) { s.view_region.max.z = NAN; }},
+      {"view region inverted", [](auto& s) { s.view_volume.min.x = 1; }},
+      {"view region NaN", [](auto& s) { s.view_volume.max.z = NAN; }},
   };
   for (const auto& [name, edit] : cases) {
     TileSet bad = good;

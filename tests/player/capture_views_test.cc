@@ -109,13 +109,13 @@ TEST(CaptureViews, LoadsColourDepthAndMaterial) {
         const double got = a.range().decode(a.depth_code_at(f, x, y));
         EXPECT_NEAR(got / want, 1.0, a.range().relative_step()) << face << " " << x << " " << y;
         // Colour is stored as half floats in the file: these values are exact in half.
-        EXPECT_EQ(a.color_at(f, x, y)[0], face / 8.0f);
-        EXPECT_EQ(a.color_at(f, x, y)[1], x / 8.0f);
-        EXPECT_EQ(a.color_at(f, x, y)[2], y / 8.0f);
+        EXPECT_EQ(a.colour_at(f, x, y)[0], face / 8.0f);
+        EXPECT_EQ(a.colour_at(f, x, y)[1], x / 8.0f);
+        EXPECT_EQ(a.colour_at(f, x, y)[2], y / 8.0f);
       }
     }
   }
-  EXPECT_EQ(views->views[1].color_at(CubeFace::kPosX, 0, 0)[0], 1.0f);  // view index added
+  EXPECT_EQ(views->views[1].colour_at(CubeFace::kPosX, 0, 0)[0], 1.0f);  // view index added
   const Material m = a.material_at(CubeFace::kNegZ, 2, 1);
   EXPECT_EQ(m.reflect, 0.5f);
   EXPECT_EQ(m.refract, 0.25f);
@@ -222,7 +222,7 @@ TEST(CaptureViews, ReprojectionAtTheViewpointShowsTheTexels) {
   for (uint32_t j = 0; j < 4; ++j) {
     for (uint32_t i = 0; i < 4; ++i) {
       const size_t k = j * 4 + i;
-      const float* want = v->color_at(CubeFace::kNegZ, 3 - i, j);
+      const float* want = v->colour_at(CubeFace::kNegZ, 3 - i, j);
       for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(img.color[3 * k + ch], want[ch], 1e-6);
       EXPECT_NEAR(img.depth[k], 1.0 + (5 + (3 - i) + 2.0 * j) / 8, 1e-3);
     }

@@ -162,15 +162,15 @@ TEST(ImageCompare, ErrorMapAndRamp) {
   EXPECT_EQ(e[0], 0.0f);
   EXPECT_NEAR(e[1], 0.4 / std::sqrt(3.0), 1e-5);
   using C = std::array<uint8_t, 3>;
-  EXPECT_EQ(heat_color(0), (C{0, 0, 0}));
-  EXPECT_EQ(heat_color(0.25), (C{0, 0, 255}));
-  EXPECT_EQ(heat_color(0.5), (C{0, 255, 255}));
-  EXPECT_EQ(heat_color(0.75), (C{255, 255, 0}));
-  EXPECT_EQ(heat_color(1), (C{255, 0, 0}));
-  EXPECT_EQ(heat_color(0.125), (C{0, 0, 128}));
-  EXPECT_EQ(heat_color(-3), (C{0, 0, 0}));
-  EXPECT_EQ(heat_color(7), (C{255, 0, 0}));
-  EXPECT_EQ(heat_color(std::nan("")), (C{255, 0, 0}));
+  EXPECT_EQ(heat_colour(0), (C{0, 0, 0}));
+  EXPECT_EQ(heat_colour(0.25), (C{0, 0, 255}));
+  EXPECT_EQ(heat_colour(0.5), (C{0, 255, 255}));
+  EXPECT_EQ(heat_colour(0.75), (C{255, 255, 0}));
+  EXPECT_EQ(heat_colour(1), (C{255, 0, 0}));
+  EXPECT_EQ(heat_colour(0.125), (C{0, 0, 128}));
+  EXPECT_EQ(heat_colour(-3), (C{0, 0, 0}));
+  EXPECT_EQ(heat_colour(7), (C{255, 0, 0}));
+  EXPECT_EQ(heat_colour(std::nan("")), (C{255, 0, 0}));
 }
 
 class ImageFiles : public ::testing::Test {
@@ -208,7 +208,7 @@ TEST_F(ImageFiles, PngHeatMapAndExrReadBack) {
   b.rgb[0] = static_cast<uint8_t>(a.rgb[0] + 13);  // error 13 / 255 / sqrt(3) at pixel 0
   ASSERT_TRUE(write_heat_map_png(dir_ / "heat.png", {4, 3, a.linear()}, {4, 3, b.linear()}).ok());
   const std::vector<uint8_t> heat = read_png(dir_ / "heat.png", &w, &h);
-  const std::array<uint8_t, 3> want = heat_color(13 / 255.0 / std::sqrt(3.0) / 0.1);
+  const std::array<uint8_t, 3> want = heat_colour(13 / 255.0 / std::sqrt(3.0) / 0.1);
   EXPECT_NEAR(heat[0], want[0], 1);
   EXPECT_NEAR(heat[1], want[1], 1);
   EXPECT_NEAR(heat[2], want[2], 1);

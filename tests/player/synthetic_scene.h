@@ -12,7 +12,7 @@
 
 #include "calf/format/cube.h"
 #include "calf/format/log_depth.h"
-#include "calf/player/cpu_renderer.h"
+#include "calf/player/lightfield_cpu_renderer.h"
 #include "calf/player/view_set.h"
 
 namespace calf::player::testing {
@@ -184,7 +184,7 @@ inline View make_view(const Scene& s, const Vec3& position, uint32_t n, bool mat
     for (float z : depth[f]) codes.push_back(range.encode_unchecked(z));
     const PixelRect all{0, 0, n, n};
     const CubeFace face = cube_face_from_index(f);
-    if (!v.write_color_rect(face, all, color[f]).ok() ||
+    if (!v.write_colour_rect(face, all, color[f]).ok() ||
         !v.write_depth_rect(face, all, codes).ok() ||
         (material && !v.write_material_rect(face, all, mat[f]).ok())) {
       std::abort();

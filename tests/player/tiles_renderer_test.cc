@@ -69,7 +69,7 @@ void set_atlas(TileSet* set, uint32_t w, uint32_t h, const std::vector<std::arra
 
 TileSet base_set() {
   TileSet s;
-  s.view_region = {{-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5}};
+  s.view_volume = {{-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5}};
   return s;
 }
 

@@ -22,7 +22,7 @@ TEST(ViewSet, StartsAsSky) {
   for (int f = 0; f < kCubeFaceCount; ++f) {
     const CubeFace face = cube_face_from_index(f);
     for (uint16_t c : v.depth_face(face)) ASSERT_EQ(c, kLog16Sky);
-    for (float c : v.color_face(face)) ASSERT_EQ(c, 0.0f);
+    for (float c : v.colour_face(face)) ASSERT_EQ(c, 0.0f);
     const Material m = v.material_at(face, 7, 7);
     EXPECT_EQ(m.reflect, 0.0f);
     EXPECT_EQ(m.refract, 0.0f);
@@ -44,8 +44,8 @@ TEST(ViewSet, RectWritesLandWhereTheySay) {
   EXPECT_EQ(v.depth_code_at(CubeFace::kNegY, 7, 6), kLog16Sky);
   EXPECT_EQ(v.depth_code_at(CubeFace::kPosY, 4, 5), kLog16Sky);
   const std::vector<float> rgb = {0.1f, 0.2f, 3.5f};  // HDR kept
-  ASSERT_TRUE(v.write_color_rect(CubeFace::kPosZ, {7, 0, 1, 1}, rgb).ok());
-  EXPECT_EQ(v.color_at(CubeFace::kPosZ, 7, 0)[2], 3.5f);
+  ASSERT_TRUE(v.write_colour_rect(CubeFace::kPosZ, {7, 0, 1, 1}, rgb).ok());
+  EXPECT_EQ(v.colour_at(CubeFace::kPosZ, 7, 0)[2], 3.5f);
   const std::vector<float> mat = {0.25f, 0.5f, 1.5f};
   ASSERT_TRUE(v.write_material_rect(CubeFace::kNegX, {0, 7, 1, 1}, mat).ok());
   EXPECT_EQ(v.material_at(CubeFace::kNegX, 0, 7).ior, 1.5f);
@@ -67,7 +67,7 @@ TEST(ViewSet, RejectsBadViewsAndRects) {
   EXPECT_EQ(v.write_depth_rect(CubeFace::kPosX, {0, 0, 4, 2}, codes, 3).id(), ErrorId::kPlayerRect);
   EXPECT_EQ(v.write_depth_rect(CubeFace::kPosX, {0, 0, 8, 8}, std::span(codes).first(63)).id(),
             ErrorId::kPlayerRect);
-  EXPECT_EQ(v.write_color_rect(static_cast<CubeFace>(6), {0, 0, 1, 1}, rgb).id(),
+  EXPECT_EQ(v.write_colour_rect(static_cast<CubeFace>(6), {0, 0, 1, 1}, rgb).id(),
             ErrorId::kPlayerRect);
   EXPECT_EQ(v.write_material_rect(CubeFace::kPosX, {0, 0, 1, 1}, rgb).id(),
             ErrorId::kPlayerNoMaterial);
@@ -115,7 +115,7 @@ TEST(ViewSet, UnmixingRecoversTheOwnColourOfEdgeTexels) {
     }
   }
   ASSERT_TRUE(v.write_depth_rect(CubeFace::kPosZ, {0, 0, n, n}, depth).ok());
-  ASSERT_TRUE(v.write_color_rect(CubeFace::kPosZ, {0, 0, n, n}, colour).ok());
+  ASSERT_TRUE(v.write_colour_rect(CubeFace::kPosZ, {0, 0, n, n}, colour).ok());
   ASSERT_TRUE(v.write_coverage_rect(CubeFace::kPosZ, {0, 0, n, n}, cov).ok());
   // On -Z (all sky, colour B) texel (2, 2) is sky a quarter covered by a near surface in colour
   // A, texel (1, 2) beside it that surface (depth 2).
@@ -132,22 +132,22 @@ TEST(ViewSet, UnmixingRecoversTheOwnColourOfEdgeTexels) {
   sky_cov[3 * s] = 0.25f;
   sky_cov[3 * s + 2] = 0xEEEE;
   ASSERT_TRUE(v.write_depth_rect(CubeFace::kNegZ, {0, 0, n, n}, sky_depth).ok());
-  ASSERT_TRUE(v.write_color_rect(CubeFace::kNegZ, {0, 0, n, n}, sky_colour).ok());
+  ASSERT_TRUE(v.write_colour_rect(CubeFace::kNegZ, {0, 0, n, n}, sky_colour).ok());
   ASSERT_TRUE(v.write_coverage_rect(CubeFace::kNegZ, {0, 0, n, n}, sky_cov).ok());
 
   unmix_coverage_colour(&v, 0.25, 0.1);
   for (uint32_t y = 0; y < n; ++y) {
     for (uint32_t x = 0; x < n; ++x) {
       const float* want = x < 4 ? a : b;
-      const float* got = v.color_at(CubeFace::kPosZ, x, y);
+      const float* got = v.colour_at(CubeFace::kPosZ, x, y);
       for (int c = 0; c < 3; ++c) {
         EXPECT_NEAR(got[c], want[c], 1e-5) << "texel (" << x << ", " << y << ") channel " << c;
       }
     }
   }
   for (int c = 0; c < 3; ++c) {
-    EXPECT_NEAR(v.color_at(CubeFace::kNegZ, 2, 2)[c], b[c], 1e-5);
-    EXPECT_NEAR(v.color_at(CubeFace::kNegZ, 1, 2)[c], a[c], 1e-5);
+    EXPECT_NEAR(v.colour_at(CubeFace::kNegZ, 2, 2)[c], b[c], 1e-5);
+    EXPECT_NEAR(v.colour_at(CubeFace::kNegZ, 1, 2)[c], a[c], 1e-5);
   }
 }
 
@@ -156,9 +156,9 @@ TEST(ViewSet, UnmixingLeavesViewsWithoutCoverageAlone) {
   View v = make(4, false);
   std::vector<float> colour(3 * 16);
   for (size_t k = 0; k < colour.size(); ++k) colour[k] = 0.01f * k;
-  ASSERT_TRUE(v.write_color_rect(CubeFace::kPosX, {0, 0, 4, 4}, colour).ok());
+  ASSERT_TRUE(v.write_colour_rect(CubeFace::kPosX, {0, 0, 4, 4}, colour).ok());
   unmix_coverage_colour(&v, 0, 0);
-  const std::span<const float> got = v.color_face(CubeFace::kPosX);
+  const std::span<const float> got = v.colour_face(CubeFace::kPosX);
   EXPECT_TRUE(std::equal(got.begin(), got.end(), colour.begin()));
 }
 

@@ -75,8 +75,8 @@ Vec3 on_pos_x(double u, double v, uint32_t n) {
   return d * (1.0 / d.x);
 }
 
-RenderOptions fixed_spp(uint32_t spp) {
-  RenderOptions o;
+LightfieldRenderOptions fixed_spp(uint32_t spp) {
+  LightfieldRenderOptions o;
   o.threads = 1;
   o.spp = spp;
   o.min_spp = spp;
@@ -227,7 +227,7 @@ TEST(Antialias, TwoSeedsAgreeAtTheDefaults) {
   for (const char* name : {"interior", "mirror-box"}) {
     auto scene = make_builtin_scene(name);
     ASSERT_TRUE(scene.ok());
-    RenderOptions a, b;
+    LightfieldRenderOptions a, b;
     b.seed = a.seed + 1;
     auto ta = FrameTracer::create(*scene, 0, a);
     auto tb = FrameTracer::create(*scene, 0, b);
@@ -277,12 +277,12 @@ Scene legacy_scene() {
 
 // Colours of a 4 x 4 cube map from the origin, 8 AO samples, seed 7, rendered with one centre
 // sample per texel (commit 5610434), printed with %.9g.
-const float kLegacyColors[] = {
-#include "antialias_legacy_colors.inc"
+const float kLegacyColours[] = {
+#include "antialias_legacy_colours.inc"
 };
 
 TEST(Antialias, OneSampleIsTheCentreSampleOfBefore) {
-  RenderOptions o;
+  LightfieldRenderOptions o;
   o.threads = 2;
   o.seed = 7;
   o.ao_samples = 8;
@@ -291,10 +291,10 @@ TEST(Antialias, OneSampleIsTheCentreSampleOfBefore) {
   ASSERT_TRUE(tracer.ok());
   capture::ViewFrame f;
   (*tracer)->render_cube({0, 0, 0}, 0, 0, 4, false, &f);
-  ASSERT_EQ(f.color.size(), std::size(kLegacyColors));
+  ASSERT_EQ(f.color.size(), std::size(kLegacyColours));
   for (size_t i = 0; i < f.color.size(); ++i) {
     // Exact on the host that froze them; Embree's kernels differ in the last bits between CPUs.
-    EXPECT_NEAR(f.color[i], kLegacyColors[i], 1e-5 * (1 + kLegacyColors[i])) << i;
+    EXPECT_NEAR(f.color[i], kLegacyColours[i], 1e-5 * (1 + kLegacyColours[i])) << i;
   }
   // Another seed changes AO somewhere: the frozen values can tell a different sampling pattern.
   o.seed = 8;
@@ -304,7 +304,7 @@ TEST(Antialias, OneSampleIsTheCentreSampleOfBefore) {
   (*other)->render_cube({0, 0, 0}, 0, 0, 4, false, &g);
   float largest = 0;
   for (size_t i = 0; i < g.color.size(); ++i) {
-    largest = std::max(largest, std::fabs(g.color[i] - kLegacyColors[i]));
+    largest = std::max(largest, std::fabs(g.color[i] - kLegacyColours[i]));
   }
   EXPECT_GT(largest, 1e-2f);
   if (std::getenv("CALF_PRINT_LEGACY")) {
@@ -313,16 +313,16 @@ TEST(Antialias, OneSampleIsTheCentreSampleOfBefore) {
 }
 
 TEST(Antialias, OptionsAreValidated) {
-  RenderOptions o;
+  LightfieldRenderOptions o;
   EXPECT_TRUE(validate_render_options(o).ok());
   o.spp = 0;
   EXPECT_EQ(validate_render_options(o).id(), ErrorId::kCaptureOption);
   o.spp = 5000;
   EXPECT_EQ(validate_render_options(o).id(), ErrorId::kCaptureOption);
-  o = RenderOptions{};
+  o = LightfieldRenderOptions{};
   o.min_spp = 0;
   EXPECT_EQ(validate_render_options(o).id(), ErrorId::kCaptureOption);
-  o = RenderOptions{};
+  o = LightfieldRenderOptions{};
   for (float t : {-0.1f, 1.5f, NAN}) {
     o.tolerance = t;
     EXPECT_EQ(validate_render_options(o).id(), ErrorId::kCaptureOption) << t;

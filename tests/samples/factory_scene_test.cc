@@ -82,7 +82,7 @@ TEST(FactoryScene, HoldsTheTrianglesItsListingPromisesMostlyInstanced) {
   EXPECT_LE(region.min.y, 1.7);
   EXPECT_GE(region.max.y, 1.7);
   EXPECT_LE(region.max.y - region.min.y, 0.25);
-  auto tracer = FrameTracer::create(*scene, 0, RenderOptions{2, 1, 0, 6, 0});
+  auto tracer = FrameTracer::create(*scene, 0, LightfieldRenderOptions{2, 1, 0, 6, 0});
   ASSERT_TRUE(tracer.ok()) << tracer.status().to_string();
   for (const auto& v : scene->default_rig.viewpoints) {
     EXPECT_FALSE((*tracer)->inside_geometry(v.position)) << v.name;

@@ -55,7 +55,7 @@ double ray_sphere(const Vec3& dir, double cx, double r) {
 TEST(Render, SphereOnPlusXAppearsOnFacePlusXWithExactDepth) {
   const double d = 3, r = 1;
   Scene s = sphere_scene(d, r);
-  auto tracer = FrameTracer::create(s, 0, RenderOptions{1, 1, 0, 6, 0});
+  auto tracer = FrameTracer::create(s, 0, LightfieldRenderOptions{1, 1, 0, 6, 0});
   ASSERT_TRUE(tracer.ok()) << tracer.status().to_string();
   capture::ViewFrame f;
   const uint32_t n = 24;
@@ -105,7 +105,7 @@ TEST(Render, RoomDepthIsExactOnEveryTexelAndContinuousAcrossSeams) {
   const glm::vec3 lo(-2, -1.5f, -3), hi(3, 2, 2.5f);
   add_room(&o.mesh, lo, hi);
   s.objects.push_back(o);
-  auto tracer = FrameTracer::create(s, 0, RenderOptions{2, 1, 2, 6, 0});
+  auto tracer = FrameTracer::create(s, 0, LightfieldRenderOptions{2, 1, 2, 6, 0});
   ASSERT_TRUE(tracer.ok()) << tracer.status().to_string();
   ASSERT_FALSE((*tracer)->inside_geometry({0, 0, 0}));
   capture::ViewFrame f;
@@ -134,12 +134,12 @@ TEST(Render, RoomDepthIsExactOnEveryTexelAndContinuousAcrossSeams) {
 TEST(Render, InsideGeometryIsDetected) {
   auto scene = make_builtin_scene("turntable");
   ASSERT_TRUE(scene.ok());
-  auto tracer = FrameTracer::create(*scene, 0, RenderOptions{});
+  auto tracer = FrameTracer::create(*scene, 0, LightfieldRenderOptions{});
   ASSERT_TRUE(tracer.ok());
   EXPECT_TRUE((*tracer)->inside_geometry({0, 0, 0}));  // inside the hull
   EXPECT_FALSE((*tracer)->inside_geometry({0, 0, 3}));
   Rig rig = list_rig({{0, 0, 3}, {0, 0.0, 0.1}});
-  Status st = check_viewpoints(*scene, rig, 1, 30, RenderOptions{});
+  Status st = check_viewpoints(*scene, rig, 1, 30, LightfieldRenderOptions{});
   EXPECT_EQ(st.id(), ErrorId::kViewpointInsideGeometry);
   EXPECT_NE(st.message().find("viewpoint 1"), std::string::npos) << st.to_string();
 }
@@ -184,7 +184,7 @@ TEST(Render, AnimationChangesDepthAndShadingWhereDepthStaysStill) {
   auto scene = make_builtin_scene("interior");
   ASSERT_TRUE(scene.ok());
   capture::ViewFrame a, b;
-  RenderOptions opt{2, 1, 4, 6, 0};
+  LightfieldRenderOptions opt{2, 1, 4, 6, 0};
   const Vec3 centre = scene->default_rig.viewpoints[0].position;
   auto t0 = FrameTracer::create(*scene, 0.0, opt);
   auto t1 = FrameTracer::create(*scene, 10 / scene->fps, opt);
@@ -269,7 +269,7 @@ TEST(Render, GroundTruthAlongTheValidationPath) {
   ASSERT_TRUE(scene.ok());
   capture::EyePath path = scene->validation_path(2, scene->fps, 12, 8);
   fs::path dir = temp_dir("gt");
-  auto r = render_ground_truth(*scene, path, RenderOptions{2, 1, 2, 6, 0}, dir, nullptr);
+  auto r = render_ground_truth(*scene, path, LightfieldRenderOptions{2, 1, 2, 6, 0}, dir, nullptr);
   ASSERT_TRUE(r.ok()) << r.status().to_string();
   auto back = capture::read_eye_path(dir / capture::kEyePathFileName);
   ASSERT_TRUE(back.ok()) << back.status().to_string();
@@ -288,7 +288,7 @@ TEST(Render, PerspectiveCentrePixelDepth) {
   // Looking straight at the sphere from the origin with an odd image size: the centre pixel's ray
   // is the axis, its depth exactly d - r.
   Scene s = sphere_scene(4, 0.5);
-  auto tracer = FrameTracer::create(s, 0, RenderOptions{1, 1, 0, 6, 0});
+  auto tracer = FrameTracer::create(s, 0, LightfieldRenderOptions{1, 1, 0, 6, 0});
   ASSERT_TRUE(tracer.ok());
   capture::PerspectiveImage img;
   capture::EyePose pose = look_at_pose(0, {0, 0, 0}, {1, 0, 0}, 30);
@@ -298,10 +298,13 @@ TEST(Render, PerspectiveCentrePixelDepth) {
 }
 
 TEST(Render, OptionsAreValidated) {
-  EXPECT_EQ(validate_render_options(RenderOptions{300, 1, 8, 6, 0}).id(), ErrorId::kCaptureOption);
-  EXPECT_EQ(validate_render_options(RenderOptions{1, 1, 8, 6, 2}).id(), ErrorId::kCaptureOption);
-  EXPECT_EQ(validate_render_options(RenderOptions{1, 1, 999, 6, 0}).id(), ErrorId::kCaptureOption);
-  EXPECT_TRUE(validate_render_options(RenderOptions{}).ok());
+  EXPECT_EQ(validate_render_options(LightfieldRenderOptions{300, 1, 8, 6, 0}).id(),
+            ErrorId::kCaptureOption);
+  EXPECT_EQ(validate_render_options(LightfieldRenderOptions{1, 1, 8, 6, 2}).id(),
+            ErrorId::kCaptureOption);
+  EXPECT_EQ(validate_render_options(LightfieldRenderOptions{1, 1, 999, 6, 0}).id(),
+            ErrorId::kCaptureOption);
+  EXPECT_TRUE(validate_render_options(LightfieldRenderOptions{}).ok());
 }
 
 }  // namespace

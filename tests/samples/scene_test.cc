@@ -127,7 +127,7 @@ TEST(Scenes, BuiltinsAreValidWithPathsAwayFromTheirViewpoints) {
     // scenes of millions of triangles, whose last frame visibility_scenes_test checks).
     const uint32_t frames = scene->triangle_count() > 1000000 ? 1 : scene->frame_count;
     Status st = check_viewpoints(*scene, scene->default_rig, frames, scene->fps,
-                                 RenderOptions{2, 1, 0, 6, 0});
+                                 LightfieldRenderOptions{2, 1, 0, 6, 0});
     EXPECT_TRUE(st.ok()) << st.to_string();
     capture::EyePath path = scene->validation_path(scene->frame_count, scene->fps, 32, 32);
     ASSERT_EQ(path.poses.size(), scene->frame_count);
@@ -201,7 +201,7 @@ TEST_F(AssimpTest, ObjCube) {
   EXPECT_EQ(scene->objects[0].mesh.triangles.size(), 12u);
   EXPECT_EQ(scene->frame_count, 1u);
   ASSERT_EQ(scene->default_rig.viewpoints.size(), 8u);
-  auto tracer = FrameTracer::create(*scene, 0, RenderOptions{1, 1, 2, 6, 0});
+  auto tracer = FrameTracer::create(*scene, 0, LightfieldRenderOptions{1, 1, 2, 6, 0});
   ASSERT_TRUE(tracer.ok());
   EXPECT_TRUE((*tracer)->inside_geometry({0, 0, 0}));
   // From +X at distance 4, the centre of face -X sees the cube's +X side at distance 3.

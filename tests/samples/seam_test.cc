@@ -89,7 +89,7 @@ TEST(Seams, ColourIsContinuousAcrossFaceSeams) {
   auto scene = make_builtin_scene("interior");
   ASSERT_TRUE(scene.ok()) << scene.status().to_string();
   ASSERT_FALSE(scene->default_rig.viewpoints.empty());
-  RenderOptions options;
+  LightfieldRenderOptions options;
   options.threads = 2;
   options.ao_samples = 4;
   options.noise = 0;

@@ -103,9 +103,9 @@ Scene quad_scene(capture::SceneTexture tex, float span, float z) {
 }
 
 // One sample through each pixel centre, no AO, no noise: these tests check the texture lookup at
-// a ray (pixel anti-aliasing, RenderOptions::spp, is tests/samples/antialias_test.cc's).
-RenderOptions centre_ray_options() {
-  RenderOptions o{1, 1, 0, 2, 0};
+// a ray (pixel anti-aliasing, LightfieldRenderOptions::spp, is tests/samples/antialias_test.cc's).
+LightfieldRenderOptions centre_ray_options() {
+  LightfieldRenderOptions o{1, 1, 0, 2, 0};
   o.spp = 1;
   return o;
 }
@@ -264,7 +264,7 @@ TEST(Texture, ConvergedPixelsFilterATextureEdgeOnlyOverThePixel) {
   const capture::SceneTexture edge =
       image(256, 256, [](uint32_t x, uint32_t) { return glm::u8vec3(x < 128 ? 0 : 255); });
   const Scene s = quad_scene(edge, 1, 0);
-  RenderOptions o{1, 1, 0, 2, 0};
+  LightfieldRenderOptions o{1, 1, 0, 2, 0};
   o.spp = 64;
   o.min_spp = 8;
   o.tolerance = 0;

@@ -72,7 +72,7 @@ void square_at(double t, double* x0, double* x1) {
 // from the square's edges: depth = the exact distance inside the square, +inf outside. Returns the
 // texels inside.
 size_t check_square(const Scene& scene, double time, double plane_z, std::vector<float>* depth) {
-  auto tracer = FrameTracer::create(scene, time, RenderOptions{1, 1, 0, 6, 0});
+  auto tracer = FrameTracer::create(scene, time, LightfieldRenderOptions{1, 1, 0, 6, 0});
   EXPECT_TRUE(tracer.ok()) << tracer.status().to_string();
   if (!tracer.ok()) return 0;
   const uint32_t n = 48;
@@ -247,7 +247,7 @@ TEST(SharedMesh, InstancesRenderAsCopies) {
     copies.objects.push_back(b);
   }
   EXPECT_EQ(instanced.triangle_count(), copies.triangle_count());
-  const RenderOptions options{2, 7, 4, 6, 0};
+  const LightfieldRenderOptions options{2, 7, 4, 6, 0};
   auto a = FrameTracer::create(instanced, 0, options);
   auto b = FrameTracer::create(copies, 0, options);
   ASSERT_TRUE(a.ok() && b.ok());

@@ -108,7 +108,7 @@ TEST_P(VisibilityScene, HoldTheTrianglesTheirListingPromises) {
   }
   // The viewpoints are outside geometry at the last frame too (scene_test checks the first).
   const double last = (scene->frame_count - 1) / scene->fps;
-  auto tracer = FrameTracer::create(*scene, last, RenderOptions{2, 1, 0, 6, 0});
+  auto tracer = FrameTracer::create(*scene, last, LightfieldRenderOptions{2, 1, 0, 6, 0});
   ASSERT_TRUE(tracer.ok()) << tracer.status().to_string();
   for (const auto& v : scene->default_rig.viewpoints) {
     EXPECT_FALSE((*tracer)->inside_geometry(v.position)) << v.name;
@@ -233,7 +233,7 @@ TEST(VisibilityScenes, CityIsMostlyHiddenFromTheCrossing) {
   auto scene = make_builtin_scene("city");
   ASSERT_TRUE(scene.ok());
   const auto start = std::chrono::steady_clock::now();
-  auto tracer = FrameTracer::create(*scene, 0, RenderOptions{2, 1, 0, 6, 0});
+  auto tracer = FrameTracer::create(*scene, 0, LightfieldRenderOptions{2, 1, 0, 6, 0});
   ASSERT_TRUE(tracer.ok()) << tracer.status().to_string();
   capture::ViewFrame frame;
   (*tracer)->render_cube({0, 1.7, 0}, 0, 0, 32, false, &frame);
@@ -264,7 +264,7 @@ TEST(VisibilityScenes, InstancedSceneRendersTheSameForAnyThreadCount) {
   ASSERT_TRUE(scene.ok());
   capture::ViewFrame first;
   for (uint32_t threads : {1u, 3u}) {
-    auto tracer = FrameTracer::create(*scene, 0.2, RenderOptions{threads, 5, 2, 6, 0});
+    auto tracer = FrameTracer::create(*scene, 0.2, LightfieldRenderOptions{threads, 5, 2, 6, 0});
     ASSERT_TRUE(tracer.ok()) << tracer.status().to_string();
     capture::ViewFrame frame;
     (*tracer)->render_cube({1.0, 1.65, -2.0}, 3, 1, 16, false, &frame);

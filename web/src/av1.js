@@ -1,6 +1,6 @@
 // AV1 colour (format/SPEC.md §11.1.12) through the browser's own AV1 decoder, WebCodecs
 // `VideoDecoder`. One decoder per colour cell, as the native decoder keeps (decoder/src/
-// clip_decoder.cc, update_cell_av1): within the GOP chunk serving a frame, decoding goes on from
+// lightfield_decoder.cc, update_cell_av1): within the GOP chunk serving a frame, decoding goes on from
 // the frame the cell's decoder last gave when that lies before it (playback: one unit per frame),
 // else it restarts at the chunk's key frame (a seek: at most the keyframe interval of units).
 // Pictures come back as their 8-bit planes (VideoFrame.copyTo); lightfield.js converts them with

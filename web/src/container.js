@@ -40,7 +40,7 @@ class Fields {
 const TIMING = [['frame_count', 4, 1, 16777216], ['fps_numerator', 4, 1, null], ['fps_denominator', 4, 1, null]];
 const TRACK_HEADERS = {
   1: [...TIMING, ['view_count', 4, 1, 65536], ['face_size', 4, 1, 16384], ['cell_size', 4, 1, 16384],
-    ['depth_tile_size', 4, 1, 16384], ['colour_format', 2, 0, null], ['depth_format', 2, 0, null],
+    ['depth_region_size', 4, 1, 16384], ['colour_format', 2, 0, null], ['depth_format', 2, 0, null],
     ['material_format', 2, 0, null], ['flags', 2, 0, null]],
   2: [...TIMING, ['tile_count', 4, 0, null], ['atlas_width', 4, 1, 16384], ['atlas_height', 4, 1, 16384],
     ['atlas_format', 2, 0, null], ['flags', 2, 0, null]],

@@ -3,7 +3,7 @@
 // to a far cap past the viewer's far plane) meets the viewer's frustum, united with the sky set
 // (the cell frustum placed at the eye). The exact separating-axis test of
 // format/src/geometry.cc over every cell (the native decoder's brute-force search, which gives
-// the same sets as its hierarchical one); the same for depth tiles on their own grid.
+// the same sets as its hierarchical one); the same for depth regions on their own grid.
 const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
 const add = (a, b) => [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
 const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -116,7 +116,7 @@ function visible(apex, face, grid, faceSize, zNear, zFar, eye) {
 }
 
 // For one eye (camera with the march range's near and far): per active view, per face, the
-// colour cells and depth tiles the frame needs: { cells: [Set × 6], tiles: [Set × 6] } by view.
+// colour cells and depth regions the frame needs: { cells: [Set × 6], tiles: [Set × 6] } by view.
 export function visibleSets(lf, camera, near, far, active) {
   const N = lf.header.face_size, eye = eyeFrustum(camera, near, far), out = new Map();
   const sky = { cells: [], tiles: [] };

@@ -423,7 +423,7 @@ export async function openLightfield(clip, t) {
   if (!COLOUR_FORMATS.includes(h.colour_format) && h.colour_format !== FORMAT.av1) fail(E.lightfieldFormat, `track ${t}: colour format ${h.colour_format}`);
   if (!DEPTH_FORMATS.includes(h.depth_format)) fail(E.lightfieldFormat, `track ${t}: depth format ${h.depth_format}`);
   if (h.material_format !== 0 && !MATERIAL_FORMATS.includes(h.material_format)) fail(E.lightfieldFormat, `track ${t}: material format ${h.material_format}`);
-  const cells = faceGrid(h.face_size, h.cell_size), tiles = faceGrid(h.face_size, h.depth_tile_size);
+  const cells = faceGrid(h.face_size, h.cell_size), tiles = faceGrid(h.face_size, h.depth_region_size);
   const byKey = new Map();
   const indexChunks = Array.from({ length: h.view_count }, () => []);
   for (const c of clip.chunks) {
@@ -464,7 +464,7 @@ export async function openLightfield(clip, t) {
 
 // Decodes every frame of one face of one view in order; calls onFrame(n, colour, depth,
 // material, coverage) with the face's arrays (reused between frames). With `only` ({ cells,
-// tiles }: Sets of colour cell and depth tile indices) the other regions are neither read nor
+// tiles }: Sets of colour cell and depth region indices) the other regions are neither read nor
 // written. Coverage (§11.1.11; mask and near count a texel) is decoded only with
 // `{ coverage: true }` in a track with coverage, else it is null and no coverage chunk is read.
 // Frames are decoded in order, so a region chunk is read once and its P-frames applied as

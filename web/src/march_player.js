@@ -1,6 +1,6 @@
 // The page's lightfield player: calf-play's GL render (raymarch.js: the native ray-march shader,
 // its view selection and march range) of a clip opened by URL over range requests. Only the
-// cells and depth tiles the pose's eye can see (culling.js, the native decoder's culling) of the
+// cells and depth regions the pose's eye can see (culling.js, the native decoder's culling) of the
 // active views are fetched and decoded, for the pose's frame; the same cells' chunks of the next
 // frames are prefetched; a face is uploaded when a pose needs another frame or new cells of it.
 import { openClip } from './container.js';
@@ -18,7 +18,7 @@ import { openRasterPlayer, rasterTracks } from './raster_player.js';
 export const PREFETCH_FRAMES = 2;
 export const CACHE_BYTES = 256 * 1024 * 1024;
 
-// frame_at_time (format/capture/src/eye_path.cc).
+// frame_at_time (capture/src/eye_path.cc).
 export function frameAtTime(seconds, fps, frameCount) {
   if (!(seconds > 0)) return 0;
   return Math.min(Math.floor(seconds * fps + 1e-9), frameCount - 1);

@@ -1,6 +1,6 @@
 // The lightfield render of calf-play's GL renderer in WebGL2: the native ray-march shader
 // (glsl_raymarch.js, generated from player/src/gl_raymarch_shader.cc) after the native GLSL
-// conventions, with the uniforms, view records and march range that player/src/gl_renderer.cc
+// conventions, with the uniforms, view records and march range that player/src/lightfield_gl_renderer.cc
 // and lightfield_representation.cc give it, and the view selection of
 // player/src/view_selection.cc. Colour is uploaded per frame as decoded (one slot, t already
 // applied on the CPU, SPEC §11.1.4), depth as r16 codes.
@@ -9,11 +9,11 @@ import { GL_FULLSCREEN_VERTEX, GL_RAYMARCH_FRAGMENT } from './glsl_raymarch.js';
 
 export const MAX_ACTIVE_VIEWS = 256;  // kGlMaxActiveViews
 
-// calf-play's defaults (RenderOptions, ViewSelectionOptions; headless: no frame budget).
+// calf-play's defaults (LightfieldRenderOptions, ViewSelectionOptions; headless: no frame budget).
 export const RENDER_DEFAULTS = {
   steps: 64, refine_steps: 8, depth_footprint: 0.9, smooth_depth_ratio: 0, min_view_distance: -1,
-  depth_decay: 500, cam_decay: 20, bilinear_color: true, depth_aware_color: true,
-  color_depth_tolerance: 0.1, mixed_texel_penalty: 3, mixed_texel_bend_texels: 5,
+  depth_decay: 500, cam_decay: 20, bilinear_colour: true, depth_aware_colour: true,
+  colour_depth_tolerance: 0.1, mixed_texel_penalty: 3, mixed_texel_bend_texels: 5,
   tight_march_start: true, surface_hints: 1, surface_hint_margin_texels: 0.2, surface_hint_vetoes: 1,
   surface_hint_substeps: 4, supersample: 1, rr: false, rr_start: 0.05, rr_max_depth: 1,
   rr_replace_view_reflection: true,
@@ -281,12 +281,12 @@ export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER
     gl.uniform1f(U('smooth_log_ratio'), Math.log1p(o.smooth_depth_ratio));
     gl.uniform1f(U('depth_decay'), o.depth_decay);
     gl.uniform1f(U('cam_decay'), o.cam_decay);
-    gl.uniform1f(U('color_depth_tolerance'), o.color_depth_tolerance);
+    gl.uniform1f(U('colour_depth_tolerance'), o.colour_depth_tolerance);
     gl.uniform1f(U('mixed_penalty_factor'), Math.exp(-o.mixed_texel_penalty));
     gl.uniform1f(U('mixed_texel_bend_texels'), o.mixed_texel_bend_texels);
     gl.uniform1i(U('tight_march_start'), o.tight_march_start ? 1 : 0);
-    gl.uniform1i(U('bilinear_color'), o.bilinear_color ? 1 : 0);
-    gl.uniform1i(U('depth_aware_color'), o.depth_aware_color ? 1 : 0);
+    gl.uniform1i(U('bilinear_colour'), o.bilinear_colour ? 1 : 0);
+    gl.uniform1i(U('depth_aware_colour'), o.depth_aware_colour ? 1 : 0);
     gl.uniform1f(U('surface_hint_margin_texels'), o.surface_hint_margin_texels);
     gl.uniform1ui(U('surface_hint_vetoes'), o.surface_hint_vetoes);
     gl.uniform1ui(U('surface_hint_substeps'), o.surface_hint_substeps);

@@ -50,8 +50,8 @@ export async function httpSource(url, { fetch: fetchImpl = fetch } = {}) {
 // cell}] or [{view, face, tile}]): per cell its t chunk and the colour chunk of keyframe k_m (the
 // one whose frames hold n) and of the next keyframe, which is needed only when t[n] ≠ 0
 // (`tValue(view, face, cell)` gives t[n] when the t chunk is at hand, else undefined and the next
-// keyframe is planned), and the depth tiles overlapping the cell (not with `{ cellTiles: false }`,
-// for a caller that names its tiles); per depth tile (named, or
+// keyframe is planned), and the depth regions overlapping the cell (not with `{ cellTiles: false }`,
+// for a caller that names its tiles); per depth region (named, or
 // overlapping a cell) the depth chunk whose frames hold n, the material chunk for a view with
 // material (not with `{ material: false }`), and with `{ coverage: true }` in a track with
 // coverage, the coverage chunk whose frames hold n (§11.1.11; not planned otherwise).

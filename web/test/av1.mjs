@@ -31,7 +31,7 @@ if (!bin) {
 const clipPath = 'tests/conformance/lightfield/av1_pred16m.calf';
 const want = readFileSync(join(ROOT, clipPath.replace(/\.calf$/, '.hashes')), 'utf8').split('\n').filter(Boolean);
 // The AV1 clip of the decoder's fuzz corpus, which must decode without a problem.
-const fuzzClip = 'tests/fuzz/corpus/clip_decoder_fuzz/valid_av1_f16_5fr.calf';
+const fuzzClip = 'tests/fuzz/corpus/lightfield_decoder_fuzz/valid_av1_f16_5fr.calf';
 const dir = mkdtempSync(join(process.env.CALF_WEB_TMP ?? tmpdir(), 'calf-web-av1-'));
 
 // The eye path: from the views' centre, looking along four directions, at frames 0 … 3 (a

@@ -187,7 +187,7 @@ async function containerCorpus(codecs) {
 // The damaged lightfield clips of the decoder's fuzz corpus (valid chunk hashes, a broken
 // §11.1 layout): each bad_* gives CALF-E202, each valid_* decodes without a problem.
 async function lightfieldCorpus(codecs) {
-  const dir = join(ROOT, 'tests/fuzz/corpus/clip_decoder_fuzz');
+  const dir = join(ROOT, 'tests/fuzz/corpus/lightfield_decoder_fuzz');
   const problems = [];
   const files = readdirSync(dir).filter((f) => f.endsWith('.calf')).sort();
   for (const f of files) {

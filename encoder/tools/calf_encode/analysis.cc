@@ -32,9 +32,9 @@ void add_options(CLI::App& app, ShardOptions& o) {
 }
 
 int run_analysis(const CommonOptions& common, const std::filesystem::path& dir,
-                 const LightfieldEncodeOptions& encode) {
+                 const encoder::LightfieldEncodeOptions& encode) {
   const auto t0 = std::chrono::steady_clock::now();
-  auto a = write_lightfield_analysis(dir, common.output, encode);
+  auto a = encoder::write_lightfield_analysis(dir, common.output, encode);
   if (!a.ok()) return fail(a.status());
   if (!common.quiet) {
     std::fprintf(stderr, "calf-encode: analysis %s of %u views in %.2f s, peak RSS %.1f MiB\n",
@@ -48,7 +48,7 @@ int run_analysis(const CommonOptions& common, const std::filesystem::path& dir,
 int run_shard(const CommonOptions& common, const std::filesystem::path& dir,
               const ShardOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
-  auto a = read_lightfield_analysis(options.analysis);
+  auto a = encoder::read_lightfield_analysis(options.analysis);
   if (!a.ok()) return fail(a.status());
   auto views = capture::parse_index_list(options.views, a->analysis.header.view_count, "views");
   if (!views.ok()) return print_error("calf-encode", views.status(), kExitUsage);
@@ -66,8 +66,8 @@ int run_shard(const CommonOptions& common, const std::filesystem::path& dir,
     first = f->front();
     count = static_cast<uint32_t>(f->size());
   }
-  auto s = encode_lightfield_shard(dir, *a, *views, first, count, common.threads, common.output,
-                                   common.max_image_pixels);
+  auto s = encoder::encode_lightfield_shard(dir, *a, *views, first, count, common.threads,
+                                            common.output, common.max_image_pixels);
   if (!s.ok()) return fail(s.status());
   if (!common.quiet) {
     std::fprintf(stderr,

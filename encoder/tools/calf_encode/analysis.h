@@ -28,7 +28,7 @@ void add_options(CLI::App& app, ShardOptions& options);
 // Step 1: the analysis pass over the capture set at `dir` with `encode`'s options, written to
 // common.output. Returns the command's exit status.
 int run_analysis(const CommonOptions& common, const std::filesystem::path& dir,
-                 const LightfieldEncodeOptions& encode);
+                 const encoder::LightfieldEncodeOptions& encode);
 
 // Step 2: the shard of options.views (and options.frame_range) of the capture set at `dir`, coded
 // with the options of the analysis file options.analysis, written to common.output. Returns the

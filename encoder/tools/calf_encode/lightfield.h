@@ -18,9 +18,9 @@ enum class ColourCodec { kBc, kAv1 };
 struct LightfieldOptions {
   // Cell, --color-format, depth coding and windows, BC1 fit, AV1 settings; threads, the image
   // budget, supercompression and the directory come from CommonOptions.
-  LightfieldEncodeOptions encode;
+  encoder::LightfieldEncodeOptions encode;
   std::string psnr = "auto";  // Q in dB, or "auto" (from the capture's render noise)
-  double psnr_noise_margin = kDefaultPsnrNoiseMargin;
+  double psnr_noise_margin = encoder::kDefaultPsnrNoiseMargin;
   std::string colour_rdo = "auto";  // lambda, or "auto" (each colour format's measured default)
   ColourCodec colour_codec = ColourCodec::kBc;
   bool no_coverage = false;

@@ -11,11 +11,11 @@ namespace calf::tools {
 
 namespace {
 
-inline constexpr EnumTable<SurfelOrderMethod, 4> kSurfelSamplers = {
-    {{"greedy-tree", SurfelOrderMethod::kGreedyTree},
-     {"progressive", SurfelOrderMethod::kProgressive},
-     {"exact", SurfelOrderMethod::kExactGreedy},
-     {"random", SurfelOrderMethod::kRandom}}};
+inline constexpr EnumTable<encoder::SurfelOrderMethod, 4> kSurfelSamplers = {
+    {{"greedy-tree", encoder::SurfelOrderMethod::kGreedyTree},
+     {"progressive", encoder::SurfelOrderMethod::kProgressive},
+     {"exact", encoder::SurfelOrderMethod::kExactGreedy},
+     {"random", encoder::SurfelOrderMethod::kRandom}}};
 
 }  // namespace
 
@@ -59,7 +59,7 @@ int run(const CommonOptions& common, const SurfelsOptions& options) {
                out.c_str(), seconds, stats->prototypes_with_surfels, stats->prototypes,
                static_cast<unsigned long long>(stats->surfels),
                static_cast<unsigned long long>(stats->candidates),
-               surfel_order_method_name(build.sampler.method), stats->sample_seconds,
+               encoder::surfel_order_method_name(build.sampler.method), stats->sample_seconds,
                stats->surfels ? static_cast<double>(encoded.surfels_stored) /
                                     static_cast<double>(stats->surfels)
                               : 0.0);

@@ -146,13 +146,13 @@ Status run_window(const std::string& clip_path, const PlaybackOptions& options,
       if (pressed(GLFW_KEY_H)) show_hud = !show_hud;
       if (pressed(GLFW_KEY_S) && shift) stereo = !stereo;
       if (pressed(GLFW_KEY_R) && lf != nullptr) {
-        RenderOptions r = lf->options().render;
+        LightfieldRenderOptions r = lf->options().render;
         r.rr = !r.rr;
         if (r.rr && !lf->has_material()) warning = "the clip has no material: RR does nothing";
         (void)lf->set_render_options(r);
       }
       if (pressed(GLFW_KEY_C) && lf != nullptr) {
-        RenderOptions r = lf->options().render;
+        LightfieldRenderOptions r = lf->options().render;
         r.coverage = r.coverage == 0 ? coverage_on : 0;
         if (r.coverage != 0 && !lf->has_coverage()) {
           warning = "the clip has no coverage stream: coverage does nothing";

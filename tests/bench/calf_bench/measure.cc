@@ -42,7 +42,7 @@ Expected<std::unique_ptr<SceneInputs>> SceneInputs::make(const std::string& name
   std::unique_ptr<SceneInputs> in(new SceneInputs());
   in->settings_ = settings;
   CALF_ASSIGN_OR_RETURN(samples::Scene scene, samples::make_builtin_scene(name));
-  samples::RenderOptions render;
+  samples::LightfieldRenderOptions render;
   render.threads = settings.threads;
 
   // `work` is this run's own fresh directory: the capture is never one left by an earlier run.

@@ -9,7 +9,7 @@
 
 #include "../ffmpeg_peers.h"
 #include "calf/capture/capture_set.h"
-#include "calf/decoder/clip_decoder.h"
+#include "calf/decoder/lightfield_decoder.h"
 #include "calf/decoder/lightfield_reference.h"
 #include "calf/format/colour.h"
 #include "calf/format/container.h"
@@ -134,16 +134,17 @@ Expected<DecodedClip> decode_clip(const fs::path& clip, const GridFrames& g) {
 }
 
 // Decode time per frame of the whole clip (every view, every cell and tile, no culling):
-// ClipDecoder::advance frame after frame; the median of frames 2..n and frame 1 apart.
+// LightfieldDecoder::advance frame after frame; the median of frames 2..n and frame 1 apart.
 struct DecodeTiming {
   double median_ms = 0, first_ms = 0;
 };
 Expected<DecodeTiming> calf_full_decode_ms(const fs::path& clip) {
   CALF_ASSIGN_OR_RETURN(container::Reader reader, container::Reader::open(clip.string()));
-  decoder::ClipDecoderOptions o;
+  decoder::LightfieldDecoderOptions o;
   o.view_dependent = false;
-  CALF_ASSIGN_OR_RETURN(decoder::ClipDecoder d, decoder::ClipDecoder::open(reader, 0, o));
-  decoder::FrameUpdates updates;
+  CALF_ASSIGN_OR_RETURN(decoder::LightfieldDecoder d,
+                        decoder::LightfieldDecoder::open(reader, 0, o));
+  decoder::LightfieldFrameUpdates updates;
   std::vector<double> ms;
   for (uint32_t f = 0; f < d.header().frame_count; ++f) {
     CALF_RETURN_IF_ERROR(d.advance(f, {}, {}, &updates));
@@ -260,7 +261,7 @@ Expected<std::vector<PeerRow>> measure_peers(const fs::path& capture_dir, const 
       "log-16 codes (per-view range over all frames, raw {} bytes){}; colour as 8-bit sRGB "
       "(raw {} bytes; calf's raw colour stream as the encoder counts it: {} bytes). calf's "
       "colour PSNR against those frames: {:.2f} dB (mean per frame, peak 255), the target of the "
-      "x265 colour peer. calf decode: ClipDecoder::advance over the whole clip (every view, "
+      "x265 colour peer. calf decode: LightfieldDecoder::advance over the whole clip (every view, "
       "cell and tile, no culling), colour and depth together: median {:.2f} ms/frame of frames "
       "2..{}, frame 1 {:.2f} ms; calf's encode s is the whole clip's (colour, depth and material "
       "together). Raw-stream peers: fastest of 3 decodes; ffmpeg peers: fastest of 3 decodes "

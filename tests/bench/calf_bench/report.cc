@@ -227,7 +227,7 @@ Status write_markdown(const fs::path& file, const std::vector<SceneResult>& scen
   out +=
       "- timings, one run per point (nothing cached between points): encode = "
       "`encode_lightfield_file`, wall seconds (CPU seconds of all threads in brackets); decode = "
-      "`ClipDecoder::advance` (what calf-play prints as decode), upload = the rest of "
+      "`LightfieldDecoder::advance` (what calf-play prints as decode), upload = the rest of "
       "`Playback::prepare` (view selection, texture upload), render = `Playback::render` (GL: "
       "draw and read-back), wall ms; *frame CPU ms* = the process's CPU time (all threads, "
       "llvmpipe's included) over prepare + render. Each is the **median over frames 2..n** of the "

@@ -48,8 +48,8 @@ const std::vector<Knob>& all_knobs();
 struct EncodeConfig {
   uint32_t cell = 32;
   double q = 50;
-  ColourCoding colour = ColourCoding::kAuto;
-  DepthCoding depth = DepthCoding::kRaw16;
+  encoder::ColourCoding colour = encoder::ColourCoding::kAuto;
+  encoder::DepthCoding depth = encoder::DepthCoding::kRaw16;
   uint32_t window = 2;
   uint32_t aabbs = 2;
   container::Compression super = container::Compression::kZstd;
@@ -64,9 +64,9 @@ struct PlayConfig {
   friend bool operator==(const PlayConfig&, const PlayConfig&) = default;
 };
 
-const char* colour_coding_name(ColourCoding c);    // "auto", "bc1", ...
-const char* depth_coding_name(DepthCoding d);      // "raw16", "bc5"
-const char* super_name(container::Compression c);  // "zstd", "lzma2", "none"
+const char* colour_coding_name(encoder::ColourCoding c);  // "auto", "bc1", ...
+const char* depth_coding_name(encoder::DepthCoding d);    // "raw16", "bc5"
+const char* super_name(container::Compression c);         // "zstd", "lzma2", "none"
 
 // One point of a scene's sweep: the base configuration with `knob` set to `value`.
 struct SweepPoint {
@@ -81,14 +81,15 @@ struct SweepPoint {
 struct PointResult {
   // Encode (shared by every point played from the same clip).
   uint64_t clip_bytes = 0, colour_bytes = 0, depth_bytes = 0, material_bytes = 0;
-  uint64_t colour_raw = 0, depth_raw = 0;  // the encoder's raw stream sizes (StreamBytes::raw)
+  uint64_t colour_raw = 0,
+           depth_raw = 0;  // the encoder's raw stream sizes (encoder::StreamBytes::raw)
   double encode_s = 0, encode_cpu_s = 0;
   std::string colour_format;  // as stored: "bc6h", "bc1", ...
   bool hdr = false;
   uint64_t colour_keyframes = 0, colour_cells = 0;
   double bc5_max_rel_error = 0;  // BC5 depth only
   // Playback over the eye path (first frame excluded from the medians, reported apart).
-  // decode: ClipDecoder::advance (what calf-play prints as "decode"); upload: the rest of
+  // decode: LightfieldDecoder::advance (what calf-play prints as "decode"); upload: the rest of
   // Playback::prepare (view selection, texture upload); render: Playback::render (GL: draw and
   // read-back).
   // *_cpu_ms: the process's CPU time over the same call (every thread: llvmpipe's, the decoder's

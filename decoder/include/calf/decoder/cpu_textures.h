@@ -1,8 +1,8 @@
-// The CPU image of a renderer's texture state: what a GPU holds after applying the ClipDecoder's
-// updates (clip_decoder.h), with every block format decoded as the GPU would (calf/format/bc.h).
-// The CPU reference renderer reads it (through the player's ViewSet), and the decoder tests use it
-// to compare the state reached by different paths (seeking vs playing, one viewer vs several,
-// the reference full-frame decoder).
+// The CPU image of a renderer's texture state: what a GPU holds after applying the
+// LightfieldDecoder's updates (lightfield_decoder.h), with every block format decoded as the GPU
+// would (calf/format/bc.h). The CPU reference renderer reads it (through the player's ViewSet), and
+// the decoder tests use it to compare the state reached by different paths (seeking vs playing, one
+// viewer vs several, the reference full-frame decoder).
 #pragma once
 
 #include <array>
@@ -10,14 +10,14 @@
 #include <span>
 #include <vector>
 
-#include "calf/decoder/clip_decoder.h"
+#include "calf/decoder/lightfield_decoder.h"
 #include "calf/format/container_types.h"
 #include "calf/format/lightfield_layout.h"
 #include "calf/format/status.h"
 
 namespace calf::decoder {
 
-// GPU-ready update bytes (clip_decoder.h formats) of a w x h rect, decoded:
+// GPU-ready update bytes (lightfield_decoder.h formats) of a w x h rect, decoded:
 // colour -> linear RGB float (3 per texel; sRGB formats through calf/format/colour.h);
 // depth -> log-16 codes; material -> 3 codes per texel (reflect, refract, ior).
 // Errors: CALF-E202 for bytes of the wrong size, CALF-E203 for a format the target lacks.
@@ -30,15 +30,15 @@ Status decode_gpu_material(container::PixelFormat format, std::span<const uint8_
 
 class CpuTextures {
  public:
-  // Every view starts as after ClipDecoder::reset(): colour slots 0, t = 0, a_slot = 0, depth all
-  // sky, material codes 0.
+  // Every view starts as after LightfieldDecoder::reset(): colour slots 0, t = 0, a_slot = 0, depth
+  // all sky, material codes 0.
   CpuTextures(const container::LightfieldTrackHeader& header,
               std::span<const LightfieldViewInfo> views);
 
   // Applies the frame's updates in order and records the visible cells' (t, a_slot).
   // Errors: CALF-E300 for an update outside the state (view, face, slot, rect), plus the decode
   // errors above. Stops at the first error.
-  Status apply(const FrameUpdates& frame);
+  Status apply(const LightfieldFrameUpdates& frame);
 
   uint32_t face_size() const { return face_size_; }
   // The colour cell grid of every face.

@@ -59,7 +59,7 @@ class LightfieldReference {
   // The interpolation weights and keyframes of one colour cell (its t chunk), for tests and tools.
   using CellTimeline = lf::CellTimeline;
   Expected<CellTimeline> cell_timeline(uint32_t view, uint32_t face, uint32_t cell) const;
-  // The rectangle counts of every frame of one depth tile (keyframes included), for tests.
+  // The rectangle counts of every frame of one depth region (keyframes included), for tests.
   Expected<std::vector<uint32_t>> depth_rect_counts(uint32_t view, uint32_t face,
                                                     uint32_t tile) const;
 

@@ -36,7 +36,7 @@ class TilesTrack {
   uint16_t atlas_format() const { return header_.atlas_format; }
   // The index chunk as read: view region and band height.
   const tiles::IndexChunk& index() const;
-  Box3 view_region() const;
+  Box3 view_volume() const;
 
   // Decodes the quads chunk (the container's errors, then CALF-E210 / E212 naming the tile).
   Status quads(std::vector<Tile>* out) const;

@@ -1,4 +1,4 @@
-// Depth P-frame regions (paper 002, Sec. 5.2, Alg. 3): which texels of a depth tile changed, and
+// Depth P-frame regions (paper 002, Sec. 5.2, Alg. 3): which texels of a depth region changed, and
 // the few tight rectangles that cover them.
 //
 // A P-frame of frame i stores the texels that differ from *any* of the previous W frames (the depth
@@ -18,7 +18,7 @@
 #include "calf/format/grid.h"
 #include "calf/format/status.h"
 
-namespace calf {
+namespace calf::encoder {
 
 // One bit per texel, row-major, width x height; 1 = the texel must be updated.
 struct ChangeMask {
@@ -52,4 +52,4 @@ Expected<std::vector<PixelRect>> fit_change_boxes(const ChangeMask& mask,
 // Texels covered by the rectangles (their total area).
 uint64_t covered_texels(std::span<const PixelRect> boxes);
 
-}  // namespace calf
+}  // namespace calf::encoder

@@ -2,7 +2,7 @@
 // .calf container out, laid out as format/SPEC.md §11.1 specifies.
 //
 //   colour    per view, face and cell (default 64 x 64): keyframes chosen by Alg. 2
-//             (calf/encoder/color_keyframes.h), each stored as one chunk in the colour format
+//             (calf/encoder/colour_keyframes.h), each stored as one chunk in the colour format
 //             (BC1 for LDR input, BC6H for HDR input, or BC7 / raw RGBA8 / raw RGBA16F), plus one
 //             chunk of 8-bit interpolation weights t per cell.
 //   depth     per view a log-16 range measured from the data (z_near / z_far over every finite
@@ -58,7 +58,7 @@
 #include "calf/format/log_depth.h"
 #include "calf/format/status.h"
 
-namespace calf {
+namespace calf::encoder {
 
 // Colour format choice; kAuto = BC1 for LDR input (every colour value <= 1), BC6H for HDR.
 // kAv1: per cell one AV1 stream of 8-bit 4:2:0 pictures (SPEC §11.1.12), LDR input only.
@@ -94,7 +94,7 @@ struct LightfieldEncodeOptions {
   ColourCoding colour = ColourCoding::kAuto;
   // The smallest lossless depth; its decode cost against raw16: docs/DECODER.md.
   DepthCoding depth = DepthCoding::kRaw16PredictedMasked;
-  uint32_t depth_tiles_per_side = 2;      // 1..64
+  uint32_t depth_regions_per_side = 2;    // 1..64
   uint32_t depth_window = 2;              // W, >= 1
   uint32_t max_aabbs = 2;                 // A, 1..64
   uint32_t depth_keyframe_interval = 30;  // a depth keyframe every K frames, >= 1
@@ -156,7 +156,7 @@ struct LightfieldEncodeStats {
   StreamBytes coverage;      // raw: 3 bytes per texel (mask, near count)
   uint64_t index_bytes = 0;  // stored bytes of the per-view index chunks
   uint64_t colour_cells = 0, colour_keyframes = 0;
-  uint64_t depth_tiles = 0, depth_keyframes = 0, depth_pframes = 0, depth_empty_pframes = 0;
+  uint64_t depth_regions = 0, depth_keyframes = 0, depth_pframes = 0, depth_empty_pframes = 0;
   uint64_t material_views = 0;
   double min_colour_quality_db = 0;  // lowest temporal quality of any frame of any cell (+inf)
   // BC5 depth only: reconstruction error against the quantised input over every finite texel of
@@ -225,7 +225,7 @@ struct LightfieldChunk {
 };
 
 // The chunks of one view in file order (SPEC §11.1: its index chunk, then per face in GL order
-// the colour cells' t and keyframe chunks, the depth tiles' chunks, the material tiles' chunks)
+// the colour cells' t and keyframe chunks, the depth regions' chunks, the material tiles' chunks)
 // and that view's figures (counts and bytes of this view only; formats and hdr as the track's).
 struct LightfieldViewEncoding {
   uint32_t view = 0;
@@ -323,4 +323,4 @@ Status spatial_colour_reference(ColourCoding coding, Bc1Fit bc1_fit, std::span<c
 // with an 8-stop peak (+inf when identical). 50 dB is an RMS error of 0.025 stops (~1.8 %).
 double psnr_log2(std::span<const float> reference, std::span<const float> test);
 
-}  // namespace calf
+}  // namespace calf::encoder

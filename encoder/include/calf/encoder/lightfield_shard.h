@@ -25,7 +25,7 @@
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/format/status.h"
 
-namespace calf {
+namespace calf::encoder {
 
 // An analysis file read back: the analysis, the options it was planned with (every option that
 // changes the bytes; threads and progress are the reader's own) and its identity.
@@ -82,4 +82,4 @@ Status merge_lightfield_shards(const LightfieldAnalysisFile& analysis,
                                std::span<const std::string> shard_paths,
                                const std::string& out_path);
 
-}  // namespace calf
+}  // namespace calf::encoder

@@ -35,7 +35,7 @@
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/format/status.h"
 
-namespace calf {
+namespace calf::encoder {
 
 // The metric of the colour keyframe test: kSrgb = PSNR on sRGB-encoded values (LDR colour),
 // kLog2 = log2-PSNR with an 8-stop peak (HDR colour).
@@ -109,4 +109,4 @@ inline constexpr double kAutoPsnrFloorDb = 10;
 inline constexpr double kDefaultPsnrNoiseMargin = 3;
 double auto_psnr_db(const NoiseEstimate& estimate, double margin, double cap = kAutoPsnrCapDb);
 
-}  // namespace calf
+}  // namespace calf::encoder

@@ -94,7 +94,7 @@
 #include "calf/format/geometry.h"
 #include "calf/format/status.h"
 
-namespace calf {
+namespace calf::encoder {
 
 enum class SurfelOrderMethod : uint8_t {
   kProgressive = 0,  // the paper's randomized rounds
@@ -176,4 +176,4 @@ Expected<PrefixSpacing> prefix_spacing(std::span<const Vec3> candidates,
                                        std::span<const uint32_t> order, uint32_t prefix,
                                        uint32_t threads = 0);
 
-}  // namespace calf
+}  // namespace calf::encoder

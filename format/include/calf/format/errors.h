@@ -101,7 +101,7 @@ enum class ErrorKind : uint8_t {
   X(kCaptureFileMissing, 135, kIo, "an image named by the manifest is missing")                 \
   X(kCaptureImageFormat, 136, kCorrupt, "an image has the wrong size, channels or type")        \
   X(kCaptureDepthPixel, 137, kCorrupt, "a depth pixel is NaN, -inf, zero or negative")          \
-  X(kCaptureColorPixel, 138, kCorrupt, "a colour pixel is NaN, infinite or negative")           \
+  X(kCaptureColourPixel, 138, kCorrupt, "a colour pixel is NaN, infinite or negative")           \
   X(kCaptureMaterialPixel, 139, kCorrupt, "a material pixel is outside its documented range")   \
   X(kCaptureIndex, 140, kInvalidArgument, "a view or frame index is outside the set")           \
   X(kCaptureWriterMisuse, 141, kInvalidArgument, "the capture writer got a bad buffer or call") \

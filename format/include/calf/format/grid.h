@@ -1,5 +1,5 @@
 // Cell and tile grids on a cube face: the one place where calf splits a face into the regions that
-// are coded, fetched and culled independently (paper 002: colour cells, Sec. 5.1; depth tiles,
+// are coded, fetched and culled independently (paper 002: colour cells, Sec. 5.1; depth regions,
 // Sec. 5.2; the per-face culling quadtree, Sec. 6.2).
 //
 // A FaceGrid splits an N x N face into square regions of side `cell_size`, laid from the top-left
@@ -7,7 +7,7 @@
 // hold the remainder: those edge cells are narrower and/or shorter (never empty), so every texel
 // belongs to exactly one cell. Cells are indexed row-major: index = cy * cells_per_side + cx.
 //
-// Colour cells use an explicit cell size (default 64). Depth tiles are asked for as a count per
+// Colour cells use an explicit cell size (default 64). Depth regions are asked for as a count per
 // side (default 2 x 2); their side is ceil(N / count) rounded up to a multiple of 4 so that BCn
 // blocks never straddle two tiles, which can leave fewer tiles than asked on tiny faces (a 6-texel
 // face split 4 x 4 gets 2 x 2 tiles of 4 and 2 texels).
@@ -46,7 +46,7 @@ class FaceGrid {
   // [1, kMaxFaceSize]; a cell larger than the face is clipped to one cell covering the face.
   static Expected<FaceGrid> with_cell_size(uint32_t face_size, uint32_t cell_size);
   // About `tiles_per_side` x `tiles_per_side` tiles, 4-aligned as described above.
-  static Expected<FaceGrid> with_tiles_per_side(uint32_t face_size, uint32_t tiles_per_side);
+  static Expected<FaceGrid> with_regions_per_side(uint32_t face_size, uint32_t tiles_per_side);
 
   uint32_t face_size() const { return face_size_; }
   uint32_t cell_size() const { return cell_size_; }

@@ -41,20 +41,20 @@ struct LightfieldTrackHeader {
   uint32_t fps_numerator = 24;
   uint32_t fps_denominator = 1;
   uint32_t view_count = 1;
-  uint32_t face_size = 1;        // cube face side, pixels
-  uint32_t cell_size = 1;        // colour cell side, pixels
-  uint32_t depth_tile_size = 1;  // depth tile side, pixels
-  uint16_t colour_format = 0;    // PixelFormat
-  uint16_t depth_format = 0;     // PixelFormat
-  uint16_t material_format = 0;  // PixelFormat, kNone without a material stream
-  uint16_t flags = 0;            // bit 0: colour is HDR
+  uint32_t face_size = 1;          // cube face side, pixels
+  uint32_t cell_size = 1;          // colour cell side, pixels
+  uint32_t depth_region_size = 1;  // depth region side, pixels
+  uint16_t colour_format = 0;      // PixelFormat
+  uint16_t depth_format = 0;       // PixelFormat
+  uint16_t material_format = 0;    // PixelFormat, kNone without a material stream
+  uint16_t flags = 0;              // bit 0: colour is HDR
   template <class Self, class V>
   static constexpr void fields(Self& s, V& v) {
     CALF_TRACK_TIMING_FIELDS(s, v);
     v(s.view_count, "view_count", Range{1, kMaxViews});
     v(s.face_size, "face_size", Range{1, kMaxDimension});
     v(s.cell_size, "cell_size", Range{1, kMaxDimension});
-    v(s.depth_tile_size, "depth_tile_size", Range{1, kMaxDimension});
+    v(s.depth_region_size, "depth_region_size", Range{1, kMaxDimension});
     v(s.colour_format, "colour_format");
     v(s.depth_format, "depth_format");
     v(s.material_format, "material_format");
@@ -234,8 +234,8 @@ inline bool region_rect_reads_state(const RegionChunk& chunk, size_t index) {
          chunk.rects[index].mask_offset != RegionRect::kNoMask;
 }
 
-// The GPU-ready bytes (clip_decoder.h's update formats) of rect `index` of a parsed region chunk:
-// kR16, kR16Predicted, kR16PredictedMasked -> little-endian u16 codes; kBc5 / kBc1 -> whole
+// The GPU-ready bytes (lightfield_decoder.h's update formats) of rect `index` of a parsed region
+// chunk: kR16, kR16Predicted, kR16PredictedMasked -> little-endian u16 codes; kBc5 / kBc1 -> whole
 // blocks, row-major; kRgb8 -> RGBA8 (reflect, refract, ior, 255); kCoverage -> 4 bytes per texel
 // (CoverageTexel::gpu_bytes: mask low byte, mask high byte, near count, far count). Replaces `out`,
 // except when region_rect_reads_state(): then `out` must hold on entry the rectangle's codes in the

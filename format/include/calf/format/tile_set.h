@@ -45,7 +45,7 @@ struct Tile {
 struct TileSet {
   // The view region the set was built for (the capture set's view volume): outside it the tiles
   // show holes and stretched texels.
-  Box3 view_region;
+  Box3 view_volume;
   std::vector<Tile> tiles;
   uint32_t atlas_width = 0, atlas_height = 0;
   // atlas_width * atlas_height * 4 bytes, row-major from the top row, RGBA (see above).

@@ -90,7 +90,7 @@ inline constexpr uint32_t kDefaultBandRows = 1024;
 struct IndexChunk {
   uint32_t layout_version = kLayoutVersion;
   uint32_t flags = 0;              // reserved, 0
-  double view_min[3] = {0, 0, 0};  // TileSet::view_region, finite, min <= max per axis
+  double view_min[3] = {0, 0, 0};  // TileSet::view_volume, finite, min <= max per axis
   double view_max[3] = {0, 0, 0};
   // Texel rows per atlas chunk: a multiple of 4 in [4, 16384]; the last band holds the rest.
   uint32_t band_rows = kDefaultBandRows;

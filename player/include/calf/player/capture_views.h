@@ -20,7 +20,7 @@
 #include "calf/capture/capture_set.h"
 #include "calf/capture/eye_path.h"
 #include "calf/format/status.h"
-#include "calf/player/cpu_renderer.h"
+#include "calf/player/lightfield_cpu_renderer.h"
 #include "calf/player/view_set.h"
 
 namespace calf::player {
@@ -47,7 +47,7 @@ uint32_t capture_frame_at(const capture::CaptureManifest& manifest, double time)
 // nearest-texel depth (+inf for sky). Meant for camera.position == view.position(), where it is
 // the reference a reconstruction at a viewpoint should reproduce: it isolates the renderer's
 // errors from the capture's resolution (a point-sampled ground truth at a viewpoint differs from
-// it at every edge). The camera must be valid (CpuRenderer::render's rules).
+// it at every edge). The camera must be valid (LightfieldCpuRenderer::render's rules).
 RenderedImage reproject_view(const View& view, const Camera& camera);
 
 }  // namespace calf::player

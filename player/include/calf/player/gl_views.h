@@ -1,5 +1,6 @@
 // The viewpoint textures on the GPU: the GL image of the decoder's texture state
-// (calf/decoder/clip_decoder.h) that the GL ray-march renderer (calf/player/gl_renderer.h) reads.
+// (calf/decoder/lightfield_decoder.h) that the GL ray-march renderer
+// (calf/player/lightfield_gl_renderer.h) reads.
 //
 // Per view, in 2D array textures whose layers are (view, face[, slot]) — the shader fetches texels
 // with texelFetch and does its own filtering and cross-face taps through the cube conventions
@@ -41,7 +42,7 @@
 #include <span>
 #include <vector>
 
-#include "calf/decoder/clip_decoder.h"
+#include "calf/decoder/lightfield_decoder.h"
 #include "calf/format/container.h"
 #include "calf/format/geometry.h"
 #include "calf/format/log_depth.h"
@@ -72,11 +73,12 @@ struct GlTextureLayout {
 };
 
 // The layout for a clip's lightfield track: every view with the track's face and cell size, its
-// position, range and material flag from `views` (ClipDecoder::view(v) for v < view_count), the
-// track's formats; depth kept as R16 unless `keep_bc5_depth`. Errors: CALF-E410 for a view count
-// other than the header's or a depth format other than r16 / BC5 (the other formats are checked
-// by GlViews::make), CALF-E020 for a view's invalid z_near / z_far. `coverage`: every view gets
-// coverage faces (a track with a coverage stream decoded with ClipDecoderOptions::coverage).
+// position, range and material flag from `views` (LightfieldDecoder::view(v) for v < view_count),
+// the track's formats; depth kept as R16 unless `keep_bc5_depth`. Errors: CALF-E410 for a view
+// count other than the header's or a depth format other than r16 / BC5 (the other formats are
+// checked by GlViews::make), CALF-E020 for a view's invalid z_near / z_far. `coverage`: every view
+// gets coverage faces (a track with a coverage stream decoded with
+// LightfieldDecoderOptions::coverage).
 Expected<GlTextureLayout> layout_for_clip(const container::LightfieldTrackHeader& header,
                                           std::span<const decoder::LightfieldViewInfo> views,
                                           bool keep_bc5_depth = false, bool coverage = false);
@@ -91,7 +93,7 @@ Expected<GlTextureLayout> layout_for_clip(const container::LightfieldTrackHeader
 // Not copyable: the updates point into `bytes`.
 struct ViewSetUpload {
   GlTextureLayout layout;
-  decoder::FrameUpdates frame;
+  decoder::LightfieldFrameUpdates frame;
   std::vector<std::vector<uint8_t>> bytes;
 
   ViewSetUpload() = default;
@@ -116,7 +118,7 @@ class GlViews {
 
   // Applies a frame's updates in order, then its cells' (t, a_slot). Stops at the first bad
   // update (those before it stay applied). Errors: as apply_update / set_cells.
-  Status apply(const decoder::FrameUpdates& frame);
+  Status apply(const decoder::LightfieldFrameUpdates& frame);
   // One update. Errors (CALF-E411, nothing is written): view, face or slot out of range, material
   // or coverage for a view without it, an empty rect or one leaving the face, a format the storage
   // does not take, block rects not 4-aligned (width / height may be short only at the face's edge),

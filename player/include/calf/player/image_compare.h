@@ -34,7 +34,7 @@
 
 #include "calf/capture/eye_path.h"
 #include "calf/format/status.h"
-#include "calf/player/cpu_renderer.h"
+#include "calf/player/lightfield_cpu_renderer.h"
 #include "calf/player/rendered_image.h"
 
 namespace calf::player {
@@ -95,10 +95,10 @@ Expected<std::vector<float>> error_map(const RgbImageRef& a, const RgbImageRef& 
 
 // The heat-map colour ramp, 8-bit RGB: t <= 0 black, 1/4 blue, 1/2 cyan, 3/4 yellow, t >= 1 red,
 // linear in between (NaN gives red: an undefined error is shown as the worst).
-std::array<uint8_t, 3> heat_color(double t);
+std::array<uint8_t, 3> heat_colour(double t);
 
 // Writes the heat map of error_map(a, b) as an 8-bit RGB PNG: a pixel's colour is
-// heat_color(error / full_scale), so full_scale (in (0, 1]; 0.1 by default, a per-pixel error of
+// heat_colour(error / full_scale), so full_scale (in (0, 1]; 0.1 by default, a per-pixel error of
 // 20 dB) and above is red.
 Status write_heat_map_png(const std::filesystem::path& path, const RgbImageRef& a,
                           const RgbImageRef& b, double full_scale = 0.1);

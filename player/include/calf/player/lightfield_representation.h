@@ -3,17 +3,18 @@
 //
 //   prepare(frame, eyes):  view selection (view_selection.h, which asks its frame budget) from
 //                          the eyes' midpoint -> the view-dependent decoder
-//                          (calf/decoder/clip_decoder.h) advances the selected views to `frame`
-//                          for the eyes' frusta -> the updates go to the GPU textures (GlViews)
-//                          or, for the CPU reference renderer, to CpuTextures and from there into
-//                          the CPU views (only the faces the updates changed are converted again);
-//   render(camera, image): ray-marches one eye with the selected views (GlRenderer or
-//                          CpuRenderer; the same RenderOptions).
+//                          (calf/decoder/lightfield_decoder.h) advances the selected views to
+//                          `frame` for the eyes' frusta -> the updates go to the GPU textures
+//                          (GlViews) or, for the CPU reference renderer, to CpuTextures and from
+//                          there into the CPU views (only the faces the updates changed are
+//                          converted again);
+//   render(camera, image): ray-marches one eye with the selected views (LightfieldGlRenderer or
+//                          LightfieldCpuRenderer; the same LightfieldRenderOptions).
 //
-// The march range (RenderOptions near / far) is derived per frame from the clip's views and the
-// eye (march_range_for), unless `fixed_march_range` is set. With RR on and material in the clip,
-// the decoder keeps every cell current (secondary rays read texels outside the eyes' frusta); this
-// is decided when the options are set, not per frame.
+// The march range (LightfieldRenderOptions near / far) is derived per frame from the clip's views
+// and the eye (march_range_for), unless `fixed_march_range` is set. With RR on and material in the
+// clip, the decoder keeps every cell current (secondary rays read texels outside the eyes' frusta);
+// this is decided when the options are set, not per frame.
 #pragma once
 
 #include <memory>
@@ -22,11 +23,11 @@
 #include <utility>
 #include <vector>
 
-#include "calf/decoder/clip_decoder.h"
+#include "calf/decoder/lightfield_decoder.h"
 #include "calf/format/container.h"
 #include "calf/format/status.h"
-#include "calf/player/cpu_renderer.h"
 #include "calf/player/gl_context.h"
+#include "calf/player/lightfield_cpu_renderer.h"
 #include "calf/player/representation.h"
 #include "calf/player/view_selection.h"
 
@@ -34,11 +35,11 @@ namespace calf::player {
 
 struct LightfieldOptions {
   // Steps, weights, RR, ... ; active_views, near and far are set per frame.
-  RenderOptions render;
+  LightfieldRenderOptions render;
   // Keep the march range in `render` instead of deriving it per frame.
   bool fixed_march_range = false;
   ViewSelectionOptions selection;
-  decoder::ClipDecoderOptions decoder;
+  decoder::LightfieldDecoderOptions decoder;
   // GL only: keep BC5 depth compressed on the GPU (gl_views.h explains the trade).
   bool keep_bc5_depth = false;
 };
@@ -76,7 +77,8 @@ class LightfieldRepresentation final : public Representation {
 
   // Whether any view carries material (the RR variant needs it).
   bool has_material() const;
-  // Whether the track has a coverage stream (RenderOptions::coverage needs it; SPEC §11.1.11).
+  // Whether the track has a coverage stream (LightfieldRenderOptions::coverage needs it; SPEC
+  // §11.1.11).
   bool has_coverage() const;
   // The CPU backend's views after the last prepare(), indexed like the clip (a view never active
   // yet is a one-texel placeholder), with the clip's coverage where it has a coverage stream;
@@ -84,12 +86,13 @@ class LightfieldRepresentation final : public Representation {
   const ViewSet* cpu_views() const;
   const std::vector<Vec3>& viewpoints() const;
   // Changes render options (RR, steps, ...) from the next render; CALF-E403 on invalid ones.
-  Status set_render_options(const RenderOptions& options);
+  Status set_render_options(const LightfieldRenderOptions& options);
   const LightfieldOptions& options() const;
   ViewSelector& selector();
 
-  // The views the decoder dropped at open (an unusable index chunk; ClipDecoder::view_problem),
-  // increasing, each with why. They are never selected; the others play.
+  // The views the decoder dropped at open (an unusable index chunk;
+  // LightfieldDecoder::view_problem), increasing, each with why. They are never selected; the
+  // others play.
   std::vector<std::pair<uint32_t, Status>> dropped_views() const;
 
   const decoder::FrameStats& last_stats() const;

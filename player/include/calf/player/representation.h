@@ -30,7 +30,7 @@
 #include <vector>
 
 #include "calf/format/status.h"
-#include "calf/player/cpu_renderer.h"
+#include "calf/player/lightfield_cpu_renderer.h"
 #include "calf/player/rendered_image.h"
 
 namespace calf::player {

@@ -67,8 +67,8 @@ class View {
   // src_stride 0 means tightly packed. Errors: CALF-E401 when the rect leaves the face, is empty,
   // the stride is shorter than a row or `src` is shorter than the rect; CALF-E402 when material
   // is written to a view made without it. Nothing is written on error.
-  Status write_color_rect(CubeFace face, const PixelRect& rect, std::span<const float> src,
-                          size_t src_stride = 0);
+  Status write_colour_rect(CubeFace face, const PixelRect& rect, std::span<const float> src,
+                           size_t src_stride = 0);
   Status write_depth_rect(CubeFace face, const PixelRect& rect, std::span<const uint16_t> src,
                           size_t src_stride = 0);
   Status write_material_rect(CubeFace face, const PixelRect& rect, std::span<const float> src,
@@ -79,14 +79,14 @@ class View {
                              size_t src_stride = 0);
 
   // Whole faces, row-major, for filling and for reading back (face_size^2 * channels elements).
-  std::span<const float> color_face(CubeFace f) const { return color_[cube_face_index(f)]; }
+  std::span<const float> colour_face(CubeFace f) const { return colour_[cube_face_index(f)]; }
   std::span<const uint16_t> depth_face(CubeFace f) const { return depth_[cube_face_index(f)]; }
   // Empty when the view has no material.
   std::span<const float> material_face(CubeFace f) const { return material_[cube_face_index(f)]; }
 
   // Texel access for the renderers; x, y < face_size (asserted in debug).
-  const float* color_at(CubeFace f, uint32_t x, uint32_t y) const {
-    return &color_[cube_face_index(f)][3 * texel_index(x, y)];
+  const float* colour_at(CubeFace f, uint32_t x, uint32_t y) const {
+    return &colour_[cube_face_index(f)][3 * texel_index(x, y)];
   }
   uint16_t depth_code_at(CubeFace f, uint32_t x, uint32_t y) const {
     return depth_[cube_face_index(f)][texel_index(x, y)];
@@ -107,7 +107,7 @@ class View {
   Vec3 position_;
   LogDepthRange range_ = *LogDepthRange::make(1, 2);
   uint32_t face_size_ = 0;
-  std::array<std::vector<float>, kCubeFaceCount> color_;
+  std::array<std::vector<float>, kCubeFaceCount> colour_;
   std::array<std::vector<uint16_t>, kCubeFaceCount> depth_;
   std::array<std::vector<float>, kCubeFaceCount> material_;
   std::array<std::vector<Coverage>, kCubeFaceCount> coverage_;

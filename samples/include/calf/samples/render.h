@@ -19,7 +19,7 @@
 // directions are points of a per-pixel scrambled (0, 2)-sequence (calf/samples/pixel_samples.h):
 // every round's samples, and the AO rays of all of a pixel's samples at a surface together, are
 // stratified. spp = 1 is one sample through the texel centre with a fixed AO pattern, bit for bit
-// the colours tests/samples/antialias_legacy_colors.inc holds.
+// the colours tests/samples/antialias_legacy_colours.inc holds.
 // Depth is the radial distance of the primary hit of the ray through the pixel centre from the
 // ray origin (the viewpoint centre), whatever `spp`: the player re-projects each texel along its
 // centre direction at its depth, so the depth must be the surface on that very ray (a mean of
@@ -54,7 +54,7 @@
 
 namespace calf::samples {
 
-struct RenderOptions {
+struct LightfieldRenderOptions {
   uint32_t threads = 0;      // 0: all hardware threads; 1..256 otherwise
   uint64_t seed = 1;         // seeds AO directions and noise
   uint32_t ao_samples = 4;   // per diffuse hit of each sample, 0..256; 0: no ambient occlusion
@@ -67,7 +67,7 @@ struct RenderOptions {
                              // 0: always spp samples
 };
 // E177 when an option is outside its range.
-Status validate_render_options(const RenderOptions& options);
+Status validate_render_options(const LightfieldRenderOptions& options);
 
 // The relative depth within which a colour sample's first hit counts as the texel's own surface
 // for coverage: 2 texel angles (4 / face size; a surface at up to 76 degrees incidence stays
@@ -92,7 +92,7 @@ class FrameTracer {
   // Embree scene of its own, instanced by the objects that place it. E174 for non-finite
   // transformed geometry, E178 when Embree fails.
   static Expected<std::unique_ptr<FrameTracer>> create(const Scene& scene, double time,
-                                                       const RenderOptions& options);
+                                                       const LightfieldRenderOptions& options);
   ~FrameTracer();
   FrameTracer(const FrameTracer&) = delete;
   FrameTracer& operator=(const FrameTracer&) = delete;
@@ -137,7 +137,7 @@ struct CaptureRequest {
   bool coverage = false;     // write the coverage channels (manifest version 2)
   uint32_t frames = 0;       // 0: scene.frame_count; else 1..100000
   Rig rig;
-  RenderOptions render;
+  LightfieldRenderOptions render;
   std::string generator = "calf-capture";  // recorded in the manifest
   // A capture shard (calf/capture/capture_shard.h, docs/FARM.md): only these views (ascending;
   // empty = every view) x frames [first_frame, last_frame] (last_frame 0 with first_frame 0 =
@@ -153,7 +153,7 @@ using ProgressFn = std::function<void(uint64_t done, uint64_t total)>;
 // Fails with E176 when a viewpoint is inside geometry at any frame (checked before anything is
 // rendered), naming the viewpoint, its position and the frame.
 Status check_viewpoints(const Scene& scene, const Rig& rig, uint32_t frames, double fps,
-                        const RenderOptions& options);
+                        const LightfieldRenderOptions& options);
 
 // Renders a complete capture set into `directory` (format/CAPTURE.md): checks options, scene and
 // viewpoints first, writes each view-frame as it is done and manifest.json last; on failure
@@ -167,7 +167,7 @@ Expected<RenderStats> render_capture_set(const Scene& scene, const CaptureReques
 // pattern (kDefaultImagePattern when empty), then eye_path.json (with that pattern) last. Poses
 // must not be inside geometry (E176).
 Expected<RenderStats> render_ground_truth(const Scene& scene, const capture::EyePath& path,
-                                          const RenderOptions& options,
+                                          const LightfieldRenderOptions& options,
                                           const std::filesystem::path& directory,
                                           const ProgressFn& progress);
 

@@ -26,7 +26,7 @@
 //   material kRgba8  4 bytes per texel: reflect, refract, ior code, 255 (material_from_codes)
 //           kBc1     BC1 blocks of (reflect, refract, ior code), not sRGB
 //   coverage kRgba8  4 bytes per texel: mask low byte, mask high byte, near count, far count
-//                    (lf::coverage_from_gpu; only with ClipDecoderOptions::coverage)
+//                    (lf::coverage_from_gpu; only with LightfieldDecoderOptions::coverage)
 // Block formats cover ceil(w / 4) x ceil(h / 4) blocks; rect x and y are multiples of 4 and w, h
 // are too unless the rect reaches the face's right / bottom edge.
 //
@@ -77,11 +77,11 @@ struct CellParams {
 };
 
 // A visible depth / material tile.
-struct TileRef {
+struct LightfieldRegionRef {
   uint32_t view = 0;
   CubeFace face = CubeFace::kPosX;
-  uint32_t tile = 0;  // index in the view's depth tile grid
-  friend bool operator==(const TileRef&, const TileRef&) = default;
+  uint32_t tile = 0;  // index in the view's depth region grid
+  friend bool operator==(const LightfieldRegionRef&, const LightfieldRegionRef&) = default;
 };
 
 struct FrameStats {
@@ -91,8 +91,8 @@ struct FrameStats {
   uint64_t culling_reused = 0;       // node decisions kept from earlier frames instead of tests
   uint32_t visible_cells = 0;        // colour cells of active views seen by a viewer
   uint32_t total_cells = 0;          // colour cells of active views
-  uint32_t visible_tiles = 0;        // depth tiles of active views seen by a viewer
-  uint32_t total_tiles = 0;
+  uint32_t visible_regions = 0;      // depth regions of active views seen by a viewer
+  uint32_t total_regions = 0;
   uint32_t updates = 0;                                            // texture updates yielded
   uint64_t colour_bytes = 0, depth_bytes = 0, material_bytes = 0;  // update payload bytes
   uint64_t coverage_bytes = 0;
@@ -111,11 +111,11 @@ struct FrameStats {
   double mbps_at_24fps() const { return update_bytes() * 8.0 * 24.0 / 1e6; }
 };
 
-struct FrameUpdates {
+struct LightfieldFrameUpdates {
   uint32_t frame = 0;
-  std::vector<TextureUpdate> updates;  // in application order
-  std::vector<CellParams> cells;       // every visible cell of every active view
-  std::vector<TileRef> tiles;          // every visible tile of every active view
+  std::vector<TextureUpdate> updates;      // in application order
+  std::vector<CellParams> cells;           // every visible cell of every active view
+  std::vector<LightfieldRegionRef> tiles;  // every visible tile of every active view
   // The chunks this frame's updates were decoded from (stats.chunks_needed ids, in order of use;
   // a chunk used twice is listed twice): what a benchmark decompresses to time "the limit".
   std::vector<uint32_t> chunks;
@@ -123,7 +123,7 @@ struct FrameUpdates {
 };
 
 // A viewer: its frustum (EyeView); several viewers share one decoder (stereo, several users).
-struct ClipDecoderOptions {
+struct LightfieldDecoderOptions {
   // false: every cell and tile of every active view is kept up to date (Table 3 "VD no").
   bool view_dependent = true;
   // Quadtree levels descended per face (0 = all; 1 = test every cell directly).
@@ -141,24 +141,24 @@ struct ClipDecoderOptions {
   bool coverage = false;
 };
 
-class ClipDecoder {
+class LightfieldDecoder {
  public:
   // `reader` must outlive the decoder. Errors as LightfieldReference::open, and
   // CALF-E300 for invalid options.
-  static Expected<ClipDecoder> open(const container::Reader& reader, uint16_t track,
-                                    const ClipDecoderOptions& options = {});
-  ClipDecoder(ClipDecoder&&) noexcept;
-  ClipDecoder& operator=(ClipDecoder&&) noexcept;
-  ~ClipDecoder();
+  static Expected<LightfieldDecoder> open(const container::Reader& reader, uint16_t track,
+                                          const LightfieldDecoderOptions& options = {});
+  LightfieldDecoder(LightfieldDecoder&&) noexcept;
+  LightfieldDecoder& operator=(LightfieldDecoder&&) noexcept;
+  ~LightfieldDecoder();
 
   const container::LightfieldTrackHeader& header() const;
   const LightfieldViewInfo& view(uint32_t v) const;
-  // The track has a coverage stream (decoded only with ClipDecoderOptions::coverage).
+  // The track has a coverage stream (decoded only with LightfieldDecoderOptions::coverage).
   bool has_coverage() const;
   // Ok, or why view v was dropped at open (its index chunk unusable; LightfieldReference::open):
   // a dropped view is never decoded, and naming it in advance()'s active views is an error.
   const Status& view_problem(uint32_t v) const;
-  const ClipDecoderOptions& options() const;
+  const LightfieldDecoderOptions& options() const;
 
   // Brings the state of `active_views` (indices, any order, no duplicates, none dropped; empty =
   // every view not dropped) to
@@ -167,7 +167,7 @@ class ClipDecoder {
   // CALF-E300 for a frame, view or eye out of range (an eye that fails eye_view_problem: not
   // finite, degenerate axes, far <= near). Corrupt chunks are not errors: see FrameStats::errors.
   Status advance(uint32_t frame, std::span<const EyeView> eyes,
-                 std::span<const uint32_t> active_views, FrameUpdates* out);
+                 std::span<const uint32_t> active_views, LightfieldFrameUpdates* out);
 
   // Turns view-dependent decoding on or off from the next advance() (e.g. a renderer that traces
   // secondary rays reads texels outside the viewers' frusta). Cells that were culled are brought
@@ -180,7 +180,7 @@ class ClipDecoder {
 
  private:
   struct Impl;
-  explicit ClipDecoder(std::unique_ptr<Impl> impl);
+  explicit LightfieldDecoder(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
 

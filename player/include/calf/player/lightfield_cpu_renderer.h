@@ -30,7 +30,7 @@
 // angle in radians) wins. |ln(d_j / r)| is the paper's |nonlin(d_tex) - nonlin(r)| times each
 // view's ln(z_far / z_near), so views with different depth ranges are weighed on one scale.
 // Colour texels are sampled bilinearly (optionally depth-aware: each of the four taps is weighted
-// by its own depth agreement beyond `color_depth_tolerance`, so silhouettes do not bleed
+// by its own depth agreement beyond `colour_depth_tolerance`, so silhouettes do not bleed
 // foreground into background); taps that fall off a face are fetched from the neighbouring face
 // through the cube conventions. Taps on a depth edge of their view ("mixed" texels: an
 // anti-aliased capture gives them the mean colour of both sides) keep only
@@ -65,7 +65,7 @@
 namespace calf::player {
 
 // Every knob of the renderer. Defaults follow the paper where it gives one.
-struct RenderOptions {
+struct LightfieldRenderOptions {
   // N_step: constant steps in normalised log depth between near and far (1..65536). The paper
   // leaves it open; 64 is what DESIGN.md's timings assume.
   uint32_t steps = 64;
@@ -103,15 +103,15 @@ struct RenderOptions {
   // distance). >= 0; 0 weighs all agreeing views equally.
   double cam_decay = 20;
   // Bilinear colour within and across faces (true), or the nearest texel (false).
-  bool bilinear_color = true;
+  bool bilinear_colour = true;
   // With bilinear colour: weigh each tap by its own depth agreement (true) or plain bilinear.
-  bool depth_aware_color = true;
+  bool depth_aware_colour = true;
   // Depth-aware colour: taps whose relative depth disagreement |ln(d_t / r)| exceeds the best
   // tap's by at most this much count as the same surface and keep their bilinear weight; only
   // the excess is penalised (depth_decay per unit). 0 penalises every difference, which on
   // slanted surfaces (neighbouring texels at different depths) skews bilinear weights towards the
   // nearest texel and shifts colour edges. >= 0.
-  double color_depth_tolerance = 0.1;
+  double colour_depth_tolerance = 0.1;
   // Mixed texels. An anti-aliased capture (calf-capture's default, any offline renderer's) gives
   // a texel on a depth edge the mean colour of the surfaces on both sides, while its depth (the
   // centre ray's) names one of them: re-projected, it paints background colour into a surface
@@ -256,20 +256,21 @@ struct MarchView {
   Vec3 position;
   double z_near = 1, z_far = 2;
 };
-Expected<RenderOptions> march_range_for(std::span<const MarchView> views, const Vec3& eye,
-                                        RenderOptions options);
-Expected<RenderOptions> march_range_for(const ViewSet& views, const Vec3& eye,
-                                        RenderOptions options);
+Expected<LightfieldRenderOptions> march_range_for(std::span<const MarchView> views, const Vec3& eye,
+                                                  LightfieldRenderOptions options);
+Expected<LightfieldRenderOptions> march_range_for(const ViewSet& views, const Vec3& eye,
+                                                  LightfieldRenderOptions options);
 
 // The checks every renderer applies to its options (CALF-E403 naming the option): ranges of
 // every field and active view indices below `view_count`.
-Status validate_render_options(const RenderOptions& options, size_t view_count);
+Status validate_render_options(const LightfieldRenderOptions& options, size_t view_count);
 
-class CpuRenderer {
+class LightfieldCpuRenderer {
  public:
   // Validates the options against the views (CALF-E403 naming the bad option). The renderer keeps
   // a reference to `views`: they must outlive it and may be updated between frames.
-  static Expected<CpuRenderer> make(const ViewSet& views, const RenderOptions& options);
+  static Expected<LightfieldCpuRenderer> make(const ViewSet& views,
+                                              const LightfieldRenderOptions& options);
 
   // Renders `camera` (the one camera model, calf/format/camera.h) into `out` (resized).
   // CALF-E403 for an invalid camera (validate_camera: non-finite position, zero or parallel
@@ -285,10 +286,10 @@ class CpuRenderer {
   // leaves when the geometry is exact (bench-player_quality --gt-depth).
   RaySample shade_at(const Vec3& origin, const Vec3& direction, double depth) const;
 
-  const RenderOptions& options() const { return options_; }
+  const LightfieldRenderOptions& options() const { return options_; }
 
  private:
-  CpuRenderer(const ViewSet& views, const RenderOptions& options);
+  LightfieldCpuRenderer(const ViewSet& views, const LightfieldRenderOptions& options);
   struct Hit {
     Vec3 p;               // the surface point
     double z = 0;         // its distance from the ray origin
@@ -297,14 +298,15 @@ class CpuRenderer {
   RaySample shade_hit(const Vec3& origin, const Vec3& direction, const Hit* hit) const;
   double tap_purity(const View& v, const Texel& t) const;
   // `exclude` (nullptr: none): a surface point of an earlier layer; each view treats its texels
-  // at that point's depth (within coverage_cluster) as absent (RenderOptions::coverage_layers).
+  // at that point's depth (within coverage_cluster) as absent
+  // (LightfieldRenderOptions::coverage_layers).
   bool empty_at(const Vec3& p, const Vec3* exclude = nullptr) const;
   bool empty_beyond(const Vec3& p, double margin_texels, uint32_t vetoes_ignored,
                     const Vec3* exclude = nullptr) const;
   bool intersect(const Vec3& origin, const Vec3& dir, double start, Hit* hit,
                  const Vec3* exclude = nullptr) const;
   // `alpha` (optional): the share of p's direction the views' front surfaces cover
-  // (RenderOptions::coverage_layers), 1 where no view has coverage.
+  // (LightfieldRenderOptions::coverage_layers), 1 where no view has coverage.
   void shade_surface(const Vec3& origin, const Vec3& p, double* rgb, int* best_view,
                      double* best_rgb = nullptr, double* alpha = nullptr) const;
   RaySample trace_layers(const Vec3& origin, const Vec3& direction) const;
@@ -315,7 +317,7 @@ class CpuRenderer {
                 double* rgb) const;
 
   const ViewSet* views_;
-  RenderOptions options_;
+  LightfieldRenderOptions options_;
   std::vector<const View*> active_;
   double min_view_distance_ = 0;
   double smooth_log_ratio_ = 0;

@@ -1,10 +1,11 @@
-// The GL ray-march renderer (calf/player/gl_renderer.h) against the CPU reference on the same
-// views, under OSMesa (llvmpipe): PSNR between the two images of the same frame >= 45 dB and the
-// same hit distances, for plain and RR rendering (Alg. 4 and with the view's reflection replaced),
-// nearest and bilinear colour, one, several and a subset of views, HDR colour, every depth-test
-// variant, surface hints, supersampling, coverage; determinism; option and camera errors.
-// Renders stay at <= 128^2 with few views: llvmpipe is slow. Figures are printed for the report.
-#include "calf/player/gl_renderer.h"
+// The GL ray-march renderer (calf/player/lightfield_gl_renderer.h) against the CPU reference on the
+// same views, under OSMesa (llvmpipe): PSNR between the two images of the same frame >= 45 dB and
+// the same hit distances, for plain and RR rendering (Alg. 4 and with the view's reflection
+// replaced), nearest and bilinear colour, one, several and a subset of views, HDR colour, every
+// depth-test variant, surface hints, supersampling, coverage; determinism; option and camera
+// errors. Renders stay at <= 128^2 with few views: llvmpipe is slow. Figures are printed for the
+// report.
+#include "calf/player/lightfield_gl_renderer.h"
 
 #include <gtest/gtest.h>
 
@@ -19,9 +20,9 @@
 
 #include "../gl_test_context.h"
 #include "../player/synthetic_scene.h"
-#include "calf/player/cpu_renderer.h"
 #include "calf/player/gl_context.h"
 #include "calf/player/gl_views.h"
+#include "calf/player/lightfield_cpu_renderer.h"
 
 namespace calf::player {
 namespace {
@@ -65,11 +66,11 @@ struct Comparison {
 
 // Renders `cam` with both renderers from the same views and options (march range from the CPU's
 // march_range_for, the same one the GL overload computes).
-Comparison compare(const ViewSet& views, const Camera& cam, RenderOptions o) {
+Comparison compare(const ViewSet& views, const Camera& cam, LightfieldRenderOptions o) {
   Comparison c;
   o = *march_range_for(views, cam.position, o);
   o.threads = 2;
-  const Expected<CpuRenderer> cpu = CpuRenderer::make(views, o);
+  const Expected<LightfieldCpuRenderer> cpu = LightfieldCpuRenderer::make(views, o);
   EXPECT_TRUE(cpu.ok()) << cpu.status().to_string();
   EXPECT_TRUE(cpu->render(cam, &c.cpu).ok());
 
@@ -79,10 +80,10 @@ Comparison compare(const ViewSet& views, const Camera& cam, RenderOptions o) {
   EXPECT_TRUE(gv.ok()) << gv.status().to_string();
   const Status applied = (*gv)->apply(up->frame);
   EXPECT_TRUE(applied.ok()) << applied.to_string();
-  const RenderOptions gl_range = *march_range_for(up->layout, cam.position, o);
+  const LightfieldRenderOptions gl_range = *march_range_for(up->layout, cam.position, o);
   EXPECT_EQ(gl_range.near, o.near);
   EXPECT_EQ(gl_range.far, o.far);
-  Expected<std::unique_ptr<GlRenderer>> gl = GlRenderer::make(**gv, o);
+  Expected<std::unique_ptr<LightfieldGlRenderer>> gl = LightfieldGlRenderer::make(**gv, o);
   EXPECT_TRUE(gl.ok()) << gl.status().to_string();
   const Status rendered = (*gl)->render(cam, &c.gl);
   EXPECT_TRUE(rendered.ok()) << rendered.to_string();
@@ -134,7 +135,7 @@ Camera between_views_camera(uint32_t size) {
   return cam;
 }
 
-TEST(GlRenderer, MatchesCpuBetweenViewpoints) {
+TEST(LightfieldGlRenderer, MatchesCpuBetweenViewpoints) {
   CALF_REQUIRE_GL();
   const ViewSet views = make_views(room_with_spheres(), corner_views({0, 0, 0.5}, 1.0), 48);
   const Camera cam = between_views_camera(128);
@@ -158,21 +159,21 @@ ViewSet tinted_views(uint32_t face) {
                            1.4f - 0.15f * static_cast<float>(i % 3)};
     for (int f = 0; f < kCubeFaceCount; ++f) {
       const CubeFace face_id = cube_face_from_index(f);
-      std::vector<float> c(v.color_face(face_id).begin(), v.color_face(face_id).end());
+      std::vector<float> c(v.colour_face(face_id).begin(), v.colour_face(face_id).end());
       for (size_t k = 0; k < c.size(); ++k) c[k] *= tint[k % 3];
-      EXPECT_TRUE(v.write_color_rect(face_id, {0, 0, face, face}, c).ok());
+      EXPECT_TRUE(v.write_colour_rect(face_id, {0, 0, face, face}, c).ok());
     }
   }
   return views;
 }
 
-TEST(GlRenderer, MatchesCpuForColourAndDepthTestVariants) {
+TEST(LightfieldGlRenderer, MatchesCpuForColourAndDepthTestVariants) {
   CALF_REQUIRE_GL();
   const ViewSet views = tinted_views(32);
   const Camera cam = between_views_camera(80);
   struct Variant {
     const char* name;
-    RenderOptions o;
+    LightfieldRenderOptions o;
   };
   std::vector<Variant> variants;
   // The two colour lookups that jump at a texel boundary run without surface hints: a confirmed
@@ -181,12 +182,12 @@ TEST(GlRenderer, MatchesCpuForColourAndDepthTestVariants) {
   // colour counts most, so float and double can pick different texels there (63.6 dB on the
   // same hits, about one pixel a texel off, once the hint margin let such a crossing through).
   // Hints with these lookups would test that rounding, not the lookups.
-  RenderOptions o;
-  o.bilinear_color = false;
+  LightfieldRenderOptions o;
+  o.bilinear_colour = false;
   o.surface_hints = 0;
   variants.push_back({"nearest colour, no hints", o});
   o = {};
-  o.depth_aware_color = false;
+  o.depth_aware_colour = false;
   o.surface_hints = 0;
   variants.push_back({"plain bilinear colour, no hints", o});
   o = {};
@@ -202,7 +203,7 @@ TEST(GlRenderer, MatchesCpuForColourAndDepthTestVariants) {
   o.cam_decay = 0;
   variants.push_back({"17 steps, no refinement, cam_decay 0", o});
   o = {};
-  o.color_depth_tolerance = 0.02;
+  o.colour_depth_tolerance = 0.02;
   o.tight_march_start = true;
   variants.push_back({"colour depth tolerance 0.02, tight start", o});
   o = {};
@@ -242,12 +243,12 @@ TEST(GlRenderer, MatchesCpuForColourAndDepthTestVariants) {
 
 // Supersampling: the same sub-pixel grid, mean and nearest depth as the CPU reference (3 x 3, so
 // the centre ray is one of them, and 2 x 2, where none is).
-TEST(GlRenderer, MatchesCpuWithSupersampling) {
+TEST(LightfieldGlRenderer, MatchesCpuWithSupersampling) {
   CALF_REQUIRE_GL();
   const ViewSet views = tinted_views(32);
   const Camera cam = between_views_camera(40);
   for (uint32_t n : {2u, 3u}) {
-    RenderOptions o;
+    LightfieldRenderOptions o;
     o.supersample = n;
     const Comparison c = compare(views, cam, o);
     report(n == 2 ? "tinted views, supersample 2" : "tinted views, supersample 3", c);
@@ -256,15 +257,15 @@ TEST(GlRenderer, MatchesCpuWithSupersampling) {
   }
 }
 
-// Surface hints (RenderOptions::surface_hints) with coarse steps, where the plain march steps over
-// thin parts and the hints find them: the hints change the image (else agreement would prove
-// nothing), and GL follows the CPU with them, also with several hints, no vetoes and an eye on a
-// viewpoint (the hint view is then the view at the eye).
-TEST(GlRenderer, MatchesCpuWithSurfaceHints) {
+// Surface hints (LightfieldRenderOptions::surface_hints) with coarse steps, where the plain march
+// steps over thin parts and the hints find them: the hints change the image (else agreement would
+// prove nothing), and GL follows the CPU with them, also with several hints, no vetoes and an eye
+// on a viewpoint (the hint view is then the view at the eye).
+TEST(LightfieldGlRenderer, MatchesCpuWithSurfaceHints) {
   CALF_REQUIRE_GL();
   const ViewSet views = tinted_views(40);
   Camera cam = between_views_camera(80);
-  RenderOptions o;
+  LightfieldRenderOptions o;
   o.steps = 6;
   o.surface_hints = 0;
   const Comparison plain = compare(views, cam, o);
@@ -292,7 +293,7 @@ TEST(GlRenderer, MatchesCpuWithSurfaceHints) {
 }
 
 // One view, the eye on it: the GL image reproduces the view's own face (mirrored), like the CPU.
-TEST(GlRenderer, MatchesCpuWithOneViewAtItsViewpoint) {
+TEST(LightfieldGlRenderer, MatchesCpuWithOneViewAtItsViewpoint) {
   CALF_REQUIRE_GL();
   const ViewSet views = make_views(room_with_spheres(), {{0.5, 0.5, 1.0}}, 48);
   Camera cam;
@@ -307,7 +308,7 @@ TEST(GlRenderer, MatchesCpuWithOneViewAtItsViewpoint) {
 }
 
 // A subset of the views in a scrambled order, and a set of views with different face sizes.
-TEST(GlRenderer, MatchesCpuWithActiveSubsetAndMixedFaceSizes) {
+TEST(LightfieldGlRenderer, MatchesCpuWithActiveSubsetAndMixedFaceSizes) {
   CALF_REQUIRE_GL();
   const Scene scene = room_with_spheres();
   const std::vector<Vec3> pos = corner_views({0, 0, 0.5}, 1.0);
@@ -315,7 +316,7 @@ TEST(GlRenderer, MatchesCpuWithActiveSubsetAndMixedFaceSizes) {
   views.views[3] = testing::make_view(scene, pos[3], 40);
   views.views[6] = testing::make_view(scene, pos[6], 24);
   const Camera cam = between_views_camera(72);
-  RenderOptions o;
+  LightfieldRenderOptions o;
   o.active_views = {6, 1, 3};
   const Comparison c = compare(views, cam, o);
   report("active views {6, 1, 3}, faces 24/32/40", c);
@@ -331,10 +332,10 @@ TEST(GlRenderer, MatchesCpuWithActiveSubsetAndMixedFaceSizes) {
   EXPECT_LT(psnr_vs(all.cpu.color, c.cpu.color), 45.0);
 }
 
-// Coverage (format/CAPTURE.md "Coverage"; RenderOptions::coverage, coverage_agreement): coarse,
-// anti-aliased views with their 4 x 4 cell coverage of the room with its spheres (a wall behind
-// every silhouette), in every view and in every second view (the others answer as without it),
-// and of a sphere five texels across against the sky. The coverage test moves many silhouette
+// Coverage (format/CAPTURE.md "Coverage"; LightfieldRenderOptions::coverage, coverage_agreement):
+// coarse, anti-aliased views with their 4 x 4 cell coverage of the room with its spheres (a wall
+// behind every silhouette), in every view and in every second view (the others answer as without
+// it), and of a sphere five texels across against the sky. The coverage test moves many silhouette
 // pixels on the CPU, so a GL renderer that ignored it would fail the flip bound.
 // The cell masks (modes 2 and 3) put the edge of what is occupied on texel boundaries, where a
 // view's texel turns from the sphere to sky; the march's refinement then places hits on such a
@@ -345,7 +346,7 @@ TEST(GlRenderer, MatchesCpuWithActiveSubsetAndMixedFaceSizes) {
 // the bound there with every coverage vote counted (mode 4 with agreement 2: 43.1 dB); the masks
 // are held to it on the room and pinned below on the sky sphere.
 // A view set without coverage renders the same bytes whatever the option says.
-TEST(GlRenderer, MatchesCpuWithCoverage) {
+TEST(LightfieldGlRenderer, MatchesCpuWithCoverage) {
   CALF_REQUIRE_GL();
   Scene sky_scene;
   sky_scene.room = false;
@@ -360,7 +361,7 @@ TEST(GlRenderer, MatchesCpuWithCoverage) {
   cam.forward = testing::unit(testing::sub(sky_scene.spheres[0].centre, cam.position));
   cam.fov_y = 24 * kPi / 180;
   cam.width = cam.height = 96;
-  RenderOptions o;
+  LightfieldRenderOptions o;
   o.steps = 128;
   size_t moved = 0;  // CPU pixels that coverage mode 4 sends to the other side of a silhouette
   for (const auto& [mode, agreement] : {std::pair{4u, 1u}, std::pair{1u, 1u}, std::pair{4u, 2u},
@@ -456,7 +457,7 @@ TEST(GlRenderer, MatchesCpuWithCoverage) {
 }
 
 // HDR colour (values up to ~10) stays HDR through the half-float textures and the float target.
-TEST(GlRenderer, MatchesCpuWithHdrColour) {
+TEST(LightfieldGlRenderer, MatchesCpuWithHdrColour) {
   CALF_REQUIRE_GL();
   const Scene scene = room_with_spheres();
   const std::vector<Vec3> pos = corner_views({0, 0, 0.5}, 1.0);
@@ -465,9 +466,9 @@ TEST(GlRenderer, MatchesCpuWithHdrColour) {
     View v = testing::make_view(scene, pos[i], 32);
     for (int f = 0; f < kCubeFaceCount; ++f) {
       const CubeFace face = cube_face_from_index(f);
-      std::vector<float> c(v.color_face(face).begin(), v.color_face(face).end());
+      std::vector<float> c(v.colour_face(face).begin(), v.colour_face(face).end());
       for (size_t k = 0; k < c.size(); ++k) c[k] = std::exp2(8.0f * c[k] - 3.0f);  // 0.2 .. 10
-      ASSERT_TRUE(v.write_color_rect(face, {0, 0, 32, 32}, c).ok());
+      ASSERT_TRUE(v.write_colour_rect(face, {0, 0, 32, 32}, c).ok());
     }
     views.views.push_back(std::move(v));
   }
@@ -519,12 +520,12 @@ ViewSet views_with_uniform_material(const MirrorFloorRoom& room, uint32_t face, 
 
 // RR as Alg. 4 writes it (no replacement of the view's own reflection) on the CPU test's mirror
 // floor: reflection rays from the material faces.
-TEST(GlRenderer, MatchesCpuWithRrOnAMirrorFloor) {
+TEST(LightfieldGlRenderer, MatchesCpuWithRrOnAMirrorFloor) {
   CALF_REQUIRE_GL();
   const MirrorFloorRoom room = mirror_floor_room(64);
   const ViewSet views = make_views(room.scene, room.positions, 48, /*material=*/true);
   Camera cam = room.camera;
-  RenderOptions o;
+  LightfieldRenderOptions o;
   o.rr = true;
   o.rr_replace_view_reflection = false;
   const Comparison rr = compare(views, cam, o);
@@ -560,15 +561,15 @@ TEST(GlRenderer, MatchesCpuWithRrOnAMirrorFloor) {
 }
 
 // RR with the view's own reflection / refraction replaced by the eye's
-// (RenderOptions::rr_replace_view_reflection): twice the secondary rays, signed weights, the
-// pixel clamped at 0. It changes the image, GL follows the CPU, for 1 and 3 bounces, mirror and
+// (LightfieldRenderOptions::rr_replace_view_reflection): twice the secondary rays, signed weights,
+// the pixel clamped at 0. It changes the image, GL follows the CPU, for 1 and 3 bounces, mirror and
 // glass, and with surface hints.
-TEST(GlRenderer, MatchesCpuWithRrViewReflectionReplaced) {
+TEST(LightfieldGlRenderer, MatchesCpuWithRrViewReflectionReplaced) {
   CALF_REQUIRE_GL();
   const MirrorFloorRoom room = mirror_floor_room(56);
   const ViewSet views = make_views(room.scene, room.positions, 40, /*material=*/true);
   Camera cam = room.camera;
-  RenderOptions o;
+  LightfieldRenderOptions o;
   o.rr = true;
   o.rr_replace_view_reflection = false;
   const Comparison alg4 = compare(views, cam, o);
@@ -594,7 +595,7 @@ TEST(GlRenderer, MatchesCpuWithRrViewReflectionReplaced) {
   EXPECT_GE(g.depth_agree, 0.99);
 }
 
-TEST(GlRenderer, IsDeterministicAndReusable) {
+TEST(LightfieldGlRenderer, IsDeterministicAndReusable) {
   CALF_REQUIRE_GL();
   const ViewSet views = make_views(room_with_spheres(), corner_views({0, 0, 0.5}, 1.0), 24);
   Expected<ViewSetUpload> up = updates_from_view_set(views);
@@ -602,8 +603,8 @@ TEST(GlRenderer, IsDeterministicAndReusable) {
   std::unique_ptr<GlViews> gv = *GlViews::make(gl_context()->gl(), up->layout);
   ASSERT_TRUE(gv->apply(up->frame).ok());
   Camera cam = between_views_camera(40);
-  const RenderOptions o = *march_range_for(up->layout, cam.position, {});
-  std::unique_ptr<GlRenderer> r = *GlRenderer::make(*gv, o);
+  const LightfieldRenderOptions o = *march_range_for(up->layout, cam.position, {});
+  std::unique_ptr<LightfieldGlRenderer> r = *LightfieldGlRenderer::make(*gv, o);
   RenderedImage a, b, c;
   ASSERT_TRUE(r->render(cam, &a).ok());
   cam.width = 23;  // another target size in between
@@ -616,31 +617,33 @@ TEST(GlRenderer, IsDeterministicAndReusable) {
   EXPECT_EQ(std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * 4), 0);
   // The hint count is compiled into the shader: set_options relinks, and the result is the image
   // of a renderer made with those options.
-  RenderOptions no_hints = o;
+  LightfieldRenderOptions no_hints = o;
   no_hints.surface_hints = 0;
   no_hints.steps = 5;  // coarse: the hints matter
   ASSERT_TRUE(r->set_options(no_hints).ok());
   RenderedImage d, e, plain;
   ASSERT_TRUE(r->render(cam, &plain).ok());
-  ASSERT_TRUE((*GlRenderer::make(*gv, no_hints))->render(cam, &e).ok());
+  ASSERT_TRUE((*LightfieldGlRenderer::make(*gv, no_hints))->render(cam, &e).ok());
   EXPECT_EQ(std::memcmp(plain.color.data(), e.color.data(), plain.color.size() * 4), 0);
-  RenderOptions hints = no_hints;
+  LightfieldRenderOptions hints = no_hints;
   hints.surface_hints = 2;
   ASSERT_TRUE(r->set_options(hints).ok());
   ASSERT_TRUE(r->render(cam, &d).ok());
-  ASSERT_TRUE((*GlRenderer::make(*gv, hints))->render(cam, &e).ok());
+  ASSERT_TRUE((*LightfieldGlRenderer::make(*gv, hints))->render(cam, &e).ok());
   EXPECT_EQ(std::memcmp(d.color.data(), e.color.data(), d.color.size() * 4), 0);
   EXPECT_NE(std::memcmp(d.depth.data(), plain.depth.data(), d.depth.size() * 4), 0);
 }
 
-TEST(GlRenderer, RejectsBadOptionsAndCameras) {
+TEST(LightfieldGlRenderer, RejectsBadOptionsAndCameras) {
   CALF_REQUIRE_GL();
   const ViewSet views = make_views(room_with_spheres(), {{0, 0, 0}}, 4);
   Expected<ViewSetUpload> up = updates_from_view_set(views);
   ASSERT_TRUE(up.ok());
   std::unique_ptr<GlViews> gv = *GlViews::make(gl_context()->gl(), up->layout);
-  const auto code = [&](RenderOptions o) { return GlRenderer::make(*gv, o).status().id(); };
-  RenderOptions o;
+  const auto code = [&](LightfieldRenderOptions o) {
+    return LightfieldGlRenderer::make(*gv, o).status().id();
+  };
+  LightfieldRenderOptions o;
   o.steps = 0;
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
   o = {};
@@ -667,11 +670,11 @@ TEST(GlRenderer, RejectsBadOptionsAndCameras) {
   o = {};
   o.coverage_layers = 2;  // the CPU reference's compositing only: refused, never ignored
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
-  std::unique_ptr<GlRenderer> r = *GlRenderer::make(*gv, {});
+  std::unique_ptr<LightfieldGlRenderer> r = *LightfieldGlRenderer::make(*gv, {});
   o = {};
   o.depth_footprint = 2;
   EXPECT_EQ(r->set_options(o).id(), ErrorId::kPlayerOptions);
-  EXPECT_EQ(r->options().depth_footprint, RenderOptions{}.depth_footprint);
+  EXPECT_EQ(r->options().depth_footprint, LightfieldRenderOptions{}.depth_footprint);
   RenderedImage img;
   Camera cam;
   cam.up = {0, 0, 2};

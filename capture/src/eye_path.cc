@@ -277,7 +277,7 @@ Expected<PerspectiveImage> read_perspective_image(const std::filesystem::path& f
     for (int c = 0; c < 3; ++c) {
       float v = rows[i * nch + idx[c]];
       if (!(v >= 0 && std::isfinite(v))) {
-        return Status(ErrorId::kCaptureColorPixel,
+        return Status(ErrorId::kCaptureColourPixel,
                       file.string() + ": pixel (" + std::to_string(i % image.width) + ", " +
                           std::to_string(i / image.width) + "): colour is not finite and >= 0");
       }

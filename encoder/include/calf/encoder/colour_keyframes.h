@@ -21,7 +21,7 @@
 
 #include "calf/format/status.h"
 
-namespace calf {
+namespace calf::encoder {
 
 // Frame `f` of the cell as the decoder will show it if f is a keyframe. Called at most once per
 // frame per select_cell_keyframes() call (results are cached), for candidate keyframes only; the
@@ -79,4 +79,4 @@ Expected<CellKeyframes> select_cell_keyframes(std::span<const float> frames, uin
 // LDR display shows. +inf when identical.
 double psnr_srgb(std::span<const float> reference, std::span<const float> test);
 
-}  // namespace calf
+}  // namespace calf::encoder

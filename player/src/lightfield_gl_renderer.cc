@@ -1,4 +1,4 @@
-#include "calf/player/gl_renderer.h"
+#include "calf/player/lightfield_gl_renderer.h"
 
 #include <algorithm>
 #include <cmath>
@@ -25,7 +25,7 @@ Status option_error(const std::string& what) {
 }
 
 // The CPU renderer's checks (both renderers accept the same options), plus the GL limits.
-Status check_options(const RenderOptions& o, size_t view_count) {
+Status check_options(const LightfieldRenderOptions& o, size_t view_count) {
   CALF_RETURN_IF_ERROR(validate_render_options(o, view_count));
   if (o.coverage_layers > 0) return option_error("coverage_layers is the CPU reference's only");
   const size_t active = o.active_views.empty() ? view_count : o.active_views.size();
@@ -51,36 +51,37 @@ Status camera_axes(const Camera& c, Vec3* forward, Vec3* right, Vec3* up) {
 
 }  // namespace
 
-Expected<RenderOptions> march_range_for(const GlTextureLayout& layout, const Vec3& eye,
-                                        RenderOptions options) {
+Expected<LightfieldRenderOptions> march_range_for(const GlTextureLayout& layout, const Vec3& eye,
+                                                  LightfieldRenderOptions options) {
   std::vector<MarchView> m;
   for (const GlViewInfo& v : layout.views)
     m.push_back({v.position, v.range.z_near(), v.range.z_far()});
   return calf::player::march_range_for(m, eye, std::move(options));
 }
 
-GlRenderer::GlRenderer(const GlViews& views, const RenderOptions& options)
+LightfieldGlRenderer::LightfieldGlRenderer(const GlViews& views,
+                                           const LightfieldRenderOptions& options)
     : views_(&views), gl_(&views.gl()), options_(options) {}
 
-GlRenderer::~GlRenderer() {
+LightfieldGlRenderer::~LightfieldGlRenderer() {
   if (program_ != 0) gl_->DeleteProgram(program_);
   if (vao_ != 0) gl_->DeleteVertexArrays(1, &vao_);
   if (view_buffer_ != 0) gl_->DeleteBuffers(1, &view_buffer_);
 }
 
-Expected<std::unique_ptr<GlRenderer>> GlRenderer::make(const GlViews& views,
-                                                       const RenderOptions& options) {
+Expected<std::unique_ptr<LightfieldGlRenderer>> LightfieldGlRenderer::make(
+    const GlViews& views, const LightfieldRenderOptions& options) {
   CALF_RETURN_IF_ERROR(check_options(options, views.layout().views.size()));
-  std::unique_ptr<GlRenderer> r(new GlRenderer(views, options));
+  std::unique_ptr<LightfieldGlRenderer> r(new LightfieldGlRenderer(views, options));
   CALF_RETURN_IF_ERROR(r->build_program());
   return r;
 }
 
-Status GlRenderer::set_options(const RenderOptions& options) {
+Status LightfieldGlRenderer::set_options(const LightfieldRenderOptions& options) {
   CALF_RETURN_IF_ERROR(check_options(options, views_->layout().views.size()));
   if (options.surface_hints != options_.surface_hints) {
     // The hint count is compiled into the shader (see build_program): a new program.
-    const RenderOptions old = options_;
+    const LightfieldRenderOptions old = options_;
     const GLuint old_program = program_;
     options_ = options;
     program_ = 0;
@@ -97,7 +98,7 @@ Status GlRenderer::set_options(const RenderOptions& options) {
   return Status::Ok();
 }
 
-Status GlRenderer::build_program() {
+Status LightfieldGlRenderer::build_program() {
   const GlFunctions& gl = *gl_;
   std::string defines =
       "#define CALF_MAX_VIEWS " + std::to_string(internal::kGlMaxActiveViews) + "\n";
@@ -119,12 +120,12 @@ Status GlRenderer::build_program() {
   return check_gl_error(gl, "building the ray-march program");
 }
 
-Status GlRenderer::draw(const Camera& camera) {
+Status LightfieldGlRenderer::draw(const Camera& camera) {
   Vec3 forward, right, up;
   CALF_RETURN_IF_ERROR(camera_axes(camera, &forward, &right, &up));
   const GlFunctions& gl = *gl_;
   const GlTextureLayout& layout = views_->layout();
-  const RenderOptions& o = options_;
+  const LightfieldRenderOptions& o = options_;
 
   // The active views, eye-relative, in the order given.
   std::vector<uint32_t> active = o.active_views;
@@ -180,7 +181,7 @@ Status GlRenderer::draw(const Camera& camera) {
   gl.Uniform1f(loc("smooth_log_ratio"), f(std::log1p(o.smooth_depth_ratio)));
   gl.Uniform1f(loc("depth_decay"), f(o.depth_decay));
   gl.Uniform1f(loc("cam_decay"), f(o.cam_decay));
-  gl.Uniform1f(loc("color_depth_tolerance"), f(o.color_depth_tolerance));
+  gl.Uniform1f(loc("colour_depth_tolerance"), f(o.colour_depth_tolerance));
   gl.Uniform1f(loc("mixed_penalty_factor"), f(std::exp(-o.mixed_texel_penalty)));
   gl.Uniform1f(loc("mixed_texel_bend_texels"), f(o.mixed_texel_bend_texels));
   gl.Uniform1ui(loc("coverage_mode"), o.coverage);
@@ -188,8 +189,8 @@ Status GlRenderer::draw(const Camera& camera) {
   gl.Uniform1f(loc("coverage_cluster"), f(o.coverage_cluster));
   gl.Uniform1ui(loc("coverage_agreement"), o.coverage_agreement);
   gl.Uniform1i(loc("tight_march_start"), o.tight_march_start ? 1 : 0);
-  gl.Uniform1i(loc("bilinear_color"), o.bilinear_color ? 1 : 0);
-  gl.Uniform1i(loc("depth_aware_color"), o.depth_aware_color ? 1 : 0);
+  gl.Uniform1i(loc("bilinear_colour"), o.bilinear_colour ? 1 : 0);
+  gl.Uniform1i(loc("depth_aware_colour"), o.depth_aware_colour ? 1 : 0);
   gl.Uniform1f(loc("surface_hint_margin_texels"), f(o.surface_hint_margin_texels));
   gl.Uniform1ui(loc("surface_hint_vetoes"), o.surface_hint_vetoes);
   gl.Uniform1ui(loc("surface_hint_substeps"), o.surface_hint_substeps);
@@ -213,7 +214,7 @@ Status GlRenderer::draw(const Camera& camera) {
   return check_gl_error(gl, "drawing the ray-march pass");
 }
 
-Status GlRenderer::render(const Camera& camera, RenderedImage* out) {
+Status LightfieldGlRenderer::render(const Camera& camera, RenderedImage* out) {
   Vec3 forward, right, up;
   CALF_RETURN_IF_ERROR(camera_axes(camera, &forward, &right, &up));
   if (target_ == nullptr) {

@@ -1,5 +1,5 @@
-// Property tests of the view-dependent decoder (decoder/include/calf/decoder/clip_decoder.h) on
-// random clips encoded by the real encoder: the state its updates build (applied by CpuTextures)
+// Property tests of the view-dependent decoder (decoder/include/calf/decoder/lightfield_decoder.h)
+// on random clips encoded by the real encoder: the state its updates build (applied by CpuTextures)
 // must equal the reference full-frame decoder (lightfield_reference.h) on every visible cell and
 // tile, whatever path led to the frame — playing 0..N, seeking straight to N, wandering there
 // through random frames, one viewer or several, hierarchical or brute-force culling, with or
@@ -19,8 +19,8 @@
 #include <vector>
 
 #include "calf/capture/capture_set.h"
-#include "calf/decoder/clip_decoder.h"
 #include "calf/decoder/cpu_textures.h"
+#include "calf/decoder/lightfield_decoder.h"
 #include "calf/decoder/lightfield_reference.h"
 #include "calf/decoder/lightfield_verify.h"
 #include "calf/encoder/lightfield_encode.h"
@@ -40,7 +40,7 @@ struct ClipSpec {
   // A second, 2 x 2 square on face 0 moving down its right edge: with one rectangle per P-frame
   // the rectangle spans both squares and the static texels between them.
   bool second_square = false;
-  LightfieldEncodeOptions options;
+  encoder::LightfieldEncodeOptions options;
 };
 
 // Smooth colour with per-seed moving squares (colour and depth), a fading face, sky patches and,
@@ -123,7 +123,7 @@ Clip make_clip(const ClipSpec& s) {
     EXPECT_TRUE(in.ok()) << in.status().to_string();
     auto writer = container::Writer::create(container::memory_sink(&clip.bytes));
     EXPECT_TRUE(writer.ok());
-    auto stats = encode_lightfield(*in, *writer, s.options);
+    auto stats = encoder::encode_lightfield(*in, *writer, s.options);
     EXPECT_TRUE(stats.ok()) << stats.status().to_string();
     EXPECT_TRUE(writer->finish().ok());
   }
@@ -141,16 +141,18 @@ ClipSpec random_spec(uint32_t seed) {
   s.views = 1 + rng() % 3;
   s.material = rng() % 2 == 0;
   s.hdr = rng() % 4 == 0;
-  LightfieldEncodeOptions& o = s.options;
+  encoder::LightfieldEncodeOptions& o = s.options;
   o.cell_size = (rng() % 2 == 0) ? 4 : 8;
   o.min_psnr_db = 35 + rng() % 20;
-  o.depth = rng() % 2 == 0 ? DepthCoding::kRaw16 : DepthCoding::kBc5;
-  o.depth_tiles_per_side = 1 + rng() % 4;
+  o.depth = rng() % 2 == 0 ? encoder::DepthCoding::kRaw16 : encoder::DepthCoding::kBc5;
+  o.depth_regions_per_side = 1 + rng() % 4;
   o.depth_keyframe_interval = 1 + rng() % 8;
   o.depth_window = 1 + rng() % 3;
   o.max_aabbs = 1 + rng() % 3;
-  const ColourCoding ldr[] = {ColourCoding::kBc1, ColourCoding::kRgba8, ColourCoding::kBc7};
-  o.colour = s.hdr ? (rng() % 2 ? ColourCoding::kBc6h : ColourCoding::kRgba16f) : ldr[rng() % 3];
+  const encoder::ColourCoding ldr[] = {encoder::ColourCoding::kBc1, encoder::ColourCoding::kRgba8,
+                                       encoder::ColourCoding::kBc7};
+  o.colour = s.hdr ? (rng() % 2 ? encoder::ColourCoding::kBc6h : encoder::ColourCoding::kRgba16f)
+                   : ldr[rng() % 3];
   return s;
 }
 
@@ -172,12 +174,13 @@ EyeView random_eye(std::mt19937& rng) {
 
 // Compares, for every visible cell and tile of `fu`, the applied state with the reference decoder
 // at `frame`. Returns the number of texels compared.
-size_t expect_matches_reference(const Clip& clip, const CpuTextures& tex, const FrameUpdates& fu,
-                                uint32_t frame, const std::string& context) {
+size_t expect_matches_reference(const Clip& clip, const CpuTextures& tex,
+                                const LightfieldFrameUpdates& fu, uint32_t frame,
+                                const std::string& context) {
   auto ref = LightfieldReference::open(*clip.reader, 0);
   EXPECT_TRUE(ref.ok());
   const auto& h = ref->header();
-  auto tiles = FaceGrid::with_cell_size(h.face_size, h.depth_tile_size);
+  auto tiles = FaceGrid::with_cell_size(h.face_size, h.depth_region_size);
   std::map<std::pair<uint32_t, int>, LightfieldFace> faces;
   auto face_of = [&](uint32_t v, CubeFace f) -> const LightfieldFace& {
     auto key = std::make_pair(v, cube_face_index(f));
@@ -226,7 +229,7 @@ size_t expect_matches_reference(const Clip& clip, const CpuTextures& tex, const 
       }
     }
   }
-  for (const TileRef& t : fu.tiles) {
+  for (const LightfieldRegionRef& t : fu.tiles) {
     const LightfieldFace& want = face_of(t.view, t.face);
     const auto depth = tex.depth(t.view, t.face);
     const auto material = tex.material(t.view, t.face);
@@ -256,10 +259,10 @@ size_t expect_matches_reference(const Clip& clip, const CpuTextures& tex, const 
   return compared;
 }
 
-FrameUpdates advance_ok(ClipDecoder& d, CpuTextures& tex, uint32_t frame,
-                        const std::vector<EyeView>& eyes,
-                        const std::vector<uint32_t>& active = {}) {
-  FrameUpdates fu;
+LightfieldFrameUpdates advance_ok(LightfieldDecoder& d, CpuTextures& tex, uint32_t frame,
+                                  const std::vector<EyeView>& eyes,
+                                  const std::vector<uint32_t>& active = {}) {
+  LightfieldFrameUpdates fu;
   const Status s = d.advance(frame, eyes, active, &fu);
   EXPECT_TRUE(s.ok()) << s.to_string();
   EXPECT_EQ(fu.stats.errors, 0u) << fu.stats.first_error;
@@ -267,29 +270,29 @@ FrameUpdates advance_ok(ClipDecoder& d, CpuTextures& tex, uint32_t frame,
   return fu;
 }
 
-ClipDecoder open_decoder(const Clip& clip, ClipDecoderOptions o = {}) {
-  auto d = ClipDecoder::open(*clip.reader, 0, o);
+LightfieldDecoder open_decoder(const Clip& clip, LightfieldDecoderOptions o = {}) {
+  auto d = LightfieldDecoder::open(*clip.reader, 0, o);
   EXPECT_TRUE(d.ok()) << d.status().to_string();
   return std::move(*d);
 }
 
-CpuTextures textures_for(const ClipDecoder& d) {
+CpuTextures textures_for(const LightfieldDecoder& d) {
   std::vector<LightfieldViewInfo> views;
   for (uint32_t v = 0; v < d.header().view_count; ++v) views.push_back(d.view(v));
   return CpuTextures(d.header(), views);
 }
 
 // Playing every frame with everything visible reproduces the reference decoder exactly.
-TEST(ClipDecoder, PlayingWithoutCullingEqualsReferenceOnEveryFrame) {
+TEST(LightfieldDecoder, PlayingWithoutCullingEqualsReferenceOnEveryFrame) {
   for (uint32_t seed = 1; seed <= 6; ++seed) {
     const ClipSpec spec = random_spec(seed);
     const Clip clip = make_clip(spec);
-    ClipDecoderOptions o;
+    LightfieldDecoderOptions o;
     o.view_dependent = false;
-    ClipDecoder d = open_decoder(clip, o);
+    LightfieldDecoder d = open_decoder(clip, o);
     CpuTextures tex = textures_for(d);
     for (uint32_t f = 0; f < spec.frames; ++f) {
-      const FrameUpdates fu = advance_ok(d, tex, f, {});
+      const LightfieldFrameUpdates fu = advance_ok(d, tex, f, {});
       EXPECT_EQ(fu.stats.visible_cells, fu.stats.total_cells);
       const size_t n = expect_matches_reference(clip, tex, fu, f, "seed " + std::to_string(seed));
       EXPECT_EQ(n, size_t{spec.views} * 6 * spec.face * spec.face * 2);
@@ -299,7 +302,7 @@ TEST(ClipDecoder, PlayingWithoutCullingEqualsReferenceOnEveryFrame) {
 
 // Seeking to N (fresh decoder), playing 0..N and wandering through random frames before N give
 // the same state for every cell and tile visible at N, equal to the reference.
-TEST(ClipDecoder, SeekingEqualsPlayingEqualsReference) {
+TEST(LightfieldDecoder, SeekingEqualsPlayingEqualsReference) {
   size_t visible_somewhere = 0;
   for (uint32_t seed = 11; seed <= 18; ++seed) {
     const ClipSpec spec = random_spec(seed);
@@ -308,15 +311,16 @@ TEST(ClipDecoder, SeekingEqualsPlayingEqualsReference) {
     for (int trial = 0; trial < 3; ++trial) {
       std::vector<EyeView> eyes = {random_eye(rng)};
       const uint32_t target = rng() % spec.frames;
-      ClipDecoder play = open_decoder(clip), seek = open_decoder(clip), wander = open_decoder(clip);
+      LightfieldDecoder play = open_decoder(clip), seek = open_decoder(clip),
+                        wander = open_decoder(clip);
       CpuTextures tp = textures_for(play), ts = textures_for(seek), tw = textures_for(wander);
-      FrameUpdates last;
+      LightfieldFrameUpdates last;
       for (uint32_t f = 0; f <= target; ++f) last = advance_ok(play, tp, f, eyes);
-      const FrameUpdates direct = advance_ok(seek, ts, target, eyes);
+      const LightfieldFrameUpdates direct = advance_ok(seek, ts, target, eyes);
       for (int hop = 0; hop < 5; ++hop) {
         advance_ok(wander, tw, rng() % spec.frames, {random_eye(rng)});
       }
-      const FrameUpdates wandered = advance_ok(wander, tw, target, eyes);
+      const LightfieldFrameUpdates wandered = advance_ok(wander, tw, target, eyes);
       EXPECT_EQ(last.cells.size(), direct.cells.size());
       EXPECT_TRUE(last.tiles == direct.tiles && direct.tiles == wandered.tiles);
       const std::string ctx = "seed " + std::to_string(seed) + " frame " + std::to_string(target);
@@ -332,7 +336,7 @@ TEST(ClipDecoder, SeekingEqualsPlayingEqualsReference) {
 }
 
 // The visible set for several viewers is the union of each one's, and the state on it is right.
-TEST(ClipDecoder, SeveralViewersGiveTheUnionOfEachViewer) {
+TEST(LightfieldDecoder, SeveralViewersGiveTheUnionOfEachViewer) {
   for (uint32_t seed = 21; seed <= 26; ++seed) {
     const ClipSpec spec = random_spec(seed);
     const Clip clip = make_clip(spec);
@@ -341,20 +345,21 @@ TEST(ClipDecoder, SeveralViewersGiveTheUnionOfEachViewer) {
     const uint32_t frame = rng() % spec.frames;
     std::set<std::tuple<uint32_t, int, uint32_t>> cells_union, tiles_union;
     for (const EyeView& e : eyes) {
-      ClipDecoder d = open_decoder(clip);
+      LightfieldDecoder d = open_decoder(clip);
       CpuTextures tex = textures_for(d);
-      const FrameUpdates fu = advance_ok(d, tex, frame, {e});
+      const LightfieldFrameUpdates fu = advance_ok(d, tex, frame, {e});
       for (const CellParams& c : fu.cells)
         cells_union.insert({c.view, cube_face_index(c.face), c.cell});
-      for (const TileRef& t : fu.tiles)
+      for (const LightfieldRegionRef& t : fu.tiles)
         tiles_union.insert({t.view, cube_face_index(t.face), t.tile});
     }
-    ClipDecoder all = open_decoder(clip);
+    LightfieldDecoder all = open_decoder(clip);
     CpuTextures tex = textures_for(all);
-    const FrameUpdates fu = advance_ok(all, tex, frame, eyes);
+    const LightfieldFrameUpdates fu = advance_ok(all, tex, frame, eyes);
     std::set<std::tuple<uint32_t, int, uint32_t>> cells, tiles;
     for (const CellParams& c : fu.cells) cells.insert({c.view, cube_face_index(c.face), c.cell});
-    for (const TileRef& t : fu.tiles) tiles.insert({t.view, cube_face_index(t.face), t.tile});
+    for (const LightfieldRegionRef& t : fu.tiles)
+      tiles.insert({t.view, cube_face_index(t.face), t.tile});
     EXPECT_EQ(cells, cells_union) << "seed " << seed;
     EXPECT_EQ(tiles, tiles_union) << "seed " << seed;
     expect_matches_reference(clip, tex, fu, frame, "seed " + std::to_string(seed));
@@ -363,7 +368,7 @@ TEST(ClipDecoder, SeveralViewersGiveTheUnionOfEachViewer) {
 
 // Hierarchical culling, brute force, every level count, background thread or not, any prefetch
 // and cache size: byte-identical updates.
-TEST(ClipDecoder, UpdatesDoNotDependOnCullingPathThreadOrCache) {
+TEST(LightfieldDecoder, UpdatesDoNotDependOnCullingPathThreadOrCache) {
   const ClipSpec spec = random_spec(31);
   const Clip clip = make_clip(spec);
   std::mt19937 rng(31);
@@ -373,11 +378,11 @@ TEST(ClipDecoder, UpdatesDoNotDependOnCullingPathThreadOrCache) {
     eyes.push_back({random_eye(rng), random_eye(rng)});
     frames.push_back(rng() % spec.frames);
   }
-  auto run = [&](ClipDecoderOptions o) {
-    ClipDecoder d = open_decoder(clip, o);
+  auto run = [&](LightfieldDecoderOptions o) {
+    LightfieldDecoder d = open_decoder(clip, o);
     std::vector<uint8_t> log;
     for (size_t i = 0; i < frames.size(); ++i) {
-      FrameUpdates fu;
+      LightfieldFrameUpdates fu;
       EXPECT_TRUE(d.advance(frames[i], eyes[i], {}, &fu).ok());
       for (const TextureUpdate& u : fu.updates) {
         const uint32_t head[] = {static_cast<uint32_t>(u.target),
@@ -398,7 +403,7 @@ TEST(ClipDecoder, UpdatesDoNotDependOnCullingPathThreadOrCache) {
   };
   const std::vector<uint8_t> base = run({});
   EXPECT_GT(base.size(), 1000u);
-  ClipDecoderOptions o;
+  LightfieldDecoderOptions o;
   o.brute_force_culling = true;
   EXPECT_EQ(run(o), base);
   for (uint32_t levels = 1; levels <= 4; ++levels) {
@@ -418,13 +423,14 @@ TEST(ClipDecoder, UpdatesDoNotDependOnCullingPathThreadOrCache) {
 
 // Sec. 7.1: a seek restarts depth from the group keyframe and then steps W frames at a time —
 // with predicted depth (r16p) too, whose rectangles decode on their own.
-class DepthSeek : public ::testing::TestWithParam<DepthCoding> {};
+class DepthSeek : public ::testing::TestWithParam<encoder::DepthCoding> {};
 INSTANTIATE_TEST_SUITE_P(Codings, DepthSeek,
-                         ::testing::Values(DepthCoding::kRaw16, DepthCoding::kRaw16Predicted,
-                                           DepthCoding::kRaw16PredictedMasked),
+                         ::testing::Values(encoder::DepthCoding::kRaw16,
+                                           encoder::DepthCoding::kRaw16Predicted,
+                                           encoder::DepthCoding::kRaw16PredictedMasked),
                          [](const auto& p) {
-                           return std::string(p.param == DepthCoding::kRaw16 ? "raw16"
-                                              : p.param == DepthCoding::kRaw16Predicted
+                           return std::string(p.param == encoder::DepthCoding::kRaw16 ? "raw16"
+                                              : p.param == encoder::DepthCoding::kRaw16Predicted
                                                   ? "pred16"
                                                   : "pred16m");
                          });
@@ -442,17 +448,17 @@ TEST_P(DepthSeek, StepsThroughTheWindow) {
   auto ref = LightfieldReference::open(*clip.reader, 0);
   ASSERT_TRUE(ref.ok());
   for (uint32_t target = 0; target < spec.frames; ++target) {
-    ClipDecoderOptions o;
+    LightfieldDecoderOptions o;
     o.view_dependent = false;
-    ClipDecoder d = open_decoder(clip, o);
+    LightfieldDecoder d = open_decoder(clip, o);
     CpuTextures tex = textures_for(d);
-    const FrameUpdates fu = advance_ok(d, tex, target, {});
+    const LightfieldFrameUpdates fu = advance_ok(d, tex, target, {});
     expect_matches_reference(clip, tex, fu, target, "frame " + std::to_string(target));
     // Expected depth updates: per tile the keyframe rect, then the rects of frames W, 2W, ...,
     // target (the last step shorter), counted from the encoder's rectangle table.
     uint64_t expected = 0;
     const uint32_t tiles_per_face =
-        spec.options.depth_tiles_per_side * spec.options.depth_tiles_per_side;
+        spec.options.depth_regions_per_side * spec.options.depth_regions_per_side;
     for (uint32_t face = 0; face < 6; ++face) {
       for (uint32_t tile = 0; tile < tiles_per_face; ++tile) {
         auto counts = ref->depth_rect_counts(0, face, tile);
@@ -479,7 +485,7 @@ TEST_P(DepthSeek, StepsThroughTheWindow) {
 // Depth format r16p is lossless: every decoded depth code of every view, face and frame equals
 // raw16's, sky (a half face and a moving square's edges beside finite depth) included; the
 // seek reads as many chunks; and on this smooth synthetic depth the depth stream is smaller.
-TEST(ClipDecoder, PredictedDepthDecodesToRaw16Codes) {
+TEST(LightfieldDecoder, PredictedDepthDecodesToRaw16Codes) {
   ClipSpec spec;
   spec.seed = 43;
   spec.frames = 7;
@@ -487,7 +493,7 @@ TEST(ClipDecoder, PredictedDepthDecodesToRaw16Codes) {
   spec.options.cell_size = 8;
   spec.options.depth_keyframe_interval = 4;
   const Clip raw = make_clip(spec);
-  spec.options.depth = DepthCoding::kRaw16Predicted;
+  spec.options.depth = encoder::DepthCoding::kRaw16Predicted;
   const Clip pred = make_clip(spec);
   auto a = LightfieldReference::open(*raw.reader, 0);
   auto b = LightfieldReference::open(*pred.reader, 0);
@@ -509,11 +515,11 @@ TEST(ClipDecoder, PredictedDepthDecodesToRaw16Codes) {
   EXPECT_GT(sky, 0u);
   // The view-dependent decoder's seek to frame 6 applies the same codes from as many chunks.
   for (const Clip* c : {&raw, &pred}) {
-    ClipDecoderOptions o;
+    LightfieldDecoderOptions o;
     o.view_dependent = false;
-    ClipDecoder d = open_decoder(*c, o);
+    LightfieldDecoder d = open_decoder(*c, o);
     CpuTextures tex = textures_for(d);
-    const FrameUpdates fu = advance_ok(d, tex, 6, {});
+    const LightfieldFrameUpdates fu = advance_ok(d, tex, 6, {});
     expect_matches_reference(*c, tex, fu, 6, c == &raw ? "raw16 seek" : "pred16 seek");
   }
   uint64_t depth_raw = 0, depth_pred = 0;
@@ -532,7 +538,7 @@ TEST(ClipDecoder, PredictedDepthDecodesToRaw16Codes) {
 // the window, or more through the W steps of a seek) builds exactly raw16's tile state. A mask
 // taken against frame n - 1 alone, or unchanged texels read from anything but the tile state,
 // would fail the jumps over skipped frames. The P-frames really skip texels.
-TEST(ClipDecoder, MaskedDepthDecodesToRaw16CodesFromAnyFrameOfTheWindow) {
+TEST(LightfieldDecoder, MaskedDepthDecodesToRaw16CodesFromAnyFrameOfTheWindow) {
   ClipSpec spec;
   spec.seed = 53;
   spec.views = 1;
@@ -542,11 +548,11 @@ TEST(ClipDecoder, MaskedDepthDecodesToRaw16CodesFromAnyFrameOfTheWindow) {
   spec.options.depth_keyframe_interval = 6;
   spec.options.depth_window = 3;
   spec.options.max_aabbs = 1;
-  spec.options.depth_tiles_per_side = 1;
+  spec.options.depth_regions_per_side = 1;
   spec.options.merge_static_groups = false;
   spec.second_square = true;
   const Clip raw = make_clip(spec);
-  spec.options.depth = DepthCoding::kRaw16PredictedMasked;
+  spec.options.depth = encoder::DepthCoding::kRaw16PredictedMasked;
   const Clip masked = make_clip(spec);
   auto a = LightfieldReference::open(*raw.reader, 0);
   auto b = LightfieldReference::open(*masked.reader, 0);
@@ -564,12 +570,12 @@ TEST(ClipDecoder, MaskedDepthDecodesToRaw16CodesFromAnyFrameOfTheWindow) {
   }
   for (uint32_t j = 0; j < spec.frames; ++j) {
     for (uint32_t n = j + 1; n < spec.frames; ++n) {
-      ClipDecoderOptions o;
+      LightfieldDecoderOptions o;
       o.view_dependent = false;
-      ClipDecoder d = open_decoder(masked, o);
+      LightfieldDecoder d = open_decoder(masked, o);
       CpuTextures tex = textures_for(d);
       advance_ok(d, tex, j, {});
-      const FrameUpdates fu = advance_ok(d, tex, n, {});
+      const LightfieldFrameUpdates fu = advance_ok(d, tex, n, {});
       // Compared with the raw16 clip's reference decode: colour is coded alike, depth must be.
       expect_matches_reference(raw, tex, fu, n,
                                "from frame " + std::to_string(j) + " to " + std::to_string(n));
@@ -584,7 +590,7 @@ TEST(ClipDecoder, MaskedDepthDecodesToRaw16CodesFromAnyFrameOfTheWindow) {
       continue;
     auto bytes = masked.reader->read_chunk(id);
     ASSERT_TRUE(bytes.ok());
-    const uint32_t side = spec.face / spec.options.depth_tiles_per_side;
+    const uint32_t side = spec.face / spec.options.depth_regions_per_side;
     auto c = lf::parse_region_chunk(*bytes, chunks[id].keys.frame_count, side, side,
                                     lf::RegionCoding::kR16PredictedMasked, "depth");
     ASSERT_TRUE(c.ok()) << c.status().to_string();
@@ -599,7 +605,7 @@ TEST(ClipDecoder, MaskedDepthDecodesToRaw16CodesFromAnyFrameOfTheWindow) {
 // across them (SPEC §11.1.2): the clip decodes to the same faces as with one chunk per K frames,
 // has fewer, smaller depth chunks, never merges across a segment boundary, and a seek still reads
 // one depth chunk per tile.
-TEST(ClipDecoder, StaticTilesKeepOneChunkAcrossGroups) {
+TEST(LightfieldDecoder, StaticTilesKeepOneChunkAcrossGroups) {
   ClipSpec spec;
   spec.seed = 47;
   spec.frames = 9;
@@ -671,7 +677,7 @@ TEST(ClipDecoder, StaticTilesKeepOneChunkAcrossGroups) {
   // merged. In a merged chunk, P-frames from the second group on are empty but for the first
   // W - 1 (what changed in the W frames before the group).
   const uint32_t tiles_per_face =
-      spec.options.depth_tiles_per_side * spec.options.depth_tiles_per_side;
+      spec.options.depth_regions_per_side * spec.options.depth_regions_per_side;
   uint32_t tiles_with_several = 0;
   for (uint32_t v = 0; v < spec.views; ++v) {
     for (uint32_t face = 0; face < 6; ++face) {
@@ -700,11 +706,11 @@ TEST(ClipDecoder, StaticTilesKeepOneChunkAcrossGroups) {
   const uint32_t cells =
       6 * (spec.face / spec.options.cell_size) * (spec.face / spec.options.cell_size);
   for (uint32_t target = 0; target < spec.frames; ++target) {
-    ClipDecoderOptions o;
+    LightfieldDecoderOptions o;
     o.view_dependent = false;
-    ClipDecoder d = open_decoder(merged, o);
+    LightfieldDecoder d = open_decoder(merged, o);
     CpuTextures tex = textures_for(d);
-    const FrameUpdates fu = advance_ok(d, tex, target, {});
+    const LightfieldFrameUpdates fu = advance_ok(d, tex, target, {});
     expect_matches_reference(merged, tex, fu, target, "merged seek " + std::to_string(target));
     const uint32_t region_chunks = spec.views * 6 * tiles_per_face * 2;
     EXPECT_GE(fu.stats.chunks_needed, region_chunks + spec.views * 2 * cells) << target;
@@ -713,13 +719,13 @@ TEST(ClipDecoder, StaticTilesKeepOneChunkAcrossGroups) {
 }
 
 // Nothing visible without viewers; a viewer looking away from a view sees fewer cells.
-TEST(ClipDecoder, VisibilityFollowsTheViewers) {
+TEST(LightfieldDecoder, VisibilityFollowsTheViewers) {
   ClipSpec spec;
   spec.seed = 51;
   spec.options.cell_size = 4;
   const Clip clip = make_clip(spec);
-  ClipDecoder d = open_decoder(clip);
-  FrameUpdates fu;
+  LightfieldDecoder d = open_decoder(clip);
+  LightfieldFrameUpdates fu;
   ASSERT_TRUE(d.advance(0, {}, {}, &fu).ok());
   EXPECT_EQ(fu.stats.visible_cells, 0u);
   EXPECT_TRUE(fu.updates.empty());
@@ -751,7 +757,7 @@ TEST(ClipDecoder, VisibilityFollowsTheViewers) {
 // stay the same (culling them again gives the same sets): any change of an eye — position,
 // direction, near or far plane, count — or of the options recomputes them. Each frame's sets equal
 // those of a fresh decoder given the same viewers.
-TEST(ClipDecoder, VisibleSetsAreKeptOnlyWhileTheViewersStay) {
+TEST(LightfieldDecoder, VisibleSetsAreKeptOnlyWhileTheViewersStay) {
   ClipSpec spec;
   spec.seed = 57;
   spec.views = 3;
@@ -766,20 +772,21 @@ TEST(ClipDecoder, VisibleSetsAreKeptOnlyWhileTheViewersStay) {
   a_turned.forward.y += 0.2;
   const std::vector<std::vector<EyeView>> steps = {
       {a}, {a}, {b}, {a}, {a_near}, {a_far}, {a_far}, {a_moved}, {a_turned}, {a, b}, {a, b}, {b}};
-  ClipDecoder kept = open_decoder(clip);
+  LightfieldDecoder kept = open_decoder(clip);
   using Set = std::set<std::tuple<uint32_t, int, uint32_t>>;
-  auto sets = [](const FrameUpdates& fu) {
+  auto sets = [](const LightfieldFrameUpdates& fu) {
     Set cells, tiles;
     for (const CellParams& c : fu.cells) cells.insert({c.view, cube_face_index(c.face), c.cell});
-    for (const TileRef& t : fu.tiles) tiles.insert({t.view, cube_face_index(t.face), t.tile});
+    for (const LightfieldRegionRef& t : fu.tiles)
+      tiles.insert({t.view, cube_face_index(t.face), t.tile});
     return std::make_pair(cells, tiles);
   };
   int changed = 0;
   for (size_t i = 0; i < steps.size(); ++i) {
     const uint32_t frame = static_cast<uint32_t>(i % spec.frames);
-    FrameUpdates fu, fresh_fu;
+    LightfieldFrameUpdates fu, fresh_fu;
     ASSERT_TRUE(kept.advance(frame, steps[i], {}, &fu).ok());
-    ClipDecoder fresh = open_decoder(clip);
+    LightfieldDecoder fresh = open_decoder(clip);
     ASSERT_TRUE(fresh.advance(frame, steps[i], {}, &fresh_fu).ok());
     EXPECT_EQ(sets(fu), sets(fresh_fu)) << "step " << i;
     const bool same =
@@ -791,19 +798,19 @@ TEST(ClipDecoder, VisibleSetsAreKeptOnlyWhileTheViewersStay) {
       EXPECT_EQ(fu.stats.culling_tests + fu.stats.culling_reused, 0u) << "step " << i;
     } else {
       EXPECT_GT(fu.stats.culling_tests + fu.stats.culling_reused, 0u) << "step " << i;
-      changed += sets(fu) != sets(FrameUpdates{}) ? 1 : 0;
+      changed += sets(fu) != sets(LightfieldFrameUpdates{}) ? 1 : 0;
     }
   }
   EXPECT_GE(changed, 5);
   // Options: brute force and view dependence switched per frame keep giving the fresh sets.
   kept.set_view_dependent(false);
-  FrameUpdates fu;
+  LightfieldFrameUpdates fu;
   ASSERT_TRUE(kept.advance(0, steps[0], {}, &fu).ok());
   EXPECT_EQ(fu.stats.visible_cells, fu.stats.total_cells);
   kept.set_view_dependent(true);
-  FrameUpdates again, fresh_fu;
+  LightfieldFrameUpdates again, fresh_fu;
   ASSERT_TRUE(kept.advance(0, steps[0], {}, &again).ok());
-  ClipDecoder fresh = open_decoder(clip);
+  LightfieldDecoder fresh = open_decoder(clip);
   ASSERT_TRUE(fresh.advance(0, steps[0], {}, &fresh_fu).ok());
   EXPECT_EQ(sets(again), sets(fresh_fu));
   EXPECT_GT(again.stats.culling_tests + again.stats.culling_reused, 0u);
@@ -812,18 +819,18 @@ TEST(ClipDecoder, VisibleSetsAreKeptOnlyWhileTheViewersStay) {
 // A moving pair of eyes (turning, stepping, zooming, now and then jumping): the decoder culls
 // mostly from its culler's memory of earlier frames, and every frame's updates are byte for byte
 // those of a decoder that tests every cell afresh (brute force, no memory) on the same sequence.
-TEST(ClipDecoder, MovingEyesCullFromMemoryWithTheSameUpdates) {
+TEST(LightfieldDecoder, MovingEyesCullFromMemoryWithTheSameUpdates) {
   ClipSpec spec;
   spec.seed = 58;
   spec.views = 3;
   spec.options.cell_size = 4;
   const Clip clip = make_clip(spec);
-  ClipDecoderOptions brute;
+  LightfieldDecoderOptions brute;
   brute.brute_force_culling = true;
   brute.background_thread = false;
-  ClipDecoderOptions quadtree;
+  LightfieldDecoderOptions quadtree;
   quadtree.background_thread = false;
-  ClipDecoder remembering = open_decoder(clip, quadtree), fresh = open_decoder(clip, brute);
+  LightfieldDecoder remembering = open_decoder(clip, quadtree), fresh = open_decoder(clip, brute);
   std::mt19937 rng(58);
   std::uniform_real_distribution<double> u01(0, 1);
   std::vector<EyeView> eyes = {random_eye(rng), random_eye(rng)};
@@ -838,7 +845,7 @@ TEST(ClipDecoder, MovingEyesCullFromMemoryWithTheSameUpdates) {
       if (step % 13 == 12) e = random_eye(rng);
     }
     const uint32_t frame = step % spec.frames;
-    FrameUpdates a, b;
+    LightfieldFrameUpdates a, b;
     ASSERT_TRUE(remembering.advance(frame, eyes, {}, &a).ok());
     ASSERT_TRUE(fresh.advance(frame, eyes, {}, &b).ok());
     ASSERT_EQ(a.updates.size(), b.updates.size()) << "step " << step;
@@ -870,18 +877,18 @@ TEST(ClipDecoder, MovingEyesCullFromMemoryWithTheSameUpdates) {
 // far to the side of a narrow viewer must therefore still decode the cells in the directions the
 // viewer looks along, although no point of the viewer's frustum lies in them (seen from the view).
 // Before this rule those cells were culled and rendered black sky bands.
-TEST(ClipDecoder, CellsInTheViewersDirectionsAreDecodedForSky) {
+TEST(LightfieldDecoder, CellsInTheViewersDirectionsAreDecodedForSky) {
   ClipSpec spec;
   spec.seed = 52;
   spec.options.cell_size = 4;
   const Clip clip = make_clip(spec);
-  ClipDecoder d = open_decoder(clip);
+  LightfieldDecoder d = open_decoder(clip);
   EyeView side;
   side.position = {0, 10, 0};  // 10 above view 0 at (-0.25, 0, 0); its frustum stays near y = 10
   side.forward = {1, 0, 0};
   side.fov_y = 0.3;
   side.far = 3;
-  FrameUpdates fu;
+  LightfieldFrameUpdates fu;
   ASSERT_TRUE(d.advance(0, std::vector<EyeView>{side}, std::vector<uint32_t>{0}, &fu).ok());
   // The +X face's centre texel of view 0 looks along (1, 0, 0); it lies in cell (2, 2) of the
   // 16-texel face's 4-texel grid.
@@ -898,15 +905,15 @@ TEST(ClipDecoder, CellsInTheViewersDirectionsAreDecodedForSky) {
   for (const CellParams& c : fu.cells) EXPECT_NE(c.face, CubeFace::kNegX);
 }
 
-TEST(ClipDecoder, BadArgumentsAreE300AndChangeNothing) {
+TEST(LightfieldDecoder, BadArgumentsAreE300AndChangeNothing) {
   ClipSpec spec;
   spec.seed = 61;
   const Clip clip = make_clip(spec);
-  ClipDecoderOptions bad;
+  LightfieldDecoderOptions bad;
   bad.cache_bytes = 1000;
-  EXPECT_EQ(ClipDecoder::open(*clip.reader, 0, bad).status().id(), ErrorId::kDecoderArgument);
-  ClipDecoder d = open_decoder(clip);
-  FrameUpdates fu;
+  EXPECT_EQ(LightfieldDecoder::open(*clip.reader, 0, bad).status().id(), ErrorId::kDecoderArgument);
+  LightfieldDecoder d = open_decoder(clip);
+  LightfieldFrameUpdates fu;
   EXPECT_EQ(d.advance(spec.frames, {}, {}, &fu).id(), ErrorId::kDecoderArgument);
   EXPECT_EQ(d.advance(0, {}, std::vector<uint32_t>{0, 0}, &fu).id(), ErrorId::kDecoderArgument);
   EXPECT_EQ(d.advance(0, {}, std::vector<uint32_t>{7}, &fu).id(), ErrorId::kDecoderArgument);
@@ -919,12 +926,12 @@ TEST(ClipDecoder, BadArgumentsAreE300AndChangeNothing) {
   e = EyeView{};
   e.up = e.forward * -2.0;  // parallel axes: the frustum would be NaN
   EXPECT_EQ(d.advance(0, std::vector<EyeView>{e}, {}, &fu).id(), ErrorId::kDecoderArgument);
-  EXPECT_EQ(ClipDecoder::open(*clip.reader, 5).status().id(), ErrorId::kInvalidArgument);
+  EXPECT_EQ(LightfieldDecoder::open(*clip.reader, 5).status().id(), ErrorId::kInvalidArgument);
 }
 
 // A damaged chunk is reported in the frame's stats; the cells needing it keep their last good
 // state, every other cell decodes, and the decoder goes on.
-TEST(ClipDecoder, CorruptChunkIsReportedAndLastGoodStateKept) {
+TEST(LightfieldDecoder, CorruptChunkIsReportedAndLastGoodStateKept) {
   ClipSpec spec;
   spec.seed = 71;
   spec.views = 1;
@@ -945,12 +952,12 @@ TEST(ClipDecoder, CorruptChunkIsReportedAndLastGoodStateKept) {
   damaged[chunks[victim].offset] ^= 0x5A;
   auto reader = container::Reader::open(container::memory_source(damaged));
   ASSERT_TRUE(reader.ok());
-  ClipDecoderOptions o;
+  LightfieldDecoderOptions o;
   o.view_dependent = false;
-  auto d = ClipDecoder::open(*reader, 0, o);
+  auto d = LightfieldDecoder::open(*reader, 0, o);
   ASSERT_TRUE(d.ok());
   CpuTextures tex = textures_for(*d);
-  FrameUpdates fu;
+  LightfieldFrameUpdates fu;
   std::vector<float> before;
   uint32_t reported = 0;
   for (uint32_t f = 0; f < spec.frames; ++f) {
@@ -984,7 +991,7 @@ TEST(ClipDecoder, CorruptChunkIsReportedAndLastGoodStateKept) {
 // A view whose index chunk is damaged (hash mismatch, CALF-E058) is dropped at open with its
 // reason; the other views decode exactly as before, and naming the dropped view is an error.
 // With every index chunk damaged, open fails.
-TEST(ClipDecoder, DamagedViewIndexDropsThatViewOnly) {
+TEST(LightfieldDecoder, DamagedViewIndexDropsThatViewOnly) {
   ClipSpec spec;
   spec.seed = 72;
   spec.views = 3;
@@ -1000,19 +1007,19 @@ TEST(ClipDecoder, DamagedViewIndexDropsThatViewOnly) {
   damaged[chunks[index_chunk[1]].offset + 3] ^= 0x10;
   auto reader = container::Reader::open(container::memory_source(damaged));
   ASSERT_TRUE(reader.ok()) << reader.status().to_string();
-  ClipDecoderOptions o;
+  LightfieldDecoderOptions o;
   o.view_dependent = false;
-  auto d = ClipDecoder::open(*reader, 0, o);
+  auto d = LightfieldDecoder::open(*reader, 0, o);
   ASSERT_TRUE(d.ok()) << d.status().to_string();
   EXPECT_TRUE(d->view_problem(0).ok());
   EXPECT_EQ(d->view_problem(1).id(), ErrorId::kContainerChunkHash)
       << d->view_problem(1).to_string();
   EXPECT_NE(d->view_problem(1).message().find("view 1 index"), std::string::npos);
   EXPECT_TRUE(d->view_problem(2).ok());
-  ClipDecoder good = open_decoder(clip, o);
+  LightfieldDecoder good = open_decoder(clip, o);
   CpuTextures tex = textures_for(*d), want = textures_for(good);
   for (uint32_t f = 0; f < spec.frames; ++f) {
-    FrameUpdates fu;
+    LightfieldFrameUpdates fu;
     ASSERT_TRUE(d->advance(f, {}, {}, &fu).ok());
     EXPECT_EQ(fu.stats.errors, 0u) << fu.stats.first_error;
     for (const auto& c : fu.cells) EXPECT_NE(c.view, 1u);
@@ -1027,7 +1034,7 @@ TEST(ClipDecoder, DamagedViewIndexDropsThatViewOnly) {
       }
     }
   }
-  FrameUpdates fu;
+  LightfieldFrameUpdates fu;
   const Status named = d->advance(0, {}, std::vector<uint32_t>{1}, &fu);
   EXPECT_EQ(named.id(), ErrorId::kDecoderArgument);
   EXPECT_NE(named.message().find("dropped"), std::string::npos) << named.to_string();
@@ -1047,11 +1054,11 @@ TEST(ClipDecoder, DamagedViewIndexDropsThatViewOnly) {
   for (uint32_t v = 0; v < spec.views; ++v) damaged[chunks[index_chunk[v]].offset + 3] ^= 0x10;
   auto one_left = container::Reader::open(container::memory_source(damaged));
   ASSERT_TRUE(one_left.ok());
-  EXPECT_TRUE(ClipDecoder::open(*one_left, 0, o).ok());
+  EXPECT_TRUE(LightfieldDecoder::open(*one_left, 0, o).ok());
   damaged[chunks[index_chunk[1]].offset + 3] ^= 0x10;  // all three damaged
   auto none_left = container::Reader::open(container::memory_source(damaged));
   ASSERT_TRUE(none_left.ok());
-  EXPECT_EQ(ClipDecoder::open(*none_left, 0, o).status().id(), ErrorId::kContainerChunkHash);
+  EXPECT_EQ(LightfieldDecoder::open(*none_left, 0, o).status().id(), ErrorId::kContainerChunkHash);
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-#include "calf/encoder/color_keyframes.h"
+#include "calf/encoder/colour_keyframes.h"
 
 #include "calf/format/colour.h"
 
@@ -8,7 +8,7 @@
 #include <optional>
 #include <string>
 
-namespace calf {
+namespace calf::encoder {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
@@ -183,4 +183,4 @@ double psnr_srgb(std::span<const float> reference, std::span<const float> test) 
   return 10.0 * std::log10(static_cast<double>(reference.size()) / sum);
 }
 
-}  // namespace calf
+}  // namespace calf::encoder

@@ -1,5 +1,5 @@
-// Tests of colour keyframe selection (encoder/include/calf/encoder/color_keyframes.h).
-#include "calf/encoder/color_keyframes.h"
+// Tests of colour keyframe selection (encoder/include/calf/encoder/colour_keyframes.h).
+#include "calf/encoder/colour_keyframes.h"
 
 #include <gtest/gtest.h>
 
@@ -36,7 +36,7 @@ std::vector<float> concat(const std::vector<Frame>& frames) {
 struct Lossless {
   const std::vector<float>* all;
   std::map<uint32_t, int> calls;
-  ShownKeyframeFn fn() {
+  encoder::ShownKeyframeFn fn() {
     return [this](uint32_t f) -> Expected<std::span<const float>> {
       ++calls[f];
       return std::span<const float>(*all).subspan(f * kSize, kSize);
@@ -44,40 +44,41 @@ struct Lossless {
   }
 };
 
-CellKeyframes select(const std::vector<float>& all, uint32_t n, const ShownKeyframeFn& shown,
-                     KeyframeOptions options = {}) {
-  auto r = select_cell_keyframes(all, n, kTexels, shown, psnr_srgb, options);
+encoder::CellKeyframes select(const std::vector<float>& all, uint32_t n,
+                              const encoder::ShownKeyframeFn& shown,
+                              encoder::KeyframeOptions options = {}) {
+  auto r = encoder::select_cell_keyframes(all, n, kTexels, shown, encoder::psnr_srgb, options);
   EXPECT_TRUE(r.ok()) << r.status().to_string();
   return *r;
 }
 
-TEST(ColorKeyframesTest, StaticCellCostsOneKeyframe) {
+TEST(ColourKeyframesTest, StaticCellCostsOneKeyframe) {
   std::mt19937 rng(1);
   const Frame a = random_frame(rng);
   const auto all = concat(std::vector<Frame>(30, a));
   Lossless shown{&all, {}};
-  const CellKeyframes k = select(all, 30, shown.fn());
+  const encoder::CellKeyframes k = select(all, 30, shown.fn());
   EXPECT_EQ(k.keyframes, (std::vector<uint32_t>{0}));
   EXPECT_EQ(k.t, std::vector<uint8_t>(30, 0));
   EXPECT_TRUE(std::isinf(k.min_quality_db));
 }
 
-TEST(ColorKeyframesTest, SingleFrame) {
+TEST(ColourKeyframesTest, SingleFrame) {
   std::mt19937 rng(2);
   const auto all = concat({random_frame(rng)});
   Lossless shown{&all, {}};
   EXPECT_EQ(select(all, 1, shown.fn()).keyframes, (std::vector<uint32_t>{0}));
 }
 
-TEST(ColorKeyframesTest, LinearFadeNeedsOnlyItsEnds) {
+TEST(ColourKeyframesTest, LinearFadeNeedsOnlyItsEnds) {
   std::mt19937 rng(3);
   const Frame a = random_frame(rng), b = random_frame(rng);
   std::vector<Frame> frames;
   for (int i = 0; i < 21; ++i) frames.push_back(lerp(a, b, i / 20.0));
   const auto all = concat(frames);
-  for (auto mode : {KeyframeSearch::kGalloping, KeyframeSearch::kExhaustive}) {
+  for (auto mode : {encoder::KeyframeSearch::kGalloping, encoder::KeyframeSearch::kExhaustive}) {
     Lossless shown{&all, {}};
-    const CellKeyframes k = select(all, 21, shown.fn(), {50.0, mode});
+    const encoder::CellKeyframes k = select(all, 21, shown.fn(), {50.0, mode});
     EXPECT_EQ(k.keyframes, (std::vector<uint32_t>{0, 20}));
     for (int i = 0; i <= 20; ++i) {
       if (i == 0 || i == 20) continue;
@@ -88,7 +89,7 @@ TEST(ColorKeyframesTest, LinearFadeNeedsOnlyItsEnds) {
   }
 }
 
-TEST(ColorKeyframesTest, UncorrelatedFramesAreAllKeyframes) {
+TEST(ColourKeyframesTest, UncorrelatedFramesAreAllKeyframes) {
   std::mt19937 rng(4);
   std::vector<Frame> frames;
   for (int i = 0; i < 8; ++i) frames.push_back(random_frame(rng));
@@ -99,21 +100,22 @@ TEST(ColorKeyframesTest, UncorrelatedFramesAreAllKeyframes) {
 
 // The same fade judged with lossy keyframes (quantised to 4 bits, as a spatial codec would) needs
 // more keyframes: quality is measured on what the decoder shows, not on the input.
-TEST(ColorKeyframesTest, QualityIsJudgedOnShownKeyframes) {
+TEST(ColourKeyframesTest, QualityIsJudgedOnShownKeyframes) {
   std::mt19937 rng(5);
   const Frame a = random_frame(rng), b = random_frame(rng);
   std::vector<Frame> frames;
   for (int i = 0; i < 9; ++i) frames.push_back(lerp(a, b, i / 8.0));
   const auto all = concat(frames);
   std::vector<Frame> lossy_store(9);
-  const ShownKeyframeFn lossy = [&](uint32_t f) -> Expected<std::span<const float>> {
+  const encoder::ShownKeyframeFn lossy = [&](uint32_t f) -> Expected<std::span<const float>> {
     lossy_store[f] = Frame(all.begin() + f * kSize, all.begin() + (f + 1) * kSize);
     for (float& v : lossy_store[f]) v = std::round(v * 15) / 15;
     return std::span<const float>(lossy_store[f]);
   };
   Lossless exact{&all, {}};
   EXPECT_EQ(select(all, 9, exact.fn(), {40.0}).keyframes, (std::vector<uint32_t>{0, 8}));
-  const CellKeyframes k = select(all, 9, lossy, {40.0, KeyframeSearch::kGalloping});
+  const encoder::CellKeyframes k =
+      select(all, 9, lossy, {40.0, encoder::KeyframeSearch::kGalloping});
   EXPECT_GT(k.keyframes.size(), 2u);
   // Every non-keyframe frame, recomputed here from the lossy keyframes and stored t, is >= Q.
   for (uint32_t x = 0; x < 9; ++x) {
@@ -122,70 +124,73 @@ TEST(ColorKeyframesTest, QualityIsJudgedOnShownKeyframes) {
     if (m == x) continue;
     ASSERT_NE(it, k.keyframes.end());
     Frame rec(kSize);
-    interpolate_keyframes(*lossy(m), *lossy(*it), k.t[x], rec);
-    EXPECT_GE(psnr_srgb(frames[x], rec), 40.0) << x;
+    encoder::interpolate_keyframes(*lossy(m), *lossy(*it), k.t[x], rec);
+    EXPECT_GE(encoder::psnr_srgb(frames[x], rec), 40.0) << x;
   }
 }
 
 // Frame 1 lies between frames 0 and 3 but not between 0 and 2: galloping stops at 1, the paper's
 // exhaustive argmax finds 3.
-TEST(ColorKeyframesTest, ExhaustiveFindsTheFarthestValidKeyframe) {
+TEST(ColourKeyframesTest, ExhaustiveFindsTheFarthestValidKeyframe) {
   std::mt19937 rng(6);
   const Frame a = random_frame(rng), c = random_frame(rng);
   const auto all = concat({a, lerp(a, c, 0.5), lerp(a, c, 0.25), c});
   Lossless g{&all, {}}, e{&all, {}};
-  EXPECT_EQ(select(all, 4, e.fn(), {50.0, KeyframeSearch::kExhaustive}).keyframes,
+  EXPECT_EQ(select(all, 4, e.fn(), {50.0, encoder::KeyframeSearch::kExhaustive}).keyframes,
             (std::vector<uint32_t>{0, 3}));
-  EXPECT_GT(select(all, 4, g.fn(), {50.0, KeyframeSearch::kGalloping}).keyframes.size(), 2u);
+  EXPECT_GT(select(all, 4, g.fn(), {50.0, encoder::KeyframeSearch::kGalloping}).keyframes.size(),
+            2u);
 }
 
 // A fade that then holds still: the farthest keyframe is the last frame, and frames equal to it
 // are reconstructed with t = 255.
-TEST(ColorKeyframesTest, FadeThenHoldReachesTheLastFrame) {
+TEST(ColourKeyframesTest, FadeThenHoldReachesTheLastFrame) {
   std::mt19937 rng(7);
   const Frame a = random_frame(rng), b = random_frame(rng);
   const auto all = concat({a, lerp(a, b, 0.5), b, b, b, b});
   Lossless shown{&all, {}};
-  const CellKeyframes k = select(all, 6, shown.fn());
+  const encoder::CellKeyframes k = select(all, 6, shown.fn());
   EXPECT_EQ(k.keyframes, (std::vector<uint32_t>{0, 5}));
   EXPECT_EQ(k.t, (std::vector<uint8_t>{0, 128, 255, 255, 255, 0}));
 }
 
-TEST(ColorKeyframesTest, BestTIsTheClosedFormRounded) {
+TEST(ColourKeyframesTest, BestTIsTheClosedFormRounded) {
   std::mt19937 rng(8);
   const Frame a = random_frame(rng), b = random_frame(rng);
   for (int t : {0, 1, 100, 128, 254, 255}) {
-    EXPECT_EQ(best_interpolation_t(lerp(a, b, t / 255.0), a, b), t);
+    EXPECT_EQ(encoder::best_interpolation_t(lerp(a, b, t / 255.0), a, b), t);
   }
-  EXPECT_EQ(best_interpolation_t(lerp(a, b, 1.7), a, b), 255);  // clamped
-  EXPECT_EQ(best_interpolation_t(lerp(a, b, -0.3), a, b), 0);
-  EXPECT_EQ(best_interpolation_t(b, a, a), 0);  // identical keyframes
+  EXPECT_EQ(encoder::best_interpolation_t(lerp(a, b, 1.7), a, b), 255);  // clamped
+  EXPECT_EQ(encoder::best_interpolation_t(lerp(a, b, -0.3), a, b), 0);
+  EXPECT_EQ(encoder::best_interpolation_t(b, a, a), 0);  // identical keyframes
 }
 
-TEST(ColorKeyframesTest, PsnrSrgb) {
+TEST(ColourKeyframesTest, PsnrSrgb) {
   const std::vector<float> zero(12, 0.0f);
-  EXPECT_TRUE(std::isinf(psnr_srgb(zero, zero)));
+  EXPECT_TRUE(std::isinf(encoder::psnr_srgb(zero, zero)));
   // sRGB 0.1 is linear ((0.1 + 0.055) / 1.055)^2.4; MSE 0.01 -> 20 dB.
   const float lin = static_cast<float>(std::pow((0.1 + 0.055) / 1.055, 2.4));
   const std::vector<float> grey(12, lin);
-  EXPECT_NEAR(psnr_srgb(zero, grey), 20.0, 1e-4);
+  EXPECT_NEAR(encoder::psnr_srgb(zero, grey), 20.0, 1e-4);
   // HDR values clamp to 1 on an LDR display.
   const std::vector<float> one(12, 1.0f), hot(12, 50.0f);
-  EXPECT_TRUE(std::isinf(psnr_srgb(one, hot)));
+  EXPECT_TRUE(std::isinf(encoder::psnr_srgb(one, hot)));
 }
 
-TEST(ColorKeyframesTest, ErrorsPropagate) {
+TEST(ColourKeyframesTest, ErrorsPropagate) {
   std::mt19937 rng(9);
   const auto all = concat({random_frame(rng), random_frame(rng), random_frame(rng)});
-  const ShownKeyframeFn failing = [](uint32_t f) -> Expected<std::span<const float>> {
+  const encoder::ShownKeyframeFn failing = [](uint32_t f) -> Expected<std::span<const float>> {
     return Status(ErrorId::kInvalidArgument, "keyframe " + std::to_string(f) + " failed");
   };
-  auto r = select_cell_keyframes(all, 3, kTexels, failing, psnr_srgb, {});
+  auto r = encoder::select_cell_keyframes(all, 3, kTexels, failing, encoder::psnr_srgb, {});
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().message(), "keyframe 0 failed");
   Lossless shown{&all, {}};
-  EXPECT_FALSE(select_cell_keyframes(all, 4, kTexels, shown.fn(), psnr_srgb, {}).ok());
-  EXPECT_FALSE(select_cell_keyframes(all, 0, kTexels, shown.fn(), psnr_srgb, {}).ok());
+  EXPECT_FALSE(
+      encoder::select_cell_keyframes(all, 4, kTexels, shown.fn(), encoder::psnr_srgb, {}).ok());
+  EXPECT_FALSE(
+      encoder::select_cell_keyframes(all, 0, kTexels, shown.fn(), encoder::psnr_srgb, {}).ok());
 }
 
 }  // namespace

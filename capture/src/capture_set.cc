@@ -68,7 +68,7 @@ Status validate_view_frame(const ViewFrame& f, std::string_view context) {
     for (int c = 0; c < 3; ++c) {
       float v = f.color[3 * i + c];
       if (!(v >= 0 && v <= kHalfMax)) {
-        return Status(ErrorId::kCaptureColorPixel,
+        return Status(ErrorId::kCaptureColourPixel,
                       ctx + ": " + texel_text(f, i) + ": colour channel " + "RGB"[c] + " is " +
                           value_text(v) + " (expected finite, >= 0 and <= 65504)");
       }

@@ -1,4 +1,4 @@
-#include "calf/player/cpu_renderer.h"
+#include "calf/player/lightfield_cpu_renderer.h"
 
 #include <algorithm>
 #include <cmath>
@@ -20,8 +20,8 @@ Status option_error(const std::string& what) {
 
 }  // namespace
 
-Expected<RenderOptions> march_range_for(std::span<const MarchView> views, const Vec3& eye,
-                                        RenderOptions options) {
+Expected<LightfieldRenderOptions> march_range_for(std::span<const MarchView> views, const Vec3& eye,
+                                                  LightfieldRenderOptions options) {
   if (views.empty()) return option_error("march range of an empty view set");
   double far = 0, near = kInf;
   for (const MarchView& v : views) {
@@ -33,18 +33,19 @@ Expected<RenderOptions> march_range_for(std::span<const MarchView> views, const 
   return options;
 }
 
-Expected<RenderOptions> march_range_for(const ViewSet& views, const Vec3& eye,
-                                        RenderOptions options) {
+Expected<LightfieldRenderOptions> march_range_for(const ViewSet& views, const Vec3& eye,
+                                                  LightfieldRenderOptions options) {
   std::vector<MarchView> m;
   for (const View& v : views.views)
     m.push_back({v.position(), v.range().z_near(), v.range().z_far()});
   return march_range_for(m, eye, std::move(options));
 }
 
-CpuRenderer::CpuRenderer(const ViewSet& views, const RenderOptions& options)
+LightfieldCpuRenderer::LightfieldCpuRenderer(const ViewSet& views,
+                                             const LightfieldRenderOptions& options)
     : views_(&views), options_(options) {}
 
-Status validate_render_options(const RenderOptions& o, size_t view_count) {
+Status validate_render_options(const LightfieldRenderOptions& o, size_t view_count) {
   if (o.steps < 1 || o.steps > 65536) {
     return option_error("steps " + std::to_string(o.steps) + " is outside [1, 65536]");
   }
@@ -73,8 +74,8 @@ Status validate_render_options(const RenderOptions& o, size_t view_count) {
   if (!(o.surface_hint_margin_texels >= 0) || !std::isfinite(o.surface_hint_margin_texels)) {
     return option_error("surface_hint_margin_texels must be finite and >= 0");
   }
-  if (!(o.color_depth_tolerance >= 0) || !std::isfinite(o.color_depth_tolerance)) {
-    return option_error("color_depth_tolerance must be finite and >= 0");
+  if (!(o.colour_depth_tolerance >= 0) || !std::isfinite(o.colour_depth_tolerance)) {
+    return option_error("colour_depth_tolerance must be finite and >= 0");
   }
   if (!(o.mixed_texel_penalty >= 0 && o.mixed_texel_penalty <= 50)) {
     return option_error("mixed_texel_penalty must be in [0, 50]");
@@ -112,10 +113,11 @@ Status validate_render_options(const RenderOptions& o, size_t view_count) {
   return Status::Ok();
 }
 
-Expected<CpuRenderer> CpuRenderer::make(const ViewSet& views, const RenderOptions& o) {
+Expected<LightfieldCpuRenderer> LightfieldCpuRenderer::make(const ViewSet& views,
+                                                            const LightfieldRenderOptions& o) {
   if (views.views.empty()) return option_error("the view set is empty");
   CALF_RETURN_IF_ERROR(validate_render_options(o, views.views.size()));
-  CpuRenderer r(views, o);
+  LightfieldCpuRenderer r(views, o);
   if (o.active_views.empty()) {
     for (const View& v : views.views) r.active_.push_back(&v);
   } else {
@@ -132,9 +134,9 @@ namespace {
 // How far in front of its surface view v sees the point at offset x from its centre (r = |x|),
 // in the view's log-16 code units: > 0 in front (empty for this view), <= 0 at or behind the
 // surface; +inf where the view sees sky. The depth compared with is depth_footprint's rule
-// (see RenderOptions), or the interpolated depth where the taps form one smooth surface.
-// Excluded depth codes (RenderOptions::coverage_layers): taps with codes in [lo, hi] are absent
-// (read as sky). An empty band (lo > hi) excludes nothing.
+// (see LightfieldRenderOptions), or the interpolated depth where the taps form one smooth surface.
+// Excluded depth codes (LightfieldRenderOptions::coverage_layers): taps with codes in [lo, hi] are
+// absent (read as sky). An empty band (lo > hi) excludes nothing.
 struct Band {
   double lo = 1, hi = 0;
   uint16_t apply(uint16_t code) const { return code >= lo && code <= hi ? kLog16Sky : code; }
@@ -172,10 +174,10 @@ double code_margin(const View& v, const Vec3& x, double r, double footprint,
   return code == kLog16Sky ? kInf : code - rcode;
 }
 
-// Coverage (RenderOptions::coverage): `margin` is code_margin's answer for the same point; where
-// it says the point lies at or behind the footprint's surface, the view's coverage decides
-// whether that surface covers the direction at sub-texel precision, and where it does not, the
-// answer is measured against the surface behind it instead.
+// Coverage (LightfieldRenderOptions::coverage): `margin` is code_margin's answer for the same
+// point; where it says the point lies at or behind the footprint's surface, the view's coverage
+// decides whether that surface covers the direction at sub-texel precision, and where it does not,
+// the answer is measured against the surface behind it instead.
 double coverage_margin(const View& v, const Vec3& x, double r, double margin, uint32_t mode,
                        double threshold, double cluster) {
   if (margin > 0 || mode == 0 || !v.has_coverage()) return margin;
@@ -248,8 +250,8 @@ double coverage_margin(const View& v, const Vec3& x, double r, double margin, ui
   return back == kLog16Sky ? kInf : back - rcode;
 }
 
-// The band of v's depth codes around the point q (RenderOptions::coverage_layers): within a
-// relative depth `cluster` of |q - P_v|.
+// The band of v's depth codes around the point q (LightfieldRenderOptions::coverage_layers): within
+// a relative depth `cluster` of |q - P_v|.
 Band exclusion_band(const View& v, const Vec3& q, double cluster) {
   const double code = v.range().normalized_from_depth(length(q - v.position())) * kLog16MaxFinite;
   const double half = cluster / v.range().relative_step();
@@ -257,9 +259,9 @@ Band exclusion_band(const View& v, const Vec3& q, double cluster) {
 }
 
 // The share of direction x (at distance r) that view v's surface at distance r covers, read from
-// its coverage masks bilinearly between cell centres (RenderOptions::coverage_layers); cells of
-// texels nearer than r (the view does not see the point there) do not count, and -1 where no
-// cell counts.
+// its coverage masks bilinearly between cell centres (LightfieldRenderOptions::coverage_layers);
+// cells of texels nearer than r (the view does not see the point there) do not count, and -1 where
+// no cell counts.
 double coverage_alpha_of_view(const View& v, const Vec3& x, double r, double cluster) {
   const uint32_t n = v.face_size();
   const FaceTexelCoord fc = texel_coord_from_direction(x, n);
@@ -305,10 +307,11 @@ double texel_angles_in_codes(const View& v, double texels) {
   return texels * 2 / v.face_size() / v.range().relative_step();
 }
 
-// Whether texel t of v lies on a depth edge of its view (see RenderOptions::mixed_texel_penalty):
-// one of its four neighbours, across face seams, is sky where t is not (or the reverse), or the
-// log depth bends at t by more than `bend_codes` log-16 codes along either axis (the second
-// difference; RenderOptions::mixed_texel_bend_texels says what bends how much).
+// Whether texel t of v lies on a depth edge of its view (see
+// LightfieldRenderOptions::mixed_texel_penalty): one of its four neighbours, across face seams, is
+// sky where t is not (or the reverse), or the log depth bends at t by more than `bend_codes` log-16
+// codes along either axis (the second difference; LightfieldRenderOptions::mixed_texel_bend_texels
+// says what bends how much).
 bool mixed_texel(const View& v, const Texel& t, double bend_codes) {
   const uint16_t code = v.depth_code_at(t.face, t.x, t.y);
   constexpr int kDx[4] = {-1, 1, 0, 0}, kDy[4] = {0, 0, -1, 1};
@@ -326,7 +329,7 @@ bool mixed_texel(const View& v, const Texel& t, double bend_codes) {
 }  // namespace
 
 // The factor a colour tap of v keeps: exp(-mixed_texel_penalty) on a depth edge, else 1.
-double CpuRenderer::tap_purity(const View& v, const Texel& t) const {
+double LightfieldCpuRenderer::tap_purity(const View& v, const Texel& t) const {
   if (mixed_penalty_factor_ == 1) return 1;
   return mixed_texel(v, t, texel_angles_in_codes(v, options_.mixed_texel_bend_texels))
              ? mixed_penalty_factor_
@@ -337,12 +340,12 @@ double CpuRenderer::tap_purity(const View& v, const Texel& t) const {
 // is not too near sees p in front of its stored surface (or sees sky there) by more than
 // `margin_texels` of its own texels, as relative depth margin_texels x 2 / face size (0 for the
 // plain test).
-bool CpuRenderer::empty_at(const Vec3& p, const Vec3* exclude) const {
+bool LightfieldCpuRenderer::empty_at(const Vec3& p, const Vec3* exclude) const {
   return empty_beyond(p, 0, 0, exclude);
 }
 
-bool CpuRenderer::empty_beyond(const Vec3& p, double margin_texels, uint32_t vetoes_ignored,
-                               const Vec3* exclude) const {
+bool LightfieldCpuRenderer::empty_beyond(const Vec3& p, double margin_texels,
+                                         uint32_t vetoes_ignored, const Vec3* exclude) const {
   bool consulted = false;
   // Votes of views whose footprint test alone sees p as empty, and of those whose coverage does
   // where the footprint test does not: the latter count once coverage_agreement of them agree.
@@ -371,8 +374,8 @@ bool CpuRenderer::empty_beyond(const Vec3& p, double margin_texels, uint32_t vet
 }
 
 // RayIntersection: constant steps in the march's normalised log depth from `start` to far.
-bool CpuRenderer::intersect(const Vec3& o, const Vec3& d, double start, Hit* hit,
-                            const Vec3* exclude) const {
+bool LightfieldCpuRenderer::intersect(const Vec3& o, const Vec3& d, double start, Hit* hit,
+                                      const Vec3* exclude) const {
   const double log_ratio = std::log(options_.far / options_.near);
   const auto lin = [&](double x) { return options_.near * std::exp(x * log_ratio); };
   if (options_.tight_march_start) {
@@ -481,8 +484,8 @@ bool CpuRenderer::intersect(const Vec3& o, const Vec3& d, double start, Hit* hit
 
 // SampleColor over the active views and their blend (CalculateColor). Weights are kept as
 // logarithms and normalised by the largest, so no view's weight underflows to zero.
-void CpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* rgb, int* best_view,
-                                double* best_rgb, double* alpha) const {
+void LightfieldCpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* rgb, int* best_view,
+                                          double* best_rgb, double* alpha) const {
   const double hit_distance = std::max(length(p - o), 1e-12);
   double sum[3] = {0, 0, 0}, wsum = 0, best = -kInf;
   struct Contribution {
@@ -511,8 +514,8 @@ void CpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* rgb, int* 
     if (ncode == kLog16Sky) continue;  // this view sees past p: it has no colour for it
     const double ndiff = std::fabs(std::log(v.range().decode(ncode) / r));
     Contribution k{-options_.depth_decay * ndiff, {0, 0, 0}, view_alpha};
-    if (!options_.bilinear_color) {
-      const float* col = v.color_at(nearest.face, nearest.x, nearest.y);
+    if (!options_.bilinear_colour) {
+      const float* col = v.colour_at(nearest.face, nearest.x, nearest.y);
       for (int ch = 0; ch < 3; ++ch) k.c[ch] = col[ch];
     } else {
       const internal::BilinearTaps taps = internal::bilinear_taps(c, v.face_size());
@@ -525,20 +528,20 @@ void CpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* rgb, int* 
       double a[4], asum = 0;
       for (int t = 0; t < 4; ++t) {
         a[t] = taps.weight[t] > 0 ? taps.weight[t] * tap_purity(v, taps.texel[t]) : 0.0;
-        if (options_.depth_aware_color) {
+        if (options_.depth_aware_colour) {
           a[t] *= diff[t] == kInf
                       ? 0.0
                       : std::exp(-options_.depth_decay *
-                                 std::max(0.0, diff[t] - dmin - options_.color_depth_tolerance));
+                                 std::max(0.0, diff[t] - dmin - options_.colour_depth_tolerance));
         }
         asum += a[t];
       }
       for (int t = 0; t < 4; ++t) {
-        const float* col = v.color_at(taps.texel[t].face, taps.texel[t].x, taps.texel[t].y);
+        const float* col = v.colour_at(taps.texel[t].face, taps.texel[t].x, taps.texel[t].y);
         for (int ch = 0; ch < 3; ++ch) k.c[ch] += a[t] / asum * col[ch];
       }
       // Depth-aware: the view's w_depth is the bilinear blend of its taps' agreements.
-      if (options_.depth_aware_color) k.log_w = -options_.depth_decay * dmin + std::log(asum);
+      if (options_.depth_aware_colour) k.log_w = -options_.depth_decay * dmin + std::log(asum);
     }
     k.log_w -= options_.cam_decay * length(o - v.position()) / hit_distance;
     if (k.log_w > best) {
@@ -567,7 +570,7 @@ void CpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* rgb, int* 
 // Sky has no parallax: every view sees it in the ray's own direction. Views whose depth there is
 // sky count (if none is, the march ended before far geometry, all views do), each with the share
 // of its taps' bilinear weight that mixed texels leave (1 where none is mixed).
-void CpuRenderer::shade_sky(const Vec3& /*origin*/, const Vec3& d, double* rgb) const {
+void LightfieldCpuRenderer::shade_sky(const Vec3& /*origin*/, const Vec3& d, double* rgb) const {
   for (int pass = 0; pass < 2; ++pass) {
     double sum[3] = {0, 0, 0};
     double n = 0;
@@ -577,8 +580,8 @@ void CpuRenderer::shade_sky(const Vec3& /*origin*/, const Vec3& d, double* rgb) 
       if (pass == 0 && !sky) continue;
       double c[3] = {0, 0, 0};
       double w = 1;  // the view's weight
-      if (!options_.bilinear_color) {
-        const float* col = v->color_at(nearest.face, nearest.x, nearest.y);
+      if (!options_.bilinear_colour) {
+        const float* col = v->colour_at(nearest.face, nearest.x, nearest.y);
         for (int ch = 0; ch < 3; ++ch) c[ch] = col[ch];
       } else {
         const internal::BilinearTaps taps =
@@ -587,13 +590,13 @@ void CpuRenderer::shade_sky(const Vec3& /*origin*/, const Vec3& d, double* rgb) 
         for (int t = 0; t < 4; ++t) {
           const bool tap_sky =
               v->depth_code_at(taps.texel[t].face, taps.texel[t].x, taps.texel[t].y) == kLog16Sky;
-          a[t] = taps.weight[t] * (pass == 0 && options_.depth_aware_color && !tap_sky ? 0 : 1);
+          a[t] = taps.weight[t] * (pass == 0 && options_.depth_aware_colour && !tap_sky ? 0 : 1);
           unpenalised += a[t];
           if (a[t] > 0) a[t] *= tap_purity(*v, taps.texel[t]);
           asum += a[t];
         }
         for (int t = 0; t < 4; ++t) {
-          const float* col = v->color_at(taps.texel[t].face, taps.texel[t].x, taps.texel[t].y);
+          const float* col = v->colour_at(taps.texel[t].face, taps.texel[t].x, taps.texel[t].y);
           for (int ch = 0; ch < 3; ++ch) c[ch] += a[t] / asum * col[ch];
         }
         w = asum / unpenalised;
@@ -608,16 +611,16 @@ void CpuRenderer::shade_sky(const Vec3& /*origin*/, const Vec3& d, double* rgb) 
   }
 }
 
-RaySample CpuRenderer::trace(const Vec3& origin, const Vec3& direction) const {
+RaySample LightfieldCpuRenderer::trace(const Vec3& origin, const Vec3& direction) const {
   if (options_.coverage_layers > 0 && !options_.rr) return trace_layers(origin, direction);
   Hit hit;
   return shade_hit(origin, direction,
                    intersect(origin, direction, options_.near, &hit) ? &hit : nullptr);
 }
 
-// RenderOptions::coverage_layers: partly covered surfaces laid front to back over what the ray
-// meets behind them.
-RaySample CpuRenderer::trace_layers(const Vec3& o, const Vec3& d) const {
+// LightfieldRenderOptions::coverage_layers: partly covered surfaces laid front to back over what
+// the ray meets behind them.
+RaySample LightfieldCpuRenderer::trace_layers(const Vec3& o, const Vec3& d) const {
   RaySample s;
   s.depth = kInf;
   double transmit = 1;
@@ -651,14 +654,16 @@ RaySample CpuRenderer::trace_layers(const Vec3& o, const Vec3& d) const {
   return s;
 }
 
-RaySample CpuRenderer::shade_at(const Vec3& origin, const Vec3& direction, double depth) const {
+RaySample LightfieldCpuRenderer::shade_at(const Vec3& origin, const Vec3& direction,
+                                          double depth) const {
   if (!std::isfinite(depth)) return shade_hit(origin, direction, nullptr);
   const Hit hit{origin + direction * depth, depth};
   return shade_hit(origin, direction, &hit);
 }
 
 // The colour and depth of a ray whose march ended at `hit` (nullptr: no surface).
-RaySample CpuRenderer::shade_hit(const Vec3& origin, const Vec3& direction, const Hit* hit) const {
+RaySample LightfieldCpuRenderer::shade_hit(const Vec3& origin, const Vec3& direction,
+                                           const Hit* hit) const {
   RaySample s;
   if (!hit) {
     shade_sky(origin, direction, s.rgb);
@@ -682,7 +687,7 @@ RaySample CpuRenderer::shade_hit(const Vec3& origin, const Vec3& direction, cons
   return s;
 }
 
-Status CpuRenderer::render(const Camera& camera, RenderedImage* out) const {
+Status LightfieldCpuRenderer::render(const Camera& camera, RenderedImage* out) const {
   CALF_RETURN_IF_ERROR(validate_camera(camera));
   const CameraFrame frame = camera_frame(camera);
   out->width = camera.width;

@@ -22,7 +22,7 @@ namespace {
 
 // The texture a material names for its base colour: glTF's baseColorTexture (assimp files it as
 // BASE_COLOR and DIFFUSE), OBJ's map_Kd and FBX's DiffuseColor (DIFFUSE). Empty when none.
-std::string base_color_path(const aiMaterial& m) {
+std::string base_colour_path(const aiMaterial& m) {
   for (aiTextureType type : {aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE}) {
     aiString path;
     if (m.GetTextureCount(type) > 0 && m.GetTexture(type, 0, &path) == AI_SUCCESS &&
@@ -93,7 +93,7 @@ Status load_model_textures(const aiScene& ai, const std::filesystem::path& model
   for (unsigned i = 0; i < ai.mNumMaterials && i < scene->materials.size(); ++i) {
     if (!ai.mMaterials[i]) continue;
     const aiMaterial& m = *ai.mMaterials[i];
-    const std::string named = base_color_path(m);
+    const std::string named = base_colour_path(m);
     if (named.empty()) continue;
     const std::string where = model.string() + ": material " + std::to_string(i) + " '" +
                               m.GetName().C_Str() + "' base-colour texture '" + named + "'";

@@ -1,4 +1,4 @@
-#include "calf/decoder/clip_decoder.h"
+#include "calf/decoder/lightfield_decoder.h"
 
 #include <algorithm>
 #include <bit>
@@ -50,13 +50,13 @@ struct ChunkRef {
 
 }  // namespace
 
-struct ClipDecoder::Impl {
+struct LightfieldDecoder::Impl {
   const container::Reader* reader = nullptr;
   uint16_t track = 0;
   container::LightfieldTrackHeader header;
   std::vector<LightfieldViewInfo> views;
   std::vector<Status> view_problems;  // Ok, or why the view was dropped at open
-  ClipDecoderOptions options;
+  LightfieldDecoderOptions options;
   FaceGrid cells = *FaceGrid::with_cell_size(1, 1);
   FaceGrid tiles = *FaceGrid::with_cell_size(1, 1);
   lf::RegionCoding depth_coding = lf::RegionCoding::kR16;
@@ -64,7 +64,7 @@ struct ClipDecoder::Impl {
   bool has_coverage = false;  // the track holds a coverage stream
   std::unique_ptr<ChunkCache> cache;
   // Node directions of the colour-cell and depth-tile quadtrees, computed once (culling.h).
-  std::optional<GridCuller> cell_culler, tile_culler;
+  std::optional<GridCuller> cell_culler, region_culler;
 
   // Chunks by (stream, view, face, region), sorted by first frame; a flat table because it is
   // consulted per visible cell and tile every frame.
@@ -83,7 +83,7 @@ struct ClipDecoder::Impl {
     uint32_t av1_chunk = UINT32_MAX;
     int64_t av1_decoded = -1, av1_uploaded = -1;
   };
-  struct TileState {
+  struct RegionState {
     int64_t frame = -1;  // the frame the renderer's texels of the tile hold
     // r16pm depth only: a copy of the codes the renderer holds (row-major, the tile's size), for
     // the unchanged texels of P-frame rectangles (SPEC §11.1.9); empty until the tile's first
@@ -92,7 +92,7 @@ struct ClipDecoder::Impl {
   };
   // Indexed [view][face * count + index].
   std::vector<std::vector<CellState>> cell_state;
-  std::vector<std::vector<TileState>> depth_state, material_state, coverage_state;
+  std::vector<std::vector<RegionState>> depth_state, material_state, coverage_state;
 
   // The frame being built: update payloads in one arena, spans fixed at the end.
   std::vector<uint8_t> arena;
@@ -110,7 +110,7 @@ struct ClipDecoder::Impl {
   // [eye][view, then the sky pass][face][cells, tiles].
   std::vector<CullMemory> cull_memory;
   std::vector<EyeView> cache_eyes;
-  ClipDecoderOptions cache_options;
+  LightfieldDecoderOptions cache_options;
   bool same_viewers(std::span<const EyeView> eyes) const {
     auto same = [](const EyeView& a, const EyeView& b) {
       return a.position == b.position && a.forward == b.forward && a.up == b.up &&
@@ -150,7 +150,7 @@ struct ClipDecoder::Impl {
                    (exact_start ? " starts at frame " : " serves frame ") + std::to_string(frame));
   }
 
-  Expected<ChunkBytes> fetch(uint32_t id, FrameUpdates* out) {
+  Expected<ChunkBytes> fetch(uint32_t id, LightfieldFrameUpdates* out) {
     FrameStats& stats = out->stats;
     bool here = false;
     CALF_ASSIGN_OR_RETURN(ChunkBytes bytes, cache->get(id, &here));
@@ -161,8 +161,8 @@ struct ClipDecoder::Impl {
     return bytes;
   }
 
-  void emit(FrameUpdates* out, UpdateTarget target, uint32_t view, uint32_t face, uint32_t slot,
-            PixelRect rect, PixelFormat format, const std::vector<uint8_t>& bytes) {
+  void emit(LightfieldFrameUpdates* out, UpdateTarget target, uint32_t view, uint32_t face,
+            uint32_t slot, PixelRect rect, PixelFormat format, const std::vector<uint8_t>& bytes) {
     TextureUpdate u;
     u.target = target;
     u.view = view;
@@ -182,18 +182,18 @@ struct ClipDecoder::Impl {
 
   Status open_tables();
   Status update_cell(uint32_t view, uint32_t face, uint32_t cell, uint32_t frame,
-                     FrameUpdates* out);
+                     LightfieldFrameUpdates* out);
   Status update_cell_av1(uint32_t view, uint32_t face, uint32_t cell, uint32_t frame,
-                         FrameUpdates* out);
+                         LightfieldFrameUpdates* out);
   bool av1 = false;  // the track's colour is AV1
   // `stream`: kDepth, kMaterial or kCoverage.
-  Status update_tile(LightfieldStream stream, uint32_t view, uint32_t face, uint32_t tile,
-                     uint32_t frame, FrameUpdates* out);
+  Status update_region(LightfieldStream stream, uint32_t view, uint32_t face, uint32_t tile,
+                       uint32_t frame, LightfieldFrameUpdates* out);
   void queue_prefetch(bool depth_like, uint32_t view, uint32_t face, uint32_t index,
                       uint32_t frame);
 };
 
-Status ClipDecoder::Impl::open_tables() {
+Status LightfieldDecoder::Impl::open_tables() {
   const uint32_t cell_count = cells.cell_count(), tile_count = tiles.cell_count();
   const auto& all = reader->chunks();
   regions_per_face = std::max(cell_count, tile_count);
@@ -236,15 +236,15 @@ Status ClipDecoder::Impl::open_tables() {
     }
   }
   cell_state.assign(header.view_count, std::vector<CellState>(size_t{6} * cell_count));
-  depth_state.assign(header.view_count, std::vector<TileState>(size_t{6} * tile_count));
-  material_state.assign(header.view_count, std::vector<TileState>(size_t{6} * tile_count));
-  coverage_state.assign(header.view_count, std::vector<TileState>(size_t{6} * tile_count));
+  depth_state.assign(header.view_count, std::vector<RegionState>(size_t{6} * tile_count));
+  material_state.assign(header.view_count, std::vector<RegionState>(size_t{6} * tile_count));
+  coverage_state.assign(header.view_count, std::vector<RegionState>(size_t{6} * tile_count));
   visible_cache.assign(header.view_count, {});
   return Status::Ok();
 }
 
-Status ClipDecoder::Impl::update_cell(uint32_t view, uint32_t face, uint32_t cell, uint32_t frame,
-                                      FrameUpdates* out) {
+Status LightfieldDecoder::Impl::update_cell(uint32_t view, uint32_t face, uint32_t cell,
+                                            uint32_t frame, LightfieldFrameUpdates* out) {
   CellState& s = cell_state[view][size_t{face} * cells.cell_count() + cell];
   if (!s.timeline) {
     CALF_ASSIGN_OR_RETURN(uint32_t id,
@@ -296,8 +296,8 @@ Status ClipDecoder::Impl::update_cell(uint32_t view, uint32_t face, uint32_t cel
 // AV1 colour: slot 0 always holds the frame, t = 0. Within the chunk serving the frame, decoding
 // goes on from the frame the cell's context holds when that lies before it (playback: one unit per
 // frame), else restarts at the chunk's key frame (a seek: at most the keyframe interval of units).
-Status ClipDecoder::Impl::update_cell_av1(uint32_t view, uint32_t face, uint32_t cell,
-                                          uint32_t frame, FrameUpdates* out) {
+Status LightfieldDecoder::Impl::update_cell_av1(uint32_t view, uint32_t face, uint32_t cell,
+                                                uint32_t frame, LightfieldFrameUpdates* out) {
   CellState& s = cell_state[view][size_t{face} * cells.cell_count() + cell];
   const PixelRect rect =
       cells.cell_rect(cell % cells.cells_per_side(), cell / cells.cells_per_side());
@@ -348,13 +348,14 @@ Status ClipDecoder::Impl::update_cell_av1(uint32_t view, uint32_t face, uint32_t
   return Status::Ok();
 }
 
-Status ClipDecoder::Impl::update_tile(LightfieldStream stream, uint32_t view, uint32_t face,
-                                      uint32_t tile, uint32_t frame, FrameUpdates* out) {
+Status LightfieldDecoder::Impl::update_region(LightfieldStream stream, uint32_t view, uint32_t face,
+                                              uint32_t tile, uint32_t frame,
+                                              LightfieldFrameUpdates* out) {
   const bool depth = stream == LightfieldStream::kDepth;
   const bool coverage = stream == LightfieldStream::kCoverage;
-  TileState& s = (depth      ? depth_state
-                  : coverage ? coverage_state
-                             : material_state)[view][size_t{face} * tiles.cell_count() + tile];
+  RegionState& s = (depth      ? depth_state
+                    : coverage ? coverage_state
+                               : material_state)[view][size_t{face} * tiles.cell_count() + tile];
   if (s.frame == frame) return Status::Ok();
   CALF_ASSIGN_OR_RETURN(uint32_t id, chunk_serving(stream, view, face, tile, frame, false));
   const container::ChunkKeys& keys = reader->chunks()[id].keys;
@@ -419,8 +420,8 @@ Status ClipDecoder::Impl::update_tile(LightfieldStream stream, uint32_t view, ui
   return Status::Ok();
 }
 
-void ClipDecoder::Impl::queue_prefetch(bool cell, uint32_t view, uint32_t face, uint32_t index,
-                                       uint32_t frame) {
+void LightfieldDecoder::Impl::queue_prefetch(bool cell, uint32_t view, uint32_t face,
+                                             uint32_t index, uint32_t frame) {
   if (cell && av1) {
     auto id = chunk_serving(LightfieldStream::kColour, view, face, index, frame, false);
     if (id.ok()) prefetch_ids.push_back(*id);
@@ -446,30 +447,30 @@ void ClipDecoder::Impl::queue_prefetch(bool cell, uint32_t view, uint32_t face, 
   }
 }
 
-ClipDecoder::ClipDecoder(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
-ClipDecoder::ClipDecoder(ClipDecoder&&) noexcept = default;
-ClipDecoder& ClipDecoder::operator=(ClipDecoder&&) noexcept = default;
-ClipDecoder::~ClipDecoder() = default;
+LightfieldDecoder::LightfieldDecoder(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+LightfieldDecoder::LightfieldDecoder(LightfieldDecoder&&) noexcept = default;
+LightfieldDecoder& LightfieldDecoder::operator=(LightfieldDecoder&&) noexcept = default;
+LightfieldDecoder::~LightfieldDecoder() = default;
 
-const container::LightfieldTrackHeader& ClipDecoder::header() const {
+const container::LightfieldTrackHeader& LightfieldDecoder::header() const {
   return impl_->header;
 }
-const LightfieldViewInfo& ClipDecoder::view(uint32_t v) const {
+const LightfieldViewInfo& LightfieldDecoder::view(uint32_t v) const {
   return impl_->views[v];
 }
-bool ClipDecoder::has_coverage() const {
+bool LightfieldDecoder::has_coverage() const {
   return impl_->has_coverage;
 }
 
-const Status& ClipDecoder::view_problem(uint32_t v) const {
+const Status& LightfieldDecoder::view_problem(uint32_t v) const {
   return impl_->view_problems[v];
 }
-const ClipDecoderOptions& ClipDecoder::options() const {
+const LightfieldDecoderOptions& LightfieldDecoder::options() const {
   return impl_->options;
 }
 
-Expected<ClipDecoder> ClipDecoder::open(const container::Reader& reader, uint16_t track,
-                                        const ClipDecoderOptions& options) {
+Expected<LightfieldDecoder> LightfieldDecoder::open(const container::Reader& reader, uint16_t track,
+                                                    const LightfieldDecoderOptions& options) {
   if (options.cache_bytes < (size_t{1} << 20)) return bad_argument("cache_bytes below 1 MiB");
   if (options.prefetch_frames > 64) return bad_argument("prefetch_frames above 64");
   CALF_ASSIGN_OR_RETURN(LightfieldReference ref, LightfieldReference::open(reader, track));
@@ -486,25 +487,25 @@ Expected<ClipDecoder> ClipDecoder::open(const container::Reader& reader, uint16_
   }
   CALF_ASSIGN_OR_RETURN(impl->cells,
                         FaceGrid::with_cell_size(impl->header.face_size, impl->header.cell_size));
-  CALF_ASSIGN_OR_RETURN(
-      impl->tiles, FaceGrid::with_cell_size(impl->header.face_size, impl->header.depth_tile_size));
+  CALF_ASSIGN_OR_RETURN(impl->tiles, FaceGrid::with_cell_size(impl->header.face_size,
+                                                              impl->header.depth_region_size));
   CALF_ASSIGN_OR_RETURN(impl->depth_coding, lf::depth_coding(impl->header.depth_format));
   if (impl->header.material_format != 0) {
     CALF_ASSIGN_OR_RETURN(impl->material_coding, lf::material_coding(impl->header.material_format));
   }
   CALF_RETURN_IF_ERROR(impl->open_tables());
   impl->cell_culler.emplace(impl->cells);
-  impl->tile_culler.emplace(impl->tiles);
+  impl->region_culler.emplace(impl->tiles);
   impl->cache =
       std::make_unique<ChunkCache>(reader, options.cache_bytes, options.background_thread);
-  return ClipDecoder(std::move(impl));
+  return LightfieldDecoder(std::move(impl));
 }
 
-void ClipDecoder::set_view_dependent(bool on) {
+void LightfieldDecoder::set_view_dependent(bool on) {
   impl_->options.view_dependent = on;
 }
 
-void ClipDecoder::reset() {
+void LightfieldDecoder::reset() {
   Impl& d = *impl_;
   for (auto& view : d.cell_state) {
     for (auto& c : view) {
@@ -519,8 +520,9 @@ void ClipDecoder::reset() {
   }
 }
 
-Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
-                            std::span<const uint32_t> active_views, FrameUpdates* out) {
+Status LightfieldDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
+                                  std::span<const uint32_t> active_views,
+                                  LightfieldFrameUpdates* out) {
   Impl& d = *impl_;
   const auto start = std::chrono::steady_clock::now();
   if (frame >= d.header.frame_count) {
@@ -567,9 +569,9 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
   };
 
   CullStats cull;
-  std::vector<uint32_t> all_cells(d.cells.cell_count()), all_tiles(d.tiles.cell_count());
+  std::vector<uint32_t> all_cells(d.cells.cell_count()), all_regions(d.tiles.cell_count());
   for (uint32_t i = 0; i < all_cells.size(); ++i) all_cells[i] = i;
-  for (uint32_t i = 0; i < all_tiles.size(); ++i) all_tiles[i] = i;
+  for (uint32_t i = 0; i < all_regions.size(); ++i) all_regions[i] = i;
   // The visible sets depend on the viewers and the culling options only (not on the frame): kept
   // from frame to frame while those stay the same, recomputed per view when it is next needed.
   if (!d.same_viewers(eyes)) {
@@ -587,7 +589,7 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
   // `view`: view_count for the sky pass.
   auto cull_cells = [&](const Vec3& apex, uint32_t view, uint32_t f, bool tiles, double z_near,
                         double z_far, size_t eye) {
-    const GridCuller& culler = tiles ? *d.tile_culler : *d.cell_culler;
+    const GridCuller& culler = tiles ? *d.region_culler : *d.cell_culler;
     const CubeFace face = static_cast<CubeFace>(f);
     if (d.options.brute_force_culling) {
       by_eye = visible_cells_brute_force(apex, face, culler.grid(), z_near, z_far,
@@ -664,11 +666,12 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
     for (uint32_t f = 0; f < 6; ++f) {
       const CubeFace face = static_cast<CubeFace>(f);
       const std::vector<uint32_t>& vis_cells = d.options.view_dependent ? vs.cells[f] : all_cells;
-      const std::vector<uint32_t>& vis_tiles = d.options.view_dependent ? vs.tiles[f] : all_tiles;
+      const std::vector<uint32_t>& vis_regions =
+          d.options.view_dependent ? vs.tiles[f] : all_regions;
       stats.total_cells += d.cells.cell_count();
-      stats.total_tiles += d.tiles.cell_count();
+      stats.total_regions += d.tiles.cell_count();
       stats.visible_cells += static_cast<uint32_t>(vis_cells.size());
-      stats.visible_tiles += static_cast<uint32_t>(vis_tiles.size());
+      stats.visible_regions += static_cast<uint32_t>(vis_regions.size());
       for (uint32_t c : vis_cells) {
         if (Status s =
                 d.av1 ? d.update_cell_av1(v, f, c, frame, out) : d.update_cell(v, f, c, frame, out);
@@ -676,17 +679,17 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
           report(s);
         }
       }
-      for (uint32_t t : vis_tiles) {
-        out->tiles.push_back(TileRef{v, face, t});
-        if (Status s = d.update_tile(LightfieldStream::kDepth, v, f, t, frame, out); !s.ok()) {
+      for (uint32_t t : vis_regions) {
+        out->tiles.push_back(LightfieldRegionRef{v, face, t});
+        if (Status s = d.update_region(LightfieldStream::kDepth, v, f, t, frame, out); !s.ok()) {
           report(s);
         }
         if (has_material) {
-          Status s = d.update_tile(LightfieldStream::kMaterial, v, f, t, frame, out);
+          Status s = d.update_region(LightfieldStream::kMaterial, v, f, t, frame, out);
           if (!s.ok()) report(s);
         }
         if (with_coverage) {
-          Status s = d.update_tile(LightfieldStream::kCoverage, v, f, t, frame, out);
+          Status s = d.update_region(LightfieldStream::kCoverage, v, f, t, frame, out);
           if (!s.ok()) report(s);
         }
       }
@@ -695,7 +698,7 @@ Status ClipDecoder::advance(uint32_t frame, std::span<const EyeView> eyes,
       for (uint32_t ahead = 1; ahead <= prefetch; ++ahead) {
         if (frame + ahead >= d.header.frame_count) break;
         for (uint32_t c : vis_cells) d.queue_prefetch(true, v, f, c, frame + ahead);
-        for (uint32_t t : vis_tiles) d.queue_prefetch(false, v, f, t, frame + ahead);
+        for (uint32_t t : vis_regions) d.queue_prefetch(false, v, f, t, frame + ahead);
       }
     }
   }

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "calf/player/cpu_renderer.h"
+#include "calf/player/lightfield_cpu_renderer.h"
 #include "sampling.h"
 
 namespace calf::player {
@@ -74,8 +74,9 @@ bool texel_normal(const View& v, const Texel& t, const Vec3& facing, Vec3* n) {
 
 // One reflection or refraction ray leaving surface point p (normal n, either orientation) for
 // an incoming unit direction d_in, shaded: the colour it brings back.
-void CpuRenderer::secondary(const Vec3& p, const Vec3& d_in, const Vec3& normal, bool refraction,
-                            double ior, uint32_t depth, double* rgb) const {
+void LightfieldCpuRenderer::secondary(const Vec3& p, const Vec3& d_in, const Vec3& normal,
+                                      bool refraction, double ior, uint32_t depth,
+                                      double* rgb) const {
   const Vec3 n = dot(normal, d_in) > 0 ? normal * -1.0 : normal;  // facing the incoming ray
   Vec3 dir = normalize(d_in - n * (2 * dot(d_in, n)));            // reflection; refraction's TIR
   if (refraction) refract_dir(d_in, n, 1.0 / ior, &dir);
@@ -87,8 +88,8 @@ void CpuRenderer::secondary(const Vec3& p, const Vec3& d_in, const Vec3& normal,
   }
 }
 
-void CpuRenderer::shade_rr(const Vec3& o, const Vec3& d, const Hit& hit, uint32_t depth,
-                           double* rgb) const {
+void LightfieldCpuRenderer::shade_rr(const Vec3& o, const Vec3& d, const Hit& hit, uint32_t depth,
+                                     double* rgb) const {
   int best = -1;
   double diffuse[3], own[3] = {0, 0, 0};
   shade_surface(o, hit.p, diffuse, &best, own);

@@ -1,15 +1,16 @@
 // The OpenGL 4.5 ray-march renderer of paper 002 Alg. 4 (and its RR variant, Sec. 6.1): the
 // player's product renderer. It implements exactly the algorithm of the scalar CPU reference
-// (calf/player/cpu_renderer.h, docs/RENDERING.md): the same RenderOptions, the same Camera model,
-// the same texel taps, footprint test, coverage test, refinement, weights, sky and RR rules — one
-// GLSL function per CPU function — and is tested against it (tests/integration/gl_renderer_test.cc:
-// PSNR between the two images of the same frame >= 45 dB).
+// (calf/player/lightfield_cpu_renderer.h, docs/RENDERING.md): the same LightfieldRenderOptions, the
+// same Camera model, the same texel taps, footprint test, coverage test, refinement, weights, sky
+// and RR rules — one GLSL function per CPU function — and is tested against it
+// (tests/integration/lightfield_gl_renderer_test.cc: PSNR between the two images of the same frame
+// >= 45 dB).
 //
 // It reads the viewpoint textures of a GlViews (calf/player/gl_views.h), which the decoder's
-// FrameUpdates (or updates_from_view_set()) fill; a cell's colour is the keyframe blend
+// LightfieldFrameUpdates (or updates_from_view_set()) fill; a cell's colour is the keyframe blend
 // mix(slot a, slot 1 - a, t / 255) done per texel in the shader. Views with coverage faces
-// answer RenderOptions::coverage and coverage_agreement as the CPU's do; the coverage test is
-// compiled into the shader only when some view of the GlViews has coverage.
+// answer LightfieldRenderOptions::coverage and coverage_agreement as the CPU's do; the coverage
+// test is compiled into the shader only when some view of the GlViews has coverage.
 //
 // A frame is one full-screen fragment pass into a framebuffer object holding RGBA32F: rgb the
 // linear colour (HDR kept), alpha the radial distance from the eye to the surface (+inf for sky),
@@ -29,8 +30,8 @@
 #include <memory>
 
 #include "calf/format/status.h"
-#include "calf/player/cpu_renderer.h"
 #include "calf/player/gl_views.h"
+#include "calf/player/lightfield_cpu_renderer.h"
 
 namespace calf::player {
 
@@ -38,33 +39,33 @@ namespace internal {
 class GlRasterTarget;
 }
 
-// march_range_for() of cpu_renderer.h for a GL texture layout: far = max_j(|eye - P_j| +
+// march_range_for() of lightfield_cpu_renderer.h for a GL texture layout: far = max_j(|eye - P_j| +
 // z_far_j), near = min_j z_near_j / 4 but no nearer
 // than far / 2^20 (a tiny z_near must not stretch the log steps). Errors: CALF-E403 for no views.
-Expected<RenderOptions> march_range_for(const GlTextureLayout& layout, const Vec3& eye,
-                                        RenderOptions options);
+Expected<LightfieldRenderOptions> march_range_for(const GlTextureLayout& layout, const Vec3& eye,
+                                                  LightfieldRenderOptions options);
 
-class GlRenderer {
+class LightfieldGlRenderer {
  public:
   // Compiles the shaders for `views` (which must outlive the renderer) and validates `options`
-  // as CpuRenderer::make does (CALF-E403 naming the option; `threads` is ignored). Errors:
-  // CALF-E404 when a shader does not compile or link (the driver's log follows).
-  static Expected<std::unique_ptr<GlRenderer>> make(const GlViews& views,
-                                                    const RenderOptions& options);
-  ~GlRenderer();
-  GlRenderer(const GlRenderer&) = delete;
-  GlRenderer& operator=(const GlRenderer&) = delete;
+  // as LightfieldCpuRenderer::make does (CALF-E403 naming the option; `threads` is ignored).
+  // Errors: CALF-E404 when a shader does not compile or link (the driver's log follows).
+  static Expected<std::unique_ptr<LightfieldGlRenderer>> make(
+      const GlViews& views, const LightfieldRenderOptions& options);
+  ~LightfieldGlRenderer();
+  LightfieldGlRenderer(const LightfieldGlRenderer&) = delete;
+  LightfieldGlRenderer& operator=(const LightfieldGlRenderer&) = delete;
 
   // New options for the next frames (active views, march range, ...). Nothing is recompiled,
   // except when surface_hints changes: the hint count is compiled into the shader (its per-hint
   // state then stays in registers; llvmpipe's first frame after it pays the compile, ~2 s).
   // Errors as make(); the old options (and program) stay on error.
-  Status set_options(const RenderOptions& options);
-  const RenderOptions& options() const { return options_; }
+  Status set_options(const LightfieldRenderOptions& options);
+  const LightfieldRenderOptions& options() const { return options_; }
 
   // Renders `camera` into `out` (resized): colour and radial distance per pixel, row 0 at the
-  // top, as CpuRenderer::render. Errors: CALF-E403 for an invalid camera (as the CPU renderer),
-  // CALF-E412 when GL reports an error.
+  // top, as LightfieldCpuRenderer::render. Errors: CALF-E403 for an invalid camera (as the CPU
+  // renderer), CALF-E412 when GL reports an error.
   Status render(const Camera& camera, RenderedImage* out);
 
   // Draws `camera` into the framebuffer bound to GL_DRAW_FRAMEBUFFER, viewport (0, 0, width,
@@ -73,12 +74,12 @@ class GlRenderer {
   Status draw(const Camera& camera);
 
  private:
-  GlRenderer(const GlViews& views, const RenderOptions& options);
+  LightfieldGlRenderer(const GlViews& views, const LightfieldRenderOptions& options);
   Status build_program();
 
   const GlViews* views_;
   const GlFunctions* gl_;
-  RenderOptions options_;
+  LightfieldRenderOptions options_;
   GLuint program_ = 0, vao_ = 0, view_buffer_ = 0;
   std::unique_ptr<internal::GlRasterTarget> target_;  // made on the first render()
 };
