@@ -199,7 +199,7 @@ Status Av1CellDecoder::rgba16f(uint32_t w, uint32_t h, lf::Av1HdrCurve curve,
 Status Av1CellDecoder::gpu_bytes(uint16_t colour_format, uint32_t w, uint32_t h,
                                  lf::Av1HdrCurve curve, std::vector<uint8_t>& out,
                                  const std::string& what) const {
-  if (colour_format == static_cast<uint16_t>(container::kPixelFormatAv1Hdr)) {
+  if (colour_format == static_cast<uint16_t>(container::PixelFormat::kAv1Hdr)) {
     return rgba16f(w, h, curve, out, what);
   }
   return rgba8(w, h, out, what);

@@ -199,7 +199,7 @@ Expected<LightfieldAnalysis> plan_lightfield(const capture::CaptureManifest& m,
       h.colour_format = pf(PixelFormat::kRgba8);
       break;
     case ColourCoding::kAv1:
-      h.colour_format = pf(av1_hdr ? container::kPixelFormatAv1Hdr : PixelFormat::kAv1);
+      h.colour_format = pf(av1_hdr ? container::PixelFormat::kAv1Hdr : PixelFormat::kAv1);
       break;
     default:
       h.colour_format = pf(PixelFormat::kRgba16f);

@@ -4,14 +4,14 @@ namespace calf::lf {
 
 bool is_av1_colour(uint16_t colour_format) {
   return colour_format == static_cast<uint16_t>(container::PixelFormat::kAv1) ||
-         colour_format == static_cast<uint16_t>(container::kPixelFormatAv1Hdr);
+         colour_format == static_cast<uint16_t>(container::PixelFormat::kAv1Hdr);
 }
 
 Expected<Av1Gop> parse_av1_chunk(std::span<const uint8_t> raw, uint32_t frame_count,
                                  uint16_t colour_format, Av1HdrCurve* curve,
                                  const std::string& what) {
   *curve = Av1HdrCurve{};
-  if (colour_format != static_cast<uint16_t>(container::kPixelFormatAv1Hdr)) {
+  if (colour_format != static_cast<uint16_t>(container::PixelFormat::kAv1Hdr)) {
     return parse_av1_gop(raw, frame_count, what);
   }
   if (raw.size() < 4) {

@@ -153,7 +153,7 @@ TEST_F(Av1Colour, HdrLayoutIsCurveHeadedGopChunksInA14File) {
   const container::Reader r = open(bytes);
   EXPECT_EQ(r.header().version_minor, container::kVersionMinorAv1Hdr);
   const auto& h = std::get<container::LightfieldTrackHeader>(r.tracks()[0].header);
-  EXPECT_EQ(h.colour_format, static_cast<uint16_t>(container::kPixelFormatAv1Hdr));
+  EXPECT_EQ(h.colour_format, static_cast<uint16_t>(container::PixelFormat::kAv1Hdr));
   EXPECT_EQ(h.flags, 1);
   uint32_t colour = 0, wide = 0;
   for (uint32_t id = 0; id < r.chunks().size(); ++id) {

@@ -61,7 +61,8 @@
 namespace calf::encoder {
 
 // Colour format choice; kAuto = BC1 for LDR input (every colour value <= 1), BC6H for HDR.
-// kAv1: per cell one AV1 stream of 8-bit 4:2:0 pictures (SPEC §11.1.12), LDR input only.
+// kAv1: per cell one AV1 stream (SPEC §11.1.12): 8-bit 4:2:0 sRGB pictures for LDR input, 10-bit
+// 4:2:0 codes of half floats (format av1hdr) for HDR input.
 enum class ColourCoding : uint8_t { kAuto, kBc1, kBc7, kBc6h, kRgba8, kRgba16f, kAv1 };
 
 // AV1 colour (ColourCoding::kAv1): SVT-AV1's settings. Each cell's frames are coded as closed

@@ -13,15 +13,6 @@
 #include "calf/format/lightfield_layout.h"
 #include "calf/format/status.h"
 
-namespace calf::container {
-
-// The colour format (PixelFormat's value 13) and the minor version a file that holds it says
-// (1.3 decoders refuse the format with CALF-E203).
-inline constexpr PixelFormat kPixelFormatAv1Hdr = static_cast<PixelFormat>(13);
-inline constexpr uint16_t kVersionMinorAv1Hdr = 4;
-
-}  // namespace calf::container
-
 namespace calf::lf {
 
 // A cell's curve: code c (0 … 1023) stands for the binary16 bits min(base + (c << shift), 0x7BFF).

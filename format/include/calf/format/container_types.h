@@ -42,6 +42,9 @@ inline constexpr uint16_t kVersionMinorCoverage = 2;
 // 1.3: a lightfield track may hold AV1 colour (colour format 12, SPEC §11.1.12), which earlier
 // decoders refuse as a colour format they lack; a writer writes minor 3 only for such a file.
 inline constexpr uint16_t kVersionMinorAv1 = 3;
+// 1.4: a lightfield track may hold HDR AV1 colour (colour format 13), which 1.3 decoders refuse
+// as a colour format they lack; a writer writes minor 4 only for such a file.
+inline constexpr uint16_t kVersionMinorAv1Hdr = 4;
 inline constexpr uint64_t kHeaderSize = 64;
 inline constexpr uint64_t kAlignment = 16;  // chunk offsets and the directory offset
 // Must-understand feature bits (SPEC.md "Header"). Bit 0 (1.1): the directory is its body's size
@@ -91,7 +94,8 @@ enum class PixelFormat : uint16_t {
   kRg8 = 9,
   kR16Predicted = 10,  // depth only: r16 codes as spatial-prediction residuals (SPEC §11.1.8)
   kR16PredictedMasked = 11,  // depth only: r16p, P-frames' changed texels only (SPEC §11.1.9)
-  kAv1 = 12,  // colour only: per cell one AV1 stream in GOP chunks (SPEC §11.1.12); 1.3
+  kAv1 = 12,     // colour only: per cell one AV1 stream in GOP chunks (SPEC §11.1.12); 1.3
+  kAv1Hdr = 13,  // colour only: AV1 of 10-bit codes of half floats on a curve (§11.1.12); 1.4
 };
 const char* pixel_format_name(uint16_t format);
 

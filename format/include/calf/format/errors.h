@@ -193,7 +193,7 @@ enum class ErrorKind : uint8_t {
   X(kTilesAtlas, 254, kLimit, "the tile textures do not fit the largest atlas")                 \
   X(kEncoderCoverage, 255, kCorrupt, "capture coverage is not whole 1/16 cells of its mask")     \
   X(kEncoderAv1, 256, kInternal, "the AV1 encoder (SVT-AV1) failed")                            \
-  X(kEncoderAv1Input, 257, kInvalidArgument, "AV1 colour was asked for HDR input")              \
+  X(kEncoderAv1Input, 257, kInvalidArgument, "reserved (HDR input is coded as av1hdr)")                    \
   /* decoder: 300-399 */                                                                        \
   X(kDecoderArgument, 300, kInvalidArgument, "a decoder option, frame, view or eye is invalid") \
   X(kAv1Decode, 301, kCorrupt, "an AV1 colour stream does not decode")                         \

@@ -276,7 +276,7 @@ struct CoverageRect {
 void append_coverage_payload(std::vector<uint8_t>& out, std::span<const CoverageRect> rects);
 
 // CALF-E203 unless `colour_format` is one §11.1 allows for colour (BC1, BC7, BC6H, rgba8, rgba16f,
-// av1).
+// av1, av1hdr).
 Status check_colour_format(uint16_t colour_format);
 
 // The GPU-ready bytes of a w x h colour keyframe payload (§11.1.5): BC1 blocks unsplit, BC6H / BC7
@@ -287,7 +287,8 @@ Status colour_payload_gpu_bytes(uint16_t colour_format, std::span<const uint8_t>
                                 const std::string& what);
 
 // The pixel format of the colour updates a decoder yields for a track of `colour_format`: the
-// format itself, but rgba8 for AV1 colour (its pictures are converted to sRGB-encoded RGBA8).
+// format itself, but rgba8 for AV1 colour (its pictures are converted to sRGB-encoded RGBA8) and
+// rgba16f for HDR AV1 colour (its 10-bit codes are half floats on the chunk's curve).
 container::PixelFormat colour_gpu_format(uint16_t colour_format);
 
 // ---- AV1 colour (§11.1.12) ----
