@@ -581,7 +581,8 @@ int main(int argc, char** argv) {
   app.add_option("--smooth", base.smooth_depth_ratio, "smooth_depth_ratio")->capture_default_str();
   app.add_option("--depth-decay", base.depth_decay, "w_depth decay")->capture_default_str();
   app.add_option("--cam-decay", base.cam_decay, "w_cam decay")->capture_default_str();
-  app.add_option("--color-tolerance", base.colour_depth_tolerance, "colour_depth_tolerance")
+  app.add_option("--colour-tolerance,--color-tolerance", base.colour_depth_tolerance,
+                 "colour_depth_tolerance")
       ->capture_default_str();
   app.add_option("--tight-start", base.tight_march_start, "tight_march_start (0/1)")
       ->capture_default_str();

@@ -120,7 +120,7 @@ void add_av1_options(CLI::App& app, LightfieldOptions& o) {
 // BC colour path with it. Returns -1 to go on, else the exit status.
 int check_av1_options(const CLI::App& app, const LightfieldOptions& o) {
   if (o.colour_codec == ColourCodec::kAv1) {
-    for (const char* opt : {"--color-format", "--colour-rdo", "--bc1-fit", "--segment-frames",
+    for (const char* opt : {"--colour-format", "--colour-rdo", "--bc1-fit", "--segment-frames",
                             "--analysis-only", "--analysis"}) {
       if (given(app, opt))
         return usage_error("calf-encode", std::string(opt) + " needs --colour-codec bc");
@@ -155,7 +155,7 @@ void add_options(CLI::App& app, LightfieldOptions& o) {
                  "with --psnr auto: dB Q stays below the render-noise estimate, 0..50")
       ->check(CLI::Range(0.0, 50.0))
       ->group(kLightfieldGroup);
-  add_enum_option(app, "--color-format", e.colour, kColourFormats,
+  add_enum_option(app, "--colour-format,--color-format", e.colour, kColourFormats,
                   "auto (BC1 for LDR input, BC6H for HDR), bc1, bc7, bc6h, rgba8, rgba16f")
       ->group(kLightfieldGroup);
   add_av1_options(app, o);
