@@ -177,9 +177,10 @@ Expected<CaptureNoise> estimate_capture_noise(const capture::CaptureSetReader& i
   const uint32_t n = static_cast<uint32_t>(m.viewpoints.size());
   const uint32_t frames = m.frame_count;
   // Which metrics to measure: the one the format implies, or both until the set's HDR-ness is
-  // known.
+  // known (kAuto, and AV1, which codes LDR and HDR input alike).
+  const bool from_input = colour == ColourCoding::kAuto || colour == ColourCoding::kAv1;
   const bool want_srgb = colour != ColourCoding::kBc6h && colour != ColourCoding::kRgba16f;
-  const bool want_log2 = colour == ColourCoding::kAuto || !want_srgb;
+  const bool want_log2 = from_input || !want_srgb;
   // The measured pairs (f, f + 1): every one, or max_pairs spread evenly.
   const uint32_t pairs = frames > 1 ? frames - 1 : 0;
   std::vector<uint8_t> measured(frames, 0);
@@ -229,7 +230,7 @@ Expected<CaptureNoise> estimate_capture_noise(const capture::CaptureSetReader& i
 
   CaptureNoise out;
   bool hdr = !want_srgb;
-  if (colour == ColourCoding::kAuto) {
+  if (from_input) {
     hdr = std::any_of(results.begin(), results.end(), [](const ViewResult& r) { return r.hdr; });
   }
   out.metric = hdr ? NoiseMetric::kLog2 : NoiseMetric::kSrgb;

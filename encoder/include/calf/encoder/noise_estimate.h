@@ -90,7 +90,7 @@ NoiseEstimate estimate_view_noise(std::span<const capture::ViewFrame> frames, No
 
 // Reads every frame of every view of `input` once (the set's HDR-ness needs every frame) and
 // measures options.max_pairs pairs per view. The metric follows the colour format as the encoder
-// resolves it: kLog2 for BC6H / RGBA16F, and for kAuto when some colour value exceeds 1.
+// resolves it: kLog2 for BC6H / RGBA16F, and for kAuto and AV1 when some colour value exceeds 1.
 // Errors: kEncoderOption (options out of range); the capture reader's; kEncoderInput (a frame
 // whose face size or material presence differs from the manifest).
 Expected<CaptureNoise> estimate_capture_noise(const capture::CaptureSetReader& input,
