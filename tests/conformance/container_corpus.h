@@ -47,7 +47,7 @@ inline Expected<Bytes> make_frozen_v1(bool compressed_directory = false) {
   lf.view_count = 3;
   lf.face_size = 128;
   lf.cell_size = 64;
-  lf.depth_tile_size = 64;
+  lf.depth_region_size = 64;
   lf.colour_format = static_cast<uint16_t>(PixelFormat::kBc1);
   lf.depth_format = static_cast<uint16_t>(PixelFormat::kR16);
   CALF_RETURN_IF_ERROR(w.add_track(lf).status());

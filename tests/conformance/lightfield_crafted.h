@@ -137,7 +137,7 @@ inline void bc1_block(uint32_t i, Rng& rng, uint8_t* block) {
 struct ClipSpec {
   std::string name;
   uint16_t colour_format = 0, depth_format = 0, material_format = 0, flags = 0;
-  uint32_t face_size = 0, cell_size = 0, depth_tile_size = 0, frame_count = 0, view_count = 1;
+  uint32_t face_size = 0, cell_size = 0, depth_region_size = 0, frame_count = 0, view_count = 1;
   uint32_t depth_keyframe_interval = 1;
   uint64_t seed = 0;
   bool lightfield_is_track_1 = false;  // track 0 is then an unknown optional kind
@@ -293,7 +293,7 @@ inline Expected<Bytes> make_clip(const ClipSpec& s) {
   h.view_count = s.view_count;
   h.face_size = s.face_size;
   h.cell_size = s.cell_size;
-  h.depth_tile_size = s.depth_tile_size;
+  h.depth_region_size = s.depth_region_size;
   h.colour_format = s.colour_format;
   h.depth_format = s.depth_format;
   h.material_format = s.material_format;
@@ -323,7 +323,7 @@ inline Expected<Bytes> make_clip(const ClipSpec& s) {
   };
   Rng rng{s.seed};
   CALF_ASSIGN_OR_RETURN(FaceGrid cells, FaceGrid::with_cell_size(s.face_size, s.cell_size));
-  CALF_ASSIGN_OR_RETURN(FaceGrid tiles, FaceGrid::with_cell_size(s.face_size, s.depth_tile_size));
+  CALF_ASSIGN_OR_RETURN(FaceGrid tiles, FaceGrid::with_cell_size(s.face_size, s.depth_region_size));
   CALF_ASSIGN_OR_RETURN(lf::RegionCoding depth, lf::depth_coding(s.depth_format));
   const bool material = s.material_format != 0;
   lf::RegionCoding mat = lf::RegionCoding::kRgb8;
@@ -420,7 +420,7 @@ inline std::vector<ClipSpec> clip_specs() {
   bc7.material_format = static_cast<uint16_t>(PixelFormat::kRgba8);
   bc7.face_size = 30;  // cells 16 + 14, tiles 12 + 12 + 6, edge blocks of 2 texels
   bc7.cell_size = 16;
-  bc7.depth_tile_size = 12;
+  bc7.depth_region_size = 12;
   bc7.frame_count = 5;
   bc7.view_count = 2;
   bc7.depth_keyframe_interval = 2;
@@ -436,7 +436,7 @@ inline std::vector<ClipSpec> clip_specs() {
   bc6h.flags = 1;  // HDR
   bc6h.face_size = 30;
   bc6h.cell_size = 16;
-  bc6h.depth_tile_size = 13;  // tiles 13 + 13 + 4: rectangles with partial blocks
+  bc6h.depth_region_size = 13;  // tiles 13 + 13 + 4: rectangles with partial blocks
   bc6h.frame_count = 5;
   bc6h.view_count = 2;
   bc6h.depth_keyframe_interval = 3;
@@ -448,7 +448,7 @@ inline std::vector<ClipSpec> clip_specs() {
   bc1.depth_format = static_cast<uint16_t>(PixelFormat::kR16);
   bc1.face_size = 10;  // cells 6 + 4, tiles 7 + 3
   bc1.cell_size = 6;
-  bc1.depth_tile_size = 7;
+  bc1.depth_region_size = 7;
   bc1.frame_count = 5;
   bc1.view_count = 2;
   bc1.depth_keyframe_interval = 5;

@@ -105,7 +105,7 @@ double psnr_srgb8(const std::vector<float>& a, const std::vector<float>& b) {
 }
 
 // log2-PSNR (SPEC §11.1.4, HDR): over log2(max(v, 2^-14)) of every channel, peak 8.
-double encoder::psnr_log2(const std::vector<float>& a, const std::vector<float>& b) {
+double psnr_log2(const std::vector<float>& a, const std::vector<float>& b) {
   double se = 0;
   for (size_t i = 0; i < a.size(); ++i) {
     const double d = std::log2(std::max(a[i], 0x1p-14f)) - std::log2(std::max(b[i], 0x1p-14f));
@@ -235,7 +235,7 @@ void Av1Colour::decoders_agree(bool hdr) {
           }
         }
         const double psnr =
-            hdr ? encoder::psnr_log2(want, face.colour) : psnr_srgb8(want, face.colour);
+            hdr ? psnr_log2(want, face.colour) : psnr_srgb8(want, face.colour);
         worst = std::min(worst, psnr);
         sum += psnr;
         ++faces;

@@ -19,22 +19,24 @@ namespace calf::tools {
 
 namespace {
 
-inline constexpr EnumTable<ColourCoding, 6> kColourFormats = {
-    {{"auto", ColourCoding::kAuto},
-     {"bc1", ColourCoding::kBc1},
-     {"bc7", ColourCoding::kBc7},
-     {"bc6h", ColourCoding::kBc6h},
-     {"rgba8", ColourCoding::kRgba8},
-     {"rgba16f", ColourCoding::kRgba16f}}};
+inline constexpr EnumTable<encoder::ColourCoding, 6> kColourFormats = {
+    {{"auto", encoder::ColourCoding::kAuto},
+     {"bc1", encoder::ColourCoding::kBc1},
+     {"bc7", encoder::ColourCoding::kBc7},
+     {"bc6h", encoder::ColourCoding::kBc6h},
+     {"rgba8", encoder::ColourCoding::kRgba8},
+     {"rgba16f", encoder::ColourCoding::kRgba16f}}};
 
-inline constexpr EnumTable<DepthCoding, 4> kDepthFormats = {
-    {{"raw16", DepthCoding::kRaw16},
-     {"pred16", DepthCoding::kRaw16Predicted},
-     {"pred16m", DepthCoding::kRaw16PredictedMasked},
-     {"bc5", DepthCoding::kBc5}}};
+inline constexpr EnumTable<encoder::DepthCoding, 4> kDepthFormats = {
+    {{"raw16", encoder::DepthCoding::kRaw16},
+     {"pred16", encoder::DepthCoding::kRaw16Predicted},
+     {"pred16m", encoder::DepthCoding::kRaw16PredictedMasked},
+     {"bc5", encoder::DepthCoding::kBc5}}};
 
-inline constexpr EnumTable<Bc1Fit, 3> kBc1Fits = {
-    {{"range", Bc1Fit::kRange}, {"refined", Bc1Fit::kRefined}, {"cluster", Bc1Fit::kCluster}}};
+inline constexpr EnumTable<encoder::Bc1Fit, 3> kBc1Fits = {
+    {{"range", encoder::Bc1Fit::kRange},
+     {"refined", encoder::Bc1Fit::kRefined},
+     {"cluster", encoder::Bc1Fit::kCluster}}};
 
 inline constexpr EnumTable<ColourCodec, 2> kColourCodecs = {
     {{"bc", ColourCodec::kBc}, {"av1", ColourCodec::kAv1}}};
@@ -43,21 +45,21 @@ inline constexpr EnumTable<ColourCodec, 2> kColourCodecs = {
 // noise_estimate.h) and sets o->min_psnr_db from it; prints the estimate and Q unless `quiet`.
 // Returns 0, or the exit status of the error it printed.
 int resolve_auto_psnr(const std::filesystem::path& dir, double margin, bool quiet,
-                      LightfieldEncodeOptions* o) {
-  if (Status s = check_lightfield_options(*o); !s.ok()) return fail(s);
+                      encoder::LightfieldEncodeOptions* o) {
+  if (Status s = encoder::check_lightfield_options(*o); !s.ok()) return fail(s);
   const auto t0 = std::chrono::steady_clock::now();
   auto input = capture::CaptureSetReader::open(dir, o->max_image_pixels);
   if (!input.ok()) return fail(input.status());
-  NoiseEstimateOptions no;
+  encoder::NoiseEstimateOptions no;
   no.threads = o->threads;
   no.max_image_pixels = o->max_image_pixels;
-  auto noise = estimate_capture_noise(*input, o->colour, no);
+  auto noise = encoder::estimate_capture_noise(*input, o->colour, no);
   if (!noise.ok()) return fail(noise.status());
-  o->min_psnr_db = auto_psnr_db(noise->set, margin);
+  o->min_psnr_db = encoder::auto_psnr_db(noise->set, margin);
   if (quiet) return 0;
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const char* metric = noise->metric == NoiseMetric::kLog2 ? "log2-PSNR" : "sRGB PSNR";
+  const char* metric = noise->metric == encoder::NoiseMetric::kLog2 ? "log2-PSNR" : "sRGB PSNR";
   if (!noise->set.psnr_db) {
     std::fprintf(stderr,
                  "calf-encode: colour noise: no estimate (%llu samples of frame-to-frame change on "
@@ -66,7 +68,7 @@ int resolve_auto_psnr(const std::filesystem::path& dir, double margin, bool quie
     return 0;
   }
   double lo = 1e9, hi = -1e9;
-  for (const NoiseEstimate& v : noise->views) {
+  for (const encoder::NoiseEstimate& v : noise->views) {
     if (!v.psnr_db) continue;
     lo = std::min(lo, *v.psnr_db);
     hi = std::max(hi, *v.psnr_db);
@@ -95,7 +97,7 @@ void add_av1_options(CLI::App& app, LightfieldOptions& o) {
                   "HDR input 10-bit codes of half floats; "
                   "format/SPEC.md 11.1.12, docs/ENCODER.md \"AV1 colour\")")
       ->group(kAv1Group);
-  Av1ColourOptions& av1 = o.encode.av1;
+  encoder::Av1ColourOptions& av1 = o.encode.av1;
   app.add_option("--av1-crf", av1.crf,
                  "av1: constant rate factor 1..63, lower is better and larger")
       ->check(CLI::Range(1u, 63u))
@@ -140,7 +142,7 @@ int check_av1_options(const CLI::App& app, const LightfieldOptions& o) {
 }  // namespace
 
 void add_options(CLI::App& app, LightfieldOptions& o) {
-  LightfieldEncodeOptions& e = o.encode;
+  encoder::LightfieldEncodeOptions& e = o.encode;
   app.add_option("--cell", e.cell_size, "colour cell side in px, multiple of 4")
       ->group(kLightfieldGroup);
   app.add_option(
@@ -216,11 +218,11 @@ void add_options(CLI::App& app, LightfieldOptions& o) {
 
 int resolve(const CLI::App& app, const CommonOptions& common, LightfieldOptions* options) {
   LightfieldOptions& lf = *options;
-  LightfieldEncodeOptions& o = lf.encode;
+  encoder::LightfieldEncodeOptions& o = lf.encode;
   if (int rc = check_av1_options(app, lf); rc >= 0) return rc;
-  if (lf.colour_codec == ColourCodec::kAv1) o.colour = ColourCoding::kAv1;
+  if (lf.colour_codec == ColourCodec::kAv1) o.colour = encoder::ColourCoding::kAv1;
   if (lf.colour_rdo == "auto") {
-    o.colour_rdo = kColourRdoAuto;
+    o.colour_rdo = encoder::kColourRdoAuto;
   } else {
     char* end = nullptr;
     o.colour_rdo = std::strtod(lf.colour_rdo.c_str(), &end);
@@ -276,7 +278,7 @@ int resolve(const CLI::App& app, const CommonOptions& common, LightfieldOptions*
 }
 
 int run(const CommonOptions& common, const LightfieldOptions& options) {
-  LightfieldEncodeOptions o = options.encode;
+  encoder::LightfieldEncodeOptions o = options.encode;
   const std::filesystem::path dir = input_folder(common.input, capture::kManifestFileName);
   const ShardOptions& shard = options.shard;
   if (options.psnr == "auto" && shard.analysis.empty()) {
@@ -306,11 +308,11 @@ int run(const CommonOptions& common, const LightfieldOptions& options) {
       std::fflush(stderr);
     };
   }
-  auto stats = encode_lightfield_file(dir, common.output, o);
+  auto stats = encoder::encode_lightfield_file(dir, common.output, o);
   if (!stats.ok()) return fail(stats.status());
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  auto line = [](const char* name, const StreamBytes& b) {
+  auto line = [](const char* name, const encoder::StreamBytes& b) {
     std::fprintf(
         stderr, "  %-8s raw %llu  temporal %llu  +spatial %llu  +%s %llu  (%.1fx)  %llu chunks\n",
         name, static_cast<unsigned long long>(b.raw), static_cast<unsigned long long>(b.temporal),
@@ -336,7 +338,7 @@ int run(const CommonOptions& common, const LightfieldOptions& options) {
                static_cast<unsigned long long>(stats->colour_keyframes),
                stats->min_colour_quality_db, static_cast<unsigned long long>(stats->depth_pframes),
                static_cast<unsigned long long>(stats->depth_empty_pframes));
-  if (o.depth == DepthCoding::kBc5) {
+  if (o.depth == encoder::DepthCoding::kBc5) {
     std::fprintf(stderr,
                  "  BC5 depth error: max relative %.3g, mean relative %.3g, sky mismatches %llu\n",
                  stats->depth_max_rel_error, stats->depth_mean_rel_error,
