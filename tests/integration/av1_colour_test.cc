@@ -234,8 +234,7 @@ void Av1Colour::decoders_agree(bool hdr) {
             for (int c = 0; c < 3; ++c) want.push_back(input.color[3 * i + c]);
           }
         }
-        const double psnr =
-            hdr ? psnr_log2(want, face.colour) : psnr_srgb8(want, face.colour);
+        const double psnr = hdr ? psnr_log2(want, face.colour) : psnr_srgb8(want, face.colour);
         worst = std::min(worst, psnr);
         sum += psnr;
         ++faces;
