@@ -82,11 +82,11 @@ TEST(OneFrame, EncodesDecodesSeeksAndPlays) {
       write_capture(tmp.path() / "cap", m, [](uint32_t v, uint32_t, capture::ViewFrame& vf) {
         fill_named_texels(v, vf);
       }).ok());
-  LightfieldEncodeOptions eo;
+  encoder::LightfieldEncodeOptions eo;
   eo.cell_size = 4;
-  eo.colour = ColourCoding::kRgba16f;
+  eo.colour = encoder::ColourCoding::kRgba16f;
   const std::string clip = tmp.file("one.calf");
-  auto stats = encode_lightfield_file(tmp.path() / "cap", clip, eo);
+  auto stats = encoder::encode_lightfield_file(tmp.path() / "cap", clip, eo);
   ASSERT_TRUE(stats.ok()) << stats.status().to_string();
   EXPECT_EQ(stats->colour_keyframes, stats->colour_cells);  // 2 views x 6 faces x 4 cells
   EXPECT_EQ(stats->colour_cells, 48u);
@@ -175,23 +175,24 @@ TEST(DepthWindow, WindowAtOrBeyondTheFrameCountWithOneRectangle) {
       }).ok());
   struct Case {
     uint32_t window, interval;
-    DepthCoding depth;
+    encoder::DepthCoding depth;
   };
   // W = the frame count in one group; W = 65535 (the largest) with groups of K = 3 frames, so
   // the window is clamped to the group; BC5 depth (rectangles 4-aligned).
-  for (const Case& k : {Case{kFrames, 30, DepthCoding::kRaw16}, Case{65535, 3, DepthCoding::kRaw16},
-                        Case{kFrames, 30, DepthCoding::kBc5}}) {
-    LightfieldEncodeOptions eo;
+  for (const Case& k : {Case{kFrames, 30, encoder::DepthCoding::kRaw16},
+                        Case{65535, 3, encoder::DepthCoding::kRaw16},
+                        Case{kFrames, 30, encoder::DepthCoding::kBc5}}) {
+    encoder::LightfieldEncodeOptions eo;
     eo.cell_size = 8;
-    eo.colour = ColourCoding::kRgba16f;  // given: no HDR pre-pass over the set
+    eo.colour = encoder::ColourCoding::kRgba16f;  // given: no HDR pre-pass over the set
     eo.depth_window = k.window;
     eo.max_aabbs = 1;
     eo.depth_keyframe_interval = k.interval;
     eo.depth = k.depth;
     const std::string name =
-        cat("W", k.window, "_K", k.interval, k.depth == DepthCoding::kBc5 ? "_bc5" : "");
+        cat("W", k.window, "_K", k.interval, k.depth == encoder::DepthCoding::kBc5 ? "_bc5" : "");
     const std::string clip = tmp.file(cat(name, ".calf"));
-    auto stats = encode_lightfield_file(tmp.path() / "cap", clip, eo);
+    auto stats = encoder::encode_lightfield_file(tmp.path() / "cap", clip, eo);
     ASSERT_TRUE(stats.ok()) << name << ": " << stats.status().to_string();
     // A = 1: every P-frame of the changing tile is one rectangle covering both changes.
     {
@@ -204,7 +205,7 @@ TEST(DepthWindow, WindowAtOrBeyondTheFrameCountWithOneRectangle) {
       ASSERT_EQ(counts->size(), kFrames);
       for (uint32_t f = 0; f < kFrames; ++f) EXPECT_EQ((*counts)[f], 1u) << name << " frame " << f;
     }
-    if (k.depth == DepthCoding::kBc5) {
+    if (k.depth == encoder::DepthCoding::kBc5) {
       // BC5 is lossy: only the absence of NaN in its error report is checked here.
       EXPECT_FALSE(std::isnan(stats->depth_mean_rel_error));
       continue;
@@ -243,8 +244,8 @@ TEST(DepthWindow, WindowAtOrBeyondTheFrameCountWithOneRectangle) {
 // ---- Face sizes ----
 
 struct Coding {
-  ColourCoding colour;
-  DepthCoding depth;
+  encoder::ColourCoding colour;
+  encoder::DepthCoding depth;
   double colour_tol;  // largest colour error against the capture
   const char* name;
 };
@@ -272,19 +273,19 @@ void check_face_size(uint32_t n, uint32_t cell, const Vec3& ray_to_last_texel) {
         }
       }).ok());
   const Coding codings[] = {
-      {ColourCoding::kRgba16f, DepthCoding::kRaw16, 0.0, "rgba16f+raw16"},
-      {ColourCoding::kBc1, DepthCoding::kBc5, 0.12, "bc1+bc5"},
-      {ColourCoding::kBc7, DepthCoding::kRaw16, 0.05, "bc7+raw16"},
-      {ColourCoding::kBc6h, DepthCoding::kBc5, 0.1, "bc6h+bc5"},
+      {encoder::ColourCoding::kRgba16f, encoder::DepthCoding::kRaw16, 0.0, "rgba16f+raw16"},
+      {encoder::ColourCoding::kBc1, encoder::DepthCoding::kBc5, 0.12, "bc1+bc5"},
+      {encoder::ColourCoding::kBc7, encoder::DepthCoding::kRaw16, 0.05, "bc7+raw16"},
+      {encoder::ColourCoding::kBc6h, encoder::DepthCoding::kBc5, 0.1, "bc6h+bc5"},
   };
   for (const Coding& k : codings) {
     const std::string what = cat("face ", n, " ", k.name);
-    LightfieldEncodeOptions eo;
+    encoder::LightfieldEncodeOptions eo;
     eo.cell_size = cell;
     eo.colour = k.colour;
     eo.depth = k.depth;
     const std::string clip = tmp.file(cat(k.name, ".calf"));
-    auto stats = encode_lightfield_file(tmp.path() / "cap", clip, eo);
+    auto stats = encoder::encode_lightfield_file(tmp.path() / "cap", clip, eo);
     ASSERT_TRUE(stats.ok()) << what << ": " << stats.status().to_string();
     for (uint32_t frame : {0u, 1u}) {
       auto decoded = decode_clip(clip, frame);
@@ -308,14 +309,14 @@ void check_face_size(uint32_t n, uint32_t cell, const Vec3& ray_to_last_texel) {
             }
           }
         }
-        if (k.depth == DepthCoding::kRaw16) {
+        if (k.depth == encoder::DepthCoding::kRaw16) {
           expect_depths(
               *decoded, 0, face, [&](uint32_t x, uint32_t y) { return texel_depth(0, f, x, y); },
               what);
         }
       }
     }
-    if (k.colour != ColourCoding::kRgba16f) continue;
+    if (k.colour != encoder::ColourCoding::kRgba16f) continue;
     // calf-play, view-dependent decoding, a 1 x 1 eye at the viewpoint aimed at the centre of
     // +X texel (n-1, n-1) (in the last, partial cell when n is not a multiple of the cell): at a
     // texel centre the bilinear colour is that texel's.
@@ -386,13 +387,14 @@ TEST(FaceSize, Faces2048) {
                   fill_face(vf, cube_face_from_index(f), rgb, 1.0f + f);
                 }
               }).ok());
-  LightfieldEncodeOptions eo;
+  encoder::LightfieldEncodeOptions eo;
   eo.cell_size = 256;
-  eo.colour = ColourCoding::kRgba16f;  // given: no HDR pre-pass; raw halves: no BC or sRGB work
+  eo.colour =
+      encoder::ColourCoding::kRgba16f;  // given: no HDR pre-pass; raw halves: no BC or sRGB work
   eo.threads = 2;
   eo.levels.zstd_level = 1;  // level 19 spends seconds on 60 MB of constant chunks
   const std::string clip = tmp.file("big.calf");
-  auto stats = encode_lightfield_file(tmp.path() / "cap", clip, eo);
+  auto stats = encoder::encode_lightfield_file(tmp.path() / "cap", clip, eo);
   ASSERT_TRUE(stats.ok()) << stats.status().to_string();
   EXPECT_EQ(stats->colour_cells, 6u * 8 * 8);
   EXPECT_EQ(stats->depth_regions, 6u * 2 * 2);

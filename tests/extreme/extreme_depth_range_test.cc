@@ -177,11 +177,11 @@ TEST(DepthRange1e4To1e6, CaptureEncodeDecodeRenderRoundTrip) {
   TempDir tmp("range");
   const FaceScene scene = wide_range_scene();
   ASSERT_TRUE(write_face_scene(tmp.path() / "cap", scene, 8).ok());
-  LightfieldEncodeOptions eo;
+  encoder::LightfieldEncodeOptions eo;
   eo.cell_size = 4;
-  eo.colour = ColourCoding::kRgba16f;
+  eo.colour = encoder::ColourCoding::kRgba16f;
   const std::string clip = tmp.file("clip.calf");
-  auto stats = encode_lightfield_file(tmp.path() / "cap", clip, eo);
+  auto stats = encoder::encode_lightfield_file(tmp.path() / "cap", clip, eo);
   ASSERT_TRUE(stats.ok()) << stats.status().to_string();
 
   // The decoder holds z_near = 1e-4, z_far = 1e6 (as floats) and the Eq. 13 code of each face.
@@ -263,13 +263,14 @@ TEST(FlatDepth, EveryDepthEqualEncodesDecodesAndRendersExactly) {
   FaceScene scene = wide_range_scene();
   for (float& d : scene.depth) d = 3.0f;  // a sphere of radius 3 around the only viewpoint
   ASSERT_TRUE(write_face_scene(tmp.path() / "cap", scene, 16).ok());
-  for (DepthCoding depth : {DepthCoding::kRaw16, DepthCoding::kBc5}) {
-    LightfieldEncodeOptions eo;
+  for (encoder::DepthCoding depth : {encoder::DepthCoding::kRaw16, encoder::DepthCoding::kBc5}) {
+    encoder::LightfieldEncodeOptions eo;
     eo.cell_size = 8;
-    eo.colour = ColourCoding::kRgba16f;
+    eo.colour = encoder::ColourCoding::kRgba16f;
     eo.depth = depth;
-    const std::string clip = tmp.file(depth == DepthCoding::kBc5 ? "bc5.calf" : "raw.calf");
-    auto stats = encode_lightfield_file(tmp.path() / "cap", clip, eo);
+    const std::string clip =
+        tmp.file(depth == encoder::DepthCoding::kBc5 ? "bc5.calf" : "raw.calf");
+    auto stats = encoder::encode_lightfield_file(tmp.path() / "cap", clip, eo);
     ASSERT_TRUE(stats.ok()) << stats.status().to_string();
     EXPECT_EQ(stats->depth_max_rel_error, 0.0);  // BC5 of a constant code is exact
     auto decoded = decode_clip(clip, 0);
@@ -336,7 +337,7 @@ TEST(FlatDepth, EveryDepthEqualEncodesDecodesAndRendersExactly) {
     // (the decoder starts from black and sky, which would show). CPU, and GL for the raw16 clip
     // (the GPU holds BC5 depth decoded to the same R16 codes).
     for (bool gl : {false, true}) {
-      if (gl && depth == DepthCoding::kBc5) continue;
+      if (gl && depth == encoder::DepthCoding::kBc5) continue;
       player::OsMesaContext* ctx = gl ? gl_context() : nullptr;
       if (gl && ctx == nullptr) continue;
       PlaybackOptions po;

@@ -43,12 +43,12 @@ Status write_wall_capture(const fs::path& dir) {
   });
 }
 
-Expected<LightfieldEncodeStats> encode(const fs::path& cap, const std::string& clip,
-                                       ColourCoding coding) {
-  LightfieldEncodeOptions eo;
+Expected<encoder::LightfieldEncodeStats> encode(const fs::path& cap, const std::string& clip,
+                                                encoder::ColourCoding coding) {
+  encoder::LightfieldEncodeOptions eo;
   eo.cell_size = 8;
   eo.colour = coding;
-  return encode_lightfield_file(cap, clip, eo);
+  return encoder::encode_lightfield_file(cap, clip, eo);
 }
 
 Camera camera(const Vec3& position, const Vec3& forward, uint32_t size = 8) {
@@ -100,8 +100,10 @@ void play_and_check(
 TEST(SkyEverywhere, EncodesSmallDecodesToSkyAndRendersTheSkyColour) {
   TempDir tmp("sky");
   ASSERT_TRUE(write_sky_capture(tmp.path() / "cap", 4).ok());
-  for (ColourCoding coding : {ColourCoding::kAuto, ColourCoding::kRgba16f}) {
-    const std::string clip = tmp.file(coding == ColourCoding::kAuto ? "auto.calf" : "f16.calf");
+  for (encoder::ColourCoding coding :
+       {encoder::ColourCoding::kAuto, encoder::ColourCoding::kRgba16f}) {
+    const std::string clip =
+        tmp.file(coding == encoder::ColourCoding::kAuto ? "auto.calf" : "f16.calf");
     auto stats = encode(tmp.path() / "cap", clip, coding);
     ASSERT_TRUE(stats.ok()) << stats.status().to_string();
     // Small: every cell one keyframe, every depth P-frame empty, each chunk a few bytes of zstd.
@@ -112,7 +114,7 @@ TEST(SkyEverywhere, EncodesSmallDecodesToSkyAndRendersTheSkyColour) {
     const uint64_t payload = stats->colour.stored + stats->depth.stored;
     const uint64_t file = fs::file_size(clip);
     std::printf("sky everywhere (%s): raw %llu bytes, %llu chunks, payload %llu, file %llu\n",
-                coding == ColourCoding::kAuto ? "BC1" : "rgba16f",
+                coding == encoder::ColourCoding::kAuto ? "BC1" : "rgba16f",
                 static_cast<unsigned long long>(stats->colour.raw + stats->depth.raw),
                 static_cast<unsigned long long>(chunks), static_cast<unsigned long long>(payload),
                 static_cast<unsigned long long>(file));
@@ -123,7 +125,7 @@ TEST(SkyEverywhere, EncodesSmallDecodesToSkyAndRendersTheSkyColour) {
     // is sky, every colour the sky's (exact in rgba16f; BC1 stores 5:6:5 sRGB endpoints).
     auto decoded = decode_clip(clip, 3);
     ASSERT_TRUE(decoded);
-    const double tol = coding == ColourCoding::kRgba16f ? 0.0 : 0.01;
+    const double tol = coding == encoder::ColourCoding::kRgba16f ? 0.0 : 0.01;
     for (uint32_t v = 0; v < 2; ++v) {
       EXPECT_FALSE(decoded->decoder->view(v).has_depth);
       EXPECT_EQ(decoded->decoder->view(v).z_near, 1.0f);
@@ -136,15 +138,15 @@ TEST(SkyEverywhere, EncodesSmallDecodesToSkyAndRendersTheSkyColour) {
         for (size_t i = 0; i < rgb.size(); ++i) ASSERT_NEAR(rgb[i], kSky[i % 3], tol);
       }
     }
-    if (coding == ColourCoding::kAuto) {
+    if (coding == encoder::ColourCoding::kAuto) {
       // On 16-texel faces the 64-byte index entry of each chunk is most of the file; on 64-texel
       // faces (4 frames, one cell per face) the whole clip is under 1 % of the raw streams.
       ASSERT_TRUE(write_sky_capture(tmp.path() / "cap64", 4, 64).ok());
-      LightfieldEncodeOptions eo;
+      encoder::LightfieldEncodeOptions eo;
       eo.cell_size = 64;
-      eo.colour = ColourCoding::kBc1;
+      eo.colour = encoder::ColourCoding::kBc1;
       const std::string big = tmp.file("sky64.calf");
-      auto s64 = encode_lightfield_file(tmp.path() / "cap64", big, eo);
+      auto s64 = encoder::encode_lightfield_file(tmp.path() / "cap64", big, eo);
       ASSERT_TRUE(s64.ok()) << s64.status().to_string();
       const uint64_t raw = s64->colour.raw + s64->depth.raw;
       std::printf("sky everywhere, 64-texel faces: raw %llu bytes, file %llu\n",
@@ -171,7 +173,7 @@ TEST(NothingToSee, EyeFarOutsideLookingAwaySeesTheSky) {
   TempDir tmp("away");
   ASSERT_TRUE(write_wall_capture(tmp.path() / "cap").ok());
   const std::string clip = tmp.file("wall.calf");
-  ASSERT_TRUE(encode(tmp.path() / "cap", clip, ColourCoding::kRgba16f).ok());
+  ASSERT_TRUE(encode(tmp.path() / "cap", clip, encoder::ColourCoding::kRgba16f).ok());
   // 50 units behind the viewpoints (the view volume is 1.5 across), looking away from the walls,
   // and 1e5 units away looking sideways: sky, decoded for these eyes by view-dependent decoding
   // (cells holding sky reach as far as the eye does).
@@ -188,7 +190,7 @@ TEST(NothingToSee, EyeBehindEveryViewsSurfaceHitsAtTheMarchStart) {
   TempDir tmp("inside");
   ASSERT_TRUE(write_wall_capture(tmp.path() / "cap").ok());
   const std::string clip = tmp.file("wall.calf");
-  ASSERT_TRUE(encode(tmp.path() / "cap", clip, ColourCoding::kRgba16f).ok());
+  ASSERT_TRUE(encode(tmp.path() / "cap", clip, encoder::ColourCoding::kRgba16f).ok());
   // The eye at (5, 0, 0) is beyond both walls (radius 3): no view has seen that space, every
   // view calls every point near it "behind my surface", so the march stops at its first sample.
   // The defined fallback: depth = the march's near end, colour = the views' blend of what they
@@ -214,7 +216,7 @@ TEST(NothingToSee, EveryViewAbstainingIsEmptySpaceShowingTheViewsColour) {
   TempDir tmp("abstain");
   ASSERT_TRUE(write_wall_capture(tmp.path() / "cap").ok());
   const std::string clip = tmp.file("wall.calf");
-  ASSERT_TRUE(encode(tmp.path() / "cap", clip, ColourCoding::kRgba16f).ok());
+  ASSERT_TRUE(encode(tmp.path() / "cap", clip, encoder::ColourCoding::kRgba16f).ok());
   auto decoded = decode_clip(clip, 0);
   ASSERT_TRUE(decoded);
   auto views = view_set_of(*decoded);
@@ -242,7 +244,7 @@ TEST(NothingToSee, NothingDecodedRendersTheInitialBlackSky) {
   TempDir tmp("undecoded");
   ASSERT_TRUE(write_wall_capture(tmp.path() / "cap").ok());
   const std::string clip = tmp.file("wall.calf");
-  ASSERT_TRUE(encode(tmp.path() / "cap", clip, ColourCoding::kRgba16f).ok());
+  ASSERT_TRUE(encode(tmp.path() / "cap", clip, encoder::ColourCoding::kRgba16f).ok());
   auto reader = container::Reader::open(clip);
   ASSERT_TRUE(reader.ok());
   auto d = decoder::LightfieldDecoder::open(*reader, 0);  // view-dependent

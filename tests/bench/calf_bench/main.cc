@@ -279,7 +279,7 @@ Status run_scene(const std::string& name, const Options& o, const ScenePlan& pla
         ref.extra.push_back({"depth", "base with lzma2", r.depth_bytes, r.encode_s});
         ref.extra.push_back({"colour", "base with lzma2", r.colour_bytes, r.encode_s});
       }
-      if (p.point.knob == Knob::kDepth && p.point.encode.depth == DepthCoding::kBc5) {
+      if (p.point.knob == Knob::kDepth && p.point.encode.depth == encoder::DepthCoding::kBc5) {
         ref.extra.push_back({"depth", "base with bc5 depth", r.depth_bytes, r.encode_s});
       }
     }
@@ -401,15 +401,16 @@ int main(int argc, char** argv) {
       parse_numbers("--aabbs", aabbs, 1, 64, 0, false, &v.aabbs, &error) &&
       parse_numbers("--views", views, 1, 65536, 0, true, &v.views, &error) &&
       parse_numbers("--steps", steps, 1, 65536, 0, false, &v.steps, &error) &&
-      parse_names<DepthCoding>("--depth-formats", depth,
-                               {{"raw16", DepthCoding::kRaw16}, {"bc5", DepthCoding::kBc5}},
-                               &v.depth, &error) &&
-      parse_names<ColourCoding>("--colour-formats", colour,
-                                {{"auto", ColourCoding::kAuto},
-                                 {"bc1", ColourCoding::kBc1},
-                                 {"bc7", ColourCoding::kBc7},
-                                 {"bc6h", ColourCoding::kBc6h}},
-                                &v.colour, &error) &&
+      parse_names<encoder::DepthCoding>(
+          "--depth-formats", depth,
+          {{"raw16", encoder::DepthCoding::kRaw16}, {"bc5", encoder::DepthCoding::kBc5}}, &v.depth,
+          &error) &&
+      parse_names<encoder::ColourCoding>("--colour-formats", colour,
+                                         {{"auto", encoder::ColourCoding::kAuto},
+                                          {"bc1", encoder::ColourCoding::kBc1},
+                                          {"bc7", encoder::ColourCoding::kBc7},
+                                          {"bc6h", encoder::ColourCoding::kBc6h}},
+                                         &v.colour, &error) &&
       parse_names<container::Compression>("--super", super,
                                           {{"zstd", container::Compression::kZstd},
                                            {"lzma2", container::Compression::kLzma2},

@@ -79,7 +79,7 @@ Expected<std::unique_ptr<SceneInputs>> SceneInputs::make(const std::string& name
 }
 
 Expected<EncodeOutcome> SceneInputs::encode(const EncodeConfig& c, const fs::path& clip) const {
-  LightfieldEncodeOptions o;
+  encoder::LightfieldEncodeOptions o;
   o.cell_size = c.cell;
   o.min_psnr_db = c.q;
   o.colour = c.colour;
@@ -90,7 +90,7 @@ Expected<EncodeOutcome> SceneInputs::encode(const EncodeConfig& c, const fs::pat
   o.threads = settings_.threads;
   EncodeOutcome out;
   const double t0 = now_seconds(), c0 = cpu_seconds();
-  CALF_ASSIGN_OR_RETURN(out.stats, encode_lightfield_file(capture_dir_, clip.string(), o));
+  CALF_ASSIGN_OR_RETURN(out.stats, encoder::encode_lightfield_file(capture_dir_, clip.string(), o));
   out.seconds = now_seconds() - t0;
   out.cpu_seconds = cpu_seconds() - c0;
   std::error_code ec;

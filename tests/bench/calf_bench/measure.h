@@ -1,13 +1,13 @@
 // calf-bench: measuring one scene — capture, ground truth, an encode, a headless playback.
 //
 // The capture set and the ground truth are rendered once per scene (calf-capture's library,
-// samples/render.h) into a work directory; every encode is a fresh encode_lightfield_file() of
-// that capture set; every playback a fresh Playback (player/playback.h) of the clip, driven pose by
-// pose along the ground truth's eye path exactly as calf-play --headless --compare does it: poses
-// sharing a time are prepared together, each is rendered and compared (image_compare.h PSNR /
-// SSIM; a pose's PSNR is capped at 100 dB like calf-play's mean). Nothing is cached between
-// points: a point's numbers come from its own encode (or the base clip, for play knobs) and its
-// own playback.
+// samples/render.h) into a work directory; every encode is a fresh
+// encoder::encode_lightfield_file() of that capture set; every playback a fresh Playback
+// (player/playback.h) of the clip, driven pose by pose along the ground truth's eye path exactly as
+// calf-play --headless --compare does it: poses sharing a time are prepared together, each is
+// rendered and compared (image_compare.h PSNR / SSIM; a pose's PSNR is capped at 100 dB like
+// calf-play's mean). Nothing is cached between points: a point's numbers come from its own encode
+// (or the base clip, for play knobs) and its own playback.
 #pragma once
 
 #include <cstdint>
@@ -34,7 +34,7 @@ struct MeasureSettings {
 
 // What an encode gave.
 struct EncodeOutcome {
-  LightfieldEncodeStats stats;
+  encoder::LightfieldEncodeStats stats;
   uint64_t file_bytes = 0;
   double seconds = 0, cpu_seconds = 0;  // wall; CPU time of the process (every thread)
 };

@@ -118,7 +118,7 @@ std::string detail(Knob k, const MeasuredPoint& p) {
       return fmt::format("stored {}{}; {} keyframes", r.colour_format, r.hdr ? " (HDR)" : " (LDR)",
                          grouped(r.colour_keyframes));
     case Knob::kDepth:
-      return p.point.encode.depth == DepthCoding::kBc5
+      return p.point.encode.depth == encoder::DepthCoding::kBc5
                  ? fmt::format("max relative depth error {:.2f} %", 100 * r.bc5_max_rel_error)
                  : "exact (log-16)";
     case Knob::kViews:
@@ -226,7 +226,8 @@ Status write_markdown(const fs::path& file, const std::vector<SceneResult>& scen
       run.machine, run.renderer, run.load_start, run.load_end, run.settings);
   out +=
       "- timings, one run per point (nothing cached between points): encode = "
-      "`encode_lightfield_file`, wall seconds (CPU seconds of all threads in brackets); decode = "
+      "`encoder::encode_lightfield_file`, wall seconds (CPU seconds of all threads in brackets); "
+      "decode = "
       "`LightfieldDecoder::advance` (what calf-play prints as decode), upload = the rest of "
       "`Playback::prepare` (view selection, texture upload), render = `Playback::render` (GL: "
       "draw and read-back), wall ms; *frame CPU ms* = the process's CPU time (all threads, "

@@ -69,28 +69,28 @@ const std::vector<Knob>& all_knobs() {
   return knobs;
 }
 
-const char* colour_coding_name(ColourCoding c) {
+const char* colour_coding_name(encoder::ColourCoding c) {
   switch (c) {
-    case ColourCoding::kAuto:
+    case encoder::ColourCoding::kAuto:
       return "auto";
-    case ColourCoding::kBc1:
+    case encoder::ColourCoding::kBc1:
       return "bc1";
-    case ColourCoding::kBc7:
+    case encoder::ColourCoding::kBc7:
       return "bc7";
-    case ColourCoding::kBc6h:
+    case encoder::ColourCoding::kBc6h:
       return "bc6h";
-    case ColourCoding::kRgba8:
+    case encoder::ColourCoding::kRgba8:
       return "rgba8";
-    case ColourCoding::kRgba16f:
+    case encoder::ColourCoding::kRgba16f:
       return "rgba16f";
-    case ColourCoding::kAv1:
+    case encoder::ColourCoding::kAv1:
       return "av1";
   }
   return "?";
 }
 
-const char* depth_coding_name(DepthCoding d) {
-  return d == DepthCoding::kBc5 ? "bc5" : "raw16";
+const char* depth_coding_name(encoder::DepthCoding d) {
+  return d == encoder::DepthCoding::kBc5 ? "bc5" : "raw16";
 }
 
 const char* super_name(container::Compression c) {

@@ -22,8 +22,10 @@ struct SweepValues {
   std::vector<uint32_t> cells = {16, 32, 64};
   std::vector<uint32_t> windows = {1, 2, 4};
   std::vector<uint32_t> aabbs = {1, 2, 4};
-  std::vector<DepthCoding> depth = {DepthCoding::kRaw16, DepthCoding::kBc5};
-  std::vector<ColourCoding> colour = {ColourCoding::kAuto, ColourCoding::kBc1, ColourCoding::kBc7};
+  std::vector<encoder::DepthCoding> depth = {encoder::DepthCoding::kRaw16,
+                                             encoder::DepthCoding::kBc5};
+  std::vector<encoder::ColourCoding> colour = {
+      encoder::ColourCoding::kAuto, encoder::ColourCoding::kBc1, encoder::ColourCoding::kBc7};
   std::vector<container::Compression> super = {container::Compression::kZstd,
                                                container::Compression::kLzma2};
   std::vector<uint32_t> views = {1, 2, 4, 0};  // 0 = all of the scene's views
