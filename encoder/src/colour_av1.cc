@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <mutex>
 #include <string>
 
 namespace calf::encoder::av1_internal {
@@ -53,6 +54,14 @@ Expected<Gop> split_units(std::span<const uint8_t> stream) {
   return units;
 }
 
+// SVT-AV1 keeps process-wide state in creating and destroying encoders (two encoders torn down at
+// once on worker threads double-free it under AddressSanitizer), so those steps take turns;
+// encoding itself runs in parallel, one encoder per GOP.
+std::mutex& svt_lifetime_mutex() {
+  static std::mutex m;
+  return m;
+}
+
 // One GOP by a fresh encoder: every picture W x H 4:2:0, frames `first` .. `first + count - 1`.
 // `yuv` holds `count` pictures of `bits` (8: a byte a sample, 10: a uint16_t a sample).
 Expected<Gop> encode_gop(const uint8_t* yuv, uint32_t bits, uint32_t W, uint32_t H, uint32_t count,
@@ -60,13 +69,17 @@ Expected<Gop> encode_gop(const uint8_t* yuv, uint32_t bits, uint32_t W, uint32_t
                          const Av1ColourOptions& o) {
   EbComponentType* handle = nullptr;
   EbSvtAv1EncConfiguration cfg;
-  if (EbErrorType e = svt_av1_enc_init_handle(&handle, nullptr, &cfg); e != EB_ErrorNone) {
-    return svt_error("svt_av1_enc_init_handle", e);
+  {
+    const std::lock_guard<std::mutex> lock(svt_lifetime_mutex());
+    if (EbErrorType e = svt_av1_enc_init_handle(&handle, nullptr, &cfg); e != EB_ErrorNone) {
+      return svt_error("svt_av1_enc_init_handle", e);
+    }
   }
   struct Closer {
     EbComponentType* h;
     bool initialised = false;
     ~Closer() {
+      const std::lock_guard<std::mutex> lock(svt_lifetime_mutex());
       if (initialised) svt_av1_enc_deinit(h);
       svt_av1_enc_deinit_handle(h);
     }
@@ -96,7 +109,12 @@ Expected<Gop> encode_gop(const uint8_t* yuv, uint32_t bits, uint32_t W, uint32_t
   if (EbErrorType e = svt_av1_enc_set_parameter(handle, &cfg); e != EB_ErrorNone) {
     return svt_error("svt_av1_enc_set_parameter", e);
   }
-  if (EbErrorType e = svt_av1_enc_init(handle); e != EB_ErrorNone) {
+  EbErrorType init_error;
+  {
+    const std::lock_guard<std::mutex> lock(svt_lifetime_mutex());
+    init_error = svt_av1_enc_init(handle);
+  }
+  if (EbErrorType e = init_error; e != EB_ErrorNone) {
     return svt_error("svt_av1_enc_init", e);
   }
   closer.initialised = true;
