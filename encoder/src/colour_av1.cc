@@ -15,10 +15,6 @@ Status svt_error(const std::string& call, int64_t code) {
   return Status(ErrorId::kEncoderAv1, "SVT-AV1 " + call + " failed (" + std::to_string(code) + ")");
 }
 
-uint8_t byte_of(double v) {
-  return static_cast<uint8_t>(std::clamp(std::lround(v), 0L, 255L));
-}
-
 // Reads a LEB128 value (AV1 §4.10.5) at `at`; false when it runs past the end.
 bool leb128(std::span<const uint8_t> b, size_t& at, uint64_t& value) {
   value = 0;
@@ -182,47 +178,44 @@ Expected<Gop> encode_gop(const uint8_t* yuv, uint32_t bits, uint32_t W, uint32_t
 
 }  // namespace
 
-void rgba_to_ycbcr420(std::span<const uint8_t> rgba, uint32_t W, uint32_t H, uint8_t* y,
-                      uint8_t* cb, uint8_t* cr) {
-  constexpr double kr = 0.2126, kb = 0.0722, kg = 1 - kr - kb;
-  for (uint32_t j = 0; j < H; j += 2) {
-    for (uint32_t i = 0; i < W; i += 2) {
-      double sb = 0, sr = 0;
-      for (uint32_t dy = 0; dy < 2; ++dy) {
-        for (uint32_t dx = 0; dx < 2; ++dx) {
-          const uint8_t* p = &rgba[((size_t{j} + dy) * W + i + dx) * 4];
-          const double l = kr * p[0] + kg * p[1] + kb * p[2];
-          y[(size_t{j} + dy) * W + i + dx] = byte_of(l);
-          sb += (p[2] - l) / (2 * (1 - kb));
-          sr += (p[0] - l) / (2 * (1 - kr));
-        }
-      }
-      cb[size_t{j / 2} * (W / 2) + i / 2] = byte_of(128 + sb / 4);
-      cr[size_t{j / 2} * (W / 2) + i / 2] = byte_of(128 + sr / 4);
-    }
-  }
-}
+namespace {
 
-void rgb10_to_ycbcr420(std::span<const uint16_t> rgb, uint32_t W, uint32_t H, uint16_t* y,
-                       uint16_t* cb, uint16_t* cr) {
+// BT.709 full range, 4:2:0 with each chroma sample the mean of its 2 x 2 luma texels: pixels of
+// `channels` samples (RGB first) coded 0 … max, codes of the same range; neutral chroma (max+1)/2.
+template <typename T>
+void ycbcr420_of(const T* px, uint32_t channels, uint32_t W, uint32_t H, long max, T* y, T* cb,
+                 T* cr) {
   constexpr double kr = 0.2126, kb = 0.0722, kg = 1 - kr - kb;
-  auto code = [](double v) { return static_cast<uint16_t>(std::clamp(std::lround(v), 0L, 1023L)); };
+  const double neutral = static_cast<double>(max + 1) / 2;
+  auto code = [max](double v) { return static_cast<T>(std::clamp(std::lround(v), 0L, max)); };
   for (uint32_t j = 0; j < H; j += 2) {
     for (uint32_t i = 0; i < W; i += 2) {
       double sb = 0, sr = 0;
       for (uint32_t dy = 0; dy < 2; ++dy) {
         for (uint32_t dx = 0; dx < 2; ++dx) {
-          const uint16_t* p = &rgb[((size_t{j} + dy) * W + i + dx) * 3];
+          const T* p = &px[((size_t{j} + dy) * W + i + dx) * channels];
           const double l = kr * p[0] + kg * p[1] + kb * p[2];
           y[(size_t{j} + dy) * W + i + dx] = code(l);
           sb += (p[2] - l) / (2 * (1 - kb));
           sr += (p[0] - l) / (2 * (1 - kr));
         }
       }
-      cb[size_t{j / 2} * (W / 2) + i / 2] = code(512 + sb / 4);
-      cr[size_t{j / 2} * (W / 2) + i / 2] = code(512 + sr / 4);
+      cb[size_t{j / 2} * (W / 2) + i / 2] = code(neutral + sb / 4);
+      cr[size_t{j / 2} * (W / 2) + i / 2] = code(neutral + sr / 4);
     }
   }
+}
+
+}  // namespace
+
+void rgba_to_ycbcr420(std::span<const uint8_t> rgba, uint32_t W, uint32_t H, uint8_t* y,
+                      uint8_t* cb, uint8_t* cr) {
+  ycbcr420_of(rgba.data(), 4, W, H, 255, y, cb, cr);
+}
+
+void rgb10_to_ycbcr420(std::span<const uint16_t> rgb, uint32_t W, uint32_t H, uint16_t* y,
+                       uint16_t* cb, uint16_t* cr) {
+  ycbcr420_of(rgb.data(), 3, W, H, 1023, y, cb, cr);
 }
 
 namespace {
