@@ -60,9 +60,12 @@ done
 # test, tests/export/three_compare.js, which drives Debian's chromium); and the web player's
 # decoder (web/, docs/WEB.md): hash-wasm (XXH3-64, XXH64), fzstd (zstd) and xz-decompress
 # (LZMA2, through xz-embedded in WebAssembly), each pure JavaScript or WebAssembly, for node and
-# the browser alike. node and npm from Debian when the machine has none.
+# the browser alike; and for AV1 colour where WebCodecs has no AV1 decoder (node), libav.js's
+# av1-opus variant (libaom's decoder in WebAssembly).
+# node and npm from Debian when the machine has none.
 NPM_PACKAGES=(gltf-validator@2.0.0-dev.3.10 three@0.187.0 playwright-core@1.64.1
-              hash-wasm@4.13.0 fzstd@0.1.1 xz-decompress@0.2.3)
+              hash-wasm@4.13.0 fzstd@0.1.1 xz-decompress@0.2.3
+              @libav.js/variant-av1-opus@6.10.9)
 install_npm_packages() {
   local dir p name version
   dir="$(cd "$(dirname "$0")/.." && pwd)/build/npm"

@@ -3,10 +3,12 @@
 // as a one-block .xz stream built around the chunk's raw LZMA2 stream). The caller passes the
 // packages' modules in, so that node (web/test) and the page (an import map) load them their way.
 import { E, fail } from './errors.js';
-import { webCodecsAv1 } from './av1.js';
+import { webCodecsAv1, wasmAv1 } from './av1.js';
 
-// `av1` (AV1 colour, SPEC §11.1.12) is the browser's WebCodecs decoder (av1.js), null under node.
-export async function makeCodecs({ hashWasm, fzstd, xz }) {
+// `av1` (AV1 colour, SPEC §11.1.12; av1.js) is the browser's WebCodecs decoder where it takes AV1
+// (unless `av1Wasm` comes with `preferWasm`), else the WebAssembly one over the libav.js instance
+// that `av1Wasm()` resolves to, else null (the track is refused with CALF-E203).
+export async function makeCodecs({ hashWasm, fzstd, xz, av1Wasm = null, preferWasm = false }) {
   const h3 = await hashWasm.createXXHash3();
   const h64 = await hashWasm.createXXHash64();
   const digest = (h, bytes) => {
@@ -19,7 +21,7 @@ export async function makeCodecs({ hashWasm, fzstd, xz }) {
     xxh64: (bytes) => digest(h64, bytes),
     zstd: (bytes, rawSize) => fzstd.decompress(bytes, new Uint8Array(rawSize)),
     lzma2: (xzBytes) => new Response(new xz.XzReadableStream(new Blob([xzBytes]).stream())).arrayBuffer(),
-    av1: await webCodecsAv1(),
+    av1: (preferWasm && av1Wasm ? null : await webCodecsAv1()) ?? (av1Wasm ? wasmAv1(av1Wasm) : null),
   };
 }
 

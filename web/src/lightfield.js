@@ -5,7 +5,7 @@ import { E, CalfError, fail } from './errors.js';
 import { readChunk } from './container.js';
 import { decodeBc1, decodeBc4, decodeBc6h, decodeBc7 } from './bc.js';
 
-export const FORMAT = { none: 0, rgba8: 1, rgba16f: 2, r16: 3, bc1: 4, bc4: 5, bc5: 6, bc6h: 7, bc7: 8, rg8: 9, r16p: 10, r16pm: 11, av1: 12 };
+export const FORMAT = { none: 0, rgba8: 1, rgba16f: 2, r16: 3, bc1: 4, bc4: 5, bc5: 6, bc6h: 7, bc7: 8, rg8: 9, r16p: 10, r16pm: 11, av1: 12, av1hdr: 13 };
 export const STREAM = { index: 0, colour: 1, depth: 2, material: 3, t: 4, coverage: 5 };
 const COLOUR_FORMATS = [FORMAT.bc1, FORMAT.bc7, FORMAT.bc6h, FORMAT.rgba8, FORMAT.rgba16f];
 const DEPTH_FORMATS = [FORMAT.r16, FORMAT.r16p, FORMAT.r16pm, FORMAT.bc5];
@@ -158,6 +158,17 @@ export function parseAv1Gop(raw, frameCount, what) {
   return units;
 }
 
+// §11.1.12: an AV1 colour chunk → { units, curve }; for av1hdr (`hdr`) the chunk starts with
+// its curve, u16 base and u16 shift, checked before the rest (CALF-E067: a chunk under 4 bytes,
+// a base above 0x7BFF, a shift above 5), as lf::parse_av1_chunk.
+export function parseAv1Chunk(raw, frameCount, hdr, what) {
+  if (!hdr) return { units: parseAv1Gop(raw, frameCount, what), curve: null };
+  if (raw.length < 4) fail(E.av1Chunk, `${what}: HDR AV1 chunk of ${raw.length} bytes`);
+  const base = raw[0] | (raw[1] << 8), shift = raw[2] | (raw[3] << 8);
+  if (base > 0x7bff || shift > 5) fail(E.av1Chunk, `${what}: curve base ${base} shift ${shift} (base at most 31743, shift at most 5)`);
+  return { units: parseAv1Gop(raw.subarray(4), frameCount, what), curve: { base, shift } };
+}
+
 // §11.1.12's normative conversion of one texel: luma y, chroma cb and cr → sRGB-encoded bytes
 // (BT.709 full range in 16 fractional bits; >> of a negative value is floor division).
 export function av1YcbcrToRgb(y, cb, cr, out, o = 0) {
@@ -184,6 +195,43 @@ export function av1Colour(picture, w, h, what) {
       av1YcbcrToRgb(ys[y * ly + x], us[c], vs[c], rgb);
       const d = 3 * (y * w + x);
       out[d] = SRGB[rgb[0]]; out[d + 1] = SRGB[rgb[1]]; out[d + 2] = SRGB[rgb[2]];
+    }
+  }
+  return out;
+}
+
+// §11.1.12 (av1hdr): one texel's 10-bit codes y, cb, cr → its R, G, B codes (0 … 1023).
+export function av1Ycbcr10ToRgb(y, cb, cr, out, o = 0) {
+  const u = cb - 512, v = cr - 512;
+  const c = (x) => (x < 0 ? 0 : x > 1023 ? 1023 : x);
+  out[o] = c(y + ((103206 * v + 32768) >> 16));
+  out[o + 1] = c(y - ((12276 * u + 30679 * v + 32768) >> 16));
+  out[o + 2] = c(y + ((121609 * u + 32768) >> 16));
+}
+
+// §11.1.12 (av1hdr): the binary16 bits that code c stands for on the curve { base, shift }.
+export function av1HdrHalfBits(curve, c) {
+  return Math.min(curve.base + c * 2 ** curve.shift, 0x7bff);
+}
+
+// §11.1.12 (av1hdr): the w × h cell of a decoded 10-bit picture (16-bit samples, av1.js) →
+// linear binary32 RGB, texel-interleaved: each code through the chunk's curve to a half float,
+// as rgba16f (§11.1.5). A picture that is not 10-bit 4:2:0 ('I420P10') or is smaller than the
+// cell is CALF-E302. Samples are taken modulo 1024, as the native decoder reads them.
+export function av1HdrColour(picture, w, h, curve, what) {
+  if (picture.format !== 'I420P10' || !picture.planes || picture.width < w || picture.height < h) {
+    fail(E.av1Picture, `${what}: a ${picture.width} x ${picture.height} picture of format ${picture.format} for a ${w} x ${h} HDR cell (10-bit 4:2:0 expected)`);
+  }
+  const value = new Float32Array(1024);
+  for (let c = 0; c < 1024; ++c) value[c] = halfToFloat(av1HdrHalfBits(curve, c));
+  const [ys, us, vs] = picture.planes, [ly, lc] = picture.strides;
+  const out = new Float32Array(3 * w * h), rgb = new Uint16Array(3);
+  for (let y = 0; y < h; ++y) {
+    for (let x = 0; x < w; ++x) {
+      const c = (y >> 1) * lc + (x >> 1);
+      av1Ycbcr10ToRgb(ys[y * ly + x] & 1023, us[c] & 1023, vs[c] & 1023, rgb);
+      const d = 3 * (y * w + x);
+      out[d] = value[rgb[0]]; out[d + 1] = value[rgb[1]]; out[d + 2] = value[rgb[2]];
     }
   }
   return out;
@@ -415,12 +463,13 @@ let openings = 0;
 // `hasCoverage` when it holds any coverage chunk (§11.1.11).
 export async function openLightfield(clip, t) {
   const h = clip.tracks[t].header;
-  // AV1 colour (§11.1.12) needs an AV1 decoder (codecs.av1: WebCodecs, in a browser); without
-  // one the track is refused as by any reader that lacks the format.
-  if (h.colour_format === FORMAT.av1 && !clip.codecs.av1) {
-    fail(E.lightfieldFormat, `track ${t}: colour format ${h.colour_format} (av1): no AV1 decoder here (the page decodes it with WebCodecs in a browser)`);
+  // AV1 colour (§11.1.12) needs an AV1 decoder (codecs.av1: WebCodecs, or its WebAssembly
+  // stand-in); without one the track is refused as by any reader that lacks the format.
+  const av1 = h.colour_format === FORMAT.av1 || h.colour_format === FORMAT.av1hdr;
+  if (av1 && !clip.codecs.av1) {
+    fail(E.lightfieldFormat, `track ${t}: colour format ${h.colour_format} (${h.colour_format === FORMAT.av1 ? 'av1' : 'av1hdr'}): no AV1 decoder here`);
   }
-  if (!COLOUR_FORMATS.includes(h.colour_format) && h.colour_format !== FORMAT.av1) fail(E.lightfieldFormat, `track ${t}: colour format ${h.colour_format}`);
+  if (!COLOUR_FORMATS.includes(h.colour_format) && !av1) fail(E.lightfieldFormat, `track ${t}: colour format ${h.colour_format}`);
   if (!DEPTH_FORMATS.includes(h.depth_format)) fail(E.lightfieldFormat, `track ${t}: depth format ${h.depth_format}`);
   if (h.material_format !== 0 && !MATERIAL_FORMATS.includes(h.material_format)) fail(E.lightfieldFormat, `track ${t}: material format ${h.material_format}`);
   const cells = faceGrid(h.face_size, h.cell_size), tiles = faceGrid(h.face_size, h.depth_region_size);
@@ -457,7 +506,6 @@ export async function openLightfield(clip, t) {
   }
   if (views.every((x) => x === null)) throw viewProblems[0];
   const hasCoverage = clip.chunks.some((c) => c.track === t && c.stream === STREAM.coverage);
-  const av1 = h.colour_format === FORMAT.av1;
   // `opened` names this opening in the AV1 decoders' cell keys (codecs.av1 may serve several).
   return { clip, track: t, header: h, cells, tiles, byKey, views, viewProblems, hasCoverage, av1, opened: ++openings };
 }
@@ -564,20 +612,24 @@ export async function decodeFaceFrames(lf, v, face, onFrame, only = null,
   }
 }
 
-// Frame n of an AV1 colour cell into the face's colour: the GOP chunk holding n parsed, its unit
-// decoded by codecs.av1 (one decoder per cell, kept across calls, so that frame after frame
-// decodes one unit each), converted by av1Colour.
+// Frame n of an AV1 colour cell into the face's colour: the GOP chunk holding n parsed (after
+// its curve for av1hdr), its unit decoded by codecs.av1 (one decoder per cell, kept across
+// calls, so that frame after frame decodes one unit each), converted by av1Colour or
+// av1HdrColour.
 async function av1Cell(lf, cell, chunks, n, colour, N) {
+  const hdr = lf.header.colour_format === FORMAT.av1hdr;
   if (!cell.chunk || n < cell.chunk.firstFrame || n >= cell.chunk.firstFrame + cell.chunk.frameCount) {
     const c = chunks.find((x) => x.firstFrame <= n && n < x.firstFrame + x.frameCount);
     if (!c) bad(`${cell.where}: no colour chunk for frame ${n}`);
     const what = `${cell.where} colour`;
-    cell.units = parseAv1Gop(await readChunk(lf.clip, c.id), c.frameCount, what);
+    const parsed = parseAv1Chunk(await readChunk(lf.clip, c.id), c.frameCount, hdr, what);
+    cell.units = parsed.units;
+    cell.curve = parsed.curve;
     cell.chunk = c;
   }
   const what = `${cell.where} colour`, { x: cx, y: cy, w: cw, h: ch } = cell.rect;
-  const picture = await lf.clip.codecs.av1.picture(cell.key, cell.chunk, cell.units, n - cell.chunk.firstFrame, what);
-  const values = av1Colour(picture, cw, ch, what);
+  const picture = await lf.clip.codecs.av1.picture(cell.key, cell.chunk, cell.units, n - cell.chunk.firstFrame, what, hdr ? 10 : 8);
+  const values = hdr ? av1HdrColour(picture, cw, ch, cell.curve, what) : av1Colour(picture, cw, ch, what);
   for (let y = 0; y < ch; ++y) colour.set(values.subarray(3 * y * cw, 3 * (y + 1) * cw), 3 * ((cy + y) * N + cx));
 }
 
