@@ -1,12 +1,15 @@
-// AV1 colour (format/SPEC.md §11.1.12) in the page, where WebCodecs decodes it (node has no AV1
-// decoder: web.conformance checks that the clip is refused there). In headless Chromium:
+// AV1 colour (format/SPEC.md §11.1.12) in the page, where WebCodecs decodes it (web.conformance
+// checks the WebAssembly back end under node). In headless Chromium:
 // - the page's decoder reproduces every hash line of tests/conformance/lightfield/av1_pred16m
-//   (web/src/hash_lines.js, as web.conformance runs it under node);
+//   and av1_hdr_pred16m (10-bit pictures, the HDR curve) with WebCodecs, and of av1_hdr_pred16m
+//   with the page's WebAssembly back end too (web/src/hash_lines.js, as web.conformance runs
+//   it under node);
 // - the AV1 clip of the decoder's fuzz corpus decodes without a problem;
 // - a temporal unit made garbage (its chunk's bytes changed in the decoder's cache) gives
 //   CALF-E301, as calf-verify gives;
 // - the page plays the clip along a 4-pose eye path (one per frame), each frame >= MIN_DB against
 //   calf-play's GL frame of the same pose (CALF_BIN), with calf-play's active views and cells;
+//   av1_hdr_pred16m one pose, likewise;
 // - garbage units met while playing give one line in the overlay (CALF-E301) and the last good
 //   frame stays on the canvas.
 //
@@ -29,7 +32,9 @@ if (!bin) {
   process.exit(1);
 }
 const clipPath = 'tests/conformance/lightfield/av1_pred16m.calf';
-const want = readFileSync(join(ROOT, clipPath.replace(/\.calf$/, '.hashes')), 'utf8').split('\n').filter(Boolean);
+const hdrPath = 'tests/conformance/lightfield/av1_hdr_pred16m.calf';
+const hashes = (path) => readFileSync(join(ROOT, path.replace(/\.calf$/, '.hashes')), 'utf8').split('\n').filter(Boolean);
+const want = hashes(clipPath), wantHdr = hashes(hdrPath);
 // The AV1 clip of the decoder's fuzz corpus, which must decode without a problem.
 const fuzzClip = 'tests/fuzz/corpus/lightfield_decoder_fuzz/valid_av1_f16_5fr.calf';
 const dir = mkdtempSync(join(process.env.CALF_WEB_TMP ?? tmpdir(), 'calf-web-av1-'));
@@ -53,6 +58,14 @@ const played = execFileSync(join(bin, 'calf-play'), [join(ROOT, clipPath), '--he
 const native = [...played.matchAll(/^pose (\d+) frame \d+: (\d+) views, (\d+)\/(\d+) cells, .*render ([0-9.]+) ms/gm)]
   .map((m) => ({ views: Number(m[2]), cells: Number(m[3]), total: Number(m[4]), ms: Number(m[5]) }));
 if (native.length !== path.poses.length) throw new Error(`calf-play gave ${native.length} pose lines: ${played}`);
+// The HDR clip: one pose (the first's direction at frame 1).
+const hdrPose = { format: 'calf-eye-path', version: 1, width: 64, height: 48, fov_y_degrees: 70, poses: [{ ...path.poses[1] }] };
+writeFileSync(join(dir, 'hdr_path.json'), JSON.stringify(hdrPose));
+const playedHdr = execFileSync(join(bin, 'calf-play'), [join(ROOT, hdrPath), '--headless', '--eye-path', join(dir, 'hdr_path.json'), '--out', join(dir, 'play_hdr')],
+  { encoding: 'utf8', stdio: ['ignore', 'pipe', 'pipe'] });
+const nativeHdr = [...playedHdr.matchAll(/^pose (\d+) frame \d+: (\d+) views, (\d+)\/(\d+) cells, .*render ([0-9.]+) ms/gm)]
+  .map((m) => ({ views: Number(m[2]), cells: Number(m[3]), total: Number(m[4]), ms: Number(m[5]) }));
+if (nativeHdr.length !== 1) throw new Error(`calf-play gave ${nativeHdr.length} pose lines for ${hdrPath}: ${playedHdr}`);
 
 const { server, port } = await startRangeServer();
 const problems = [];
@@ -64,13 +77,21 @@ try {
   if (!ready) throw new Error(`the page did not open ${clipPath}: ${overlay} ${consoleLines.join(' | ')}`);
   // The page's decoder, with the page's codecs (WebCodecs for AV1), on the whole clip; then with
   // one unit of the first colour chunk made garbage (every byte 0xff, its size kept).
-  const got = await page.evaluate(async ({ url, fuzzUrl }) => {
+  const got = await page.evaluate(async ({ url, hdrUrl, fuzzUrl }) => {
     const { decodeLines } = await import('/web/src/hash_lines.js');
+    const { wasmAv1 } = await import('/web/src/av1.js');
     const codecs = window.calfPlayer.lf.clip.codecs;
     const bytes = new Uint8Array(await (await fetch(url)).arrayBuffer());
-    const t = performance.now();
+    const hdrBytes = new Uint8Array(await (await fetch(hdrUrl)).arrayBuffer());
+    let t = performance.now();
     const clean = await decodeLines(bytes, codecs);
     const ms = performance.now() - t;
+    t = performance.now();
+    const hdr = await decodeLines(hdrBytes, codecs);
+    const hdrMs = performance.now() - t;
+    t = performance.now();
+    const hdrWasm = await decodeLines(hdrBytes, { ...codecs, av1: wasmAv1(window.calfAv1Wasm) });
+    const hdrWasmMs = performance.now() - t;
     let damaged;
     try {
       damaged = await decodeLines(bytes, codecs, (clip) => {
@@ -83,16 +104,19 @@ try {
       damaged = { lines: [], problems: [e.message] };
     }
     const fuzz = await decodeLines(new Uint8Array(await (await fetch(fuzzUrl)).arrayBuffer()), codecs);
-    return { clean, ms, damaged: damaged.problems[0] ?? null, fuzz: { lines: fuzz.lines.length, problem: fuzz.problems[0] ?? null } };
-  }, { url: `/${clipPath}`, fuzzUrl: `/${fuzzClip}` });
-  const diffs = [];
-  for (let i = 0; i < Math.max(want.length, got.clean.lines.length); ++i) {
-    if (want[i] !== got.clean.lines[i]) diffs.push(`line ${i + 1}: expected '${want[i] ?? ''}', got '${got.clean.lines[i] ?? ''}'`);
+    return { clean, ms, hdr, hdrMs, hdrWasm, hdrWasmMs, damaged: damaged.problems[0] ?? null, fuzz: { lines: fuzz.lines.length, problem: fuzz.problems[0] ?? null } };
+  }, { url: `/${clipPath}`, hdrUrl: `/${hdrPath}`, fuzzUrl: `/${fuzzClip}` });
+  for (const [name, wanted, result, ms, how] of [['av1_pred16m', want, got.clean, got.ms, 'WebCodecs'], ['av1_hdr_pred16m', wantHdr, got.hdr, got.hdrMs, 'WebCodecs'],
+    ['av1_hdr_pred16m', wantHdr, got.hdrWasm, got.hdrWasmMs, 'WebAssembly']]) {
+    const diffs = [];
+    for (let i = 0; i < Math.max(wanted.length, result.lines.length); ++i) {
+      if (wanted[i] !== result.lines[i]) diffs.push(`line ${i + 1}: expected '${wanted[i] ?? ''}', got '${result.lines[i] ?? ''}'`);
+    }
+    console.log(`web.av1: ${name} in the page's decoder (${how}): ${wanted.length - diffs.length} of ${wanted.length} hash lines reproduced, ` +
+      `${ms.toFixed(0)} ms${result.problems.length ? ` (${result.problems[0]})` : ''}`);
+    for (const d of diffs.slice(0, 5)) problems.push(`conformance of ${name} (${how}): ${d}`);
+    if (result.problems.length) problems.push(`conformance of ${name} (${how}): ${result.problems[0]}`);
   }
-  console.log(`web.av1: av1_pred16m in the page's decoder (WebCodecs): ${want.length - diffs.length} of ${want.length} hash lines reproduced, ` +
-    `${got.ms.toFixed(0)} ms${got.clean.problems.length ? ` (${got.clean.problems[0]})` : ''}`);
-  for (const d of diffs.slice(0, 5)) problems.push(`conformance: ${d}`);
-  if (got.clean.problems.length) problems.push(`conformance: ${got.clean.problems[0]}`);
   console.log(`web.av1: ${fuzzClip}: ${got.fuzz.lines} lines, ${got.fuzz.problem ?? 'no problem'}`);
   if (got.fuzz.problem || got.fuzz.lines === 0) problems.push(`${fuzzClip}: ${got.fuzz.lines} lines, ${got.fuzz.problem ?? 'no problem'}`);
   console.log(`web.av1: a garbage temporal unit: ${got.damaged ?? 'no problem'}`);
@@ -133,6 +157,21 @@ try {
   console.log(`web.av1: garbage units while playing: overlay '${bad.overlay}', the last frame ${bad.same ? 'stays' : 'changed'}`);
   if (!bad.overlay.startsWith('CALF-E301 ') || bad.overlay.includes('\n')) problems.push(`garbage units while playing: overlay '${bad.overlay}'`);
   if (!bad.same) problems.push('garbage units while playing: the canvas changed');
+
+  // The HDR clip, one pose, in the same page (RGBA16F colour).
+  const hdrPlay = await playClip(browser, held, `http://127.0.0.1:${port}`, `/${hdrPath}`);
+  if (!hdrPlay.ready) problems.push(`the page did not open ${hdrPath}: ${hdrPlay.overlay}`);
+  else {
+    await renderEyePath(page, hdrPose, (i, r, rgb) => {
+      const png = readPng(join(dir, 'play_hdr', `frame_${String(i).padStart(5, '0')}.png`));
+      const db = psnr(rgb, png.rgb), n = nativeHdr[i];
+      console.log(`web.av1: av1_hdr_pred16m pose ${i} frame ${r.frame}: ${r.active.length} views, ${r.visibleCells}/${r.totalCells} cells (calf-play ${n.views}, ${n.cells}/${n.total}), ` +
+        `${db.toFixed(2)} dB against calf-play, colour ${r.colourUpload}; render ${r.renderMs.toFixed(1)} ms (SwiftShader) against calf-play's ${n.ms} ms (llvmpipe)`);
+      if (r.active.length !== n.views || r.visibleCells !== n.cells || r.totalCells !== n.total) problems.push(`HDR pose ${i}: views or cells differ from calf-play's`);
+      if (!(db >= MIN_DB)) problems.push(`HDR pose ${i}: ${db.toFixed(2)} dB against calf-play, below ${MIN_DB}`);
+      if (new Set(rgb).size < 4) problems.push(`HDR pose ${i}: the canvas is blank`);
+    }, (i, message) => problems.push(`HDR pose ${i}: ${message}`));
+  }
 } finally {
   await browser.close();
   server.kill();
