@@ -49,9 +49,12 @@ export function wasmAv1(load) {
     decoders = null;
     fail(E.lightfieldFormat, `no AV1 decoder here: the WebAssembly decoder does not load (${e?.message ?? e})`);
   }));
+  let loaded = null;
   return {
-    picture: async (...args) => (await get()).picture(...args),
-    close: () => { if (decoders) decoders.then((d) => d.close(), () => {}); },
+    picture: async (...args) => (loaded = await get()).picture(...args),
+    release: (prefix) => loaded?.release(prefix),
+    open: () => loaded?.open() ?? 0,
+    close: () => loaded?.close(),
   };
 }
 
@@ -102,7 +105,7 @@ export function makeLibavDecoders(libav) {
     queue = p.catch(() => {});
     return p;
   }
-  return { picture, close: () => { for (const k of [...cells.keys()]) drop(k); } };
+  return { picture, ...housekeeping(cells, drop) };
 }
 
 // A libav.js frame (one byte array, its planes at layout's offsets and strides) as av1.js's
@@ -133,7 +136,7 @@ function samples(b, bytes) {
 // ({ id, firstFrame }) whose temporal units are `units`, for the cell named `key`, from a stream
 // of `bits` (8 or 10) per sample; resolves to { format, width, height, planes: [y, u, v],
 // strides: [y, u, v] } (copies, in samples; the VideoFrame is closed) or throws CALF-E301.
-// `close()` closes every decoder.
+// `release`, `close` and `open` below (housekeeping).
 export function makeAv1Decoders(api = globalThis) {
   const cells = new Map();  // key -> state, in least recently used order
   const drop = (key) => {
@@ -204,7 +207,18 @@ export function makeAv1Decoders(api = globalThis) {
     for (const k of [...s.pictures.keys()]) if (k < ts) s.pictures.delete(k);
     return p;
   }
-  return { picture, close: () => { for (const k of [...cells.keys()]) drop(k); } };
+  return { picture, ...housekeeping(cells, drop) };
+}
+
+// The decoders' housekeeping: `release(prefix)` closes the decoders of the cells whose keys
+// start with it (a track that is closed: lightfield.js's closeLightfield), `close()` every one,
+// `open()` counts those open.
+function housekeeping(cells, drop) {
+  return {
+    release: (prefix) => { for (const k of [...cells.keys()]) if (k.startsWith(prefix)) drop(k); },
+    close: () => { for (const k of [...cells.keys()]) drop(k); },
+    open: () => cells.size,
+  };
 }
 
 // A VideoFrame's visible picture as its planes, then the frame closed (I420: Y, U, V of 8-bit

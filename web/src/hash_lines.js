@@ -2,7 +2,7 @@
 // them, from the page's decoder: shared by web/test/conformance.mjs (node) and web/test/av1.mjs
 // (the page in Chromium, where WebCodecs decodes AV1 colour).
 import { openClip, bytesSource, readChunk } from './container.js';
-import { openLightfield, decodeFaceFrames, faceHash } from './lightfield.js';
+import { openLightfield, closeLightfield, decodeFaceFrames, faceHash } from './lightfield.js';
 import { tilesLines } from './tiles.js';
 import { meshLines } from './mesh.js';
 import { CalfError } from './errors.js';
@@ -38,6 +38,7 @@ export async function decodeLines(bytes, codecs, tamper = null) {
         }
       }
     }
+    closeLightfield(lf);
     for (let n = 0; n < h.frame_count; ++n) {
       for (let v = 0; v < h.view_count; ++v) {
         for (let f = 0; f < 6; ++f) {

@@ -27,7 +27,7 @@ export function faceGrid(n, c) {
 }
 
 // sRGB byte → linear binary32 (§11.1.5: binary64 arithmetic, rounded once).
-const SRGB = Float32Array.from({ length: 256 }, (_, b) => {
+export const SRGB = Float32Array.from({ length: 256 }, (_, b) => {
   const c = b / 255;
   return c <= 0.04045 ? c / 12.92 : Math.pow((c + 0.055) / 1.055, 2.4);
 });
@@ -610,6 +610,11 @@ export async function decodeFaceFrames(lf, v, face, onFrame, only = null,
     }
     await onFrame(n, colour, depth, material, coverage);
   }
+}
+
+// Closes what an opened track holds beyond its chunks: the AV1 decoders of its cells.
+export function closeLightfield(lf) {
+  if (lf.av1) lf.clip.codecs.av1?.release(`${lf.opened}/`);
 }
 
 // Frame n of an AV1 colour cell into the face's colour: the GOP chunk holding n parsed (after

@@ -4,12 +4,12 @@
 // active views are fetched and decoded, for the pose's frame; the same cells' chunks of the next
 // frames are prefetched; a face is uploaded when a pose needs another frame or new cells of it.
 import { openClip } from './container.js';
-import { openLightfield, decodeFaceFrames, parseTimeline, bcBlocks, STREAM } from './lightfield.js';
+import { openLightfield, closeLightfield, decodeFaceFrames, parseTimeline, bcBlocks, STREAM } from './lightfield.js';
 import { readChunk } from './container.js';
 import { E, fail } from './errors.js';
 import { cachedT, chunkFetchCounts, fetched, httpSource, planFrame, prefetch, rateMeter, touchChunk, trimCache } from './stream.js';
 import { makeCodecs } from './codecs.js';
-import { bcUpload, makeRaymarcher, marchRange, selectViews } from './raymarch.js';
+import { bcUpload, cpuUpload, makeRaymarcher, marchRange, selectViews } from './raymarch.js';
 import { visibleSets } from './culling.js';
 import { openRasterPlayer, rasterTracks } from './raster_player.js';
 
@@ -60,7 +60,8 @@ export async function openMarchPlayer({ canvas, url, source: given = null, deps,
   // BCn colour goes to the GPU as blocks where the browser takes them (the query string's
   // bc=0 turns it off), else it is decoded to RGBA on the CPU.
   const bc = deps.noBc ? null : bcUpload(gl, h.colour_format, N);
-  const renderer = makeRaymarcher(gl, { views: lf.views, faceSize: N, cellSize: h.cell_size, bc });
+  const cpu = cpuUpload(gl, h.colour_format);
+  const renderer = makeRaymarcher(gl, { views: lf.views, faceSize: N, cellSize: h.cell_size, bc, cpu });
   // Prefetch: after a frame's own chunks, those of the next `prefetchFrames` frames (wrapping, as
   // the page loops) for the same cells and tiles, in the background; chunks the cache holds
   // beyond `cacheBytes` raw bytes are dropped, least recently used first.
@@ -249,11 +250,13 @@ export async function openMarchPlayer({ canvas, url, source: given = null, deps,
     const renderMs = draw(camera, prepared);
     const insideVolume = report(prepared, renderMs, camera.position);
     const { frame, active, visibleCells, totalCells } = prepared;
-    return { frame, active, renderMs, insideVolume, colourUpload: bc ? bc.name : 'RGBA32F (decoded on the CPU)', visibleCells, totalCells, bytes: source.stats.bytes, size: source.size, requests: source.stats.requests };
+    return { frame, active, renderMs, insideVolume, colourUpload: bc ? bc.name : cpu.name, visibleCells, totalCells, bytes: source.stats.bytes, size: source.size, requests: source.stats.requests };
   }
   const pixels = () => canvasRgb(gl, canvas);
   const views = lf.views.filter((v) => v);
   const startEye = [0, 1, 2].map((k) => views.reduce((s, v) => s + v.position[k], 0) / views.length);
+  // The page calls it when another clip replaces this one: its AV1 decoders are closed.
+  const close = () => closeLightfield(lf);
   return { gl, lf, renderPose, prepare, draw, report, pixels, stats, fps, frameCount: F, startEye, volume, inside,
-    prefetchFrames, settled, fetchCounts, source };
+    prefetchFrames, settled, fetchCounts, source, close };
 }

@@ -6,6 +6,7 @@
 // applied on the CPU, SPEC §11.1.4), depth as r16 codes.
 import { GLSL_CONVENTIONS } from './glsl_conventions.js';
 import { GL_FULLSCREEN_VERTEX, GL_RAYMARCH_FRAGMENT } from './glsl_raymarch.js';
+import { SRGB } from './lightfield.js';
 
 export const MAX_ACTIVE_VIEWS = 256;  // kGlMaxActiveViews
 
@@ -156,11 +157,32 @@ export function bcUpload(gl, format, faceSize) {
   return null;
 }
 
+// The texture of colour decoded on the CPU, by colour format: AV1 pictures as the native player
+// uploads them (GlViews: av1 as rgba8's sRGB bytes, SRGB8_ALPHA8; av1hdr as rgba16f's halves,
+// RGBA16F), any other format as binary32 (RGBA32F).
+export function cpuUpload(gl, format) {
+  if (format === 12) return { internal: gl.SRGB8_ALPHA8, srgb: true, name: 'SRGB8_ALPHA8 (AV1, decoded on the CPU)' };
+  if (format === 13) return { internal: gl.RGBA16F, srgb: false, name: 'RGBA16F (HDR AV1, decoded on the CPU)' };
+  return { internal: gl.RGBA32F, srgb: false, name: 'RGBA32F (decoded on the CPU)' };
+}
+
+// The sRGB byte whose rgba8 decoding (§11.1.5, lightfield.js's SRGB) is `v`: the colour of an
+// av1 picture went through it, so this is exact.
+function srgbByte(v) {
+  let lo = 0, hi = 255;
+  while (lo < hi) {
+    const mid = (lo + hi) >> 1;
+    if (SRGB[mid] < v) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo;
+}
+
 // A renderer for one lightfield track: `views` are the clip's view records (null: dropped),
 // faces of `faceSize` texels in cells of `cellSize`. With `bc` (bcUpload), colour keyframes are
 // uploaded as blocks into two slots a face and the cell texture holds each cell's slot and t, as
-// in the native player; without, one RGBA32F slot holds the colour the CPU decoded.
-export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER_DEFAULTS, bc = null }) {
+// in the native player; without, one slot of `cpu` (cpuUpload) holds the colour the CPU decoded.
+export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER_DEFAULTS, bc = null, cpu = cpuUpload(gl, 0) }) {
   if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('WebGL2 without EXT_color_buffer_float: no float render target');
   const vertex = `#version 300 es\n${GL_FULLSCREEN_VERTEX}`;
   const march = program(gl, vertex, fragmentSource({ hints: options.surface_hints }), 'ray-march');
@@ -177,7 +199,7 @@ export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER
   };
   // Units as the native binding qualifiers: colour 0, depth 1, cells 2, material 3.
   const slots = bc ? 2 : 1;
-  const colourTex = texture(0, bc ? bc.internal : gl.RGBA32F, N, N, slots * layers);
+  const colourTex = texture(0, bc ? bc.internal : cpu.internal, N, N, slots * layers);
   const depthTex = texture(1, gl.R16UI, N, N, layers);
   const cellTex = texture(2, gl.R32UI, cellsPerSide, cellsPerSide, layers);
   gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 0, cellsPerSide, cellsPerSide, layers, gl.RED_INTEGER, gl.UNSIGNED_INT,
@@ -189,16 +211,23 @@ export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER
   const viewBuffer = gl.createBuffer();
   const vao = gl.createVertexArray();
   let target = null, targetTex = null, targetW = 0, targetH = 0;
-  const rgba = new Float32Array(4 * N * N);
+  const rgba = cpu.srgb ? new Uint8Array(4 * N * N) : new Float32Array(4 * N * N);
 
-  // colour: 3 floats a texel (linear RGB), depth: r16 codes, of one face of one view.
+  // colour: 3 floats a texel (linear RGB), depth: r16 codes, of one face of one view. RGBA16F
+  // takes the floats as they are (the colour of a format it serves is half floats: exact).
   function uploadFace(view, face, colour, depth) {
-    for (let i = 0; i < N * N; ++i) {
-      rgba[4 * i] = colour[3 * i]; rgba[4 * i + 1] = colour[3 * i + 1]; rgba[4 * i + 2] = colour[3 * i + 2]; rgba[4 * i + 3] = 1;
+    if (cpu.srgb) {
+      for (let i = 0; i < N * N; ++i) {
+        rgba[4 * i] = srgbByte(colour[3 * i]); rgba[4 * i + 1] = srgbByte(colour[3 * i + 1]); rgba[4 * i + 2] = srgbByte(colour[3 * i + 2]); rgba[4 * i + 3] = 255;
+      }
+    } else {
+      for (let i = 0; i < N * N; ++i) {
+        rgba[4 * i] = colour[3 * i]; rgba[4 * i + 1] = colour[3 * i + 1]; rgba[4 * i + 2] = colour[3 * i + 2]; rgba[4 * i + 3] = 1;
+      }
     }
     gl.activeTexture(gl.TEXTURE0);
     gl.bindTexture(gl.TEXTURE_2D_ARRAY, colourTex);
-    gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 6 * view + face, N, N, 1, gl.RGBA, gl.FLOAT, rgba);
+    gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 6 * view + face, N, N, 1, gl.RGBA, cpu.srgb ? gl.UNSIGNED_BYTE : gl.FLOAT, rgba);
     gl.activeTexture(gl.TEXTURE1);
     gl.bindTexture(gl.TEXTURE_2D_ARRAY, depthTex);
     gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 6 * view + face, N, N, 1, gl.RED_INTEGER, gl.UNSIGNED_SHORT, depth);

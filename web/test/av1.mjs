@@ -9,7 +9,10 @@
 //   CALF-E301, as calf-verify gives;
 // - the page plays the clip along a 4-pose eye path (one per frame), each frame >= MIN_DB against
 //   calf-play's GL frame of the same pose (CALF_BIN), with calf-play's active views and cells;
-//   av1_hdr_pred16m one pose, likewise;
+//   av1_hdr_pred16m one pose, likewise; colour goes up as the native player uploads it
+//   (SRGB8_ALPHA8 bytes, RGBA16F halves);
+// - the page's AV1 decoders close with the track they decode: a whole clip's decode leaves none
+//   open, and a clip the page replaces closes its own;
 // - garbage units met while playing give one line in the overlay (CALF-E301) and the last good
 //   frame stays on the canvas.
 //
@@ -83,6 +86,7 @@ try {
     const codecs = window.calfPlayer.lf.clip.codecs;
     const bytes = new Uint8Array(await (await fetch(url)).arrayBuffer());
     const hdrBytes = new Uint8Array(await (await fetch(hdrUrl)).arrayBuffer());
+    const openBefore = codecs.av1.open();
     let t = performance.now();
     const clean = await decodeLines(bytes, codecs);
     const ms = performance.now() - t;
@@ -92,6 +96,7 @@ try {
     t = performance.now();
     const hdrWasm = await decodeLines(hdrBytes, { ...codecs, av1: wasmAv1(window.calfAv1Wasm) });
     const hdrWasmMs = performance.now() - t;
+    const openAfter = codecs.av1.open();
     let damaged;
     try {
       damaged = await decodeLines(bytes, codecs, (clip) => {
@@ -104,7 +109,7 @@ try {
       damaged = { lines: [], problems: [e.message] };
     }
     const fuzz = await decodeLines(new Uint8Array(await (await fetch(fuzzUrl)).arrayBuffer()), codecs);
-    return { clean, ms, hdr, hdrMs, hdrWasm, hdrWasmMs, damaged: damaged.problems[0] ?? null, fuzz: { lines: fuzz.lines.length, problem: fuzz.problems[0] ?? null } };
+    return { clean, ms, hdr, hdrMs, hdrWasm, hdrWasmMs, openBefore, openAfter, damaged: damaged.problems[0] ?? null, fuzz: { lines: fuzz.lines.length, problem: fuzz.problems[0] ?? null } };
   }, { url: `/${clipPath}`, hdrUrl: `/${hdrPath}`, fuzzUrl: `/${fuzzClip}` });
   for (const [name, wanted, result, ms, how] of [['av1_pred16m', want, got.clean, got.ms, 'WebCodecs'], ['av1_hdr_pred16m', wantHdr, got.hdr, got.hdrMs, 'WebCodecs'],
     ['av1_hdr_pred16m', wantHdr, got.hdrWasm, got.hdrWasmMs, 'WebAssembly']]) {
@@ -117,6 +122,8 @@ try {
     for (const d of diffs.slice(0, 5)) problems.push(`conformance of ${name} (${how}): ${d}`);
     if (result.problems.length) problems.push(`conformance of ${name} (${how}): ${result.problems[0]}`);
   }
+  console.log(`web.av1: the page's AV1 decoders open: ${got.openBefore} before the clips' decodes, ${got.openAfter} after`);
+  if (got.openAfter !== got.openBefore) problems.push(`the decodes of whole clips left ${got.openAfter - got.openBefore} AV1 decoders open`);
   console.log(`web.av1: ${fuzzClip}: ${got.fuzz.lines} lines, ${got.fuzz.problem ?? 'no problem'}`);
   if (got.fuzz.problem || got.fuzz.lines === 0) problems.push(`${fuzzClip}: ${got.fuzz.lines} lines, ${got.fuzz.problem ?? 'no problem'}`);
   console.log(`web.av1: a garbage temporal unit: ${got.damaged ?? 'no problem'}`);
@@ -134,6 +141,7 @@ try {
     if (r.active.length !== n.views || r.visibleCells !== n.cells || r.totalCells !== n.total) problems.push(`pose ${i}: views or cells differ from calf-play's`);
     if (!(db >= MIN_DB)) problems.push(`pose ${i}: ${db.toFixed(2)} dB against calf-play, below ${MIN_DB}`);
     if (new Set(rgb).size < 4) problems.push(`pose ${i}: the canvas is blank`);
+    if (!r.colourUpload.startsWith('SRGB8_ALPHA8')) problems.push(`pose ${i}: colour went up as ${r.colourUpload}, not SRGB8_ALPHA8 (rgba8's bytes)`);
   }, (i, message) => problems.push(`pose ${i}: ${message}`));
 
   // Garbage units while playing: every colour chunk's units after the first made garbage in the
@@ -158,8 +166,13 @@ try {
   if (!bad.overlay.startsWith('CALF-E301 ') || bad.overlay.includes('\n')) problems.push(`garbage units while playing: overlay '${bad.overlay}'`);
   if (!bad.same) problems.push('garbage units while playing: the canvas changed');
 
-  // The HDR clip, one pose, in the same page (RGBA16F colour).
+  // The HDR clip, one pose, in the same page (RGBA16F colour); the clip it replaces closes its
+  // AV1 decoders.
+  const openedBefore = await page.evaluate(() => { window.calfReplaced = window.calfPlayer; return window.calfReplaced.lf.clip.codecs.av1.open(); });
   const hdrPlay = await playClip(browser, held, `http://127.0.0.1:${port}`, `/${hdrPath}`);
+  const openedAfter = await page.evaluate(() => window.calfReplaced.lf.clip.codecs.av1.open());
+  console.log(`web.av1: av1_pred16m's AV1 decoders open: ${openedBefore} while it plays, ${openedAfter} once av1_hdr_pred16m replaced it`);
+  if (!(openedBefore > 0 && openedAfter === 0)) problems.push(`the replaced clip's AV1 decoders: ${openedBefore} open while it played, ${openedAfter} after`);
   if (!hdrPlay.ready) problems.push(`the page did not open ${hdrPath}: ${hdrPlay.overlay}`);
   else {
     await renderEyePath(page, hdrPose, (i, r, rgb) => {
@@ -170,6 +183,7 @@ try {
       if (r.active.length !== n.views || r.visibleCells !== n.cells || r.totalCells !== n.total) problems.push(`HDR pose ${i}: views or cells differ from calf-play's`);
       if (!(db >= MIN_DB)) problems.push(`HDR pose ${i}: ${db.toFixed(2)} dB against calf-play, below ${MIN_DB}`);
       if (new Set(rgb).size < 4) problems.push(`HDR pose ${i}: the canvas is blank`);
+      if (!r.colourUpload.startsWith('RGBA16F')) problems.push(`HDR pose ${i}: colour went up as ${r.colourUpload}, not RGBA16F`);
     }, (i, message) => problems.push(`HDR pose ${i}: ${message}`));
   }
 } finally {
