@@ -83,7 +83,13 @@ export function makeLibavDecoders(libav) {
   async function run(key, chunk, units, i, what) {
     let s = cells.get(key);
     if (s) { cells.delete(key); cells.set(key, s); }  // most recently used
-    if (!s || s.chunkId !== chunk.id || s.next > i + 1 || (s.next === i + 1 && !s.last)) s = await open(key, chunk.id);
+    if (!s) s = await open(key, chunk.id);
+    else if (s.chunkId !== chunk.id || s.next > i + 1 || (s.next === i + 1 && !s.last)) {
+      // A restart at a key frame (unit 0: a sequence header and a key frame, which refreshes
+      // every reference) reuses the cell's context: libaom's set-up costs more than the unit.
+      await libav.avcodec_flush_buffers(s.c);
+      Object.assign(s, { chunkId: chunk.id, next: 0, last: null });
+    }
     if (s.next === i + 1) return s.last;
     for (; s.next <= i; ++s.next) {
       const frame = chunk.firstFrame + s.next;
