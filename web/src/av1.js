@@ -1,12 +1,12 @@
 // AV1 colour (format/SPEC.md §11.1.12) through one interface, `picture()`, with two back ends:
 // the browser's own WebCodecs `VideoDecoder` where it decodes AV1, else libav.js's av1-opus
-// variant (libaom's decoder in WebAssembly: node, or a browser without AV1 in WebCodecs). One decoder per colour cell, as the native decoder keeps
-// (decoder/src/lightfield_decoder.cc, update_cell_av1): within the GOP chunk serving a frame,
-// decoding goes on from the frame the cell's decoder last gave when that lies before it
-// (playback: one unit per frame), else it restarts at the chunk's key frame (a seek: at most the
-// keyframe interval of units). Pictures come back as their planes (8-bit samples for av1,
-// 16-bit for av1hdr's 10-bit ones); lightfield.js converts them with SPEC's
-// integer formulas. Errors are the native decoder's: a unit the decoder refuses, or one that
+// variant (libaom's decoder in WebAssembly: node, or a browser without AV1 in WebCodecs). One
+// decoder per colour cell, as the native decoder keeps (decoder/src/lightfield_decoder.cc,
+// update_cell_av1): within the GOP chunk serving a frame, decoding goes on from the frame the
+// cell's decoder last gave when that lies before it (playback: one unit per frame), else it
+// restarts at the chunk's key frame (a seek: at most the keyframe interval of units). Pictures
+// come back as their planes (8-bit samples for av1, 16-bit for av1hdr's 10-bit ones);
+// lightfield.js converts them with SPEC's integer formulas. Errors are the native decoder's: a unit the decoder refuses, or one that
 // gives no picture or more than one, CALF-E301; the picture's checks (CALF-E302) are
 // lightfield.js's.
 import { E, fail } from './errors.js';
@@ -14,9 +14,6 @@ import { E, fail } from './errors.js';
 // The codec strings of AV1 Main profile, 8 bits (av1) and 10 bits (av1hdr), 4:2:0; the level is
 // advisory to a software decoder.
 const CODEC = { 8: 'av01.0.04M.08', 10: 'av01.0.04M.10' };
-// Frame n is given the timestamp n · US microseconds: the WebAssembly back end keeps
-// timestamps in whole milliseconds.
-const US = 1000;
 // Open decoders kept at most: above it the least recently used one is closed (its cell restarts
 // from its chunk's key frame when it is next needed).
 const MAX_DECODERS = 96;
@@ -182,11 +179,11 @@ export function makeAv1Decoders(api = globalThis) {
     let s = cells.get(key);
     if (s) { cells.delete(key); cells.set(key, s); }  // most recently used
     if (!s || s.chunkId !== chunk.id || s.bits !== bits || s.next > i || s.flushed || s.error) s = open(key, chunk.id, bits);
-    const frame = chunk.firstFrame + i, ts = US * frame;
-    const bad = (why) => { drop(key); fail(E.av1Decode, `${what} frame ${frame}: ${why}`); };
+    const ts = chunk.firstFrame + i;
+    const bad = (why) => { drop(key); fail(E.av1Decode, `${what} frame ${ts}: ${why}`); };
     for (; s.next <= i; ++s.next) {
       try {
-        s.decoder.decode(new api.EncodedVideoChunk({ type: s.next === 0 ? 'key' : 'delta', timestamp: US * (chunk.firstFrame + s.next), data: units[s.next] }));
+        s.decoder.decode(new api.EncodedVideoChunk({ type: s.next === 0 ? 'key' : 'delta', timestamp: chunk.firstFrame + s.next, data: units[s.next] }));
       } catch (e) {
         bad(`the temporal unit does not decode (${e.name}: ${e.message})`);
       }
@@ -209,7 +206,7 @@ export function makeAv1Decoders(api = globalThis) {
     const p = await s.pictures.get(ts);
     if (!p) bad('the picture could not be read (VideoFrame.copyTo)');
     // A unit before this one that gave no picture shows as a missing timestamp.
-    for (let u = chunk.firstFrame; u < frame; ++u) if (!s.counts.has(US * u) && s.flushed) bad(`unit ${u - chunk.firstFrame} gives no picture`);
+    for (let u = chunk.firstFrame; u < ts; ++u) if (!s.counts.has(u) && s.flushed) bad(`unit ${u - chunk.firstFrame} gives no picture`);
     for (const k of [...s.pictures.keys()]) if (k < ts) s.pictures.delete(k);
     return p;
   }

@@ -1,6 +1,7 @@
 // The conformance hash lines of a clip (format/SPEC.md §14), as `calf-verify --decode` prints
-// them, from the page's decoder: shared by web/test/conformance.mjs (node) and web/test/av1.mjs
-// (the page in Chromium, where WebCodecs decodes AV1 colour).
+// them, from the page's decoder: shared by web/test/conformance.mjs (node, where AV1 colour goes
+// through the WebAssembly decoder) and web/test/av1.mjs (the page in Chromium: WebCodecs and the
+// WebAssembly decoder).
 import { openClip, bytesSource, readChunk } from './container.js';
 import { openLightfield, closeLightfield, decodeFaceFrames, faceHash } from './lightfield.js';
 import { tilesLines } from './tiles.js';

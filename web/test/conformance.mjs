@@ -266,7 +266,7 @@ async function main() {
   }
   const { codecs } = loaded;
   if (!codecs.av1) {
-    console.log(`web conformance: skipped: ${loaded.av1Missing}`);
+    console.log(`web conformance: skipped: ${loaded.av1Missing ?? 'no AV1 decoder'}`);
     process.exit(process.env.CI === 'true' ? 1 : 77);
   }
   if (process.argv[2] === '--time') {
