@@ -78,6 +78,24 @@ struct Captured {
   }
 };
 
+// Options that render `poses` poses of a path written into `dir` to `out`, as `files`.
+HeadlessSessionOptions render_options(const Playback& play, const fs::path& dir, size_t poses,
+                                      const fs::path& out, FrameFiles files) {
+  write_text(dir / "path.json", capture::serialize_eye_path(eye_path(play, poses, "")));
+  HeadlessSessionOptions o;
+  o.eye_path = dir / "path.json";
+  o.out = out;
+  o.frame_files = files;
+  return o;
+}
+
+// Opens a session on `play` with `o` and runs it into `c`.
+Expected<HeadlessSummary> run_session(Playback& play, const HeadlessSessionOptions& o,
+                                      Captured* c) {
+  CALF_ASSIGN_OR_RETURN(HeadlessSession session, HeadlessSession::open(play, nullptr, nullptr, o));
+  return session.run(c->sinks());
+}
+
 size_t count(const std::string& text, const std::string& what) {
   size_t n = 0;
   for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
@@ -88,16 +106,9 @@ TEST(HeadlessSession, RendersEveryPoseAndWritesItsFrames) {
   std::unique_ptr<Playback> play = open_playback();
   ASSERT_NE(play, nullptr);
   const fs::path dir = scratch("frames");
-  write_text(dir / "path.json", capture::serialize_eye_path(eye_path(*play, 3, "")));
-  HeadlessSessionOptions o;
-  o.eye_path = dir / "path.json";
-  o.out = dir / "out";
-  o.frame_files = FrameFiles::kBoth;
-  auto session = HeadlessSession::open(*play, nullptr, nullptr, o);
-  ASSERT_TRUE(session.ok()) << session.status().to_string();
-  EXPECT_EQ(session->eye_path().poses.size(), 3u);
+  const HeadlessSessionOptions o = render_options(*play, dir, 3, dir / "out", FrameFiles::kBoth);
   Captured c;
-  auto summary = session->run(c.sinks());
+  auto summary = run_session(*play, o, &c);
   ASSERT_TRUE(summary.ok()) << summary.status().to_string();
   ASSERT_EQ(summary->poses.size(), 3u);
   EXPECT_EQ(summary->files_written, 6u);
@@ -125,25 +136,17 @@ TEST(HeadlessSession, ComparisonFiguresMatchTheReport) {
   ASSERT_NE(play, nullptr);
   const fs::path dir = scratch("compare");
   // Ground truth: the frames of a first session as EXR (half floats), under the path's pattern.
-  write_text(dir / "path.json", capture::serialize_eye_path(eye_path(*play, 2, "")));
-  HeadlessSessionOptions first;
-  first.eye_path = dir / "path.json";
-  first.out = dir / "gt";
-  first.frame_files = FrameFiles::kExr;
-  {
-    auto s = HeadlessSession::open(*play, nullptr, nullptr, first);
-    ASSERT_TRUE(s.ok()) << s.status().to_string();
-    ASSERT_TRUE(s->run({}).ok());
-  }
+  Captured ground_truth;
+  ASSERT_TRUE(
+      run_session(*play, render_options(*play, dir, 2, dir / "gt", FrameFiles::kExr), &ground_truth)
+          .ok());
   write_text(dir / "gt" / capture::kEyePathFileName,
              capture::serialize_eye_path(eye_path(*play, 2, "frame_{pose:05}.exr")));
   HeadlessSessionOptions o;
   o.compare = dir / "gt";
   o.out = dir / "out";
-  auto session = HeadlessSession::open(*play, nullptr, nullptr, o);
-  ASSERT_TRUE(session.ok()) << session.status().to_string();
   Captured c;
-  auto summary = session->run(c.sinks());
+  auto summary = run_session(*play, o, &c);
   ASSERT_TRUE(summary.ok()) << summary.status().to_string();
   EXPECT_EQ(summary->compared, 2u);
   // The same renders: only the ground truth's half-float rounding differs.
@@ -181,6 +184,9 @@ TEST(HeadlessSession, RefusesAMissingOrBadEyePath) {
   // Ground truth asked for along a path that names no images.
   write_text(dir / "path.json", capture::serialize_eye_path(eye_path(*play, 1, "")));
   o.eye_path = dir / "path.json";
+  auto session = HeadlessSession::open(*play, nullptr, nullptr, o);
+  ASSERT_TRUE(session.ok()) << session.status().to_string();
+  EXPECT_EQ(session->eye_path().poses.size(), 1u);
   o.compare = dir;
   EXPECT_EQ(HeadlessSession::open(*play, nullptr, nullptr, o).status().id(),
             ErrorId::kPlaybackOption);
