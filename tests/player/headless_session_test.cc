@@ -102,13 +102,25 @@ size_t count(const std::string& text, const std::string& what) {
   return n;
 }
 
-TEST(HeadlessSession, RendersEveryPoseAndWritesItsFrames) {
-  std::unique_ptr<Playback> play = open_playback();
-  ASSERT_NE(play, nullptr);
-  const fs::path dir = scratch("frames");
-  const HeadlessSessionOptions o = render_options(*play, dir, 3, dir / "out", FrameFiles::kBoth);
+// A playback of the clip and a scratch directory named after the test.
+class HeadlessSessionTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    play_ = open_playback();
+    ASSERT_NE(play_, nullptr);
+    dir_ = scratch(::testing::UnitTest::GetInstance()->current_test_info()->name());
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::unique_ptr<Playback> play_;
+  fs::path dir_;
+};
+
+TEST_F(HeadlessSessionTest, RendersEveryPoseAndWritesItsFrames) {
+  Playback& play = *play_;
+  const fs::path& dir = dir_;
+  const HeadlessSessionOptions o = render_options(play, dir, 3, dir / "out", FrameFiles::kBoth);
   Captured c;
-  auto summary = run_session(*play, o, &c);
+  auto summary = run_session(play, o, &c);
   ASSERT_TRUE(summary.ok()) << summary.status().to_string();
   ASSERT_EQ(summary->poses.size(), 3u);
   EXPECT_EQ(summary->files_written, 6u);
@@ -128,25 +140,23 @@ TEST(HeadlessSession, RendersEveryPoseAndWritesItsFrames) {
   EXPECT_NE(c.report.find("3 poses: mean decode "), std::string::npos) << c.report;
   EXPECT_EQ(c.report.find("PSNR"), std::string::npos);
   EXPECT_TRUE(c.notices.empty());
-  fs::remove_all(dir);
 }
 
-TEST(HeadlessSession, ComparisonFiguresMatchTheReport) {
-  std::unique_ptr<Playback> play = open_playback();
-  ASSERT_NE(play, nullptr);
-  const fs::path dir = scratch("compare");
+TEST_F(HeadlessSessionTest, ComparisonFiguresMatchTheReport) {
+  Playback& play = *play_;
+  const fs::path& dir = dir_;
   // Ground truth: the frames of a first session as EXR (half floats), under the path's pattern.
   Captured ground_truth;
   ASSERT_TRUE(
-      run_session(*play, render_options(*play, dir, 2, dir / "gt", FrameFiles::kExr), &ground_truth)
+      run_session(play, render_options(play, dir, 2, dir / "gt", FrameFiles::kExr), &ground_truth)
           .ok());
   write_text(dir / "gt" / capture::kEyePathFileName,
-             capture::serialize_eye_path(eye_path(*play, 2, "frame_{pose:05}.exr")));
+             capture::serialize_eye_path(eye_path(play, 2, "frame_{pose:05}.exr")));
   HeadlessSessionOptions o;
   o.compare = dir / "gt";
   o.out = dir / "out";
   Captured c;
-  auto summary = run_session(*play, o, &c);
+  auto summary = run_session(play, o, &c);
   ASSERT_TRUE(summary.ok()) << summary.status().to_string();
   EXPECT_EQ(summary->compared, 2u);
   // The same renders: only the ground truth's half-float rounding differs.
@@ -165,32 +175,29 @@ TEST(HeadlessSession, ComparisonFiguresMatchTheReport) {
                 summary->poses[1].ssim);
   EXPECT_NE(c.report.find(line), std::string::npos) << c.report;
   EXPECT_NE(c.report.find("noise floor: unknown"), std::string::npos);
-  fs::remove_all(dir);
 }
 
-TEST(HeadlessSession, RefusesAMissingOrBadEyePath) {
-  std::unique_ptr<Playback> play = open_playback();
-  ASSERT_NE(play, nullptr);
-  const fs::path dir = scratch("bad");
+TEST_F(HeadlessSessionTest, RefusesAMissingOrBadEyePath) {
+  Playback& play = *play_;
+  const fs::path& dir = dir_;
   HeadlessSessionOptions o;
-  EXPECT_EQ(HeadlessSession::open(*play, nullptr, nullptr, o).status().id(),
+  EXPECT_EQ(HeadlessSession::open(play, nullptr, nullptr, o).status().id(),
             ErrorId::kPlaybackOption);
   o.eye_path = dir / "missing.json";
-  EXPECT_EQ(HeadlessSession::open(*play, nullptr, nullptr, o).status().id(), ErrorId::kFileOpen);
+  EXPECT_EQ(HeadlessSession::open(play, nullptr, nullptr, o).status().id(), ErrorId::kFileOpen);
   write_text(dir / "bad.json", "{\"format\": \"calf-eye-path\", ");
   o.eye_path = dir / "bad.json";
-  EXPECT_EQ(HeadlessSession::open(*play, nullptr, nullptr, o).status().id(),
+  EXPECT_EQ(HeadlessSession::open(play, nullptr, nullptr, o).status().id(),
             ErrorId::kManifestSyntax);
   // Ground truth asked for along a path that names no images.
-  write_text(dir / "path.json", capture::serialize_eye_path(eye_path(*play, 1, "")));
+  write_text(dir / "path.json", capture::serialize_eye_path(eye_path(play, 1, "")));
   o.eye_path = dir / "path.json";
-  auto session = HeadlessSession::open(*play, nullptr, nullptr, o);
+  auto session = HeadlessSession::open(play, nullptr, nullptr, o);
   ASSERT_TRUE(session.ok()) << session.status().to_string();
   EXPECT_EQ(session->eye_path().poses.size(), 1u);
   o.compare = dir;
-  EXPECT_EQ(HeadlessSession::open(*play, nullptr, nullptr, o).status().id(),
+  EXPECT_EQ(HeadlessSession::open(play, nullptr, nullptr, o).status().id(),
             ErrorId::kPlaybackOption);
-  fs::remove_all(dir);
 }
 
 }  // namespace
