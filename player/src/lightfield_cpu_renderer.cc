@@ -45,7 +45,7 @@ LightfieldCpuRenderer::LightfieldCpuRenderer(const ViewSet& views,
                                              const LightfieldRenderOptions& options)
     : views_(&views), options_(options) {}
 
-Status validate_render_options(const LightfieldRenderOptions& o, size_t view_count) {
+Status validate_render_options(const LightfieldRenderOptions& o) {
   if (o.steps < 1 || o.steps > 65536) {
     return option_error("steps " + std::to_string(o.steps) + " is outside [1, 65536]");
   }
@@ -104,7 +104,11 @@ Status validate_render_options(const LightfieldRenderOptions& o, size_t view_cou
   if (o.rr_max_depth < 1 || o.rr_max_depth > 8) {
     return option_error("rr_max_depth is outside [1, 8]");
   }
-  for (uint32_t i : o.active_views) {
+  return Status::Ok();
+}
+
+Status validate_active_views(std::span<const uint32_t> active_views, size_t view_count) {
+  for (uint32_t i : active_views) {
     if (i >= view_count) {
       return option_error("active view " + std::to_string(i) + " is not below the view count " +
                           std::to_string(view_count));
@@ -116,13 +120,9 @@ Status validate_render_options(const LightfieldRenderOptions& o, size_t view_cou
 Expected<LightfieldCpuRenderer> LightfieldCpuRenderer::make(const ViewSet& views,
                                                             const LightfieldRenderOptions& o) {
   if (views.views.empty()) return option_error("the view set is empty");
-  CALF_RETURN_IF_ERROR(validate_render_options(o, views.views.size()));
+  CALF_RETURN_IF_ERROR(validate_render_options(o));
   LightfieldCpuRenderer r(views, o);
-  if (o.active_views.empty()) {
-    for (const View& v : views.views) r.active_.push_back(&v);
-  } else {
-    for (uint32_t i : o.active_views) r.active_.push_back(&views.views[i]);
-  }
+  for (const View& v : views.views) r.active_.push_back(&v);
   r.smooth_log_ratio_ = std::log1p(std::max(o.smooth_depth_ratio, 0.0));
   r.min_view_distance_ = o.min_view_distance < 0 ? o.near : o.min_view_distance;
   r.mixed_penalty_factor_ = std::exp(-o.mixed_texel_penalty);
@@ -687,7 +687,22 @@ RaySample LightfieldCpuRenderer::shade_hit(const Vec3& origin, const Vec3& direc
   return s;
 }
 
-Status LightfieldCpuRenderer::render(const Camera& camera, RenderedImage* out) const {
+Expected<LightfieldCpuRenderer> LightfieldCpuRenderer::restricted_to(
+    std::span<const uint32_t> active_views) const {
+  if (active_views.empty()) return *this;
+  CALF_RETURN_IF_ERROR(validate_active_views(active_views, views_->views.size()));
+  LightfieldCpuRenderer r = *this;
+  r.active_.clear();
+  for (uint32_t i : active_views) r.active_.push_back(&views_->views[i]);
+  return r;
+}
+
+Status LightfieldCpuRenderer::render(const Camera& camera, std::span<const uint32_t> active_views,
+                                     RenderedImage* out) const {
+  if (!active_views.empty()) {
+    CALF_ASSIGN_OR_RETURN(const LightfieldCpuRenderer restricted, restricted_to(active_views));
+    return restricted.render(camera, {}, out);
+  }
   CALF_RETURN_IF_ERROR(validate_camera(camera));
   const CameraFrame frame = camera_frame(camera);
   out->width = camera.width;

@@ -25,10 +25,16 @@ Status option_error(const std::string& what) {
 }
 
 // The CPU renderer's checks (both renderers accept the same options), plus the GL limits.
-Status check_options(const LightfieldRenderOptions& o, size_t view_count) {
-  CALF_RETURN_IF_ERROR(validate_render_options(o, view_count));
+Status check_options(const LightfieldRenderOptions& o) {
+  CALF_RETURN_IF_ERROR(validate_render_options(o));
   if (o.coverage_layers > 0) return option_error("coverage_layers is the CPU reference's only");
-  const size_t active = o.active_views.empty() ? view_count : o.active_views.size();
+  return Status::Ok();
+}
+
+// The frame's active views: below the view count, at most as many as the shader's view block holds.
+Status check_active_views(std::span<const uint32_t> active_views, size_t view_count) {
+  CALF_RETURN_IF_ERROR(validate_active_views(active_views, view_count));
+  const size_t active = active_views.empty() ? view_count : active_views.size();
   if (active > internal::kGlMaxActiveViews) {
     return option_error(std::to_string(active) + " active views, the GL renderer takes at most " +
                         std::to_string(internal::kGlMaxActiveViews));
@@ -71,14 +77,14 @@ LightfieldGlRenderer::~LightfieldGlRenderer() {
 
 Expected<std::unique_ptr<LightfieldGlRenderer>> LightfieldGlRenderer::make(
     const GlViews& views, const LightfieldRenderOptions& options) {
-  CALF_RETURN_IF_ERROR(check_options(options, views.layout().views.size()));
+  CALF_RETURN_IF_ERROR(check_options(options));
   std::unique_ptr<LightfieldGlRenderer> r(new LightfieldGlRenderer(views, options));
   CALF_RETURN_IF_ERROR(r->build_program());
   return r;
 }
 
 Status LightfieldGlRenderer::set_options(const LightfieldRenderOptions& options) {
-  CALF_RETURN_IF_ERROR(check_options(options, views_->layout().views.size()));
+  CALF_RETURN_IF_ERROR(check_options(options));
   if (options.surface_hints != options_.surface_hints) {
     // The hint count is compiled into the shader (see build_program): a new program.
     const LightfieldRenderOptions old = options_;
@@ -120,7 +126,8 @@ Status LightfieldGlRenderer::build_program() {
   return check_gl_error(gl, "building the ray-march program");
 }
 
-Status LightfieldGlRenderer::draw(const Camera& camera) {
+Status LightfieldGlRenderer::draw(const Camera& camera, std::span<const uint32_t> active_views) {
+  CALF_RETURN_IF_ERROR(check_active_views(active_views, views_->layout().views.size()));
   Vec3 forward, right, up;
   CALF_RETURN_IF_ERROR(camera_axes(camera, &forward, &right, &up));
   const GlFunctions& gl = *gl_;
@@ -128,7 +135,7 @@ Status LightfieldGlRenderer::draw(const Camera& camera) {
   const LightfieldRenderOptions& o = options_;
 
   // The active views, eye-relative, in the order given.
-  std::vector<uint32_t> active = o.active_views;
+  std::vector<uint32_t> active(active_views.begin(), active_views.end());
   if (active.empty()) {
     for (uint32_t v = 0; v < layout.views.size(); ++v) active.push_back(v);
   }
@@ -214,7 +221,8 @@ Status LightfieldGlRenderer::draw(const Camera& camera) {
   return check_gl_error(gl, "drawing the ray-march pass");
 }
 
-Status LightfieldGlRenderer::render(const Camera& camera, RenderedImage* out) {
+Status LightfieldGlRenderer::render(const Camera& camera, std::span<const uint32_t> active_views,
+                                    RenderedImage* out) {
   Vec3 forward, right, up;
   CALF_RETURN_IF_ERROR(camera_axes(camera, &forward, &right, &up));
   if (target_ == nullptr) {
@@ -222,7 +230,7 @@ Status LightfieldGlRenderer::render(const Camera& camera, RenderedImage* out) {
   }
   CALF_RETURN_IF_ERROR(
       target_->bind_and_clear(camera.width, camera.height, "the ray-march render target"));
-  CALF_RETURN_IF_ERROR(draw(camera));
+  CALF_RETURN_IF_ERROR(draw(camera, active_views));
   return target_->read_back("reading back the frame", out);
 }
 

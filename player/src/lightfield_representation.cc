@@ -129,11 +129,8 @@ Expected<std::unique_ptr<LightfieldRepresentation>> LightfieldRepresentation::op
     CALF_ASSIGN_OR_RETURN(GlTextureLayout layout, layout_for_clip(h, views, options.keep_bc5_depth,
                                                                   impl->decoder->has_coverage()));
     CALF_ASSIGN_OR_RETURN(impl->gl_views, GlViews::make(*gl, std::move(layout)));
-    // A view set with no active view is refused by the option check: validate with all views.
-    LightfieldRenderOptions probe = options.render;
-    probe.active_views.clear();
     CALF_ASSIGN_OR_RETURN(impl->lightfield_gl_renderer,
-                          LightfieldGlRenderer::make(*impl->gl_views, probe));
+                          LightfieldGlRenderer::make(*impl->gl_views, options.render));
   } else {
     impl->cpu_textures.emplace(h, views);
     const LogDepthRange placeholder_range = *LogDepthRange::make(1, 2);
@@ -215,10 +212,8 @@ Status LightfieldRepresentation::report_frame_time(double frame_ms) {
 }
 
 Status LightfieldRepresentation::set_render_options(const LightfieldRenderOptions& options) {
-  LightfieldRenderOptions probe = options;
-  probe.active_views.clear();
   if (impl_->lightfield_gl_renderer)
-    CALF_RETURN_IF_ERROR(impl_->lightfield_gl_renderer->set_options(probe));
+    CALF_RETURN_IF_ERROR(impl_->lightfield_gl_renderer->set_options(options));
   impl_->options.render = options;
   impl_->decoder->set_view_dependent(impl_->view_dependent_for(options));
   return Status::Ok();
@@ -403,15 +398,15 @@ LightfieldRenderOptions LightfieldRepresentation::Impl::frame_options(const Vec3
 Status LightfieldRepresentation::render(const Camera& camera, RenderedImage* out) {
   Impl& d = *impl_;
   const auto t0 = std::chrono::steady_clock::now();
-  LightfieldRenderOptions r = d.frame_options(camera.position);
-  r.active_views = d.selection.active;
+  const LightfieldRenderOptions r = d.frame_options(camera.position);
+  const std::span<const uint32_t> active = d.selection.active;
   if (d.lightfield_gl_renderer) {
     CALF_RETURN_IF_ERROR(d.lightfield_gl_renderer->set_options(r));
-    CALF_RETURN_IF_ERROR(d.lightfield_gl_renderer->render(camera, out));
+    CALF_RETURN_IF_ERROR(d.lightfield_gl_renderer->render(camera, active, out));
   } else {
     // The view set is indexed like the clip; the active views in selection order, as the GL path.
     CALF_ASSIGN_OR_RETURN(LightfieldCpuRenderer cpu, LightfieldCpuRenderer::make(d.view_set, r));
-    CALF_RETURN_IF_ERROR(cpu.render(camera, out));
+    CALF_RETURN_IF_ERROR(cpu.render(camera, active, out));
   }
   d.render_ms = ms_since(t0);
   return Status::Ok();

@@ -3,23 +3,18 @@
 // cameras and a Dear ImGui HUD, or headless through OSMesa along an eye path, writing frames and
 // comparing them with calf-capture's ground truth. Errors are one line with a stable id and exit
 // status 1; usage errors exit 2 (command_line.h).
-#include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <initializer_list>
 #include <memory>
-#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
-#include "calf/capture/eye_path.h"
-#include "calf/player/contact_sheet.h"
-#include "calf/player/error_breakdown.h"
 #include "calf/player/gl_context.h"
-#include "calf/player/image_compare.h"
+#include "calf/player/headless_session.h"
 #include "calf/player/playback.h"
 #include "calf_play/play_window.h"
 #include "command_line.h"
@@ -50,348 +45,39 @@ struct HeadlessArgs {
   // --breakdown: the capture set the clip was made from (error classes); --breakdown-lossless:
   // a lossless clip of it (the codec class).
   std::string breakdown, breakdown_lossless;
-  uint32_t sheet_rows = 8;
-  bool heat_maps = true;
+  uint32_t sheet_rows = HeadlessSessionOptions{}.sheet_rows;
+  bool heat_maps = HeadlessSessionOptions{}.heat_maps;
   double surfel_target_ms = 0;    // --surfel-target-ms: report render times to the controller
   bool surfel_foveation = false;  // --surfel-foveation: print the peripheral objects per pose
 };
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const size_t m = v.size() / 2;
-  return v.size() % 2 ? v[m] : (v[m - 1] + v[m]) / 2;
-}
-
-// The images of the poses chosen for the contact sheet, kept until the end of the path.
-struct SheetTile {
-  RenderedImage rendered;
-  capture::PerspectiveImage ground_truth;
-};
-
-// Per-pose figures of CLIP against the full-scene clip (--compare-clip).
-struct ClipComparison {
-  double sum_eps = 0, max_eps = 0, sum_psnr = 0, sum_ssim = 0;
-  double min_psnr = INFINITY, min_ssim = INFINITY;
-  size_t max_eps_pose = 0;
-  uint32_t count = 0;
-  std::vector<double> render_ms;  // the full-scene clip's
-};
-
-// Plays `path` pose by pose; poses sharing a time (a stereo pair) are prepared together. With
-// `full`, the same poses are rendered from the full-scene clip too and compared (epsilon).
+// The headless evaluation (player/include/calf/player/headless_session.h): the report on stdout,
+// notices on stderr.
 int run_headless(Playback& play, Playback* full, Playback* lossless, const HeadlessArgs& a) {
-  fs::path gt_dir;
-  capture::EyePath path;
-  if (!a.compare.empty()) gt_dir = a.compare;
-  const fs::path path_file =
-      !a.eye_path.empty() ? fs::path(a.eye_path) : gt_dir / capture::kEyePathFileName;
-  auto loaded = capture::read_eye_path(path_file);
-  if (!loaded.ok()) return fail(loaded.status());
-  path = std::move(*loaded);
-  if (!gt_dir.empty() && path.image_pattern.empty()) {
-    return fail(Status(ErrorId::kPlaybackOption,
-                       path_file.string() + " names no ground-truth images to compare with"));
-  }
-  // The noise floor: the ground truth against the same poses rendered with another seed
-  // (format/CAPTURE.md, "Noise floor"); no figure measures the reconstruction more finely.
-  fs::path floor_dir;
-  if (!gt_dir.empty()) {
-    std::error_code ec;
-    if (!a.noise_floor.empty()) {
-      floor_dir = a.noise_floor;
-    } else if (fs::exists(gt_dir / capture::kNoiseFloorDirName / capture::kEyePathFileName, ec)) {
-      floor_dir = gt_dir / capture::kNoiseFloorDirName;
-    }
-  }
-  capture::EyePath floor_path;
-  if (!floor_dir.empty()) {
-    auto f = capture::read_eye_path(floor_dir / capture::kEyePathFileName);
-    if (!f.ok()) return fail(f.status());
-    floor_path = std::move(*f);
-    if (floor_path.image_pattern.empty() || floor_path.poses != path.poses ||
-        floor_path.width != path.width || floor_path.height != path.height) {
-      return fail(Status(ErrorId::kPlaybackOption,
-                         (floor_dir / capture::kEyePathFileName).string() +
-                             " is not ground truth of the same poses and image size"));
-    }
-  }
-  // The error breakdown: the capture set's views at the frame of each pose, loaded once a frame.
-  std::unique_ptr<capture::CaptureSetReader> breakdown_reader;
-  if (!a.breakdown.empty()) {
-    auto r = capture::CaptureSetReader::open(a.breakdown);
-    if (!r.ok()) return fail(r.status());
-    breakdown_reader = std::make_unique<capture::CaptureSetReader>(std::move(*r));
-  }
-  std::optional<CaptureVisibility> visibility;
-  ErrorBreakdown breakdown_sum;
-  RenderedImage lossless_image;
-  double floor_sum_psnr = 0, floor_sum_ssim = 0, floor_min_psnr = INFINITY;
-  size_t floor_min_pose = 0;
-  if (!a.out.empty()) {
-    std::error_code ec;
-    fs::create_directories(a.out, ec);
-    if (ec) return fail(Status(ErrorId::kFileWrite, a.out + ": " + ec.message()));
-  }
-  // The light-field figures printed per pose are the first lightfield track's (if any).
-  const LightfieldRepresentation* lf = play.lightfield();
+  const HeadlessSessionOptions options{.eye_path = a.eye_path,
+                                       .out = a.out,
+                                       .frame_files = a.format == "exr"    ? FrameFiles::kExr
+                                                      : a.format == "both" ? FrameFiles::kBoth
+                                                                           : FrameFiles::kPng,
+                                       .compare = a.compare,
+                                       .heat_maps = a.heat_maps,
+                                       .noise_floor = a.noise_floor,
+                                       .breakdown = a.breakdown,
+                                       .contact_sheet = a.contact_sheet,
+                                       .sheet_rows = a.sheet_rows,
+                                       .surfel_target_ms = a.surfel_target_ms,
+                                       .surfel_foveation = a.surfel_foveation};
+  auto session = HeadlessSession::open(play, full, lossless, options);
+  if (!session.ok()) return fail(session.status());
   warn_dropped_views(play);
-  if (lf != nullptr && lf->options().render.rr && !lf->has_material()) {
-    std::fprintf(stderr, "calf-play: notice: the clip has no material stream; --rr is ignored\n");
-  }
-  double sum_psnr = 0, sum_ssim = 0, sum_decode = 0, sum_mbps = 0;
-  double min_psnr = INFINITY, min_ssim = INFINITY;
-  size_t min_psnr_pose = 0, min_ssim_pose = 0;
-  std::vector<double> decode_ms, render_ms;
-  uint32_t compared = 0, outside = 0;
-  const std::vector<size_t> sheet_poses =
-      a.contact_sheet.empty() ? std::vector<size_t>{}
-                              : contact_sheet_poses(path.poses.size(), a.sheet_rows);
-  std::vector<SheetTile> sheet;
-  RenderedImage image, full_image;
-  ClipComparison cc;
-  for (size_t i = 0; i < path.poses.size();) {
-    size_t j = i + 1;
-    while (j < path.poses.size() && path.poses[j].time == path.poses[i].time) ++j;
-    std::vector<Camera> eyes;
-    for (size_t k = i; k < j; ++k) eyes.push_back(capture::camera_from_pose(path, k));
-    const uint32_t frame = play.frame_at_time(path.poses[i].time);
-    if (Status s = play.prepare(frame, eyes); !s.ok()) return fail(s);
-    if (lossless != nullptr) {
-      if (Status s = lossless->prepare(lossless->frame_at_time(path.poses[i].time), eyes); !s.ok())
-        return fail(s);
-    }
-    if (breakdown_reader) {
-      const capture::CaptureManifest& m = breakdown_reader->manifest();
-      const uint32_t cf = capture::frame_at_time(path.poses[i].time, m.fps, m.frame_count);
-      if (!visibility || visibility->frame() != cf) {
-        auto v = CaptureVisibility::load(*breakdown_reader, cf);
-        if (!v.ok()) return fail(v.status());
-        visibility = std::move(*v);
-      }
-    }
-    if (full != nullptr) {
-      if (Status s = full->prepare(full->frame_at_time(path.poses[i].time), eyes); !s.ok())
-        return fail(s);
-    }
-    const decoder::FrameStats st = lf != nullptr ? lf->last_stats() : decoder::FrameStats{};
-    if (st.errors > 0) {
-      std::fprintf(stderr,
-                   "calf-play: warning: frame %u: %u damaged chunk(s), last good state "
-                   "kept: %s\n",
-                   frame, st.errors, st.first_error.c_str());
-    }
-    for (size_t k = i; k < j; ++k) {
-      const Camera& cam = eyes[k - i];
-      if (!play.inside_view_volume(cam.position) && outside++ == 0) {
-        std::fprintf(stderr,
-                     "calf-play: warning: pose %zu is outside the clip's view volume; "
-                     "expect holes and stretched parallax\n",
-                     k);
-      }
-      if (Status s = play.render(cam, &image); !s.ok()) return fail(s);
-      char name[32];
-      std::snprintf(name, sizeof name, "frame_%05zu", k);
-      if (!a.out.empty()) {
-        if (a.format == "png" || a.format == "both") {
-          if (Status s = write_png(fs::path(a.out) / (std::string(name) + ".png"), rgb_ref(image));
-              !s.ok())
-            return fail(s);
-        }
-        if (a.format == "exr" || a.format == "both") {
-          if (Status s = write_exr(fs::path(a.out) / (std::string(name) + ".exr"), image); !s.ok())
-            return fail(s);
-        }
-      }
-      const FrameFigures fig = play.figures();
-      if (lf != nullptr) {
-        std::printf(
-            "pose %zu frame %u: %zu views, %u/%u cells, %.2f Mbps@24, decode %.2f ms, "
-            "render %.1f ms",
-            k, frame, lf->last_selection().active.size(), st.visible_cells, st.total_cells,
-            st.mbps_at_24fps(), st.decode_ms, play.last_render_ms());
-      } else if (fig.quads) {
-        std::printf("pose %zu frame %u: %zu tiles, overdraw mean %.2f peak %u, render %.1f ms", k,
-                    frame, fig.quads->count, fig.quads->mean_overdraw, fig.quads->peak_overdraw,
-                    play.last_render_ms());
-      } else {
-        std::printf("pose %zu frame %u: %llu triangles, render %.1f ms", k, frame,
-                    static_cast<unsigned long long>(fig.triangles_drawn), play.last_render_ms());
-      }
-      if (fig.points) {
-        const FrameFigures::Points& pts = *fig.points;
-        std::printf(", %llu surfels at %.2f px", static_cast<unsigned long long>(pts.drawn),
-                    pts.point_size);
-        if (a.surfel_foveation) std::printf(" (%u objects peripheral)", pts.peripheral_objects);
-        // The passes the controller models apart, wall and process CPU time; its prediction.
-        const SurfelPassTimes& pt = pts.passes;
-        std::printf(" (passes: mesh %.1f + surfels %.1f ms; CPU %.1f + %.1f of %.1f ms)",
-                    pt.mesh_ms, pt.surfels_ms, pt.mesh_cpu_ms, pt.surfels_cpu_ms, pt.frame_cpu_ms);
-        if (a.surfel_target_ms > 0) std::printf(", predicted %.1f ms", pts.predicted_frame_ms);
-        // Headless has no display: the render time stands for the frame time the point-size
-        // controller follows (only when it has a target; not the first, which compiles shaders).
-        if (a.surfel_target_ms > 0 && k > 0) {
-          if (Status s = play.report_frame_time(play.last_render_ms()); !s.ok()) return fail(s);
-        }
-      }
-      if (full != nullptr) {
-        if (Status s = full->render(cam, &full_image); !s.ok()) return fail(s);
-        auto eps = missing_geometry(image, full_image);
-        if (!eps.ok()) return fail(eps.status());
-        auto p = psnr(rgb_ref(image), rgb_ref(full_image));
-        if (!p.ok()) return fail(p.status());
-        auto s = ssim(rgb_ref(image), rgb_ref(full_image));
-        if (!s.ok()) return fail(s.status());
-        std::printf(", vs full (%.1f ms): epsilon %.4f %%, PSNR %.2f dB, SSIM %.4f",
-                    full->last_render_ms(), 100 * eps->epsilon, *p, *s);
-        cc.sum_eps += eps->epsilon;
-        if (eps->epsilon > cc.max_eps || cc.count == 0)
-          cc.max_eps = eps->epsilon, cc.max_eps_pose = k;
-        cc.sum_psnr += std::min(*p, 100.0);
-        cc.sum_ssim += *s;
-        cc.min_psnr = std::min(cc.min_psnr, std::min(*p, 100.0));
-        cc.min_ssim = std::min(cc.min_ssim, *s);
-        cc.render_ms.push_back(full->last_render_ms());
-        ++cc.count;
-      }
-      sum_decode += st.decode_ms;
-      sum_mbps += st.mbps_at_24fps();
-      decode_ms.push_back(st.decode_ms);
-      render_ms.push_back(play.last_render_ms());
-      if (!gt_dir.empty()) {
-        auto gt = capture::read_perspective_image(gt_dir / capture::eye_image_file_name(path, k));
-        if (!gt.ok()) return fail(gt.status());
-        auto p = psnr(rgb_ref(image), rgb_ref(*gt));
-        if (!p.ok()) return fail(p.status());
-        auto s = ssim(rgb_ref(image), rgb_ref(*gt));
-        if (!s.ok()) return fail(s.status());
-        std::printf(", PSNR %.2f dB, SSIM %.4f", *p, *s);
-        if (!floor_dir.empty()) {
-          auto other = capture::read_perspective_image(floor_dir /
-                                                       capture::eye_image_file_name(floor_path, k));
-          if (!other.ok()) return fail(other.status());
-          auto fp = psnr(rgb_ref(*gt), rgb_ref(*other));
-          if (!fp.ok()) return fail(fp.status());
-          auto fssim = ssim(rgb_ref(*gt), rgb_ref(*other));
-          if (!fssim.ok()) return fail(fssim.status());
-          const double clamped = std::min(*fp, 100.0);
-          std::printf(" (noise floor %.2f dB, %.4f)", clamped, *fssim);
-          floor_sum_psnr += clamped;
-          floor_sum_ssim += *fssim;
-          if (clamped < floor_min_psnr) floor_min_psnr = clamped, floor_min_pose = k;
-        }
-        sum_psnr += std::min(*p, 100.0);  // an exact frame counts as 100 dB, not infinity
-        sum_ssim += *s;
-        ++compared;
-        if (std::min(*p, 100.0) < min_psnr) min_psnr = std::min(*p, 100.0), min_psnr_pose = k;
-        if (*s < min_ssim) min_ssim = *s, min_ssim_pose = k;
-        if (!a.out.empty() && a.heat_maps) {
-          const fs::path heat = fs::path(a.out) / (std::string("heat_") + (name + 6) + ".png");
-          if (Status hs = write_heat_map_png(heat, rgb_ref(image), rgb_ref(*gt)); !hs.ok())
-            return fail(hs);
-        }
-        if (visibility) {
-          if (lossless != nullptr) {
-            if (Status ls = lossless->render(cam, &lossless_image); !ls.ok()) return fail(ls);
-          }
-          const RgbImageRef lossless_ref = rgb_ref(lossless_image);
-          std::vector<uint8_t> classes;
-          std::vector<float> squared;
-          auto b = classify_errors(image, *gt, cam, *visibility,
-                                   lossless != nullptr ? &lossless_ref : nullptr, {}, &classes,
-                                   &squared);
-          if (!b.ok()) return fail(b.status());
-          std::printf(
-              ", error: disocclusion %.1f %% silhouette %.1f %% geometry %.1f %% shading %.1f %%",
-              100 * b->share(ErrorClass::kDisocclusion), 100 * b->share(ErrorClass::kSilhouette),
-              100 * b->share(ErrorClass::kGeometry), 100 * b->share(ErrorClass::kShading));
-          if (lossless != nullptr)
-            std::printf(" codec %.1f %%", 100 * b->share(ErrorClass::kCodec));
-          breakdown_sum += *b;
-          if (!a.out.empty()) {
-            const fs::path map = fs::path(a.out) / (std::string("classes_") + (name + 6) + ".png");
-            if (Status ws = write_error_class_png(map, cam.width, cam.height, classes, squared);
-                !ws.ok())
-              return fail(ws);
-          }
-        }
-        if (std::binary_search(sheet_poses.begin(), sheet_poses.end(), k)) {
-          sheet.push_back({image, std::move(*gt)});
-        }
-      }
-      std::printf("\n");
-    }
-    i = j;
-  }
-  const double n = static_cast<double>(path.poses.size());
-  // The first render compiles shaders and fills caches: it is reported apart from the rest.
-  const double first_render = render_ms.empty() ? 0 : render_ms.front();
-  const double later_render =
-      render_ms.size() > 1 ? median({render_ms.begin() + 1, render_ms.end()}) : first_render;
-  std::printf(
-      "%zu poses: mean decode %.2f ms (median %.2f), render first %.1f ms then median "
-      "%.1f ms, mean %.2f Mbps@24\n",
-      path.poses.size(), sum_decode / n, median(decode_ms), first_render, later_render,
-      sum_mbps / n);
-  if (cc.count > 0) {
-    const double full_first = cc.render_ms.front();
-    const double full_later = cc.render_ms.size() > 1
-                                  ? median({cc.render_ms.begin() + 1, cc.render_ms.end()})
-                                  : full_first;
-    std::printf(
-        "against the full scene (%u poses): epsilon mean %.4f %% max %.4f %% (pose %zu); PSNR mean "
-        "%.2f dB min %.2f dB (an identical pose counts as 100 dB); SSIM mean %.4f min %.4f\n",
-        cc.count, 100 * cc.sum_eps / cc.count, 100 * cc.max_eps, cc.max_eps_pose,
-        cc.sum_psnr / cc.count, cc.min_psnr, cc.sum_ssim / cc.count, cc.min_ssim);
-    std::printf(
-        "frame time (median render after the first): %.1f ms this clip, %.1f ms full scene\n",
-        later_render, full_later);
-  }
-  if (compared > 0) {
-    std::printf("mean PSNR %.2f dB, mean SSIM %.4f\n", sum_psnr / compared, sum_ssim / compared);
-    std::printf("worst pose: PSNR %.2f dB (pose %zu), SSIM %.4f (pose %zu)\n", min_psnr,
-                min_psnr_pose, min_ssim, min_ssim_pose);
-    if (visibility) {
-      const ErrorBreakdown& b = breakdown_sum;
-      std::printf(
-          "error breakdown (share of the squared error over all poses; share of the pixels): "
-          "disocclusion %.1f %% (%.1f %%), silhouette %.1f %% (%.1f %%), geometry %.1f %% "
-          "(%.1f %%), shading %.1f %% (%.1f %%), ",
-          100 * b.share(ErrorClass::kDisocclusion), 100 * b.pixel_share(ErrorClass::kDisocclusion),
-          100 * b.share(ErrorClass::kSilhouette), 100 * b.pixel_share(ErrorClass::kSilhouette),
-          100 * b.share(ErrorClass::kGeometry), 100 * b.pixel_share(ErrorClass::kGeometry),
-          100 * b.share(ErrorClass::kShading), 100 * b.pixel_share(ErrorClass::kShading));
-      if (b.codec_measured) {
-        std::printf("codec %.1f %% (%.1f %%)\n", 100 * b.share(ErrorClass::kCodec),
-                    100 * b.pixel_share(ErrorClass::kCodec));
-      } else {
-        std::printf("codec not measured (give --breakdown-lossless)\n");
-      }
-    }
-    if (!floor_dir.empty()) {
-      std::printf(
-          "noise floor (ground truth against %s, another seed): mean PSNR %.2f dB, mean SSIM "
-          "%.4f, lowest %.2f dB (pose %zu)\n",
-          floor_dir.string().c_str(), floor_sum_psnr / compared, floor_sum_ssim / compared,
-          floor_min_psnr, floor_min_pose);
-    } else {
-      std::printf(
-          "noise floor: unknown (no %s/%s: calf-capture --ground-truth writes it, or give "
-          "--noise-floor)\n",
-          gt_dir.string().c_str(), capture::kNoiseFloorDirName);
-    }
-  }
-  if (!sheet.empty()) {
-    std::vector<ContactSheetRow> rows;
-    for (const SheetTile& t : sheet) rows.push_back({rgb_ref(t.ground_truth), rgb_ref(t.rendered)});
-    auto composed = compose_contact_sheet(rows);
-    if (!composed.ok()) return fail(composed.status());
-    if (Status s = write_png_rgb8(a.contact_sheet, *composed); !s.ok()) return fail(s);
-    std::printf(
-        "contact sheet: %s (%zu poses; ground truth | calf | error heat map, red = "
-        "error 0.1 of full scale or more)\n",
-        a.contact_sheet.c_str(), rows.size());
-  }
+  const HeadlessSinks sinks{
+      .report = [](std::string_view text) { std::fwrite(text.data(), 1, text.size(), stdout); },
+      .notice =
+          [](std::string_view line) {
+            std::fprintf(stderr, "calf-play: %.*s\n", static_cast<int>(line.size()), line.data());
+          }};
+  auto summary = session->run(sinks);
+  if (!summary.ok()) return fail(summary.status());
   return 0;
 }
 

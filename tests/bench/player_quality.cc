@@ -232,6 +232,12 @@ bool g_breakdown = false;
 // sky (the decision replaced, the march's depth kept elsewhere).
 enum class GtDepth { kNone, kAll, kSky, kSurface, kDecision };
 GtDepth g_gt_depth = GtDepth::kNone;
+std::vector<uint32_t> g_active_views;  // --active (empty: every view)
+
+// The CPU renderer over `views` with `o`, restricted to --active.
+LightfieldCpuRenderer make_renderer(const ViewSet& views, const LightfieldRenderOptions& o) {
+  return need(need(LightfieldCpuRenderer::make(views, o)).restricted_to(g_active_views));
+}
 
 // Re-shades the rays of `img` (rendered by `renderer` from `cam`, one ray per pixel) that
 // g_gt_depth names at `reference`'s depth: all of them, or those the reference sends to the sky
@@ -394,7 +400,7 @@ std::vector<Score> measure(const char* section, std::vector<Pose>& poses, FrameC
     for (size_t vi = 0; vi < variants.size(); ++vi) {
       const LightfieldRenderOptions o =
           need(march_range_for(views, cam.position, variants[vi].options));
-      const LightfieldCpuRenderer renderer = need(LightfieldCpuRenderer::make(views, o));
+      const LightfieldCpuRenderer renderer = make_renderer(views, o);
       RenderedImage img;
       const double t0 = now_s();
       if (Status s = renderer.render(cam, &img); !s.ok()) die(s);
@@ -475,7 +481,7 @@ void write_silhouette_montage(const fs::path& file, const Pose& p, const ViewSet
     o.coverage_layers =
         plus == std::string::npos ? 0 : static_cast<uint32_t>(std::stoul(setting.substr(plus + 1)));
     o = need(march_range_for(views, cam.position, o));
-    const LightfieldCpuRenderer renderer = need(LightfieldCpuRenderer::make(views, o));
+    const LightfieldCpuRenderer renderer = make_renderer(views, o);
     RenderedImage img;
     if (Status s = renderer.render(cam, &img); !s.ok()) die(s);
     renders.push_back(std::move(img));
@@ -689,7 +695,7 @@ int main(int argc, char** argv) {
   if (g_supersample < 1 || g_supersample > 8) {
     die(Status(ErrorId::kInvalidArgument, "--supersample must be in 1..8"));
   }
-  if (!active_arg.empty()) base.active_views = parse_list(active_arg);
+  if (!active_arg.empty()) g_active_views = parse_list(active_arg);
   const capture::CaptureSetReader reader = need(capture::CaptureSetReader::open(capture_dir));
   const capture::CaptureManifest& m = reader.manifest();
   std::vector<Variant> variants;

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -66,13 +67,14 @@ struct Comparison {
 
 // Renders `cam` with both renderers from the same views and options (march range from the CPU's
 // march_range_for, the same one the GL overload computes).
-Comparison compare(const ViewSet& views, const Camera& cam, LightfieldRenderOptions o) {
+Comparison compare(const ViewSet& views, const Camera& cam, LightfieldRenderOptions o,
+                   std::span<const uint32_t> active = {}) {
   Comparison c;
   o = *march_range_for(views, cam.position, o);
   o.threads = 2;
   const Expected<LightfieldCpuRenderer> cpu = LightfieldCpuRenderer::make(views, o);
   EXPECT_TRUE(cpu.ok()) << cpu.status().to_string();
-  EXPECT_TRUE(cpu->render(cam, &c.cpu).ok());
+  EXPECT_TRUE(cpu->render(cam, active, &c.cpu).ok());
 
   Expected<ViewSetUpload> up = updates_from_view_set(views);
   EXPECT_TRUE(up.ok()) << up.status().to_string();
@@ -85,7 +87,7 @@ Comparison compare(const ViewSet& views, const Camera& cam, LightfieldRenderOpti
   EXPECT_EQ(gl_range.far, o.far);
   Expected<std::unique_ptr<LightfieldGlRenderer>> gl = LightfieldGlRenderer::make(**gv, o);
   EXPECT_TRUE(gl.ok()) << gl.status().to_string();
-  const Status rendered = (*gl)->render(cam, &c.gl);
+  const Status rendered = (*gl)->render(cam, active, &c.gl);
   EXPECT_TRUE(rendered.ok()) << rendered.to_string();
   if (c.gl.color.size() != c.cpu.color.size()) return c;
 
@@ -317,14 +319,13 @@ TEST(LightfieldGlRenderer, MatchesCpuWithActiveSubsetAndMixedFaceSizes) {
   views.views[6] = testing::make_view(scene, pos[6], 24);
   const Camera cam = between_views_camera(72);
   LightfieldRenderOptions o;
-  o.active_views = {6, 1, 3};
-  const Comparison c = compare(views, cam, o);
+  const uint32_t active[] = {6, 1, 3};
+  const Comparison c = compare(views, cam, o, active);
   report("active views {6, 1, 3}, faces 24/32/40", c);
   EXPECT_GE(c.psnr, 45.0);
   expect_float_agreement(c);
   EXPECT_GE(c.depth_agree, 0.99);
   // The subset matters: all eight views give a different image.
-  o.active_views.clear();
   const Comparison all = compare(views, cam, o);
   report("all 8 views, faces 24/32/40", all);
   EXPECT_GE(all.psnr, 45.0);
@@ -650,9 +651,6 @@ TEST(LightfieldGlRenderer, RejectsBadOptionsAndCameras) {
   o.far = std::numeric_limits<double>::infinity();
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
   o = {};
-  o.active_views = {1};
-  EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
-  o = {};
   o.rr_max_depth = 9;
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
   o = {};
@@ -663,9 +661,6 @@ TEST(LightfieldGlRenderer, RejectsBadOptionsAndCameras) {
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
   o = {};
   o.supersample = 9;
-  EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
-  o = {};
-  o.active_views.assign(257, 0);  // more than the shader's view block holds
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
   o = {};
   o.coverage_layers = 2;  // the CPU reference's compositing only: refused, never ignored
@@ -685,6 +680,14 @@ TEST(LightfieldGlRenderer, RejectsBadOptionsAndCameras) {
   cam = {};
   cam.width = 0;
   EXPECT_EQ(r->render(cam, &img).id(), ErrorId::kPlayerOptions);
+  // The frame's active views: an index at or above the view count, more than the shader's view
+  // block holds.
+  cam = {};
+  cam.width = cam.height = 4;
+  const uint32_t past_the_end[] = {1};
+  EXPECT_EQ(r->render(cam, past_the_end, &img).id(), ErrorId::kPlayerOptions);
+  const std::vector<uint32_t> too_many(257, 0);
+  EXPECT_EQ(r->render(cam, too_many, &img).id(), ErrorId::kPlayerOptions);
   EXPECT_EQ(march_range_for(GlTextureLayout{}, {}, {}).status().id(), ErrorId::kPlayerOptions);
 }
 

@@ -784,9 +784,6 @@ TEST(LightfieldCpuRenderer, RejectsBadOptionsAndCameras) {
   o.far = std::numeric_limits<double>::infinity();
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
   o = {};
-  o.active_views = {1};
-  EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
-  o = {};
   o.threads = 0;
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
   o = {};
@@ -834,6 +831,14 @@ TEST(LightfieldCpuRenderer, RejectsBadOptionsAndCameras) {
   cam = {};
   cam.width = 0;
   EXPECT_EQ(r.render(cam, &img).id(), ErrorId::kPlayerOptions);
+  // The frame's active views: an index at or above the view count.
+  cam = {};
+  cam.width = cam.height = 4;
+  const uint32_t past_the_end[] = {1};
+  EXPECT_EQ(r.render(cam, past_the_end, &img).id(), ErrorId::kPlayerOptions);
+  EXPECT_EQ(r.restricted_to(past_the_end).status().id(), ErrorId::kPlayerOptions);
+  const uint32_t first[] = {0};
+  EXPECT_TRUE(r.render(cam, first, &img).ok());
 }
 
 // The RR variant on a mirror floor between viewpoints. Known gap: on this scene RR does not yet

@@ -211,8 +211,6 @@ struct LightfieldRenderOptions {
   // within one step (a silhouette grazed by the ray, a fin) shows as a crossing between two
   // substeps. Each hint offers its first crossing of a step.
   uint32_t surface_hint_substeps = 4;
-  // Indices into the ViewSet of the views to use, in any order; empty = all views.
-  std::vector<uint32_t> active_views;
   // Worker threads over image rows (1..256). The result does not depend on it.
   uint32_t threads = 1;
   // Eye rays per pixel along each axis (1..8). The pixel's colour is the mean of n x n rays
@@ -261,21 +259,33 @@ Expected<LightfieldRenderOptions> march_range_for(std::span<const MarchView> vie
 Expected<LightfieldRenderOptions> march_range_for(const ViewSet& views, const Vec3& eye,
                                                   LightfieldRenderOptions options);
 
-// The checks every renderer applies to its options (CALF-E403 naming the option): ranges of
-// every field and active view indices below `view_count`.
-Status validate_render_options(const LightfieldRenderOptions& options, size_t view_count);
+// The checks every renderer applies to its options (CALF-E403 naming the option): the range of
+// every field.
+Status validate_render_options(const LightfieldRenderOptions& options);
+
+// The views a frame uses (per-frame state, apart from the options): indices into the view set, in
+// any order; empty = every view. CALF-E403 for an index not below `view_count`.
+Status validate_active_views(std::span<const uint32_t> active_views, size_t view_count);
 
 class LightfieldCpuRenderer {
  public:
   // Validates the options against the views (CALF-E403 naming the bad option). The renderer keeps
-  // a reference to `views`: they must outlive it and may be updated between frames.
+  // a reference to `views`: they must outlive it and may be updated between frames. It uses every
+  // view until restricted_to() or render()'s `active_views` names some.
   static Expected<LightfieldCpuRenderer> make(const ViewSet& views,
                                               const LightfieldRenderOptions& options);
 
-  // Renders `camera` (the one camera model, calf/format/camera.h) into `out` (resized).
-  // CALF-E403 for an invalid camera (validate_camera: non-finite position, zero or parallel
-  // forward / up, fov outside (0, pi), size outside 1..16384).
-  Status render(const Camera& camera, RenderedImage* out) const;
+  // The same renderer using only `active_views` (validate_active_views; empty = every view) in
+  // render(), trace() and shade_at().
+  Expected<LightfieldCpuRenderer> restricted_to(std::span<const uint32_t> active_views) const;
+
+  // Renders `camera` (the one camera model, calf/format/camera.h) into `out` (resized) with the
+  // frame's `active_views` (empty = this renderer's views). CALF-E403 for an invalid camera
+  // (validate_camera: non-finite position, zero or parallel forward / up, fov outside (0, pi),
+  // size outside 1..16384) or active view.
+  Status render(const Camera& camera, std::span<const uint32_t> active_views,
+                RenderedImage* out) const;
+  Status render(const Camera& camera, RenderedImage* out) const { return render(camera, {}, out); }
 
   // One ray from `origin` along unit `direction`: Alg. 4 Main (or Main_RR with options.rr).
   RaySample trace(const Vec3& origin, const Vec3& direction) const;

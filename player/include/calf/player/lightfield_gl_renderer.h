@@ -28,6 +28,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 
 #include "calf/format/status.h"
 #include "calf/player/gl_views.h"
@@ -56,22 +57,26 @@ class LightfieldGlRenderer {
   LightfieldGlRenderer(const LightfieldGlRenderer&) = delete;
   LightfieldGlRenderer& operator=(const LightfieldGlRenderer&) = delete;
 
-  // New options for the next frames (active views, march range, ...). Nothing is recompiled,
+  // New options for the next frames (march range, weights, ...). Nothing is recompiled,
   // except when surface_hints changes: the hint count is compiled into the shader (its per-hint
   // state then stays in registers; llvmpipe's first frame after it pays the compile, ~2 s).
   // Errors as make(); the old options (and program) stay on error.
   Status set_options(const LightfieldRenderOptions& options);
   const LightfieldRenderOptions& options() const { return options_; }
 
-  // Renders `camera` into `out` (resized): colour and radial distance per pixel, row 0 at the
-  // top, as LightfieldCpuRenderer::render. Errors: CALF-E403 for an invalid camera (as the CPU
-  // renderer), CALF-E412 when GL reports an error.
-  Status render(const Camera& camera, RenderedImage* out);
+  // Renders `camera` with the frame's `active_views` (indices into the layout's views, in any
+  // order; empty = every view) into `out` (resized): colour and radial distance per pixel, row 0
+  // at the top, as LightfieldCpuRenderer::render. Errors: CALF-E403 for an invalid camera (as the
+  // CPU renderer) or active view (validate_active_views, or more than the shader's view block
+  // holds), CALF-E412 when GL reports an error.
+  Status render(const Camera& camera, std::span<const uint32_t> active_views, RenderedImage* out);
+  Status render(const Camera& camera, RenderedImage* out) { return render(camera, {}, out); }
 
-  // Draws `camera` into the framebuffer bound to GL_DRAW_FRAMEBUFFER, viewport (0, 0, width,
-  // height) of the camera, output 0 = (rgb, radial distance): for a player that composites the
-  // result itself. Leaves program, textures and buffer bindings changed.
-  Status draw(const Camera& camera);
+  // Draws `camera` with `active_views` (as render()) into the framebuffer bound to
+  // GL_DRAW_FRAMEBUFFER, viewport (0, 0, width, height) of the camera, output 0 = (rgb, radial
+  // distance): for a player that composites the result itself. Leaves program, textures and
+  // buffer bindings changed.
+  Status draw(const Camera& camera, std::span<const uint32_t> active_views = {});
 
  private:
   LightfieldGlRenderer(const GlViews& views, const LightfieldRenderOptions& options);

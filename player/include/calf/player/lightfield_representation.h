@@ -34,7 +34,8 @@
 namespace calf::player {
 
 struct LightfieldOptions {
-  // Steps, weights, RR, ... ; active_views, near and far are set per frame.
+  // Steps, weights, RR, ... ; near and far are set per frame. The frame's active views (view
+  // selection's) go to the renderer's render() apart from these options.
   LightfieldRenderOptions render;
   // Keep the march range in `render` instead of deriving it per frame.
   bool fixed_march_range = false;

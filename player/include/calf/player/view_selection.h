@@ -82,7 +82,7 @@ inline constexpr uint32_t kNoView = 0xFFFFFFFFu;
 
 // One frame's selection.
 struct ViewSelection {
-  // The active views, best priority first (pass as LightfieldRenderOptions::active_views).
+  // The active views, best priority first (pass to the renderer's render()).
   std::vector<uint32_t> active;
   // The slot table: slots[s] is the view in texture slot s, or kNoView for a hole left by a view
   // that went inactive. No trailing holes; size <= max_active. A view keeps its slot for as long
