@@ -66,6 +66,7 @@ uniform bool depth_aware_colour;
 uniform float surface_hint_margin_texels;  // of its own texels a vetoing view must see beyond
 uniform uint surface_hint_vetoes;   // vetoes a hint crossing survives
 uniform uint surface_hint_substeps; // hint tests per step
+uniform uint surface_hint_coverage; // LightfieldRenderOptions::surface_hint_coverage (0, 1)
 uniform bool rr;
 uniform bool rr_replace_view_reflection;
 uniform float rr_start;
@@ -328,6 +329,27 @@ int hint_side(uint h, vec3 o, vec3 d, float x) {
   return float(code) > calf_code_from_log_depth(log(r), log_range(v)) ? 1 : 0;
 }
 
+// ---- LightfieldCpuRenderer::hint_confirmed (surface_hint_coverage 1): whether view h's coverage
+// says its surface covers the direction, at the point x of the ray, inside the texel the
+// direction falls in (its cell); no coverage confirms ----
+bool hint_confirmed(uint h, vec3 o, vec3 d, float x) {
+#ifdef CALF_COVERAGE
+  CalfView v = views[h];
+  if (surface_hint_coverage == 0u || v.coverage_layer < 0) return true;
+  vec3 rel = o + d * lin(x) - v.position;
+  int face = face_of(rel);
+  vec2 uv = texel_coord(rel, face, v.face_size);
+  ivec2 t = ivec2(clamp_texel(uv.x, v.face_size), clamp_texel(uv.y, v.face_size));
+  uvec4 cov = texelFetch(coverage_tex, ivec3(t, v.coverage_layer + face), 0);
+  uint mask = cov.x | cov.y << 8;
+  if (mask == 0xFFFFu) return true;
+  ivec2 cell = clamp(ivec2(floor((uv - floor(uv)) * 4.0)), ivec2(0), ivec2(3));
+  return ((mask >> uint(4 * cell.y + cell.x)) & 1u) != 0u;
+#else
+  return true;
+#endif
+}
+
 bool intersect(vec3 o, vec3 d, float start, out float z_hit) {
   z_hit = INF;
   if (tight_march_start) {
@@ -433,17 +455,21 @@ bool intersect(vec3 o, vec3 d, float start, out float z_hit) {
       for (int h = 0; h < CALF_HINTS; ++h) {
         crossing[h] = INF;
         if (uint(h) >= hints) continue;
+        bool crossed = false;  // each hint offers its first crossing of the step
         for (uint s = i == 0u ? surface_hint_substeps : 1u; s <= surface_hint_substeps; ++s) {
           float xs = s == surface_hint_substeps ? x : x - step + float(s) * sub_step;
           int now = hint_side(hint[h], o, d, xs);
-          if (i > 0u && crossing[h] == INF && prev[h] == 1 && now == 0) {
+          if (i > 0u && !crossed && prev[h] == 1 && now == 0) {
+            crossed = true;
             float clo = xs - sub_step, chi = xs;
             for (uint b = 0u; b < refine_steps; ++b) {
               float mid = 0.5 * (clo + chi);
               if (hint_side(hint[h], o, d, mid) == 1) clo = mid; else chi = mid;
             }
-            crossing[h] = 0.5 * (clo + chi);
-            any = true;
+            if (hint_confirmed(hint[h], o, d, chi)) {
+              crossing[h] = 0.5 * (clo + chi);
+              any = true;
+            }
           }
           prev[h] = now;
         }

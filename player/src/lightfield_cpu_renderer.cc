@@ -93,6 +93,7 @@ Status validate_render_options(const LightfieldRenderOptions& o) {
   if (o.coverage_agreement < 1 || o.coverage_agreement > 65536) {
     return option_error("coverage_agreement is outside [1, 65536]");
   }
+  if (o.surface_hint_coverage > 3) return option_error("surface_hint_coverage is not 0, 1, 2 or 3");
   if (o.coverage_layers > 8) return option_error("coverage_layers is above 8");
   if (o.coverage_alpha > 2) return option_error("coverage_alpha is not 0, 1 or 2");
   if (!std::isfinite(o.min_view_distance)) return option_error("min_view_distance is not finite");
@@ -300,6 +301,36 @@ double coverage_alpha_of_view(const View& v, const Vec3& x, double r, double clu
   return wsum > 0 ? std::clamp(alpha / wsum, 0.0, 1.0) : -1.0;
 }
 
+// Whether view v's coverage says its surface covers the direction of x (at distance r) inside
+// the texel the direction falls in (LightfieldRenderOptions::surface_hint_coverage): 1 where the
+// 4 x 4 cell mask of that texel shows the texel's own surface at the direction's cell (or at one
+// of the cells around it, `grow` = 1), 0 where it does not, -1 where v has nothing to say (no
+// coverage; with `at_depth`, a texel not within a relative depth `cluster` of r or sky).
+int hint_cell_covered(const View& v, const Vec3& x, double r, int grow, bool at_depth,
+                      double cluster) {
+  if (!v.has_coverage()) return -1;
+  const Texel t = texel_from_direction(x, v.face_size());
+  const uint16_t code = v.depth_code_at(t.face, t.x, t.y);
+  if (at_depth) {
+    if (code == kLog16Sky) return -1;
+    const double rcode = v.range().normalized_from_depth(r) * kLog16MaxFinite;
+    if (std::fabs(code - rcode) > cluster / v.range().relative_step()) return -1;
+  }
+  const uint32_t mask = v.coverage_at(t.face, t.x, t.y).mask;
+  if (mask == 0xFFFF) return 1;
+  const FaceTexelCoord fc = texel_coord_from_direction(x, v.face_size());
+  const auto cell = [](double u) {
+    return std::clamp(static_cast<int>(std::floor((u - std::floor(u)) * 4)), 0, 3);
+  };
+  const int cx = cell(fc.u), cy = cell(fc.v);
+  for (int j = std::max(cy - grow, 0); j <= std::min(cy + grow, 3); ++j) {
+    for (int i = std::max(cx - grow, 0); i <= std::min(cx + grow, 3); ++i) {
+      if ((mask >> (4 * j + i)) & 1u) return 1;
+    }
+  }
+  return 0;
+}
+
 // `texels` texel angles of v (2 / face size radians each, a texel's width at the face centre) as
 // a relative depth, in v's log-16 code units: the scale of the hint margin and the mixed-texel
 // bend.
@@ -464,8 +495,9 @@ bool LightfieldCpuRenderer::intersect(const Vec3& o, const Vec3& d, double start
             (side(hint[h], mid) == 1 ? lo : hi) = mid;
           }
           const double xc = 0.5 * (lo + hi);
-          if (xc < found && !empty_beyond(o + d * lin(xc), options_.surface_hint_margin_texels,
-                                          options_.surface_hint_vetoes, exclude)) {
+          if (xc < found && hint_confirmed(o, d, lin(hi), lin(xc), hint[h]) &&
+              !empty_beyond(o + d * lin(xc), options_.surface_hint_margin_texels,
+                            options_.surface_hint_vetoes, exclude)) {
             found = xc;
           }
         }
@@ -478,6 +510,31 @@ bool LightfieldCpuRenderer::intersect(const Vec3& o, const Vec3& d, double start
       hit->hinted = true;
       return true;
     }
+  }
+  return false;
+}
+
+// LightfieldRenderOptions::surface_hint_coverage: whether the coverage of the hint view h confirms
+// its crossing of the ray (o, d) at distance zc, found between zc and the first point zb behind
+// h's surface.
+bool LightfieldCpuRenderer::hint_confirmed(const Vec3& o, const Vec3& d, double zb, double zc,
+                                           const View* h) const {
+  const uint32_t mode = options_.surface_hint_coverage;
+  if (mode == 0) return true;
+  // The texel whose surface the ray went behind, at the direction of the point behind it.
+  const Vec3 xb = o + d * zb - h->position();
+  const int own = hint_cell_covered(*h, xb, length(xb), mode == 2 ? 1 : 0, false, 0);
+  if (own != 0) return true;
+  if (mode != 3) return false;
+  // Mode 3: another view whose nearest texel lies at the crossing's depth and covers its
+  // direction there.
+  const Vec3 p = o + d * zc;
+  for (const View* v : active_) {
+    if (v == h) continue;
+    const Vec3 x = p - v->position();
+    const double r = length(x);
+    if (r <= min_view_distance_) continue;
+    if (hint_cell_covered(*v, x, r, 0, true, options_.coverage_cluster) == 1) return true;
   }
   return false;
 }

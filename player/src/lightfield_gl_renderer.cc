@@ -28,6 +28,9 @@ Status option_error(const std::string& what) {
 Status check_options(const LightfieldRenderOptions& o) {
   CALF_RETURN_IF_ERROR(validate_render_options(o));
   if (o.coverage_layers > 0) return option_error("coverage_layers is the CPU reference's only");
+  if (o.surface_hint_coverage > 1) {
+    return option_error("surface_hint_coverage 2 and 3 are the CPU reference's only");
+  }
   return Status::Ok();
 }
 
@@ -201,6 +204,7 @@ Status LightfieldGlRenderer::draw(const Camera& camera, std::span<const uint32_t
   gl.Uniform1f(loc("surface_hint_margin_texels"), f(o.surface_hint_margin_texels));
   gl.Uniform1ui(loc("surface_hint_vetoes"), o.surface_hint_vetoes);
   gl.Uniform1ui(loc("surface_hint_substeps"), o.surface_hint_substeps);
+  gl.Uniform1ui(loc("surface_hint_coverage"), o.surface_hint_coverage);
   gl.Uniform1i(loc("rr"), o.rr ? 1 : 0);
   gl.Uniform1i(loc("rr_replace_view_reflection"), o.rr_replace_view_reflection ? 1 : 0);
   gl.Uniform1f(loc("rr_start"), f(o.rr_start));

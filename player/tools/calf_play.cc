@@ -247,6 +247,12 @@ static int command_main(int argc, char** argv) {
                  "light field, with --coverage: a point that a view calls empty only through its "
                  "coverage is empty once this many views say so")
       ->check(CLI::Range(1u, 65536u));
+  app.add_option(
+         "--hint-coverage", o.render.surface_hint_coverage,
+         "light field, with coverage: a surface hint's crossing ends the ray only where the "
+         "hint view's coverage covers the ray's direction in its texel (the direction's "
+         "cell): 0 off, 1 on")
+      ->check(CLI::Range(0u, 1u));
   app.add_option("--supersample", o.render.supersample,
                  "light field: N x N eye rays per pixel on an even grid, colour their mean (a box "
                  "filter, as the ground truth's), depth the nearest; anti-aliases silhouettes and "
@@ -280,7 +286,7 @@ static int command_main(int argc, char** argv) {
   group("Light field renderer", {"--steps", "--rr", "--no-rr-replace", "--hints", "--hint-substeps",
                                  "--mixed-texel-penalty", "--supersample", "--views", "--priority",
                                  "--frame-ms", "--no-view-dependent"});
-  group("Light field coverage", {"--coverage", "--coverage-agreement"});
+  group("Light field coverage", {"--coverage", "--coverage-agreement", "--hint-coverage"});
   group("Surfels", {"--surfel-point-size", "--surfel-target-ms", "--surfel-clock", "--surfel-blend",
                     "--surfel-foveation"});
   group("Tiles", {"--tiles-blend", "--tiles-occlusion-alpha", "--tiles-occlusion-epsilon"});

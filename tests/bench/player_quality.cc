@@ -593,6 +593,10 @@ int main(int argc, char** argv) {
   app.add_option("--tight-start", base.tight_march_start, "tight_march_start (0/1)")
       ->capture_default_str();
   app.add_option("--hints", base.surface_hints, "surface_hints")->capture_default_str();
+  app.add_option("--hint-coverage", base.surface_hint_coverage,
+                 "surface_hint_coverage: 0 off, 1 a hint crossing needs its cell covered, 2 or a "
+                 "cell next to it, 3 or another view's cell at its depth")
+      ->capture_default_str();
   app.add_option("--mixed-penalty", base.mixed_texel_penalty, "mixed_texel_penalty (0 = off)")
       ->capture_default_str();
   app.add_option("--mixed-bend", base.mixed_texel_bend_texels, "mixed_texel_bend_texels")
@@ -764,7 +768,7 @@ int main(int argc, char** argv) {
       "texels), tight start %d, "
       "hints %u (margin %.3f texels, vetoes %u, substeps %u), rr_start %.3f, rr replace %d, "
       "supersample %u (renderer %u), threads %u; coverage %u (threshold %.2f, cluster %.3f, "
-      "agreement %u, unmix %.2f, layers %u, alpha rule %u)\n",
+      "agreement %u, unmix %.2f, layers %u, alpha rule %u, hint coverage %u)\n",
       m.scene.c_str(), m.viewpoints.size(), m.face_size, m.frame_count, base.steps,
       base.refine_steps, base.depth_footprint, base.smooth_depth_ratio, base.depth_decay,
       base.cam_decay, base.colour_depth_tolerance, base.mixed_texel_penalty,
@@ -772,7 +776,7 @@ int main(int argc, char** argv) {
       base.surface_hint_margin_texels, base.surface_hint_vetoes, base.surface_hint_substeps,
       base.rr_start, base.rr_replace_view_reflection, g_supersample, base.supersample, base.threads,
       base.coverage, base.coverage_threshold, base.coverage_cluster, base.coverage_agreement, unmix,
-      base.coverage_layers, base.coverage_alpha);
+      base.coverage_layers, base.coverage_alpha, base.surface_hint_coverage);
   FrameCache frames(reader, unmix);
   if (!montage_file.empty()) {
     if (between.empty()) die(Status(ErrorId::kInvalidArgument, "--montage needs --eye-path"));

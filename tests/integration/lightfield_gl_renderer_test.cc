@@ -391,6 +391,32 @@ TEST(LightfieldGlRenderer, MatchesCpuWithCoverage) {
   std::printf("coverage 4 moves %zu of %u pixels across the silhouette\n", moved,
               cam.width * cam.height);
   EXPECT_GT(moved, 100u);
+  // Hint crossings confirmed by the hint view's cell (surface_hint_coverage 1): the CPU sends the
+  // grazing rays that the hints grew onto the sphere to the sky, so a GL renderer that ignored
+  // the rule would fail the flip bound (measured: 66.2 dB, coverage off; 182 pixels moved).
+  o.coverage_agreement = 1;
+  size_t unhinted = 0;
+  for (const auto& [mode, rule] : {std::pair{0u, 1u}, std::pair{1u, 1u}}) {
+    o.coverage = mode;
+    o.surface_hint_coverage = rule;
+    const Comparison c = compare(sky_views, cam, o);
+    const std::string what = "sphere against the sky, coverage " + std::to_string(mode) +
+                             ", hint coverage " + std::to_string(rule);
+    report(what.c_str(), c);
+    EXPECT_GE(c.psnr, 45.0) << what;
+    EXPECT_LE(c.flips, 9u) << what;
+    if (mode == 0 && rule == 1) {
+      o.surface_hint_coverage = 0;
+      const Comparison off = compare(sky_views, cam, o);
+      for (size_t k = 0; k < off.cpu.depth.size(); ++k) {
+        unhinted += std::isfinite(off.cpu.depth[k]) != std::isfinite(c.cpu.depth[k]);
+      }
+    }
+  }
+  o.surface_hint_coverage = 0;
+  std::printf("hint coverage 1 moves %zu of %u pixels across the silhouette\n", unhinted,
+              cam.width * cam.height);
+  EXPECT_GT(unhinted, 20u);
 
   // A wall behind the silhouettes; coverage in views 0 and 2 only.
   const Scene room = room_with_spheres();
@@ -664,6 +690,11 @@ TEST(LightfieldGlRenderer, RejectsBadOptionsAndCameras) {
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
   o = {};
   o.coverage_layers = 2;  // the CPU reference's compositing only: refused, never ignored
+  EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
+  o = {};
+  o.surface_hint_coverage = 2;  // the CPU reference's only: refused, never ignored
+  EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
+  o.surface_hint_coverage = 3;
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
   std::unique_ptr<LightfieldGlRenderer> r = *LightfieldGlRenderer::make(*gv, {});
   o = {};

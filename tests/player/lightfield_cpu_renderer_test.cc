@@ -594,6 +594,84 @@ TEST(LightfieldCpuRenderer, CoverageLayersShowTheSkyBehindGrownSilhouettes) {
   EXPECT_LT(inside_hinted, 1.1 * inside_off + 1e-3 * inside);
 }
 
+// Hint crossings confirmed by coverage (LightfieldRenderOptions::surface_hint_coverage): the sphere
+// of CoveragePlacesSilhouettesInsideTexels between four coarse anti-aliased views, and the thin
+// spheres of CoverageAgreementKeepsThinParts. The hint view's grazing rays cross its edge texels'
+// depth beside the sphere, where the texel's cells show the sky: without the rule such a crossing
+// ends the ray on the sphere (a grown silhouette), with it the march goes on to the sky. Counted:
+// eye pixels the render sends to a sphere where the ground truth sees sky (grown), and the thin
+// spheres' pixels found at their depth (within 5 %). Measured: 1085 grown pixels without the
+// rule, 907 with R = 1 (1062 with R = 2, 907 with R = 3); with coverage mode 3, 508 and 417; the
+// thin spheres keep 1200 of 1239 pixels either way.
+TEST(LightfieldCpuRenderer, HintCoverageStopsGrowingSilhouettesIntoTheSky) {
+  Scene scene;
+  scene.room = false;
+  scene.uniform_sky = true;
+  scene.spheres = {{{0.05, -0.03, -2.0}, 0.3}};
+  const std::vector<Vec3> pos = {
+      {-0.3, 0.1, 0.2}, {0.3, -0.1, 0.2}, {0.1, 0.3, 0.1}, {-0.1, -0.3, 0.1}};
+  ViewSet views = make_views(scene, pos, 32, false, 4);
+  for (View& v : views.views) testing::add_coverage(scene, &v);
+  const Vec3 eye = {0.04, 0.03, 0.1};
+  Camera cam;
+  cam.position = eye;
+  cam.forward = testing::unit(testing::sub(scene.spheres[0].centre, eye));
+  cam.fov_y = 24 * kPi / 180;
+  cam.width = cam.height = 96;
+  const RenderedImage gt = ground_truth(scene, cam);
+  const auto grown = [&](uint32_t rule, uint32_t coverage) {
+    LightfieldRenderOptions o;
+    o.steps = 128;
+    o.coverage = coverage;
+    o.surface_hint_coverage = rule;
+    const RenderedImage img = render(views, cam, o);
+    size_t n = 0, sphere = 0;
+    for (size_t k = 0; k < gt.depth.size(); ++k) {
+      n += !std::isfinite(gt.depth[k]) && std::isfinite(img.depth[k]);
+      sphere += std::isfinite(gt.depth[k]);
+    }
+    std::printf("hint coverage %u, coverage %u: %zu grown pixels (sphere %zu), %.2f dB\n", rule,
+                coverage, n, sphere, psnr(img.color, gt.color));
+    EXPECT_GE(sphere, 1000u);
+    return static_cast<double>(n);
+  };
+  const double off = grown(0, 0), own = grown(1, 0), near = grown(2, 0), agreed = grown(3, 0);
+  EXPECT_GE(off, 100);
+  EXPECT_LT(own, 0.9 * off);
+  EXPECT_LE(own, near);
+  EXPECT_LE(own, agreed);
+  EXPECT_LT(grown(1, 3), 0.9 * grown(0, 3));
+
+  Scene thin;
+  thin.room = false;
+  thin.uniform_sky = true;
+  for (int k = 0; k < 5; ++k) thin.spheres.push_back({{-0.8 + 0.4 * k, 0.05 * k - 0.1, -2.0}, 0.1});
+  ViewSet thin_views = make_views(thin, pos, 32, false, 4);
+  for (View& v : thin_views.views) testing::add_coverage(thin, &v);
+  Camera wide;
+  wide.position = eye;
+  wide.forward = {0, 0, -1};
+  wide.fov_y = 30 * kPi / 180;
+  wide.width = wide.height = 128;
+  const RenderedImage thin_gt = ground_truth(thin, wide);
+  const auto found = [&](uint32_t rule) {
+    LightfieldRenderOptions o;
+    o.steps = 128;
+    o.surface_hint_coverage = rule;
+    const RenderedImage img = render(thin_views, wide, o);
+    size_t on_sphere = 0, right = 0;
+    for (size_t k = 0; k < thin_gt.depth.size(); ++k) {
+      if (!std::isfinite(thin_gt.depth[k])) continue;
+      ++on_sphere;
+      right += std::fabs(img.depth[k] / thin_gt.depth[k] - 1) < 0.05;
+    }
+    std::printf("hint coverage %u: %zu of %zu thin-sphere pixels found\n", rule, right, on_sphere);
+    return static_cast<double>(right) / on_sphere;
+  };
+  const double thin_off = found(0);
+  EXPECT_GT(found(1), 0.9 * thin_off);
+}
+
 // Views without coverage render exactly as before whatever the coverage option says.
 TEST(LightfieldCpuRenderer, ViewsWithoutCoverageRenderAsBefore) {
   const ViewSet views = make_views(room_with_spheres(), corner_views({0, 0, 0.5}, 1.0), 24);
@@ -609,6 +687,10 @@ TEST(LightfieldCpuRenderer, ViewsWithoutCoverageRenderAsBefore) {
   const RenderedImage c = render(views, cam, on);
   EXPECT_EQ(a.color, c.color);
   EXPECT_EQ(a.depth, c.depth);
+  on.surface_hint_coverage = 3;
+  const RenderedImage d = render(views, cam, on);
+  EXPECT_EQ(a.color, d.color);
+  EXPECT_EQ(a.depth, d.depth);
 }
 
 TEST(LightfieldCpuRenderer, ImageDoesNotDependOnThreadCount) {

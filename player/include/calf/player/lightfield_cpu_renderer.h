@@ -211,6 +211,16 @@ struct LightfieldRenderOptions {
   // within one step (a silhouette grazed by the ray, a fin) shows as a crossing between two
   // substeps. Each hint offers its first crossing of a step.
   uint32_t surface_hint_substeps = 4;
+  // Hint crossings confirmed by coverage (views that carry it): a hint
+  // view's crossing ends the ray only where that view's coverage says its surface covers the
+  // ray's direction inside the texel the ray went behind (its 4 x 4 cell mask at the direction
+  // of the first point behind the surface). 0: off (every crossing counts, as without coverage);
+  // 1: the direction's own cell; 2: that cell or one next to it in the texel; 3: as 1, or where
+  // another view whose nearest texel at the crossing lies at its depth (within coverage_cluster)
+  // covers its direction there (2 and 3: the CPU reference only, the GL renderer refuses them). A
+  // hint view without coverage confirms every crossing. Off by default (docs/RENDERING.md
+  // "Coverage").
+  uint32_t surface_hint_coverage = 0;
   // Worker threads over image rows (1..256). The result does not depend on it.
   uint32_t threads = 1;
   // Eye rays per pixel along each axis (1..8). The pixel's colour is the mean of n x n rays
@@ -307,6 +317,7 @@ class LightfieldCpuRenderer {
   };
   RaySample shade_hit(const Vec3& origin, const Vec3& direction, const Hit* hit) const;
   double tap_purity(const View& v, const Texel& t) const;
+  bool hint_confirmed(const Vec3& o, const Vec3& d, double zb, double zc, const View* h) const;
   // `exclude` (nullptr: none): a surface point of an earlier layer; each view treats its texels
   // at that point's depth (within coverage_cluster) as absent
   // (LightfieldRenderOptions::coverage_layers).
