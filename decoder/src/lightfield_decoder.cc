@@ -333,6 +333,9 @@ Status LightfieldDecoder::Impl::update_cell_av1(uint32_t view, uint32_t face, ui
       }
       s.av1_decoded = keys.first_frame + u;
     }
+    const uint32_t pictures = frame - keys.first_frame + 1 - next;
+    out->stats.av1_pictures += pictures;
+    out->stats.av1_max_pictures_per_cell = std::max(out->stats.av1_max_pictures_per_cell, pictures);
     std::vector<uint8_t> gpu;
     CALF_RETURN_IF_ERROR(
         s.av1->gpu_bytes(header.colour_format, rect.width, rect.height, curve, gpu, what));

@@ -25,6 +25,13 @@
 //   bench-lightfield_table1 --capture DIR [--capture DIR ...] [--threads N] [--psnr Q]
 //       [--depth-format raw16|pred16|pred16m] [--depth-fixed-groups] [--no-colour-peers]
 //       [--no-lzma2] [--video-peers [--x265-preset P] [--x265-params K=V:...]]
+//       [--psnr-auto] [--av1-crf N ... [--av1-preset P] [--av1-keyframe-interval K]
+//       [--av1-cell C] [--csv FILE] [--no-peer-table] [--x265-pix-fmt F]]
+//
+// --av1-crf (with --video-peers) adds the AV1 colour mode (calf-encode --colour-codec av1) at each
+// CRF: the BC clip and each AV1 clip are decoded, their colour's PSNR against the capture taken
+// as the peer set takes it, and x265 matched to each; printed with bytes, ratio to x265, encode
+// s, decode ms, uploaded bytes and seek cost per frame, and the capture's render noise estimate.
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -46,6 +53,7 @@
 
 #include "calf/capture/capture_set.h"
 #include "calf/encoder/lightfield_encode.h"
+#include "calf/encoder/noise_estimate.h"
 #include "calf/format/bc.h"
 #include "calf/format/colour.h"
 #include "calf/format/log_depth.h"
@@ -208,7 +216,74 @@ struct Run {
   bool fixed_groups = false, lzma2 = true;
   bool video_peers = false;
   bench::PeerSettings peers;
+  bool peer_table = true;  // false: --video-peers measures the colour codings' matches only
+  bool psnr_auto = false;  // Q from the capture's noise estimate, as calf-encode --psnr auto
+  // The AV1 colour mode beside BC (with --video-peers): one encode per CRF, each matched by x265.
+  std::vector<uint32_t> av1_crfs;
+  encoder::Av1ColourOptions av1;
+  uint32_t av1_cell = 64;
+  std::string csv;  // append one line per colour coding matched by x265 (empty: none)
 };
+
+std::string noise_text(const encoder::NoiseEstimate& e, encoder::NoiseMetric metric) {
+  if (!e.psnr_db) return fmt::format("none ({} samples)", e.samples);
+  return fmt::format("{:.2f} dB {}", *e.psnr_db,
+                     metric == encoder::NoiseMetric::kLog2 ? "log2-PSNR" : "sRGB PSNR");
+}
+
+// The colour codings side by side, each against x265 at the PSNR it reaches.
+void print_matches(const std::string& scene, const capture::CaptureManifest& m,
+                   const std::optional<encoder::CaptureNoise>& noise,
+                   const std::vector<bench::ColourMatch>& rows, const std::string& error,
+                   const Run& run) {
+  fmt::print(
+      "Colour codings against x265 ({}, {}{}{}) at matched PSNR: PSNR of each "
+      "decoding's 8-bit sRGB frames against the capture's (mean per frame); render noise of the "
+      "capture (frame-to-frame, the keyframe test's metric): {}. Decode: LightfieldDecoder::"
+      "advance, every cell of every view, median ms of frames 2..{} in order; uploaded: mean "
+      "texture bytes a frame; seek: mean ms of a jump (last frame down to 1, then forwards by "
+      "2) and the most AV1 pictures one cell decoded for a jump.\n\n",
+      run.peers.x265_pix_fmt == "auto" ? std::string("8-bit 4:4:4 or RGB") : run.peers.x265_pix_fmt,
+      run.peers.x265_preset, run.peers.x265_params.empty() ? "" : ", ", run.peers.x265_params,
+      noise ? noise_text(noise->set, noise->metric) : std::string("not measured"), m.frame_count);
+  if (!error.empty()) {
+    fmt::print("- failed: {}\n\n", error);
+    return;
+  }
+  fmt::print(
+      "| colour coding | bytes | PSNR | x265 bytes | x265 PSNR (CRF) | × x265 | encode s | decode "
+      "ms/frame | uploaded bytes/frame | seek ms (pictures) |\n");
+  fmt::print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  std::FILE* csv = run.csv.empty() ? nullptr : std::fopen(run.csv.c_str(), "a");
+  for (const bench::ColourMatch& r : rows) {
+    const bool x = r.x265.available || r.x265.bytes > 0;
+    fmt::print(
+        "| {} | {} | {:.2f} dB | {} | {} | {} | {:.2f} | {:.2f} | {} | {:.2f} ({}) |\n",
+        r.calf.label, bytes(r.calf.colour_bytes), r.psnr_db,
+        x ? bytes(r.x265.bytes) : std::string("—"),
+        x ? fmt::format("{:.2f} dB ({:.2f})", r.x265.psnr_db, r.x265.crf) : "n/a: " + r.x265.note,
+        x && r.x265.bytes ? fmt::format("{:.2f}", static_cast<double>(r.calf.colour_bytes) /
+                                                      static_cast<double>(r.x265.bytes))
+                          : std::string("—"),
+        r.calf.encode_s, r.decode_ms, bytes(static_cast<uint64_t>(r.upload_bytes)), r.seek_ms,
+        r.seek_max_units);
+    if (csv) {
+      std::string label = r.calf.label;
+      std::replace(label.begin(), label.end(), ',', ';');
+      fmt::print(csv, "{},{},{},{},{:.4f},{},{:.4f},{:.0f},{:.3f},{:.3f}\n", scene, m.face_size,
+                 m.viewpoints.size(), label, r.psnr_db, r.calf.colour_bytes, r.x265.psnr_db,
+                 static_cast<double>(r.x265.bytes), r.calf.encode_s, r.decode_ms);
+    }
+  }
+  if (csv) std::fclose(csv);
+  for (const bench::ColourMatch& r : rows) {
+    if (!r.x265.note.empty() && r.x265.available) {
+      fmt::print("- x265 beside {}: {}\n", r.calf.label, r.x265.note);
+    }
+  }
+  fmt::print("\n");
+  std::fflush(stdout);
+}
 
 int run_one(const fs::path& dir, const Run& run) {
   const uint32_t threads = run.threads;
@@ -219,6 +294,22 @@ int run_one(const fs::path& dir, const Run& run) {
     return 1;
   }
   const auto& m = in->manifest();
+  // The render noise of the capture (the keyframe test's metric), which --psnr-auto sets Q from.
+  std::optional<encoder::CaptureNoise> noise;
+  double min_psnr_db = run.min_psnr_db;
+  if (run.psnr_auto || !run.av1_crfs.empty()) {
+    encoder::NoiseEstimateOptions no;
+    no.threads = threads;
+    auto n = encoder::estimate_capture_noise(*in, encoder::ColourCoding::kAuto, no);
+    if (!n.ok()) {
+      fmt::print(stderr, "{}: {}\n", dir.string(), n.status().to_string());
+      return 1;
+    }
+    noise = *n;
+    if (run.psnr_auto) {
+      min_psnr_db = encoder::auto_psnr_db(noise->set, encoder::kDefaultPsnrNoiseMargin);
+    }
+  }
   const fs::path tmp = fs::temp_directory_path() / fmt::format("calf-table1-{}", ::getpid());
   fs::create_directories(tmp);
   const fs::path zstd_clip = tmp / "zstd.calf";
@@ -228,7 +319,7 @@ int run_one(const fs::path& dir, const Run& run) {
                      bool merge_static_groups) {
     encoder::LightfieldEncodeOptions o;
     o.threads = threads;
-    o.min_psnr_db = run.min_psnr_db;
+    o.min_psnr_db = min_psnr_db;
     o.depth = depth;
     o.merge_static_groups = merge_static_groups;
     o.supercompression = sc;
@@ -288,7 +379,7 @@ int run_one(const fs::path& dir, const Run& run) {
   // calf-bench's peer set on the same capture, against the zstd clip.
   std::vector<bench::PeerRow> video_peers;
   std::string video_notes;
-  if (run.video_peers) {
+  if (run.video_peers && run.peer_table) {
     bench::CalfReference ref;
     ref.base_clip = zstd_clip;
     ref.base.colour_bytes = s.colour.stored;
@@ -307,6 +398,38 @@ int run_one(const fs::path& dir, const Run& run) {
       video_notes = "video peers failed: " + rows.status().to_string();
     }
   }
+  // BC and the AV1 mode at each CRF, each against x265 at the PSNR it reaches.
+  std::vector<bench::ColourMatch> matches;
+  std::string match_error;
+  if (run.video_peers && !run.av1_crfs.empty()) {
+    std::vector<bench::ColourClip> clips;
+    clips.push_back({fmt::format("{} Q {:.2f}", format_name(s.colour_format), min_psnr_db),
+                     zstd_clip, s.colour.stored, z->seconds});
+    for (uint32_t crf : run.av1_crfs) {
+      encoder::LightfieldEncodeOptions o = options(container::Compression::kZstd, run.depth, merge);
+      o.colour = encoder::ColourCoding::kAv1;
+      o.cell_size = run.av1_cell;
+      o.av1 = run.av1;
+      o.av1.crf = crf;
+      const fs::path clip = tmp / fmt::format("av1_{}.calf", crf);
+      auto r = encode(dir, clip, o, true);
+      if (!r.ok()) {
+        match_error = r.status().to_string();
+        break;
+      }
+      clips.push_back({fmt::format("AV1 CRF {}, preset {}, cell {}, K {}", crf, run.av1.preset,
+                                   run.av1_cell, run.av1.keyframe_interval),
+                       clip, r->stats.colour.stored, r->seconds});
+    }
+    if (match_error.empty()) {
+      auto mr = bench::match_colour_to_x265(dir, clips, run.peers);
+      if (mr.ok()) {
+        matches = std::move(*mr);
+      } else {
+        match_error = mr.status().to_string();
+      }
+    }
+  }
   fs::remove_all(tmp);
 
   const std::string scene = m.scene.empty() ? dir.filename().string() : m.scene;
@@ -314,7 +437,7 @@ int run_one(const fs::path& dir, const Run& run) {
              m.viewpoints.size(), m.frame_count, m.face_size, s.hdr ? "HDR" : "LDR");
   fmt::print(
       "Capture `{}`; colour {} (raw = {}), Q {} dB, depth {} (raw = log-16 u16); threads {}.\n\n",
-      dir.string(), format_name(s.colour_format), s.hdr ? "RGBA16F" : "RGBA8 sRGB", run.min_psnr_db,
+      dir.string(), format_name(s.colour_format), s.hdr ? "RGBA16F" : "RGBA8 sRGB", min_psnr_db,
       format_name(s.depth_format), threads);
   fmt::print("| stage | colour bytes | colour ratio | depth bytes | depth ratio |\n");
   fmt::print("|---|---:|---:|---:|---:|\n");
@@ -397,11 +520,13 @@ int run_one(const fs::path& dir, const Run& run) {
     fmt::print("- material: none (no view sees a reflective or refractive texel)\n");
   }
   fmt::print("\n");
-  if (run.video_peers) {
+  if (run.video_peers && run.peer_table) {
     fmt::print("Video peers (calf-bench's peer set, docs/BENCH.md \"The peers\"): {}\n\n",
                video_notes);
     if (!video_peers.empty()) fmt::print("{}\n", bench::peer_table(video_peers));
   }
+  if (!run.av1_crfs.empty() && run.video_peers)
+    print_matches(scene, m, noise, matches, match_error, run);
   std::fflush(stdout);
   return 0;
 }
@@ -441,11 +566,36 @@ int main(int argc, char** argv) {
   app.add_option("--x265-params", run.peers.x265_params,
                  "further x265 parameters of the colour peer, key=value:key=value (default none); "
                  "keyint=1 makes it intra-only, each frame decodable alone as each calf frame is");
+  bool no_peer_table = false;
+  app.add_flag("--no-peer-table", no_peer_table,
+               "with --video-peers and --av1-crf: only the colour codings against x265, not the "
+               "peer set's table (default: both)");
+  app.add_flag("--psnr-auto", run.psnr_auto,
+               "Q from the capture's render noise estimate, as calf-encode --psnr auto (margin 3 "
+               "dB); overrides --psnr (default off)");
+  app.add_option("--x265-pix-fmt", run.peers.x265_pix_fmt,
+                 "pixel format of x265 in the colour codings' matches: auto (yuv444p, else gbrp) "
+                 "or an ffmpeg pix_fmt, e.g. yuv420p (default auto)");
+  app.add_option("--av1-crf", run.av1_crfs,
+                 "with --video-peers: also encode the AV1 colour mode at this CRF (repeatable) and "
+                 "set BC and each AV1 encode against x265 at matched PSNR (default none)")
+      ->check(CLI::Range(1, 63));
+  app.add_option("--av1-preset", run.av1.preset, "SVT-AV1 preset of those encodes (default 8)")
+      ->check(CLI::Range(0, 13));
+  app.add_option("--av1-keyframe-interval", run.av1.keyframe_interval,
+                 "their key frame interval (default 30)")
+      ->check(CLI::Range(1, 100000));
+  app.add_option("--av1-cell", run.av1_cell,
+                 "their colour cell size, one AV1 stream per cell (default 64)");
+  app.add_option("--csv", run.csv,
+                 "append one line per colour coding matched by x265: scene, face, views, coding, "
+                 "PSNR, bytes, x265 PSNR, x265 bytes, encode s, decode ms (default none)");
   CLI11_PARSE(app, argc, argv);
   run.depth = depth == "pred16"    ? encoder::DepthCoding::kRaw16Predicted
               : depth == "pred16m" ? encoder::DepthCoding::kRaw16PredictedMasked
                                    : encoder::DepthCoding::kRaw16;
   run.colour_peers = !no_colour_peers;
+  run.peer_table = !no_peer_table;
   run.lzma2 = !no_lzma2;
   run.have_xz = have_tool("xz");
   run.have_zstd = have_tool("zstd");

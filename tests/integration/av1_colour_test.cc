@@ -276,6 +276,36 @@ std::vector<uint8_t> with_colour_chunk(const container::Reader& r, uint32_t view
       edit);
 }
 
+// A seek decodes at most the keyframe interval of pictures per cell: it restarts at the key frame
+// of the GOP holding the frame. GOPs of 3 over 5 frames are frames 0-2 and 3-4; the pictures each
+// jump needs follow from that layout alone.
+TEST_F(Av1Colour, SeekDecodesWithinTheKeyframeInterval) {
+  encoder::LightfieldEncodeOptions o = options();
+  o.av1.keyframe_interval = 3;
+  const std::vector<uint8_t> bytes = encode(o);
+  const container::Reader r = open(bytes);
+  decoder::LightfieldDecoderOptions dopt;
+  dopt.view_dependent = false;
+  dopt.background_thread = false;
+  auto dec = decoder::LightfieldDecoder::open(r, 0, dopt);
+  ASSERT_TRUE(dec.ok()) << dec.status().to_string();
+  const uint32_t cells = 6 * spec_.views;  // one cell per 16-texel face
+  struct Step {
+    uint32_t frame, pictures;
+  };
+  // 4: key 3, then 4; 2: key 0, 1, 2; 0: back to the key; 1: on from 0; 3: the other GOP's key;
+  // 2: key 0 again, 1, 2; 4: key 3, then 4; 4 again: nothing to decode.
+  for (const Step s : {Step{4, 2}, Step{2, 3}, Step{0, 1}, Step{1, 1}, Step{3, 1}, Step{2, 3},
+                       Step{4, 2}, Step{4, 0}}) {
+    decoder::LightfieldFrameUpdates updates;
+    ASSERT_TRUE(dec->advance(s.frame, {}, {}, &updates).ok());
+    EXPECT_EQ(updates.stats.errors, 0u) << updates.stats.first_error;
+    EXPECT_EQ(updates.stats.av1_max_pictures_per_cell, s.pictures) << "frame " << s.frame;
+    EXPECT_EQ(updates.stats.av1_pictures, s.pictures * cells) << "frame " << s.frame;
+    EXPECT_LE(updates.stats.av1_max_pictures_per_cell, o.av1.keyframe_interval);
+  }
+}
+
 TEST_F(Av1Colour, DamagedChunksAreRefusedWithTheirIds) {
   const std::vector<uint8_t> bytes = encode(options());
   const container::Reader r = open(bytes);

@@ -340,4 +340,62 @@ Expected<std::vector<PeerRow>> measure_peers(const fs::path& capture_dir, const 
   return rows;
 }
 
+Expected<std::vector<ColourMatch>> match_colour_to_x265(const fs::path& capture_dir,
+                                                        std::span<const ColourClip> clips,
+                                                        const PeerSettings& settings) {
+  CALF_ASSIGN_OR_RETURN(capture::CaptureSetReader in, capture::CaptureSetReader::open(capture_dir));
+  CALF_ASSIGN_OR_RETURN(GridFrames g, capture_grid(in));
+  const size_t frame_bytes = size_t{g.width} * g.height * 3;
+  std::vector<ColourMatch> out;
+  for (const ColourClip& c : clips) {
+    ColourMatch m;
+    m.calf = c;
+    CALF_ASSIGN_OR_RETURN(DecodedClip decoded, decode_clip(c.clip, g));
+    m.psnr_db = mean_psnr_db(g.rgb, decoded.rgb, frame_bytes, g.frames);
+    CALF_ASSIGN_OR_RETURN(container::Reader reader, container::Reader::open(c.clip.string()));
+    decoder::LightfieldDecoderOptions o;
+    o.view_dependent = false;
+    {
+      CALF_ASSIGN_OR_RETURN(decoder::LightfieldDecoder d,
+                            decoder::LightfieldDecoder::open(reader, 0, o));
+      decoder::LightfieldFrameUpdates updates;
+      std::vector<double> ms;
+      double upload = 0;
+      for (uint32_t f = 0; f < g.frames; ++f) {
+        CALF_RETURN_IF_ERROR(d.advance(f, {}, {}, &updates));
+        if (updates.stats.errors > 0) {
+          return Status(ErrorId::kInternal, c.clip.string() + ": " + updates.stats.first_error);
+        }
+        if (f > 0) ms.push_back(updates.stats.decode_ms);
+        upload += static_cast<double>(updates.stats.update_bytes());
+      }
+      m.decode_ms = ms.empty() ? 0 : median(ms);
+      m.upload_bytes = upload / g.frames;
+    }
+    // Seeks: after frame 0, jumps backwards from the last frame to frame 1 (each a restart at
+    // its GOP's key frame), then forwards by two.
+    {
+      CALF_ASSIGN_OR_RETURN(decoder::LightfieldDecoder d,
+                            decoder::LightfieldDecoder::open(reader, 0, o));
+      decoder::LightfieldFrameUpdates updates;
+      CALF_RETURN_IF_ERROR(d.advance(0, {}, {}, &updates));
+      std::vector<uint32_t> jumps;
+      for (uint32_t f = g.frames; f-- > 1;) jumps.push_back(f);
+      for (uint32_t f = 2; f < g.frames; f += 2) jumps.push_back(f);
+      double sum = 0;
+      for (uint32_t f : jumps) {
+        CALF_RETURN_IF_ERROR(d.advance(f, {}, {}, &updates));
+        sum += updates.stats.decode_ms;
+        m.seek_max_units = std::max(m.seek_max_units, updates.stats.av1_max_pictures_per_cell);
+      }
+      m.seek_ms = jumps.empty() ? 0 : sum / static_cast<double>(jumps.size());
+    }
+    m.x265 = x265_colour_matched(g.rgb, g.width, g.height, g.frames, m.psnr_db,
+                                 settings.colour_tolerance_db, settings.x265_pix_fmt,
+                                 settings.x265_preset, 3, settings.x265_params);
+    out.push_back(std::move(m));
+  }
+  return out;
+}
+
 }  // namespace calf::bench

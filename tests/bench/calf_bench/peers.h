@@ -19,9 +19,11 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <vector>
 
+#include "../ffmpeg_peers.h"
 #include "calf/format/status.h"
 #include "sweep.h"
 
@@ -32,6 +34,9 @@ struct PeerSettings {
   std::string x265_preset = "medium";
   std::string x265_params;           // further x265 parameters of the colour peer, e.g. "keyint=1"
   double colour_tolerance_db = 0.5;  // how close x265's PSNR must come to calf's (dB)
+  // The x265 colour peer's pixel format in match_colour_to_x265: "auto" (yuv444p, else gbrp) or an
+  // ffmpeg pix_fmt such as yuv420p (the AV1 mode's subsampling).
+  std::string x265_pix_fmt = "auto";
 };
 
 // calf's numbers the peer table compares against, from the sweep.
@@ -53,5 +58,32 @@ struct CalfReference {
 Expected<std::vector<PeerRow>> measure_peers(const std::filesystem::path& capture_dir,
                                              const CalfReference& calf,
                                              const PeerSettings& settings, std::string* notes);
+
+// One more calf clip of the same capture (e.g. the AV1 colour mode at a CRF) to set against x265.
+struct ColourClip {
+  std::string label;           // e.g. "AV1 CRF 32, cell 128, K 4"
+  std::filesystem::path clip;  // decoded here
+  uint64_t colour_bytes = 0;   // its colour stream's stored bytes
+  double encode_s = 0;         // its whole encode
+};
+
+// A clip's colour against x265 at the PSNR it reaches: both judged as the peer set's 8-bit sRGB
+// frames against the capture's (peak 255, mean per frame). Seek figures time
+// LightfieldDecoder::advance on a fresh decoder (no culling) jumping to `seek_frames` frames.
+struct ColourMatch {
+  ColourClip calf;
+  double psnr_db = 0;           // calf's decoded colour against the capture
+  double decode_ms = 0;         // median advance() ms per frame in playback order, frames 2..n
+  double upload_bytes = 0;      // mean texture-update payload bytes per frame (every view)
+  double seek_ms = 0;           // mean advance() ms of a jump to a frame, fresh decoder
+  uint32_t seek_max_units = 0;  // the most AV1 pictures one cell decoded for one jump (0: BC)
+  PeerResult x265;
+};
+
+// Each clip of `clips` (of the capture at `capture_dir`) decoded and matched by x265 (settings'
+// preset, parameters and tolerance), in order.
+Expected<std::vector<ColourMatch>> match_colour_to_x265(const std::filesystem::path& capture_dir,
+                                                        std::span<const ColourClip> clips,
+                                                        const PeerSettings& settings);
 
 }  // namespace calf::bench

@@ -96,6 +96,9 @@ struct FrameStats {
   uint32_t updates = 0;                                            // texture updates yielded
   uint64_t colour_bytes = 0, depth_bytes = 0, material_bytes = 0;  // update payload bytes
   uint64_t coverage_bytes = 0;
+  // AV1 colour: pictures decoded (every cell), and the most one cell decoded: 1 in playback, at
+  // most the keyframe interval after a seek (a restart at the GOP's key frame). 0 for BC colour.
+  uint32_t av1_pictures = 0, av1_max_pictures_per_cell = 0;
   uint32_t chunks_needed = 0;          // chunks this frame's updates were decoded from
   uint32_t chunks_read_on_demand = 0;  // of those, read by advance() itself (not prefetched)
   size_t cached_bytes = 0;             // decompressed chunks held by the cache after the frame
