@@ -517,6 +517,33 @@ TEST(LightfieldCpuRenderer, CoverageAgreementKeepsThinParts) {
   EXPECT_GT(agreed, 0.94 * off);
 }
 
+// The sphere of CoveragePlacesSilhouettesInsideTexels between four coarse anti-aliased views
+// with coverage, and an eye close to them looking at it, with its ground truth.
+struct SphereBetweenViews {
+  Scene scene;
+  std::vector<Vec3> pos;  // the views' positions
+  Vec3 eye;
+  ViewSet views;
+  Camera cam;
+  RenderedImage gt;
+};
+SphereBetweenViews sphere_between_views() {
+  SphereBetweenViews s;
+  s.scene.room = false;
+  s.scene.uniform_sky = true;
+  s.scene.spheres = {{{0.05, -0.03, -2.0}, 0.3}};
+  s.pos = {{-0.3, 0.1, 0.2}, {0.3, -0.1, 0.2}, {0.1, 0.3, 0.1}, {-0.1, -0.3, 0.1}};
+  s.views = make_views(s.scene, s.pos, 32, false, 4);
+  for (View& v : s.views.views) testing::add_coverage(s.scene, &v);
+  s.eye = {0.04, 0.03, 0.1};
+  s.cam.position = s.eye;
+  s.cam.forward = testing::unit(testing::sub(s.scene.spheres[0].centre, s.eye));
+  s.cam.fov_y = 24 * kPi / 180;
+  s.cam.width = s.cam.height = 96;
+  s.gt = ground_truth(s.scene, s.cam);
+  return s;
+}
+
 // Compositing partly covered surfaces (LightfieldRenderOptions::coverage_layers): the sphere of
 // CoveragePlacesSilhouettesInsideTexels between four coarse anti-aliased views. Where the march
 // ends on the sphere but the eye ray misses it (the footprint rule grows the silhouette by up to
@@ -525,21 +552,10 @@ TEST(LightfieldCpuRenderer, CoverageAgreementKeepsThinParts) {
 // error against the ground truth of the pixels the march grows onto the sphere, and of those
 // well inside it.
 TEST(LightfieldCpuRenderer, CoverageLayersShowTheSkyBehindGrownSilhouettes) {
-  Scene scene;
-  scene.room = false;
-  scene.uniform_sky = true;
-  scene.spheres = {{{0.05, -0.03, -2.0}, 0.3}};
-  const std::vector<Vec3> pos = {
-      {-0.3, 0.1, 0.2}, {0.3, -0.1, 0.2}, {0.1, 0.3, 0.1}, {-0.1, -0.3, 0.1}};
-  ViewSet views = make_views(scene, pos, 32, false, 4);
-  for (View& v : views.views) testing::add_coverage(scene, &v);
-  const Vec3 eye = {0.04, 0.03, 0.1};
-  Camera cam;
-  cam.position = eye;
-  cam.forward = testing::unit(testing::sub(scene.spheres[0].centre, eye));
-  cam.fov_y = 24 * kPi / 180;
-  cam.width = cam.height = 96;
-  const RenderedImage gt = ground_truth(scene, cam);
+  const SphereBetweenViews setup = sphere_between_views();
+  const ViewSet& views = setup.views;
+  const Camera& cam = setup.cam;
+  const RenderedImage& gt = setup.gt;
   LightfieldRenderOptions o;
   o.steps = 128;
   const RenderedImage off = render(views, cam, o);
@@ -604,21 +620,12 @@ TEST(LightfieldCpuRenderer, CoverageLayersShowTheSkyBehindGrownSilhouettes) {
 // rule, 907 with R = 1 (1062 with R = 2, 907 with R = 3); with coverage mode 3, 508 and 417; the
 // thin spheres keep 1200 of 1239 pixels either way.
 TEST(LightfieldCpuRenderer, HintCoverageStopsGrowingSilhouettesIntoTheSky) {
-  Scene scene;
-  scene.room = false;
-  scene.uniform_sky = true;
-  scene.spheres = {{{0.05, -0.03, -2.0}, 0.3}};
-  const std::vector<Vec3> pos = {
-      {-0.3, 0.1, 0.2}, {0.3, -0.1, 0.2}, {0.1, 0.3, 0.1}, {-0.1, -0.3, 0.1}};
-  ViewSet views = make_views(scene, pos, 32, false, 4);
-  for (View& v : views.views) testing::add_coverage(scene, &v);
-  const Vec3 eye = {0.04, 0.03, 0.1};
-  Camera cam;
-  cam.position = eye;
-  cam.forward = testing::unit(testing::sub(scene.spheres[0].centre, eye));
-  cam.fov_y = 24 * kPi / 180;
-  cam.width = cam.height = 96;
-  const RenderedImage gt = ground_truth(scene, cam);
+  const SphereBetweenViews setup = sphere_between_views();
+  const std::vector<Vec3>& pos = setup.pos;
+  const Vec3& eye = setup.eye;
+  const ViewSet& views = setup.views;
+  const Camera& cam = setup.cam;
+  const RenderedImage& gt = setup.gt;
   const auto grown = [&](uint32_t rule, uint32_t coverage) {
     LightfieldRenderOptions o;
     o.steps = 128;
