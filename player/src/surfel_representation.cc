@@ -13,13 +13,19 @@
 #include "calf/decoder/mesh_track.h"
 #include "calf/decoder/surfels_track.h"
 #include "calf/format/surfels_layout.h"
+#include "calf/player/frame_controller.h"
 #include "calf/player/rendered_image.h"
-#include "calf/player/surfel_frame_controller.h"
 #include "calf/player/surfel_renderer.h"
 #include "object_transform.h"
 
 namespace calf::player {
 namespace {
+
+// The frame controller's passes: the near meshes (triangles) and the surfels. The mesh pass's
+// share is 3/4: it costs per triangle and per covered pixel, which the triangles predict only in
+// part (frame_controller.h).
+constexpr size_t kMeshPass = 0, kSurfelPass = 1;
+constexpr double kMeshShare = 0.75;
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -119,8 +125,8 @@ struct SurfelRepresentation::Impl {
   // foveation factor included; 0 for a prototype without surfels) and its mesh's triangles.
   std::vector<double> unit_radius;
   std::vector<uint64_t> triangles;
-  std::unique_ptr<SurfelFrameController> controller;  // with a target frame time
-  SurfelWork work;                                    // the prepared frame's
+  std::unique_ptr<FrameController> controller;  // with a target frame time
+  FrameWork work;                               // the prepared frame's
   // The passes' times since the latest prepare: [0] wall, [1] process CPU, ms.
   double mesh_ms[2] = {0, 0}, surfels_ms[2] = {0, 0}, frame_ms[2] = {0, 0};
   std::unique_ptr<GlSurfelRenderer> gl;
@@ -135,7 +141,7 @@ struct SurfelRepresentation::Impl {
   void measure(const Camera& first);
   // How object o is drawn at point size s, and its prefix (0 unless surfels are drawn).
   Drawn classify(size_t o, double s, uint32_t* count, double* radius) const;
-  SurfelWork work_at(double s) const;
+  FrameWork work_at(double s) const;
   // Sets the draw list, the mesh's visible objects and the counts for point size s.
   void apply(double s);
 };
@@ -199,12 +205,16 @@ Expected<std::unique_ptr<SurfelRepresentation>> SurfelRepresentation::open(
     impl->triangles.push_back(o.drawn_triangles(mesh_list.prototypes[o.prototype]));
   }
   if (options.target_frame_ms > 0) {
-    SurfelControllerOptions c;
+    // The knob is the point size: continuous, the work falls as it grows; a symmetric deadband
+    // and no limit on growth (the point size has no cautious step).
+    FrameControllerOptions c;
     c.target_ms = options.target_frame_ms;
-    c.min_point_size = options.min_point_size;
-    c.max_point_size = options.max_point_size;
-    c.deadband = options.controller_deadband;
-    impl->controller = std::make_unique<SurfelFrameController>(c, options.point_size);
+    c.min = options.min_point_size;
+    c.max = options.max_point_size;
+    c.pass_share[kMeshPass] = kMeshShare;
+    c.pass_share[kSurfelPass] = 1;
+    c.shrink_above = c.grow_below = options.controller_deadband;
+    impl->controller = std::make_unique<FrameController>(c, options.point_size);
   }
   CALF_RETURN_IF_ERROR(validate_surfel_draw_list(impl->list));
   if (backend == RenderBackend::kGl) {
@@ -260,13 +270,15 @@ Drawn SurfelRepresentation::Impl::classify(size_t o, double s, uint32_t* count,
   return need > options.blend_share * rec.surfel_count ? Drawn::kBoth : Drawn::kSurfels;
 }
 
-SurfelWork SurfelRepresentation::Impl::work_at(double s) const {
-  SurfelWork w;
+FrameWork SurfelRepresentation::Impl::work_at(double s) const {
+  FrameWork w;
   for (size_t o = 0; o < list.objects.size(); ++o) {
     uint32_t count;
     double radius;
-    if (classify(o, s, &count, &radius) != Drawn::kSurfels) w.triangles += triangles[o];
-    w.surfels += count;
+    if (classify(o, s, &count, &radius) != Drawn::kSurfels) {
+      w.pass[kMeshPass] += static_cast<double>(triangles[o]);
+    }
+    w.pass[kSurfelPass] += count;
   }
   return w;
 }
@@ -282,10 +294,10 @@ void SurfelRepresentation::Impl::apply(double s) {
     ++counts[static_cast<int>(how)];
     mesh->set_object_visible(o, how != Drawn::kSurfels);
   }
-  work.surfels = 0;
-  for (const SurfelDrawObject& obj : list.objects) work.surfels += obj.count;
-  work.triangles = mesh->triangles_drawn();
-  surfels = work.surfels;
+  surfels = 0;
+  for (const SurfelDrawObject& obj : list.objects) surfels += obj.count;
+  work.pass[kMeshPass] = static_cast<double>(mesh->triangles_drawn());
+  work.pass[kSurfelPass] = static_cast<double>(surfels);
 }
 
 std::string_view SurfelRepresentation::kind() const {
@@ -394,8 +406,11 @@ Status SurfelRepresentation::report_frame_time(double frame_ms) {
     // Wall clock: the caller's frame time, the passes inside it; CPU clock: the process CPU
     // time of the renders since the prepare and of their passes.
     const int c = d.options.controller_clock == SurfelClock::kCpu ? 1 : 0;
-    d.controller->report(d.work,
-                         {d.mesh_ms[c], d.surfels_ms[c], c == 1 ? d.frame_ms[1] : frame_ms});
+    FrameTimes times;
+    times.pass_ms[kMeshPass] = d.mesh_ms[c];
+    times.pass_ms[kSurfelPass] = d.surfels_ms[c];
+    times.frame_ms = c == 1 ? d.frame_ms[1] : frame_ms;
+    d.controller->report(d.work, times);
   }
   return Status::Ok();
 }

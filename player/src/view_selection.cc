@@ -16,6 +16,15 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Performance culling's back-off: a growth that breaks the budget doubles the wait before the
+// next, up to this many times grow_after_frames.
+constexpr uint32_t kMaxGrowthBackoff = 32;
+
+std::string out_of_range(const char* field, double value, const char* range) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.9g", value);
+  return std::string(field) + " = " + buf + " is outside " + range;
+}
 
 // Shortest faithful text of a number ("0.5", "nan", "1e+300"), for messages.
 std::string num(double x) {
@@ -34,6 +43,31 @@ Status option_error(const char* field, double value, const char* range) {
   return Status(ErrorId::kViewSelectOptions, std::string("view selection option ") + field + " = " +
                                                  num(value) + " is outside " + range);
 }
+
+}  // namespace
+
+std::string frame_budget_problem(const FrameBudgetOptions& o) {
+  // `!(x >= lo && x <= hi)` so that NaN fails every range check.
+  if (!(o.target_frame_ms >= 0 && std::isfinite(o.target_frame_ms))) {
+    return out_of_range("target_frame_ms", o.target_frame_ms, "[0, inf)");
+  }
+  if (!(o.fixed_cost_ms >= 0 && std::isfinite(o.fixed_cost_ms))) {
+    return out_of_range("fixed_cost_ms", o.fixed_cost_ms, "[0, inf)");
+  }
+  if (!(o.over_budget_tolerance >= 0 && o.over_budget_tolerance <= 1)) {
+    return out_of_range("over_budget_tolerance", o.over_budget_tolerance, "[0, 1]");
+  }
+  if (!(o.grow_headroom >= 0 && o.grow_headroom < 1)) {
+    return out_of_range("grow_headroom", o.grow_headroom, "[0, 1)");
+  }
+  if (o.grow_after_frames < 1) return out_of_range("grow_after_frames", 0, "[1, 2^32)");
+  if (!(o.cost_smoothing > 0 && o.cost_smoothing <= 1)) {
+    return out_of_range("cost_smoothing", o.cost_smoothing, "(0, 1]");
+  }
+  return "";
+}
+
+namespace {
 
 Status check_options(const ViewSelectionOptions& o) {
   if (o.priority != ViewPriority::kDistance && o.priority != ViewPriority::kAngle) {
@@ -67,12 +101,23 @@ Status check_options(const ViewSelectionOptions& o) {
   return Status::Ok();
 }
 
-// The frame budget's options: the selector's, its units bounded by [min_active, max_active].
-FrameBudgetOptions budget_options(const ViewSelectionOptions& o) {
-  FrameBudgetOptions b = o.budget;
-  b.min_units = o.min_active;
-  b.max_units = o.max_active;
-  return b;
+// The controller's options: the active count, bounded by [min_active, max_active].
+FrameControllerOptions controller_options(const ViewSelectionOptions& o) {
+  const FrameBudgetOptions& b = o.budget;
+  FrameControllerOptions c;
+  c.target_ms = b.target_frame_ms;
+  c.min = o.min_active;
+  c.max = o.max_active;
+  c.integer = true;
+  c.work_grows = true;
+  c.memory = 1 - b.cost_smoothing;
+  c.shrink_above = b.over_budget_tolerance;
+  c.grow_below = b.grow_headroom;
+  c.grow_margin = b.grow_headroom;
+  c.grow_step = 1;
+  c.grow_after_frames = b.grow_after_frames;
+  c.max_growth_backoff = kMaxGrowthBackoff;
+  return c;
 }
 
 struct Ranked {
@@ -110,8 +155,9 @@ Expected<ViewSelector> ViewSelector::make(std::vector<Vec3> viewpoints,
 void ViewSelector::reset() {
   slots_.clear();
   std::fill(was_active_.begin(), was_active_.end(), 0);
-  budget_.set_options(budget_options(options_));
-  budget_.reset();
+  controller_.set_options(controller_options(options_));
+  controller_.reset(options_.max_active);
+  units_ = available_ = 0;
 }
 
 Status ViewSelector::exclude(uint32_t view) {
@@ -127,7 +173,7 @@ Status ViewSelector::exclude(uint32_t view) {
 Status ViewSelector::set_options(const ViewSelectionOptions& options) {
   CALF_RETURN_IF_ERROR(check_options(options));
   options_ = options;
-  budget_.set_options(budget_options(options_));
+  controller_.set_options(controller_options(options_));
   return Status::Ok();
 }
 
@@ -173,8 +219,6 @@ Expected<ViewSelection> ViewSelector::select(const Vec3& position, const Vec3& f
   });
 
   ViewSelection sel;
-  sel.performance_limit = budget_.allowed();
-  const uint32_t cap = sel.performance_limit;
   const double cone_rad = o.view_cone_deg * kPi / 180.0;
   const double redundancy_rad = o.redundancy_angle_deg * kPi / 180.0;
 
@@ -212,6 +256,10 @@ Expected<ViewSelection> ViewSelector::select(const Vec3& position, const Vec3& f
     }
     kept.push_back(v);
   }
+  // 4. The controller's limit (planned at the latest report).
+  available_ = static_cast<uint32_t>(kept.size());
+  sel.performance_limit = performance_limit();
+  const uint32_t cap = sel.performance_limit;
   if (kept.size() > cap) {
     sel.culled_by_performance = static_cast<uint32_t>(kept.size() - cap);
     kept.resize(cap);
@@ -263,12 +311,37 @@ Expected<ViewSelection> ViewSelector::select(const Vec3& position, const Vec3& f
 
   slots_ = std::move(slots);
   was_active_ = std::move(now_active);
-  budget_.record_units(static_cast<uint32_t>(kept.size()));
+  units_ = static_cast<uint32_t>(kept.size());
   return sel;
 }
 
+uint32_t ViewSelector::performance_limit() const {
+  return controller_.on() ? static_cast<uint32_t>(controller_.knob()) : options_.max_active;
+}
+
 Status ViewSelector::report_frame_time(double frame_ms) {
-  return budget_.report_frame_time(frame_ms);
+  if (!(frame_ms >= 0) || !std::isfinite(frame_ms)) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.9g", frame_ms);
+    return Status(ErrorId::kViewSelectFrameTime, std::string("reported frame time ") + buf +
+                                                     " ms is not a finite non-negative number");
+  }
+  if (units_ == 0) return Status::Ok();
+  FrameWork work;
+  work.pass[0] = units_;
+  FrameTimes times;
+  times.pass_ms[0] = std::max(0.0, frame_ms - options_.budget.fixed_cost_ms);
+  times.frame_ms = frame_ms;
+  controller_.report(work, times);
+  // The next frame's limit, planned for as many views as survived the other cullings this frame:
+  // the work at a limit k is min(k, available) views.
+  const double available = available_;
+  controller_.plan([available](double k) {
+    FrameWork w;
+    w.pass[0] = std::min(k, available);
+    return w;
+  });
+  return Status::Ok();
 }
 
 }  // namespace calf::player

@@ -168,7 +168,7 @@ TEST(SurfelRepresentation, FiguresAreTheDrawListsPoints) {
 }
 
 // The controller's wiring (its law is tested on a simulated cost in
-// tests/player/surfel_frame_controller_test.cc): prepare asks it for the size, report_frame_time
+// tests/player/frame_controller_test.cc): prepare asks it for the size, report_frame_time
 // feeds it the frame and the passes' times; far too slow frames drive the size to its maximum,
 // fast ones to its minimum.
 TEST(SurfelRepresentation, ControllerMovesThePointSizeTowardsTheTargetWithinItsClamp) {

@@ -1,5 +1,5 @@
 // The wall-clock rate of displayed frames, for a HUD's fps figure and a frame budget's reports
-// (frame_budget.h). Only the instants at which frames were displayed count: a figure computed
+// (frame_controller.h). Only the instants at which frames were displayed count: a figure computed
 // from anything else (the time between two polls of the event loop, a render call alone) can
 // claim thousands of frames per second while each frame takes seconds.
 #pragma once

@@ -12,7 +12,7 @@
 //                         representation shows, +inf depth where it shows nothing;
 //   report_frame_time(ms) after the frame is displayed: the wall time between displayed frames,
 //                         for representations that fit their work to a frame budget
-//                         (frame_budget.h);
+//                         (frame_controller.h);
 //   stats()               what the HUD and reports print, generically;
 //   figures()             the numbers reports compute with, the same struct for every kind.
 //

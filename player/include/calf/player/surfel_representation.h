@@ -24,7 +24,7 @@
 //   render:   the mesh objects through the mesh renderer, the surfel objects through the surfel
 //             splatter (surfel_renderer.h), composited by radial depth;
 //             With target_frame_ms > 0, prepare first asks the frame-time controller
-//             (surfel_frame_controller.h) for the point size: it is given the exact work (surfels
+//             (frame_controller.h) for the point size: it is given the exact work (surfels
 //             and mesh triangles) this view needs at any point size and picks the size its model
 //             of the two passes predicts to meet the target;
 //   render:   the mesh pass and the surfel pass are timed apart (wall and process CPU time);

@@ -22,22 +22,24 @@
 //      that stays never needs a full re-upload (Sec. 6.3: "the order of the active viewpoints is
 //      maintained as much as possible with respect to the previous frame").
 //
-// Performance culling asks a frame budget (calf/player/frame_budget.h) how many views the frame
-// may use: the caller renders with the selection, then reports that frame's time
-// (report_frame_time), and the budget's controller (model frame_ms = fixed_cost_ms + n *
-// per_view_ms, n the active count) lowers or raises the limit. Its knobs are
-// ViewSelectionOptions::budget; its units are active views, bounded by [min_active, max_active].
+// Performance culling asks the frame controller (calf/player/frame_controller.h) how many views the
+// frame may use: its knob is the active count, an integer in [min_active, max_active] whose work
+// is the count itself (one pass: the views, the frame less fixed_cost_ms). The caller renders with
+// the selection, then reports that frame's time (report_frame_time), which plans the next limit
+// for as many views as survived the other cullings. Its knobs are
+// ViewSelectionOptions::budget (PerformanceOptions below).
 //
 // Stereo: pass the midpoint of the two eyes and the mean forward direction.
 // Everything is deterministic: same inputs, same calls, same results.
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "calf/format/geometry.h"
 #include "calf/format/status.h"
-#include "calf/player/frame_budget.h"
+#include "calf/player/frame_controller.h"
 
 namespace calf::player {
 
@@ -47,6 +49,32 @@ enum class ViewPriority : uint8_t {
   kAngle,     // smallest angle at reference_point between eye and viewpoint first: viewpoints
               // surrounding an object (the paper's Spaceship)
 };
+
+// Performance culling's knobs, mapped onto the frame controller's (frame_controller.h has the law).
+// Checked by ViewSelector::make / set_options (CALF-E450).
+struct FrameBudgetOptions {
+  // Frame-time target in ms (>= 0, finite); 0 turns the controller off (the limit is max_active).
+  // Default: 90 Hz, the rate of head-mounted displays paper 002 aims at (Sec. 7.2).
+  double target_frame_ms = 1000.0 / 90.0;
+  // The part of a frame's time that does not depend on the view count, in ms (>= 0, finite).
+  double fixed_cost_ms = 0.0;
+  // Shrink when the predicted frame exceeds target * (1 + tolerance), [0, 1] (the controller's
+  // shrink_above).
+  double over_budget_tolerance = 0.05;
+  // Grow only to a count predicted at most target * (1 - headroom), [0, 1) (the controller's
+  // grow_below and grow_margin).
+  double grow_headroom = 0.10;
+  // Consecutive frames with room before the limit grows by one view, >= 1 (the controller's
+  // grow_after_frames; grow_step is one view, the back-off up to 32 times). Default: a third of
+  // a second at 90 Hz.
+  uint32_t grow_after_frames = 30;
+  // Weight of the newest frame in the model, (0, 1] (the controller's memory is 1 - this).
+  double cost_smoothing = 0.25;
+};
+
+// Why a knob of `options` is out of the ranges above, naming the first ("target_frame_ms = -1 is
+// outside [0, inf)"; NaN fails every range), or "" when all are in range.
+std::string frame_budget_problem(const FrameBudgetOptions& options);
 
 // Every knob of the selector, with its default. Checked by ViewSelector::make / set_options
 // (CALF-E450 names the field and its range).
@@ -69,9 +97,7 @@ struct ViewSelectionOptions {
   // Ranking stickiness for views active last frame, [0, 1): their priority key counts
   // (1 - margin) times its value. 0 turns it off.
   double incumbent_margin = 0.05;
-  // Performance culling's controller (frame_budget.h documents its knobs and defaults; make /
-  // set_options check their ranges). Its units are active views: min_units / max_units are not
-  // read, the selector bounds the count by [min_active, max_active].
+  // Performance culling's knobs (above); the count stays in [min_active, max_active].
   FrameBudgetOptions budget;
 };
 
@@ -137,11 +163,11 @@ class ViewSelector {
   const ViewSelectionOptions& options() const { return options_; }
   const std::vector<Vec3>& viewpoints() const { return viewpoints_; }
   // The controller's current limit on the active count.
-  uint32_t performance_limit() const { return budget_.limit(); }
-  // The running per-view cost estimate in ms; 0 before any frame time was reported.
-  double per_view_cost_ms() const { return budget_.per_unit_cost_ms(); }
-  // The frame budget performance culling asks (its units are active views).
-  const FrameBudget& budget() const { return budget_; }
+  uint32_t performance_limit() const;
+  // The model's mean cost per active view in ms; 0 before any frame time was reported.
+  double per_view_cost_ms() const { return controller_.per_unit_ms(0); }
+  // The controller performance culling asks (its knob is the active count).
+  const FrameController& controller() const { return controller_; }
 
  private:
   ViewSelector() = default;
@@ -152,7 +178,9 @@ class ViewSelector {
   std::vector<uint8_t> was_active_;  // per view: in slots_
   std::vector<uint8_t> excluded_;    // per view: never selected (exclude)
   bool selected_once_ = false;
-  FrameBudget budget_;  // performance culling
+  FrameController controller_{{}, 1};  // performance culling
+  uint32_t units_ = 0;                 // views of the latest selection
+  uint32_t available_ = 0;             // views of the latest selection before performance culling
 };
 
 }  // namespace calf::player

@@ -1,6 +1,8 @@
-// SurfelFrameController against a simulated surfel frame: no clock, every cost is computed from a
-// cost model with deterministic noise, so the tests check the control law, not the machine.
-#include "calf/player/surfel_frame_controller.h"
+// FrameController against simulated frames, a surfel frame (two passes, the point size as knob)
+// and a light-field frame (one pass, the active-view count as knob): no clock, every cost is
+// computed from a cost model with deterministic noise, so the tests check the control law, not
+// the machine.
+#include "calf/player/frame_controller.h"
 
 #include <gtest/gtest.h>
 
@@ -22,10 +24,13 @@ struct View {
   double switch_size = 1.6;
 };
 
-SurfelWork work_of(const View& v, double s) {
-  SurfelWork w;
-  w.surfels = static_cast<uint64_t>(std::ceil(v.k / (s * s)));
-  w.triangles = v.near_triangles + (s < v.switch_size ? v.switch_triangles : 0);
+constexpr size_t kMesh = 0, kSurfels = 1;  // the surfel frame's passes
+
+FrameWork work_of(const View& v, double s) {
+  FrameWork w;
+  w.pass[kSurfels] = std::ceil(v.k / (s * s));
+  w.pass[kMesh] =
+      static_cast<double>(v.near_triangles + (s < v.switch_size ? v.switch_triangles : 0));
   return w;
 }
 
@@ -42,19 +47,28 @@ struct Machine {
     const double u = static_cast<double>(state >> 11) / 9007199254740992.0;  // [0, 1)
     return 1 + noise * (2 * u - 1);
   }
-  SurfelFrameTimes run(const SurfelWork& w, double s) {
-    SurfelFrameTimes t;
-    t.mesh_ms = w.triangles > 0 ? load * (25 + 0.004 * w.triangles) * jitter() : 0;
-    t.surfels_ms =
-        w.surfels > 0 ? load * (15 + 0.002 * w.surfels + 5e-5 * w.surfels * s * s) * jitter() : 0;
-    t.frame_ms = t.mesh_ms + t.surfels_ms + load * 5 * jitter();
+  FrameTimes run(const FrameWork& w, double s) {
+    FrameTimes t;
+    const double tris = w.pass[kMesh], surfels = w.pass[kSurfels];
+    t.pass_ms[kMesh] = tris > 0 ? load * (25 + 0.004 * tris) * jitter() : 0;
+    t.pass_ms[kSurfels] =
+        surfels > 0 ? load * (15 + 0.002 * surfels + 5e-5 * surfels * s * s) * jitter() : 0;
+    t.frame_ms = t.pass_ms[kMesh] + t.pass_ms[kSurfels] + load * 5 * jitter();
     return t;
   }
 };
 
-SurfelControllerOptions options(double target) {
-  SurfelControllerOptions o;
+// The surfel mode's configuration (surfel_representation.cc): the point size in [1, 16],
+// continuous, work falling as it grows; the mesh pass's share 3/4; a +-5 % deadband; growth
+// unlimited.
+FrameControllerOptions options(double target) {
+  FrameControllerOptions o;
   o.target_ms = target;
+  o.min = 1;
+  o.max = 16;
+  o.pass_share[kMesh] = 0.75;
+  o.pass_share[kSurfels] = 1;
+  o.shrink_above = o.grow_below = 0.05;
   return o;
 }
 
@@ -63,14 +77,14 @@ struct Trace {
 };
 
 // Plays `views` through the controller: plan, render on `machine`, report.
-Trace play(SurfelFrameController* c, Machine* machine, const std::vector<View>& views) {
+Trace play(FrameController* c, Machine* machine, const std::vector<View>& views) {
   Trace out;
   for (const View& v : views) {
     const double s = c->plan([&](double size) { return work_of(v, size); });
     EXPECT_GE(s, 1.0);
     EXPECT_LE(s, 16.0);
-    const SurfelWork w = work_of(v, s);
-    const SurfelFrameTimes t = machine->run(w, s);
+    const FrameWork w = work_of(v, s);
+    const FrameTimes t = machine->run(w, s);
     c->report(w, t);
     out.frame_ms.push_back(t.frame_ms);
     out.sizes.push_back(s);
@@ -96,17 +110,17 @@ int within(const std::vector<double>& ms, size_t from, double target, double tol
   return n;
 }
 
-TEST(SurfelFrameController, KeepsTheSizeUntilAFrameIsMeasured) {
-  SurfelFrameController c(options(300), 1.5);
+TEST(FrameControllerSurfels, KeepsTheSizeUntilAFrameIsMeasured) {
+  FrameController c(options(300), 1.5);
   EXPECT_EQ(c.plan([](double s) { return work_of(View{}, s); }), 1.5);
   EXPECT_EQ(c.predicted_ms(), 0);
 }
 
-TEST(SurfelFrameController, ConvergesOnAStaticViewWithoutOscillating) {
+TEST(FrameControllerSurfels, ConvergesOnAStaticViewWithoutOscillating) {
   // Start far off on both sides: at 1 px the frame takes ~1000 ms, at 8 px ~90 ms.
   for (const double start : {1.0, 8.0}) {
     SCOPED_TRACE("start " + std::to_string(start));
-    SurfelFrameController c(options(300), start);
+    FrameController c(options(300), start);
     Machine m;
     const Trace t = play(&c, &m, std::vector<View>(30, View{}));
     // The first frame only measures; the plans after it scale from the recent mean costs, whose
@@ -132,8 +146,8 @@ std::vector<View> walk() {
   return views;
 }
 
-TEST(SurfelFrameController, HoldsTheTargetWhileTheNearMeshesSwitch) {
-  SurfelFrameController c(options(300), 1.5);
+TEST(FrameControllerSurfels, HoldsTheTargetWhileTheNearMeshesSwitch) {
+  FrameController c(options(300), 1.5);
   Machine m;
   const Trace t = play(&c, &m, walk());
   // After the model has seen both kinds of view (poses 0-5), every pose within +-10 %.
@@ -143,7 +157,7 @@ TEST(SurfelFrameController, HoldsTheTargetWhileTheNearMeshesSwitch) {
   }
 }
 
-TEST(SurfelFrameController, ThePapersReactiveRuleMissesTheSameWalk) {
+TEST(FrameControllerSurfels, ThePapersReactiveRuleMissesTheSameWalk) {
   // The scenario is one a controller must model: the paper's rule (Sec. 4.3: s = (3 s + s t /
   // target) / 4 outside [0.9, 1.1]) on the same walk and machine misses many poses.
   Machine m;
@@ -151,7 +165,7 @@ TEST(SurfelFrameController, ThePapersReactiveRuleMissesTheSameWalk) {
   int ok = 0;
   const std::vector<View> views = walk();
   for (size_t i = 0; i < views.size(); ++i) {
-    const SurfelFrameTimes t = m.run(work_of(views[i], s), s);
+    const FrameTimes t = m.run(work_of(views[i], s), s);
     if (i >= 6) ok += std::abs(t.frame_ms / 300 - 1) <= 0.10;
     const double r = t.frame_ms / 300;
     if (r < 0.9 || r > 1.1) s = std::clamp((3 * s + s * r) / 4, 1.0, 16.0);
@@ -159,10 +173,10 @@ TEST(SurfelFrameController, ThePapersReactiveRuleMissesTheSameWalk) {
   EXPECT_LT(ok, 25) << "of 34";
 }
 
-TEST(SurfelFrameController, FollowsAChangeOfLoad) {
+TEST(FrameControllerSurfels, FollowsAChangeOfLoad) {
   // The machine gets 40 % slower at frame 15 (another job starts): the fits' weighted means
   // forget the old costs and the size follows within a few frames.
-  SurfelFrameController c(options(300), 2);
+  FrameController c(options(300), 2);
   Machine m;
   std::vector<View> views(15, View{});
   Trace before = play(&c, &m, views);
@@ -173,28 +187,89 @@ TEST(SurfelFrameController, FollowsAChangeOfLoad) {
   EXPECT_LE(reversals(after.sizes, 0), 1);
 }
 
-TEST(SurfelFrameController, UnreachableTargetsClampWithoutHunting) {
+TEST(FrameControllerSurfels, UnreachableTargetsClampWithoutHunting) {
   {
     // 50 ms: the mesh pass alone takes more; the controller goes to the largest size and stays.
-    SurfelFrameController c(options(50), 2);
+    FrameController c(options(50), 2);
     Machine m;
     const Trace t = play(&c, &m, std::vector<View>(12, View{}));
     for (size_t i = 2; i < t.sizes.size(); ++i) EXPECT_EQ(t.sizes[i], 16.0) << i;
   }
   {
     // 5 s: even 1 px is fast enough; the smallest size, the best image.
-    SurfelFrameController c(options(5000), 4);
+    FrameController c(options(5000), 4);
     Machine m;
     const Trace t = play(&c, &m, std::vector<View>(12, View{}));
     for (size_t i = 1; i < t.sizes.size(); ++i) EXPECT_EQ(t.sizes[i], 1.0) << i;
   }
 }
 
-TEST(SurfelFrameController, SameReportsGiveTheSameSizes) {
-  SurfelFrameController a(options(300), 1.5), b(options(300), 1.5);
+TEST(FrameControllerSurfels, SameReportsGiveTheSameSizes) {
+  FrameController a(options(300), 1.5), b(options(300), 1.5);
   Machine ma, mb;
   const Trace ta = play(&a, &ma, walk()), tb = play(&b, &mb, walk());
   EXPECT_EQ(ta.sizes, tb.sizes);
+}
+
+// The light field's configuration (view_selection.cc with the default FrameBudgetOptions): the
+// active-view count in [1, 16], an integer, work growing with it; one pass; memory 0.75; shrink
+// above +5 %, grow to a count predicted 10 % under the target, one view after 30 frames with room.
+FrameControllerOptions lightfield(double target) {
+  FrameControllerOptions o;
+  o.target_ms = target;
+  o.min = 1;
+  o.max = 16;
+  o.integer = true;
+  o.work_grows = true;
+  o.memory = 0.75;
+  o.shrink_above = 0.05;
+  o.grow_below = o.grow_margin = 0.10;
+  o.grow_step = 1;
+  o.grow_after_frames = 30;
+  o.max_growth_backoff = 32;
+  return o;
+}
+
+// A light-field frame: 2 ms + 0.9 ms per active view, times the load, +-3 % jitter.
+struct ViewMachine {
+  Machine jitter;  // its jitter only
+  double load = 1;
+  FrameTimes run(double views) {
+    FrameTimes t;
+    t.frame_ms = load * (2 + 0.9 * views) * jitter.jitter();
+    t.pass_ms[0] = t.frame_ms;  // fixed_cost_ms 0: the whole frame is the views' pass
+    return t;
+  }
+};
+
+TEST(FrameControllerLightfield, HoldsNinetyHertzAndFollowsAChangeOfLoad) {
+  const double target = 1000.0 / 90;
+  FrameController c(lightfield(target), 16);
+  ViewMachine m;
+  std::vector<double> ms, views;
+  for (int frame = 0; frame < 240; ++frame) {
+    if (frame == 120) m.load = 1.4;  // another job starts: every view costs 40 % more
+    const double k = c.plan([](double n) {
+      FrameWork w;
+      w.pass[0] = n;  // every view survives the other cullings
+      return w;
+    });
+    ASSERT_EQ(k, std::floor(k));
+    ASSERT_GE(k, 1);
+    ASSERT_LE(k, 16);
+    FrameWork w;
+    w.pass[0] = k;
+    const FrameTimes t = m.run(k);
+    c.report(w, t);
+    ms.push_back(t.frame_ms);
+    views.push_back(k);
+  }
+  // At load 1, 10 views take 11 ms (11 would take 11.9): within +-10 % from the sixth frame on.
+  EXPECT_EQ(within(std::vector<double>(ms.begin(), ms.begin() + 120), 6, target, 0.10), 114);
+  // At load 1.4, 7 views take 11.6 ms: within +-10 % again six frames after the change.
+  EXPECT_EQ(within(ms, 126, target, 0.10), 114);
+  EXPECT_LT(views.back(), views[119]);
+  EXPECT_LE(reversals(views, 6), 2);
 }
 
 }  // namespace
