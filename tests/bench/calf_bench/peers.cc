@@ -134,9 +134,11 @@ Expected<DecodedClip> decode_clip(const fs::path& clip, const GridFrames& g) {
 }
 
 // Decode time per frame of the whole clip (every view, every cell and tile, no culling):
-// LightfieldDecoder::advance frame after frame; the median of frames 2..n and frame 1 apart.
+// LightfieldDecoder::advance frame after frame; the median of frames 2..n and frame 1 apart, and
+// the bytes the frames' updates upload, on average.
 struct DecodeTiming {
   double median_ms = 0, first_ms = 0;
+  double mean_update_bytes = 0;
 };
 Expected<DecodeTiming> calf_full_decode_ms(const fs::path& clip) {
   CALF_ASSIGN_OR_RETURN(container::Reader reader, container::Reader::open(clip.string()));
@@ -146,14 +148,17 @@ Expected<DecodeTiming> calf_full_decode_ms(const fs::path& clip) {
                         decoder::LightfieldDecoder::open(reader, 0, o));
   decoder::LightfieldFrameUpdates updates;
   std::vector<double> ms;
+  double update_bytes = 0;
   for (uint32_t f = 0; f < d.header().frame_count; ++f) {
     CALF_RETURN_IF_ERROR(d.advance(f, {}, {}, &updates));
     if (updates.stats.errors > 0) {
       return Status(ErrorId::kInternal, clip.string() + ": " + updates.stats.first_error);
     }
     ms.push_back(updates.stats.decode_ms);
+    update_bytes += static_cast<double>(updates.stats.update_bytes());
   }
   DecodeTiming t;
+  t.mean_update_bytes = update_bytes / static_cast<double>(ms.size());
   t.first_ms = ms.front();
   if (ms.size() > 1) ms.erase(ms.begin());
   t.median_ms = median(ms);
@@ -352,26 +357,12 @@ Expected<std::vector<ColourMatch>> match_colour_to_x265(const fs::path& capture_
     m.calf = c;
     CALF_ASSIGN_OR_RETURN(DecodedClip decoded, decode_clip(c.clip, g));
     m.psnr_db = mean_psnr_db(g.rgb, decoded.rgb, frame_bytes, g.frames);
+    CALF_ASSIGN_OR_RETURN(DecodeTiming timing, calf_full_decode_ms(c.clip));
+    m.decode_ms = g.frames > 1 ? timing.median_ms : 0;
+    m.upload_bytes = timing.mean_update_bytes;
     CALF_ASSIGN_OR_RETURN(container::Reader reader, container::Reader::open(c.clip.string()));
     decoder::LightfieldDecoderOptions o;
     o.view_dependent = false;
-    {
-      CALF_ASSIGN_OR_RETURN(decoder::LightfieldDecoder d,
-                            decoder::LightfieldDecoder::open(reader, 0, o));
-      decoder::LightfieldFrameUpdates updates;
-      std::vector<double> ms;
-      double upload = 0;
-      for (uint32_t f = 0; f < g.frames; ++f) {
-        CALF_RETURN_IF_ERROR(d.advance(f, {}, {}, &updates));
-        if (updates.stats.errors > 0) {
-          return Status(ErrorId::kInternal, c.clip.string() + ": " + updates.stats.first_error);
-        }
-        if (f > 0) ms.push_back(updates.stats.decode_ms);
-        upload += static_cast<double>(updates.stats.update_bytes());
-      }
-      m.decode_ms = ms.empty() ? 0 : median(ms);
-      m.upload_bytes = upload / g.frames;
-    }
     // Seeks: after frame 0, jumps backwards from the last frame to frame 1 (each a restart at
     // its GOP's key frame), then forwards by two.
     {
