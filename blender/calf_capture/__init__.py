@@ -37,6 +37,11 @@ if bpy is not None:
         face_size: bpy.props.IntProperty(name="Face size", default=64, min=1, max=16384)
         samples: bpy.props.IntProperty(name="Samples", default=64, min=1)
         seed: bpy.props.IntProperty(name="Seed", default=0)
+        adaptive_threshold: bpy.props.FloatProperty(
+            name="Adaptive threshold", default=capture.CAPTURE_ADAPTIVE_THRESHOLD, min=0.0,
+            max=1.0, precision=4,
+            description="Cycles' adaptive sampling noise threshold; 0 = off (every pixel gets "
+            "every sample)")
 
     class CALF_OT_capture(bpy.types.Operator):
         """Render a calf capture set of this scene (six faces per viewpoint and frame)"""
@@ -54,6 +59,7 @@ if bpy is not None:
                 o.collection = s.collection.name if s.collection else ""
             o.volume_object = s.volume_object.name if s.volume_object else ""
             o.face_size, o.samples, o.seed = s.face_size, s.samples, s.seed
+            o.adaptive_threshold = s.adaptive_threshold
             try:
                 m = capture.capture_set(context.scene, o)
             except capture.CaptureError as e:
@@ -79,6 +85,7 @@ if bpy is not None:
             col.prop(s, "face_size")
             col.prop(s, "samples")
             col.prop(s, "seed")
+            col.prop(s, "adaptive_threshold")
             col.operator(CALF_OT_capture.bl_idname, icon="RENDER_ANIMATION")
 
     _classes = (CalfCaptureSettings, CALF_OT_capture, CALF_PT_capture)

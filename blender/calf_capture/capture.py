@@ -26,6 +26,11 @@ NOISE_FLOOR_DIR = "noise-floor"
 MAX_FACE_SIZE = 16384   # calf's kMaxFaceSize
 MAX_IMAGE_SIDE = 16384  # calf's ground-truth image side limit
 HALF_MAX = 65504.0
+# Cycles' adaptive sampling (noise threshold; 0 turns it off, so that every pixel gets --samples):
+# off for ground truth, whose noise floor must fall as samples rise (docs/BLENDER.md, "Cost and
+# quality").
+GT_ADAPTIVE_THRESHOLD = 0.0
+CAPTURE_ADAPTIVE_THRESHOLD = 0.0
 
 
 class CaptureError(Exception):
@@ -55,6 +60,7 @@ class CaptureOptions:
         self.clip_end = 1e5
         self.threads = 0          # 0: Blender's automatic thread count
         self.coverage = False     # also write coverage (a version-2 set) from a 4x finer depth
+        self.adaptive_threshold = CAPTURE_ADAPTIVE_THRESHOLD  # 0: Cycles' adaptive sampling off
 
 
 def _fmt(p):
@@ -130,7 +136,7 @@ class _Renderer:
     """A temporary camera and the render settings the add-on needs; render() returns the colour
     (RGB list) and the planar depth of the camera's W x H image, row 0 at the top."""
 
-    def __init__(self, scene, samples, seed, clip_start, clip_end, threads):
+    def __init__(self, scene, samples, seed, clip_start, clip_end, threads, adaptive_threshold):
         check_cycles(scene)
         self.scene = scene
         self.samples = samples
@@ -150,6 +156,12 @@ class _Renderer:
         s.set(c, "device", "CPU")
         s.set(c, "use_denoising", False)
         s.set(c, "use_animated_seed", False)
+        # Adaptive sampling stops a pixel once its noise is below the threshold, whatever the
+        # samples; with the threshold 0 every pixel gets every sample.
+        s.set(c, "use_adaptive_sampling", adaptive_threshold > 0)
+        if adaptive_threshold > 0:
+            s.set(c, "adaptive_threshold", adaptive_threshold)
+            s.set(c, "adaptive_min_samples", 0)  # Cycles' automatic minimum
         s.set(r, "resolution_percentage", 100)
         s.set(r, "pixel_aspect_x", 1.0)
         s.set(r, "pixel_aspect_y", 1.0)
@@ -327,6 +339,13 @@ def frame_range(scene, options):
     return first, last
 
 
+def check_adaptive_threshold(value):
+    """CaptureError E006 unless 0 <= value <= 1 (Cycles' range; 0 turns adaptive sampling off)."""
+    if not 0.0 <= value <= 1.0:
+        raise CaptureError("CALF-E006", "--adaptive-threshold %r is outside 0..1 (0: adaptive "
+                           "sampling off)" % value, usage=True)
+
+
 def check_size(name, value, limit):
     if not 1 <= value <= limit:
         raise CaptureError("CALF-E006", "%s %d is outside calf's range 1..%d" %
@@ -353,6 +372,7 @@ def capture_set(scene, options, log=print):
     check_size("face size", options.face_size, MAX_FACE_SIZE)
     if options.samples < 1:
         raise CaptureError("CALF-E006", "--samples must be >= 1", usage=True)
+    check_adaptive_threshold(options.adaptive_threshold)
     first, last = frame_range(scene, options)
     views, box = viewpoints(scene, options)
     if len(views) > 4096:
@@ -374,7 +394,7 @@ def capture_set(scene, options, log=print):
         "viewpoints": [{"name": name, "position": list(p)} for name, p in views],
     }
     renderer = _Renderer(scene, options.samples, options.seed, options.clip_start,
-                         options.clip_end, options.threads)
+                         options.clip_end, options.threads, options.adaptive_threshold)
     progress = Progress(len(views) * (last - first + 1), log)
     try:
         for frame in range(first, last + 1):
@@ -500,23 +520,26 @@ def _render_path(scene, renderer, eye_path, out_dir, first, seed_offset, progres
 
 
 def ground_truth(scene, eye_path, out, samples, seed, first, noise_floor=True, clip_start=0.01,
-                 clip_end=1e5, threads=0, log=print):
+                 clip_end=1e5, threads=0, log=print,
+                 adaptive_threshold=GT_ADAPTIVE_THRESHOLD):
     """Renders `eye_path` (a calf eye-path dict; its width and height are the image size) into
     `out` as calf-play --compare reads it: gt_NNNNN.exr, and eye_path.json last; with
     `noise_floor`, first the same poses at seed + 1 into out/noise-floor/. Scene time t is scene
-    frame first + t * fps."""
+    frame first + t * fps. `adaptive_threshold` is Cycles' noise threshold, 0 = adaptive sampling
+    off (every pixel gets `samples`)."""
     check_cycles(scene)
     check_size("ground-truth width", eye_path["width"], MAX_IMAGE_SIDE)
     check_size("ground-truth height", eye_path["height"], MAX_IMAGE_SIDE)
     if samples < 1:
         raise CaptureError("CALF-E006", "--samples must be >= 1", usage=True)
+    check_adaptive_threshold(adaptive_threshold)
     check_output_dir(out)
     main_json = os.path.join(out, "eye_path.json")
     if os.path.lexists(main_json):
         os.remove(main_json)
     written = dict(eye_path)
     written["image_pattern"] = GT_PATTERN
-    renderer = _Renderer(scene, samples, seed, clip_start, clip_end, threads)
+    renderer = _Renderer(scene, samples, seed, clip_start, clip_end, threads, adaptive_threshold)
     passes = [(os.path.join(out, NOISE_FLOOR_DIR), 1, "noise floor")] if noise_floor else []
     passes.append((out, 0, "ground truth"))
     progress = Progress(len(passes) * len(eye_path["poses"]), log)

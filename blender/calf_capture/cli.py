@@ -73,6 +73,11 @@ def parser():
                    help="texels per face side, 1..16384; default 64")
     g.add_argument("--samples", type=int, default=64, metavar="N",
                    help="Cycles samples per pixel of the colour renders; default 64")
+    g.add_argument("--adaptive-threshold", type=float, default=None, metavar="T",
+                   help="Cycles' adaptive sampling: a pixel stops sampling once its noise is "
+                   "below T (0..1); 0 = off, every pixel gets --samples. Default 0 for the "
+                   "capture set and the ground truth (with adaptive sampling on, the ground "
+                   "truth's noise floor stops falling as --samples rises)")
     g.add_argument("--seed", type=int, default=0,
                    help="Cycles seed; default 0 (the noise floor of --ground-truth uses seed + 1)")
     g.add_argument("--clip-start", type=float, default=0.01, metavar="D",
@@ -129,7 +134,8 @@ def run(argv):
             return
         capture.ground_truth(scene, eye_path, args.out, args.samples, args.seed, first,
                              not args.no_noise_floor, args.clip_start, args.clip_end,
-                             args.threads)
+                             args.threads, adaptive_threshold=capture.GT_ADAPTIVE_THRESHOLD
+                             if args.adaptive_threshold is None else args.adaptive_threshold)
         print("%s: wrote ground truth of %d poses (%dx%d) to %s" %
               (PROG, len(eye_path["poses"]), eye_path["width"], eye_path["height"], args.out))
         return
@@ -147,6 +153,8 @@ def _options(args):
     o.face_size, o.samples, o.seed = args.face_size, args.samples, args.seed
     o.clip_start, o.clip_end, o.threads = args.clip_start, args.clip_end, args.threads
     o.coverage = args.coverage
+    if args.adaptive_threshold is not None:
+        o.adaptive_threshold = args.adaptive_threshold
     return o
 
 
