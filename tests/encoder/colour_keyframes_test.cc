@@ -295,12 +295,13 @@ TEST(ColourKeyframesTest, NoiseAwareTestKeepsAChangeAboveTheNoise) {
 }
 
 TEST(ColourKeyframesTest, NoiseAwareTestKeepsALocalChange) {
-  // The same change in one 8 x 8 block of the 16: over the whole cell it adds 25 / 16 times the
-  // noise variance, less than the noise part; the block's own test keeps it a keyframe.
+  // A change of 4 sigma rms in one 8 x 8 block of the 16: over the whole cell it adds the noise
+  // variance (16 / 16), within what Q allows beyond the noise part; the block's own test keeps it
+  // a keyframe.
   std::mt19937 rng(13);
   const std::vector<double> signal = random_signal(rng);
   std::vector<double> changed = signal;
-  std::normal_distribution<double> pattern(0.0, 5 * kSigma);
+  std::normal_distribution<double> pattern(0.0, 4 * kSigma);
   for (uint32_t y = 8; y < 16; ++y) {
     for (uint32_t i = (y * kSide + 8) * 3; i < (y * kSide + 16) * 3; ++i) {
       changed[i] = std::clamp(changed[i] + pattern(rng), 0.0, 1.0);
