@@ -13,16 +13,62 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
+// A value in the noise model's metric, over its peak (8 stops for log2, 1 for sRGB).
+double metric_value(float v, bool log2) {
+  return log2 ? std::log2(std::max(v, 1.0f / 16384.0f)) / 8.0 : srgb_from_linear(v);
+}
+
+// The median of chi-square with one degree of freedom: median(r^2) / var(r) for Gaussian r.
+constexpr double kMedianOfSquares = 0.454936;
+
+// Whether `test` (reconstructed at weight t / 255) passes for `reference` under the noise-aware
+// test (KeyframeOptions::noise).
+bool noise_aware_passes(const CellNoise& noise, std::span<const float> reference,
+                        std::span<const float> test, uint8_t t, double min_quality_db) {
+  const double w = t / 255.0;
+  const double parts = 1.0 + (1.0 - w) * (1.0 - w) + w * w;
+  const double max_error = std::pow(10.0, -min_quality_db / 10.0);
+  const uint32_t bx_count = (noise.width + kCellNoiseBlock - 1) / kCellNoiseBlock;
+  const uint32_t by_count = (noise.height + kCellNoiseBlock - 1) / kCellNoiseBlock;
+  if (noise.block_variance.size() != size_t{bx_count} * by_count ||
+      reference.size() != size_t{noise.width} * noise.height * 3 ||
+      test.size() != reference.size()) {
+    return false;
+  }
+  for (uint32_t by = 0; by < by_count; ++by) {
+    for (uint32_t bx = 0; bx < bx_count; ++bx) {
+      double sum = 0;
+      size_t count = 0;
+      const uint32_t y1 = std::min(noise.height, (by + 1) * kCellNoiseBlock);
+      const uint32_t x1 = std::min(noise.width, (bx + 1) * kCellNoiseBlock);
+      for (uint32_t y = by * kCellNoiseBlock; y < y1; ++y) {
+        for (size_t i = (size_t{y} * noise.width + bx * kCellNoiseBlock) * 3;
+             i < (size_t{y} * noise.width + x1) * 3; ++i) {
+          const double d =
+              metric_value(reference[i], noise.log2) - metric_value(test[i], noise.log2);
+          sum += d * d;
+          ++count;
+        }
+      }
+      const double expected = parts * noise.block_variance[size_t{by} * bx_count + bx];
+      if (!(sum / static_cast<double>(count) - expected <= max_error)) return false;
+    }
+  }
+  return true;
+}
+
 // Alg. 2's state for one cell: original frames, the keyframes as shown (cached), scratch space.
 class CellSearch {
  public:
   CellSearch(std::span<const float> frames, uint32_t frame_count, size_t frame_size,
-             const ShownKeyframeFn& shown, const CellQualityFn& quality, double min_quality)
+             const ShownKeyframeFn& shown, const CellQualityFn& quality,
+             const KeyframeOptions& options)
       : frames_(frames),
         frame_size_(frame_size),
         shown_(shown),
         quality_(quality),
-        min_quality_(min_quality),
+        min_quality_(options.min_quality_db),
+        noise_(options.noise),
         cache_(frame_count),
         scratch_(frame_size) {}
 
@@ -52,11 +98,18 @@ class CellSearch {
     return std::pair{quality_(frame(x), scratch_), t};
   }
 
+  // Whether frame x reconstructed as `test` at weight t, of quality q, passes: q >= Q, or the
+  // noise-aware test.
+  bool passes(double q, uint32_t x, std::span<const float> test, uint8_t t) const {
+    if (q >= min_quality_) return true;
+    return noise_ != nullptr && noise_aware_passes(*noise_, frame(x), test, t, min_quality_);
+  }
+
   // Whether every frame strictly between m and n passes (Eq. 11's indicator).
   Expected<bool> segment_passes(uint32_t m, uint32_t n) {
     for (uint32_t x = m + 1; x < n; ++x) {
       CALF_ASSIGN_OR_RETURN(auto qt, reconstruct(x, m, n));
-      if (!(qt.first >= min_quality_)) return false;
+      if (!passes(qt.first, x, scratch_, qt.second)) return false;
     }
     return true;
   }
@@ -65,7 +118,7 @@ class CellSearch {
   Expected<bool> holds(uint32_t m, uint32_t last) {
     CALF_ASSIGN_OR_RETURN(std::span<const float> a, keyframe(m));
     for (uint32_t x = m + 1; x <= last; ++x) {
-      if (!(quality_(frame(x), a) >= min_quality_)) return false;
+      if (!passes(quality_(frame(x), a), x, a, 0)) return false;
     }
     return true;
   }
@@ -76,6 +129,7 @@ class CellSearch {
   const ShownKeyframeFn& shown_;
   const CellQualityFn& quality_;
   double min_quality_;
+  const CellNoise* noise_;
   std::vector<std::optional<std::span<const float>>> cache_;
   std::vector<float> scratch_;
 };
@@ -144,7 +198,7 @@ Expected<CellKeyframes> select_cell_keyframes(std::span<const float> frames, uin
                                                  " frames of " + std::to_string(texel_count) +
                                                  " RGB texels");
   }
-  CellSearch search(frames, frame_count, frame_size, shown, quality, options.min_quality_db);
+  CellSearch search(frames, frame_count, frame_size, shown, quality, options);
   CellKeyframes out;
   out.keyframes.push_back(0);
   out.t.assign(frame_count, 0);
@@ -169,6 +223,48 @@ Expected<CellKeyframes> select_cell_keyframes(std::span<const float> frames, uin
     }
     out.keyframes.push_back(n);
     m = n;
+  }
+  return out;
+}
+
+CellNoise measure_cell_noise(std::span<const float> frames, uint32_t frame_count, uint32_t width,
+                             uint32_t height, bool log2, double factor, double max_variance) {
+  CellNoise out;
+  out.width = width;
+  out.height = height;
+  out.log2 = log2;
+  const uint32_t bx_count = (width + kCellNoiseBlock - 1) / kCellNoiseBlock;
+  const uint32_t by_count = (height + kCellNoiseBlock - 1) / kCellNoiseBlock;
+  out.block_variance.assign(size_t{bx_count} * by_count, 0.0);
+  const size_t n = size_t{width} * height * 3;
+  if (frame_count < 2 || width < 3 || height < 3 || frames.size() < n * frame_count) return out;
+  // Per block, the squared high-passed differences of every pair (texels on the cell's border,
+  // without 4 neighbours, are left out).
+  std::vector<std::vector<double>> squares(out.block_variance.size());
+  std::vector<double> d(n);
+  for (uint32_t f = 1; f < frame_count; ++f) {
+    const float* a = &frames[(f - 1) * n];
+    const float* b = &frames[f * n];
+    for (size_t i = 0; i < n; ++i) d[i] = metric_value(b[i], log2) - metric_value(a[i], log2);
+    for (uint32_t y = 1; y + 1 < height; ++y) {
+      for (uint32_t x = 1; x + 1 < width; ++x) {
+        std::vector<double>& block =
+            squares[size_t{y / kCellNoiseBlock} * bx_count + x / kCellNoiseBlock];
+        for (uint32_t c = 0; c < 3; ++c) {
+          auto at = [&](uint32_t xx, uint32_t yy) { return d[(size_t{yy} * width + xx) * 3 + c]; };
+          const double r =
+              at(x, y) - (at(x - 1, y) + at(x + 1, y) + at(x, y - 1) + at(x, y + 1)) / 4;
+          block.push_back(r * r);
+        }
+      }
+    }
+  }
+  for (size_t i = 0; i < squares.size(); ++i) {
+    std::vector<double>& s = squares[i];
+    if (s.empty()) continue;
+    auto mid = s.begin() + static_cast<std::ptrdiff_t>(s.size() / 2);
+    std::nth_element(s.begin(), mid, s.end());
+    out.block_variance[i] = std::min(max_variance, factor * *mid / kMedianOfSquares / 2.5);
   }
   return out;
 }

@@ -31,6 +31,12 @@ Status validate_options(const LightfieldEncodeOptions& o) {
   if (!(o.min_psnr_db > 0 && o.min_psnr_db <= 200)) {
     return bad("--psnr " + std::to_string(o.min_psnr_db) + ": expected (0, 200] dB");
   }
+  if (!(o.noise_psnr_db == 0 || (o.noise_psnr_db > 0 && o.noise_psnr_db <= 300))) {
+    return bad("noise level " + std::to_string(o.noise_psnr_db) + ": expected 0 or (0, 300] dB");
+  }
+  if (!(o.noise_factor >= 0 && o.noise_factor <= 16)) {
+    return bad("--psnr-noise-factor " + std::to_string(o.noise_factor) + ": expected [0, 16]");
+  }
   if (o.depth_regions_per_side < 1 || o.depth_regions_per_side > 64) {
     return bad("depth regions per side " + std::to_string(o.depth_regions_per_side) +
                ": expected [1, 64]");

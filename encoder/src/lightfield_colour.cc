@@ -37,6 +37,11 @@ void gather_cell_halves(const ViewData& v, uint32_t face, const PixelRect& r, ui
   }
 }
 
+// The noise-aware keyframe test counts a block's own render noise up to this many times the
+// capture's estimate (darker regions are noisier in log2; docs/ENCODER.md "Keyframes and render
+// noise").
+constexpr double kNoiseBlockCap = 8;
+
 // Linear RGB as 8-bit sRGB RGBA (alpha 255): what the LDR formats code.
 std::vector<uint8_t> srgb8_rgba_of(std::span<const float> rgb) {
   const size_t n = rgb.size() / 3;
@@ -266,6 +271,15 @@ void colour_task(const Context& ctx, uint32_t face, uint32_t cell, TaskOut& out)
   for (uint32_t s0 = 0; s0 < frames; s0 += segment) {
     const uint32_t len = std::min(segment, frames - s0);
     const ShownKeyframeFn shown_in = [&](uint32_t f) { return shown(s0 + f); };
+    // The noise-aware test: each block's own noise, at most kNoiseBlockCap times the capture's.
+    CellNoise noise;
+    if (ctx.options->noise_psnr_db > 0 && ctx.options->noise_factor > 0) {
+      noise = measure_cell_noise(
+          std::span<const float>(shown_all).subspan(s0 * n * 3, size_t{len} * n * 3), len, r.width,
+          r.height, ctx.hdr, ctx.options->noise_factor,
+          kNoiseBlockCap * std::pow(10.0, -ctx.options->noise_psnr_db / 10.0));
+      ko.noise = &noise;
+    }
     auto part = select_cell_keyframes(
         std::span<const float>(shown_all).subspan(s0 * n * 3, size_t{len} * n * 3), len,
         static_cast<uint32_t>(n), shown_in, quality, ko);

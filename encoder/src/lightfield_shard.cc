@@ -36,7 +36,7 @@ constexpr const char* kAnalysisKey = "calf.lightfield_analysis";
 constexpr const char* kAnalysisIdKey = "calf.lightfield_analysis_id";
 constexpr const char* kShardViewsKey = "calf.lightfield_shard_views";
 constexpr const char* kShardFramesKey = "calf.lightfield_shard_frames";  // "first-last"
-constexpr const char* kRecordMagic = "calf-lightfield-analysis 5";
+constexpr const char* kRecordMagic = "calf-lightfield-analysis 6";
 constexpr const char* kRecordMagicPrefix = "calf-lightfield-analysis ";
 
 std::string hex_double(double v) {
@@ -51,7 +51,8 @@ std::string analysis_record(const LightfieldAnalysis& a, const LightfieldEncodeO
                             const std::vector<std::vector<uint64_t>>& pixels) {
   std::ostringstream s;
   s << kRecordMagic << "\n";
-  s << "cell " << o.cell_size << "\npsnr " << hex_double(o.min_psnr_db) << "\ncolour "
+  s << "cell " << o.cell_size << "\npsnr " << hex_double(o.min_psnr_db) << "\nnoise_psnr "
+    << hex_double(o.noise_psnr_db) << "\nnoise_factor " << hex_double(o.noise_factor) << "\ncolour "
     << static_cast<int>(o.colour) << "\ndepth " << static_cast<int>(o.depth) << "\ntiles "
     << o.depth_regions_per_side << "\nwindow " << o.depth_window << "\naabbs " << o.max_aabbs
     << "\nkeyframe_interval " << o.depth_keyframe_interval << "\nsupercompression "
@@ -132,6 +133,12 @@ Status parse_record(const std::string& path, const std::string& text, Lightfield
   std::string key;
   if (!(in >> key) || key != "psnr" || !read_double(in, &o->min_psnr_db)) {
     return bad_record(path, "psnr");
+  }
+  if (!(in >> key) || key != "noise_psnr" || !read_double(in, &o->noise_psnr_db)) {
+    return bad_record(path, "noise_psnr");
+  }
+  if (!(in >> key) || key != "noise_factor" || !read_double(in, &o->noise_factor)) {
+    return bad_record(path, "noise_factor");
   }
   if (!field("colour", static_cast<uint64_t>(ColourCoding::kRgba16f)))
     return bad_record(path, "colour");

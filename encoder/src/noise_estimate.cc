@@ -253,4 +253,9 @@ double auto_psnr_db(const NoiseEstimate& estimate, double margin, double cap) {
   return std::clamp(*estimate.psnr_db - margin, std::min(kAutoPsnrFloorDb, cap), cap);
 }
 
+double auto_noise_psnr_db(const NoiseEstimate& estimate, double margin, double cap) {
+  if (!estimate.psnr_db || !(auto_psnr_db(estimate, margin, cap) < cap)) return 0;
+  return std::clamp(*estimate.psnr_db, 1e-3, 300.0);
+}
+
 }  // namespace calf::encoder

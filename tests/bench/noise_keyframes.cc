@@ -1,13 +1,13 @@
 // Keyframes and render noise (docs/ENCODER.md "Keyframes and render noise"): encodes a capture
 // set with the colour keyframe threshold Q at 50 dB (calf-encode --psnr 50) and at --psnr auto
-// for each margin given (calf/encoder/noise_estimate.h), and prints per encode the colour stream's
-// stored bytes, its keyframes and the PSNR of the decoded colour (every face of every view and
-// frame, 8-bit sRGB as calf-bench's peers measure it, one MSE over everything) against the input
-// and against a reference capture of the same viewpoints (--reference: the scene rendered
-// converged, ground truth at the capture's own texels). Prints markdown.
+// for each margin and noise factor given (calf/encoder/noise_estimate.h), and prints per encode the
+// colour stream's stored bytes, its keyframes and the PSNR of the decoded colour (every face of
+// every view and frame, 8-bit sRGB as calf-bench's peers measure it, one MSE over everything)
+// against the input and against a reference capture of the same viewpoints (--reference: the scene
+// rendered converged, ground truth at the capture's own texels). Prints markdown.
 //
 //   bench-noise_keyframes --capture NOISY [--reference CONVERGED] [--margin 4 --margin 6 ...]
-//       [--threads N]
+//       [--factor 0 --factor 3 ...] [--threads N]
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -87,7 +87,7 @@ int fail(const Status& s) {
 int main(int argc, char** argv) {
   CLI::App app{"bench-noise_keyframes: colour bytes and PSNR at --psnr 50 and --psnr auto"};
   std::string capture_dir, reference_dir;
-  std::vector<double> margins;
+  std::vector<double> margins, factors;
   uint32_t threads = 0;
   app.add_option("--capture", capture_dir, "the capture set encoded")->required();
   app.add_option("--reference", reference_dir,
@@ -95,9 +95,12 @@ int main(int argc, char** argv) {
   app.add_option("--margin", margins,
                  "--psnr-noise-margin values (repeatable; default: the "
                  "default margin)");
+  app.add_option("--factor", factors,
+                 "--psnr-noise-factor values (repeatable; default: the default factor)");
   app.add_option("--threads", threads, "encoder threads, 0 = all cores (default 0)");
   CLI11_PARSE(app, argc, argv);
   if (margins.empty()) margins.push_back(encoder::kDefaultPsnrNoiseMargin);
+  if (factors.empty()) factors.push_back(encoder::kDefaultNoiseFactor);
 
   auto input = capture::CaptureSetReader::open(capture_dir);
   if (!input.ok()) return fail(input.status());
@@ -129,16 +132,28 @@ int main(int argc, char** argv) {
   std::printf("|---|---:|---:|---:|---:|---:|%s\n", ref_rgb ? "---:|---:|" : "");
   const fs::path clip = fs::temp_directory_path() /
                         fmt::format("bench-noise_keyframes-{}.calf", static_cast<long>(getpid()));
-  std::vector<std::pair<std::string, double>> runs = {{"50", 50.0}};
+  struct Run {
+    std::string label;
+    double q = 50;
+    double noise_db = 0;
+    double factor = 0;
+  };
+  std::vector<Run> runs = {{"50", 50.0, 0, 0}};
   for (const double m : margins) {
-    runs.emplace_back(fmt::format("auto, margin {:g}", m), encoder::auto_psnr_db(noise->set, m));
+    for (const double k : factors) {
+      runs.push_back({fmt::format("auto, margin {:g}, factor {:g}", m, k),
+                      encoder::auto_psnr_db(noise->set, m),
+                      encoder::auto_noise_psnr_db(noise->set, m), k});
+    }
   }
   uint64_t base_bytes = 0;
   double base_ref = 0;
-  for (const auto& [label, q] : runs) {
+  for (const auto& [label, q, noise_db, factor] : runs) {
     encoder::LightfieldEncodeOptions o;
     o.threads = threads;
     o.min_psnr_db = q;
+    o.noise_psnr_db = noise_db;
+    o.noise_factor = factor;
     auto stats = encoder::encode_lightfield_file(capture_dir, clip.string(), o);
     if (!stats.ok()) return fail(stats.status());
     auto out_rgb = clip_srgb(clip);

@@ -3,9 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <map>
 #include <random>
+
+#include "calf/format/colour.h"
 
 namespace calf {
 namespace {
@@ -191,6 +195,120 @@ TEST(ColourKeyframesTest, ErrorsPropagate) {
       encoder::select_cell_keyframes(all, 4, kTexels, shown.fn(), encoder::psnr_srgb, {}).ok());
   EXPECT_FALSE(
       encoder::select_cell_keyframes(all, 0, kTexels, shown.fn(), encoder::psnr_srgb, {}).ok());
+}
+
+// The noise-aware test (KeyframeOptions::noise). A static signal in sRGB values, each frame with
+// its own Gaussian noise of sigma 0.01 (noise PSNR 40 dB in psnr_srgb's metric), on a 32 x 32
+// cell (16 blocks of 8 x 8).
+constexpr uint32_t kSide = 32;
+constexpr uint32_t kNoisyTexels = kSide * kSide;
+constexpr double kSigma = 0.01;
+constexpr double kNoiseDb = 40.0;  // -20 log10(kSigma)
+
+std::vector<float> noisy_frame(const std::vector<double>& signal_srgb, std::mt19937& rng) {
+  std::normal_distribution<double> n(0.0, kSigma);
+  std::vector<float> f(signal_srgb.size());
+  for (size_t i = 0; i < f.size(); ++i) {
+    f[i] = linear_from_srgb(static_cast<float>(signal_srgb[i] + n(rng)));
+  }
+  return f;
+}
+
+std::vector<double> random_signal(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.3, 0.7);
+  std::vector<double> s(kNoisyTexels * 3);
+  for (double& v : s) v = u(rng);
+  return s;
+}
+
+// Q 1 dB below the noise: a frame held or interpolated from noisy keyframes measures 1.5 to 2
+// times the noise variance against its own noisy input, so the plain test fails it.
+encoder::CellKeyframes select_noisy(const std::vector<float>& all, uint32_t frames,
+                                    bool noise_aware) {
+  const encoder::ShownKeyframeFn shown = [&](uint32_t f) -> Expected<std::span<const float>> {
+    return std::span<const float>(all).subspan(size_t{f} * kNoisyTexels * 3, kNoisyTexels * 3);
+  };
+  const double variance = kSigma * kSigma;
+  const encoder::CellNoise noise =
+      encoder::measure_cell_noise(all, frames, kSide, kSide, false, 1.0, 4 * variance);
+  encoder::KeyframeOptions o;
+  o.min_quality_db = kNoiseDb - 1;
+  if (noise_aware) o.noise = &noise;
+  auto r = encoder::select_cell_keyframes(all, frames, kNoisyTexels, shown, encoder::psnr_srgb, o);
+  EXPECT_TRUE(r.ok()) << r.status().to_string();
+  return *r;
+}
+
+// Frames of `signal`, frame `changed_frame` of `changed` instead.
+std::vector<float> noisy_sequence(const std::vector<double>& signal,
+                                  const std::vector<double>& changed, int changed_frame,
+                                  std::mt19937& rng) {
+  std::vector<float> all;
+  for (int f = 0; f < 8; ++f) {
+    const std::vector<float> frame = noisy_frame(f == changed_frame ? changed : signal, rng);
+    all.insert(all.end(), frame.begin(), frame.end());
+  }
+  return all;
+}
+
+TEST(ColourKeyframesTest, CellNoiseMeasuresEachBlocksNoise) {
+  std::mt19937 rng(10);
+  const std::vector<double> signal = random_signal(rng);
+  const auto all = noisy_sequence(signal, signal, -1, rng);
+  const encoder::CellNoise noise =
+      encoder::measure_cell_noise(all, 8, kSide, kSide, false, 1.0, 1.0);
+  ASSERT_EQ(noise.block_variance.size(), 16u);
+  for (const double v : noise.block_variance)
+    EXPECT_NEAR(v, kSigma * kSigma, 0.25 * kSigma * kSigma);
+  // factor scales it, max_variance bounds it; one frame has no pair: 0.
+  const encoder::CellNoise half =
+      encoder::measure_cell_noise(all, 8, kSide, kSide, false, 0.5, 1.0);
+  EXPECT_DOUBLE_EQ(half.block_variance[5], noise.block_variance[5] / 2);
+  const encoder::CellNoise capped =
+      encoder::measure_cell_noise(all, 8, kSide, kSide, false, 1.0, 1e-5);
+  EXPECT_EQ(capped.block_variance[5], 1e-5);
+  EXPECT_EQ(encoder::measure_cell_noise(all, 1, kSide, kSide, false, 1.0, 1.0).block_variance,
+            std::vector<double>(16, 0.0));
+}
+
+TEST(ColourKeyframesTest, NoiseAwareTestInterpolatesStaticNoise) {
+  std::mt19937 rng(11);
+  const std::vector<double> signal = random_signal(rng);
+  const auto all = noisy_sequence(signal, signal, -1, rng);
+  // The plain test charges the noise: every frame is a keyframe.
+  EXPECT_EQ(select_noisy(all, 8, false).keyframes.size(), 8u);
+  // Not charging the known noise, the static cell is one or two keyframes.
+  EXPECT_LE(select_noisy(all, 8, true).keyframes.size(), 2u);
+}
+
+TEST(ColourKeyframesTest, NoiseAwareTestKeepsAChangeAboveTheNoise) {
+  // Frame 4 differs from the others by a pattern of 5 sigma rms (25 times the noise variance):
+  // it cannot be interpolated and stays a keyframe.
+  std::mt19937 rng(12);
+  const std::vector<double> signal = random_signal(rng);
+  std::vector<double> changed = signal;
+  std::normal_distribution<double> pattern(0.0, 5 * kSigma);
+  for (double& v : changed) v = std::clamp(v + pattern(rng), 0.0, 1.0);
+  const encoder::CellKeyframes k = select_noisy(noisy_sequence(signal, changed, 4, rng), 8, true);
+  EXPECT_NE(std::find(k.keyframes.begin(), k.keyframes.end(), 4u), k.keyframes.end());
+  EXPECT_LE(k.keyframes.size(), 4u);
+}
+
+TEST(ColourKeyframesTest, NoiseAwareTestKeepsALocalChange) {
+  // A change of 4 sigma rms in one 8 x 8 block of the 16: over the whole cell it adds the noise
+  // variance (16 / 16), within what Q allows beyond the noise part; the block's own test keeps it
+  // a keyframe.
+  std::mt19937 rng(13);
+  const std::vector<double> signal = random_signal(rng);
+  std::vector<double> changed = signal;
+  std::normal_distribution<double> pattern(0.0, 4 * kSigma);
+  for (uint32_t y = 8; y < 16; ++y) {
+    for (uint32_t i = (y * kSide + 8) * 3; i < (y * kSide + 16) * 3; ++i) {
+      changed[i] = std::clamp(changed[i] + pattern(rng), 0.0, 1.0);
+    }
+  }
+  const encoder::CellKeyframes k = select_noisy(noisy_sequence(signal, changed, 4, rng), 8, true);
+  EXPECT_NE(std::find(k.keyframes.begin(), k.keyframes.end(), 4u), k.keyframes.end());
 }
 
 }  // namespace

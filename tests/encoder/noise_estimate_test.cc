@@ -150,5 +150,17 @@ TEST(NoiseEstimateTest, AutoPsnrIsTheEstimateLessTheMarginCappedAt50) {
   EXPECT_DOUBLE_EQ(encoder::auto_psnr_db(e, 4.0), encoder::kAutoPsnrFloorDb);
 }
 
+TEST(NoiseEstimateTest, NoiseAwareTestOnlyWhereQIsBelowTheCap) {
+  encoder::NoiseEstimate e;
+  EXPECT_EQ(encoder::auto_noise_psnr_db(e, 3.0), 0.0);  // no estimate: off
+  e.psnr_db = 43.0;
+  EXPECT_DOUBLE_EQ(encoder::auto_noise_psnr_db(e, 3.0), 43.0);
+  // Q = min(50, 53 - 3) = 50, the cap: the plain test, as with --psnr 50.
+  e.psnr_db = 53.0;
+  EXPECT_EQ(encoder::auto_noise_psnr_db(e, 3.0), 0.0);
+  e.psnr_db = 52.9;
+  EXPECT_DOUBLE_EQ(encoder::auto_noise_psnr_db(e, 3.0), 52.9);
+}
+
 }  // namespace
 }  // namespace calf

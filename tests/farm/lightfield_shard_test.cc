@@ -205,6 +205,61 @@ TEST(LightfieldShardFrames, FrameRangeShardsEqualSegmentedEncode) {
   EXPECT_FALSE(fs::exists(work / "x.calf"));
 }
 
+// The noise-aware keyframe test (--psnr auto on a capture with per-frame render noise): the
+// analysis file records the noise estimate and factor, and frame-range shards code each segment's
+// cells as one encode does (each segment measures its own cells' noise).
+TEST(LightfieldShardFrames, NoiseAwareShardsEqualOneMachineEncode) {
+  const fs::path dir = scratch() / "noisy-mirror-box";
+  if (!fs::exists(dir / capture::kManifestFileName)) {
+    auto scene = samples::make_builtin_scene("mirror-box");
+    ASSERT_TRUE(scene.ok()) << scene.status().to_string();
+    samples::CaptureRequest r = tiny_request(*scene, 4);
+    r.render.noise = 0.05f;
+    ASSERT_TRUE(samples::render_capture_set(*scene, r, dir, nullptr).ok());
+  }
+  const fs::path work = scratch() / "noisy-work";
+  fs::create_directories(work);
+  encoder::LightfieldEncodeOptions o;
+  o.threads = 2;
+  o.segment_frames = 2;
+  o.depth_keyframe_interval = 1;
+  o.min_psnr_db = 42.7;
+  o.noise_psnr_db = 45.7;
+  o.noise_factor = 3;
+  const std::string one = (work / "one.calf").string();
+  ASSERT_TRUE(encoder::encode_lightfield_file(dir, one, o).ok());
+  encoder::LightfieldEncodeOptions plain = o;
+  plain.noise_psnr_db = 0;
+  const std::string plain_path = (work / "plain.calf").string();
+  ASSERT_TRUE(encoder::encode_lightfield_file(dir, plain_path, plain).ok());
+  EXPECT_FALSE(bytes_of(plain_path) == bytes_of(one)) << "the noise-aware test changed nothing";
+
+  ASSERT_TRUE(encoder::write_lightfield_analysis(dir, (work / "a.calf").string(), o).ok());
+  auto a = encoder::read_lightfield_analysis((work / "a.calf").string());
+  ASSERT_TRUE(a.ok()) << a.status().to_string();
+  EXPECT_EQ(a->options.noise_psnr_db, 45.7);
+  EXPECT_EQ(a->options.noise_factor, 3.0);
+  const auto groups = split(a->analysis.header.view_count, 2);
+  std::vector<std::string> shards;
+  for (uint32_t g = 0; g < 2; ++g) {
+    for (uint32_t first : {0u, 2u}) {
+      std::string name = "n";
+      name += std::to_string(g);
+      name += '-';
+      name += std::to_string(first);
+      name += ".calf";
+      const std::string path = (work / name).string();
+      auto s = encoder::encode_lightfield_shard(dir, *a, groups[g], first, 2, 1, path);
+      ASSERT_TRUE(s.ok()) << s.status().to_string();
+      shards.push_back(path);
+    }
+  }
+  const std::string merged = (work / "merged.calf").string();
+  const Status m = encoder::merge_lightfield_shards(*a, shards, merged);
+  ASSERT_TRUE(m.ok()) << m.to_string();
+  EXPECT_TRUE(bytes_of(merged) == bytes_of(one));
+}
+
 TEST(LightfieldShardErrors, MergeRefusesMissingForeignAndOverlappingShards) {
   const fs::path dir = capture_of("turntable", 2, "views");
   ASSERT_TRUE(fs::exists(dir / capture::kManifestFileName));

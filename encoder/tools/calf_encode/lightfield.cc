@@ -56,6 +56,7 @@ int resolve_auto_psnr(const std::filesystem::path& dir, double margin, bool quie
   auto noise = encoder::estimate_capture_noise(*input, o->colour, no);
   if (!noise.ok()) return fail(noise.status());
   o->min_psnr_db = encoder::auto_psnr_db(noise->set, margin);
+  o->noise_psnr_db = encoder::auto_noise_psnr_db(noise->set, margin);
   if (quiet) return 0;
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -78,10 +79,12 @@ int resolve_auto_psnr(const std::filesystem::path& dir, double margin, bool quie
   std::fprintf(stderr,
                "calf-encode: colour noise %.2f dB %s (%s%llu samples of frame-to-frame change on "
                "static geometry, %.2f s); --psnr auto: Q = %.2f dB (min(50, estimate - margin "
-               "%g))\n",
+               "%g))%s\n",
                *noise->set.psnr_db, metric, views.c_str(),
-               static_cast<unsigned long long>(noise->set.samples), seconds, o->min_psnr_db,
-               margin);
+               static_cast<unsigned long long>(noise->set.samples), seconds, o->min_psnr_db, margin,
+               o->noise_psnr_db > 0
+                   ? fmt::format(", noise-aware (factor {:g})", o->noise_factor).c_str()
+                   : "");
   return 0;
 }
 
@@ -156,6 +159,12 @@ void add_options(CLI::App& app, LightfieldOptions& o) {
   app.add_option("--psnr-noise-margin", o.psnr_noise_margin,
                  "with --psnr auto: dB Q stays below the render-noise estimate, 0..50")
       ->check(CLI::Range(0.0, 50.0))
+      ->group(kLightfieldGroup);
+  app.add_option("--psnr-noise-factor", e.noise_factor,
+                 "with --psnr auto and Q below 50: the keyframe test does not count this many "
+                 "times each 8 x 8 block's measured render noise in an interpolated frame's "
+                 "error, 0..16 (0: the plain test)")
+      ->check(CLI::Range(0.0, 16.0))
       ->group(kLightfieldGroup);
   add_enum_option(app, "--colour-format,--color-format", e.colour, kColourFormats,
                   "auto (BC1 for LDR input, BC6H for HDR), bc1, bc7, bc6h, rgba8, rgba16f")
@@ -239,6 +248,9 @@ int resolve(const CLI::App& app, const CommonOptions& common, LightfieldOptions*
     }
     if (given(app, "--psnr-noise-margin")) {
       return usage_error("calf-encode", "--psnr-noise-margin needs --psnr auto");
+    }
+    if (given(app, "--psnr-noise-factor")) {
+      return usage_error("calf-encode", "--psnr-noise-factor needs --psnr auto");
     }
   }
   o.merge_static_groups = !lf.fixed_groups;

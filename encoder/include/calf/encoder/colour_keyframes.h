@@ -41,9 +41,27 @@ enum class KeyframeSearch : uint8_t {
   kExhaustive,
 };
 
+// The noise-aware test's model of one cell's render noise (measure_cell_noise).
+struct CellNoise {
+  uint32_t width = 0, height = 0;  // the cell in texels (frames are rows of RGB texels)
+  bool log2 = false;  // the metric: log2 of max(v, 2^-14) over an 8-stop peak (HDR), else sRGB
+  // Per block of kCellNoiseBlock x kCellNoiseBlock texels, row-major: the noise variance per
+  // frame not charged for, relative to the metric's peak squared.
+  std::vector<double> block_variance;
+};
+inline constexpr uint32_t kCellNoiseBlock = 8;
+
 struct KeyframeOptions {
   double min_quality_db = 50.0;  // the paper's Q
   KeyframeSearch search = KeyframeSearch::kGalloping;
+  // The noise-aware test (null = off). Render noise of variance s^2 per frame, independent between
+  // frames, makes a frame reconstructed as (1 - w) K_m + w K_n differ from its own noisy input by
+  // its signal error plus a noise part of expected variance (1 + (1 - w)^2 + w^2) s^2 (its own
+  // noise and the keyframes', partly averaged). A frame that fails Q as measured still passes when
+  // in every block the error less that part, with the block's s^2, keeps Q (the quality function
+  // must then be PSNR in noise->log2's metric): noise spreads over the cell, a local change does
+  // not hide in the cell's mean.
+  const CellNoise* noise = nullptr;
 };
 
 struct CellKeyframes {
@@ -74,6 +92,15 @@ Expected<CellKeyframes> select_cell_keyframes(std::span<const float> frames, uin
                                               uint32_t texel_count, const ShownKeyframeFn& shown,
                                               const CellQualityFn& quality,
                                               const KeyframeOptions& options);
+
+// The render noise of a cell's frames (frame_count frames of width x height RGB texels, as the
+// keyframe test sees them) for the noise-aware test: per block, the difference d of consecutive
+// frames in the metric goes through a spatial high-pass (d less the mean of its 4 neighbours',
+// which cancels smooth signal change; white noise of variance s^2 per frame gives it 2.5 s^2);
+// the median of its squares over the block's texels and every pair (a local change does not move
+// it) gives s^2, times `factor`, at most max_variance. No pair, or blocks without change: 0.
+CellNoise measure_cell_noise(std::span<const float> frames, uint32_t frame_count, uint32_t width,
+                             uint32_t height, bool log2, double factor, double max_variance);
 
 // PSNR in dB of two linear-RGB cells after both are encoded to sRGB and clamped to [0, 1]: what an
 // LDR display shows. +inf when identical.

@@ -88,10 +88,18 @@ enum class Bc1Fit : uint8_t { kRange, kRefined, kCluster };
 // LightfieldEncodeOptions::colour_rdo's "auto": the measured default of each colour format
 // (colour_rdo_lambda).
 inline constexpr double kColourRdoAuto = -1;
+// LightfieldEncodeOptions::noise_factor's default (docs/ENCODER.md "Keyframes and render noise").
+inline constexpr double kDefaultNoiseFactor = 3;
 
 struct LightfieldEncodeOptions {
   uint32_t cell_size = 64;  // colour cell side (px), 4..16384 and a multiple of 4
   double min_psnr_db = 50;  // Q, (0, 200]
+  // The noise-aware keyframe test (KeyframeOptions::noise, docs/ENCODER.md "Keyframes and render
+  // noise"), set by calf-encode --psnr auto when the estimate sets Q below 50: the capture's
+  // render-noise estimate as PSNR in the colour test's metric, 0 = off (the plain test), else
+  // (0, 300]; and the factor on each block's measured noise (the part not charged for), [0, 16].
+  double noise_psnr_db = 0;
+  double noise_factor = kDefaultNoiseFactor;
   ColourCoding colour = ColourCoding::kAuto;
   // The smallest lossless depth; its decode cost against raw16: docs/DECODER.md.
   DepthCoding depth = DepthCoding::kRaw16PredictedMasked;

@@ -109,4 +109,10 @@ inline constexpr double kAutoPsnrFloorDb = 10;
 inline constexpr double kDefaultPsnrNoiseMargin = 3;
 double auto_psnr_db(const NoiseEstimate& estimate, double margin, double cap = kAutoPsnrCapDb);
 
+// --psnr auto's noise-aware keyframe test (LightfieldEncodeOptions::noise_psnr_db): the estimate,
+// or 0 (off) without one and where Q = auto_psnr_db(estimate, margin, cap) is the cap (content
+// whose noise lies far below Q codes as with a number).
+double auto_noise_psnr_db(const NoiseEstimate& estimate, double margin,
+                          double cap = kAutoPsnrCapDb);
+
 }  // namespace calf::encoder
