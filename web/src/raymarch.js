@@ -28,7 +28,7 @@ export const RENDER_DEFAULTS = {
 export const COVERAGE_PARAMETERS = [
   { name: 'coverage', option: 'coverage', min: 0, max: 4, integer: true },
   { name: 'coverage-threshold', option: 'coverage_threshold', min: 0, max: 1, integer: false },
-  { name: 'coverage-cluster', option: 'coverage_cluster', min: 0, max: 1, integer: false },
+  { name: 'coverage-cluster', option: 'coverage_cluster', min: 0, max: Infinity, integer: false },
   { name: 'coverage-agreement', option: 'coverage_agreement', min: 1, max: 65536, integer: true },
   { name: 'hint-coverage', option: 'surface_hint_coverage', min: 0, max: 1, integer: true },
 ];
@@ -41,7 +41,8 @@ export function renderOptionsFromParams(params) {
     if (text === null) continue;
     const x = Number(text);
     if (text.trim() === '' || !Number.isFinite(x) || x < p.min || x > p.max || (p.integer && !Number.isInteger(x))) {
-      fail(E.playerOptions, `${p.name}=${text}: expected ${p.integer ? 'an integer' : 'a number'} in ${p.min}..${p.max}`);
+      const range = p.max === Infinity ? `>= ${p.min}` : `in ${p.min}..${p.max}`;
+      fail(E.playerOptions, `${p.name}=${text}: expected ${p.integer ? 'an integer' : 'a finite number'} ${range}`);
     }
     o[p.option] = x;
   }

@@ -12,7 +12,8 @@
 // within MIN_DB of calf-play at the same options, the page must fetch coverage chunks, and of
 // the pixels the hint rule moves (calf-play's defaults against --hint-coverage 0) at least
 // MOVED_SHARE must be nearer calf-play's defaults than the frame without the rule. Prints the
-// page's render ms at those options and with coverage read by neither rule.
+// page's render ms at those options and with coverage read by neither rule. &hint-coverage=2 is
+// one overlay line, CALF-E403.
 //
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM --clip CLIP EYE_PATH   (a given clip)
@@ -52,6 +53,7 @@ if (given) {
   run('calf-capture', ['--scene', 'turntable', '--face-size', '48', '--frames', '1', '--spp', '1', '--coverage', '--quiet', '--out', join(dir, 'covcap')]);
   run('calf-capture', ['--scene', 'turntable', '--ground-truth', '--gt-size', '64x48', '--frames', '1', '--spp', '1', '--quiet', '--out', join(dir, 'covgt')]);
   run('calf-encode', [join(dir, 'covcap'), '-o', join(dir, 'coverage.calf'), '--cell', '16', '--quiet', '--color-format', 'rgba16f']);
+  run('calf-encode', [join(dir, 'covcap'), '-o', join(dir, 'coverage-none.calf'), '--cell', '16', '--quiet', '--color-format', 'rgba16f', '--no-coverage']);
 }
 // The coverage clip's calf-play frames: at the options the page is opened with, at the defaults
 // (the page after the C key), and without the hint rule (the pixels the rule moves).
@@ -121,9 +123,41 @@ if (!given) await matchCoverage();
   await browser.close();
   server.kill();
 }
+// The page's render ms of the prepared pose 0 of `poses` (median of 3 draws) at each of
+// `settings` ([name, coverage, surface_hint_coverage]; none: the options as they are).
+function drawMs(page, poses, settings) {
+  return page.evaluate(async ({ poses, settings }) => {
+    const p = window.calfPlayer, pose = poses[0];
+    const camera = { position: pose.position, forward: pose.forward, up: pose.up, fovY: (pose.fov_y_degrees * Math.PI) / 180, width: pose.width, height: pose.height };
+    const prepared = await p.prepare(camera, pose.time);
+    const ms = {};
+    for (const [name, coverage, hint] of settings) {
+      if (coverage !== undefined) { p.options.coverage = coverage; p.options.surface_hint_coverage = hint; }
+      const t = [];
+      for (let k = 0; k < 3; ++k) t.push(p.draw(camera, prepared));
+      ms[name] = t.sort((a, b) => a - b)[1];
+    }
+    return ms;
+  }, { poses, settings });
+}
+
 // The coverage clip (see the top): one page opened with calf-play's coverage options in its URL.
 async function matchCoverage() {
   const covPath = JSON.parse(readFileSync(join(dir, 'covgt', 'eye_path.json'), 'utf8'));
+  const poses = covPath.poses.map((q) => ({ ...q, width: covPath.width, height: covPath.height }));
+  // The same capture without its coverage stream, in the page that played the clips above (the
+  // shader without CALF_COVERAGE): calf-play's frame with coverage read by neither rule.
+  const none = await playClip(browser, held, `http://127.0.0.1:${port}`, '/clips/coverage-none.calf');
+  let noneMs = NaN;
+  if (!none.ready) problems.push(`coverage-none: the page did not open the clip: ${none.overlay}`);
+  else {
+    await renderEyePath(none.page, covPath, (i, got, rgb) => {
+      const db = psnr(rgb, readPng(join(dir, 'play-cov-norule', `frame_${String(i).padStart(5, '0')}.png`)).rgb);
+      console.log(`web.match: coverage-none (no coverage stream) pose ${i}: ${db.toFixed(2)} dB against calf-play's coverage clip at --hint-coverage 0`);
+      if (!(db >= MIN_DB)) problems.push(`coverage-none pose ${i}: ${db.toFixed(2)} dB against calf-play, below ${MIN_DB}`);
+    }, (i, message) => problems.push(`coverage-none pose ${i}: ${message}`));
+    noneMs = (await drawMs(none.page, poses, [['none']])).none;
+  }
   const { page, consoleLines, ready, overlay } = await openPage(browser,
     `http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/clips/coverage.calf&coverage=3&hint-coverage=1`);
   if (!ready) {
@@ -165,27 +199,24 @@ async function matchCoverage() {
     if (moved < 5) problems.push(`coverage pose ${i}: the hint rule moves only ${moved} pixels, too few to test it`);
     else if (nearer < MOVED_SHARE * moved) problems.push(`coverage pose ${i}: the page follows the hint rule at ${nearer} of the ${moved} pixels it moves`);
   });
-  // Coverage chunks fetched (and counted in the bytes); render ms at each setting (median of 3 draws).
-  const f = await page.evaluate(async (poses) => {
+  // Coverage chunks fetched (and counted in the bytes); render ms at each setting.
+  const f = await page.evaluate(async () => {
     const p = window.calfPlayer;
     await p.settled();
     const ids = [...p.fetchCounts().keys()].filter((id) => p.lf.clip.chunks[id].stream === 5);
-    const pose = poses[0];
-    const camera = { position: pose.position, forward: pose.forward, up: pose.up, fovY: (pose.fov_y_degrees * Math.PI) / 180, width: pose.width, height: pose.height };
-    const prepared = await p.prepare(camera, pose.time);
-    const ms = {};
-    for (const [name, coverage, hint] of [['coverage 3, hint rule', 3, 1], ['defaults: coverage off, hint rule', 0, 1], ['neither', 0, 0]]) {
-      p.options.coverage = coverage; p.options.surface_hint_coverage = hint;
-      const t = [];
-      for (let k = 0; k < 3; ++k) t.push(p.draw(camera, prepared));
-      ms[name] = t.sort((a, b) => a - b)[1];
-    }
-    return { chunks: ids.length, bytes: ids.reduce((s, id) => s + p.lf.clip.chunks[id].storedSize, 0), total: p.source.stats.bytes, ms };
-  }, covPath.poses.map((q) => ({ ...q, width: covPath.width, height: covPath.height })));
-  console.log(`web.match: coverage clip: ${f.chunks} coverage chunks fetched (${f.bytes} of the ${f.total} bytes fetched); page render ms (median of 3): ` +
-    Object.entries(f.ms).map(([k, v]) => `${k} ${v.toFixed(1)}`).join(', '));
+    return { chunks: ids.length, bytes: ids.reduce((s, id) => s + p.lf.clip.chunks[id].storedSize, 0), total: p.source.stats.bytes };
+  });
+  const ms = { 'without a coverage stream': noneMs,
+    ...await drawMs(page, poses, [['coverage 3 and the hint rule', 3, 1], ['the defaults (the hint rule)', 0, 1], ['neither', 0, 0]]) };
+  console.log(`web.match: coverage clip: ${f.chunks} coverage chunks fetched (${f.bytes} of the ${f.total} bytes fetched); page render ms of pose 0 ` +
+    `(SwiftShader, median of 3 draws): ${Object.entries(ms).map(([k, v]) => `${k} ${v.toFixed(1)}`).join(', ')}`);
   if (f.chunks === 0) problems.push('coverage: the page fetched no coverage chunk');
   await page.close();
+  // A coverage option outside its range: one overlay line with calf-play's id for it.
+  const bad = await openPage(browser, `http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/clips/coverage.calf&hint-coverage=2`);
+  console.log(`web.match: &hint-coverage=2: ${bad.overlay}`);
+  if (bad.ready || !bad.overlay.startsWith('CALF-E403 hint-coverage=2: ')) problems.push(`coverage: &hint-coverage=2 gave '${bad.overlay}'`);
+  await bad.page.close();
 }
 for (const p of problems) console.log(`web.match: FAIL ${p}`);
 if (problems.length === 0) rmSync(dir, { recursive: true, force: true });
