@@ -251,7 +251,7 @@ static int command_main(int argc, char** argv) {
          "--hint-coverage", o.render.surface_hint_coverage,
          "light field, with coverage: a surface hint's crossing ends the ray only where the "
          "hint view's coverage covers the ray's direction in its texel (the direction's "
-         "cell): 0 off, 1 on")
+         "cell): 0 off, 1 on (default; clips without coverage play alike at 0 and 1)")
       ->check(CLI::Range(0u, 1u));
   app.add_option("--supersample", o.render.supersample,
                  "light field: N x N eye rays per pixel on an even grid, colour their mean (a box "

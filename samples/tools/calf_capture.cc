@@ -190,8 +190,10 @@ static int command_main(int argc, char** argv) {
   app.add_flag("--coverage", coverage,
                "also write each texel's coverage: the shares of its square whose first surface "
                "lies nearer and farther than its depth, from the colour samples (capture set "
-               "version 2, format/CAPTURE.md \"Coverage\"). Default off: calf-encode does not "
-               "carry it yet; the CPU reference reads it from the set");
+               "version 2, format/CAPTURE.md \"Coverage\"). calf-encode carries it as the clip's "
+               "coverage stream (SPEC 11.1.11), and the renderers read it from the clip or the "
+               "set: 5-15 % more clip bytes (docs/ENCODER.md) for silhouettes placed inside the "
+               "texel (calf-play --coverage, --hint-coverage). Default off");
   app.add_option("--min-spp", render.min_spp,
                  "samples of the first round, 1..4096; rounds double the count until the "
                  "pixel's standard error is within --tolerance or --spp samples are taken")

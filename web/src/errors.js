@@ -9,7 +9,7 @@ export const E = {
   compression: 'CALF-E056', chunkSize: 'CALF-E057', chunkHash: 'CALF-E058',
   decompress: 'CALF-E059', padding: 'CALF-E060', chunkId: 'CALF-E061', coverageChunk: 'CALF-E065',
   coverageDepth: 'CALF-E066', av1Chunk: 'CALF-E067', av1Decode: 'CALF-E301', av1Picture: 'CALF-E302', lightfieldChunk: 'CALF-E202',
-  lightfieldFormat: 'CALF-E203', playbackClip: 'CALF-E460',
+  lightfieldFormat: 'CALF-E203', playerOptions: 'CALF-E403', playbackClip: 'CALF-E460',
   tilesChunk: 'CALF-E210', tilesUnsupported: 'CALF-E211', tilesValue: 'CALF-E212', tilesLimit: 'CALF-E213',
   meshChunk: 'CALF-E220', meshUnsupported: 'CALF-E221', meshIndex: 'CALF-E222', meshValue: 'CALF-E223',
   meshLimit: 'CALF-E224',

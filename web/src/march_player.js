@@ -3,13 +3,15 @@
 // cells and depth regions the pose's eye can see (culling.js, the native decoder's culling) of the
 // active views are fetched and decoded, for the pose's frame; the same cells' chunks of the next
 // frames are prefetched; a face is uploaded when a pose needs another frame or new cells of it.
+// A clip with a coverage stream (SPEC §11.1.11) has its coverage fetched, decoded and uploaded
+// with the depth regions, as calf-play's GL renderer reads it whatever its coverage options say.
 import { openClip } from './container.js';
 import { openLightfield, closeLightfield, decodeFaceFrames, parseTimeline, bcBlocks, STREAM } from './lightfield.js';
 import { readChunk } from './container.js';
 import { E, fail } from './errors.js';
 import { cachedT, chunkFetchCounts, fetched, httpSource, planFrame, prefetch, rateMeter, touchChunk, trimCache } from './stream.js';
 import { makeCodecs } from './codecs.js';
-import { bcUpload, cpuUpload, makeRaymarcher, marchRange, selectViews } from './raymarch.js';
+import { bcUpload, cpuUpload, makeRaymarcher, marchRange, selectViews, RENDER_DEFAULTS } from './raymarch.js';
 import { visibleSets } from './culling.js';
 import { openRasterPlayer, rasterTracks } from './raster_player.js';
 
@@ -39,8 +41,21 @@ export function canvasRgb(gl, canvas) {
   return rgb;
 }
 
+// The texels of decoded coverage (lightfield.js: mask and near count a texel) as the native
+// coverage texture holds them (lf::coverage_to_gpu): mask low byte, mask high byte, near count,
+// far count (16 − near − the mask's cells).
+export function coverageGpuBytes(coverage, out, from, to) {
+  for (let i = from; i < to; ++i) {
+    const mask = coverage[2 * i], near = coverage[2 * i + 1];
+    let pop = 0;
+    for (let b = mask; b; b &= b - 1) ++pop;
+    out[4 * i] = mask & 255; out[4 * i + 1] = mask >> 8; out[4 * i + 2] = near; out[4 * i + 3] = Math.max(0, 16 - near - pop);
+  }
+}
+
 // The clip: `url` (read with range requests), or `source` (container.js's bytesSource, e.g. a
-// local file's bytes; nothing is fetched).
+// local file's bytes; nothing is fetched). deps.render: the render options (RENDER_DEFAULTS by
+// default; index.html's renderOptionsFromParams).
 export async function openMarchPlayer({ canvas, url, source: given = null, deps, status }) {
   const gl = canvas.getContext('webgl2', { preserveDrawingBuffer: true, antialias: false });
   if (!gl) throw new Error('WebGL2 is not available');
@@ -61,7 +76,11 @@ export async function openMarchPlayer({ canvas, url, source: given = null, deps,
   // bc=0 turns it off), else it is decoded to RGBA on the CPU.
   const bc = deps.noBc ? null : bcUpload(gl, h.colour_format, N);
   const cpu = cpuUpload(gl, h.colour_format);
-  const renderer = makeRaymarcher(gl, { views: lf.views, faceSize: N, cellSize: h.cell_size, bc, cpu });
+  const withCoverage = lf.hasCoverage;
+  const options = { ...(deps.render ?? RENDER_DEFAULTS) };
+  const renderer = makeRaymarcher(gl, { views: lf.views, faceSize: N, cellSize: h.cell_size, bc, cpu, options, coverage: withCoverage });
+  // The C key's coverage mode (calf-play's window: --coverage's mode, else 3).
+  const coverageOn = options.coverage || 3;
   // Prefetch: after a frame's own chunks, those of the next `prefetchFrames` frames (wrapping, as
   // the page loops) for the same cells and tiles, in the background; chunks the cache holds
   // beyond `cacheBytes` raw bytes are dropped, least recently used first.
@@ -75,7 +94,7 @@ export async function openMarchPlayer({ canvas, url, source: given = null, deps,
   const stats = { decodeMs: 0, fetchMs: 0, cellsDecoded: 0, tilesDecoded: 0, prefetched: 0 };
   const running = new Set();  // prefetches in flight
   const rate = rateMeter(source, F / fps);
-  const plan = (needed, n) => planFrame(lf, n, needed, cachedT(lf, n), { material: false, cellTiles: false });
+  const plan = (needed, n) => planFrame(lf, n, needed, cachedT(lf, n), { material: false, cellTiles: false, coverage: withCoverage });
   // Fetches what frame n of the regions `needed` asks for: t chunks first, so that the next
   // colour keyframe is fetched only where t[n] ≠ 0. Returns the chunk ids of the frame.
   async function fetchFrame(needed, n) {
@@ -119,7 +138,8 @@ export async function openMarchPlayer({ canvas, url, source: given = null, deps,
     if (!faces.has(v)) {
       const six = (make) => Array.from({ length: 6 }, make);
       faces.set(v, { frame: -1, colour: six(() => new Float32Array(3 * N * N)), depth: six(() => new Uint16Array(N * N)),
-        cells: six(() => new Set()), tiles: six(() => new Set()), values: six(() => new Uint32Array(lf.cells.count)) });
+        cells: six(() => new Set()), tiles: six(() => new Set()), values: six(() => new Uint32Array(lf.cells.count)),
+        coverage: withCoverage ? six(() => new Uint8Array(4 * N * N)) : null });
     }
     const d = faces.get(v);
     if (d.frame !== n) {
@@ -134,7 +154,7 @@ export async function openMarchPlayer({ canvas, url, source: given = null, deps,
       if (bc) await uploadBc(v, face, only.cells, n, d.values[face]);
       const cpu = { cells: bc ? new Set() : only.cells, tiles: only.tiles };
       if (cpu.cells.size || cpu.tiles.size) {
-        await decodeFaceFrames(lf, v, face, (m, colour, depth) => {
+        await decodeFaceFrames(lf, v, face, (m, colour, depth, material, coverage) => {
           for (const r of cpu.cells) {
             const { x, y, w, h: rh } = lf.cells.rect(r);
             for (let j = y; j < y + rh; ++j) d.colour[face].set(colour.subarray(3 * (j * N + x), 3 * (j * N + x + w)), 3 * (j * N + x));
@@ -142,9 +162,11 @@ export async function openMarchPlayer({ canvas, url, source: given = null, deps,
           for (const r of cpu.tiles) {
             const { x, y, w, h: rh } = lf.tiles.rect(r);
             for (let j = y; j < y + rh; ++j) d.depth[face].set(depth.subarray(j * N + x, j * N + x + w), j * N + x);
+            if (coverage) for (let j = y; j < y + rh; ++j) coverageGpuBytes(coverage, d.coverage[face], j * N + x, j * N + x + w);
           }
-        }, cpu, { material: false, from: n, to: n + 1 });
+        }, cpu, { material: false, coverage: withCoverage, from: n, to: n + 1 });
       }
+      if (withCoverage && cpu.tiles.size) renderer.uploadCoverage(v, face, d.coverage[face]);
       if (bc) { if (cpu.tiles.size) renderer.uploadDepth(v, face, d.depth[face]); }
       else renderer.uploadFace(v, face, d.colour[face], d.depth[face]);
       stats.decodeMs += performance.now() - t0;
@@ -232,8 +254,9 @@ export async function openMarchPlayer({ canvas, url, source: given = null, deps,
   // The overlay line of a drawn pose; position: the viewer's.
   function report(prepared, renderMs, position, eyes = 1) {
     const out = inside(position) ? '' : '; the eye is outside the view volume';
+    const cov = withCoverage ? `, coverage ${options.coverage ? `mode ${options.coverage}` : 'off'}` : '';
     status(`frame ${prepared.frame}: ${eyes === 2 ? 'two eyes, ' : ''}${prepared.active.length} of ${lf.views.length} views, ${prepared.visibleCells}/${prepared.totalCells} cells, ` +
-      `render ${renderMs.toFixed(1)} ms; ${stats.cellsDecoded} cells decoded (${stats.decodeMs.toFixed(0)} ms), ` +
+      `render ${renderMs.toFixed(1)} ms${cov}; ${stats.cellsDecoded} cells decoded (${stats.decodeMs.toFixed(0)} ms), ` +
       `${fetched(source, rate)}${out}`);
     return !out;
   }
@@ -257,6 +280,8 @@ export async function openMarchPlayer({ canvas, url, source: given = null, deps,
   const startEye = [0, 1, 2].map((k) => views.reduce((s, v) => s + v.position[k], 0) / views.length);
   // The page calls it when another clip replaces this one: its AV1 decoders are closed.
   const close = () => closeLightfield(lf);
+  // The window player's C key: coverage off, or back on at its mode; returns the mode now.
+  const toggleCoverage = () => (options.coverage = options.coverage ? 0 : coverageOn);
   return { gl, lf, renderPose, prepare, draw, report, pixels, stats, fps, frameCount: F, startEye, volume, inside,
-    prefetchFrames, settled, fetchCounts, source, close };
+    prefetchFrames, settled, fetchCounts, source, close, options, hasCoverage: withCoverage, toggleCoverage };
 }

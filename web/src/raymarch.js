@@ -3,10 +3,12 @@
 // conventions, with the uniforms, view records and march range that player/src/lightfield_gl_renderer.cc
 // and lightfield_representation.cc give it, and the view selection of
 // player/src/view_selection.cc. Colour is uploaded per frame as decoded (one slot, t already
-// applied on the CPU, SPEC §11.1.4), depth as r16 codes.
+// applied on the CPU, SPEC §11.1.4), depth as r16 codes, coverage (§11.1.11) as the native
+// coverage texels.
 import { GLSL_CONVENTIONS } from './glsl_conventions.js';
 import { GL_FULLSCREEN_VERTEX, GL_RAYMARCH_FRAGMENT } from './glsl_raymarch.js';
 import { SRGB } from './lightfield.js';
+import { E, fail } from './errors.js';
 
 export const MAX_ACTIVE_VIEWS = 256;  // kGlMaxActiveViews
 
@@ -17,13 +19,40 @@ export const RENDER_DEFAULTS = {
   colour_depth_tolerance: 0.1, mixed_texel_penalty: 3, mixed_texel_bend_texels: 5,
   tight_march_start: true, surface_hints: 1, surface_hint_margin_texels: 0.2, surface_hint_vetoes: 1,
   surface_hint_substeps: 4, supersample: 1, rr: false, rr_start: 0.05, rr_max_depth: 1,
-  rr_replace_view_reflection: true,
+  rr_replace_view_reflection: true, coverage: 0, coverage_threshold: 0.5, coverage_cluster: 0.05,
+  coverage_agreement: 1, surface_hint_coverage: 1,
 };
+// The coverage options a page URL may set (index.html?coverage=3&hint-coverage=1), named as
+// calf-play's and bench-player_quality's options, with their ranges; the window player's C key
+// turns `coverage` on (its given mode, else 3) and off.
+export const COVERAGE_PARAMETERS = [
+  { name: 'coverage', option: 'coverage', min: 0, max: 4, integer: true },
+  { name: 'coverage-threshold', option: 'coverage_threshold', min: 0, max: 1, integer: false },
+  { name: 'coverage-cluster', option: 'coverage_cluster', min: 0, max: Infinity, integer: false },
+  { name: 'coverage-agreement', option: 'coverage_agreement', min: 1, max: 65536, integer: true },
+  { name: 'hint-coverage', option: 'surface_hint_coverage', min: 0, max: 1, integer: true },
+];
+// The render options that `params` (URLSearchParams) give on top of RENDER_DEFAULTS; a value that
+// is not a number in its range is CALF-E403, as the native renderer's options.
+export function renderOptionsFromParams(params) {
+  const o = { ...RENDER_DEFAULTS };
+  for (const p of COVERAGE_PARAMETERS) {
+    const text = params.get(p.name);
+    if (text === null) continue;
+    const x = Number(text);
+    if (text.trim() === '' || !Number.isFinite(x) || x < p.min || x > p.max || (p.integer && !Number.isInteger(x))) {
+      const range = p.max === Infinity ? `>= ${p.min}` : `in ${p.min}..${p.max}`;
+      fail(E.playerOptions, `${p.name}=${text}: expected ${p.integer ? 'an integer' : 'a finite number'} ${range}`);
+    }
+    o[p.option] = x;
+  }
+  return o;
+}
 export const SELECTION_DEFAULTS = { redundancy_angle_deg: 5, max_active: 9, incumbent_margin: 0.05 };
 
 // GLSL 4.50 → GLSL ES 3.00: ES has no binding qualifier (the page sets sampler units and the
 // block binding from JavaScript instead); everything else compiles as it is.
-export function fragmentSource({ depthBc5 = false, hints = 1 } = {}) {
+export function fragmentSource({ depthBc5 = false, hints = 1, coverage = false } = {}) {
   let body = GL_RAYMARCH_FRAGMENT;
   const rewrites = [[/layout\(std140, binding = 0\) uniform CalfViews/, 'layout(std140) uniform CalfViews'],
     [/layout\(binding = (\d)\) uniform/g, 'uniform']];
@@ -34,7 +63,7 @@ export function fragmentSource({ depthBc5 = false, hints = 1 } = {}) {
   return '#version 300 es\nprecision highp float;\nprecision highp int;\n' +
     'precision highp sampler2DArray;\nprecision highp usampler2DArray;\n' +
     `#define CALF_MAX_VIEWS ${MAX_ACTIVE_VIEWS}\n${depthBc5 ? '#define CALF_DEPTH_BC5\n' : ''}` +
-    `#define CALF_HINTS ${hints}\n${GLSL_CONVENTIONS}${body}`;
+    `#define CALF_HINTS ${hints}\n${coverage ? '#define CALF_COVERAGE\n' : ''}${GLSL_CONVENTIONS}${body}`;
 }
 
 const PRESENT = `#version 300 es
@@ -182,10 +211,14 @@ function srgbByte(v) {
 // faces of `faceSize` texels in cells of `cellSize`. With `bc` (bcUpload), colour keyframes are
 // uploaded as blocks into two slots a face and the cell texture holds each cell's slot and t, as
 // in the native player; without, one slot of `cpu` (cpuUpload) holds the colour the CPU decoded.
-export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER_DEFAULTS, bc = null, cpu = cpuUpload(gl, 0) }) {
+// With `coverage` (the clip has a coverage stream) the shader is compiled with CALF_COVERAGE and
+// every view has six coverage layers (layer 6 × view + face, as the native GlViews lays out a
+// clip whose views all carry coverage); without, the shader is the one without coverage.
+// `options` are read at each render (the C key changes options.coverage).
+export function makeRaymarcher(gl, { views, faceSize, cellSize, options = { ...RENDER_DEFAULTS }, bc = null, cpu = cpuUpload(gl, 0), coverage = false }) {
   if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('WebGL2 without EXT_color_buffer_float: no float render target');
   const vertex = `#version 300 es\n${GL_FULLSCREEN_VERTEX}`;
-  const march = program(gl, vertex, fragmentSource({ hints: options.surface_hints }), 'ray-march');
+  const march = program(gl, vertex, fragmentSource({ hints: options.surface_hints, coverage }), 'ray-march');
   const present = program(gl, vertex, PRESENT, 'present');
   const N = faceSize, layers = 6 * views.length, cellsPerSide = Math.ceil(N / cellSize);
   const texture = (unit, internal, w, h, d) => {
@@ -205,8 +238,16 @@ export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER
   gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 0, cellsPerSide, cellsPerSide, layers, gl.RED_INTEGER, gl.UNSIGNED_INT,
     new Uint32Array(cellsPerSide * cellsPerSide * layers));  // slot 0, t = 0: the colour as uploaded
   const materialTex = texture(3, gl.RGBA8, 1, 1, 1);
+  // Coverage texels (RGBA8UI: mask low byte, mask high byte, near count, far count), cleared to
+  // the plain texel (mask 0xFFFF: every cell its own surface) as the native renderer clears them;
+  // a one-texel placeholder without coverage.
+  const coverageLayers = coverage ? layers : 1, coverageSide = coverage ? N : 1;
+  const coverageTex = texture(4, gl.RGBA8UI, coverageSide, coverageSide, coverageLayers);
+  const plain = new Uint8Array(4 * coverageSide * coverageSide * coverageLayers);
+  for (let i = 0; i < plain.length; i += 4) plain[i] = plain[i + 1] = 255;
+  gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 0, coverageSide, coverageSide, coverageLayers, gl.RGBA_INTEGER, gl.UNSIGNED_BYTE, plain);
   gl.useProgram(march);
-  ['colour_tex', 'depth_tex', 'cell_tex', 'material_tex'].forEach((name, unit) => gl.uniform1i(gl.getUniformLocation(march, name), unit));
+  ['colour_tex', 'depth_tex', 'cell_tex', 'material_tex', 'coverage_tex'].forEach((name, unit) => gl.uniform1i(gl.getUniformLocation(march, name), unit));
   gl.uniformBlockBinding(march, gl.getUniformBlockIndex(march, 'CalfViews'), 0);
   const viewBuffer = gl.createBuffer();
   const vao = gl.createVertexArray();
@@ -238,6 +279,12 @@ export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER
     gl.activeTexture(gl.TEXTURE1);
     gl.bindTexture(gl.TEXTURE_2D_ARRAY, depthTex);
     gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 6 * view + face, N, N, 1, gl.RED_INTEGER, gl.UNSIGNED_SHORT, depth);
+  }
+  // The coverage of one face of one view: 4 bytes a texel (coverageGpuBytes).
+  function uploadCoverage(view, face, bytes) {
+    gl.activeTexture(gl.TEXTURE4);
+    gl.bindTexture(gl.TEXTURE_2D_ARRAY, coverageTex);
+    gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 6 * view + face, N, N, 1, gl.RGBA_INTEGER, gl.UNSIGNED_BYTE, bytes);
   }
   // BCn: a keyframe's blocks (rect's blocks row by row) into a slot of one face of one view.
   function uploadBlocks(view, face, slot, rect, blocks) {
@@ -273,20 +320,20 @@ export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER
       const info = views[v], r = logRange(info), b = 16 * k;
       f32.set([info.position[0] - camera.position[0], info.position[1] - camera.position[1], info.position[2] - camera.position[2],
         r.log_near, r.step, r.inv_step, info.zNear, info.zFar], b);
-      // No material and no coverage layer: the page draws neither.
-      u32[b + 8] = N; u32[b + 9] = cellSize; u32[b + 10] = 6 * v; i32[b + 11] = -1; i32[b + 12] = -1;
+      // No material layer (the page draws none); the view's coverage layers where the clip has them.
+      u32[b + 8] = N; u32[b + 9] = cellSize; u32[b + 10] = 6 * v; i32[b + 11] = -1; i32[b + 12] = coverage ? 6 * v : -1;
     });
     gl.bindBuffer(gl.UNIFORM_BUFFER, viewBuffer);
     gl.bufferData(gl.UNIFORM_BUFFER, records, gl.STREAM_DRAW);
     gl.bindBufferBase(gl.UNIFORM_BUFFER, 0, viewBuffer);
-    [colourTex, depthTex, cellTex, materialTex].forEach((t, unit) => {
+    [colourTex, depthTex, cellTex, materialTex, coverageTex].forEach((t, unit) => {
       gl.activeTexture(gl.TEXTURE0 + unit);
       gl.bindTexture(gl.TEXTURE_2D_ARRAY, t);
     });
     if (!target || targetW !== camera.width || targetH !== camera.height) {
       if (target) { gl.deleteFramebuffer(target); gl.deleteTexture(targetTex); }
       targetTex = gl.createTexture();
-      gl.activeTexture(gl.TEXTURE4);
+      gl.activeTexture(gl.TEXTURE5);
       gl.bindTexture(gl.TEXTURE_2D, targetTex);
       gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA32F, camera.width, camera.height);
       gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
@@ -313,12 +360,17 @@ export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER
     gl.uniform1f(U('colour_depth_tolerance'), o.colour_depth_tolerance);
     gl.uniform1f(U('mixed_penalty_factor'), Math.exp(-o.mixed_texel_penalty));
     gl.uniform1f(U('mixed_texel_bend_texels'), o.mixed_texel_bend_texels);
+    gl.uniform1ui(U('coverage_mode'), o.coverage);
+    gl.uniform1f(U('coverage_threshold'), o.coverage_threshold);
+    gl.uniform1f(U('coverage_cluster'), o.coverage_cluster);
+    gl.uniform1ui(U('coverage_agreement'), o.coverage_agreement);
     gl.uniform1i(U('tight_march_start'), o.tight_march_start ? 1 : 0);
     gl.uniform1i(U('bilinear_colour'), o.bilinear_colour ? 1 : 0);
     gl.uniform1i(U('depth_aware_colour'), o.depth_aware_colour ? 1 : 0);
     gl.uniform1f(U('surface_hint_margin_texels'), o.surface_hint_margin_texels);
     gl.uniform1ui(U('surface_hint_vetoes'), o.surface_hint_vetoes);
     gl.uniform1ui(U('surface_hint_substeps'), o.surface_hint_substeps);
+    gl.uniform1ui(U('surface_hint_coverage'), o.surface_hint_coverage);
     gl.uniform1i(U('rr'), 0);  // no material textures on the page yet
     gl.uniform1i(U('rr_replace_view_reflection'), o.rr_replace_view_reflection ? 1 : 0);
     gl.uniform1f(U('rr_start'), o.rr_start);
@@ -336,12 +388,12 @@ export function makeRaymarcher(gl, { views, faceSize, cellSize, options = RENDER
     const vp = out ? out.viewport : { x: 0, y: 0 };
     gl.viewport(vp.x, vp.y, camera.width, camera.height);
     gl.useProgram(present);
-    gl.activeTexture(gl.TEXTURE4);
+    gl.activeTexture(gl.TEXTURE5);
     gl.bindTexture(gl.TEXTURE_2D, targetTex);
-    gl.uniform1i(gl.getUniformLocation(present, 'frame_tex'), 4);
+    gl.uniform1i(gl.getUniformLocation(present, 'frame_tex'), 5);
     gl.uniform2i(gl.getUniformLocation(present, 'origin'), vp.x, vp.y);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
     gl.bindVertexArray(null);
   }
-  return { uploadFace, uploadDepth, uploadBlocks, uploadCells, render };
+  return { uploadFace, uploadDepth, uploadCoverage, uploadBlocks, uploadCells, render, options };
 }

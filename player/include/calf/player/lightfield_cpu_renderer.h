@@ -218,9 +218,9 @@ struct LightfieldRenderOptions {
   // 1: the direction's own cell; 2: that cell or one next to it in the texel; 3: as 1, or where
   // another view whose nearest texel at the crossing lies at its depth (within coverage_cluster)
   // covers its direction there (2 and 3: the CPU reference only, the GL renderer refuses them). A
-  // hint view without coverage confirms every crossing. Off by default (docs/RENDERING.md
-  // "Coverage").
-  uint32_t surface_hint_coverage = 0;
+  // hint view without coverage confirms every crossing, so a view set without coverage renders
+  // the same at 0 and 1. Default 1 (docs/SILHOUETTES.md "Hint crossings confirmed by coverage").
+  uint32_t surface_hint_coverage = 1;
   // Worker threads over image rows (1..256). The result does not depend on it.
   uint32_t threads = 1;
   // Eye rays per pixel along each axis (1..8). The pixel's colour is the mean of n x n rays
