@@ -580,7 +580,8 @@ int main(int argc, char** argv) {
                  "with --video-peers: also encode the AV1 colour mode at this CRF (repeatable) and "
                  "set BC and each AV1 encode against x265 at matched PSNR (default none)")
       ->check(CLI::Range(1, 63));
-  app.add_option("--av1-preset", run.av1.preset, "SVT-AV1 preset of those encodes (default 8)")
+  app.add_option("--av1-preset", run.av1.preset,
+                 "SVT-AV1 preset of those encodes (default 5, calf-encode's)")
       ->check(CLI::Range(0, 13));
   app.add_option("--av1-keyframe-interval", run.av1.keyframe_interval,
                  "their key frame interval (default 30)")

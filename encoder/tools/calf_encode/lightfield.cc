@@ -111,7 +111,8 @@ void add_av1_options(CLI::App& app, LightfieldOptions& o) {
       ->default_str("")
       ->group(kAv1Group);
   app.add_option("--av1-preset", av1.preset,
-                 "av1: SVT-AV1 preset 0..13, higher is faster and larger")
+                 "av1: SVT-AV1 preset 0..13, higher is faster and larger (docs/ENCODER.md "
+                 "measures 5 and 8 against x265)")
       ->check(CLI::Range(0u, 13u))
       ->group(kAv1Group);
   app.add_option("--av1-keyframe-interval", av1.keyframe_interval,

@@ -71,7 +71,7 @@ enum class ColourCoding : uint8_t { kAuto, kBc1, kBc7, kBc6h, kRgba8, kRgba16f, 
 struct Av1ColourOptions {
   uint32_t crf = 32;                // constant rate factor 1..63 (lower: better and larger)
   uint32_t qp = 0;                  // 1..63: a fixed quantiser instead of the CRF; 0 = CRF
-  uint32_t preset = 8;              // SVT-AV1 preset 0..13 (higher: faster, larger)
+  uint32_t preset = 5;              // SVT-AV1 preset 0..13 (higher: faster, larger)
   uint32_t keyframe_interval = 30;  // K >= 1: a key frame every K frames, the seek granularity
 };
 // kRaw16: log-16 codes as 16-bit planes (SPEC §11.1.6); kRaw16Predicted: the same codes as
