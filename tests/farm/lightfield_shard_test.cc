@@ -70,6 +70,28 @@ std::vector<std::vector<uint32_t>> split(uint32_t n, uint32_t k) {
   return out;
 }
 
+// Codes frames [first, first + 2) of the analysis's views in two view groups, one shard per group
+// and first frame (in the order of `firsts`), named PREFIX<group>-<first>.calf in `work`.
+void encode_frame_shards(const fs::path& dir, const encoder::LightfieldAnalysisFile& a,
+                         std::initializer_list<uint32_t> firsts, uint32_t threads,
+                         const char* prefix, const fs::path& work,
+                         std::vector<std::string>* shards) {
+  const auto groups = split(a.analysis.header.view_count, 2);
+  for (uint32_t g = 0; g < 2; ++g) {
+    for (uint32_t first : firsts) {
+      std::string name = prefix;  // append, not operator+: GCC 12 -O3 misfires -Wrestrict on it
+      name += std::to_string(g);
+      name += '-';
+      name += std::to_string(first);
+      name += ".calf";
+      const std::string path = (work / name).string();
+      auto s = encoder::encode_lightfield_shard(dir, a, groups[g], first, 2, threads, path);
+      ASSERT_TRUE(s.ok()) << s.status().to_string();
+      shards->push_back(path);
+    }
+  }
+}
+
 class LightfieldShardScenes : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(LightfieldShardScenes, MergedViewShardsEqualOneMachineEncode) {
@@ -169,19 +191,7 @@ TEST(LightfieldShardFrames, FrameRangeShardsEqualSegmentedEncode) {
   EXPECT_EQ(a->options.depth, encoder::DepthCoding::kRaw16PredictedMasked);
   const auto groups = split(a->analysis.header.view_count, 2);
   std::vector<std::string> shards;
-  for (uint32_t g = 0; g < 2; ++g) {
-    for (uint32_t first : {2u, 0u}) {
-      std::string name = "s";  // append, not operator+: GCC 12 -O3 misfires -Wrestrict on it
-      name += std::to_string(g);
-      name += '-';
-      name += std::to_string(first);
-      name += ".calf";
-      const std::string path = (work / name).string();
-      auto s = encoder::encode_lightfield_shard(dir, *a, groups[g], first, 2, 2, path);
-      ASSERT_TRUE(s.ok()) << s.status().to_string();
-      shards.push_back(path);
-    }
-  }
+  ASSERT_NO_FATAL_FAILURE(encode_frame_shards(dir, *a, {2u, 0u}, 2, "s", work, &shards));
   const std::string merged = (work / "merged.calf").string();
   const Status m = encoder::merge_lightfield_shards(*a, shards, merged);
   ASSERT_TRUE(m.ok()) << m.to_string();
@@ -239,21 +249,8 @@ TEST(LightfieldShardFrames, NoiseAwareShardsEqualOneMachineEncode) {
   ASSERT_TRUE(a.ok()) << a.status().to_string();
   EXPECT_EQ(a->options.noise_psnr_db, 45.7);
   EXPECT_EQ(a->options.noise_factor, 3.0);
-  const auto groups = split(a->analysis.header.view_count, 2);
   std::vector<std::string> shards;
-  for (uint32_t g = 0; g < 2; ++g) {
-    for (uint32_t first : {0u, 2u}) {
-      std::string name = "n";
-      name += std::to_string(g);
-      name += '-';
-      name += std::to_string(first);
-      name += ".calf";
-      const std::string path = (work / name).string();
-      auto s = encoder::encode_lightfield_shard(dir, *a, groups[g], first, 2, 1, path);
-      ASSERT_TRUE(s.ok()) << s.status().to_string();
-      shards.push_back(path);
-    }
-  }
+  ASSERT_NO_FATAL_FAILURE(encode_frame_shards(dir, *a, {0u, 2u}, 1, "n", work, &shards));
   const std::string merged = (work / "merged.calf").string();
   const Status m = encoder::merge_lightfield_shards(*a, shards, merged);
   ASSERT_TRUE(m.ok()) << m.to_string();
