@@ -1,5 +1,6 @@
 #include "calf/encoder/colour_keyframes.h"
 
+#include "calf/encoder/noise_estimate.h"
 #include "calf/format/colour.h"
 
 #include <algorithm>
@@ -15,7 +16,8 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // A value in the noise model's metric, over its peak (8 stops for log2, 1 for sRGB).
 double metric_value(float v, bool log2) {
-  return log2 ? std::log2(std::max(v, 1.0f / 16384.0f)) / 8.0 : srgb_from_linear(v);
+  return log2 ? noise_metric_value(NoiseMetric::kLog2, v) / 8.0
+              : noise_metric_value(NoiseMetric::kSrgb, v);
 }
 
 // The median of chi-square with one degree of freedom: median(r^2) / var(r) for Gaussian r.
@@ -264,7 +266,8 @@ CellNoise measure_cell_noise(std::span<const float> frames, uint32_t frame_count
     if (s.empty()) continue;
     auto mid = s.begin() + static_cast<std::ptrdiff_t>(s.size() / 2);
     std::nth_element(s.begin(), mid, s.end());
-    out.block_variance[i] = std::min(max_variance, factor * *mid / kMedianOfSquares / 2.5);
+    out.block_variance[i] =
+        std::min(max_variance, factor * *mid / kMedianOfSquares / kNoiseHighPassGain);
   }
   return out;
 }

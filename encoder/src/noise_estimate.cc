@@ -18,16 +18,11 @@ namespace {
 
 constexpr double kTopDb = 200;  // samples at or above this PSNR (or without energy) share a bin
 constexpr size_t kBins = static_cast<size_t>(kTopDb / kNoiseBinDb) + 1;
-// r has 1.25 times the variance of d, and d twice a frame's: sigma^2 = M / 2.5.
-const double kResidualGainDb = 10.0 * std::log10(2.5);
+// sigma^2 = M / kNoiseHighPassGain.
+const double kResidualGainDb = 10.0 * std::log10(kNoiseHighPassGain);
 
 double peak_squared(NoiseMetric m) {
   return m == NoiseMetric::kLog2 ? 64.0 : 1.0;
-}
-
-float metric_value(NoiseMetric m, float linear) {
-  constexpr float kFloor = 1.0f / 16384.0f;  // psnr_log2's floor, 2^-14
-  return m == NoiseMetric::kLog2 ? std::log2(std::max(linear, kFloor)) : srgb_from_linear(linear);
 }
 
 // Same depth and material in both frames (sky against sky counts as the same).
@@ -55,6 +50,11 @@ Status validate(const NoiseEstimateOptions& o) {
 
 }  // namespace
 
+float noise_metric_value(NoiseMetric m, float linear) {
+  constexpr float kFloor = 1.0f / 16384.0f;  // psnr_log2's floor, 2^-14
+  return m == NoiseMetric::kLog2 ? std::log2(std::max(linear, kFloor)) : srgb_from_linear(linear);
+}
+
 NoiseSamples::NoiseSamples() : bins_(kBins, 0) {}
 
 void NoiseSamples::add_pair(const capture::ViewFrame& a, const capture::ViewFrame& b,
@@ -79,8 +79,8 @@ void NoiseSamples::add_pair(const capture::ViewFrame& a, const capture::ViewFram
     auto diff = [&](size_t j) -> const float* {
       if (!have[j]) {
         for (int c = 0; c < 3; ++c) {
-          d[3 * j + c] = metric_value(metric, b.color[3 * (base + j) + c]) -
-                         metric_value(metric, a.color[3 * (base + j) + c]);
+          d[3 * j + c] = noise_metric_value(metric, b.color[3 * (base + j) + c]) -
+                         noise_metric_value(metric, a.color[3 * (base + j) + c]);
         }
         have[j] = 1;
       }

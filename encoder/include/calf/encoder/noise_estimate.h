@@ -41,6 +41,14 @@ namespace calf::encoder {
 // kLog2 = log2-PSNR with an 8-stop peak (HDR colour).
 enum class NoiseMetric : uint8_t { kSrgb, kLog2 };
 
+// A linear colour value in `m`: its sRGB encoding, or log2 of it (at least 2^-14, psnr_log2's
+// floor). The estimate and the keyframe test's noise model measure in it.
+float noise_metric_value(NoiseMetric m, float linear);
+
+// The variance of the high-pass r = d - mean of d's 4 neighbours over one frame's noise variance,
+// for d the difference of two frames with independent white noise: 2 (d) x 1.25 (r).
+constexpr double kNoiseHighPassGain = 2.5;
+
 struct NoiseEstimateOptions {
   uint32_t block = 8;        // B, the block side in texels, 4..64
   uint64_t min_blocks = 16;  // fewer samples than this: no estimate, >= 1
