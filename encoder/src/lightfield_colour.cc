@@ -266,23 +266,25 @@ void colour_task(const Context& ctx, uint32_t face, uint32_t cell, TaskOut& out)
   // Closed segments: the search restarts at every segment's first frame (ctx.first_frame is a
   // segment boundary), so a segment's keyframes and t depend on its own frames only.
   const uint32_t segment = ctx.options->segment_frames ? ctx.options->segment_frames : frames;
+  // The noise-aware test: each segment's blocks' own noise, at most kNoiseBlockCap times the
+  // capture's.
+  const bool noise_aware = ctx.options->noise_psnr_db > 0 && ctx.options->noise_factor > 0;
+  CellNoise noise;
+  if (noise_aware) ko.noise = &noise;
   CellKeyframes all;
   all.min_quality_db = kInf;
   for (uint32_t s0 = 0; s0 < frames; s0 += segment) {
     const uint32_t len = std::min(segment, frames - s0);
     const ShownKeyframeFn shown_in = [&](uint32_t f) { return shown(s0 + f); };
-    // The noise-aware test: each block's own noise, at most kNoiseBlockCap times the capture's.
-    CellNoise noise;
-    if (ctx.options->noise_psnr_db > 0 && ctx.options->noise_factor > 0) {
+    const std::span<const float> cell_frames =
+        std::span<const float>(shown_all).subspan(s0 * n * 3, size_t{len} * n * 3);
+    if (noise_aware) {
       noise = measure_cell_noise(
-          std::span<const float>(shown_all).subspan(s0 * n * 3, size_t{len} * n * 3), len, r.width,
-          r.height, ctx.hdr, ctx.options->noise_factor,
+          cell_frames, len, r.width, r.height, ctx.hdr, ctx.options->noise_factor,
           kNoiseBlockCap * std::pow(10.0, -ctx.options->noise_psnr_db / 10.0));
-      ko.noise = &noise;
     }
-    auto part = select_cell_keyframes(
-        std::span<const float>(shown_all).subspan(s0 * n * 3, size_t{len} * n * 3), len,
-        static_cast<uint32_t>(n), shown_in, quality, ko);
+    auto part =
+        select_cell_keyframes(cell_frames, len, static_cast<uint32_t>(n), shown_in, quality, ko);
     if (!part.ok()) {
       out.status = part.status();
       return;
