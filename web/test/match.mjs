@@ -57,29 +57,48 @@ if (given) {
 }
 // The coverage clip's calf-play frames: at the options the page is opened with, at the defaults
 // (the page after the C key), and without the hint rule (the pixels the rule moves).
+// calf-play headless along `gtDir`'s eye path, its frames into play-NAME: each pose's active views,
+// visible and total cells and render ms, from its pose lines.
+function playNative(clip, gtDir, name, args = []) {
+  const played = run('calf-play', [join(dir, clip), '--headless', '--eye-path', join(dir, gtDir, 'eye_path.json'), '--out', join(dir, `play-${name}`), ...args]);
+  const poses = [...played.matchAll(/^pose (\d+) frame \d+: (\d+) views, (\d+)\/(\d+) cells, .*render ([0-9.]+) ms/gm)]
+    .map((m) => ({ views: Number(m[2]), cells: Number(m[3]), total: Number(m[4]), ms: Number(m[5]) }));
+  if (poses.length === 0) throw new Error(`no pose lines in calf-play's output: ${played}`);
+  return poses;
+}
 const coverageRuns = given ? [] : [['cov-on', ['--coverage', '3', '--hint-coverage', '1']], ['cov-default', []], ['cov-norule', ['--hint-coverage', '0']]];
 const coveragePlayed = {};
-for (const [name, args] of coverageRuns) {
-  const played = run('calf-play', [join(dir, 'coverage.calf'), '--headless', '--eye-path', join(dir, 'covgt', 'eye_path.json'), '--out', join(dir, `play-${name}`), ...args]);
-  coveragePlayed[name] = [...played.matchAll(/^pose (\d+) frame \d+: (\d+) views, (\d+)\/(\d+) cells, .*render ([0-9.]+) ms/gm)]
-    .map((m) => ({ views: Number(m[2]), cells: Number(m[3]), total: Number(m[4]), ms: Number(m[5]) }));
-}
+for (const [name, args] of coverageRuns) coveragePlayed[name] = playNative('coverage.calf', 'covgt', name, args);
 // The same capture twice: rgba16f colour (the page decodes it to RGBA on the CPU) and BC1 (the
 // page uploads the blocks where WEBGL_compressed_texture_s3tc_srgb exists, as SwiftShader has).
 const clips = given ? [['given', null]] : [['rgba16f', ['--color-format', 'rgba16f']], ['bc1', ['--color-format', 'bc1', '--bc1-fit', 'range', '--colour-rdo', '0']]];
 const native = {};
 for (const [name, args] of clips) {
   if (args) run('calf-encode', [join(dir, 'cap'), '-o', join(dir, `${name}.calf`), '--cell', '16', '--quiet', ...args]);
-  const played = run('calf-play', [join(dir, `${name}.calf`), '--headless', '--eye-path', join(dir, 'gt', 'eye_path.json'), '--out', join(dir, `play-${name}`)]);
-  native[name] = [...played.matchAll(/^pose (\d+) frame \d+: (\d+) views, (\d+)\/(\d+) cells, .*render ([0-9.]+) ms/gm)]
-    .map((m) => ({ views: Number(m[2]), cells: Number(m[3]), total: Number(m[4]), ms: Number(m[5]) }));
-  if (native[name].length === 0) throw new Error(`no pose lines in calf-play's output: ${played}`);
+  native[name] = playNative(`${name}.calf`, 'gt', name);
 }
 console.log(`web.match: clips and calf-play frames made in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
 const path = JSON.parse(readFileSync(join(dir, 'gt', 'eye_path.json'), 'utf8'));
 
 const { server, port } = await startRangeServer({ '/clips': dir });
 const problems = [];
+// One pose of the page against calf-play's frame of it (play-NAME) and its pose line n: prints
+// the dB and both renders' ms; the same views and cells, a canvas that is not blank and MIN_DB.
+// Returns the dB.
+function comparePose(label, name, i, got, rgb, n = {}) {
+  const db = psnr(rgb, readPng(join(dir, `play-${name}`, `frame_${String(i).padStart(5, '0')}.png`)).rgb);
+  console.log(`web.match: ${label} pose ${i} frame ${got.frame} (colour ${got.colourUpload}): ${got.active.length} views, ${got.visibleCells}/${got.totalCells} cells ` +
+    `(calf-play ${n.views} views, ${n.cells}/${n.total}), ${db.toFixed(2)} dB against calf-play; ` +
+    `render ${got.renderMs.toFixed(1)} ms (SwiftShader) against calf-play's ${n.ms} ms (llvmpipe); ` +
+    `${got.bytes} of ${got.size} bytes fetched so far in ${got.requests} requests`);
+  if (got.active.length !== n.views || got.visibleCells !== n.cells || got.totalCells !== n.total) {
+    problems.push(`${label} pose ${i}: ${got.active.length} views, ${got.visibleCells}/${got.totalCells} cells; calf-play ${n.views}, ${n.cells}/${n.total}`);
+  }
+  const colours = colourCount(rgb);
+  if (colours < 16) problems.push(`${label} pose ${i}: the canvas is blank (${colours} colours)`);
+  if (!(db >= MIN_DB)) problems.push(`${label} pose ${i}: ${db.toFixed(2)} dB against calf-play, below ${MIN_DB}`);
+  return db;
+}
 const browser = await launchChromium(chromium);
 const held = {};  // one page plays the clips in turn (the ray march compiles once)
 try {
@@ -89,20 +108,8 @@ for (const [name] of clips) {
     problems.push(`${name}: the page did not open the clip: ${overlay} ${consoleLines.join(' | ')}`);
   } else {
     await renderEyePath(page, path, (i, got, rgb) => {
-      const want = readPng(join(dir, `play-${name}`, `frame_${String(i).padStart(5, '0')}.png`));
-      const db = psnr(rgb, want.rgb);
-      const n = native[name][i] ?? {};
-      console.log(`web.match: ${name} pose ${i} frame ${got.frame} (colour ${got.colourUpload}): ${got.active.length} views, ${got.visibleCells}/${got.totalCells} cells ` +
-        `(calf-play ${n.views} views, ${n.cells}/${n.total}), ${db.toFixed(2)} dB against calf-play; ` +
-        `render ${got.renderMs.toFixed(1)} ms (SwiftShader) against calf-play's ${n.ms} ms (llvmpipe); ` +
-        `${got.bytes} of ${got.size} bytes fetched so far in ${got.requests} requests`);
-      if (got.active.length !== n.views || got.visibleCells !== n.cells || got.totalCells !== n.total) {
-        problems.push(`${name} pose ${i}: ${got.active.length} views, ${got.visibleCells}/${got.totalCells} cells; calf-play ${n.views}, ${n.cells}/${n.total}`);
-      }
+      comparePose(name, name, i, got, rgb, native[name][i]);
       if (name === 'bc1' && !got.colourUpload.startsWith('BC1')) problems.push(`bc1 pose ${i}: colour went up as ${got.colourUpload}, not as BC1 blocks`);
-      const colours = colourCount(rgb);
-      if (colours < 16) problems.push(`${name} pose ${i}: the canvas is blank (${colours} colours)`);
-      if (!(db >= MIN_DB)) problems.push(`${name} pose ${i}: ${db.toFixed(2)} dB against calf-play, below ${MIN_DB}`);
     }, (i, message) => problems.push(`${name} pose ${i}: ${message} ${consoleLines.join(' | ')}`));
     // Along the path, with the prefetches done: less than the whole clip, no chunk twice.
     const f = await page.evaluate(async () => {
@@ -166,14 +173,7 @@ async function matchCoverage() {
   }
   const frame = (name, i) => readPng(join(dir, `play-${name}`, `frame_${String(i).padStart(5, '0')}.png`)).rgb;
   const pass = async (name, what, check) => renderEyePath(page, covPath, (i, got, rgb) => {
-    const db = psnr(rgb, frame(name, i));
-    const n = coveragePlayed[name][i] ?? {};
-    console.log(`web.match: coverage ${what} pose ${i}: ${got.active.length} views, ${got.visibleCells}/${got.totalCells} cells ` +
-      `(calf-play ${n.views} views, ${n.cells}/${n.total}), ${db.toFixed(2)} dB against calf-play; render ${got.renderMs.toFixed(1)} ms ` +
-      `(SwiftShader) against calf-play's ${n.ms} ms (llvmpipe); ${got.bytes} of ${got.size} bytes fetched so far in ${got.requests} requests`);
-    if (got.active.length !== n.views || got.visibleCells !== n.cells) problems.push(`coverage ${what} pose ${i}: ${got.active.length} views, ${got.visibleCells} cells; calf-play ${n.views}, ${n.cells}`);
-    if (colourCount(rgb) < 16) problems.push(`coverage ${what} pose ${i}: the canvas is blank`);
-    if (!(db >= MIN_DB)) problems.push(`coverage ${what} pose ${i}: ${db.toFixed(2)} dB against calf-play, below ${MIN_DB}`);
+    comparePose(`coverage ${what}`, name, i, got, rgb, coveragePlayed[name][i]);
     if (check) check(i, rgb);
   }, (i, message) => problems.push(`coverage ${what} pose ${i}: ${message} ${consoleLines.join(' | ')}`));
   await pass('cov-on', '--coverage 3 --hint-coverage 1');
