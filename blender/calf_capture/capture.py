@@ -156,6 +156,9 @@ class _Renderer:
         s.set(c, "device", "CPU")
         s.set(c, "use_denoising", False)
         s.set(c, "use_animated_seed", False)
+        # A scene's render time limit would stop a render before its samples: off, so that every
+        # face and ground-truth pose gets the samples asked for.
+        s.set(c, "time_limit", 0.0)
         # Adaptive sampling stops a pixel once its noise is below the threshold, whatever the
         # samples; with the threshold 0 every pixel gets every sample.
         s.set(c, "use_adaptive_sampling", adaptive_threshold > 0)

@@ -3,7 +3,7 @@ case runs the headless command's argument handling (cli.run) and must raise the 
 error id, as a usage error (exit 2) or not (exit 1), with a one-line message, and write no
 manifest. The last case disables the Cycles add-on. Before them, the Cycles settings that the
 add-on's first colour render of a capture set and of ground truth runs with (samples, adaptive
-sampling, its threshold) for the default and a given --adaptive-threshold, and that the scene's own
+sampling, its threshold, the time limit) for the default and a given --adaptive-threshold, and that the scene's own
 settings are back afterwards (the render itself is stubbed out). Exit status 0 when every case
 holds.
 
@@ -51,24 +51,27 @@ class _Rendered(Exception):
 
 def _spy(renderer, width, height, samples, filter_width, seed):
     c = renderer.scene.cycles
-    raise _Rendered((samples, c.use_adaptive_sampling, round(c.adaptive_threshold, 6)))
+    raise _Rendered((samples, c.use_adaptive_sampling, round(c.adaptive_threshold, 6),
+                     c.time_limit))
 
 
 scene = bpy.context.scene
 real_render_once = capture._Renderer._render_once
 capture._Renderer._render_once = _spy
-SETTINGS = [  # name, arguments, (samples, adaptive sampling, threshold) of the first render
-    ("cycles_capture_default", ["--rig", "list:0,1,0", "--face-size", "2"], (8, False, 0.02)),
+SETTINGS = [  # name, arguments, (samples, adaptive sampling, threshold, time limit) of the first
+    # render
+    ("cycles_capture_default", ["--rig", "list:0,1,0", "--face-size", "2"], (8, False, 0.02, 0)),
     ("cycles_capture_adaptive", ["--rig", "list:0,1,0", "--face-size", "2",
-                                 "--adaptive-threshold", "0.05"], (8, True, 0.05)),
-    ("cycles_gt_default", ["--ground-truth", "--eye-path", eye], (8, False, 0.02)),
+                                 "--adaptive-threshold", "0.05"], (8, True, 0.05, 0)),
+    ("cycles_gt_default", ["--ground-truth", "--eye-path", eye], (8, False, 0.02, 0)),
     ("cycles_gt_adaptive", ["--ground-truth", "--eye-path", eye, "--adaptive-threshold",
-                            "0.004"], (8, True, 0.004)),
+                            "0.004"], (8, True, 0.004, 0)),
 ]
 for name, args, want in SETTINGS:
     # The scene's own settings differ from everything the add-on sets, and must come back.
     scene.cycles.use_adaptive_sampling, scene.cycles.adaptive_threshold = True, 0.02
     scene.cycles.samples = 3
+    scene.cycles.time_limit = 0.5  # a user's render time limit, which would cut samples short
     try:
         cli.run(["--out", os.path.join(work, name), "--samples", "8"] + args)
         got = "no render"
@@ -77,10 +80,11 @@ for name, args, want in SETTINGS:
     except capture.CaptureError as e:
         got = str(e)
     back = (scene.cycles.samples, scene.cycles.use_adaptive_sampling,
-            round(scene.cycles.adaptive_threshold, 6))
-    ok = got == want and back == (3, True, 0.02)
+            round(scene.cycles.adaptive_threshold, 6), scene.cycles.time_limit)
+    ok = got == want and back == (3, True, 0.02, 0.5)
     failed += not ok
-    print("error_cases: %s %s: first render (samples, adaptive, threshold) %s, want %s; scene "
+    print("error_cases: %s %s: first render (samples, adaptive, threshold, time limit) %s, want "
+          "%s; scene "
           "after %s" % ("ok" if ok else "FAIL", name, got, want, back))
 capture._Renderer._render_once = real_render_once
 
