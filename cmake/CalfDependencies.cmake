@@ -38,8 +38,9 @@ calf_find_config(nlohmann_json nlohmann-json3-dev)
 # commands
 calf_find_config(CLI11 libcli11-dev)
 calf_find_config(fmt libfmt-dev)
-# AV1 colour (format/SPEC.md §11.1.12): SVT-AV1 encodes, dav1d decodes
+# AV1 colour (format/SPEC.md §11.1.12): SVT-AV1 encodes 4:2:0, libaom 4:4:4, dav1d decodes
 calf_find_pkgconfig(SVTAV1 SvtAv1Enc libsvtav1enc-dev)
+calf_find_pkgconfig(AOM aom libaom-dev)
 calf_find_pkgconfig(DAV1D dav1d libdav1d-dev)
 # threads for encoders and the capture tool
 calf_find_config(TBB libtbb-dev)

@@ -9,8 +9,8 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config git ca-certificates
   # format: compression and hashing
   libzstd-dev liblzma-dev libxxhash-dev
-  # AV1 colour: SVT-AV1 encodes, dav1d decodes
-  libsvtav1enc-dev libdav1d-dev
+  # AV1 colour: SVT-AV1 encodes 4:2:0, libaom 4:4:4, dav1d decodes
+  libsvtav1enc-dev libaom-dev libdav1d-dev
   # capture sets: images and manifests
   libopenimageio-dev libopenexr-dev libpng-dev nlohmann-json3-dev
   # command lines and text; man pages generated from each command's --help

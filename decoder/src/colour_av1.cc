@@ -120,50 +120,62 @@ Status Av1CellDecoder::decode(std::span<const uint8_t> unit, const std::string& 
   return Status::Ok();
 }
 
-Status Av1CellDecoder::rgba8(uint32_t w, uint32_t h, std::vector<uint8_t>& out,
+namespace {
+
+// The picture's layout and bit depth against the track's: a 4:4:4 stream where the track says
+// 4:2:0 (or the reverse), another bit depth, or a picture smaller than the cell is CALF-E302.
+Status check_picture(const Dav1dPictureParameters& p, int bits, bool chroma444, uint32_t w,
+                     uint32_t h, const std::string& what) {
+  const Dav1dPixelLayout layout = chroma444 ? DAV1D_PIXEL_LAYOUT_I444 : DAV1D_PIXEL_LAYOUT_I420;
+  if (p.bpc == bits && p.layout == layout && p.w >= 0 && p.h >= 0 &&
+      static_cast<uint32_t>(p.w) >= w && static_cast<uint32_t>(p.h) >= h) {
+    return Status::Ok();
+  }
+  auto layout_name = [](int l) -> std::string {
+    return l == DAV1D_PIXEL_LAYOUT_I420   ? "4:2:0"
+           : l == DAV1D_PIXEL_LAYOUT_I444 ? "4:4:4"
+           : l == DAV1D_PIXEL_LAYOUT_I422 ? "4:2:2"
+                                          : "4:0:0";
+  };
+  return Status(ErrorId::kAv1Picture,
+                what + ": a " + std::to_string(p.w) + " x " + std::to_string(p.h) + " " +
+                    layout_name(p.layout) + " picture of " + std::to_string(p.bpc) +
+                    " bits for a " + std::to_string(w) + " x " + std::to_string(h) + " cell (" +
+                    std::to_string(bits) + "-bit " + layout_name(layout) +
+                    " expected by the track's colour format)");
+}
+
+}  // namespace
+
+Status Av1CellDecoder::rgba8(uint32_t w, uint32_t h, bool chroma444, std::vector<uint8_t>& out,
                              const std::string& what) const {
   const Impl& d = *impl_;
   if (!d.has_picture) return Status(ErrorId::kAv1Picture, what + ": no decoded picture");
-  const Dav1dPictureParameters& p = d.picture.p;
-  if (p.bpc != 8 || p.layout != DAV1D_PIXEL_LAYOUT_I420 || p.w < 0 || p.h < 0 ||
-      static_cast<uint32_t>(p.w) < w || static_cast<uint32_t>(p.h) < h) {
-    return Status(ErrorId::kAv1Picture,
-                  what + ": a " + std::to_string(p.w) + " x " + std::to_string(p.h) +
-                      " picture of " + std::to_string(p.bpc) + " bits, layout " +
-                      std::to_string(p.layout) + ", for a " + std::to_string(w) + " x " +
-                      std::to_string(h) + " cell (8-bit 4:2:0 expected)");
-  }
+  CALF_RETURN_IF_ERROR(check_picture(d.picture.p, 8, chroma444, w, h, what));
   out.resize(size_t{w} * h * 4);
   const auto* ys = static_cast<const uint8_t*>(d.picture.data[0]);
   const auto* us = static_cast<const uint8_t*>(d.picture.data[1]);
   const auto* vs = static_cast<const uint8_t*>(d.picture.data[2]);
   const ptrdiff_t ly = d.picture.stride[0], lc = d.picture.stride[1];
+  const uint32_t sub = chroma444 ? 0 : 1;  // chroma sample (x >> sub, y >> sub)
   for (uint32_t y = 0; y < h; ++y) {
     const uint8_t* yr = ys + y * ly;
-    const uint8_t* ur = us + (y >> 1) * lc;
-    const uint8_t* vr = vs + (y >> 1) * lc;
+    const uint8_t* ur = us + (y >> sub) * lc;
+    const uint8_t* vr = vs + (y >> sub) * lc;
     uint8_t* o = &out[size_t{y} * w * 4];
     for (uint32_t x = 0; x < w; ++x) {
-      av1_ycbcr_to_rgb(yr[x], ur[x >> 1], vr[x >> 1], o + 4 * x);
+      av1_ycbcr_to_rgb(yr[x], ur[x >> sub], vr[x >> sub], o + 4 * x);
       o[4 * x + 3] = 255;
     }
   }
   return Status::Ok();
 }
 
-Status Av1CellDecoder::rgba16f(uint32_t w, uint32_t h, lf::Av1HdrCurve curve,
+Status Av1CellDecoder::rgba16f(uint32_t w, uint32_t h, bool chroma444, lf::Av1HdrCurve curve,
                                std::vector<uint8_t>& out, const std::string& what) const {
   const Impl& d = *impl_;
   if (!d.has_picture) return Status(ErrorId::kAv1Picture, what + ": no decoded picture");
-  const Dav1dPictureParameters& p = d.picture.p;
-  if (p.bpc != 10 || p.layout != DAV1D_PIXEL_LAYOUT_I420 || p.w < 0 || p.h < 0 ||
-      static_cast<uint32_t>(p.w) < w || static_cast<uint32_t>(p.h) < h) {
-    return Status(ErrorId::kAv1Picture,
-                  what + ": a " + std::to_string(p.w) + " x " + std::to_string(p.h) +
-                      " picture of " + std::to_string(p.bpc) + " bits, layout " +
-                      std::to_string(p.layout) + ", for a " + std::to_string(w) + " x " +
-                      std::to_string(h) + " HDR cell (10-bit 4:2:0 expected)");
-  }
+  CALF_RETURN_IF_ERROR(check_picture(d.picture.p, 10, chroma444, w, h, what));
   // The half float bits of every code, once per picture.
   uint16_t half[1024];
   for (uint32_t c = 0; c < 1024; ++c) half[c] = lf::av1_hdr_half_bits(curve, c);
@@ -178,14 +190,15 @@ Status Av1CellDecoder::rgba16f(uint32_t w, uint32_t h, lf::Av1HdrCurve curve,
     std::memcpy(&v, row + 2 * size_t{x}, 2);
     return static_cast<uint16_t>(v & 1023);
   };
+  const uint32_t sub = chroma444 ? 0 : 1;
   for (uint32_t y = 0; y < h; ++y) {
     const uint8_t* yr = ys + y * ly;
-    const uint8_t* ur = us + (y >> 1) * lc;
-    const uint8_t* vr = vs + (y >> 1) * lc;
+    const uint8_t* ur = us + (y >> sub) * lc;
+    const uint8_t* vr = vs + (y >> sub) * lc;
     uint8_t* o = &out[size_t{y} * w * 8];
     for (uint32_t x = 0; x < w; ++x) {
       uint16_t rgb[3];
-      av1_ycbcr10_to_rgb(sample(yr, x), sample(ur, x >> 1), sample(vr, x >> 1), rgb);
+      av1_ycbcr10_to_rgb(sample(yr, x), sample(ur, x >> sub), sample(vr, x >> sub), rgb);
       const uint16_t texel[4] = {half[rgb[0]], half[rgb[1]], half[rgb[2]], 0x3C00};
       for (int c = 0; c < 4; ++c) {
         o[8 * x + 2 * c] = static_cast<uint8_t>(texel[c]);
@@ -199,10 +212,9 @@ Status Av1CellDecoder::rgba16f(uint32_t w, uint32_t h, lf::Av1HdrCurve curve,
 Status Av1CellDecoder::gpu_bytes(uint16_t colour_format, uint32_t w, uint32_t h,
                                  lf::Av1HdrCurve curve, std::vector<uint8_t>& out,
                                  const std::string& what) const {
-  if (colour_format == static_cast<uint16_t>(container::PixelFormat::kAv1Hdr)) {
-    return rgba16f(w, h, curve, out, what);
-  }
-  return rgba8(w, h, out, what);
+  const bool chroma444 = lf::is_av1_chroma444(colour_format);
+  if (lf::is_av1_hdr_colour(colour_format)) return rgba16f(w, h, chroma444, curve, out, what);
+  return rgba8(w, h, chroma444, out, what);
 }
 
 }  // namespace calf::decoder

@@ -29,16 +29,19 @@ class Av1CellDecoder {
   // Errors: CALF-E301 (`what` names cell and frame); after one, reset() before the next unit.
   Status decode(std::span<const uint8_t> unit, const std::string& what);
   // The top-left w x h texels of the last picture as RGBA8 (§11.1.12's integer conversion,
-  // alpha 255), row-major. Errors: CALF-E302 for no picture, a picture that is not 8-bit 4:2:0 or
-  // is smaller than w x h.
-  Status rgba8(uint32_t w, uint32_t h, std::vector<uint8_t>& out, const std::string& what) const;
-  // HDR AV1 colour (format 13): the top-left w x h texels of the last picture as RGBA16F
+  // alpha 255), row-major; chroma of 4:2:0 pictures (`chroma444` false) is taken at (x/2, y/2),
+  // of 4:4:4 pictures at (x, y). Errors: CALF-E302 for no picture, a picture that is not 8-bit of
+  // that subsampling or is smaller than w x h.
+  Status rgba8(uint32_t w, uint32_t h, bool chroma444, std::vector<uint8_t>& out,
+               const std::string& what) const;
+  // HDR AV1 colour (formats 13 and 15): the top-left w x h texels of the last picture as RGBA16F
   // (§11.1.12: the 10-bit conversion, each code through `curve`, alpha 1.0), little-endian
-  // halves, row-major. Errors: CALF-E302 for no picture, a picture that is not 10-bit 4:2:0 or is
-  // smaller than w x h.
-  Status rgba16f(uint32_t w, uint32_t h, lf::Av1HdrCurve curve, std::vector<uint8_t>& out,
-                 const std::string& what) const;
-  // The last picture as the colour format's GPU bytes: rgba8 for av1, rgba16f for av1hdr.
+  // halves, row-major. Errors: CALF-E302 for no picture, a picture that is not 10-bit of the
+  // subsampling `chroma444` says or is smaller than w x h.
+  Status rgba16f(uint32_t w, uint32_t h, bool chroma444, lf::Av1HdrCurve curve,
+                 std::vector<uint8_t>& out, const std::string& what) const;
+  // The last picture as the colour format's GPU bytes: rgba8 for av1 and av1-444, rgba16f for
+  // av1hdr and av1hdr-444.
   Status gpu_bytes(uint16_t colour_format, uint32_t w, uint32_t h, lf::Av1HdrCurve curve,
                    std::vector<uint8_t>& out, const std::string& what) const;
 

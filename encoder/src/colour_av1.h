@@ -1,5 +1,6 @@
-// AV1 colour (format/SPEC.md §11.1.12): one cell's frames, as sRGB-encoded RGBA8, encoded with
-// SVT-AV1 into closed GOPs of temporal units. Private to the light-field encoder.
+// AV1 colour (format/SPEC.md §11.1.12): one cell's frames, as sRGB-encoded RGBA8 or HDR codes,
+// encoded into closed GOPs of temporal units: 4:2:0 by SVT-AV1, 4:4:4 by libaom
+// (Av1ColourOptions::chroma444). Private to the light-field encoder.
 #pragma once
 
 #include <cstdint>
@@ -18,9 +19,10 @@ using Gop = std::vector<std::vector<uint8_t>>;
 
 // Encodes `frames` frames of a w x h cell (`rgba`: frame after frame, row-major, 4 bytes a texel,
 // alpha ignored) as GOPs of options.keyframe_interval frames (the last may be shorter), each by a
-// fresh single-threaded SVT-AV1 encoder, so that the bytes depend on the pictures and the options
-// only. Pictures narrower or lower than 64 texels (SVT-AV1's least) or not a multiple of 8 are
-// padded by repeating the last column and row. Errors: CALF-E256 (kEncoderAv1).
+// fresh single-threaded encoder (SVT-AV1 for 4:2:0, libaom for 4:4:4), so that the bytes depend
+// on the pictures and the options only. Pictures narrower or lower than 64 texels (SVT-AV1's least)
+// or not a multiple of 8 are padded by repeating the last column and row. Errors: CALF-E256
+// (kEncoderAv1).
 Expected<std::vector<Gop>> encode_cell(std::span<const uint8_t> rgba, uint32_t w, uint32_t h,
                                        uint32_t frames, uint32_t fps_numerator,
                                        uint32_t fps_denominator, const Av1ColourOptions& options);
@@ -39,7 +41,8 @@ struct HdrCell {
   std::vector<Gop> gops;
 };
 // As encode_cell, for binary16 linear RGB (`half`: frame after frame, row-major, 3 values a
-// texel): each channel through hdr_code, then 10-bit 4:2:0 pictures. Errors: CALF-E256.
+// texel): each channel through hdr_code, then 10-bit 4:2:0 (or 4:4:4) pictures. Errors:
+// CALF-E256.
 Expected<HdrCell> encode_cell_hdr(std::span<const uint16_t> half, uint32_t w, uint32_t h,
                                   uint32_t frames, uint32_t fps_numerator, uint32_t fps_denominator,
                                   const Av1ColourOptions& options);
@@ -51,6 +54,11 @@ void rgba_to_ycbcr420(std::span<const uint8_t> rgba, uint32_t W, uint32_t H, uin
                       uint8_t* cb, uint8_t* cr);
 // The same for 10-bit codes (`rgb`: 3 a texel, 0 … 1023; chroma centred on 512).
 void rgb10_to_ycbcr420(std::span<const uint16_t> rgb, uint32_t W, uint32_t H, uint16_t* y,
+                       uint16_t* cb, uint16_t* cr);
+// The 4:4:4 conversions: every plane W x H, chroma of each texel its own.
+void rgba_to_ycbcr444(std::span<const uint8_t> rgba, uint32_t W, uint32_t H, uint8_t* y,
+                      uint8_t* cb, uint8_t* cr);
+void rgb10_to_ycbcr444(std::span<const uint16_t> rgb, uint32_t W, uint32_t H, uint16_t* y,
                        uint16_t* cb, uint16_t* cr);
 
 }  // namespace calf::encoder::av1_internal

@@ -66,8 +66,11 @@ Status validate_options(const LightfieldEncodeOptions& o) {
     if (a.crf < 1 || a.crf > 63)
       return bad("--av1-crf " + std::to_string(a.crf) + ": expected [1, 63]");
     if (a.qp > 63) return bad("--av1-qp " + std::to_string(a.qp) + ": expected [1, 63]");
-    if (a.preset > 13)
-      return bad("--av1-preset " + std::to_string(a.preset) + ": expected [0, 13]");
+    if (a.preset > (a.chroma444 ? 9u : 13u)) {
+      return bad("--av1-preset " + std::to_string(a.preset) +
+                 (a.chroma444 ? ": expected [0, 9] (libaom cpu-used, --av1-chroma 444)"
+                              : ": expected [0, 13]"));
+    }
     if (a.keyframe_interval < 1) return bad("--av1-keyframe-interval 0: expected >= 1");
     if (o.segment_frames != 0) return bad("--segment-frames with AV1 colour: not supported");
   }
@@ -205,7 +208,11 @@ Expected<LightfieldAnalysis> plan_lightfield(const capture::CaptureManifest& m,
       h.colour_format = pf(PixelFormat::kRgba8);
       break;
     case ColourCoding::kAv1:
-      h.colour_format = pf(av1_hdr ? container::PixelFormat::kAv1Hdr : PixelFormat::kAv1);
+      if (options.av1.chroma444) {
+        h.colour_format = pf(av1_hdr ? PixelFormat::kAv1HdrChroma444 : PixelFormat::kAv1Chroma444);
+      } else {
+        h.colour_format = pf(av1_hdr ? PixelFormat::kAv1Hdr : PixelFormat::kAv1);
+      }
       break;
     default:
       h.colour_format = pf(PixelFormat::kRgba16f);

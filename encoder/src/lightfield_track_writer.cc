@@ -22,9 +22,12 @@ Expected<LightfieldTrackWriter> LightfieldTrackWriter::begin(container::Writer& 
   // A coverage stream is a 1.2 feature (SPEC §11.1.11): the file says so in its minor version.
   if (analysis.coverage) writer.require_minor_version(container::kVersionMinorCoverage);
   // So is AV1 colour (1.3, SPEC §11.1.12), which earlier decoders refuse as an unknown format.
+  // HDR AV1 colour is 1.4, 4:4:4 AV1 colour 1.5.
   if (analysis.colour == ColourCoding::kAv1) {
-    writer.require_minor_version(analysis.hdr ? container::kVersionMinorAv1Hdr
-                                              : container::kVersionMinorAv1);
+    writer.require_minor_version(lf::is_av1_chroma444(analysis.header.colour_format)
+                                     ? container::kVersionMinorAv1Chroma444
+                                 : analysis.hdr ? container::kVersionMinorAv1Hdr
+                                                : container::kVersionMinorAv1);
   }
   LightfieldEncodeStats stats;
   stats.colour_format = analysis.header.colour_format;

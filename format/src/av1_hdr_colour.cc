@@ -2,16 +2,34 @@
 
 namespace calf::lf {
 
+namespace {
+bool is(uint16_t colour_format, container::PixelFormat f) {
+  return colour_format == static_cast<uint16_t>(f);
+}
+}  // namespace
+
 bool is_av1_colour(uint16_t colour_format) {
-  return colour_format == static_cast<uint16_t>(container::PixelFormat::kAv1) ||
-         colour_format == static_cast<uint16_t>(container::PixelFormat::kAv1Hdr);
+  using container::PixelFormat;
+  return is(colour_format, PixelFormat::kAv1) || is(colour_format, PixelFormat::kAv1Hdr) ||
+         is(colour_format, PixelFormat::kAv1Chroma444) ||
+         is(colour_format, PixelFormat::kAv1HdrChroma444);
+}
+
+bool is_av1_hdr_colour(uint16_t colour_format) {
+  return is(colour_format, container::PixelFormat::kAv1Hdr) ||
+         is(colour_format, container::PixelFormat::kAv1HdrChroma444);
+}
+
+bool is_av1_chroma444(uint16_t colour_format) {
+  return is(colour_format, container::PixelFormat::kAv1Chroma444) ||
+         is(colour_format, container::PixelFormat::kAv1HdrChroma444);
 }
 
 Expected<Av1Gop> parse_av1_chunk(std::span<const uint8_t> raw, uint32_t frame_count,
                                  uint16_t colour_format, Av1HdrCurve* curve,
                                  const std::string& what) {
   *curve = Av1HdrCurve{};
-  if (colour_format != static_cast<uint16_t>(container::PixelFormat::kAv1Hdr)) {
+  if (!is_av1_hdr_colour(colour_format)) {
     return parse_av1_gop(raw, frame_count, what);
   }
   if (raw.size() < 4) {

@@ -17,8 +17,9 @@ const char* compression_name(Compression c) {
 }
 
 const char* pixel_format_name(uint16_t format) {
-  static const char* kNames[] = {"none", "rgba8", "rgba16f", "r16",  "bc1",   "bc4", "bc5",
-                                 "bc6h", "bc7",   "rg8",     "r16p", "r16pm", "av1", "av1hdr"};
+  static const char* kNames[] = {"none", "rgba8",  "rgba16f", "r16",       "bc1",  "bc4",
+                                 "bc5",  "bc6h",   "bc7",     "rg8",       "r16p", "r16pm",
+                                 "av1",  "av1hdr", "av1-444", "av1hdr-444"};
   return format < sizeof kNames / sizeof kNames[0] ? kNames[format] : "unknown";
 }
 

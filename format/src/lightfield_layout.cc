@@ -485,7 +485,8 @@ void region_rect_gpu_bytes(const RegionChunk& chunk, size_t index, std::vector<u
 Status check_colour_format(uint16_t colour_format) {
   for (PixelFormat f :
        {PixelFormat::kBc1, PixelFormat::kBc7, PixelFormat::kBc6h, PixelFormat::kRgba8,
-        PixelFormat::kRgba16f, PixelFormat::kAv1, container::PixelFormat::kAv1Hdr}) {
+        PixelFormat::kRgba16f, PixelFormat::kAv1, PixelFormat::kAv1Hdr, PixelFormat::kAv1Chroma444,
+        PixelFormat::kAv1HdrChroma444}) {
     if (is(colour_format, f)) return Status::Ok();
   }
   return Status(ErrorId::kLightfieldFormat, "colour format " + std::to_string(colour_format) +
@@ -542,8 +543,12 @@ Status colour_payload_gpu_bytes(uint16_t colour_format, std::span<const uint8_t>
 }
 
 container::PixelFormat colour_gpu_format(uint16_t colour_format) {
-  if (is(colour_format, PixelFormat::kAv1)) return PixelFormat::kRgba8;
-  if (is(colour_format, container::PixelFormat::kAv1Hdr)) return PixelFormat::kRgba16f;
+  if (is(colour_format, PixelFormat::kAv1) || is(colour_format, PixelFormat::kAv1Chroma444)) {
+    return PixelFormat::kRgba8;
+  }
+  if (is(colour_format, PixelFormat::kAv1Hdr) || is(colour_format, PixelFormat::kAv1HdrChroma444)) {
+    return PixelFormat::kRgba16f;
+  }
   return static_cast<PixelFormat>(colour_format);
 }
 

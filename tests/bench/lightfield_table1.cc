@@ -26,7 +26,8 @@
 //       [--depth-format raw16|pred16|pred16m] [--depth-fixed-groups] [--no-colour-peers]
 //       [--no-lzma2] [--video-peers [--x265-preset P] [--x265-params K=V:...]]
 //       [--psnr-auto] [--av1-crf N ... [--av1-preset P] [--av1-keyframe-interval K]
-//       [--av1-cell C] [--csv FILE] [--no-peer-table] [--x265-pix-fmt F]]
+//       [--av1-cell C] [--av1-chroma 420|444 ...] [--csv FILE] [--no-peer-table]
+//       [--x265-pix-fmt F]]
 //
 // --av1-crf (with --video-peers) adds the AV1 colour mode (calf-encode --colour-codec av1) at each
 // CRF: the BC clip and each AV1 clip are decoded, their colour's PSNR against the capture taken
@@ -220,6 +221,7 @@ struct Run {
   bool psnr_auto = false;  // Q from the capture's noise estimate, as calf-encode --psnr auto
   // The AV1 colour mode beside BC (with --video-peers): one encode per CRF, each matched by x265.
   std::vector<uint32_t> av1_crfs;
+  std::vector<std::string> av1_chromas = {"420"};  // each CRF at each (calf-encode --av1-chroma)
   encoder::Av1ColourOptions av1;
   uint32_t av1_cell = 64;
   std::string csv;  // append one line per colour coding matched by x265 (empty: none)
@@ -405,21 +407,26 @@ int run_one(const fs::path& dir, const Run& run) {
     std::vector<bench::ColourClip> clips;
     clips.push_back({fmt::format("{} Q {:.2f}", format_name(s.colour_format), min_psnr_db),
                      zstd_clip, s.colour.stored, z->seconds});
-    for (uint32_t crf : run.av1_crfs) {
-      encoder::LightfieldEncodeOptions o = options(container::Compression::kZstd, run.depth, merge);
-      o.colour = encoder::ColourCoding::kAv1;
-      o.cell_size = run.av1_cell;
-      o.av1 = run.av1;
-      o.av1.crf = crf;
-      const fs::path clip = tmp / fmt::format("av1_{}.calf", crf);
-      auto r = encode(dir, clip, o, true);
-      if (!r.ok()) {
-        match_error = r.status().to_string();
-        break;
+    for (const std::string& chroma : run.av1_chromas) {
+      for (uint32_t crf : run.av1_crfs) {
+        encoder::LightfieldEncodeOptions o =
+            options(container::Compression::kZstd, run.depth, merge);
+        o.colour = encoder::ColourCoding::kAv1;
+        o.cell_size = run.av1_cell;
+        o.av1 = run.av1;
+        o.av1.crf = crf;
+        o.av1.chroma444 = chroma == "444";
+        const fs::path clip = tmp / fmt::format("av1_{}_{}.calf", chroma, crf);
+        auto r = encode(dir, clip, o, true);
+        if (!r.ok()) {
+          match_error = r.status().to_string();
+          break;
+        }
+        clips.push_back({fmt::format("AV1 {} CRF {}, preset {}, cell {}, K {}",
+                                     o.av1.chroma444 ? "4:4:4" : "4:2:0", crf, run.av1.preset,
+                                     run.av1_cell, run.av1.keyframe_interval),
+                         clip, r->stats.colour.stored, r->seconds});
       }
-      clips.push_back({fmt::format("AV1 CRF {}, preset {}, cell {}, K {}", crf, run.av1.preset,
-                                   run.av1_cell, run.av1.keyframe_interval),
-                       clip, r->stats.colour.stored, r->seconds});
     }
     if (match_error.empty()) {
       auto mr = bench::match_colour_to_x265(dir, clips, run.peers);
@@ -581,8 +588,13 @@ int main(int argc, char** argv) {
                  "set BC and each AV1 encode against x265 at matched PSNR (default none)")
       ->check(CLI::Range(1, 63));
   app.add_option("--av1-preset", run.av1.preset,
-                 "SVT-AV1 preset of those encodes (default 5, calf-encode's)")
+                 "SVT-AV1 preset (libaom cpu-used for 4:4:4) of those encodes (default 5, "
+                 "calf-encode's)")
       ->check(CLI::Range(0, 13));
+  app.add_option("--av1-chroma", run.av1_chromas,
+                 "their chroma, 420 (SVT-AV1) or 444 (libaom), each CRF at each given "
+                 "(repeatable; default 420)")
+      ->check(CLI::IsMember({"420", "444"}));
   app.add_option("--av1-keyframe-interval", run.av1.keyframe_interval,
                  "their key frame interval (default 30)")
       ->check(CLI::Range(1, 100000));

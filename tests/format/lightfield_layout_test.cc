@@ -3,6 +3,8 @@
 // those bytes, and each rule of the SPEC is a CALF-E202 naming what is wrong.
 #include "calf/format/lightfield_layout.h"
 
+#include "calf/format/av1_hdr_colour.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -205,6 +207,33 @@ TEST(LightfieldLayout, Av1GopChunk) {
   EXPECT_EQ(colour_payload_gpu_bytes(12, raw, 4, 4, gpu, "c").id(), ErrorId::kLightfieldFormat);
   EXPECT_EQ(colour_gpu_format(12), container::PixelFormat::kRgba8);
   EXPECT_EQ(colour_gpu_format(4), container::PixelFormat::kBc1);
+  // The 4:4:4 formats (1.5): av1-444 gives rgba8 as av1, av1hdr-444 rgba16f as av1hdr; 16 is no
+  // colour format.
+  EXPECT_TRUE(check_colour_format(14).ok());
+  EXPECT_TRUE(check_colour_format(15).ok());
+  EXPECT_EQ(check_colour_format(16).id(), ErrorId::kLightfieldFormat);
+  EXPECT_EQ(colour_gpu_format(14), container::PixelFormat::kRgba8);
+  EXPECT_EQ(colour_gpu_format(13), container::PixelFormat::kRgba16f);
+  EXPECT_EQ(colour_gpu_format(15), container::PixelFormat::kRgba16f);
+  EXPECT_STREQ(container::pixel_format_name(14), "av1-444");
+  EXPECT_STREQ(container::pixel_format_name(15), "av1hdr-444");
+  // Which AV1 formats are HDR (a curve heads each chunk) and which 4:4:4.
+  for (uint16_t f = 0; f < 17; ++f) {
+    EXPECT_EQ(is_av1_colour(f), f >= 12 && f <= 15) << f;
+    EXPECT_EQ(is_av1_hdr_colour(f), f == 13 || f == 15) << f;
+    EXPECT_EQ(is_av1_chroma444(f), f == 14 || f == 15) << f;
+  }
+  // av1hdr-444's chunk is headed by the curve as av1hdr's; av1-444's is the GOP alone.
+  Bytes headed = {0x00, 0x3C, 0x02, 0x00};
+  headed.insert(headed.end(), raw.begin(), raw.end());
+  Av1HdrCurve curve;
+  auto g15 = parse_av1_chunk(headed, 2, 15, &curve, "c");
+  ASSERT_TRUE(g15.ok()) << g15.status().to_string();
+  EXPECT_EQ(curve.base, 0x3C00);
+  EXPECT_EQ(curve.shift, 2);
+  EXPECT_EQ(g15->units.size(), 2u);
+  EXPECT_TRUE(parse_av1_chunk(raw, 2, 14, &curve, "c").ok());
+  EXPECT_EQ(parse_av1_chunk(raw, 2, 15, &curve, "c").status().id(), ErrorId::kAv1Chunk);
 }
 
 }  // namespace

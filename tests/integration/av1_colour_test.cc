@@ -3,8 +3,10 @@
 // encodes independent of the thread count, the reference decoder and the view-dependent decoder (in
 // order and seeking) giving the same colour, that colour close to the input, and damaged chunks
 // refused with their ids; the same for a HDR capture set (format av1hdr: 10-bit codes of half
-// floats, a curve per cell). With CALF_CONFORMANCE_OUT set it writes the conformance clips
-// av1_pred16m and av1_hdr_pred16m there.
+// floats, a curve per cell), and for both with 4:4:4 pictures (formats av1-444 and av1hdr-444,
+// libaom, the High profile, container 1.5), whose texel-frequency chroma 4:2:0 cannot keep. With
+// CALF_CONFORMANCE_OUT set it writes the conformance clips av1_pred16m, av1_hdr_pred16m,
+// av1_444_pred16m and av1_hdr_444_pred16m there.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -15,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -54,12 +57,14 @@ class Av1Colour : public ::testing::Test {
   void TearDown() override { fs::remove_all(root_); }
 
   // The conformance clip's options: one stream per 16-texel face, a key frame every 2 frames.
-  static encoder::LightfieldEncodeOptions options(uint32_t threads = 1) {
+  // With `chroma444` the 4:4:4 clips' (libaom, cpu-used 6: its preset 10 is out of range).
+  static encoder::LightfieldEncodeOptions options(uint32_t threads = 1, bool chroma444 = false) {
     encoder::LightfieldEncodeOptions o;
     o.colour = encoder::ColourCoding::kAv1;
     o.cell_size = 16;
     o.av1.keyframe_interval = 2;
-    o.av1.preset = 10;
+    o.av1.preset = chroma444 ? 6 : 10;
+    o.av1.chroma444 = chroma444;
     o.threads = threads;
     return o;
   }
@@ -87,7 +92,7 @@ class Av1Colour : public ::testing::Test {
     return std::move(*r);
   }
 
-  void decoders_agree(bool hdr);
+  void decoders_agree(bool hdr, bool chroma444);
 
   fs::path root_;
   SceneSpec spec_{.face = 16, .frames = 5, .views = 2};
@@ -113,6 +118,18 @@ double psnr_log2(const std::vector<float>& a, const std::vector<float>& b) {
   }
   const double mse = se / static_cast<double>(a.size());
   return mse == 0 ? 99 : 10 * std::log10(64.0 / mse);
+}
+
+// seq_profile of the sequence header in a GOP's first unit (AV1 §5.5.1: the header's first 3
+// bits): 0 Main (4:2:0), 1 High (4:4:4). The unit is a temporal delimiter (0x12 0x00) and then the
+// sequence header OBU, its size a LEB128 value.
+int seq_profile(std::span<const uint8_t> unit) {
+  size_t at = 2;
+  if (unit.size() < 4 || ((unit[at] >> 3) & 15) != 1) return -1;
+  ++at;
+  while (at < unit.size() && (unit[at] & 0x80)) ++at;
+  ++at;
+  return at < unit.size() ? unit[at] >> 5 : -1;
 }
 
 TEST_F(Av1Colour, LayoutIsGopChunksWithoutTChunksInA13File) {
@@ -144,8 +161,45 @@ TEST_F(Av1Colour, LayoutIsGopChunksWithoutTChunksInA13File) {
       EXPECT_EQ(unit[1], 0x00);
     }
     EXPECT_EQ((gop->units[0][2] >> 3) & 15, 1);
+    EXPECT_EQ(seq_profile(gop->units[0]), 0);  // Main
   }
   EXPECT_EQ(colour, spec_.views * 6 * 3);
+}
+
+// 4:4:4 pictures: formats av1-444 (LDR) and av1hdr-444 (HDR), a 1.5 file, the same GOP chunks
+// (HDR: headed by the curve), every stream's sequence header the High profile.
+TEST_F(Av1Colour, Chroma444IsTheHighProfileInA15File) {
+  for (const bool hdr : {false, true}) {
+    SCOPED_TRACE(hdr ? "HDR" : "LDR");
+    const std::vector<uint8_t> bytes = encode(options(1, true), hdr);
+    const container::Reader r = open(bytes);
+    EXPECT_EQ(r.header().version_minor, container::kVersionMinorAv1Chroma444);
+    const auto& h = std::get<container::LightfieldTrackHeader>(r.tracks()[0].header);
+    EXPECT_EQ(h.colour_format, static_cast<uint16_t>(hdr ? container::PixelFormat::kAv1HdrChroma444
+                                                         : container::PixelFormat::kAv1Chroma444));
+    EXPECT_EQ(h.flags, hdr ? 1 : 0);
+    uint32_t colour = 0;
+    for (uint32_t id = 0; id < r.chunks().size(); ++id) {
+      const container::ChunkKeys& k = r.chunks()[id].keys;
+      EXPECT_NE(k.stream, static_cast<uint16_t>(LightfieldStream::kTParams));
+      if (k.stream != static_cast<uint16_t>(LightfieldStream::kColour)) continue;
+      ++colour;
+      EXPECT_EQ(k.frame_count, k.first_frame == 4 ? 1u : 2u);
+      auto raw = r.read_chunk(id);
+      ASSERT_TRUE(raw.ok());
+      lf::Av1HdrCurve curve;
+      auto gop = lf::parse_av1_chunk(*raw, k.frame_count, h.colour_format, &curve, "chunk");
+      ASSERT_TRUE(gop.ok()) << gop.status().to_string();
+      ASSERT_EQ(gop->units.size(), k.frame_count);
+      for (const auto& unit : gop->units) {
+        ASSERT_GE(unit.size(), 3u);
+        EXPECT_EQ(unit[0], 0x12);
+        EXPECT_EQ(unit[1], 0x00);
+      }
+      EXPECT_EQ(seq_profile(gop->units[0]), 1);  // High
+    }
+    EXPECT_EQ(colour, spec_.views * 6 * 3);
+  }
 }
 
 TEST_F(Av1Colour, HdrLayoutIsCurveHeadedGopChunksInA14File) {
@@ -181,21 +235,25 @@ TEST_F(Av1Colour, HdrLayoutIsCurveHeadedGopChunksInA14File) {
 }
 
 TEST_F(Av1Colour, EncodeDoesNotDependOnTheThreadCount) {
-  EXPECT_EQ(encode(options(1)), encode(options(2)));
-  EXPECT_EQ(encode(options(1), true), encode(options(2), true));
-}
-
-TEST_F(Av1Colour, DecodersAgreeInOrderAndSeekingAndFollowTheInput) {
-  for (const bool hdr : {false, true}) {
-    SCOPED_TRACE(hdr ? "HDR (av1hdr)" : "LDR (av1)");
-    decoders_agree(hdr);
+  for (const bool chroma444 : {false, true}) {
+    EXPECT_EQ(encode(options(1, chroma444)), encode(options(2, chroma444)));
+    EXPECT_EQ(encode(options(1, chroma444), true), encode(options(2, chroma444), true));
   }
 }
 
-void Av1Colour::decoders_agree(bool hdr) {
+TEST_F(Av1Colour, DecodersAgreeInOrderAndSeekingAndFollowTheInput) {
+  for (const bool chroma444 : {false, true}) {
+    for (const bool hdr : {false, true}) {
+      SCOPED_TRACE(std::string(hdr ? "HDR (av1hdr" : "LDR (av1") + (chroma444 ? "-444)" : ")"));
+      decoders_agree(hdr, chroma444);
+    }
+  }
+}
+
+void Av1Colour::decoders_agree(bool hdr, bool chroma444) {
   SceneSpec spec = spec_;
   spec.hdr = hdr;
-  const std::vector<uint8_t> bytes = encode(options(), hdr);
+  const std::vector<uint8_t> bytes = encode(options(1, chroma444), hdr);
   const container::Reader r = open(bytes);
   auto ref = decoder::LightfieldReference::open(r, 0);
   ASSERT_TRUE(ref.ok()) << ref.status().to_string();
@@ -244,11 +302,13 @@ void Av1Colour::decoders_agree(bool hdr) {
   // The synthetic scene is smooth gradients and a square with hard edges moving across a 16-texel
   // face: 4:2:0 chroma blurs those edges. Measured with SVT-AV1 1.4.1 (preset 10, CRF 32): LDR
   // (PSNR of sRGB bytes) mean 36.44 dB, worst face-frame 25.39 dB; HDR (log2-PSNR) mean 40.73 dB,
-  // worst 25.33 dB. The upper bounds say when the coding got lossless by accident (or the test
-  // compares the decoder with itself).
+  // worst 25.33 dB; with 4:4:4 pictures (libaom 3.6.0, cpu-used 6, CQ level 32) LDR mean
+  // 45.34 dB, worst 35.49 dB, HDR mean 52.47 dB, worst 32.91 dB. The upper bounds say when the
+  // coding got lossless by accident (or the test compares the decoder with itself).
   const double mean = sum / faces;
-  std::printf("AV1 colour (%s) vs input: mean %.2f dB, worst %.2f dB over %d face-frames\n",
-              hdr ? "HDR, log2-PSNR" : "LDR, sRGB PSNR", mean, worst, faces);
+  std::printf("AV1 colour (%s, %s) vs input: mean %.2f dB, worst %.2f dB over %d face-frames\n",
+              hdr ? "HDR, log2-PSNR" : "LDR, sRGB PSNR", chroma444 ? "4:4:4" : "4:2:0", mean, worst,
+              faces);
   EXPECT_GT(mean, 30.0);
   EXPECT_LT(mean, 60.0);
   EXPECT_GT(worst, 20.0);
@@ -257,8 +317,8 @@ void Av1Colour::decoders_agree(bool hdr) {
   EXPECT_TRUE(verified.problems.empty())
       << (verified.problems.empty() ? "" : verified.problems[0].to_string());
   if (const char* out_dir = std::getenv("CALF_CONFORMANCE_OUT")) {
-    std::ofstream(fs::path(out_dir) / (hdr ? "av1_hdr_pred16m.calf" : "av1_pred16m.calf"),
-                  std::ios::binary)
+    const std::string name = std::string(hdr ? "av1_hdr" : "av1") + (chroma444 ? "_444" : "");
+    std::ofstream(fs::path(out_dir) / (name + "_pred16m.calf"), std::ios::binary)
         .write(reinterpret_cast<const char*>(bytes.data()),
                static_cast<std::streamsize>(bytes.size()));
   }
@@ -371,6 +431,102 @@ TEST_F(Av1Colour, HdrCurveOutOfRangeIsRefused) {
   }
 }
 
+// A red / green checkerboard at texel frequency: 4:2:0 keeps one chroma sample per 2 x 2 texels,
+// the mean of two reds and two greens, so no bit rate brings it back; 4:4:4 keeps every texel's.
+TEST_F(Av1Colour, Chroma444KeepsTexelFrequencyColourThat420Loses) {
+  SceneSpec spec = spec_;
+  spec.animated = false;
+  auto checker = [&](uint32_t v, uint32_t f) {
+    capture::ViewFrame vf = testing_support::make_frame(spec, v, f);
+    for (uint32_t face = 0; face < 6; ++face) {
+      for (uint32_t y = 0; y < spec.face; ++y) {
+        for (uint32_t x = 0; x < spec.face; ++x) {
+          const size_t i = vf.texel_index(static_cast<CubeFace>(face), x, y);
+          const bool red = (x + y) % 2 == 0;
+          vf.color[3 * i] = red ? 0.8f : 0.05f;
+          vf.color[3 * i + 1] = red ? 0.05f : 0.8f;
+          vf.color[3 * i + 2] = 0.05f;
+        }
+      }
+    }
+    return vf;
+  };
+  ASSERT_TRUE(testing_support::write_capture(root_ / "checker", spec, checker).ok());
+  auto in = capture::CaptureSetReader::open(root_ / "checker");
+  ASSERT_TRUE(in.ok());
+  double psnr[2] = {0, 0};
+  for (const bool chroma444 : {false, true}) {
+    encoder::LightfieldEncodeOptions o = options(1, chroma444);
+    o.av1.crf = 20;
+    std::vector<uint8_t> bytes;
+    auto writer = container::Writer::create(container::memory_sink(&bytes));
+    ASSERT_TRUE(writer.ok());
+    ASSERT_TRUE(encoder::encode_lightfield(*in, *writer, o).ok());
+    ASSERT_TRUE(writer->finish().ok());
+    const container::Reader r = open(bytes);
+    auto ref = decoder::LightfieldReference::open(r, 0);
+    ASSERT_TRUE(ref.ok()) << ref.status().to_string();
+    decoder::LightfieldFace face;
+    std::vector<float> want, got;
+    for (uint32_t v = 0; v < spec.views; ++v) {
+      const capture::ViewFrame input = checker(v, 1);
+      for (uint32_t f = 0; f < 6; ++f) {
+        ASSERT_TRUE(ref->decode_face(v, f, 1, &face).ok());
+        got.insert(got.end(), face.colour.begin(), face.colour.end());
+        for (uint32_t y = 0; y < spec.face; ++y) {
+          for (uint32_t x = 0; x < spec.face; ++x) {
+            const size_t i = input.texel_index(static_cast<CubeFace>(f), x, y);
+            for (int c = 0; c < 3; ++c) want.push_back(input.color[3 * i + c]);
+          }
+        }
+      }
+    }
+    psnr[chroma444] = psnr_srgb8(want, got);
+  }
+  std::printf("red / green texel checkerboard at CRF 20: 4:2:0 %.2f dB, 4:4:4 %.2f dB\n", psnr[0],
+              psnr[1]);
+  EXPECT_LT(psnr[0], 15.0);
+  EXPECT_GT(psnr[1], 30.0);
+}
+
+// A 4:4:4 stream where the track says 4:2:0, and the reverse: the colour chunk of one cell taken
+// from the other clip decodes, and its picture is refused as not the track's (E302), in one line
+// that names the cell and both layouts.
+TEST_F(Av1Colour, ChromaOtherThanTheTrackSaysIsRefused) {
+  const std::vector<uint8_t> b420 = encode(options(1, false)), b444 = encode(options(1, true));
+  const container::Reader r420 = open(b420), r444 = open(b444);
+  auto chunk_of = [](const container::Reader& r, uint32_t view, uint32_t face) {
+    for (uint32_t id = 0; id < r.chunks().size(); ++id) {
+      const container::ChunkKeys& k = r.chunks()[id].keys;
+      if (k.stream == static_cast<uint16_t>(LightfieldStream::kColour) && k.view == view &&
+          k.face == face && k.first_frame == 0) {
+        return *r.read_chunk(id);
+      }
+    }
+    return std::vector<uint8_t>{};
+  };
+  const std::vector<uint8_t> c420 = chunk_of(r420, 1, 2), c444 = chunk_of(r444, 1, 2);
+  ASSERT_FALSE(c420.empty());
+  ASSERT_FALSE(c444.empty());
+  const auto in420 = with_colour_chunk(r420, 1, 2, [&](std::vector<uint8_t>& raw) { raw = c444; });
+  const auto in444 = with_colour_chunk(r444, 1, 2, [&](std::vector<uint8_t>& raw) { raw = c420; });
+  for (const auto* file : {&in420, &in444}) {
+    const container::Reader damaged = open(*file);
+    const decoder::LightfieldVerifyResult v = decoder::verify_lightfield_track(damaged, 0, true, 4);
+    ASSERT_FALSE(v.problems.empty());
+    const Status& p = v.problems[0];
+    EXPECT_EQ(p.id(), ErrorId::kAv1Picture) << p.to_string();
+    EXPECT_NE(p.message().find("view 1 face 2"), std::string::npos) << p.message();
+    const bool track444 = file == &in444;
+    EXPECT_NE(p.message().find(track444 ? "4:2:0 picture" : "4:4:4 picture"), std::string::npos)
+        << p.message();
+    EXPECT_NE(p.message().find(track444 ? "8-bit 4:4:4 expected" : "8-bit 4:2:0 expected"),
+              std::string::npos)
+        << p.message();
+    EXPECT_EQ(p.to_string().find('\n'), std::string::npos);
+  }
+}
+
 TEST_F(Av1Colour, BadOptionsAreRefused) {
   auto in = capture::CaptureSetReader::open(root_ / "set");
   ASSERT_TRUE(in.ok());
@@ -380,6 +536,12 @@ TEST_F(Av1Colour, BadOptionsAreRefused) {
   o = options();
   o.av1.crf = 64;
   EXPECT_EQ(encoder::analyse_lightfield(*in, o).status().id(), ErrorId::kEncoderOption);
+  // libaom's cpu-used (4:4:4) goes up to 9, SVT-AV1's preset to 13.
+  o = options(1, true);
+  o.av1.preset = 10;
+  EXPECT_EQ(encoder::analyse_lightfield(*in, o).status().id(), ErrorId::kEncoderOption);
+  o.av1.preset = 9;
+  EXPECT_TRUE(encoder::analyse_lightfield(*in, o).ok());
 }
 
 }  // namespace

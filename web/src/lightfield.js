@@ -5,7 +5,7 @@ import { E, CalfError, fail } from './errors.js';
 import { readChunk } from './container.js';
 import { decodeBc1, decodeBc4, decodeBc6h, decodeBc7 } from './bc.js';
 
-export const FORMAT = { none: 0, rgba8: 1, rgba16f: 2, r16: 3, bc1: 4, bc4: 5, bc5: 6, bc6h: 7, bc7: 8, rg8: 9, r16p: 10, r16pm: 11, av1: 12, av1hdr: 13 };
+export const FORMAT = { none: 0, rgba8: 1, rgba16f: 2, r16: 3, bc1: 4, bc4: 5, bc5: 6, bc6h: 7, bc7: 8, rg8: 9, r16p: 10, r16pm: 11, av1: 12, av1hdr: 13, av1_444: 14, av1hdr_444: 15 };
 export const STREAM = { index: 0, colour: 1, depth: 2, material: 3, t: 4, coverage: 5 };
 const COLOUR_FORMATS = [FORMAT.bc1, FORMAT.bc7, FORMAT.bc6h, FORMAT.rgba8, FORMAT.rgba16f];
 const DEPTH_FORMATS = [FORMAT.r16, FORMAT.r16p, FORMAT.r16pm, FORMAT.bc5];
@@ -468,6 +468,12 @@ export async function openLightfield(clip, t) {
   const av1 = h.colour_format === FORMAT.av1 || h.colour_format === FORMAT.av1hdr;
   if (av1 && !clip.codecs.av1) {
     fail(E.lightfieldFormat, `track ${t}: colour format ${h.colour_format} (${h.colour_format === FORMAT.av1 ? 'av1' : 'av1hdr'}): no AV1 decoder here`);
+  }
+  // 4:4:4 AV1 colour (container 1.5, the AV1 High profile) is refused by name: the page decodes
+  // 4:2:0 pictures only (WebCodecs' AV1 Main profile, and the WebAssembly back end's I420 and
+  // I420P10); calf-play plays such a clip.
+  if (h.colour_format === FORMAT.av1_444 || h.colour_format === FORMAT.av1hdr_444) {
+    fail(E.lightfieldFormat, `track ${t}: colour format ${h.colour_format} (${h.colour_format === FORMAT.av1_444 ? 'av1-444' : 'av1hdr-444'}): 4:4:4 AV1 colour (the High profile) is not played here; re-encode with calf-encode --av1-chroma 420`);
   }
   if (!COLOUR_FORMATS.includes(h.colour_format) && !av1) fail(E.lightfieldFormat, `track ${t}: colour format ${h.colour_format}`);
   if (!DEPTH_FORMATS.includes(h.depth_format)) fail(E.lightfieldFormat, `track ${t}: depth format ${h.depth_format}`);

@@ -61,18 +61,24 @@
 namespace calf::encoder {
 
 // Colour format choice; kAuto = BC1 for LDR input (every colour value <= 1), BC6H for HDR.
-// kAv1: per cell one AV1 stream (SPEC §11.1.12): 8-bit 4:2:0 sRGB pictures for LDR input, 10-bit
-// 4:2:0 codes of half floats (format av1hdr) for HDR input.
+// kAv1: per cell one AV1 stream (SPEC §11.1.12): 8-bit sRGB pictures for LDR input, 10-bit codes
+// of half floats (format av1hdr) for HDR input; 4:2:0 by SVT-AV1 or 4:4:4 by libaom
+// (Av1ColourOptions::chroma444, formats av1-444 and av1hdr-444).
 enum class ColourCoding : uint8_t { kAuto, kBc1, kBc7, kBc6h, kRgba8, kRgba16f, kAv1 };
 
-// AV1 colour (ColourCoding::kAv1): SVT-AV1's settings. Each cell's frames are coded as closed
-// GOPs of `keyframe_interval` frames, one fresh single-threaded encoder each, so the bytes never
-// depend on LightfieldEncodeOptions::threads.
+// AV1 colour (ColourCoding::kAv1): the AV1 encoder's settings. Each cell's frames are coded as
+// closed GOPs of `keyframe_interval` frames, one fresh single-threaded encoder each, so the bytes
+// never depend on LightfieldEncodeOptions::threads.
 struct Av1ColourOptions {
-  uint32_t crf = 32;                // constant rate factor 1..63 (lower: better and larger)
-  uint32_t qp = 0;                  // 1..63: a fixed quantiser instead of the CRF; 0 = CRF
-  uint32_t preset = 5;              // SVT-AV1 preset 0..13 (higher: faster, larger)
+  uint32_t crf = 32;    // constant rate factor 1..63 (lower: better and larger); libaom: cq-level
+  uint32_t qp = 0;      // 1..63: a fixed quantiser instead of the CRF; 0 = CRF
+  uint32_t preset = 5;  // SVT-AV1 preset 0..13, or with chroma444 libaom cpu-used 0..9 (higher:
+                        // faster, larger)
   uint32_t keyframe_interval = 30;  // K >= 1: a key frame every K frames, the seek granularity
+  // false: 4:2:0 pictures by SVT-AV1 (formats av1, av1hdr; the Main profile every decoder plays);
+  // true: 4:4:4 pictures by libaom (formats av1-444, av1hdr-444; the High profile, container
+  // 1.5), which keep the per-texel colour 4:2:0 averages away (docs/ENCODER.md "AV1 colour").
+  bool chroma444 = false;
 };
 // kRaw16: log-16 codes as 16-bit planes (SPEC §11.1.6); kRaw16Predicted: the same codes as
 // spatial-prediction residuals (depth format r16p, SPEC §11.1.8), lossless like kRaw16 and

@@ -27,13 +27,18 @@ inline uint16_t av1_hdr_half_bits(Av1HdrCurve c, uint32_t code) {
   return static_cast<uint16_t>(bits < 0x7BFFu ? bits : 0x7BFFu);
 }
 
-// True for the two AV1 colour formats (av1, av1hdr).
+// True for the four AV1 colour formats (av1, av1hdr, av1-444, av1hdr-444).
 bool is_av1_colour(uint16_t colour_format);
+// True for the HDR AV1 colour formats (av1hdr, av1hdr-444): 10-bit codes on a curve, each chunk
+// headed by it.
+bool is_av1_hdr_colour(uint16_t colour_format);
+// True for the AV1 colour formats of 4:4:4 pictures (av1-444, av1hdr-444; container 1.5).
+bool is_av1_chroma444(uint16_t colour_format);
 
-// An AV1 colour chunk of either format: for av1hdr the head's curve (u16 base, u16 shift) is read
-// into `curve` and the GOP after it parsed by parse_av1_gop; for av1 the chunk is the GOP and
-// `curve` keeps its default. Errors: CALF-E067 (kAv1Chunk) as parse_av1_gop, and for an av1hdr
-// chunk shorter than its curve or whose curve has a base above 0x7BFF or a shift above 5.
+// An AV1 colour chunk of any AV1 format: for av1hdr(-444) the head's curve (u16 base, u16 shift)
+// is read into `curve` and the GOP after it parsed by parse_av1_gop; for av1(-444) the chunk is
+// the GOP and `curve` keeps its default. Errors: CALF-E067 (kAv1Chunk) as parse_av1_gop, and for an
+// av1hdr chunk shorter than its curve or whose curve has a base above 0x7BFF or a shift above 5.
 Expected<Av1Gop> parse_av1_chunk(std::span<const uint8_t> raw, uint32_t frame_count,
                                  uint16_t colour_format, Av1HdrCurve* curve,
                                  const std::string& what);

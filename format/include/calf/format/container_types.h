@@ -45,6 +45,10 @@ inline constexpr uint16_t kVersionMinorAv1 = 3;
 // 1.4: a lightfield track may hold HDR AV1 colour (colour format 13), which 1.3 decoders refuse
 // as a colour format they lack; a writer writes minor 4 only for such a file.
 inline constexpr uint16_t kVersionMinorAv1Hdr = 4;
+// 1.5: a lightfield track may hold AV1 colour of 4:4:4 pictures (colour formats 14 and 15, the
+// AV1 High profile), which 1.4 decoders refuse as a colour format they lack; a writer writes
+// minor 5 only for such a file.
+inline constexpr uint16_t kVersionMinorAv1Chroma444 = 5;
 inline constexpr uint64_t kHeaderSize = 64;
 inline constexpr uint64_t kAlignment = 16;  // chunk offsets and the directory offset
 // Must-understand feature bits (SPEC.md "Header"). Bit 0 (1.1): the directory is its body's size
@@ -96,6 +100,8 @@ enum class PixelFormat : uint16_t {
   kR16PredictedMasked = 11,  // depth only: r16p, P-frames' changed texels only (SPEC §11.1.9)
   kAv1 = 12,     // colour only: per cell one AV1 stream in GOP chunks (SPEC §11.1.12); 1.3
   kAv1Hdr = 13,  // colour only: AV1 of 10-bit codes of half floats on a curve (§11.1.12); 1.4
+  kAv1Chroma444 = 14,     // colour only: av1 with 4:4:4 pictures (§11.1.12); 1.5
+  kAv1HdrChroma444 = 15,  // colour only: av1hdr with 4:4:4 pictures (§11.1.12); 1.5
 };
 const char* pixel_format_name(uint16_t format);
 

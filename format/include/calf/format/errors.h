@@ -192,12 +192,12 @@ enum class ErrorKind : uint8_t {
   X(kTilesBudget, 253, kInvalidArgument, "the tile budget cannot cover the view region")        \
   X(kTilesAtlas, 254, kLimit, "the tile textures do not fit the largest atlas")                 \
   X(kEncoderCoverage, 255, kCorrupt, "capture coverage is not whole 1/16 cells of its mask")     \
-  X(kEncoderAv1, 256, kInternal, "the AV1 encoder (SVT-AV1) failed")                            \
+  X(kEncoderAv1, 256, kInternal, "the AV1 encoder (SVT-AV1 or libaom) failed")                  \
   X(kEncoderAv1Input, 257, kInvalidArgument, "reserved (HDR input is coded as av1hdr)")                    \
   /* decoder: 300-399 */                                                                        \
   X(kDecoderArgument, 300, kInvalidArgument, "a decoder option, frame, view or eye is invalid") \
   X(kAv1Decode, 301, kCorrupt, "an AV1 colour stream does not decode")                         \
-  X(kAv1Picture, 302, kCorrupt, "a decoded AV1 picture is not the cell's 8-bit 4:2:0 frame")    \
+  X(kAv1Picture, 302, kCorrupt, "a decoded AV1 picture is not the cell's frame of the track's bit depth and subsampling")\
   /* player: 400-499 */                                                                         \
   X(kPlayerViewSet, 400, kInvalidArgument, "a view's face size or position is invalid")         \
   X(kPlayerRect, 401, kInvalidArgument, "a texture update rect or its source buffer is invalid") \
