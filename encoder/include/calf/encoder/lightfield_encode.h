@@ -100,6 +100,12 @@ struct LightfieldEncodeOptions {
   // (0, 300]; and the factor on each block's measured noise (the part not charged for), [0, 16].
   double noise_psnr_db = 0;
   double noise_factor = kDefaultNoiseFactor;
+  // The temporal pre-filter of render noise on static geometry (calf/encoder/colour_denoise.h):
+  // before any colour coding, each view's texels whose geometry stays put are averaged over a
+  // window of this many frames where the change is one the noise explains; 0 or 1 = off (the
+  // default here; calf-encode turns it on with --psnr auto's noise-aware test), at most 64.
+  // Each block's noise counts at most 8 times noise_psnr_db's when that is set.
+  uint32_t denoise_window = 0;
   ColourCoding colour = ColourCoding::kAuto;
   // The smallest lossless depth; its decode cost against raw16: docs/DECODER.md.
   DepthCoding depth = DepthCoding::kRaw16PredictedMasked;
@@ -168,6 +174,8 @@ struct LightfieldEncodeStats {
   uint64_t depth_regions = 0, depth_keyframes = 0, depth_pframes = 0, depth_empty_pframes = 0;
   uint64_t material_views = 0;
   double min_colour_quality_db = 0;  // lowest temporal quality of any frame of any cell (+inf)
+  // denoise_window > 1: texel-frames whose colour the pre-filter replaced by a temporal mean.
+  uint64_t colour_denoised = 0;
   // BC5 depth only: reconstruction error against the quantised input over every finite texel of
   // every frame, as relative depth error |z' / z - 1|, and texels whose sky-ness changed.
   double depth_max_rel_error = 0, depth_mean_rel_error = 0;
