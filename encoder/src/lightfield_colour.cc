@@ -346,6 +346,8 @@ double psnr_log2(std::span<const float> reference, std::span<const float> test) 
 
 double colour_rdo_lambda(const LightfieldEncodeOptions& options, ColourCoding coding) {
   if (options.colour_rdo != kColourRdoAuto) return options.colour_rdo;
+  if (coding == ColourCoding::kBc6h && options.noise_psnr_db > 0 && options.denoise_window > 1)
+    return kDenoisedBc6hRdo;
   return coding == ColourCoding::kBc1 ? 12.0 : 0.5;
 }
 

@@ -7,6 +7,7 @@
 #include <random>
 #include <vector>
 
+#include "calf/encoder/lightfield_encode.h"
 #include "calf/format/bc.h"
 #include "calf/format/colour.h"
 
@@ -243,6 +244,23 @@ TEST(ColourDenoiseTest, WindowOneAndBadSizes) {
                                             {}, v.frames, kFace, o);
   ASSERT_FALSE(bad.ok());
   EXPECT_EQ(bad.status().id(), ErrorId::kInvalidArgument);
+}
+
+// --colour-rdo auto's BC6H lambda is kDenoisedBc6hRdo only for a capture measured noisy with the
+// pre-filter on: converged content (no noise level) and the other formats keep their defaults.
+TEST(ColourDenoiseTest, RdoStrengthFollowsThePreFilter) {
+  encoder::LightfieldEncodeOptions o;
+  o.denoise_window = 16;
+  EXPECT_EQ(encoder::colour_rdo_lambda(o, encoder::ColourCoding::kBc6h), 0.5);  // no noise level
+  o.noise_psnr_db = 45.7;
+  EXPECT_EQ(encoder::colour_rdo_lambda(o, encoder::ColourCoding::kBc6h), encoder::kDenoisedBc6hRdo);
+  EXPECT_EQ(encoder::colour_rdo_lambda(o, encoder::ColourCoding::kBc7), 0.5);
+  EXPECT_EQ(encoder::colour_rdo_lambda(o, encoder::ColourCoding::kBc1), 12.0);
+  o.denoise_window = 0;
+  EXPECT_EQ(encoder::colour_rdo_lambda(o, encoder::ColourCoding::kBc6h), 0.5);
+  o.denoise_window = 16;
+  o.colour_rdo = 0.25;
+  EXPECT_EQ(encoder::colour_rdo_lambda(o, encoder::ColourCoding::kBc6h), 0.25);
 }
 
 }  // namespace

@@ -232,7 +232,9 @@ void add_options(CLI::App& app, LightfieldOptions& o) {
          "lambda per estimated bit saved; 0 = off, the blocks exactly as the BCn encoder "
          "made them; rgba8 / rgba16f ignore it; auto = 0.5 for BC6H / BC7 (31-69 % fewer "
          "BC6H colour bytes on the built-in scenes for <= 0.02 dB against ground truth) and "
-         "12 for BC1 (32-46 % with the default --bc1-fit, within 0.02 dB) "
+         "12 for BC1 (32-46 % with the default --bc1-fit, within 0.02 dB); 2 for BC6H "
+         "where --psnr auto measures render noise and --denoise-window is on (docs/ENCODER.md "
+         "\"Keyframes and render noise\") "
          "(docs/ENCODER.md; the measurements: git log -p docs/ENCODER.md)")
       ->group(kLightfieldGroup);
   add_enum_option(app, "--bc1-fit", e.bc1_fit, kBc1Fits,
