@@ -13,6 +13,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "calf/encoder/colour_denoise.h"
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/format/av1_hdr_colour.h"
 #include "calf/format/grid.h"
@@ -36,6 +37,10 @@ Status validate_options(const LightfieldEncodeOptions& o) {
   }
   if (!(o.noise_factor >= 0 && o.noise_factor <= 16)) {
     return bad("--psnr-noise-factor " + std::to_string(o.noise_factor) + ": expected [0, 16]");
+  }
+  if (o.denoise_window > kMaxDenoiseWindow) {
+    return bad("--denoise-window " + std::to_string(o.denoise_window) + ": expected [0, " +
+               std::to_string(kMaxDenoiseWindow) + "]");
   }
   if (o.depth_regions_per_side < 1 || o.depth_regions_per_side > 64) {
     return bad("depth regions per side " + std::to_string(o.depth_regions_per_side) +

@@ -37,11 +37,6 @@ void gather_cell_halves(const ViewData& v, uint32_t face, const PixelRect& r, ui
   }
 }
 
-// The noise-aware keyframe test counts a block's own render noise up to this many times the
-// capture's estimate (darker regions are noisier in log2; docs/ENCODER.md "Keyframes and render
-// noise").
-constexpr double kNoiseBlockCap = 8;
-
 // Linear RGB as 8-bit sRGB RGBA (alpha 255): what the LDR formats code.
 std::vector<uint8_t> srgb8_rgba_of(std::span<const float> rgb) {
   const size_t n = rgb.size() / 3;
@@ -351,6 +346,8 @@ double psnr_log2(std::span<const float> reference, std::span<const float> test) 
 
 double colour_rdo_lambda(const LightfieldEncodeOptions& options, ColourCoding coding) {
   if (options.colour_rdo != kColourRdoAuto) return options.colour_rdo;
+  if (coding == ColourCoding::kBc6h && options.noise_psnr_db > 0 && options.denoise_window > 1)
+    return kDenoisedBc6hRdo;
   return coding == ColourCoding::kBc1 ? 12.0 : 0.5;
 }
 

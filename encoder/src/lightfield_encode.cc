@@ -1,5 +1,6 @@
 #include "calf/encoder/lightfield_encode.h"
 
+#include <cmath>
 #include <span>
 #include <string>
 #include <utility>
@@ -9,6 +10,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "calf/encoder/colour_denoise.h"
 #include "calf/format/grid.h"
 #include "calf/format/lightfield_layout.h"
 #include "lightfield_internal.h"
@@ -77,6 +79,7 @@ void add_figures(LightfieldEncodeStats& total, const LightfieldEncodeStats& part
   total.depth_empty_pframes += part.depth_empty_pframes;
   total.material_views += part.material_views;
   total.min_colour_quality_db = std::min(total.min_colour_quality_db, part.min_colour_quality_db);
+  total.colour_denoised += part.colour_denoised;
   total.depth_max_rel_error = std::max(total.depth_max_rel_error, part.depth_max_rel_error);
   total.depth_sum_rel_error += part.depth_sum_rel_error;
   total.depth_finite_texels += part.depth_finite_texels;
@@ -99,6 +102,7 @@ using lightfield_internal::add_figures;
 using lightfield_internal::Context;
 using lightfield_internal::figures_of;
 using lightfield_internal::kInf;
+using lightfield_internal::kNoiseBlockCap;
 using lightfield_internal::Pending;
 using lightfield_internal::read_view;
 using lightfield_internal::RegionStream;
@@ -179,6 +183,21 @@ Expected<LightfieldViewEncoding> encode_lightfield_view_frames(
   CALF_RETURN_IF_ERROR(
       read_view(input, v, analysis.views[v], analysis.coverage, first_frame, frame_count, &view));
   if (view.has_material) stats.material_views += 1;
+  if (options.denoise_window > 1) {
+    // The pre-filter sees the frames of this range only: the range is whole segments, and no
+    // window crosses a segment, so a shard filters its frames as one encode does.
+    StaticDenoiseOptions d;
+    d.window = options.denoise_window;
+    d.log2 = analysis.hdr;
+    if (options.noise_psnr_db > 0)
+      d.max_variance = kNoiseBlockCap * std::pow(10.0, -options.noise_psnr_db / 10.0);
+    d.segment_frames = options.segment_frames;
+    d.threads = options.threads;
+    CALF_ASSIGN_OR_RETURN(const StaticDenoiseStats ds,
+                          denoise_static_colour(view.colour, view.depth, view.material, view.frames,
+                                                view.face_size, d));
+    stats.colour_denoised += ds.averaged;
+  }
 
   // The view's index chunk (SPEC §11.1 "View index chunk").
   lf::ViewIndex vi;

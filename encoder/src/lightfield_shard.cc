@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "calf/capture/capture_shard.h"
+#include "calf/encoder/colour_denoise.h"
 #include "calf/format/clip_metadata.h"
 #include "calf/format/container.h"
 #include "calf/format/container_codec.h"
@@ -36,7 +37,7 @@ constexpr const char* kAnalysisKey = "calf.lightfield_analysis";
 constexpr const char* kAnalysisIdKey = "calf.lightfield_analysis_id";
 constexpr const char* kShardViewsKey = "calf.lightfield_shard_views";
 constexpr const char* kShardFramesKey = "calf.lightfield_shard_frames";  // "first-last"
-constexpr const char* kRecordMagic = "calf-lightfield-analysis 6";
+constexpr const char* kRecordMagic = "calf-lightfield-analysis 7";
 constexpr const char* kRecordMagicPrefix = "calf-lightfield-analysis ";
 
 std::string hex_double(double v) {
@@ -52,16 +53,16 @@ std::string analysis_record(const LightfieldAnalysis& a, const LightfieldEncodeO
   std::ostringstream s;
   s << kRecordMagic << "\n";
   s << "cell " << o.cell_size << "\npsnr " << hex_double(o.min_psnr_db) << "\nnoise_psnr "
-    << hex_double(o.noise_psnr_db) << "\nnoise_factor " << hex_double(o.noise_factor) << "\ncolour "
-    << static_cast<int>(o.colour) << "\ndepth " << static_cast<int>(o.depth) << "\ntiles "
-    << o.depth_regions_per_side << "\nwindow " << o.depth_window << "\naabbs " << o.max_aabbs
-    << "\nkeyframe_interval " << o.depth_keyframe_interval << "\nsupercompression "
-    << static_cast<int>(o.supercompression) << "\nzstd_level " << o.levels.zstd_level
-    << "\nlzma_preset " << o.levels.lzma_preset << "\nsegment_frames " << o.segment_frames
-    << "\nmerge_static_groups " << (o.merge_static_groups ? 1 : 0) << "\ncolour_rdo "
-    << hex_double(o.colour_rdo) << "\nbc1_fit " << static_cast<int>(o.bc1_fit) << "\ncoverage "
-    << (o.coverage ? 1 : 0) << "\nresolved_colour " << static_cast<int>(a.colour) << "\nviews "
-    << a.views.size() << "\n";
+    << hex_double(o.noise_psnr_db) << "\nnoise_factor " << hex_double(o.noise_factor)
+    << "\ndenoise_window " << o.denoise_window << "\ncolour " << static_cast<int>(o.colour)
+    << "\ndepth " << static_cast<int>(o.depth) << "\ntiles " << o.depth_regions_per_side
+    << "\nwindow " << o.depth_window << "\naabbs " << o.max_aabbs << "\nkeyframe_interval "
+    << o.depth_keyframe_interval << "\nsupercompression " << static_cast<int>(o.supercompression)
+    << "\nzstd_level " << o.levels.zstd_level << "\nlzma_preset " << o.levels.lzma_preset
+    << "\nsegment_frames " << o.segment_frames << "\nmerge_static_groups "
+    << (o.merge_static_groups ? 1 : 0) << "\ncolour_rdo " << hex_double(o.colour_rdo)
+    << "\nbc1_fit " << static_cast<int>(o.bc1_fit) << "\ncoverage " << (o.coverage ? 1 : 0)
+    << "\nresolved_colour " << static_cast<int>(a.colour) << "\nviews " << a.views.size() << "\n";
   for (size_t v = 0; v < a.views.size(); ++v) {
     const LightfieldViewFacts& f = a.views[v];
     s << "view " << v << " " << (f.depth_range ? 1 : 0) << " "
@@ -140,6 +141,8 @@ Status parse_record(const std::string& path, const std::string& text, Lightfield
   if (!(in >> key) || key != "noise_factor" || !read_double(in, &o->noise_factor)) {
     return bad_record(path, "noise_factor");
   }
+  if (!field("denoise_window", kMaxDenoiseWindow)) return bad_record(path, "denoise_window");
+  o->denoise_window = static_cast<uint32_t>(x);
   if (!field("colour", static_cast<uint64_t>(ColourCoding::kRgba16f)))
     return bad_record(path, "colour");
   o->colour = static_cast<ColourCoding>(x);

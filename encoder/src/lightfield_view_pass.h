@@ -21,6 +21,11 @@ namespace calf::encoder::lightfield_internal {
 
 inline constexpr double kInf = std::numeric_limits<double>::infinity();
 
+// The noise-aware keyframe test and the pre-filter count a block's own render noise up to this
+// many times the capture's estimate (darker regions are noisier in log2; docs/ENCODER.md
+// "Keyframes and render noise").
+inline constexpr double kNoiseBlockCap = 8;
+
 // ---- Colour conversions (SPEC §11.1: 8-bit colour formats hold sRGB-encoded values) ----
 
 inline uint16_t half_from_colour(float v) {

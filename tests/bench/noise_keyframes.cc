@@ -1,13 +1,16 @@
 // Keyframes and render noise (docs/ENCODER.md "Keyframes and render noise"): encodes a capture
 // set with the colour keyframe threshold Q at 50 dB (calf-encode --psnr 50) and at --psnr auto
-// for each margin and noise factor given (calf/encoder/noise_estimate.h), and prints per encode the
-// colour stream's stored bytes, its keyframes and the PSNR of the decoded colour (every face of
+// for each margin, noise factor and pre-filter window given (calf/encoder/noise_estimate.h,
+// colour_denoise.h; the window applies where --psnr auto turns the noise-aware test on, as
+// calf-encode's --denoise-window auto does), and prints per encode the colour stream's stored
+// bytes, its keyframes, the encode's wall time and the PSNR of the decoded colour (every face of
 // every view and frame, 8-bit sRGB as calf-bench's peers measure it, one MSE over everything)
 // against the input and against a reference capture of the same viewpoints (--reference: the scene
 // rendered converged, ground truth at the capture's own texels). Prints markdown.
 //
 //   bench-noise_keyframes --capture NOISY [--reference CONVERGED] [--margin 4 --margin 6 ...]
-//       [--factor 0 --factor 3 ...] [--threads N]
+//       [--factor 0 --factor 3 ...] [--window 0 --window 4 ...] [--rdo auto --rdo 1 ...]
+//       [--threads N]
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -23,6 +26,7 @@
 
 #include "calf/capture/capture_set.h"
 #include "calf/decoder/lightfield_reference.h"
+#include "calf/encoder/colour_denoise.h"
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/encoder/noise_estimate.h"
 #include "calf/format/colour.h"
@@ -88,6 +92,8 @@ int main(int argc, char** argv) {
   CLI::App app{"bench-noise_keyframes: colour bytes and PSNR at --psnr 50 and --psnr auto"};
   std::string capture_dir, reference_dir;
   std::vector<double> margins, factors;
+  std::vector<uint32_t> windows;
+  std::vector<std::string> rdos;
   uint32_t threads = 0;
   app.add_option("--capture", capture_dir, "the capture set encoded")->required();
   app.add_option("--reference", reference_dir,
@@ -97,10 +103,17 @@ int main(int argc, char** argv) {
                  "default margin)");
   app.add_option("--factor", factors,
                  "--psnr-noise-factor values (repeatable; default: the default factor)");
+  app.add_option("--window", windows,
+                 "--denoise-window values (repeatable; default: the default window; 0 = off)")
+      ->check(CLI::Range(0u, encoder::kMaxDenoiseWindow));
+  app.add_option("--rdo", rdos,
+                 "--colour-rdo values of the --psnr auto encodes (repeatable; default: auto)");
   app.add_option("--threads", threads, "encoder threads, 0 = all cores (default 0)");
   CLI11_PARSE(app, argc, argv);
   if (margins.empty()) margins.push_back(encoder::kDefaultPsnrNoiseMargin);
   if (factors.empty()) factors.push_back(encoder::kDefaultNoiseFactor);
+  if (windows.empty()) windows.push_back(encoder::kDefaultDenoiseWindow);
+  if (rdos.empty()) rdos.push_back("auto");
 
   auto input = capture::CaptureSetReader::open(capture_dir);
   if (!input.ok()) return fail(input.status());
@@ -127,9 +140,10 @@ int main(int argc, char** argv) {
               ref_rgb
                   ? fmt::format("; input vs reference {:.2f} dB", psnr(*in_rgb, *ref_rgb)).c_str()
                   : "");
-  std::printf("| --psnr | Q (dB) | colour bytes | × Q 50 | keyframes | vs input (dB) |%s\n",
-              ref_rgb ? " vs reference (dB) | Δ vs Q 50 (dB) |" : "");
-  std::printf("|---|---:|---:|---:|---:|---:|%s\n", ref_rgb ? "---:|---:|" : "");
+  std::printf(
+      "| --psnr | Q (dB) | colour bytes | × Q 50 | keyframes | encode s | vs input (dB) |%s\n",
+      ref_rgb ? " vs reference (dB) | Δ vs Q 50 (dB) |" : "");
+  std::printf("|---|---:|---:|---:|---:|---:|---:|%s\n", ref_rgb ? "---:|---:|" : "");
   const fs::path clip = fs::temp_directory_path() /
                         fmt::format("bench-noise_keyframes-{}.calf", static_cast<long>(getpid()));
   struct Run {
@@ -137,25 +151,39 @@ int main(int argc, char** argv) {
     double q = 50;
     double noise_db = 0;
     double factor = 0;
+    uint32_t window = 0;
+    double rdo = encoder::kColourRdoAuto;
   };
-  std::vector<Run> runs = {{"50", 50.0, 0, 0}};
+  std::vector<Run> runs = {{"50", 50.0, 0, 0, 0, encoder::kColourRdoAuto}};
   for (const double m : margins) {
     for (const double k : factors) {
-      runs.push_back({fmt::format("auto, margin {:g}, factor {:g}", m, k),
-                      encoder::auto_psnr_db(noise->set, m),
-                      encoder::auto_noise_psnr_db(noise->set, m), k});
+      for (const uint32_t w : windows) {
+        for (const std::string& r : rdos) {
+          const double noise_db = encoder::auto_noise_psnr_db(noise->set, m);
+          const double rdo = r == "auto" ? encoder::kColourRdoAuto : std::stod(r);
+          runs.push_back({fmt::format("auto, margin {:g}, factor {:g}, window {}{}", m, k, w,
+                                      r == "auto" ? std::string() : ", colour-rdo " + r),
+                          encoder::auto_psnr_db(noise->set, m), noise_db, k, noise_db > 0 ? w : 0,
+                          rdo});
+        }
+      }
     }
   }
   uint64_t base_bytes = 0;
   double base_ref = 0;
-  for (const auto& [label, q, noise_db, factor] : runs) {
+  for (const auto& [label, q, noise_db, factor, window, rdo] : runs) {
     encoder::LightfieldEncodeOptions o;
     o.threads = threads;
     o.min_psnr_db = q;
     o.noise_psnr_db = noise_db;
     o.noise_factor = factor;
+    o.denoise_window = window;
+    o.colour_rdo = rdo;
+    const auto e0 = std::chrono::steady_clock::now();
     auto stats = encoder::encode_lightfield_file(capture_dir, clip.string(), o);
     if (!stats.ok()) return fail(stats.status());
+    const double encode_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - e0).count();
     auto out_rgb = clip_srgb(clip);
     if (!out_rgb.ok()) return fail(out_rgb.status());
     const uint64_t bytes = stats->colour.stored;
@@ -163,12 +191,12 @@ int main(int argc, char** argv) {
     const double vs_ref = ref_rgb ? psnr(*ref_rgb, *out_rgb) : NAN;
     if (label == "50") base_ref = vs_ref;
     std::printf(
-        "| %s | %.2f | %llu | %.3f | %llu of %llu | %.2f |", label.c_str(), q,
+        "| %s | %.2f | %llu | %.3f | %llu of %llu | %.2f | %.2f |", label.c_str(), q,
         static_cast<unsigned long long>(bytes),
         static_cast<double>(bytes) / static_cast<double>(base_bytes),
         static_cast<unsigned long long>(stats->colour_keyframes),
         static_cast<unsigned long long>(stats->colour_cells * input->manifest().frame_count),
-        psnr(*in_rgb, *out_rgb));
+        encode_s, psnr(*in_rgb, *out_rgb));
     if (ref_rgb) std::printf(" %.2f | %+.2f |", vs_ref, vs_ref - base_ref);
     std::printf("\n");
     std::fflush(stdout);

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "../scratch_dir.h"
@@ -255,6 +256,80 @@ TEST(LightfieldShardFrames, NoiseAwareShardsEqualOneMachineEncode) {
   const Status m = encoder::merge_lightfield_shards(*a, shards, merged);
   ASSERT_TRUE(m.ok()) << m.to_string();
   EXPECT_TRUE(bytes_of(merged) == bytes_of(one));
+}
+
+// The temporal pre-filter (denoise_window, calf/encoder/colour_denoise.h) on the same noisy
+// capture: the analysis file records the window, and frame-range shards filter each segment as one
+// encode does (no window crosses a segment).
+TEST(LightfieldShardFrames, DenoisedShardsEqualOneMachineEncode) {
+  const fs::path dir = scratch() / "noisy-mirror-box";
+  if (!fs::exists(dir / capture::kManifestFileName)) {
+    auto scene = samples::make_builtin_scene("mirror-box");
+    ASSERT_TRUE(scene.ok()) << scene.status().to_string();
+    samples::CaptureRequest r = tiny_request(*scene, 4);
+    r.render.noise = 0.05f;
+    ASSERT_TRUE(samples::render_capture_set(*scene, r, dir, nullptr).ok());
+  }
+  const fs::path work = scratch() / "denoise-work";
+  fs::create_directories(work);
+  encoder::LightfieldEncodeOptions o;
+  o.threads = 2;
+  o.segment_frames = 2;
+  o.depth_keyframe_interval = 1;
+  o.min_psnr_db = 42.7;
+  o.noise_psnr_db = 45.7;
+  o.noise_factor = 3;
+  o.denoise_window = 4;
+  const std::string one = (work / "one.calf").string();
+  auto stats = encoder::encode_lightfield_file(dir, one, o);
+  ASSERT_TRUE(stats.ok()) << stats.status().to_string();
+  EXPECT_GT(stats->colour_denoised, 0u);
+  encoder::LightfieldEncodeOptions off = o;
+  off.denoise_window = 0;
+  const std::string off_path = (work / "off.calf").string();
+  ASSERT_TRUE(encoder::encode_lightfield_file(dir, off_path, off).ok());
+  EXPECT_FALSE(bytes_of(off_path) == bytes_of(one)) << "the pre-filter changed nothing";
+
+  const std::string a_path = (work / "a.calf").string();
+  ASSERT_TRUE(encoder::write_lightfield_analysis(dir, a_path, o).ok());
+  auto a = encoder::read_lightfield_analysis(a_path);
+  ASSERT_TRUE(a.ok()) << a.status().to_string();
+  EXPECT_EQ(a->options.denoise_window, 4u);
+  std::vector<std::string> shards;
+  ASSERT_NO_FATAL_FAILURE(encode_frame_shards(dir, *a, {2u, 0u}, 1, "d", work, &shards));
+  const std::string merged = (work / "merged.calf").string();
+  const Status m = encoder::merge_lightfield_shards(*a, shards, merged);
+  ASSERT_TRUE(m.ok()) << m.to_string();
+  EXPECT_TRUE(bytes_of(merged) == bytes_of(one));
+
+  // An analysis file of the record version before the window (6) is refused, naming it.
+  auto reader = container::Reader::open(a_path);
+  ASSERT_TRUE(reader.ok());
+  const std::string* record = reader->find_metadata("calf.lightfield_analysis");
+  const std::string* id = reader->find_metadata("calf.lightfield_analysis_id");
+  ASSERT_TRUE(record && id);
+  std::string old = *record;
+  ASSERT_EQ(old.rfind("calf-lightfield-analysis 7\n", 0), 0u);
+  old.replace(0, std::string("calf-lightfield-analysis 7").size(), "calf-lightfield-analysis 6");
+  const size_t line = old.find("denoise_window 4\n");
+  ASSERT_NE(line, std::string::npos);
+  old.erase(line, std::string("denoise_window 4\n").size());
+  const std::string v6 = (work / "v6.calf").string();
+  {
+    auto w = container::Writer::create(v6);
+    ASSERT_TRUE(w.ok());
+    const auto* header = std::get_if<container::LightfieldTrackHeader>(&reader->tracks()[0].header);
+    ASSERT_NE(header, nullptr);
+    ASSERT_TRUE(w->add_track(*header).ok());
+    ASSERT_TRUE(w->set_metadata("calf.lightfield_analysis", old).ok());
+    ASSERT_TRUE(w->set_metadata("calf.lightfield_analysis_id", *id).ok());
+    ASSERT_TRUE(w->finish().ok());
+  }
+  auto refused = encoder::read_lightfield_analysis(v6);
+  ASSERT_FALSE(refused.ok());
+  expect_one_line(refused.status(), ErrorId::kShardFile);
+  EXPECT_NE(refused.status().message().find("record version '6'"), std::string::npos)
+      << refused.status().to_string();
 }
 
 TEST(LightfieldShardErrors, MergeRefusesMissingForeignAndOverlappingShards) {

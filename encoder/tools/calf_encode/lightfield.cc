@@ -45,10 +45,11 @@ inline constexpr EnumTable<ColourCodec, 2> kColourCodecs = {
 inline constexpr EnumTable<bool, 2> kAv1Chroma = {{{"420", false}, {"444", true}}};
 
 // --psnr auto: estimates the render noise of the capture set at `dir` (calf/encoder/
-// noise_estimate.h) and sets o->min_psnr_db from it; prints the estimate and Q unless `quiet`.
-// Returns 0, or the exit status of the error it printed.
-int resolve_auto_psnr(const std::filesystem::path& dir, double margin, bool quiet,
-                      encoder::LightfieldEncodeOptions* o) {
+// noise_estimate.h) and sets o->min_psnr_db from it, and with `denoise_auto` the pre-filter's
+// window (on with the noise-aware test, BC colour only); prints the estimate and Q unless
+// `quiet`. Returns 0, or the exit status of the error it printed.
+int resolve_auto_psnr(const std::filesystem::path& dir, double margin, bool denoise_auto,
+                      bool quiet, encoder::LightfieldEncodeOptions* o) {
   if (Status s = encoder::check_lightfield_options(*o); !s.ok()) return fail(s);
   const auto t0 = std::chrono::steady_clock::now();
   auto input = capture::CaptureSetReader::open(dir, o->max_image_pixels);
@@ -60,6 +61,11 @@ int resolve_auto_psnr(const std::filesystem::path& dir, double margin, bool quie
   if (!noise.ok()) return fail(noise.status());
   o->min_psnr_db = encoder::auto_psnr_db(noise->set, margin);
   o->noise_psnr_db = encoder::auto_noise_psnr_db(noise->set, margin);
+  if (denoise_auto) {
+    o->denoise_window = o->noise_psnr_db > 0 && o->colour != encoder::ColourCoding::kAv1
+                            ? encoder::kDefaultDenoiseWindow
+                            : 0;
+  }
   if (quiet) return 0;
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -79,15 +85,18 @@ int resolve_auto_psnr(const std::filesystem::path& dir, double margin, bool quie
   }
   const std::string views =
       lo <= hi ? fmt::format("views {:.2f}-{:.2f}; ", lo, hi) : std::string("no view alone; ");
-  std::fprintf(stderr,
-               "calf-encode: colour noise %.2f dB %s (%s%llu samples of frame-to-frame change on "
-               "static geometry, %.2f s); --psnr auto: Q = %.2f dB (min(50, estimate - margin "
-               "%g))%s\n",
-               *noise->set.psnr_db, metric, views.c_str(),
-               static_cast<unsigned long long>(noise->set.samples), seconds, o->min_psnr_db, margin,
-               o->noise_psnr_db > 0
-                   ? fmt::format(", noise-aware (factor {:g})", o->noise_factor).c_str()
-                   : "");
+  std::fprintf(
+      stderr,
+      "calf-encode: colour noise %.2f dB %s (%s%llu samples of frame-to-frame change on "
+      "static geometry, %.2f s); --psnr auto: Q = %.2f dB (min(50, estimate - margin "
+      "%g))%s%s\n",
+      *noise->set.psnr_db, metric, views.c_str(),
+      static_cast<unsigned long long>(noise->set.samples), seconds, o->min_psnr_db, margin,
+      o->noise_psnr_db > 0 ? fmt::format(", noise-aware (factor {:g})", o->noise_factor).c_str()
+                           : "",
+      o->denoise_window > 1
+          ? fmt::format(", static texels averaged over {} frames", o->denoise_window).c_str()
+          : "");
   return 0;
 }
 
@@ -181,6 +190,16 @@ void add_options(CLI::App& app, LightfieldOptions& o) {
                  "error, 0..16 (0: the plain test)")
       ->check(CLI::Range(0.0, 16.0))
       ->group(kLightfieldGroup);
+  app.add_option("--denoise-window", o.denoise_window,
+                 "temporal pre-filter of render noise: before colour coding, each texel on static "
+                 "geometry (depth and material unchanged) takes the mean of up to W frames around "
+                 "it where its change, at the texel and over its 3 x 3 neighbourhood, is within "
+                 "3 standard deviations of its 8 x 8 block's measured frame-to-frame noise; "
+                 "0..64 (0 or 1: off) or auto: " +
+                     std::to_string(encoder::kDefaultDenoiseWindow) +
+                     " where --psnr auto finds render noise (Q below 50, BC colour), else off "
+                     "(docs/ENCODER.md \"Keyframes and render noise\")")
+      ->group(kLightfieldGroup);
   add_enum_option(app, "--colour-format,--color-format", e.colour, kColourFormats,
                   "auto (BC1 for LDR input, BC6H for HDR), bc1, bc7, bc6h, rgba8, rgba16f")
       ->group(kLightfieldGroup);
@@ -227,7 +246,9 @@ void add_options(CLI::App& app, LightfieldOptions& o) {
          "lambda per estimated bit saved; 0 = off, the blocks exactly as the BCn encoder "
          "made them; rgba8 / rgba16f ignore it; auto = 0.5 for BC6H / BC7 (31-69 % fewer "
          "BC6H colour bytes on the built-in scenes for <= 0.02 dB against ground truth) and "
-         "12 for BC1 (32-46 % with the default --bc1-fit, within 0.02 dB) "
+         "12 for BC1 (32-46 % with the default --bc1-fit, within 0.02 dB); 2 for BC6H "
+         "where --psnr auto measures render noise and --denoise-window is on (docs/ENCODER.md "
+         "\"Keyframes and render noise\") "
          "(docs/ENCODER.md; the measurements: git log -p docs/ENCODER.md)")
       ->group(kLightfieldGroup);
   add_enum_option(app, "--bc1-fit", e.bc1_fit, kBc1Fits,
@@ -254,6 +275,17 @@ int resolve(const CLI::App& app, const CommonOptions& common, LightfieldOptions*
       return usage_error("calf-encode", "--colour-rdo " + lf.colour_rdo +
                                             ": expected a number in [0, 1e6] or auto");
     }
+  }
+  if (lf.denoise_window != "auto") {
+    char* end = nullptr;
+    const unsigned long w = std::strtoul(lf.denoise_window.c_str(), &end, 10);
+    if (lf.denoise_window.empty() || *end != '\0' || lf.denoise_window[0] == '-' ||
+        w > encoder::kMaxDenoiseWindow) {
+      return usage_error("calf-encode",
+                         "--denoise-window " + lf.denoise_window + ": expected a number in [0, " +
+                             std::to_string(encoder::kMaxDenoiseWindow) + "] or auto");
+    }
+    o.denoise_window = static_cast<uint32_t>(w);
   }
   if (lf.psnr != "auto") {
     char* end = nullptr;
@@ -311,7 +343,9 @@ int run(const CommonOptions& common, const LightfieldOptions& options) {
   if (options.psnr == "auto" && shard.analysis.empty()) {
     // Q from the capture's render noise, decided before pass 1 so that an analysis file records
     // the number and its shards code with it.
-    if (int rc = resolve_auto_psnr(dir, options.psnr_noise_margin, common.quiet, &o); rc != 0)
+    if (int rc = resolve_auto_psnr(dir, options.psnr_noise_margin, options.denoise_window == "auto",
+                                   common.quiet, &o);
+        rc != 0)
       return rc;
   }
   if (shard.analysis_only) return run_analysis(common, dir, o);
@@ -365,6 +399,11 @@ int run(const CommonOptions& common, const LightfieldOptions& options) {
                static_cast<unsigned long long>(stats->colour_keyframes),
                stats->min_colour_quality_db, static_cast<unsigned long long>(stats->depth_pframes),
                static_cast<unsigned long long>(stats->depth_empty_pframes));
+  if (o.denoise_window > 1) {
+    std::fprintf(stderr, "  denoise: %llu of %llu texel-frames averaged over up to %u frames\n",
+                 static_cast<unsigned long long>(stats->colour_denoised),
+                 static_cast<unsigned long long>(stats->depth.raw / 2), o.denoise_window);
+  }
   if (o.depth == encoder::DepthCoding::kBc5) {
     std::fprintf(stderr,
                  "  BC5 depth error: max relative %.3g, mean relative %.3g, sky mismatches %llu\n",

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "calf/encoder/colour_denoise.h"
 #include "calf/encoder/lightfield_encode.h"
 #include "calf/encoder/noise_estimate.h"
 #include "calf_encode/analysis.h"
@@ -21,6 +22,9 @@ struct LightfieldOptions {
   encoder::LightfieldEncodeOptions encode;
   std::string psnr = "auto";  // Q in dB, or "auto" (from the capture's render noise)
   double psnr_noise_margin = encoder::kDefaultPsnrNoiseMargin;
+  // The pre-filter's window, or "auto" (encoder::kDefaultDenoiseWindow where --psnr auto turns
+  // the noise-aware test on with BC colour, else off).
+  std::string denoise_window = "auto";
   std::string colour_rdo = "auto";  // lambda, or "auto" (each colour format's measured default)
   ColourCodec colour_codec = ColourCodec::kBc;
   bool no_coverage = false;

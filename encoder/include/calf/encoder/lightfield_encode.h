@@ -94,6 +94,11 @@ enum class Bc1Fit : uint8_t { kRange, kRefined, kCluster };
 // LightfieldEncodeOptions::colour_rdo's "auto": the measured default of each colour format
 // (colour_rdo_lambda).
 inline constexpr double kColourRdoAuto = -1;
+// kColourRdoAuto's lambda for BC6H colour of a capture measured noisy (noise_psnr_db > 0) with the
+// pre-filter on (denoise_window > 1): what is left of the noise costs BC6H blocks their
+// neighbours' bytes, and the filter's gain against the converged render pays for it
+// (docs/ENCODER.md "Keyframes and render noise").
+inline constexpr double kDenoisedBc6hRdo = 2;
 // LightfieldEncodeOptions::noise_factor's default (docs/ENCODER.md "Keyframes and render noise").
 inline constexpr double kDefaultNoiseFactor = 3;
 
@@ -106,6 +111,12 @@ struct LightfieldEncodeOptions {
   // (0, 300]; and the factor on each block's measured noise (the part not charged for), [0, 16].
   double noise_psnr_db = 0;
   double noise_factor = kDefaultNoiseFactor;
+  // The temporal pre-filter of render noise on static geometry (calf/encoder/colour_denoise.h):
+  // before any colour coding, each view's texels whose geometry stays put are averaged over a
+  // window of this many frames where the change is one the noise explains; 0 or 1 = off (the
+  // default here; calf-encode turns it on with --psnr auto's noise-aware test), at most 64.
+  // Each block's noise counts at most 8 times noise_psnr_db's when that is set.
+  uint32_t denoise_window = 0;
   ColourCoding colour = ColourCoding::kAuto;
   // The smallest lossless depth; its decode cost against raw16: docs/DECODER.md.
   DepthCoding depth = DepthCoding::kRaw16PredictedMasked;
@@ -133,7 +144,8 @@ struct LightfieldEncodeOptions {
   // bit saved, [0, 1e6]; 0 = off (the blocks as the BCn encoder made them). BC1, BC6H and BC7
   // keyframes; rgba8 / rgba16f ignore it. Applied to the keyframes after the
   // keyframe search. kColourRdoAuto (the default): 0.5 for BC6H / BC7, 12 for BC1, each chosen
-  // by measurement (docs/ENCODER.md "Colour RDO", "BC1 fit"); see colour_rdo_lambda.
+  // by measurement (docs/ENCODER.md "Colour RDO", "BC1 fit"), and kDenoisedBc6hRdo for BC6H of a
+  // noisy capture with the pre-filter on; see colour_rdo_lambda.
   double colour_rdo = kColourRdoAuto;
   // BC1 colour only: the block fit (above). Cluster fit by default: with the BC1
   // RDO at its default it is what keeps LDR content within 0.05 dB of --colour-rdo 0
@@ -174,6 +186,8 @@ struct LightfieldEncodeStats {
   uint64_t depth_regions = 0, depth_keyframes = 0, depth_pframes = 0, depth_empty_pframes = 0;
   uint64_t material_views = 0;
   double min_colour_quality_db = 0;  // lowest temporal quality of any frame of any cell (+inf)
+  // denoise_window > 1: texel-frames whose colour the pre-filter replaced by a temporal mean.
+  uint64_t colour_denoised = 0;
   // BC5 depth only: reconstruction error against the quantised input over every finite texel of
   // every frame, as relative depth error |z' / z - 1|, and texels whose sky-ness changed.
   double depth_max_rel_error = 0, depth_mean_rel_error = 0;
@@ -323,7 +337,8 @@ Expected<LightfieldEncodeStats> encode_lightfield_file(const std::filesystem::pa
 
 // The RDO lambda an encode uses for colour coded as `coding` (kBc1 / kBc6h / kBc7; the resolved
 // format, not kAuto): options.colour_rdo, or, when that is kColourRdoAuto, the format's default
-// (BC1 12, BC6H and BC7 0.5). BC1's differs because a BC1 candidate saves at most 30 estimated
+// (BC1 12, BC6H and BC7 0.5; BC6H kDenoisedBc6hRdo when noise_psnr_db > 0 and denoise_window > 1).
+// BC1's differs because a BC1 candidate saves at most 30 estimated
 // bits where a BC6H / BC7 one saves 104, so the same lambda buys far fewer bytes (at 0.5: BC1
 // 10-27 % of its colour bytes, BC6H 31-69 %, docs/ENCODER.md).
 double colour_rdo_lambda(const LightfieldEncodeOptions& options, ColourCoding coding);
