@@ -216,18 +216,22 @@ TEST(LightfieldShardFrames, FrameRangeShardsEqualSegmentedEncode) {
   EXPECT_FALSE(fs::exists(work / "x.calf"));
 }
 
+// A 4-frame mirror-box capture with per-frame render noise in `dir`, unless one is there.
+void make_noisy_mirror_box(const fs::path& dir) {
+  if (fs::exists(dir / capture::kManifestFileName)) return;
+  auto scene = samples::make_builtin_scene("mirror-box");
+  ASSERT_TRUE(scene.ok()) << scene.status().to_string();
+  samples::CaptureRequest r = tiny_request(*scene, 4);
+  r.render.noise = 0.05f;
+  ASSERT_TRUE(samples::render_capture_set(*scene, r, dir, nullptr).ok());
+}
+
 // The noise-aware keyframe test (--psnr auto on a capture with per-frame render noise): the
 // analysis file records the noise estimate and factor, and frame-range shards code each segment's
 // cells as one encode does (each segment measures its own cells' noise).
 TEST(LightfieldShardFrames, NoiseAwareShardsEqualOneMachineEncode) {
   const fs::path dir = scratch() / "noisy-mirror-box";
-  if (!fs::exists(dir / capture::kManifestFileName)) {
-    auto scene = samples::make_builtin_scene("mirror-box");
-    ASSERT_TRUE(scene.ok()) << scene.status().to_string();
-    samples::CaptureRequest r = tiny_request(*scene, 4);
-    r.render.noise = 0.05f;
-    ASSERT_TRUE(samples::render_capture_set(*scene, r, dir, nullptr).ok());
-  }
+  ASSERT_NO_FATAL_FAILURE(make_noisy_mirror_box(dir));
   const fs::path work = scratch() / "noisy-work";
   fs::create_directories(work);
   encoder::LightfieldEncodeOptions o;
@@ -263,13 +267,7 @@ TEST(LightfieldShardFrames, NoiseAwareShardsEqualOneMachineEncode) {
 // encode does (no window crosses a segment).
 TEST(LightfieldShardFrames, DenoisedShardsEqualOneMachineEncode) {
   const fs::path dir = scratch() / "noisy-mirror-box";
-  if (!fs::exists(dir / capture::kManifestFileName)) {
-    auto scene = samples::make_builtin_scene("mirror-box");
-    ASSERT_TRUE(scene.ok()) << scene.status().to_string();
-    samples::CaptureRequest r = tiny_request(*scene, 4);
-    r.render.noise = 0.05f;
-    ASSERT_TRUE(samples::render_capture_set(*scene, r, dir, nullptr).ok());
-  }
+  ASSERT_NO_FATAL_FAILURE(make_noisy_mirror_box(dir));
   const fs::path work = scratch() / "denoise-work";
   fs::create_directories(work);
   encoder::LightfieldEncodeOptions o;
