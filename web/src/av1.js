@@ -1,19 +1,23 @@
 // AV1 colour (format/SPEC.md §11.1.12) through one interface, `picture()`, with two back ends:
 // the browser's own WebCodecs `VideoDecoder` where it decodes AV1, else libav.js's av1-opus
-// variant (libaom's decoder in WebAssembly: node, or a browser without AV1 in WebCodecs). One
+// variant (libaom's decoder in WebAssembly: node, or a browser without AV1 in WebCodecs, or
+// whose WebCodecs does not take the stream's profile: 4:4:4 is AV1's High profile). One
 // decoder per colour cell, as the native decoder keeps (decoder/src/lightfield_decoder.cc,
 // update_cell_av1): within the GOP chunk serving a frame, decoding goes on from the frame the
 // cell's decoder last gave when that lies before it (playback: one unit per frame), else it
 // restarts at the chunk's key frame (a seek: at most the keyframe interval of units). Pictures
-// come back as their planes (8-bit samples for av1, 16-bit for av1hdr's 10-bit ones);
-// lightfield.js converts them with SPEC's integer formulas. Errors are the native decoder's: a unit the decoder refuses, or one that
+// come back as their planes (8-bit samples for av1 and av1-444, 16-bit for the 10-bit ones of
+// av1hdr and av1hdr-444; 4:2:0 or 4:4:4 as the stream codes them); lightfield.js converts them
+// with SPEC's integer formulas. Errors are the native decoder's: a unit the decoder refuses, or one that
 // gives no picture or more than one, CALF-E301; the picture's checks (CALF-E302) are
 // lightfield.js's.
 import { E, fail } from './errors.js';
 
-// The codec strings of AV1 Main profile, 8 bits (av1) and 10 bits (av1hdr), 4:2:0; the level is
-// advisory to a software decoder.
-const CODEC = { 8: 'av01.0.04M.08', 10: 'av01.0.04M.10' };
+// The codec strings by bits and chroma: the AV1 Main profile (0) for 4:2:0 (av1, av1hdr), the
+// High profile (1) for 4:4:4 (av1-444, av1hdr-444); 8 or 10 bits. The level (04: 3.0) and tier
+// are advisory to a software decoder.
+const CODEC = { '8/420': 'av01.0.04M.08', '10/420': 'av01.0.04M.10', '8/444': 'av01.1.04M.08', '10/444': 'av01.1.04M.10' };
+const config = (bits, chroma444) => `${bits}/${chroma444 ? 444 : 420}`;
 // Open decoders kept at most: above it the least recently used one is closed (its cell restarts
 // from its chunk's key frame when it is next needed).
 const MAX_DECODERS = 96;
@@ -22,18 +26,23 @@ const MAX_DECODERS = 96;
 // restarts from the key frame). Only speed depends on it, never a result.
 const WAIT_MS = 1000;
 
-// The AV1 decoders of `codecs.av1` over `api` ({ VideoDecoder, EncodedVideoChunk }: this
-// JavaScript's own WebCodecs by default) when its VideoDecoder takes AV1, else null.
-export async function webCodecsAv1(api = globalThis) {
-  const VD = api.VideoDecoder;
-  if (typeof VD !== 'function' || typeof api.EncodedVideoChunk !== 'function') return null;
+// Whether `api`'s VideoDecoder takes the codec string of `key` (CODEC's keys).
+async function takes(api, key) {
   try {
-    const s = await VD.isConfigSupported({ codec: CODEC[8], optimizeForLatency: true });
-    if (!s.supported) return null;
+    return (await api.VideoDecoder.isConfigSupported({ codec: CODEC[key], optimizeForLatency: true })).supported === true;
   } catch {
-    return null;
+    return false;
   }
-  return makeAv1Decoders(api);
+}
+
+// The AV1 decoders of `codecs.av1` over `api` ({ VideoDecoder, EncodedVideoChunk }: this
+// JavaScript's own WebCodecs by default) when its VideoDecoder takes AV1 (the Main profile,
+// 8 bits), else null. A stream of a profile it does not take (4:4:4, the High profile, where
+// isConfigSupported says no) goes to `fallback` (wasmAv1's decoders) when given.
+export async function webCodecsAv1(api = globalThis, fallback = null) {
+  if (typeof api.VideoDecoder !== 'function' || typeof api.EncodedVideoChunk !== 'function') return null;
+  if (!(await takes(api, '8/420'))) return null;
+  return makeAv1Decoders(api, fallback);
 }
 
 // The AV1 decoders of `codecs.av1` where WebCodecs has none: libav.js's av1-opus variant (libaom's
@@ -48,6 +57,7 @@ export function wasmAv1(load) {
   }));
   let loaded = null;
   return {
+    backEnd: async () => 'WebAssembly',
     picture: async (...args) => (loaded = await get()).picture(...args),
     release: (prefix) => loaded?.release(prefix),
     open: () => loaded?.open() ?? 0,
@@ -55,8 +65,12 @@ export function wasmAv1(load) {
   };
 }
 
-// libav's pixel formats of the pictures SPEC allows: 8-bit and 10-bit (little-endian) 4:2:0.
-const LIBAV_FORMATS = { 0: 'I420', 62: 'I420P10' };
+// libav's pixel formats (AVPixelFormat of the libav.js build: YUV420P, YUV444P, YUV420P10LE,
+// YUV444P10LE) of the pictures SPEC allows, by WebCodecs' names.
+const LIBAV_FORMATS = { 0: 'I420', 5: 'I444', 62: 'I420P10', 68: 'I444P10' };
+// Bytes a sample and whether chroma is halved both ways, by picture format.
+const SAMPLE_BYTES = { I420: 1, I420P10: 2, I444: 1, I444P10: 2 };
+const HALVED = { I420: true, I420P10: true, I444: false, I444P10: false };
 
 // makeAv1Decoders' interface over a libav.js instance: one libaom decoder context per cell, fed
 // the units in order (each gives its picture at once); the same restarts and errors.
@@ -108,20 +122,21 @@ export function makeLibavDecoders(libav) {
     queue = p.catch(() => {});
     return p;
   }
-  return { picture, ...housekeeping(cells, drop) };
+  return { picture, backEnd: async () => 'WebAssembly', ...housekeeping(cells, drop) };
 }
 
 // A libav.js frame (one byte array, its planes at layout's offsets and strides) as av1.js's
-// picture: 8-bit samples for YUV420P, 16-bit for YUV420P10LE; another format has no planes.
+// picture: 8-bit samples for YUV420P and YUV444P, 16-bit for YUV420P10LE and YUV444P10LE;
+// another format has no planes.
 function libavPicture(f) {
   const format = LIBAV_FORMATS[f.format] ?? `libav pixel format ${f.format}`;
   const crop = f.crop ?? { left: 0, right: 0, top: 0, bottom: 0 };
   const width = f.width - crop.left - crop.right, height = f.height - crop.top - crop.bottom;
   const out = { format, width, height, planes: null, strides: null };
-  const bytes = { I420: 1, I420P10: 2 }[format];
+  const bytes = SAMPLE_BYTES[format];
   if (!bytes || crop.left || crop.top) return out;
   out.planes = f.layout.slice(0, 3).map((l, k) => {
-    const n = l.stride * (k ? Math.ceil(f.height / 2) : f.height);
+    const n = l.stride * (k && HALVED[format] ? Math.ceil(f.height / 2) : f.height);
     return samples(f.data.slice(l.offset, l.offset + n), bytes);
   });
   out.strides = f.layout.slice(0, 3).map((l) => l.stride / bytes);
@@ -135,12 +150,24 @@ function samples(b, bytes) {
   return Uint16Array.from({ length: b.length >> 1 }, (_, j) => b[2 * j] | (b[2 * j + 1] << 8));
 }
 
-// { picture(key, chunk, units, i, what, bits) }: the picture of unit i of GOP chunk `chunk`
-// ({ id, firstFrame }) whose temporal units are `units`, for the cell named `key`, from a stream
-// of `bits` (8 or 10) per sample; resolves to { format, width, height, planes: [y, u, v],
-// strides: [y, u, v] } (copies, in samples; the VideoFrame is closed) or throws CALF-E301.
-// `release`, `close` and `open` below (housekeeping).
-export function makeAv1Decoders(api = globalThis) {
+// { picture(key, chunk, units, i, what, bits, chroma444) }: the picture of unit i of GOP chunk
+// `chunk` ({ id, firstFrame }) whose temporal units are `units`, for the cell named `key`, from a
+// stream of `bits` (8 or 10) per sample, 4:4:4 (the High profile) when `chroma444`, else 4:2:0;
+// resolves to { format, width, height, planes: [y, u, v], strides: [y, u, v] } (copies, in
+// samples; the VideoFrame is closed) or throws CALF-E301. `backEnd(bits, chroma444)` resolves to
+// 'WebCodecs' where VideoDecoder.isConfigSupported takes the profile's codec string, else to
+// `fallback`'s ('WebAssembly'), which then decodes those streams, else to null. `release`,
+// `close` and `open` below (housekeeping), over both.
+export function makeAv1Decoders(api = globalThis, fallback = null) {
+  const supported = new Map();  // CODEC key -> Promise<boolean>
+  const own = (key) => {
+    if (!supported.has(key)) supported.set(key, takes(api, key));
+    return supported.get(key);
+  };
+  async function backEnd(bits, chroma444) {
+    if (await own(config(bits, chroma444))) return 'WebCodecs';
+    return fallback ? fallback.backEnd(bits, chroma444) : null;
+  }
   const cells = new Map();  // key -> state, in least recently used order
   const drop = (key) => {
     const s = cells.get(key);
@@ -149,10 +176,10 @@ export function makeAv1Decoders(api = globalThis) {
     if (s.decoder.state !== 'closed') s.decoder.close();
     for (const w of s.waiters.values()) w.reject(null);
   };
-  function open(key, chunkId, bits) {
+  function open(key, chunkId, codec) {
     drop(key);
     while (cells.size >= MAX_DECODERS) drop(cells.keys().next().value);
-    const s = { chunkId, bits, next: 0, pictures: new Map(), counts: new Map(), waiters: new Map(), error: null, flushed: false, decoder: null };
+    const s = { chunkId, codec, next: 0, pictures: new Map(), counts: new Map(), waiters: new Map(), error: null, flushed: false, decoder: null };
     s.decoder = new api.VideoDecoder({
       output: (frame) => {
         const ts = frame.timestamp;
@@ -171,14 +198,19 @@ export function makeAv1Decoders(api = globalThis) {
         for (const w of s.waiters.values()) w.resolve();
       },
     });
-    s.decoder.configure({ codec: CODEC[bits], optimizeForLatency: true });
+    s.decoder.configure({ codec: CODEC[codec], optimizeForLatency: true });
     cells.set(key, s);
     return s;
   }
-  async function picture(key, chunk, units, i, what, bits = 8) {
+  async function picture(key, chunk, units, i, what, bits = 8, chroma444 = false) {
+    const codec = config(bits, chroma444);
+    if (!(await own(codec))) {
+      if (!fallback) fail(E.lightfieldFormat, `${what}: no AV1 decoder here for ${PROFILE[codec]}: VideoDecoder does not take ${CODEC[codec]}`);
+      return fallback.picture(key, chunk, units, i, what, bits, chroma444);
+    }
     let s = cells.get(key);
     if (s) { cells.delete(key); cells.set(key, s); }  // most recently used
-    if (!s || s.chunkId !== chunk.id || s.bits !== bits || s.next > i || s.flushed || s.error) s = open(key, chunk.id, bits);
+    if (!s || s.chunkId !== chunk.id || s.codec !== codec || s.next > i || s.flushed || s.error) s = open(key, chunk.id, codec);
     const ts = chunk.firstFrame + i;
     const bad = (why) => { drop(key); fail(E.av1Decode, `${what} frame ${ts}: ${why}`); };
     for (; s.next <= i; ++s.next) {
@@ -210,32 +242,37 @@ export function makeAv1Decoders(api = globalThis) {
     for (const k of [...s.pictures.keys()]) if (k < ts) s.pictures.delete(k);
     return p;
   }
-  return { picture, ...housekeeping(cells, drop) };
+  return { picture, backEnd, ...housekeeping(cells, drop, fallback) };
 }
+
+// The profiles by CODEC key, as lines name them.
+export const PROFILE = { '8/420': 'the Main profile, 8-bit 4:2:0', '10/420': 'the Main profile, 10-bit 4:2:0',
+  '8/444': 'the High profile, 8-bit 4:4:4', '10/444': 'the High profile, 10-bit 4:4:4' };
 
 // The decoders' housekeeping: `release(prefix)` closes the decoders of the cells whose keys
 // start with it (a track that is closed: lightfield.js's closeLightfield), `close()` every one,
-// `open()` counts those open.
-function housekeeping(cells, drop) {
+// `open()` counts those open; each also over `fallback`'s.
+function housekeeping(cells, drop, fallback = null) {
   return {
-    release: (prefix) => { for (const k of [...cells.keys()]) if (k.startsWith(prefix)) drop(k); },
-    close: () => { for (const k of [...cells.keys()]) drop(k); },
-    open: () => cells.size,
+    release: (prefix) => { for (const k of [...cells.keys()]) if (k.startsWith(prefix)) drop(k); fallback?.release(prefix); },
+    close: () => { for (const k of [...cells.keys()]) drop(k); fallback?.close(); },
+    open: () => cells.size + (fallback?.open() ?? 0),
   };
 }
 
-// A VideoFrame's visible picture as its planes, then the frame closed (I420: Y, U, V of 8-bit
-// samples; I420P10: of 16-bit little-endian samples, as Uint16Arrays; another format resolves
-// with no planes, for lightfield.js to refuse).
+// A VideoFrame's visible picture as its planes, then the frame closed (I420, I444: Y, U, V of
+// 8-bit samples; I420P10, I444P10: of 16-bit little-endian samples, as Uint16Arrays; another
+// format resolves with no planes, for lightfield.js to refuse).
 async function copyFrame(frame) {
   const { width, height } = frame.visibleRect;
   const out = { format: frame.format, width, height, planes: null, strides: null };
   try {
-    const bytes = { I420: 1, I420P10: 2 }[frame.format];
+    const bytes = SAMPLE_BYTES[frame.format];
     if (!bytes) return out;
     const buffer = new Uint8Array(frame.allocationSize());
     const layout = await frame.copyTo(buffer);
-    out.planes = layout.map((l, k) => samples(buffer.slice(l.offset, l.offset + l.stride * (k ? Math.ceil(height / 2) : height)), bytes));
+    const rows = (k) => (k && HALVED[frame.format] ? Math.ceil(height / 2) : height);
+    out.planes = layout.map((l, k) => samples(buffer.slice(l.offset, l.offset + l.stride * rows(k)), bytes));
     out.strides = layout.map((l) => l.stride / bytes);
     return out;
   } finally {

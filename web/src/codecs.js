@@ -7,8 +7,11 @@ import { webCodecsAv1, wasmAv1 } from './av1.js';
 
 // `av1` (AV1 colour, SPEC §11.1.12; av1.js) is the browser's WebCodecs decoder where it takes AV1
 // (unless `av1Wasm` comes with `preferWasm`), else the WebAssembly one over the libav.js instance
-// that `av1Wasm()` resolves to, else null (the track is refused with CALF-E203).
+// that `av1Wasm()` resolves to, else null (the track is refused with CALF-E203). A stream of a
+// profile that WebCodecs does not take (isConfigSupported: the High profile of 4:4:4 colour, as
+// a rule) goes to the WebAssembly one where there is one, else its track is refused (CALF-E203).
 export async function makeCodecs({ hashWasm, fzstd, xz, av1Wasm = null, preferWasm = false }) {
+  const wasm = av1Wasm ? wasmAv1(av1Wasm) : null;
   const h3 = await hashWasm.createXXHash3();
   const h64 = await hashWasm.createXXHash64();
   const digest = (h, bytes) => {
@@ -21,7 +24,7 @@ export async function makeCodecs({ hashWasm, fzstd, xz, av1Wasm = null, preferWa
     xxh64: (bytes) => digest(h64, bytes),
     zstd: (bytes, rawSize) => fzstd.decompress(bytes, new Uint8Array(rawSize)),
     lzma2: (xzBytes) => new Response(new xz.XzReadableStream(new Blob([xzBytes]).stream())).arrayBuffer(),
-    av1: (preferWasm && av1Wasm ? null : await webCodecsAv1()) ?? (av1Wasm ? wasmAv1(av1Wasm) : null),
+    av1: (preferWasm && wasm ? null : await webCodecsAv1(globalThis, wasm)) ?? wasm,
   };
 }
 

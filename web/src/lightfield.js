@@ -6,6 +6,13 @@ import { readChunk } from './container.js';
 import { decodeBc1, decodeBc4, decodeBc6h, decodeBc7 } from './bc.js';
 
 export const FORMAT = { none: 0, rgba8: 1, rgba16f: 2, r16: 3, bc1: 4, bc4: 5, bc5: 6, bc6h: 7, bc7: 8, rg8: 9, r16p: 10, r16pm: 11, av1: 12, av1hdr: 13, av1_444: 14, av1hdr_444: 15 };
+// The AV1 colour formats (§11.1.12): bits a sample, 4:4:4 or 4:2:0, and the AV1 profile.
+const AV1_FORMATS = {
+  [FORMAT.av1]: { name: 'av1', bits: 8, chroma444: false, profile: 'the Main profile' },
+  [FORMAT.av1hdr]: { name: 'av1hdr', bits: 10, chroma444: false, profile: 'the Main profile' },
+  [FORMAT.av1_444]: { name: 'av1-444', bits: 8, chroma444: true, profile: 'the High profile (4:4:4)' },
+  [FORMAT.av1hdr_444]: { name: 'av1hdr-444', bits: 10, chroma444: true, profile: 'the High profile (4:4:4)' },
+};
 export const STREAM = { index: 0, colour: 1, depth: 2, material: 3, t: 4, coverage: 5 };
 const COLOUR_FORMATS = [FORMAT.bc1, FORMAT.bc7, FORMAT.bc6h, FORMAT.rgba8, FORMAT.rgba16f];
 const DEPTH_FORMATS = [FORMAT.r16, FORMAT.r16p, FORMAT.r16pm, FORMAT.bc5];
@@ -179,19 +186,34 @@ export function av1YcbcrToRgb(y, cb, cr, out, o = 0) {
   out[o + 2] = c(y + ((121609 * u + 32768) >> 16));
 }
 
+// The layout and bits of the picture formats av1.js gives (WebCodecs' names).
+const PICTURE_FORMATS = { I420: ['4:2:0', 8], I420P10: ['4:2:0', 10], I444: ['4:4:4', 8], I444P10: ['4:4:4', 10] };
+
+// A picture that is not of the `bits` and chroma (4:4:4 when `chroma444`, else 4:2:0) the
+// track's colour format says, or is smaller than the w × h cell, is CALF-E302, in the native
+// decoder's words (decoder/src/colour_av1.cc).
+function checkPicture(picture, bits, chroma444, w, h, what) {
+  const want = `${chroma444 ? 'I444' : 'I420'}${bits === 10 ? 'P10' : ''}`;
+  if (picture.format === want && picture.planes && picture.width >= w && picture.height >= h) return;
+  const known = PICTURE_FORMATS[picture.format];
+  const has = known ? `${known[0]} picture of ${known[1]} bits` : `picture of format ${picture.format}`;
+  fail(E.av1Picture, `${what}: a ${picture.width} x ${picture.height} ${has} for a ${w} x ${h} cell ` +
+    `(${bits}-bit ${chroma444 ? '4:4:4' : '4:2:0'} expected by the track's colour format)`);
+}
+
 // §11.1.12: the w × h cell of a decoded AV1 picture ({ format, width, height, planes: [Y, U, V],
 // strides }, av1.js) → linear binary32 RGB, texel-interleaved, through the sRGB bytes exactly as
-// rgba8 (§11.1.5). A picture that is not 8-bit 4:2:0 ('I420') or is smaller than the cell is
-// CALF-E302.
-export function av1Colour(picture, w, h, what) {
-  if (picture.format !== 'I420' || !picture.planes || picture.width < w || picture.height < h) {
-    fail(E.av1Picture, `${what}: a ${picture.width} x ${picture.height} picture of format ${picture.format} for a ${w} x ${h} cell (8-bit 4:2:0 expected)`);
-  }
+// rgba8 (§11.1.5). Chroma is at (x >> 1, y >> 1) of a 4:2:0 picture ('I420', av1) and at (x, y)
+// of a 4:4:4 one ('I444', av1-444: `chroma444`); a picture of the other layout or of 10 bits, or
+// smaller than the cell, is CALF-E302.
+export function av1Colour(picture, w, h, what, chroma444 = false) {
+  checkPicture(picture, 8, chroma444, w, h, what);
   const [ys, us, vs] = picture.planes, [ly, lc] = picture.strides;
+  const sub = chroma444 ? 0 : 1;
   const out = new Float32Array(3 * w * h), rgb = new Uint8Array(3);
   for (let y = 0; y < h; ++y) {
     for (let x = 0; x < w; ++x) {
-      const c = (y >> 1) * lc + (x >> 1);
+      const c = (y >> sub) * lc + (x >> sub);
       av1YcbcrToRgb(ys[y * ly + x], us[c], vs[c], rgb);
       const d = 3 * (y * w + x);
       out[d] = SRGB[rgb[0]]; out[d + 1] = SRGB[rgb[1]]; out[d + 2] = SRGB[rgb[2]];
@@ -216,19 +238,19 @@ export function av1HdrHalfBits(curve, c) {
 
 // §11.1.12 (av1hdr): the w × h cell of a decoded 10-bit picture (16-bit samples, av1.js) →
 // linear binary32 RGB, texel-interleaved: each code through the chunk's curve to a half float,
-// as rgba16f (§11.1.5). A picture that is not 10-bit 4:2:0 ('I420P10') or is smaller than the
-// cell is CALF-E302. Samples are taken modulo 1024, as the native decoder reads them.
-export function av1HdrColour(picture, w, h, curve, what) {
-  if (picture.format !== 'I420P10' || !picture.planes || picture.width < w || picture.height < h) {
-    fail(E.av1Picture, `${what}: a ${picture.width} x ${picture.height} picture of format ${picture.format} for a ${w} x ${h} HDR cell (10-bit 4:2:0 expected)`);
-  }
+// as rgba16f (§11.1.5). Chroma as av1Colour's: 'I420P10' pictures (av1hdr), or 'I444P10' ones
+// when `chroma444` (av1hdr-444); another picture, or one smaller than the cell, is CALF-E302.
+// Samples are taken modulo 1024, as the native decoder reads them.
+export function av1HdrColour(picture, w, h, curve, what, chroma444 = false) {
+  checkPicture(picture, 10, chroma444, w, h, what);
   const value = new Float32Array(1024);
   for (let c = 0; c < 1024; ++c) value[c] = halfToFloat(av1HdrHalfBits(curve, c));
   const [ys, us, vs] = picture.planes, [ly, lc] = picture.strides;
+  const sub = chroma444 ? 0 : 1;
   const out = new Float32Array(3 * w * h), rgb = new Uint16Array(3);
   for (let y = 0; y < h; ++y) {
     for (let x = 0; x < w; ++x) {
-      const c = (y >> 1) * lc + (x >> 1);
+      const c = (y >> sub) * lc + (x >> sub);
       av1Ycbcr10ToRgb(ys[y * ly + x] & 1023, us[c] & 1023, vs[c] & 1023, rgb);
       const d = 3 * (y * w + x);
       out[d] = value[rgb[0]]; out[d + 1] = value[rgb[1]]; out[d + 2] = value[rgb[2]];
@@ -464,16 +486,15 @@ let openings = 0;
 export async function openLightfield(clip, t) {
   const h = clip.tracks[t].header;
   // AV1 colour (§11.1.12) needs an AV1 decoder (codecs.av1: WebCodecs, or its WebAssembly
-  // stand-in); without one the track is refused as by any reader that lacks the format.
-  const av1 = h.colour_format === FORMAT.av1 || h.colour_format === FORMAT.av1hdr;
-  if (av1 && !clip.codecs.av1) {
-    fail(E.lightfieldFormat, `track ${t}: colour format ${h.colour_format} (${h.colour_format === FORMAT.av1 ? 'av1' : 'av1hdr'}): no AV1 decoder here`);
-  }
-  // 4:4:4 AV1 colour (container 1.5, the AV1 High profile) is refused by name: the page decodes
-  // 4:2:0 pictures only (WebCodecs' AV1 Main profile, and the WebAssembly back end's I420 and
-  // I420P10); calf-play plays such a clip.
-  if (h.colour_format === FORMAT.av1_444 || h.colour_format === FORMAT.av1hdr_444) {
-    fail(E.lightfieldFormat, `track ${t}: colour format ${h.colour_format} (${h.colour_format === FORMAT.av1_444 ? 'av1-444' : 'av1hdr-444'}): 4:4:4 AV1 colour (the High profile) is not played here; re-encode with calf-encode --av1-chroma 420`);
+  // stand-in) that takes the stream's profile (4:4:4 is AV1's High profile); without one the
+  // track is refused as by any reader that lacks the format.
+  const av1 = AV1_FORMATS[h.colour_format] ?? null;
+  if (av1) {
+    const named = `track ${t}: colour format ${h.colour_format} (${av1.name})`;
+    if (!clip.codecs.av1) fail(E.lightfieldFormat, `${named}: no AV1 decoder here`);
+    if ((await clip.codecs.av1.backEnd?.(av1.bits, av1.chroma444)) === null) {
+      fail(E.lightfieldFormat, `${named}: no AV1 decoder here for ${av1.profile} (VideoDecoder.isConfigSupported says no, and no WebAssembly decoder)`);
+    }
   }
   if (!COLOUR_FORMATS.includes(h.colour_format) && !av1) fail(E.lightfieldFormat, `track ${t}: colour format ${h.colour_format}`);
   if (!DEPTH_FORMATS.includes(h.depth_format)) fail(E.lightfieldFormat, `track ${t}: depth format ${h.depth_format}`);
@@ -513,7 +534,7 @@ export async function openLightfield(clip, t) {
   if (views.every((x) => x === null)) throw viewProblems[0];
   const hasCoverage = clip.chunks.some((c) => c.track === t && c.stream === STREAM.coverage);
   // `opened` names this opening in the AV1 decoders' cell keys (codecs.av1 may serve several).
-  return { clip, track: t, header: h, cells, tiles, byKey, views, viewProblems, hasCoverage, av1, opened: ++openings };
+  return { clip, track: t, header: h, cells, tiles, byKey, views, viewProblems, hasCoverage, av1: av1 !== null, av1Format: av1, opened: ++openings };
 }
 
 // Decodes every frame of one face of one view in order; calls onFrame(n, colour, depth,
@@ -624,11 +645,11 @@ export function closeLightfield(lf) {
 }
 
 // Frame n of an AV1 colour cell into the face's colour: the GOP chunk holding n parsed (after
-// its curve for av1hdr), its unit decoded by codecs.av1 (one decoder per cell, kept across
-// calls, so that frame after frame decodes one unit each), converted by av1Colour or
+// its curve for av1hdr and av1hdr-444), its unit decoded by codecs.av1 (one decoder per cell,
+// kept across calls, so that frame after frame decodes one unit each), converted by av1Colour or
 // av1HdrColour.
 async function av1Cell(lf, cell, chunks, n, colour, N) {
-  const hdr = lf.header.colour_format === FORMAT.av1hdr;
+  const { bits, chroma444 } = lf.av1Format, hdr = bits === 10;
   if (!cell.chunk || n < cell.chunk.firstFrame || n >= cell.chunk.firstFrame + cell.chunk.frameCount) {
     const c = chunks.find((x) => x.firstFrame <= n && n < x.firstFrame + x.frameCount);
     if (!c) bad(`${cell.where}: no colour chunk for frame ${n}`);
@@ -639,8 +660,8 @@ async function av1Cell(lf, cell, chunks, n, colour, N) {
     cell.chunk = c;
   }
   const what = `${cell.where} colour`, { x: cx, y: cy, w: cw, h: ch } = cell.rect;
-  const picture = await lf.clip.codecs.av1.picture(cell.key, cell.chunk, cell.units, n - cell.chunk.firstFrame, what, hdr ? 10 : 8);
-  const values = hdr ? av1HdrColour(picture, cw, ch, cell.curve, what) : av1Colour(picture, cw, ch, what);
+  const picture = await lf.clip.codecs.av1.picture(cell.key, cell.chunk, cell.units, n - cell.chunk.firstFrame, what, bits, chroma444);
+  const values = hdr ? av1HdrColour(picture, cw, ch, cell.curve, what, chroma444) : av1Colour(picture, cw, ch, what, chroma444);
   for (let y = 0; y < ch; ++y) colour.set(values.subarray(3 * y * cw, 3 * (y + 1) * cw), 3 * ((cy + y) * N + cx));
 }
 

@@ -187,11 +187,11 @@ export function bcUpload(gl, format, faceSize) {
 }
 
 // The texture of colour decoded on the CPU, by colour format: AV1 pictures as the native player
-// uploads them (GlViews: av1 as rgba8's sRGB bytes, SRGB8_ALPHA8; av1hdr as rgba16f's halves,
-// RGBA16F), any other format as binary32 (RGBA32F).
+// uploads them (GlViews: av1 and av1-444 as rgba8's sRGB bytes, SRGB8_ALPHA8; av1hdr and
+// av1hdr-444 as rgba16f's halves, RGBA16F), any other format as binary32 (RGBA32F).
 export function cpuUpload(gl, format) {
-  if (format === 12) return { internal: gl.SRGB8_ALPHA8, srgb: true, name: 'SRGB8_ALPHA8 (AV1, decoded on the CPU)' };
-  if (format === 13) return { internal: gl.RGBA16F, srgb: false, name: 'RGBA16F (HDR AV1, decoded on the CPU)' };
+  if (format === 12 || format === 14) return { internal: gl.SRGB8_ALPHA8, srgb: true, name: 'SRGB8_ALPHA8 (AV1, decoded on the CPU)' };
+  if (format === 13 || format === 15) return { internal: gl.RGBA16F, srgb: false, name: 'RGBA16F (HDR AV1, decoded on the CPU)' };
   return { internal: gl.RGBA32F, srgb: false, name: 'RGBA32F (decoded on the CPU)' };
 }
 

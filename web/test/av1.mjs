@@ -3,14 +3,16 @@
 // - the page's decoder reproduces every hash line of tests/conformance/lightfield/av1_pred16m
 //   and av1_hdr_pred16m (10-bit pictures, the HDR curve) with WebCodecs, and of av1_hdr_pred16m
 //   with the page's WebAssembly back end too (web/src/hash_lines.js, as web.conformance runs
-//   it under node);
+//   it under node); likewise the 4:4:4 clips av1_444_pred16m and av1_hdr_444_pred16m (the AV1
+//   High profile) through the back end the page picks for them (WebCodecs where its
+//   VideoDecoder.isConfigSupported takes 'av01.1.04M.08' / '.10'; the line names it);
 // - the AV1 clip of the decoder's fuzz corpus decodes without a problem;
 // - a temporal unit made garbage (its chunk's bytes changed in the decoder's cache) gives
 //   CALF-E301, as calf-verify gives;
 // - the page plays the clip along a 4-pose eye path (one per frame), each frame >= MIN_DB against
 //   calf-play's GL frame of the same pose (CALF_BIN), with calf-play's active views and cells;
-//   av1_hdr_pred16m one pose, likewise; colour goes up as the native player uploads it
-//   (SRGB8_ALPHA8 bytes, RGBA16F halves);
+//   av1_hdr_pred16m, av1_444_pred16m and av1_hdr_444_pred16m one pose each, likewise; colour
+//   goes up as the native player uploads it (SRGB8_ALPHA8 bytes, RGBA16F halves);
 // - the page's AV1 decoders close with the track they decode: a whole clip's decode leaves none
 //   open, and a clip the page replaces closes its own;
 // - garbage units met while playing give one line in the overlay (CALF-E301) and the last good
@@ -38,6 +40,8 @@ const clipPath = 'tests/conformance/lightfield/av1_pred16m.calf';
 const hdrPath = 'tests/conformance/lightfield/av1_hdr_pred16m.calf';
 const hashes = (path) => readFileSync(join(ROOT, path.replace(/\.calf$/, '.hashes')), 'utf8').split('\n').filter(Boolean);
 const want = hashes(clipPath), wantHdr = hashes(hdrPath);
+const path444 = 'tests/conformance/lightfield/av1_444_pred16m.calf', hdrPath444 = 'tests/conformance/lightfield/av1_hdr_444_pred16m.calf';
+const want444 = hashes(path444), wantHdr444 = hashes(hdrPath444);
 // The AV1 clip of the decoder's fuzz corpus, which must decode without a problem.
 const fuzzClip = 'tests/fuzz/corpus/lightfield_decoder_fuzz/valid_av1_f16_5fr.calf';
 const dir = mkdtempSync(join(process.env.CALF_WEB_TMP ?? tmpdir(), 'calf-web-av1-'));
@@ -64,11 +68,15 @@ if (native.length !== path.poses.length) throw new Error(`calf-play gave ${nativ
 // The HDR clip: one pose (the first's direction at frame 1).
 const hdrPose = { format: 'calf-eye-path', version: 1, width: 64, height: 48, fov_y_degrees: 70, poses: [{ ...path.poses[1] }] };
 writeFileSync(join(dir, 'hdr_path.json'), JSON.stringify(hdrPose));
-const playedHdr = execFileSync(join(bin, 'calf-play'), [join(ROOT, hdrPath), '--headless', '--eye-path', join(dir, 'hdr_path.json'), '--out', join(dir, 'play_hdr')],
-  { encoding: 'utf8', stdio: ['ignore', 'pipe', 'pipe'] });
-const nativeHdr = [...playedHdr.matchAll(/^pose (\d+) frame \d+: (\d+) views, (\d+)\/(\d+) cells, .*render ([0-9.]+) ms/gm)]
-  .map((m) => ({ views: Number(m[2]), cells: Number(m[3]), total: Number(m[4]), ms: Number(m[5]) }));
-if (nativeHdr.length !== 1) throw new Error(`calf-play gave ${nativeHdr.length} pose lines for ${hdrPath}: ${playedHdr}`);
+// The HDR clip and the 4:4:4 ones, one pose each, in the page that replaces the clip before.
+const onePose = [[hdrPath, 'av1_hdr_pred16m', 'RGBA16F'], [path444, 'av1_444_pred16m', 'SRGB8_ALPHA8'], [hdrPath444, 'av1_hdr_444_pred16m', 'RGBA16F']].map(([clip, name, upload]) => {
+  const played1 = execFileSync(join(bin, 'calf-play'), [join(ROOT, clip), '--headless', '--eye-path', join(dir, 'hdr_path.json'), '--out', join(dir, `play_${name}`)],
+    { encoding: 'utf8', stdio: ['ignore', 'pipe', 'pipe'] });
+  const poses = [...played1.matchAll(/^pose (\d+) frame \d+: (\d+) views, (\d+)\/(\d+) cells, .*render ([0-9.]+) ms/gm)]
+    .map((m) => ({ views: Number(m[2]), cells: Number(m[3]), total: Number(m[4]), ms: Number(m[5]) }));
+  if (poses.length !== 1) throw new Error(`calf-play gave ${poses.length} pose lines for ${clip}: ${played1}`);
+  return { clip, name, upload, native: poses };
+});
 
 const { server, port } = await startRangeServer();
 const problems = [];
@@ -80,7 +88,7 @@ try {
   if (!ready) throw new Error(`the page did not open ${clipPath}: ${overlay} ${consoleLines.join(' | ')}`);
   // The page's decoder, with the page's codecs (WebCodecs for AV1), on the whole clip; then with
   // one unit of the first colour chunk made garbage (every byte 0xff, its size kept).
-  const got = await page.evaluate(async ({ url, hdrUrl, fuzzUrl }) => {
+  const got = await page.evaluate(async ({ url, hdrUrl, fuzzUrl, url444, hdrUrl444 }) => {
     const { decodeLines } = await import('/web/src/hash_lines.js');
     const { wasmAv1 } = await import('/web/src/av1.js');
     const codecs = window.calfPlayer.lf.clip.codecs;
@@ -96,6 +104,13 @@ try {
     t = performance.now();
     const hdrWasm = await decodeLines(hdrBytes, { ...codecs, av1: wasmAv1(window.calfAv1Wasm) });
     const hdrWasmMs = performance.now() - t;
+    const high = [];
+    for (const [u, bits] of [[url444, 8], [hdrUrl444, 10]]) {
+      const b = new Uint8Array(await (await fetch(u)).arrayBuffer());
+      const how = await codecs.av1.backEnd(bits, true);
+      t = performance.now();
+      high.push({ how, ...await decodeLines(b, codecs), ms: performance.now() - t });
+    }
     const openAfter = codecs.av1.open();
     let damaged;
     try {
@@ -109,10 +124,11 @@ try {
       damaged = { lines: [], problems: [e.message] };
     }
     const fuzz = await decodeLines(new Uint8Array(await (await fetch(fuzzUrl)).arrayBuffer()), codecs);
-    return { clean, ms, hdr, hdrMs, hdrWasm, hdrWasmMs, openBefore, openAfter, damaged: damaged.problems[0] ?? null, fuzz: { lines: fuzz.lines.length, problem: fuzz.problems[0] ?? null } };
-  }, { url: `/${clipPath}`, hdrUrl: `/${hdrPath}`, fuzzUrl: `/${fuzzClip}` });
+    return { clean, ms, hdr, hdrMs, hdrWasm, hdrWasmMs, high, openBefore, openAfter, damaged: damaged.problems[0] ?? null, fuzz: { lines: fuzz.lines.length, problem: fuzz.problems[0] ?? null } };
+  }, { url: `/${clipPath}`, hdrUrl: `/${hdrPath}`, fuzzUrl: `/${fuzzClip}`, url444: `/${path444}`, hdrUrl444: `/${hdrPath444}` });
   for (const [name, wanted, result, ms, how] of [['av1_pred16m', want, got.clean, got.ms, 'WebCodecs'], ['av1_hdr_pred16m', wantHdr, got.hdr, got.hdrMs, 'WebCodecs'],
-    ['av1_hdr_pred16m', wantHdr, got.hdrWasm, got.hdrWasmMs, 'WebAssembly']]) {
+    ['av1_hdr_pred16m', wantHdr, got.hdrWasm, got.hdrWasmMs, 'WebAssembly'],
+    ['av1_444_pred16m', want444, got.high[0], got.high[0].ms, got.high[0].how], ['av1_hdr_444_pred16m', wantHdr444, got.high[1], got.high[1].ms, got.high[1].how]]) {
     const diffs = [];
     for (let i = 0; i < Math.max(wanted.length, result.lines.length); ++i) {
       if (wanted[i] !== result.lines[i]) diffs.push(`line ${i + 1}: expected '${wanted[i] ?? ''}', got '${result.lines[i] ?? ''}'`);
@@ -167,24 +183,29 @@ try {
   if (!bad.same) problems.push('garbage units while playing: the canvas changed');
 
   // The HDR clip, one pose, in the same page (RGBA16F colour); the clip it replaces closes its
-  // AV1 decoders.
+  // AV1 decoders. Then the 4:4:4 clips likewise (SRGB8_ALPHA8, RGBA16F).
   const openedBefore = await page.evaluate(() => { window.calfReplaced = window.calfPlayer; return window.calfReplaced.lf.clip.codecs.av1.open(); });
-  const hdrPlay = await playClip(browser, held, `http://127.0.0.1:${port}`, `/${hdrPath}`);
-  const openedAfter = await page.evaluate(() => window.calfReplaced.lf.clip.codecs.av1.open());
-  console.log(`web.av1: av1_pred16m's AV1 decoders open: ${openedBefore} while it plays, ${openedAfter} once av1_hdr_pred16m replaced it`);
-  if (!(openedBefore > 0 && openedAfter === 0)) problems.push(`the replaced clip's AV1 decoders: ${openedBefore} open while it played, ${openedAfter} after`);
-  if (!hdrPlay.ready) problems.push(`the page did not open ${hdrPath}: ${hdrPlay.overlay}`);
-  else {
+  for (const [k, { clip, name, upload, native: nativeOne }] of onePose.entries()) {
+    const played = await playClip(browser, held, `http://127.0.0.1:${port}`, `/${clip}`);
+    if (k === 0) {
+      const openedAfter = await page.evaluate(() => window.calfReplaced.lf.clip.codecs.av1.open());
+      console.log(`web.av1: av1_pred16m's AV1 decoders open: ${openedBefore} while it plays, ${openedAfter} once av1_hdr_pred16m replaced it`);
+      if (!(openedBefore > 0 && openedAfter === 0)) problems.push(`the replaced clip's AV1 decoders: ${openedBefore} open while it played, ${openedAfter} after`);
+    }
+    if (!played.ready) {
+      problems.push(`the page did not open ${clip}: ${played.overlay}`);
+      continue;
+    }
     await renderEyePath(page, hdrPose, (i, r, rgb) => {
-      const png = readPng(join(dir, 'play_hdr', `frame_${String(i).padStart(5, '0')}.png`));
-      const db = psnr(rgb, png.rgb), n = nativeHdr[i];
-      console.log(`web.av1: av1_hdr_pred16m pose ${i} frame ${r.frame}: ${r.active.length} views, ${r.visibleCells}/${r.totalCells} cells (calf-play ${n.views}, ${n.cells}/${n.total}), ` +
+      const png = readPng(join(dir, `play_${name}`, `frame_${String(i).padStart(5, '0')}.png`));
+      const db = psnr(rgb, png.rgb), n = nativeOne[i];
+      console.log(`web.av1: ${name} pose ${i} frame ${r.frame}: ${r.active.length} views, ${r.visibleCells}/${r.totalCells} cells (calf-play ${n.views}, ${n.cells}/${n.total}), ` +
         `${db.toFixed(2)} dB against calf-play, colour ${r.colourUpload}; render ${r.renderMs.toFixed(1)} ms (SwiftShader) against calf-play's ${n.ms} ms (llvmpipe)`);
-      if (r.active.length !== n.views || r.visibleCells !== n.cells || r.totalCells !== n.total) problems.push(`HDR pose ${i}: views or cells differ from calf-play's`);
-      if (!(db >= MIN_DB)) problems.push(`HDR pose ${i}: ${db.toFixed(2)} dB against calf-play, below ${MIN_DB}`);
-      if (new Set(rgb).size < 4) problems.push(`HDR pose ${i}: the canvas is blank`);
-      if (!r.colourUpload.startsWith('RGBA16F')) problems.push(`HDR pose ${i}: colour went up as ${r.colourUpload}, not RGBA16F`);
-    }, (i, message) => problems.push(`HDR pose ${i}: ${message}`));
+      if (r.active.length !== n.views || r.visibleCells !== n.cells || r.totalCells !== n.total) problems.push(`${name} pose ${i}: views or cells differ from calf-play's`);
+      if (!(db >= MIN_DB)) problems.push(`${name} pose ${i}: ${db.toFixed(2)} dB against calf-play, below ${MIN_DB}`);
+      if (new Set(rgb).size < 4) problems.push(`${name} pose ${i}: the canvas is blank`);
+      if (!r.colourUpload.startsWith(upload)) problems.push(`${name} pose ${i}: colour went up as ${r.colourUpload}, not ${upload}`);
+    }, (i, message) => problems.push(`${name} pose ${i}: ${message}`));
   }
 } finally {
   await browser.close();
