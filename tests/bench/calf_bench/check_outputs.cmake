@@ -6,11 +6,17 @@
 #   ROWS    how many rows that table must have
 #   NO_TOOLS 1 when the run had neither gnuplot nor ffmpeg on its PATH: no PNGs, the notice that
 #           plots were skipped, and the ffmpeg peers reported n/a with the reason
+#   NO_PEERS 1 when the run had --no-peers: sweep.md says the peers were not measured
+#   EXPECT  optional, KNOB|VALUE|COLUMN|REGEX items separated by white space: sweep.csv has exactly
+#           one row of that knob and value, and its COLUMN matches ^REGEX$
+#           (e.g. "av1|444:32|stored_colour_format|av1hdr-444 margin|3|q_used|[1-4][0-9][.][0-9]+")
 # sweep.csv: a header and POINTS rows of the same column count, PSNR, bytes and frame CPU ms
 # positive, and the Pareto flags equal to the front recomputed here from the clip bytes / frame
 # CPU ms / PSNR columns.
 # sweep.md: the scene's section, the table with ROWS rows, the peers. Plots: the gnuplot scripts
 # and data always; the PNGs when gnuplot is installed, else the notice that they were skipped.
+# Empty CSV fields (a column that does not apply to a row) stay list elements.
+cmake_policy(SET CMP0007 NEW)
 foreach(f sweep.md sweep.csv ${SCENE}.dat ${SCENE}_psnr_bytes.gp ${SCENE}_psnr_ms.gp
           ${SCENE}_front_bytes.dat ${SCENE}_front_ms.dat)
   if(NOT EXISTS "${DIR}/${f}")
@@ -84,8 +90,43 @@ foreach(axis bytes ms)
   endforeach()
 endforeach()
 
+# EXPECT: named columns of named rows.
+string(REGEX REPLACE "[ \t\n]+" ";" expects "${EXPECT}")
+foreach(expect ${expects})
+  string(REPLACE "|" ";" parts "${expect}")
+  list(GET parts 0 e_knob)
+  list(GET parts 1 e_value)
+  list(GET parts 2 e_column)
+  list(GET parts 3 e_regex)
+  list(FIND columns ${e_column} e_index)
+  if(e_index LESS 0)
+    message(FATAL_ERROR "sweep.csv has no column ${e_column}")
+  endif()
+  set(found 0)
+  foreach(line ${lines})
+    string(REPLACE "," ";" fields "${line}")
+    list(GET fields 1 f_knob)
+    list(GET fields 2 f_value)
+    if(f_knob STREQUAL e_knob AND f_value STREQUAL e_value)
+      math(EXPR found "${found} + 1")
+      list(GET fields ${e_index} f_column)
+      if(NOT f_column MATCHES "^${e_regex}$")
+        message(FATAL_ERROR "sweep.csv row ${e_knob}=${e_value}: ${e_column} is '${f_column}', expected ^${e_regex}$")
+      endif()
+    endif()
+  endforeach()
+  if(NOT found EQUAL 1)
+    message(FATAL_ERROR "sweep.csv has ${found} rows of ${e_knob}=${e_value}, expected 1")
+  endif()
+endforeach()
+
 file(READ "${DIR}/sweep.md" md)
-foreach(text "## ${SCENE}" "### ${TABLE}" "### Peers" "| stream | method |" "total wall time" "${POINTS} points")
+if(NO_PEERS)
+  set(peers_text "Not measured (--no-peers)")
+else()
+  set(peers_text "| stream | method |")
+endif()
+foreach(text "## ${SCENE}" "### ${TABLE}" "### Peers" "${peers_text}" "total wall time" "${POINTS} points")
   string(FIND "${md}" "${text}" at)
   if(at LESS 0)
     message(FATAL_ERROR "sweep.md lacks '${text}'")

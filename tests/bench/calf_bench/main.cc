@@ -20,6 +20,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "calf/encoder/colour_denoise.h"
 #include "calf/format/container_types.h"
 #include "calf/player/gl_context.h"
 #include "calf/samples/scene.h"
@@ -210,6 +211,10 @@ void copy_encode(const EncodeOutcome& e, PointResult* r) {
   r->colour_keyframes = e.stats.colour_keyframes;
   r->colour_cells = e.stats.colour_cells;
   r->bc5_max_rel_error = e.stats.depth_max_rel_error;
+  r->q_used = e.q_used;
+  r->noise_db = e.noise_db;
+  r->denoise_used = e.denoise_window;
+  r->colour_denoised = e.stats.colour_denoised;
 }
 
 // Measures one scene: every point of its plan, then the peers.
@@ -296,6 +301,9 @@ Status run_scene(const std::string& name, const Options& o, const ScenePlan& pla
 }  // namespace
 
 int main(int argc, char** argv) {
+  // SVT-AV1 (the av1 knob's 4:2:0 points) prints its banner and settings to stderr unless SVT_LOG
+  // says otherwise; set before any thread starts, and a user's own setting is kept.
+  setenv("SVT_LOG", "0", 0);
   CLI::App app{
       "calf-bench: speed <-> accuracy sweeps of calf on the built-in scenes (docs/BENCH.md).\n"
       "Per scene: capture once, ground truth along its eye path once, then one knob at a time "
@@ -311,7 +319,9 @@ int main(int argc, char** argv) {
   std::string q = "35,40,45,50,55", cells = "16,32,64", windows = "1,2,4", aabbs = "1,2,4";
   std::string depth = "raw16,bc5", colour = "auto,bc1,bc7", super = "zstd,lzma2";
   std::string views = "1,2,4,all", steps = "16,32,64,128", renderer = "gl";
+  std::string av1 = "420:20,420:32,444:32", denoise = "0,4,16", margins = "2,4";
   uint32_t face = 128, frames = 8, gt = 128, threads = 0, base_cell = 32;
+  float noise = 0;
   bool quick = false, no_peers = false, no_ffmpeg = false, keep = false;
   app.add_option("--scenes", scenes,
                  "built-in scenes, comma-separated (default "
@@ -326,6 +336,10 @@ int main(int argc, char** argv) {
   app.add_option("--face", face,
                  "cube face size of the captures, texels (default 128; --quick 64)");
   app.add_option("--frames", frames, "frames captured (default 8; --quick 4)");
+  app.add_option("--noise", noise,
+                 "per-frame colour noise amplitude of the captures in [0, 1], as calf-capture "
+                 "--noise adds it (the ground truth is rendered without it); above 0 the knobs "
+                 "denoise and margin join 'all' (default 0: converged captures)");
   app.add_option("--gt-size", gt,
                  "ground-truth image side in pixels; one pose per frame "
                  "along the scene's eye path (default 128; --quick 64)");
@@ -337,7 +351,8 @@ int main(int argc, char** argv) {
                  "--headless) or cpu (the scalar reference renderer) (default gl)");
   app.add_option("--knobs", knobs,
                  "knobs to sweep, comma-separated: q, cell, window, aabbs, "
-                 "depth, colour, super, views, steps, or all (default all)");
+                 "depth, colour, super, views, steps, av1, denoise, margin, or all = every knob "
+                 "but av1, and but denoise and margin unless --noise is above 0 (default all)");
   app.add_option(
       "--base-cell", base_cell,
       "colour cell size of the base configuration "
@@ -355,6 +370,17 @@ int main(int argc, char** argv) {
                  "active view counts, 'all' = every viewpoint (default "
                  "1,2,4,all; --quick 1,all)");
   app.add_option("--steps", steps, "ray-march steps (default 16,32,64,128; --quick 32,64)");
+  app.add_option("--av1", av1,
+                 "AV1 colour points CHROMA:CRF, CHROMA 420 (SVT-AV1) or 444 (libaom), CRF 1..63; "
+                 "each an encode with --colour-codec av1, one stream per face (cell = --face) and "
+                 "one key frame (--av1-keyframe-interval = --frames) (default "
+                 "420:20,420:32,444:32)");
+  app.add_option("--denoise-windows", denoise,
+                 "render-noise pre-filter windows (calf-encode --denoise-window, 0..64, 0 = off) "
+                 "at the base's Q 50; needs --noise (default 0,4,16; --quick 0,2,4)");
+  app.add_option("--margins", margins,
+                 "noise margins in dB (calf-encode --psnr auto --psnr-noise-margin, 0..50, with "
+                 "--denoise-window auto); needs --noise (default 2,4)");
   app.add_flag("--quick", quick,
                "fewer points and a smaller capture, for trying things: the "
                "--quick values above unless given");
@@ -386,6 +412,7 @@ int main(int argc, char** argv) {
     quick_default("--colour-formats", colour, "auto,bc7");
     quick_default("--views", views, "1,all");
     quick_default("--steps", steps, "32,64");
+    quick_default("--denoise-windows", denoise, "0,2,4");
     if (app.count("--face") == 0) face = 64;
     if (app.count("--frames") == 0) frames = 4;
     if (app.count("--gt-size") == 0) gt = 64;
@@ -394,7 +421,10 @@ int main(int argc, char** argv) {
   std::string error;
   SweepValues& v = o.values;
   const bool lists_ok =
-      parse_knobs(knobs, &v.knobs, &error) &&
+      parse_knobs(knobs, noise > 0, &v.knobs, &error) && parse_av1_points(av1, &v.av1, &error) &&
+      parse_numbers("--denoise-windows", denoise, 0, encoder::kMaxDenoiseWindow, 0, false,
+                    &v.denoise, &error) &&
+      parse_numbers("--margins", margins, 0, 50, 0, false, &v.margins, &error) &&
       parse_numbers("--q", q, 1e-3, 200, 0, false, &v.q, &error) &&
       parse_numbers("--cells", cells, 4, 16384, 4, false, &v.cells, &error) &&
       parse_numbers("--windows", windows, 1, 1e6, 0, false, &v.windows, &error) &&
@@ -430,6 +460,16 @@ int main(int argc, char** argv) {
     return fail(fmt::format("--base-cell {} is not a multiple of 4 of at least 4", base_cell), 2);
   }
   if (threads > 256) return fail(fmt::format("--threads {} is above 256", threads), 2);
+  if (!(noise >= 0 && noise <= 1))
+    return fail(fmt::format("--noise {} is outside [0, 1]", noise), 2);
+  for (Knob k : v.knobs) {
+    if (is_noise_knob(k) && noise == 0) {
+      return fail(fmt::format("--knobs {} needs --noise above 0: the built-in captures are "
+                              "converged (Q stays 50, the pre-filter off)",
+                              knob_name(k)),
+                  2);
+    }
+  }
   for (const std::string& s : split(scenes)) {
     bool known = false;
     std::string names;
@@ -442,6 +482,9 @@ int main(int argc, char** argv) {
     if (std::find(o.scenes.begin(), o.scenes.end(), s) == o.scenes.end()) o.scenes.push_back(s);
   }
   v.base_encode.cell = base_cell;
+  v.av1_cell = face;
+  v.av1_keyframe_interval = frames;
+  o.measure.noise = noise;
   o.measure.face_size = face;
   o.measure.frames = frames;
   o.measure.gt_width = o.measure.gt_height = gt;
@@ -462,10 +505,14 @@ int main(int argc, char** argv) {
   run.machine = machine_text();
   run.load_start = load_average();
   run.settings = fmt::format(
-      "faces {}², {} frames, ground truth {}×{} (one pose per frame), threads {} ({}), base = "
+      "faces {}², {} frames{}, ground truth {}×{} (one pose per frame), threads {} ({}), base = "
       "calf-encode defaults with cell {} (Q {:g}, colour auto, depth raw16, W 2, A 2, zstd) and "
       "calf-play --headless defaults ({} views, {} steps, no performance culling)",
-      face, frames, gt, gt, threads, threads ? "as given" : "all cores", base_cell, v.base_encode.q,
+      face, frames,
+      noise > 0
+          ? fmt::format(", render noise {:g} (calf-capture --noise; ground truth without)", noise)
+          : "",
+      gt, gt, threads, threads ? "as given" : "all cores", base_cell, v.base_encode.q,
       v.base_play.views, v.base_play.steps);
 
   std::error_code ec;

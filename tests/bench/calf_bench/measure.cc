@@ -9,6 +9,8 @@
 #include <fmt/format.h>
 
 #include "calf/capture/capture_set.h"
+#include "calf/encoder/colour_denoise.h"
+#include "calf/encoder/noise_estimate.h"
 #include "calf/player/capture_views.h"
 #include "calf/player/image_compare.h"
 #include "calf/player/playback.h"
@@ -52,6 +54,7 @@ Expected<std::unique_ptr<SceneInputs>> SceneInputs::make(const std::string& name
   request.frames = settings.frames;
   request.rig = scene.default_rig;
   request.render = render;
+  request.render.noise = settings.noise;
   request.generator = "calf-bench";
   double t0 = now_seconds();
   CALF_RETURN_IF_ERROR(
@@ -88,8 +91,32 @@ Expected<EncodeOutcome> SceneInputs::encode(const EncodeConfig& c, const fs::pat
   o.max_aabbs = c.aabbs;
   o.supercompression = c.super;
   o.threads = settings_.threads;
+  o.av1.chroma444 = c.av1_444;
+  o.av1.crf = c.av1_crf;
+  o.av1.keyframe_interval = c.av1_keyframe_interval;
+  o.denoise_window = c.denoise_window;
   EncodeOutcome out;
   const double t0 = now_seconds(), c0 = cpu_seconds();
+  if (c.psnr_auto) {
+    // calf-encode --psnr auto --psnr-noise-margin M --denoise-window auto: Q, the noise-aware
+    // test and the pre-filter's window from the capture's render-noise estimate.
+    CALF_RETURN_IF_ERROR(encoder::check_lightfield_options(o));
+    CALF_ASSIGN_OR_RETURN(capture::CaptureSetReader input,
+                          capture::CaptureSetReader::open(capture_dir_, o.max_image_pixels));
+    encoder::NoiseEstimateOptions no;
+    no.threads = o.threads;
+    no.max_image_pixels = o.max_image_pixels;
+    CALF_ASSIGN_OR_RETURN(encoder::CaptureNoise noise,
+                          encoder::estimate_capture_noise(input, o.colour, no));
+    o.min_psnr_db = encoder::auto_psnr_db(noise.set, c.noise_margin);
+    o.noise_psnr_db = encoder::auto_noise_psnr_db(noise.set, c.noise_margin);
+    o.denoise_window = o.noise_psnr_db > 0 && o.colour != encoder::ColourCoding::kAv1
+                           ? encoder::kDefaultDenoiseWindow
+                           : 0;
+    out.noise_db = noise.set.psnr_db.value_or(0);
+  }
+  out.q_used = o.min_psnr_db;
+  out.denoise_window = o.denoise_window;
   CALF_ASSIGN_OR_RETURN(out.stats, encoder::encode_lightfield_file(capture_dir_, clip.string(), o));
   out.seconds = now_seconds() - t0;
   out.cpu_seconds = cpu_seconds() - c0;

@@ -27,8 +27,10 @@ struct MeasureSettings {
   uint32_t face_size = 128;
   uint32_t frames = 8;
   uint32_t gt_width = 128, gt_height = 128;
-  uint32_t threads = 0;                     // capture, encode and CPU-render threads; 0 = all cores
-  bool use_gl = true;                       // false: the CPU reference renderer
+  uint32_t threads = 0;  // capture, encode and CPU-render threads; 0 = all cores
+  float noise = 0;       // the capture's per-frame colour noise (calf-capture --noise), [0, 1]; the
+                         // ground truth is rendered without it
+  bool use_gl = true;    // false: the CPU reference renderer
   const player::GlFunctions* gl = nullptr;  // the current OSMesa context's (use_gl)
 };
 
@@ -37,6 +39,9 @@ struct EncodeOutcome {
   encoder::LightfieldEncodeStats stats;
   uint64_t file_bytes = 0;
   double seconds = 0, cpu_seconds = 0;  // wall; CPU time of the process (every thread)
+  double q_used = 0;                    // Q the encode used (psnr_auto: from the estimate)
+  double noise_db = 0;                  // psnr_auto: the render-noise estimate, 0 = none
+  uint32_t denoise_window = 0;          // the pre-filter's window the encode used
 };
 
 // A scene's capture set and ground truth on disk, and the ground truth in memory.
@@ -56,7 +61,8 @@ class SceneInputs {
   double ground_truth_seconds() const { return gt_s_; }
   const capture::EyePath& eye_path() const { return path_; }
 
-  // Encodes the capture set with `config` into `clip` (wall time measured around the call).
+  // Encodes the capture set with `config` into `clip` (wall time measured around the call; with
+  // config.psnr_auto the noise estimate, as calf-encode --psnr auto makes it, is inside it).
   Expected<EncodeOutcome> encode(const EncodeConfig& config,
                                  const std::filesystem::path& clip) const;
 

@@ -127,6 +127,23 @@ std::string detail(Knob k, const MeasuredPoint& p) {
     case Knob::kWindow:
     case Knob::kAabbs:
       return fmt::format("{:.1f} Mbps@24 of updates", r.mean_mbps);
+    case Knob::kAv1:
+      return p.point.encode.colour == encoder::ColourCoding::kAv1
+                 ? fmt::format("stored {}, cell {}, a key frame every {} frames", r.colour_format,
+                               p.point.encode.cell, p.point.encode.av1_keyframe_interval)
+                 : fmt::format("stored {}; {} keyframes", r.colour_format,
+                               grouped(r.colour_keyframes));
+    case Knob::kDenoise:
+    case Knob::kMargin: {
+      const std::string noise = p.point.encode.psnr_auto
+                                    ? (r.noise_db > 0 ? fmt::format("noise {:.2f} dB, ", r.noise_db)
+                                                      : std::string("no noise estimate, "))
+                                    : "";
+      return fmt::format(
+          "{}Q {:.2f}, window {}: {} texel-frames averaged; {} keyframes / {} cells", noise,
+          r.q_used, r.denoise_used > 1 ? std::to_string(r.denoise_used) : "off",
+          grouped(r.colour_denoised), grouped(r.colour_keyframes), grouped(r.colour_cells));
+    }
     default:
       return "";
   }
@@ -154,6 +171,12 @@ std::string base_value(Knob k, const SweepPoint& p) {
       return fmt::format("{}", p.play.views);
     case Knob::kSteps:
       return fmt::format("{}", p.play.steps);
+    case Knob::kAv1:
+      return fmt::format("bc, colour {}", colour_coding_name(e.colour));
+    case Knob::kDenoise:
+      return fmt::format("{}", e.denoise_window);
+    case Knob::kMargin:
+      return fmt::format("none: Q {:g}", e.q);
     case Knob::kBase:
       break;
   }
@@ -187,7 +210,8 @@ Status write_csv(const fs::path& file, const std::vector<SceneResult>& scenes) {
       "colour_keyframes,encode_s,encode_cpu_s,decode_ms,upload_ms,render_ms,frame_ms,"
       "prepare_cpu_ms,render_cpu_ms,frame_cpu_ms,first_decode_ms,first_upload_ms,"
       "first_render_ms,frames,mean_active_views,mean_mbps_at_24fps,psnr_db,worst_psnr_db,ssim,"
-      "front_bytes,front_cpu_ms\n";
+      "front_bytes,front_cpu_ms,av1,psnr_auto_margin,q_used,noise_psnr_db,denoise_window,"
+      "colour_denoised\n";
   for (const SceneResult& s : scenes) {
     for (const MeasuredPoint& p : s.points) {
       const EncodeConfig& e = p.point.encode;
@@ -195,7 +219,7 @@ Status write_csv(const fs::path& file, const std::vector<SceneResult>& scenes) {
       out += fmt::format(
           "{},{},{},{},{},{},{:g},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3f},{:.3f},{:.3f},"
           "{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{},{:.2f},{:.3f},{:.3f},"
-          "{:.3f},{:.5f},{},{}\n",
+          "{:.3f},{:.5f},{},{},{},{},{:.3f},{:.3f},{},{}\n",
           s.scene, knob_name(p.point.knob), csv_field(p.point.value), csv_field(p.point.label),
           p.is_base ? 1 : 0, e.cell, e.q, colour_coding_name(e.colour), depth_coding_name(e.depth),
           e.window, e.aabbs, super_name(e.super), p.point.play.views, p.point.play.steps,
@@ -204,7 +228,12 @@ Status write_csv(const fs::path& file, const std::vector<SceneResult>& scenes) {
           r.upload_ms, r.render_ms, r.total_ms(), r.prepare_cpu_ms, r.render_cpu_ms,
           r.total_cpu_ms(), r.first_decode_ms, r.first_upload_ms, r.first_render_ms, r.frames,
           r.mean_active_views, r.mean_mbps, r.psnr_db, r.worst_psnr_db, r.ssim,
-          r.front_bytes ? 1 : 0, r.front_ms ? 1 : 0);
+          r.front_bytes ? 1 : 0, r.front_ms ? 1 : 0,
+          e.colour == encoder::ColourCoding::kAv1
+              ? fmt::format("{}:{}", e.av1_444 ? 444 : 420, e.av1_crf)
+              : std::string(),
+          e.psnr_auto ? fmt::format("{:g}", e.noise_margin) : std::string(), r.q_used, r.noise_db,
+          r.denoise_used, r.colour_denoised);
     }
   }
   return write_file_whole(file, out);
@@ -363,6 +392,12 @@ PointStyle point_style(Knob k) {
       return {9, 1.3, "#17becf"};
     case Knob::kSteps:
       return {11, 1.3, "#7f7f00"};
+    case Knob::kAv1:
+      return {12, 1.3, "#393b79"};
+    case Knob::kDenoise:
+      return {13, 1.3, "#637939"};
+    case Knob::kMargin:
+      return {14, 1.3, "#843c39"};
   }
   return {1, 1.3, "#000000"};
 }

@@ -5,6 +5,8 @@
 // cell 32) and, one knob at a time, the configurations around it:
 //   encode knobs  Q, cell size, depth window W, AABB limit A, depth format, colour format,
 //                 supercompression: each point is a fresh encode, then a headless playback;
+//                 AV1 colour (chroma and CRF), render-noise pre-filter window, --psnr auto's
+//                 noise margin (the last two on a capture given render noise, --noise);
 //   play knobs    active view count, ray-march steps: the base clip played again.
 // Every point records bytes (clip, colour, depth, material), encode seconds, decode and render
 // milliseconds per frame (median over the eye path's frames, the first frame apart) and the mean
@@ -18,6 +20,7 @@
 #include <vector>
 
 #include "calf/encoder/lightfield_encode.h"
+#include "calf/encoder/noise_estimate.h"
 #include "calf/format/container_types.h"
 
 namespace calf::bench {
@@ -33,7 +36,10 @@ enum class Knob : uint8_t {
   kColour,
   kSuper,
   kViews,
-  kSteps
+  kSteps,
+  kAv1,
+  kDenoise,
+  kMargin
 };
 
 // The command-line name of a knob ("q", "cell", ...) and the heading a table gets.
@@ -43,6 +49,12 @@ const char* knob_title(Knob knob);
 bool is_encode_knob(Knob knob);
 // Every knob but kBase, in table order.
 const std::vector<Knob>& all_knobs();
+// The knobs "--knobs all" sweeps: all_knobs() but kAv1 (named on its own: AV1 encodes are the
+// slowest points, and the default run keeps the committed run's points) and, unless `noisy`, the
+// render-noise knobs (kDenoise, kMargin), which act only on a capture given render noise.
+std::vector<Knob> default_knobs(bool noisy);
+// Whether a knob acts only on a capture with render noise (calf-bench --noise).
+bool is_noise_knob(Knob knob);
 
 // What calf-encode gets for one point.
 struct EncodeConfig {
@@ -53,6 +65,16 @@ struct EncodeConfig {
   uint32_t window = 2;
   uint32_t aabbs = 2;
   container::Compression super = container::Compression::kZstd;
+  // AV1 colour (colour == kAv1): 4:4:4 (libaom) or 4:2:0 (SVT-AV1), the CRF, the cell size is
+  // `cell`, a key frame every av1_keyframe_interval frames (calf-encode --av1-*).
+  bool av1_444 = false;
+  uint32_t av1_crf = 32;
+  uint32_t av1_keyframe_interval = 30;
+  // Q from the capture's render noise (calf-encode --psnr auto --psnr-noise-margin M, with
+  // --denoise-window auto: the window calf-encode picks); false: Q = q and the window below.
+  bool psnr_auto = false;
+  double noise_margin = encoder::kDefaultPsnrNoiseMargin;
+  uint32_t denoise_window = 0;  // --denoise-window W without psnr_auto, 0 or 1 = off
   friend bool operator==(const EncodeConfig&, const EncodeConfig&) = default;
 };
 
@@ -88,6 +110,11 @@ struct PointResult {
   bool hdr = false;
   uint64_t colour_keyframes = 0, colour_cells = 0;
   double bc5_max_rel_error = 0;  // BC5 depth only
+  // What the encode used: Q (psnr_auto: from the noise estimate), the estimate (dB, 0 = none or
+  // not asked), the pre-filter's window and the texel-frames it averaged.
+  double q_used = 0, noise_db = 0;
+  uint32_t denoise_used = 0;
+  uint64_t colour_denoised = 0;
   // Playback over the eye path (first frame excluded from the medians, reported apart).
   // decode: LightfieldDecoder::advance (what calf-play prints as "decode"); upload: the rest of
   // Playback::prepare (view selection, texture upload); render: Playback::render (GL: draw and

@@ -1,6 +1,7 @@
 #include "sweep_plan.h"
 
 #include <algorithm>
+#include <cstdlib>
 
 #include <fmt/format.h>
 
@@ -28,6 +29,12 @@ const char* knob_name(Knob knob) {
       return "views";
     case Knob::kSteps:
       return "steps";
+    case Knob::kAv1:
+      return "av1";
+    case Knob::kDenoise:
+      return "denoise";
+    case Knob::kMargin:
+      return "margin";
   }
   return "?";
 }
@@ -54,6 +61,13 @@ const char* knob_title(Knob knob) {
       return "active views (calf-play --views)";
     case Knob::kSteps:
       return "ray-march steps (calf-play --steps)";
+    case Knob::kAv1:
+      return "AV1 colour, chroma:CRF (calf-encode --colour-codec av1 --av1-chroma --av1-crf, "
+             "one stream per face)";
+    case Knob::kDenoise:
+      return "render-noise pre-filter window (calf-encode --denoise-window, Q as the base's)";
+    case Knob::kMargin:
+      return "noise margin (calf-encode --psnr auto --psnr-noise-margin, --denoise-window auto)";
   }
   return "?";
 }
@@ -63,9 +77,21 @@ bool is_encode_knob(Knob knob) {
 }
 
 const std::vector<Knob>& all_knobs() {
-  static const std::vector<Knob> knobs = {Knob::kQ,     Knob::kCell,  Knob::kWindow,
-                                          Knob::kAabbs, Knob::kDepth, Knob::kColour,
-                                          Knob::kSuper, Knob::kViews, Knob::kSteps};
+  static const std::vector<Knob> knobs = {
+      Knob::kQ,     Knob::kCell,  Knob::kWindow, Knob::kAabbs, Knob::kDepth,   Knob::kColour,
+      Knob::kSuper, Knob::kViews, Knob::kSteps,  Knob::kAv1,   Knob::kDenoise, Knob::kMargin};
+  return knobs;
+}
+
+bool is_noise_knob(Knob knob) {
+  return knob == Knob::kDenoise || knob == Knob::kMargin;
+}
+
+std::vector<Knob> default_knobs(bool noisy) {
+  std::vector<Knob> knobs;
+  for (Knob k : all_knobs()) {
+    if (k != Knob::kAv1 && (noisy || !is_noise_knob(k))) knobs.push_back(k);
+  }
   return knobs;
 }
 
@@ -161,6 +187,26 @@ SweepPoint varied(const SweepValues& s, Knob k, size_t i, uint32_t view_count) {
       p.value = number(s.steps[i]);
       p.label = fmt::format("s{}", p.value);
       break;
+    case Knob::kAv1:
+      p.encode.colour = encoder::ColourCoding::kAv1;
+      p.encode.cell = s.av1_cell;
+      p.encode.av1_444 = s.av1[i].chroma444;
+      p.encode.av1_crf = s.av1[i].crf;
+      p.encode.av1_keyframe_interval = s.av1_keyframe_interval;
+      p.value = fmt::format("{}:{}", s.av1[i].chroma444 ? 444 : 420, s.av1[i].crf);
+      p.label = "av1 " + p.value;
+      break;
+    case Knob::kDenoise:
+      p.encode.denoise_window = s.denoise[i];
+      p.value = number(s.denoise[i]);
+      p.label = fmt::format("dn{}", p.value);
+      break;
+    case Knob::kMargin:
+      p.encode.psnr_auto = true;
+      p.encode.noise_margin = s.margins[i];
+      p.value = number(s.margins[i]);
+      p.label = fmt::format("m{}", p.value);
+      break;
     case Knob::kBase:
       break;
   }
@@ -187,6 +233,12 @@ size_t value_count(const SweepValues& s, Knob k) {
       return s.views.size();
     case Knob::kSteps:
       return s.steps.size();
+    case Knob::kAv1:
+      return s.av1.size();
+    case Knob::kDenoise:
+      return s.denoise.size();
+    case Knob::kMargin:
+      return s.margins.size();
     case Knob::kBase:
       break;
   }
@@ -208,6 +260,9 @@ ScenePlan plan_scene(const SweepValues& s, uint32_t view_count) {
   for (Knob k : all_knobs()) {
     if (std::find(s.knobs.begin(), s.knobs.end(), k) == s.knobs.end()) continue;
     std::vector<size_t> rows;
+    // AV1 colour and --psnr auto have no value equal to the base's: their tables start with the
+    // base's row (BC colour, Q 50) to compare with.
+    if (k == Knob::kAv1 || k == Knob::kMargin) rows.push_back(0);
     for (size_t i = 0; i < value_count(s, k); ++i) {
       SweepPoint p = varied(s, k, i, view_count);
       size_t at = plan.points.size();
@@ -228,7 +283,7 @@ ScenePlan plan_scene(const SweepValues& s, uint32_t view_count) {
   return plan;
 }
 
-bool parse_knobs(const std::string& text, std::vector<Knob>* out, std::string* error) {
+bool parse_knobs(const std::string& text, bool noisy, std::vector<Knob>* out, std::string* error) {
   out->clear();
   size_t at = 0;
   while (at <= text.size()) {
@@ -236,7 +291,9 @@ bool parse_knobs(const std::string& text, std::vector<Knob>* out, std::string* e
     if (comma == std::string::npos) comma = text.size();
     const std::string item = text.substr(at, comma - at);
     if (item == "all") {
-      *out = all_knobs();
+      for (Knob k : default_knobs(noisy)) {
+        if (std::find(out->begin(), out->end(), k) == out->end()) out->push_back(k);
+      }
     } else {
       const auto& known = all_knobs();
       auto it =
@@ -249,6 +306,30 @@ bool parse_knobs(const std::string& text, std::vector<Knob>* out, std::string* e
       }
       if (std::find(out->begin(), out->end(), *it) == out->end()) out->push_back(*it);
     }
+    at = comma + 1;
+  }
+  return true;
+}
+
+bool parse_av1_points(const std::string& text, std::vector<Av1Point>* out, std::string* error) {
+  out->clear();
+  size_t at = 0;
+  while (at <= text.size()) {
+    size_t comma = text.find(',', at);
+    if (comma == std::string::npos) comma = text.size();
+    const std::string item = text.substr(at, comma - at);
+    const size_t colon = item.find(':');
+    const std::string chroma = item.substr(0, colon);
+    const std::string crf = colon == std::string::npos ? "" : item.substr(colon + 1);
+    char* end = nullptr;
+    const unsigned long v = std::strtoul(crf.c_str(), &end, 10);
+    if ((chroma != "420" && chroma != "444") || crf.empty() || *end != 0 || crf[0] == '-' ||
+        crf[0] == '+' || v < 1 || v > 63) {
+      *error =
+          fmt::format("--av1: '{}' is not CHROMA:CRF with CHROMA 420 or 444 and CRF 1..63", item);
+      return false;
+    }
+    out->push_back({chroma == "444", static_cast<uint32_t>(v)});
     at = comma + 1;
   }
   return true;
