@@ -14,6 +14,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include <fmt/format.h>
@@ -23,6 +24,7 @@
 #include "calf/decoder/tiles_track.h"
 #include "calf/export/mesh_export.h"
 #include "calf/export/tiles_export.h"
+#include "calf/format/av1_hdr_colour.h"
 #include "calf/format/container.h"
 #include "calf/format/files.h"
 #include "command_line.h"
@@ -176,6 +178,15 @@ constexpr const char* kWebNpmFiles[] = {
     "xz-decompress/dist/package/xz-decompress.js",
     "xz-decompress/package.json",
 };
+// The WebAssembly AV1 decoder the page loads where the browser's WebCodecs does not decode a
+// clip's AV1 colour (web/index.html: libav.js's av1-opus variant, its single-threaded WebAssembly
+// build; package.json names its licence, LGPL-2.1): copied only for a clip with AV1 colour.
+constexpr const char* kWebAv1Files[] = {
+    "@libav.js/variant-av1-opus/dist/libav-av1-opus.mjs",
+    "@libav.js/variant-av1-opus/dist/libav-6.10.9.0-av1-opus.wasm.mjs",
+    "@libav.js/variant-av1-opus/dist/libav-6.10.9.0-av1-opus.wasm.wasm",
+    "@libav.js/variant-av1-opus/package.json",
+};
 // What the page's imports of build/npm become in the folder.
 constexpr const char* kWebNpmFrom = "../build/npm/node_modules/";
 constexpr const char* kWebNpmTo = "./npm/";
@@ -185,8 +196,9 @@ struct WebSources {
   fs::path web, npm;  // web/ (index.html, src/) and node_modules
 };
 
-// The first place holding every file, or CALF-E485 naming the first file missing in the last.
-calf::Expected<WebSources> find_web_sources() {
+// The first place holding every file (with `av1`, kWebAv1Files too), or CALF-E485 naming the
+// first file missing in the last.
+calf::Expected<WebSources> find_web_sources(bool av1) {
   std::vector<WebSources> candidates;
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
@@ -199,6 +211,9 @@ calf::Expected<WebSources> find_web_sources() {
   for (const WebSources& c : candidates) {
     std::vector<fs::path> needed = {c.web / "index.html", c.web / "src" / "player.js"};
     for (const char* f : kWebNpmFiles) needed.push_back(c.npm / f);
+    if (av1) {
+      for (const char* f : kWebAv1Files) needed.push_back(c.npm / f);
+    }
     missing.clear();
     for (const fs::path& f : needed) {
       if (!fs::is_regular_file(f, ec)) {
@@ -266,10 +281,16 @@ class TempDir {
 };
 
 int export_web(const std::string& clip, const std::string& dir, bool quiet) {
-  // The clip must be one calf reads (not a calf file, unreadable: its own id).
+  // The clip must be one calf reads (not a calf file, unreadable: its own id). A lightfield track
+  // with AV1 colour takes the WebAssembly decoder along.
+  bool av1 = false;
   {
     auto reader = calf::container::Reader::open(clip);
     if (!reader.ok()) return fail(reader.status());
+    for (const auto& track : reader->tracks()) {
+      const auto* lf = std::get_if<calf::container::LightfieldTrackHeader>(&track.header);
+      if (lf != nullptr && calf::lf::is_av1_colour(lf->colour_format)) av1 = true;
+    }
   }
   std::error_code ec;
   const fs::path target = fs::path(dir).lexically_normal();
@@ -281,7 +302,7 @@ int export_web(const std::string& clip, const std::string& dir, bool quiet) {
                                dir + " exists and is not an empty folder"));
     }
   }
-  auto sources = find_web_sources();
+  auto sources = find_web_sources(av1);
   if (!sources.ok()) return fail(sources.status());
   const WebSources& src = sources.value();
 
@@ -339,6 +360,11 @@ int export_web(const std::string& clip, const std::string& dir, bool quiet) {
   if (ec) return write_error((src.web / "src").string());
   for (const char* f : kWebNpmFiles) {
     if (!copy(src.npm / f, temp.path() / kWebNpmTo / f)) return write_error(f);
+  }
+  if (av1) {
+    for (const char* f : kWebAv1Files) {
+      if (!copy(src.npm / f, temp.path() / kWebNpmTo / f)) return write_error(f);
+    }
   }
   if (!copy(clip, temp.path() / clip_name)) return write_error(clip);
   // Into place whole: a new folder, or over an empty one (rename(2) replaces an empty folder).
