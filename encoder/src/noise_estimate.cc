@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "calf/encoder/colour_denoise.h"
 #include "calf/format/colour.h"
 #include "lightfield_internal.h"
 
@@ -256,6 +257,25 @@ double auto_psnr_db(const NoiseEstimate& estimate, double margin, double cap) {
 double auto_noise_psnr_db(const NoiseEstimate& estimate, double margin, double cap) {
   if (!estimate.psnr_db || !(auto_psnr_db(estimate, margin, cap) < cap)) return 0;
   return std::clamp(*estimate.psnr_db, 1e-3, 300.0);
+}
+
+Expected<CaptureNoise> apply_auto_psnr(const std::filesystem::path& dir, double margin,
+                                       bool denoise_auto, LightfieldEncodeOptions* options) {
+  LightfieldEncodeOptions& o = *options;
+  CALF_RETURN_IF_ERROR(check_lightfield_options(o));
+  CALF_ASSIGN_OR_RETURN(capture::CaptureSetReader input,
+                        capture::CaptureSetReader::open(dir, o.max_image_pixels));
+  NoiseEstimateOptions no;
+  no.threads = o.threads;
+  no.max_image_pixels = o.max_image_pixels;
+  CALF_ASSIGN_OR_RETURN(CaptureNoise noise, estimate_capture_noise(input, o.colour, no));
+  o.min_psnr_db = auto_psnr_db(noise.set, margin);
+  o.noise_psnr_db = auto_noise_psnr_db(noise.set, margin);
+  if (denoise_auto) {
+    o.denoise_window =
+        o.noise_psnr_db > 0 && o.colour != ColourCoding::kAv1 ? kDefaultDenoiseWindow : 0;
+  }
+  return noise;
 }
 
 }  // namespace calf::encoder

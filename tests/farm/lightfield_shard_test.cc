@@ -226,6 +226,20 @@ void make_noisy_mirror_box(const fs::path& dir) {
   ASSERT_TRUE(samples::render_capture_set(*scene, r, dir, nullptr).ok());
 }
 
+// What --psnr auto gives that capture (Q 42.7 dB, the noise-aware test at its 45.7 dB estimate,
+// factor 3), in segments of 2 frames with a depth keyframe every frame, so that frame-range
+// shards can split it.
+encoder::LightfieldEncodeOptions noise_aware_options() {
+  encoder::LightfieldEncodeOptions o;
+  o.threads = 2;
+  o.segment_frames = 2;
+  o.depth_keyframe_interval = 1;
+  o.min_psnr_db = 42.7;
+  o.noise_psnr_db = 45.7;
+  o.noise_factor = 3;
+  return o;
+}
+
 // The noise-aware keyframe test (--psnr auto on a capture with per-frame render noise): the
 // analysis file records the noise estimate and factor, and frame-range shards code each segment's
 // cells as one encode does (each segment measures its own cells' noise).
@@ -234,13 +248,7 @@ TEST(LightfieldShardFrames, NoiseAwareShardsEqualOneMachineEncode) {
   ASSERT_NO_FATAL_FAILURE(make_noisy_mirror_box(dir));
   const fs::path work = scratch() / "noisy-work";
   fs::create_directories(work);
-  encoder::LightfieldEncodeOptions o;
-  o.threads = 2;
-  o.segment_frames = 2;
-  o.depth_keyframe_interval = 1;
-  o.min_psnr_db = 42.7;
-  o.noise_psnr_db = 45.7;
-  o.noise_factor = 3;
+  encoder::LightfieldEncodeOptions o = noise_aware_options();
   const std::string one = (work / "one.calf").string();
   ASSERT_TRUE(encoder::encode_lightfield_file(dir, one, o).ok());
   encoder::LightfieldEncodeOptions plain = o;
@@ -270,13 +278,7 @@ TEST(LightfieldShardFrames, DenoisedShardsEqualOneMachineEncode) {
   ASSERT_NO_FATAL_FAILURE(make_noisy_mirror_box(dir));
   const fs::path work = scratch() / "denoise-work";
   fs::create_directories(work);
-  encoder::LightfieldEncodeOptions o;
-  o.threads = 2;
-  o.segment_frames = 2;
-  o.depth_keyframe_interval = 1;
-  o.min_psnr_db = 42.7;
-  o.noise_psnr_db = 45.7;
-  o.noise_factor = 3;
+  encoder::LightfieldEncodeOptions o = noise_aware_options();
   o.denoise_window = 4;
   const std::string one = (work / "one.calf").string();
   auto stats = encoder::encode_lightfield_file(dir, one, o);

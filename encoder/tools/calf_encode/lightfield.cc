@@ -50,22 +50,9 @@ inline constexpr EnumTable<bool, 2> kAv1Chroma = {{{"420", false}, {"444", true}
 // `quiet`. Returns 0, or the exit status of the error it printed.
 int resolve_auto_psnr(const std::filesystem::path& dir, double margin, bool denoise_auto,
                       bool quiet, encoder::LightfieldEncodeOptions* o) {
-  if (Status s = encoder::check_lightfield_options(*o); !s.ok()) return fail(s);
   const auto t0 = std::chrono::steady_clock::now();
-  auto input = capture::CaptureSetReader::open(dir, o->max_image_pixels);
-  if (!input.ok()) return fail(input.status());
-  encoder::NoiseEstimateOptions no;
-  no.threads = o->threads;
-  no.max_image_pixels = o->max_image_pixels;
-  auto noise = encoder::estimate_capture_noise(*input, o->colour, no);
+  auto noise = encoder::apply_auto_psnr(dir, margin, denoise_auto, o);
   if (!noise.ok()) return fail(noise.status());
-  o->min_psnr_db = encoder::auto_psnr_db(noise->set, margin);
-  o->noise_psnr_db = encoder::auto_noise_psnr_db(noise->set, margin);
-  if (denoise_auto) {
-    o->denoise_window = o->noise_psnr_db > 0 && o->colour != encoder::ColourCoding::kAv1
-                            ? encoder::kDefaultDenoiseWindow
-                            : 0;
-  }
   if (quiet) return 0;
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

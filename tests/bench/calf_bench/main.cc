@@ -41,25 +41,13 @@ int fail(const std::string& message, int code) {
   return code;
 }
 
-std::vector<std::string> split(const std::string& text) {
-  std::vector<std::string> out;
-  size_t at = 0;
-  while (at <= text.size()) {
-    size_t comma = text.find(',', at);
-    if (comma == std::string::npos) comma = text.size();
-    out.push_back(text.substr(at, comma - at));
-    at = comma + 1;
-  }
-  return out;
-}
-
 // Parses a comma-separated list of numbers in [lo, hi] (multiples of `step` when step > 0);
 // "all" becomes 0 when `allow_all`. The error names the option and the item.
 template <typename T>
 bool parse_numbers(const std::string& option, const std::string& text, double lo, double hi,
                    uint32_t step, bool allow_all, std::vector<T>* out, std::string* error) {
   out->clear();
-  for (const std::string& item : split(text)) {
+  for (const std::string& item : split_commas(text)) {
     if (allow_all && item == "all") {
       out->push_back(0);
       continue;
@@ -86,7 +74,7 @@ template <typename T>
 bool parse_names(const std::string& option, const std::string& text,
                  const std::map<std::string, T>& names, std::vector<T>* out, std::string* error) {
   out->clear();
-  for (const std::string& item : split(text)) {
+  for (const std::string& item : split_commas(text)) {
     auto it = names.find(item);
     if (it == names.end()) {
       std::string known;
@@ -470,7 +458,7 @@ int main(int argc, char** argv) {
                   2);
     }
   }
-  for (const std::string& s : split(scenes)) {
+  for (const std::string& s : split_commas(scenes)) {
     bool known = false;
     std::string names;
     for (const samples::SceneInfo& i : samples::builtin_scenes()) {

@@ -100,19 +100,8 @@ Expected<EncodeOutcome> SceneInputs::encode(const EncodeConfig& c, const fs::pat
   if (c.psnr_auto) {
     // calf-encode --psnr auto --psnr-noise-margin M --denoise-window auto: Q, the noise-aware
     // test and the pre-filter's window from the capture's render-noise estimate.
-    CALF_RETURN_IF_ERROR(encoder::check_lightfield_options(o));
-    CALF_ASSIGN_OR_RETURN(capture::CaptureSetReader input,
-                          capture::CaptureSetReader::open(capture_dir_, o.max_image_pixels));
-    encoder::NoiseEstimateOptions no;
-    no.threads = o.threads;
-    no.max_image_pixels = o.max_image_pixels;
-    CALF_ASSIGN_OR_RETURN(encoder::CaptureNoise noise,
-                          encoder::estimate_capture_noise(input, o.colour, no));
-    o.min_psnr_db = encoder::auto_psnr_db(noise.set, c.noise_margin);
-    o.noise_psnr_db = encoder::auto_noise_psnr_db(noise.set, c.noise_margin);
-    o.denoise_window = o.noise_psnr_db > 0 && o.colour != encoder::ColourCoding::kAv1
-                           ? encoder::kDefaultDenoiseWindow
-                           : 0;
+    CALF_ASSIGN_OR_RETURN(const encoder::CaptureNoise noise,
+                          encoder::apply_auto_psnr(capture_dir_, c.noise_margin, true, &o));
     out.noise_db = noise.set.psnr_db.value_or(0);
   }
   out.q_used = o.min_psnr_db;

@@ -283,13 +283,21 @@ ScenePlan plan_scene(const SweepValues& s, uint32_t view_count) {
   return plan;
 }
 
-bool parse_knobs(const std::string& text, bool noisy, std::vector<Knob>* out, std::string* error) {
-  out->clear();
+std::vector<std::string> split_commas(const std::string& text) {
+  std::vector<std::string> out;
   size_t at = 0;
   while (at <= text.size()) {
     size_t comma = text.find(',', at);
     if (comma == std::string::npos) comma = text.size();
-    const std::string item = text.substr(at, comma - at);
+    out.push_back(text.substr(at, comma - at));
+    at = comma + 1;
+  }
+  return out;
+}
+
+bool parse_knobs(const std::string& text, bool noisy, std::vector<Knob>* out, std::string* error) {
+  out->clear();
+  for (const std::string& item : split_commas(text)) {
     if (item == "all") {
       for (Knob k : default_knobs(noisy)) {
         if (std::find(out->begin(), out->end(), k) == out->end()) out->push_back(k);
@@ -306,18 +314,13 @@ bool parse_knobs(const std::string& text, bool noisy, std::vector<Knob>* out, st
       }
       if (std::find(out->begin(), out->end(), *it) == out->end()) out->push_back(*it);
     }
-    at = comma + 1;
   }
   return true;
 }
 
 bool parse_av1_points(const std::string& text, std::vector<Av1Point>* out, std::string* error) {
   out->clear();
-  size_t at = 0;
-  while (at <= text.size()) {
-    size_t comma = text.find(',', at);
-    if (comma == std::string::npos) comma = text.size();
-    const std::string item = text.substr(at, comma - at);
+  for (const std::string& item : split_commas(text)) {
     const size_t colon = item.find(':');
     const std::string chroma = item.substr(0, colon);
     const std::string crf = colon == std::string::npos ? "" : item.substr(colon + 1);
@@ -330,7 +333,6 @@ bool parse_av1_points(const std::string& text, std::vector<Av1Point>* out, std::
       return false;
     }
     out->push_back({chroma == "444", static_cast<uint32_t>(v)});
-    at = comma + 1;
   }
   return true;
 }

@@ -57,6 +57,9 @@ struct ScenePlan {
 // count become the count).
 ScenePlan plan_scene(const SweepValues& values, uint32_t view_count);
 
+// The items of a comma-separated list, empty ones kept ("" is one empty item).
+std::vector<std::string> split_commas(const std::string& text);
+
 // Parses a comma-separated knob list ("q,cell,views" or "all"); the error names the bad item
 // and lists the known knobs.
 // "all" is default_knobs(noisy).

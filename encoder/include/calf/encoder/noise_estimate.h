@@ -27,6 +27,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <optional>
 #include <span>
 #include <vector>
@@ -122,5 +123,14 @@ double auto_psnr_db(const NoiseEstimate& estimate, double margin, double cap = k
 // whose noise lies far below Q codes as with a number).
 double auto_noise_psnr_db(const NoiseEstimate& estimate, double margin,
                           double cap = kAutoPsnrCapDb);
+
+// --psnr auto as calf-encode applies it: checks `options`, estimates the render noise of the
+// capture set at `dir` (estimate_capture_noise with options' threads and image limit) and sets
+// options->min_psnr_db = auto_psnr_db and noise_psnr_db = auto_noise_psnr_db with `margin`; with
+// `denoise_auto` (--denoise-window auto) also options->denoise_window: kDefaultDenoiseWindow
+// (colour_denoise.h) where the noise-aware test is on and colour is not AV1, else 0. Returns the
+// estimate. Errors: check_lightfield_options', the capture set's, estimate_capture_noise's.
+Expected<CaptureNoise> apply_auto_psnr(const std::filesystem::path& dir, double margin,
+                                       bool denoise_auto, LightfieldEncodeOptions* options);
 
 }  // namespace calf::encoder
