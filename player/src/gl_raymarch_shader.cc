@@ -54,6 +54,8 @@ uniform float smooth_log_ratio;  // ln(1 + smooth_depth_ratio)
 uniform float depth_decay;
 uniform float cam_decay;
 uniform float colour_depth_tolerance;
+uniform float colour_sharpen;             // LightfieldRenderOptions::colour_sharpen
+uniform float colour_sharpen_jump_texels;
 uniform float mixed_penalty_factor;  // exp(-mixed_texel_penalty); 1 = off
 uniform float mixed_texel_bend_texels;  // in texel angles, 2 / face size radians
 uniform uint coverage_mode;      // LightfieldRenderOptions::coverage (read with CALF_COVERAGE only)
@@ -508,6 +510,37 @@ float tap_purity(CalfView v, ivec3 t) {
   return mixed_texel(v, t) ? mixed_penalty_factor : 1.0;
 }
 
+// ---- sharpen_strengths (sampling.cc), LightfieldCpuRenderer::tap_colour: the colour a bilinear
+// tap reads, sharpened between texel centres ----
+vec2 sharpen_strengths(Taps taps) {
+  vec2 a = vec2(taps.weight[1] + taps.weight[3], taps.weight[2] + taps.weight[3]);
+  return colour_sharpen * 4.0 * a * (1.0 - a);
+}
+
+vec3 tap_colour(CalfView v, ivec3 t, vec2 strength) {
+  vec3 c = colour_at(v, t);
+  if ((!(strength.x > 0.0) && !(strength.y > 0.0)) || mixed_texel(v, t)) return c;
+  uint code = depth_code(v, t);
+  bool sky = code == CALF_LOG16_SKY;
+  float jump = texel_angles_in_codes(v, colour_sharpen_jump_texels);
+  vec3 sum = vec3(0.0);
+  for (int axis = 0; axis < 2; ++axis) {
+    float s = axis == 0 ? strength.x : strength.y;
+    if (!(s > 0.0)) continue;
+    ivec2 d = axis == 0 ? ivec2(1, 0) : ivec2(0, 1);
+    ivec3 ta = texel_beyond_face(t.z, t.x - d.x, t.y - d.y, v.face_size);
+    ivec3 tb = texel_beyond_face(t.z, t.x + d.x, t.y + d.y, v.face_size);
+    uint ca = depth_code(v, ta), cb = depth_code(v, tb);
+    if ((ca == CALF_LOG16_SKY) != sky || (cb == CALF_LOG16_SKY) != sky) continue;
+    if (!sky && (abs(float(ca) - float(code)) > jump || abs(float(cb) - float(code)) > jump)) {
+      continue;
+    }
+    if (mixed_texel(v, ta) || mixed_texel(v, tb)) continue;
+    sum += s * (2.0 * c - colour_at(v, ta) - colour_at(v, tb));
+  }
+  return max(c + sum, vec3(0.0));
+}
+
 // ---- LightfieldCpuRenderer::shade_surface: SampleColor + CalculateColor ----
 // The weighted mean is accumulated online, rescaled whenever a larger log weight arrives: the
 // same exp(log_w - best) normalisation as the CPU's two passes, without an array of views.
@@ -553,7 +586,8 @@ vec3 shade_surface(vec3 o, vec3 p, out int best_view, out vec3 best_colour) {
         }
         asum += a[t];
       }
-      for (int t = 0; t < 4; ++t) c += a[t] / asum * colour_at(v, taps.texel[t]);
+      vec2 strength = sharpen_strengths(taps);
+      for (int t = 0; t < 4; ++t) c += a[t] / asum * tap_colour(v, taps.texel[t], strength);
       if (depth_aware_colour) log_w = -depth_decay * dmin + log(asum);
     }
     log_w -= cam_decay * length(o - v.position) / hit_distance;
@@ -599,7 +633,8 @@ vec3 shade_sky(vec3 d) {
           if (a[t] > 0.0) a[t] *= tap_purity(v, taps.texel[t]);
           asum += a[t];
         }
-        for (int t = 0; t < 4; ++t) c += a[t] / asum * colour_at(v, taps.texel[t]);
+        vec2 strength = sharpen_strengths(taps);
+      for (int t = 0; t < 4; ++t) c += a[t] / asum * tap_colour(v, taps.texel[t], strength);
         w = asum / unpenalised;
       }
       sum += w * c;

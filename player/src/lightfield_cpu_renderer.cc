@@ -77,6 +77,12 @@ Status validate_render_options(const LightfieldRenderOptions& o) {
   if (!(o.colour_depth_tolerance >= 0) || !std::isfinite(o.colour_depth_tolerance)) {
     return option_error("colour_depth_tolerance must be finite and >= 0");
   }
+  if (!(o.colour_sharpen >= 0 && o.colour_sharpen <= 1)) {
+    return option_error("colour_sharpen must be in [0, 1]");
+  }
+  if (!(o.colour_sharpen_jump_texels >= 0) || !std::isfinite(o.colour_sharpen_jump_texels)) {
+    return option_error("colour_sharpen_jump_texels must be finite and >= 0");
+  }
   if (!(o.mixed_texel_penalty >= 0 && o.mixed_texel_penalty <= 50)) {
     return option_error("mixed_texel_penalty must be in [0, 50]");
   }
@@ -367,6 +373,42 @@ double LightfieldCpuRenderer::tap_purity(const View& v, const Texel& t) const {
              : 1;
 }
 
+// A bilinear colour tap: the texel's colour, sharpened along each axis with strength[axis]
+// (LightfieldRenderOptions::colour_sharpen) where the texel and both its neighbours along the
+// axis lie on one surface and none is a mixed texel, whose colour holds the other side's.
+void LightfieldCpuRenderer::tap_colour(const View& v, const Texel& t, const double strength[2],
+                                       double rgb[3]) const {
+  const float* c = v.colour_at(t.face, t.x, t.y);
+  for (int ch = 0; ch < 3; ++ch) rgb[ch] = c[ch];
+  if (!(strength[0] > 0) && !(strength[1] > 0)) return;
+  const double bend_codes = texel_angles_in_codes(v, options_.mixed_texel_bend_texels);
+  if (mixed_texel(v, t, bend_codes)) return;
+  const double jump_codes = texel_angles_in_codes(v, options_.colour_sharpen_jump_texels);
+  const uint16_t code = v.depth_code_at(t.face, t.x, t.y);
+  double sum[3] = {0, 0, 0};
+  for (int axis = 0; axis < 2; ++axis) {
+    if (!(strength[axis] > 0)) continue;
+    const float* side[2];
+    bool same_surface = true;
+    for (int s = 0; s < 2 && same_surface; ++s) {
+      const int64_t step = s == 0 ? -1 : 1;
+      const Texel u = internal::texel_beyond_face(t.face, int64_t{t.x} + (axis == 0 ? step : 0),
+                                                  int64_t{t.y} + (axis == 1 ? step : 0),
+                                                  v.face_size());
+      const uint16_t other = v.depth_code_at(u.face, u.x, u.y);
+      same_surface = (other == kLog16Sky) == (code == kLog16Sky) &&
+                     (code == kLog16Sky || std::abs(int{other} - int{code}) <= jump_codes) &&
+                     !mixed_texel(v, u, bend_codes);
+      side[s] = v.colour_at(u.face, u.x, u.y);
+    }
+    if (!same_surface) continue;
+    for (int ch = 0; ch < 3; ++ch) {
+      sum[ch] += strength[axis] * (2.0 * c[ch] - side[0][ch] - side[1][ch]);
+    }
+  }
+  for (int ch = 0; ch < 3; ++ch) rgb[ch] = std::max(0.0, rgb[ch] + sum[ch]);
+}
+
 // BetweenViewpointAndGeometry (footnote 2) over the active views: true as soon as one view that
 // is not too near sees p in front of its stored surface (or sees sky there) by more than
 // `margin_texels` of its own texels, as relative depth margin_texels x 2 / face size (0 for the
@@ -593,8 +635,11 @@ void LightfieldCpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* 
         }
         asum += a[t];
       }
+      double strength[2];
+      internal::sharpen_strengths(taps, options_.colour_sharpen, strength);
       for (int t = 0; t < 4; ++t) {
-        const float* col = v.colour_at(taps.texel[t].face, taps.texel[t].x, taps.texel[t].y);
+        double col[3];
+        tap_colour(v, taps.texel[t], strength, col);
         for (int ch = 0; ch < 3; ++ch) k.c[ch] += a[t] / asum * col[ch];
       }
       // Depth-aware: the view's w_depth is the bilinear blend of its taps' agreements.
@@ -652,8 +697,11 @@ void LightfieldCpuRenderer::shade_sky(const Vec3& /*origin*/, const Vec3& d, dou
           if (a[t] > 0) a[t] *= tap_purity(*v, taps.texel[t]);
           asum += a[t];
         }
+        double strength[2];
+        internal::sharpen_strengths(taps, options_.colour_sharpen, strength);
         for (int t = 0; t < 4; ++t) {
-          const float* col = v->colour_at(taps.texel[t].face, taps.texel[t].x, taps.texel[t].y);
+          double col[3];
+          tap_colour(*v, taps.texel[t], strength, col);
           for (int ch = 0; ch < 3; ++ch) c[ch] += a[t] / asum * col[ch];
         }
         w = asum / unpenalised;

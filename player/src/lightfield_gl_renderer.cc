@@ -192,6 +192,8 @@ Status LightfieldGlRenderer::draw(const Camera& camera, std::span<const uint32_t
   gl.Uniform1f(loc("depth_decay"), f(o.depth_decay));
   gl.Uniform1f(loc("cam_decay"), f(o.cam_decay));
   gl.Uniform1f(loc("colour_depth_tolerance"), f(o.colour_depth_tolerance));
+  gl.Uniform1f(loc("colour_sharpen"), f(o.colour_sharpen));
+  gl.Uniform1f(loc("colour_sharpen_jump_texels"), f(o.colour_sharpen_jump_texels));
   gl.Uniform1f(loc("mixed_penalty_factor"), f(std::exp(-o.mixed_texel_penalty)));
   gl.Uniform1f(loc("mixed_texel_bend_texels"), f(o.mixed_texel_bend_texels));
   gl.Uniform1ui(loc("coverage_mode"), o.coverage);

@@ -36,4 +36,10 @@ BilinearTaps bilinear_taps(const FaceTexelCoord& c, uint32_t n) {
   return t;
 }
 
+void sharpen_strengths(const BilinearTaps& taps, double k, double strength[2]) {
+  const double ax = taps.weight[1] + taps.weight[3], ay = taps.weight[2] + taps.weight[3];
+  strength[0] = k * 4 * ax * (1 - ax);
+  strength[1] = k * 4 * ay * (1 - ay);
+}
+
 }  // namespace calf::player::internal

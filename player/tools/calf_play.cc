@@ -236,6 +236,20 @@ static int command_main(int argc, char** argv) {
                  "comes from texels wholly on one surface; 0..50, 0 = off (docs/RENDERING.md "
                  "\"Mixed texels\")")
       ->check(CLI::Range(0.0, 50.0));
+  app.add_option("--colour-sharpen", o.render.colour_sharpen,
+                 "light field: sharpened colour taps, giving back what a bilinear tap between "
+                 "texel centres blurs: each tap adds K 4 a (1 - a) times its texel's discrete "
+                 "Laplacian along each axis (a: the tap's fraction along it) whose neighbours lie "
+                 "on the texel's surface, none of them a mixed texel; 0..1, 0 = off "
+                 "(docs/RENDERING.md \"Sharpened colour\")")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  app.add_option("--colour-sharpen-jump", o.render.colour_sharpen_jump_texels,
+                 "light field, with --colour-sharpen: neighbours whose depth differs by more "
+                 "than this many texel angles (2 / face size radians) are another surface and "
+                 "stop the sharpening along their axis")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--coverage", o.render.coverage,
                  "light field: how the renderer (GL or CPU) uses a clip's coverage stream (SPEC "
                  "11.1.11) in its emptiness test, as bench-player_quality --coverage uses a "
@@ -284,7 +298,8 @@ static int command_main(int argc, char** argv) {
       {"--eye-path", "--out", "--format", "--compare", "--no-heat-maps", "--noise-floor",
        "--compare-clip", "--breakdown", "--breakdown-lossless", "--contact-sheet", "--sheet-rows"});
   group("Light field renderer", {"--steps", "--rr", "--no-rr-replace", "--hints", "--hint-substeps",
-                                 "--mixed-texel-penalty", "--supersample", "--views", "--priority",
+                                 "--mixed-texel-penalty", "--colour-sharpen", "--colour-sharpen-jump",
+                                 "--supersample", "--views", "--priority",
                                  "--frame-ms", "--no-view-dependent"});
   group("Light field coverage", {"--coverage", "--coverage-agreement", "--hint-coverage"});
   group("Surfels", {"--surfel-point-size", "--surfel-target-ms", "--surfel-clock", "--surfel-blend",

@@ -2,9 +2,9 @@
 // same views, under OSMesa (llvmpipe): PSNR between the two images of the same frame >= 45 dB and
 // the same hit distances, for plain and RR rendering (Alg. 4 and with the view's reflection
 // replaced), nearest and bilinear colour, one, several and a subset of views, HDR colour, every
-// depth-test variant, surface hints, supersampling, coverage; determinism; option and camera
-// errors. Renders stay at <= 128^2 with few views: llvmpipe is slow. Figures are printed for the
-// report.
+// depth-test variant, surface hints, supersampling, coverage, sharpened colour; determinism;
+// option and camera errors. Renders stay at <= 128^2 with few views: llvmpipe is slow. Figures
+// are printed for the report.
 #include "calf/player/lightfield_gl_renderer.h"
 
 #include <gtest/gtest.h>
@@ -256,6 +256,33 @@ TEST(LightfieldGlRenderer, MatchesCpuWithSupersampling) {
     report(n == 2 ? "tinted views, supersample 2" : "tinted views, supersample 3", c);
     EXPECT_GE(c.psnr, 45.0);
     expect_float_agreement(c, "supersample " + std::to_string(n));
+  }
+}
+
+// Sharpened colour taps (LightfieldRenderOptions::colour_sharpen) on anti-aliased views of a
+// textured room, seen across face seams: sharpening changes the image (else agreement would prove
+// nothing) and GL follows the CPU, also with a jump limit that stops it at the spheres' depth
+// steps and at slanted walls.
+TEST(LightfieldGlRenderer, MatchesCpuWithSharpenedColour) {
+  CALF_REQUIRE_GL();
+  Scene scene = room_with_spheres();
+  scene.texture_scale = 6;
+  const ViewSet views = make_views(scene, corner_views({0, 0, 0.5}, 1.0), 32, false, 2);
+  const Camera cam = between_views_camera(80);
+  LightfieldRenderOptions o;
+  const Comparison plain = compare(views, cam, o);
+  for (const auto& [strength, jump] : {std::pair{0.2, 8.0}, std::pair{1.0, 1.0}}) {
+    o.colour_sharpen = strength;
+    o.colour_sharpen_jump_texels = jump;
+    const Comparison c = compare(views, cam, o);
+    char what[64];
+    std::snprintf(what, sizeof what, "textured room, colour sharpen %.1f, jump %.0f", strength,
+                  jump);
+    report(what, c);
+    EXPECT_LT(psnr_vs(plain.cpu.color, c.cpu.color), strength < 0.5 ? 40.0 : 30.0) << what;
+    EXPECT_GE(c.psnr, 45.0) << what;
+    expect_float_agreement(c, what);
+    EXPECT_GE(c.depth_agree, 0.99) << what;
   }
 }
 

@@ -800,6 +800,81 @@ TEST(LightfieldCpuRenderer, SupersamplingApproachesTheAntiAliasedImage) {
   }
 }
 
+// Sharpened colour taps (LightfieldRenderOptions::colour_sharpen), worked by hand: one view, the
+// eye on it, a one-pixel camera along the ray through texel-space point (u, 8.5) of the -Z face,
+// whose rows read 0.5 but for column 9, 0.9 (0.1 for the clamp). Halfway between the centres of
+// columns 8 and 9 (u = 9, a = 1/2 along x, 0 along y) each tap adds k 4 a (1 - a) = k times its
+// Laplacian along x: column 8 reads 0.5 + k (1.0 - 1.4), column 9 0.9 + k (1.8 - 1.0), so the
+// pixel is 0.7 + 0.2 k. At a texel centre (a = 0) the texel is read as it is, whatever k. With
+// column 7 on another surface, column 8 is not sharpened: 0.7 + 0.4 k. With 0.1 at column 9 and
+// k = 1, column 8 reads 0.5 + (1.0 - 0.6) and column 9 0.1 + (0.2 - 1.0) < 0: clamped, the pixel
+// is (0.9 + 0) / 2.
+TEST(LightfieldCpuRenderer, SharpenedColourAddsTheLaplacianBetweenTexelCentres) {
+  constexpr uint32_t n = 16;
+  ViewSet views = make_views(Scene{}, {{0, 0, 0}}, n);  // the room alone: -Z is a flat wall
+  View& v = views.views[0];
+  const auto paint = [&](float column9) {
+    std::vector<float> rows(3 * n * n);
+    for (uint32_t k = 0; k < n * n; ++k) {
+      for (int ch = 0; ch < 3; ++ch) rows[3 * k + ch] = k % n == 9 ? column9 : 0.5f;
+    }
+    ASSERT_TRUE(v.write_colour_rect(CubeFace::kNegZ, {0, 0, n, n}, rows).ok());
+  };
+  const auto pixel_at = [&](double u, double k, double jump_texels = 8) {
+    Camera cam;
+    cam.position = v.position();
+    cam.forward = direction_from_texel_coord({CubeFace::kNegZ, u, 8.5}, n);
+    cam.fov_y = 0.01;
+    cam.width = cam.height = 1;
+    LightfieldRenderOptions o;
+    o.colour_sharpen = k;
+    o.colour_sharpen_jump_texels = jump_texels;
+    o.surface_hints = 0;
+    return render(views, cam, o).color[0];
+  };
+  paint(0.9f);
+  EXPECT_NEAR(pixel_at(9.0, 0), 0.7, 1e-4);
+  EXPECT_NEAR(pixel_at(9.0, 0.2), 0.7 + 0.2 * 0.2, 1e-4);
+  EXPECT_NEAR(pixel_at(9.0, 1), 0.7 + 0.2, 1e-4);
+  EXPECT_NEAR(pixel_at(9.5, 1), 0.9, 1e-4);  // column 9's centre
+  EXPECT_NEAR(pixel_at(8.5, 1), 0.5, 1e-4);  // column 8's
+  // Column 7 moves 25 % farther: ln 1.25 is 1.8 texel angles (2 / 16 radians) of this view,
+  // another surface for a jump limit of 1, the same surface for the default 8.
+  std::vector<uint16_t> code = {v.depth_code_at(CubeFace::kNegZ, 7, 8)};
+  const double z = v.range().decode(code[0]);
+  code[0] = v.range().encode_unchecked(static_cast<float>(1.25 * z));
+  ASSERT_TRUE(v.write_depth_rect(CubeFace::kNegZ, {7, 8, 1, 1}, code).ok());
+  EXPECT_NEAR(pixel_at(9.0, 0.2, 1), 0.7 + 0.4 * 0.2, 1e-4);
+  EXPECT_NEAR(pixel_at(9.0, 0.2), 0.7 + 0.2 * 0.2, 1e-4);
+  paint(0.1f);
+  EXPECT_NEAR(pixel_at(9.0, 1), (0.9 + 0) / 2, 1e-4);
+}
+
+// What sharpening buys (docs/RENDERING.md "Sharpened colour"): anti-aliased views of a textured
+// room (4 x 4 colour samples per texel, a few texels per period of the texture) seen between
+// viewpoints at about one texel per pixel, with 2 x 2 eye rays, against the 4 x 4 anti-aliased
+// ground truth. Bilinear taps blur each texel's footprint mean again; the default (k = 0.2) gives
+// part of it back, k = 1 overshoots.
+TEST(LightfieldCpuRenderer, SharpenedColourApproachesTheAntiAliasedImage) {
+  Scene scene = room_with_spheres();
+  scene.texture_scale = 6;
+  const ViewSet views = make_views(scene, corner_views({0, 0, 0.5}, 1.0), 64, false, 4);
+  const Camera cam = between_viewpoints_camera(56, 56);  // 1.25 degrees a pixel; texels 1.4
+  const RenderedImage gt = ground_truth(scene, cam, 4);
+  double p[3];
+  const double strengths[3] = {0, LightfieldRenderOptions{}.colour_sharpen, 1};
+  for (int k = 0; k < 3; ++k) {
+    LightfieldRenderOptions o;
+    o.supersample = 2;
+    o.colour_sharpen = strengths[k];
+    p[k] = psnr(render(views, cam, o).color, gt.color);
+    std::printf("colour_sharpen %.1f against the anti-aliased ground truth: %.2f dB\n",
+                strengths[k], p[k]);
+  }
+  EXPECT_GT(p[1], p[0] + 0.5);
+  EXPECT_LT(p[2], p[1]);
+}
+
 // Rays exactly along face seams and cube corners, from a viewpoint and from between viewpoints.
 TEST(LightfieldCpuRenderer, RaysAlongSeamsAndCorners) {
   const Scene scene = room_with_spheres();
@@ -898,6 +973,17 @@ TEST(LightfieldCpuRenderer, RejectsBadOptionsAndCameras) {
   o = {};
   for (double bad : {-0.5, std::numeric_limits<double>::infinity()}) {
     o.mixed_texel_bend_texels = bad;
+    EXPECT_EQ(code(o), ErrorId::kPlayerOptions) << bad;
+  }
+  o = {};
+  for (double bad : {-0.1, 1.5, std::nan("")}) {
+    o.colour_sharpen = bad;
+    EXPECT_EQ(code(o), ErrorId::kPlayerOptions) << bad;
+  }
+  o.colour_sharpen = 1;
+  EXPECT_TRUE(LightfieldCpuRenderer::make(views, o).ok());
+  for (double bad : {-1.0, std::numeric_limits<double>::infinity()}) {
+    o.colour_sharpen_jump_texels = bad;
     EXPECT_EQ(code(o), ErrorId::kPlayerOptions) << bad;
   }
   o = {};

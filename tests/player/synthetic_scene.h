@@ -28,6 +28,9 @@ struct Scene {
   std::vector<Sphere> spheres;
   bool mirror_floor = false;  // the floor y = -room_half is a perfect mirror (material (1, 0, 1))
   bool uniform_sky = false;   // sky is one colour instead of a gradient
+  // Multiplies the albedo's spatial frequencies: 1 is the smooth default, 8 a texture of a few
+  // texels per period at the tests' face sizes.
+  double texture_scale = 1;
 };
 
 inline Vec3 add(const Vec3& a, const Vec3& b) {
@@ -92,13 +95,15 @@ inline bool cast(const Scene& s, const Vec3& o, const Vec3& d, SceneHit* h) {
   return true;
 }
 
-// Smooth albedo, continuous across the room's walls (a function of position only) so that only
-// the spheres' silhouettes are colour edges; tens of texels per period at the tests' face sizes.
-inline void albedo(const SceneHit& h, double rgb[3]) {
+// Albedo, continuous across the room's walls (a function of position only) so that only the
+// spheres' silhouettes are colour edges; at `scale` 1 smooth, tens of texels per period at the
+// tests' face sizes (Scene::texture_scale multiplies its frequencies).
+inline void albedo(const SceneHit& h, double scale, double rgb[3]) {
   const double k = h.object >= 6 ? 0.4 * (h.object - 5) : 0.0;
-  rgb[0] = 0.5 + 0.3 * std::sin(0.9 * h.p.x + k) * std::cos(0.8 * h.p.z);
-  rgb[1] = 0.5 + 0.3 * std::cos(0.7 * h.p.y - 0.9 * h.p.x + 2 * k);
-  rgb[2] = 0.45 + 0.25 * std::sin(0.6 * h.p.z + 0.5 * h.p.y + k);
+  const Vec3 p = mul(h.p, scale);
+  rgb[0] = 0.5 + 0.3 * std::sin(0.9 * p.x + k) * std::cos(0.8 * p.z);
+  rgb[1] = 0.5 + 0.3 * std::cos(0.7 * p.y - 0.9 * p.x + 2 * k);
+  rgb[2] = 0.45 + 0.25 * std::sin(0.6 * p.z + 0.5 * p.y + k);
 }
 
 inline void sky(const Scene& s, const Vec3& d, double rgb[3]) {
@@ -129,7 +134,7 @@ inline void shade(const Scene& s, const Vec3& o, const Vec3& d, double rgb[3], d
     shade(s, h.p, r, rgb, &dummy, nullptr, bounces - 1);
     return;
   }
-  albedo(h, rgb);
+  albedo(h, s.texture_scale, rgb);
 }
 
 // The mean colour of k x k rays from `o` through the centres of a k x k grid over a pixel or

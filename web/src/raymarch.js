@@ -16,27 +16,29 @@ export const MAX_ACTIVE_VIEWS = 256;  // kGlMaxActiveViews
 export const RENDER_DEFAULTS = {
   steps: 64, refine_steps: 8, depth_footprint: 0.9, smooth_depth_ratio: 0, min_view_distance: -1,
   depth_decay: 500, cam_decay: 20, bilinear_colour: true, depth_aware_colour: true,
-  colour_depth_tolerance: 0.1, mixed_texel_penalty: 3, mixed_texel_bend_texels: 5,
+  colour_depth_tolerance: 0.1, colour_sharpen: 0.2, colour_sharpen_jump_texels: 8, mixed_texel_penalty: 3, mixed_texel_bend_texels: 5,
   tight_march_start: true, surface_hints: 1, surface_hint_margin_texels: 0.2, surface_hint_vetoes: 1,
   surface_hint_substeps: 4, supersample: 1, rr: false, rr_start: 0.05, rr_max_depth: 1,
   rr_replace_view_reflection: true, coverage: 0, coverage_threshold: 0.5, coverage_cluster: 0.05,
   coverage_agreement: 1, surface_hint_coverage: 1,
 };
-// The coverage options a page URL may set (index.html?coverage=3&hint-coverage=1), named as
-// calf-play's and bench-player_quality's options, with their ranges; the window player's C key
-// turns `coverage` on (its given mode, else 3) and off.
-export const COVERAGE_PARAMETERS = [
+// The render options a page URL may set (index.html?coverage=3&hint-coverage=1&colour-sharpen=0.1),
+// named as calf-play's and bench-player_quality's options, with their ranges; the window player's
+// C key turns `coverage` on (its given mode, else 3) and off.
+export const RENDER_PARAMETERS = [
   { name: 'coverage', option: 'coverage', min: 0, max: 4, integer: true },
   { name: 'coverage-threshold', option: 'coverage_threshold', min: 0, max: 1, integer: false },
   { name: 'coverage-cluster', option: 'coverage_cluster', min: 0, max: Infinity, integer: false },
   { name: 'coverage-agreement', option: 'coverage_agreement', min: 1, max: 65536, integer: true },
   { name: 'hint-coverage', option: 'surface_hint_coverage', min: 0, max: 1, integer: true },
+  { name: 'colour-sharpen', option: 'colour_sharpen', min: 0, max: 1, integer: false },
+  { name: 'colour-sharpen-jump', option: 'colour_sharpen_jump_texels', min: 0, max: Infinity, integer: false },
 ];
 // The render options that `params` (URLSearchParams) give on top of RENDER_DEFAULTS; a value that
 // is not a number in its range is CALF-E403, as the native renderer's options.
 export function renderOptionsFromParams(params) {
   const o = { ...RENDER_DEFAULTS };
-  for (const p of COVERAGE_PARAMETERS) {
+  for (const p of RENDER_PARAMETERS) {
     const text = params.get(p.name);
     if (text === null) continue;
     const x = Number(text);
@@ -358,6 +360,8 @@ export function makeRaymarcher(gl, { views, faceSize, cellSize, options = { ...R
     gl.uniform1f(U('depth_decay'), o.depth_decay);
     gl.uniform1f(U('cam_decay'), o.cam_decay);
     gl.uniform1f(U('colour_depth_tolerance'), o.colour_depth_tolerance);
+    gl.uniform1f(U('colour_sharpen'), o.colour_sharpen);
+    gl.uniform1f(U('colour_sharpen_jump_texels'), o.colour_sharpen_jump_texels);
     gl.uniform1f(U('mixed_penalty_factor'), Math.exp(-o.mixed_texel_penalty));
     gl.uniform1f(U('mixed_texel_bend_texels'), o.mixed_texel_bend_texels);
     gl.uniform1ui(U('coverage_mode'), o.coverage);

@@ -112,6 +112,21 @@ struct LightfieldRenderOptions {
   // slanted surfaces (neighbouring texels at different depths) skews bilinear weights towards the
   // nearest texel and shifts colour edges. >= 0.
   double colour_depth_tolerance = 0.1;
+  // Sharpened colour taps. A capture texel already holds its footprint's mean colour, and a
+  // bilinear tap between texel centres blurs it once more: at fraction a along an axis it keeps
+  // |1 - a + a e^(-2 pi i f)| of frequency f (cycles per texel), cos(pi f) halfway. So each of
+  // the four taps of a bilinear lookup (surface and sky) reads its texel's colour c plus, per
+  // axis, k 4 a (1 - a) (2c - p - q), p and q its neighbours along the axis (across face seams);
+  // the sum is clamped at 0. At a texel centre (a = 0: an eye at a viewpoint, pixel on texel)
+  // nothing changes; halfway k = 1/8 gives the weights of Catmull-Rom's cubic (-1/16, 9/16,
+  // 9/16, -1/16). An axis counts only where the texel and both neighbours lie on one surface
+  // (both sky, or log depths within colour_sharpen_jump_texels texel angles, 2 / face size
+  // radians each: a plane seen at incidence i steps by tan(i) of them per texel) and none of the
+  // three is a mixed texel (mixed_texel_bend_texels), whose colour holds the other side's: a
+  // depth edge is never sharpened across. colour_sharpen is k, in [0, 1], 0 = off; the jump is
+  // finite and >= 0. What they buy: docs/RENDERING.md "Sharpened colour".
+  double colour_sharpen = 0.2;
+  double colour_sharpen_jump_texels = 8;
   // Mixed texels. An anti-aliased capture (calf-capture's default, any offline renderer's) gives
   // a texel on a depth edge the mean colour of the surfaces on both sides, while its depth (the
   // centre ray's) names one of them: re-projected, it paints background colour into a surface
@@ -317,6 +332,7 @@ class LightfieldCpuRenderer {
   };
   RaySample shade_hit(const Vec3& origin, const Vec3& direction, const Hit* hit) const;
   double tap_purity(const View& v, const Texel& t) const;
+  void tap_colour(const View& v, const Texel& t, const double strength[2], double rgb[3]) const;
   bool hint_confirmed(const Vec3& o, const Vec3& d, double zb, double zc, const View* h) const;
   // `exclude` (nullptr: none): a surface point of an earlier layer; each view treats its texels
   // at that point's depth (within coverage_cluster) as absent
