@@ -7,8 +7,10 @@
 
 namespace calf {
 
-CellDirections cell_directions(CubeFace face, uint32_t face_size, const PixelRect& rect) {
-  const double u0 = rect.x, v0 = rect.y, u1 = rect.x + rect.width, v1 = rect.y + rect.height;
+CellDirections cell_directions(CubeFace face, uint32_t face_size, const PixelRect& rect,
+                               double grow_texels) {
+  const double u0 = rect.x - grow_texels, v0 = rect.y - grow_texels;
+  const double u1 = rect.x + rect.width + grow_texels, v1 = rect.y + rect.height + grow_texels;
   const double us[4] = {u0, u1, u1, u0}, vs[4] = {v0, v0, v1, v1};
   const Vec3 axis = direction_from_face_coord({face, 0.5, 0.5});
   CellDirections c;
@@ -44,9 +46,9 @@ Frustum frustum_of(const std::array<Vec3, 8>& p) {
 }  // namespace
 
 Frustum cell_frustum(const Vec3& viewpoint, CubeFace face, uint32_t face_size,
-                     const PixelRect& rect, double z_near, double z_far) {
-  return frustum_of(
-      cell_frustum_corners(cell_directions(face, face_size, rect), viewpoint, z_near, z_far));
+                     const PixelRect& rect, double z_near, double z_far, double grow_texels) {
+  return frustum_of(cell_frustum_corners(cell_directions(face, face_size, rect, grow_texels),
+                                         viewpoint, z_near, z_far));
 }
 
 namespace {
@@ -62,8 +64,8 @@ struct Search {
 
   // The eyes (indices into `eyes`, among `candidates`) whose frustum meets `range`'s frustum.
   std::vector<uint32_t> meeting(const CellRange& range, const std::vector<uint32_t>& candidates) {
-    const Frustum f =
-        cell_frustum(viewpoint, face, grid.face_size(), grid.rect_of_cells(range), z_near, z_far);
+    const Frustum f = cell_frustum(viewpoint, face, grid.face_size(), grid.rect_of_cells(range),
+                                   z_near, z_far, kRenderReachTexels);
     std::vector<uint32_t> hit;
     for (uint32_t e : candidates) {
       if (stats) ++stats->tests;
@@ -112,8 +114,8 @@ std::vector<uint32_t> visible_cells_brute_force(const Vec3& viewpoint, CubeFace 
   std::vector<uint32_t> out;
   for (uint32_t cy = 0; cy < grid.cells_per_side(); ++cy) {
     for (uint32_t cx = 0; cx < grid.cells_per_side(); ++cx) {
-      const Frustum f =
-          cell_frustum(viewpoint, face, grid.face_size(), grid.cell_rect(cx, cy), z_near, z_far);
+      const Frustum f = cell_frustum(viewpoint, face, grid.face_size(), grid.cell_rect(cx, cy),
+                                     z_near, z_far, kRenderReachTexels);
       for (const Frustum& eye : eyes) {
         if (stats) ++stats->tests;
         if (frusta_intersect(eye, f)) {
@@ -188,7 +190,8 @@ GridCuller::GridCuller(const FaceGrid& grid) : grid_(grid) {
           Node& n = nodes_[f][level_start_[l] + iy * (1u << l) + ix];
           n.range = grid.quadtree_node_cells(l, ix, iy);
           if (n.range.empty()) continue;
-          n.cell = cell_directions(face, grid.face_size(), grid.rect_of_cells(n.range));
+          n.cell = cell_directions(face, grid.face_size(), grid.rect_of_cells(n.range),
+                                   kRenderReachTexels);
           const Vec3 centre = n.cell.dirs[0] + n.cell.dirs[1] + n.cell.dirs[2] + n.cell.dirs[3];
           for (int i = 0; i < 4; ++i) {
             n.side[i] = cross(n.cell.dirs[i], n.cell.dirs[(i + 1) % 4]);

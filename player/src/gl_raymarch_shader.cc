@@ -538,7 +538,7 @@ vec3 tap_colour(CalfView v, ivec3 t, vec2 strength) {
     if (mixed_texel(v, ta) || mixed_texel(v, tb)) continue;
     sum += s * (2.0 * c - colour_at(v, ta) - colour_at(v, tb));
   }
-  return max(c + sum, vec3(0.0));
+  return clamp(c + sum, vec3(0.0), vec3(65504.0));  // what colour texels can hold
 }
 
 // ---- LightfieldCpuRenderer::shade_surface: SampleColor + CalculateColor ----

@@ -406,7 +406,9 @@ void LightfieldCpuRenderer::tap_colour(const View& v, const Texel& t, const doub
       sum[ch] += strength[axis] * (2.0 * c[ch] - side[0][ch] - side[1][ch]);
     }
   }
-  for (int ch = 0; ch < 3; ++ch) rgb[ch] = std::max(0.0, rgb[ch] + sum[ch]);
+  // Within what colour texels can hold (0 to the largest half float), so that a sharpened tap
+  // stays finite wherever a renderer stores it.
+  for (int ch = 0; ch < 3; ++ch) rgb[ch] = std::clamp(rgb[ch] + sum[ch], 0.0, 65504.0);
 }
 
 // BetweenViewpointAndGeometry (footnote 2) over the active views: true as soon as one view that

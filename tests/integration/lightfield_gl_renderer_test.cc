@@ -270,6 +270,7 @@ TEST(LightfieldGlRenderer, MatchesCpuWithSharpenedColour) {
   const ViewSet views = make_views(scene, corner_views({0, 0, 0.5}, 1.0), 32, false, 2);
   const Camera cam = between_views_camera(80);
   LightfieldRenderOptions o;
+  o.colour_sharpen = 0;
   const Comparison plain = compare(views, cam, o);
   for (const auto& [strength, jump] : {std::pair{0.2, 8.0}, std::pair{1.0, 1.0}}) {
     o.colour_sharpen = strength;

@@ -83,9 +83,14 @@ export function eyeFrustum(camera, near, far) {
   return frustum(n, fa);
 }
 
-// cell_directions + cell_frustum_corners for one rect of a face.
+// kRenderReachTexels (calf/decoder/culling.h): each cell's rect is tested grown by this much, so
+// that every texel a visible point's colour reads (bilinear and sharpened taps) is decoded.
+export const RENDER_REACH_TEXELS = 2;
+
+// cell_directions + cell_frustum_corners for one rect of a face, grown by RENDER_REACH_TEXELS.
 function cellFrustum(apex, face, faceSize, rect, zNear, zFar) {
-  const u0 = rect.x, v0 = rect.y, u1 = rect.x + rect.w, v1 = rect.y + rect.h;
+  const g = RENDER_REACH_TEXELS;
+  const u0 = rect.x - g, v0 = rect.y - g, u1 = rect.x + rect.w + g, v1 = rect.y + rect.h + g;
   const us = [u0, u1, u1, u0], vs = [v0, v0, v1, v1];
   const axis = faceDirection(face, 0.5, 0.5);
   const dirs = [], cos = [];

@@ -27,10 +27,17 @@
 
 namespace calf {
 
+// How far, in texels, the light-field renderers read around a point they sample: a bilinear tap
+// lies within one texel of it, and a sharpened tap reads its neighbours one texel further
+// (LightfieldRenderOptions::colour_sharpen). The visibility searches below test each cell's
+// rectangle grown by this much, so that every texel a visible point's colour reads is decoded.
+inline constexpr double kRenderReachTexels = 2;
+
 // The frustum of texel rectangle `rect` of `face` on a cube map of `face_size` texels centred at
-// `viewpoint`, for radial depths [z_near, z_far] (0 < z_near < z_far, finite).
+// `viewpoint`, for radial depths [z_near, z_far] (0 < z_near < z_far, finite), the rectangle
+// grown by `grow_texels` >= 0 on every side (continuing the face's plane past its edges).
 Frustum cell_frustum(const Vec3& viewpoint, CubeFace face, uint32_t face_size,
-                     const PixelRect& rect, double z_near, double z_far);
+                     const PixelRect& rect, double z_near, double z_far, double grow_texels = 0);
 
 // Counts of frustum-frustum tests, for Table 4 of the paper. `exact_tests` counts the full
 // separating-axis tests GridCuller falls back to (the reference searches below count none).
@@ -67,7 +74,8 @@ struct CellDirections {
   std::array<double, 4> cos{};
   double min_cos = 1, max_cos = 1;
 };
-CellDirections cell_directions(CubeFace face, uint32_t face_size, const PixelRect& rect);
+CellDirections cell_directions(CubeFace face, uint32_t face_size, const PixelRect& rect,
+                               double grow_texels = 0);
 // The 8 corners (near 0..3, far 0..3) of the frustum of `cell` seen from `viewpoint` for radial
 // depths [z_near, z_far].
 std::array<Vec3, 8> cell_frustum_corners(const CellDirections& cell, const Vec3& viewpoint,

@@ -117,7 +117,7 @@ struct LightfieldRenderOptions {
   // |1 - a + a e^(-2 pi i f)| of frequency f (cycles per texel), cos(pi f) halfway. So each of
   // the four taps of a bilinear lookup (surface and sky) reads its texel's colour c plus, per
   // axis, k 4 a (1 - a) (2c - p - q), p and q its neighbours along the axis (across face seams);
-  // the sum is clamped at 0. At a texel centre (a = 0: an eye at a viewpoint, pixel on texel)
+  // the sum is clamped to what texels hold, [0, 65504]. At a texel centre (a = 0: an eye at a viewpoint, pixel on texel)
   // nothing changes; halfway k = 1/8 gives the weights of Catmull-Rom's cubic (-1/16, 9/16,
   // 9/16, -1/16). An axis counts only where the texel and both neighbours lie on one surface
   // (both sky, or log depths within colour_sharpen_jump_texels texel angles, 2 / face size
