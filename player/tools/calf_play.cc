@@ -240,8 +240,9 @@ static int command_main(int argc, char** argv) {
                  "light field: sharpened colour taps, giving back what a bilinear tap between "
                  "texel centres blurs: each tap adds K 4 a (1 - a) times its texel's discrete "
                  "Laplacian along each axis (a: the tap's fraction along it) whose neighbours lie "
-                 "on the texel's surface, none of them a mixed texel; 0..1, 0 = off "
-                 "(docs/RENDERING.md \"Sharpened colour\")")
+                 "on the texel's surface, none of them a mixed texel; 0..1, 0 = off; 0.2 gains "
+                 "0.4-1.7 dB at the resolution-matched setting on textured content for 1.4x the "
+                 "render time or more (docs/RENDERING.md \"Sharpened colour\")")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   app.add_option("--colour-sharpen-jump", o.render.colour_sharpen_jump_texels,

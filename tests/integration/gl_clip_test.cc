@@ -237,9 +237,7 @@ TEST(GlClip, DecodedBc1ClipWithBc5DepthMatchesTheCpuRenderer) {
   o.min_psnr_db = 40;
   o.colour = encoder::ColourCoding::kBc1;
   o.depth = encoder::DepthCoding::kBc5;
-  // llvmpipe rounds BC1's interpolants its own way; sharpened colour taps (colour_sharpen 0.2)
-  // carry a texel's difference into its neighbours' taps (measured 54.6-56.0 dB with them).
-  play("BC1 + BC5 (CPU-decoded)", o, false, 53);
+  play("BC1 + BC5 (CPU-decoded)", o, false, 55);
   play("BC1 + BC5 (GPU-decoded)", o, true, 0);
 }
 

@@ -16,7 +16,7 @@ export const MAX_ACTIVE_VIEWS = 256;  // kGlMaxActiveViews
 export const RENDER_DEFAULTS = {
   steps: 64, refine_steps: 8, depth_footprint: 0.9, smooth_depth_ratio: 0, min_view_distance: -1,
   depth_decay: 500, cam_decay: 20, bilinear_colour: true, depth_aware_colour: true,
-  colour_depth_tolerance: 0.1, colour_sharpen: 0.2, colour_sharpen_jump_texels: 8, mixed_texel_penalty: 3, mixed_texel_bend_texels: 5,
+  colour_depth_tolerance: 0.1, colour_sharpen: 0, colour_sharpen_jump_texels: 8, mixed_texel_penalty: 3, mixed_texel_bend_texels: 5,
   tight_march_start: true, surface_hints: 1, surface_hint_margin_texels: 0.2, surface_hint_vetoes: 1,
   surface_hint_substeps: 4, supersample: 1, rr: false, rr_start: 0.05, rr_max_depth: 1,
   rr_replace_view_reflection: true, coverage: 0, coverage_threshold: 0.5, coverage_cluster: 0.05,

@@ -123,9 +123,10 @@ struct LightfieldRenderOptions {
   // (both sky, or log depths within colour_sharpen_jump_texels texel angles, 2 / face size
   // radians each: a plane seen at incidence i steps by tan(i) of them per texel) and none of the
   // three is a mixed texel (mixed_texel_bend_texels), whose colour holds the other side's: a
-  // depth edge is never sharpened across. colour_sharpen is k, in [0, 1], 0 = off; the jump is
-  // finite and >= 0. What they buy: docs/RENDERING.md "Sharpened colour".
-  double colour_sharpen = 0.2;
+  // depth edge is never sharpened across. colour_sharpen is k, in [0, 1], 0 = off (the default:
+  // it costs 1.4x the GL render time on llvmpipe at one ray per pixel); 0.2 is the measured best.
+  // The jump is finite and >= 0. What they cost and buy: docs/RENDERING.md "Sharpened colour".
+  double colour_sharpen = 0;
   double colour_sharpen_jump_texels = 8;
   // Mixed texels. An anti-aliased capture (calf-capture's default, any offline renderer's) gives
   // a texel on a depth edge the mean colour of the surfaces on both sides, while its depth (the
