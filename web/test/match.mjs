@@ -13,7 +13,9 @@
 // the pixels the hint rule moves (calf-play's defaults against --hint-coverage 0) at least
 // MOVED_SHARE must be nearer calf-play's defaults than the frame without the rule. Prints the
 // page's render ms at those options and with coverage read by neither rule. &hint-coverage=2 is
-// one overlay line, CALF-E403.
+// one overlay line, CALF-E403. Sharpened colour: a page opened with &colour-sharpen=0.2 is within
+// MIN_DB of calf-play --colour-sharpen 0.2, whose frames it must change; &colour-sharpen=2 is
+// CALF-E403.
 //
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM --clip CLIP EYE_PATH   (a given clip)
@@ -66,7 +68,8 @@ function playNative(clip, gtDir, name, args = []) {
   if (poses.length === 0) throw new Error(`no pose lines in calf-play's output: ${played}`);
   return poses;
 }
-const coverageRuns = given ? [] : [['cov-on', ['--coverage', '3', '--hint-coverage', '1']], ['cov-default', []], ['cov-norule', ['--hint-coverage', '0']]];
+const coverageRuns = given ? [] : [['cov-on', ['--coverage', '3', '--hint-coverage', '1']], ['cov-default', []], ['cov-norule', ['--hint-coverage', '0']],
+  ['cov-sharp', ['--coverage', '3', '--hint-coverage', '1', '--colour-sharpen', '0.2']]];
 const coveragePlayed = {};
 for (const [name, args] of coverageRuns) coveragePlayed[name] = playNative('coverage.calf', 'covgt', name, args);
 // The same capture twice: rgba16f colour (the page decodes it to RGBA on the CPU) and BC1 (the
@@ -217,6 +220,25 @@ async function matchCoverage() {
   console.log(`web.match: &hint-coverage=2: ${bad.overlay}`);
   if (bad.ready || !bad.overlay.startsWith('CALF-E403 hint-coverage=2: ')) problems.push(`coverage: &hint-coverage=2 gave '${bad.overlay}'`);
   await bad.page.close();
+  // Sharpened colour taps (&colour-sharpen=0.2, calf-play --colour-sharpen 0.2): the page follows
+  // calf-play at that option, which changes calf-play's frames.
+  const sharp = await openPage(browser,
+    `http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/clips/coverage.calf&coverage=3&hint-coverage=1&colour-sharpen=0.2`);
+  if (!sharp.ready) {
+    problems.push(`colour-sharpen: the page did not open the clip: ${sharp.overlay}`);
+  } else {
+    await renderEyePath(sharp.page, covPath, (i, got, rgb) => {
+      comparePose('colour-sharpen 0.2', 'cov-sharp', i, got, rgb, coveragePlayed['cov-sharp'][i]);
+      const apart = psnr(frame('cov-on', i), frame('cov-sharp', i));
+      console.log(`web.match: colour-sharpen pose ${i}: calf-play's frames with and without it are ${apart.toFixed(2)} dB apart`);
+      if (!(apart < 60)) problems.push(`colour-sharpen pose ${i}: calf-play's frame hardly changes (${apart.toFixed(2)} dB), too little to test it`);
+    }, (i, message) => problems.push(`colour-sharpen pose ${i}: ${message}`));
+  }
+  await sharp.page.close();
+  const badSharp = await openPage(browser, `http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/clips/coverage.calf&colour-sharpen=2`);
+  console.log(`web.match: &colour-sharpen=2: ${badSharp.overlay}`);
+  if (badSharp.ready || !badSharp.overlay.startsWith('CALF-E403 colour-sharpen=2: ')) problems.push(`colour-sharpen: &colour-sharpen=2 gave '${badSharp.overlay}'`);
+  await badSharp.page.close();
 }
 for (const p of problems) console.log(`web.match: FAIL ${p}`);
 if (problems.length === 0) rmSync(dir, { recursive: true, force: true });
