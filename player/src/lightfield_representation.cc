@@ -439,6 +439,10 @@ RepresentationStats LightfieldRepresentation::stats() const {
   if (d.options.render.coverage != 0) coverage = format("mode %u", d.options.render.coverage);
   if (!d.decoder->has_coverage()) coverage += " (none in the clip)";
   out.entries.push_back({"coverage", coverage});
+  // Sharpened colour taps (the window's K key turns them on and off).
+  out.entries.push_back({"colour sharpen", d.options.render.colour_sharpen > 0
+                                               ? format("k %.2f", d.options.render.colour_sharpen)
+                                               : std::string("off")});
   if (st.errors) out.entries.push_back({"damaged chunks", st.first_error, true});
   return out;
 }

@@ -346,7 +346,8 @@ TEST_F(LightfieldCoverage, DamagedCoverageChunksAreE065AndContradictionsE066) {
 // The GL player uploads a clip's coverage (kCoverage updates into its coverage textures) and
 // answers LightfieldRenderOptions::coverage as the CPU player does, frame after frame (the coverage
 // of face 0's moving square changes with it), with the coverage test on (modes 4 and 3) and off.
-// The C key of calf-play's window switches between the two.
+// The C key of calf-play's window switches between the two. Sharpened colour taps (the K key)
+// through both players too.
 TEST_F(LightfieldCoverage, GlPlayerUsesTheClipsCoverageAsTheCpuPlayer) {
   CALF_REQUIRE_GL();
   encoder::LightfieldEncodeOptions o;
@@ -404,6 +405,36 @@ TEST_F(LightfieldCoverage, GlPlayerUsesTheClipsCoverageAsTheCpuPlayer) {
     if (st.name != "coverage") continue;
     found = true;
     EXPECT_EQ(st.value, "off");
+  }
+  EXPECT_TRUE(found);
+  // Sharpened colour taps through both players (the window's K key): the GL player's textures and
+  // the CPU player's views give the same frame, which sharpening changes; the HUD says so.
+  player::LightfieldRenderOptions ro = lo.render;
+  ro.coverage = 0;
+  player::RenderedImage plain;
+  ASSERT_TRUE((*cpu)->set_render_options(ro).ok());
+  ASSERT_TRUE((*cpu)->render(cam, &plain).ok());
+  ro.colour_sharpen = 0.5;
+  ASSERT_TRUE((*gl)->set_render_options(ro).ok());
+  ASSERT_TRUE((*cpu)->set_render_options(ro).ok());
+  player::RenderedImage a, b;
+  ASSERT_TRUE((*gl)->render(cam, &a).ok());
+  ASSERT_TRUE((*cpu)->render(cam, &b).ok());
+  double se = 0, moved = 0;
+  for (size_t k = 0; k < a.color.size(); ++k) {
+    se += (double{a.color[k]} - b.color[k]) * (double{a.color[k]} - b.color[k]);
+    moved = std::max(moved, std::fabs(double{b.color[k]} - plain.color[k]));
+  }
+  const double p = se == 0 ? 200 : 10 * std::log10(a.color.size() / se);
+  std::printf("colour sharpen 0.5: GL vs CPU player %.2f dB; the CPU frame moves by up to %.3f\n", p,
+              moved);
+  EXPECT_GE(p, 45.0);
+  EXPECT_GT(moved, 0.01);
+  found = false;
+  for (const player::Statistic& st : (*gl)->stats().entries) {
+    if (st.name != "colour sharpen") continue;
+    found = true;
+    EXPECT_EQ(st.value, "k 0.50");
   }
   EXPECT_TRUE(found);
 }

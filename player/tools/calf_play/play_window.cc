@@ -125,6 +125,10 @@ Status run_window(const std::string& clip_path, const PlaybackOptions& options,
   // The coverage mode the C key turns on: --coverage's, or the grown cell mask.
   const uint32_t coverage_on =
       lf != nullptr && lf->options().render.coverage != 0 ? lf->options().render.coverage : 3;
+  // The sharpening the K key turns on: --colour-sharpen's, or the measured best 0.2.
+  const double sharpen_on = lf != nullptr && lf->options().render.colour_sharpen > 0
+                                ? lf->options().render.colour_sharpen
+                                : 0.2;
   while (!glfwWindowShouldClose(window)) {
     glfwPollEvents();
     const auto now = std::chrono::steady_clock::now();
@@ -157,6 +161,11 @@ Status run_window(const std::string& clip_path, const PlaybackOptions& options,
         if (r.coverage != 0 && !lf->has_coverage()) {
           warning = "the clip has no coverage stream: coverage does nothing";
         }
+        (void)lf->set_render_options(r);
+      }
+      if (pressed(GLFW_KEY_K) && lf != nullptr) {
+        LightfieldRenderOptions r = lf->options().render;
+        r.colour_sharpen = r.colour_sharpen > 0 ? 0 : sharpen_on;
         (void)lf->set_render_options(r);
       }
       const bool key_v = pressed(GLFW_KEY_V);
