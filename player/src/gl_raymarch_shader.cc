@@ -634,7 +634,7 @@ vec3 shade_sky(vec3 d) {
           asum += a[t];
         }
         vec2 strength = sharpen_strengths(taps);
-      for (int t = 0; t < 4; ++t) c += a[t] / asum * tap_colour(v, taps.texel[t], strength);
+        for (int t = 0; t < 4; ++t) c += a[t] / asum * tap_colour(v, taps.texel[t], strength);
         w = asum / unpenalised;
       }
       sum += w * c;

@@ -392,9 +392,9 @@ void LightfieldCpuRenderer::tap_colour(const View& v, const Texel& t, const doub
     bool same_surface = true;
     for (int s = 0; s < 2 && same_surface; ++s) {
       const int64_t step = s == 0 ? -1 : 1;
-      const Texel u = internal::texel_beyond_face(t.face, int64_t{t.x} + (axis == 0 ? step : 0),
-                                                  int64_t{t.y} + (axis == 1 ? step : 0),
-                                                  v.face_size());
+      const Texel u =
+          internal::texel_beyond_face(t.face, int64_t{t.x} + (axis == 0 ? step : 0),
+                                      int64_t{t.y} + (axis == 1 ? step : 0), v.face_size());
       const uint16_t other = v.depth_code_at(u.face, u.x, u.y);
       same_surface = (other == kLog16Sky) == (code == kLog16Sky) &&
                      (code == kLog16Sky || std::abs(int{other} - int{code}) <= jump_codes) &&

@@ -298,10 +298,10 @@ static int command_main(int argc, char** argv) {
       "Headless evaluation (--headless)",
       {"--eye-path", "--out", "--format", "--compare", "--no-heat-maps", "--noise-floor",
        "--compare-clip", "--breakdown", "--breakdown-lossless", "--contact-sheet", "--sheet-rows"});
-  group("Light field renderer", {"--steps", "--rr", "--no-rr-replace", "--hints", "--hint-substeps",
-                                 "--mixed-texel-penalty", "--colour-sharpen", "--colour-sharpen-jump",
-                                 "--supersample", "--views", "--priority",
-                                 "--frame-ms", "--no-view-dependent"});
+  group("Light field renderer",
+        {"--steps", "--rr", "--no-rr-replace", "--hints", "--hint-substeps",
+         "--mixed-texel-penalty", "--colour-sharpen", "--colour-sharpen-jump", "--supersample",
+         "--views", "--priority", "--frame-ms", "--no-view-dependent"});
   group("Light field coverage", {"--coverage", "--coverage-agreement", "--hint-coverage"});
   group("Surfels", {"--surfel-point-size", "--surfel-target-ms", "--surfel-clock", "--surfel-blend",
                     "--surfel-foveation"});

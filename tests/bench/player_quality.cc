@@ -769,7 +769,8 @@ int main(int argc, char** argv) {
 
   std::printf(
       "## %s: %zu views, face %u, %u frames; steps %u, refine %u, footprint %.2f, smooth "
-      "%.2f, depth_decay %.0f, cam_decay %.0f, colour tolerance %.2f, sharpen %.2f (jump %.1f texels), mixed texels %.1f (bend %.2f "
+      "%.2f, depth_decay %.0f, cam_decay %.0f, colour tolerance %.2f, sharpen %.2f (jump %.1f "
+      "texels), mixed texels %.1f (bend %.2f "
       "texels), tight start %d, "
       "hints %u (margin %.3f texels, vetoes %u, substeps %u), rr_start %.3f, rr replace %d, "
       "supersample %u (renderer %u), threads %u; coverage %u (threshold %.2f, cluster %.3f, "
@@ -777,11 +778,11 @@ int main(int argc, char** argv) {
       m.scene.c_str(), m.viewpoints.size(), m.face_size, m.frame_count, base.steps,
       base.refine_steps, base.depth_footprint, base.smooth_depth_ratio, base.depth_decay,
       base.cam_decay, base.colour_depth_tolerance, base.colour_sharpen,
-      base.colour_sharpen_jump_texels, base.mixed_texel_penalty,
-      base.mixed_texel_bend_texels, base.tight_march_start, base.surface_hints,
-      base.surface_hint_margin_texels, base.surface_hint_vetoes, base.surface_hint_substeps,
-      base.rr_start, base.rr_replace_view_reflection, g_supersample, base.supersample, base.threads,
-      base.coverage, base.coverage_threshold, base.coverage_cluster, base.coverage_agreement, unmix,
+      base.colour_sharpen_jump_texels, base.mixed_texel_penalty, base.mixed_texel_bend_texels,
+      base.tight_march_start, base.surface_hints, base.surface_hint_margin_texels,
+      base.surface_hint_vetoes, base.surface_hint_substeps, base.rr_start,
+      base.rr_replace_view_reflection, g_supersample, base.supersample, base.threads, base.coverage,
+      base.coverage_threshold, base.coverage_cluster, base.coverage_agreement, unmix,
       base.coverage_layers, base.coverage_alpha, base.surface_hint_coverage);
   FrameCache frames(reader, unmix);
   if (!montage_file.empty()) {

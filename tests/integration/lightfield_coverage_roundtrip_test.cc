@@ -426,8 +426,8 @@ TEST_F(LightfieldCoverage, GlPlayerUsesTheClipsCoverageAsTheCpuPlayer) {
     moved = std::max(moved, std::fabs(double{b.color[k]} - plain.color[k]));
   }
   const double p = se == 0 ? 200 : 10 * std::log10(a.color.size() / se);
-  std::printf("colour sharpen 0.5: GL vs CPU player %.2f dB; the CPU frame moves by up to %.3f\n", p,
-              moved);
+  std::printf("colour sharpen 0.5: GL vs CPU player %.2f dB; the CPU frame moves by up to %.3f\n",
+              p, moved);
   EXPECT_GE(p, 45.0);
   EXPECT_GT(moved, 0.01);
   found = false;

@@ -117,12 +117,12 @@ struct LightfieldRenderOptions {
   // |1 - a + a e^(-2 pi i f)| of frequency f (cycles per texel), cos(pi f) halfway. So each of
   // the four taps of a bilinear lookup (surface and sky) reads its texel's colour c plus, per
   // axis, k 4 a (1 - a) (2c - p - q), p and q its neighbours along the axis (across face seams);
-  // the sum is clamped to what texels hold, [0, 65504]. At a texel centre (a = 0: an eye at a viewpoint, pixel on texel)
-  // nothing changes; halfway k = 1/8 gives the weights of Catmull-Rom's cubic (-1/16, 9/16,
-  // 9/16, -1/16). An axis counts only where the texel and both neighbours lie on one surface
-  // (both sky, or log depths within colour_sharpen_jump_texels texel angles, 2 / face size
-  // radians each: a plane seen at incidence i steps by tan(i) of them per texel) and none of the
-  // three is a mixed texel (mixed_texel_bend_texels), whose colour holds the other side's: a
+  // the sum is clamped to what texels hold, [0, 65504]. At a texel centre (a = 0: an eye at a
+  // viewpoint, pixel on texel) nothing changes; halfway k = 1/8 gives the weights of Catmull-Rom's
+  // cubic (-1/16, 9/16, 9/16, -1/16). An axis counts only where the texel and both neighbours lie
+  // on one surface (both sky, or log depths within colour_sharpen_jump_texels texel angles, 2 /
+  // face size radians each: a plane seen at incidence i steps by tan(i) of them per texel) and none
+  // of the three is a mixed texel (mixed_texel_bend_texels), whose colour holds the other side's: a
   // depth edge is never sharpened across. colour_sharpen is k, in [0, 1], 0 = off (the default:
   // it costs 1.4x the GL render time on llvmpipe at one ray per pixel); 0.2 is the measured best.
   // The jump is finite and >= 0. What they cost and buy: docs/RENDERING.md "Sharpened colour".
