@@ -132,6 +132,29 @@ int seq_profile(std::span<const uint8_t> unit) {
   return at < unit.size() ? unit[at] >> 5 : -1;
 }
 
+// What every AV1 colour layout shares: no t-parameter chunk, and each colour chunk of track 0 an
+// AV1 chunk of its format (parse_av1_chunk) holding one unit per frame. `check` sees each colour
+// chunk's keys, GOP and curve; `count` the number of colour chunks.
+void for_each_colour_gop(const container::Reader& r, uint32_t* count,
+                         const std::function<void(const container::ChunkKeys&, const lf::Av1Gop&,
+                                                  const lf::Av1HdrCurve&)>& check) {
+  const auto& h = std::get<container::LightfieldTrackHeader>(r.tracks()[0].header);
+  *count = 0;
+  for (uint32_t id = 0; id < r.chunks().size(); ++id) {
+    const container::ChunkKeys& k = r.chunks()[id].keys;
+    EXPECT_NE(k.stream, static_cast<uint16_t>(LightfieldStream::kTParams));
+    if (k.stream != static_cast<uint16_t>(LightfieldStream::kColour)) continue;
+    ++*count;
+    auto raw = r.read_chunk(id);
+    ASSERT_TRUE(raw.ok());
+    lf::Av1HdrCurve curve;
+    auto gop = lf::parse_av1_chunk(*raw, k.frame_count, h.colour_format, &curve, "chunk");
+    ASSERT_TRUE(gop.ok()) << gop.status().to_string();
+    ASSERT_EQ(gop->units.size(), k.frame_count);
+    check(k, *gop, curve);
+  }
+}
+
 TEST_F(Av1Colour, LayoutIsGopChunksWithoutTChunksInA13File) {
   const std::vector<uint8_t> bytes = encode(options());
   const container::Reader r = open(bytes);
@@ -140,29 +163,21 @@ TEST_F(Av1Colour, LayoutIsGopChunksWithoutTChunksInA13File) {
   EXPECT_EQ(h.colour_format, static_cast<uint16_t>(container::PixelFormat::kAv1));
   EXPECT_EQ(h.flags, 0);
   uint32_t colour = 0;
-  for (uint32_t id = 0; id < r.chunks().size(); ++id) {
-    const container::ChunkKeys& k = r.chunks()[id].keys;
-    EXPECT_NE(k.stream, static_cast<uint16_t>(LightfieldStream::kTParams));
-    if (k.stream != static_cast<uint16_t>(LightfieldStream::kColour)) continue;
-    ++colour;
-    // GOPs of 2 frames over 5: 0+2, 2+2, 4+1.
-    EXPECT_EQ(k.first_frame % 2, 0u);
-    EXPECT_EQ(k.frame_count, k.first_frame == 4 ? 1u : 2u);
-    auto raw = r.read_chunk(id);
-    ASSERT_TRUE(raw.ok());
-    auto gop = lf::parse_av1_gop(*raw, k.frame_count, "chunk");
-    ASSERT_TRUE(gop.ok()) << gop.status().to_string();
-    ASSERT_EQ(gop->units.size(), k.frame_count);
-    // Every unit starts with a temporal delimiter OBU (type 2, with a size field: 0x12 0x00); the
-    // first then holds the sequence header (type 1).
-    for (const auto& unit : gop->units) {
-      ASSERT_GE(unit.size(), 3u);
-      EXPECT_EQ(unit[0], 0x12);
-      EXPECT_EQ(unit[1], 0x00);
-    }
-    EXPECT_EQ((gop->units[0][2] >> 3) & 15, 1);
-    EXPECT_EQ(seq_profile(gop->units[0]), 0);  // Main
-  }
+  for_each_colour_gop(
+      r, &colour, [](const container::ChunkKeys& k, const lf::Av1Gop& gop, const lf::Av1HdrCurve&) {
+        // GOPs of 2 frames over 5: 0+2, 2+2, 4+1.
+        EXPECT_EQ(k.first_frame % 2, 0u);
+        EXPECT_EQ(k.frame_count, k.first_frame == 4 ? 1u : 2u);
+        // Every unit starts with a temporal delimiter OBU (type 2, with a size field: 0x12 0x00);
+        // the first then holds the sequence header (type 1).
+        for (const auto& unit : gop.units) {
+          ASSERT_GE(unit.size(), 3u);
+          EXPECT_EQ(unit[0], 0x12);
+          EXPECT_EQ(unit[1], 0x00);
+        }
+        EXPECT_EQ((gop.units[0][2] >> 3) & 15, 1);
+        EXPECT_EQ(seq_profile(gop.units[0]), 0);  // Main
+      });
   EXPECT_EQ(colour, spec_.views * 6 * 3);
 }
 
@@ -179,25 +194,17 @@ TEST_F(Av1Colour, Chroma444IsTheHighProfileInA15File) {
                                                          : container::PixelFormat::kAv1Chroma444));
     EXPECT_EQ(h.flags, hdr ? 1 : 0);
     uint32_t colour = 0;
-    for (uint32_t id = 0; id < r.chunks().size(); ++id) {
-      const container::ChunkKeys& k = r.chunks()[id].keys;
-      EXPECT_NE(k.stream, static_cast<uint16_t>(LightfieldStream::kTParams));
-      if (k.stream != static_cast<uint16_t>(LightfieldStream::kColour)) continue;
-      ++colour;
-      EXPECT_EQ(k.frame_count, k.first_frame == 4 ? 1u : 2u);
-      auto raw = r.read_chunk(id);
-      ASSERT_TRUE(raw.ok());
-      lf::Av1HdrCurve curve;
-      auto gop = lf::parse_av1_chunk(*raw, k.frame_count, h.colour_format, &curve, "chunk");
-      ASSERT_TRUE(gop.ok()) << gop.status().to_string();
-      ASSERT_EQ(gop->units.size(), k.frame_count);
-      for (const auto& unit : gop->units) {
-        ASSERT_GE(unit.size(), 3u);
-        EXPECT_EQ(unit[0], 0x12);
-        EXPECT_EQ(unit[1], 0x00);
-      }
-      EXPECT_EQ(seq_profile(gop->units[0]), 1);  // High
-    }
+    for_each_colour_gop(
+        r, &colour,
+        [](const container::ChunkKeys& k, const lf::Av1Gop& gop, const lf::Av1HdrCurve&) {
+          EXPECT_EQ(k.frame_count, k.first_frame == 4 ? 1u : 2u);
+          for (const auto& unit : gop.units) {
+            ASSERT_GE(unit.size(), 3u);
+            EXPECT_EQ(unit[0], 0x12);
+            EXPECT_EQ(unit[1], 0x00);
+          }
+          EXPECT_EQ(seq_profile(gop.units[0]), 1);  // High
+        });
     EXPECT_EQ(colour, spec_.views * 6 * 3);
   }
 }
@@ -210,26 +217,18 @@ TEST_F(Av1Colour, HdrLayoutIsCurveHeadedGopChunksInA14File) {
   EXPECT_EQ(h.colour_format, static_cast<uint16_t>(container::PixelFormat::kAv1Hdr));
   EXPECT_EQ(h.flags, 1);
   uint32_t colour = 0, wide = 0;
-  for (uint32_t id = 0; id < r.chunks().size(); ++id) {
-    const container::ChunkKeys& k = r.chunks()[id].keys;
-    EXPECT_NE(k.stream, static_cast<uint16_t>(LightfieldStream::kTParams));
-    if (k.stream != static_cast<uint16_t>(LightfieldStream::kColour)) continue;
-    ++colour;
-    auto raw = r.read_chunk(id);
-    ASSERT_TRUE(raw.ok());
-    lf::Av1HdrCurve curve;
-    auto gop = lf::parse_av1_chunk(*raw, k.frame_count, h.colour_format, &curve, "chunk");
-    ASSERT_TRUE(gop.ok()) << gop.status().to_string();
-    ASSERT_EQ(gop->units.size(), k.frame_count);
-    // The synthetic scene's LDR faces lie within [2^-14, 1] (a span of 0x3800 bits, which shift 4
-    // covers); its face 4 goes up to 40 (SceneSpec), which its top code must reach.
-    EXPECT_GE(curve.base, 0x0400);
-    EXPECT_LE(curve.shift, k.face == 4 ? 5 : 4);
-    if (k.face == 4) wide += lf::av1_hdr_half_bits(curve, 1023) > 0x4900;  // above 10
-    // Unit 0: a temporal delimiter, then the sequence header.
-    EXPECT_EQ(gop->units[0][0], 0x12);
-    EXPECT_EQ((gop->units[0][2] >> 3) & 15, 1);
-  }
+  for_each_colour_gop(
+      r, &colour,
+      [&wide](const container::ChunkKeys& k, const lf::Av1Gop& gop, const lf::Av1HdrCurve& curve) {
+        // The synthetic scene's LDR faces lie within [2^-14, 1] (a span of 0x3800 bits, which shift
+        // 4 covers); its face 4 goes up to 40 (SceneSpec), which its top code must reach.
+        EXPECT_GE(curve.base, 0x0400);
+        EXPECT_LE(curve.shift, k.face == 4 ? 5 : 4);
+        if (k.face == 4) wide += lf::av1_hdr_half_bits(curve, 1023) > 0x4900;  // above 10
+        // Unit 0: a temporal delimiter, then the sequence header.
+        EXPECT_EQ(gop.units[0][0], 0x12);
+        EXPECT_EQ((gop.units[0][2] >> 3) & 15, 1);
+      });
   EXPECT_EQ(colour, spec_.views * 6 * 3);
   EXPECT_EQ(wide, spec_.views * 3);
 }
