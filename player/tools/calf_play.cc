@@ -230,6 +230,26 @@ static int command_main(int argc, char** argv) {
       ->check(CLI::Range(0, 4));
   app.add_option("--hint-substeps", o.render.surface_hint_substeps, "hint tests per march step")
       ->check(CLI::Range(1, 64));
+  app.add_option("--hint-vetoes", o.render.surface_hint_vetoes,
+                 "light field: a surface hint's crossing ends the ray unless more than this many "
+                 "views see it in front of their surface by more than --hint-margin of their "
+                 "texels; 0: one such view rejects it (fewer silhouettes grown into the sky, "
+                 "docs/SILHOUETTES.md \"The march's quality knobs\")")
+      ->check(CLI::Range(0u, 65536u))
+      ->capture_default_str();
+  app.add_option("--hint-margin", o.render.surface_hint_margin_texels,
+                 "light field: how far in front of its surface, in its own texel angles, a view "
+                 "must see a hint crossing to veto it")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--cam-decay", o.render.cam_decay,
+                 "light field: view blending, w_cam = exp(-D |o - P_j| / |p - o|) (the eye's "
+                 "distance from viewpoint P_j over the hit's distance); lower blends more views, "
+                 "which gains on textured models and loses on glossy content "
+                 "(docs/SILHOUETTES.md \"The march's quality knobs\"), and an eye on a "
+                 "viewpoint then no longer copies that view alone")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--mixed-texel-penalty", o.render.mixed_texel_penalty,
                  "light field: colour taps on a depth edge of their view (an anti-aliased "
                  "capture mixes both sides' colours there) keep e^-P of their weight, so colour "
@@ -299,9 +319,10 @@ static int command_main(int argc, char** argv) {
       {"--eye-path", "--out", "--format", "--compare", "--no-heat-maps", "--noise-floor",
        "--compare-clip", "--breakdown", "--breakdown-lossless", "--contact-sheet", "--sheet-rows"});
   group("Light field renderer",
-        {"--steps", "--rr", "--no-rr-replace", "--hints", "--hint-substeps",
-         "--mixed-texel-penalty", "--colour-sharpen", "--colour-sharpen-jump", "--supersample",
-         "--views", "--priority", "--frame-ms", "--no-view-dependent"});
+        {"--steps", "--rr", "--no-rr-replace", "--hints", "--hint-substeps", "--hint-vetoes",
+         "--hint-margin", "--cam-decay", "--mixed-texel-penalty", "--colour-sharpen",
+         "--colour-sharpen-jump", "--supersample", "--views", "--priority", "--frame-ms",
+         "--no-view-dependent"});
   group("Light field coverage", {"--coverage", "--coverage-agreement", "--hint-coverage"});
   group("Surfels", {"--surfel-point-size", "--surfel-target-ms", "--surfel-clock", "--surfel-blend",
                     "--surfel-foveation"});

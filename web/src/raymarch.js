@@ -22,7 +22,7 @@ export const RENDER_DEFAULTS = {
   rr_replace_view_reflection: true, coverage: 0, coverage_threshold: 0.5, coverage_cluster: 0.05,
   coverage_agreement: 1, surface_hint_coverage: 1,
 };
-// The render options a page URL may set (index.html?coverage=3&hint-coverage=1&colour-sharpen=0.1),
+// The render options a page URL may set (index.html?coverage=3&hint-coverage=1&colour-sharpen=0.1&hints=4),
 // named as calf-play's and bench-player_quality's options, with their ranges; the window player's
 // C key turns `coverage` on (its given mode, else 3) and off.
 export const RENDER_PARAMETERS = [
@@ -33,6 +33,12 @@ export const RENDER_PARAMETERS = [
   { name: 'hint-coverage', option: 'surface_hint_coverage', min: 0, max: 1, integer: true },
   { name: 'colour-sharpen', option: 'colour_sharpen', min: 0, max: 1, integer: false },
   { name: 'colour-sharpen-jump', option: 'colour_sharpen_jump_texels', min: 0, max: Infinity, integer: false },
+  { name: 'steps', option: 'steps', min: 1, max: 65536, integer: true },
+  { name: 'hints', option: 'surface_hints', min: 0, max: 4, integer: true },
+  { name: 'hint-substeps', option: 'surface_hint_substeps', min: 1, max: 64, integer: true },
+  { name: 'hint-vetoes', option: 'surface_hint_vetoes', min: 0, max: 65536, integer: true },
+  { name: 'hint-margin', option: 'surface_hint_margin_texels', min: 0, max: Infinity, integer: false },
+  { name: 'cam-decay', option: 'cam_decay', min: 0, max: Infinity, integer: false },
 ];
 // The render options that `params` (URLSearchParams) give on top of RENDER_DEFAULTS; a value that
 // is not a number in its range is CALF-E403, as the native renderer's options.

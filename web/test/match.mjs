@@ -13,9 +13,10 @@
 // the pixels the hint rule moves (calf-play's defaults against --hint-coverage 0) at least
 // MOVED_SHARE must be nearer calf-play's defaults than the frame without the rule. Prints the
 // page's render ms at those options and with coverage read by neither rule. &hint-coverage=2 is
-// one overlay line, CALF-E403. Sharpened colour: a page opened with &colour-sharpen=0.2 is within
-// MIN_DB of calf-play --colour-sharpen 0.2, whose frames it must change; &colour-sharpen=2 is
-// CALF-E403.
+// one overlay line, CALF-E403. Sharpened colour and the march's quality knobs: a page opened with
+// &colour-sharpen=0.2&steps=128&hints=4&hint-vetoes=0&cam-decay=10 holds those options and is within
+// MIN_DB of calf-play with the same, whose frames they must change; &colour-sharpen=2 and
+// &hints=5 are CALF-E403.
 //
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM --clip CLIP EYE_PATH   (a given clip)
@@ -29,6 +30,13 @@ import { readPng, psnr } from './frames.mjs';
 // The floor the brief sets is 40 dB; the measured figures are in docs/WEB.md.
 const MIN_DB = 40;
 const MOVED_SHARE = 0.9;
+// The quality setting of docs/SILHOUETTES.md "The march's quality knobs" (at one ray a pixel: the
+// page has no supersampling): calf-play's options, the page's URL parameters, the option values.
+const QUALITY = {
+  native: ['--colour-sharpen', '0.2', '--steps', '128', '--hints', '4', '--hint-vetoes', '0', '--cam-decay', '10'],
+  url: 'colour-sharpen=0.2&steps=128&hints=4&hint-vetoes=0&cam-decay=10',
+  options: { colour_sharpen: 0.2, steps: 128, surface_hints: 4, surface_hint_vetoes: 0, cam_decay: 10 },
+};
 const chromium = process.argv[2] && !process.argv[2].startsWith('--') ? process.argv[2] : '/usr/bin/chromium';
 // --clip CLIP EYE_PATH: a measurement of a given clip (e.g. tools/demo.sh's) along a given eye
 // path instead of the test's two clips; only calf-play is needed in CALF_BIN.
@@ -69,7 +77,7 @@ function playNative(clip, gtDir, name, args = []) {
   return poses;
 }
 const coverageRuns = given ? [] : [['cov-on', ['--coverage', '3', '--hint-coverage', '1']], ['cov-default', []], ['cov-norule', ['--hint-coverage', '0']],
-  ['cov-sharp', ['--coverage', '3', '--hint-coverage', '1', '--colour-sharpen', '0.2']]];
+  ['cov-sharp', ['--coverage', '3', '--hint-coverage', '1', ...QUALITY.native]]];
 const coveragePlayed = {};
 for (const [name, args] of coverageRuns) coveragePlayed[name] = playNative('coverage.calf', 'covgt', name, args);
 // The same capture twice: rgba16f colour (the page decodes it to RGBA on the CPU) and BC1 (the
@@ -220,25 +228,33 @@ async function matchCoverage() {
   console.log(`web.match: &hint-coverage=2: ${bad.overlay}`);
   if (bad.ready || !bad.overlay.startsWith('CALF-E403 hint-coverage=2: ')) problems.push(`coverage: &hint-coverage=2 gave '${bad.overlay}'`);
   await bad.page.close();
-  // Sharpened colour taps (&colour-sharpen=0.2, calf-play --colour-sharpen 0.2): the page follows
-  // calf-play at that option, which changes calf-play's frames.
+  // Sharpened colour taps and the march's quality knobs (QUALITY): the page holds the URL's
+  // options and follows calf-play at them, which change calf-play's frames.
   const sharp = await openPage(browser,
-    `http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/clips/coverage.calf&coverage=3&hint-coverage=1&colour-sharpen=0.2`);
+    `http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/clips/coverage.calf&coverage=3&hint-coverage=1&${QUALITY.url}`);
   if (!sharp.ready) {
-    problems.push(`colour-sharpen: the page did not open the clip: ${sharp.overlay}`);
+    problems.push(`quality options: the page did not open the clip: ${sharp.overlay}`);
   } else {
+    const held = await sharp.page.evaluate(() => ({ ...window.calfPlayer.options }));
+    for (const [k, v] of Object.entries(QUALITY.options)) {
+      if (held[k] !== v) problems.push(`quality options: &${QUALITY.url} left ${k} ${held[k]}, not ${v}`);
+    }
     await renderEyePath(sharp.page, covPath, (i, got, rgb) => {
-      comparePose('colour-sharpen 0.2', 'cov-sharp', i, got, rgb, coveragePlayed['cov-sharp'][i]);
+      comparePose(QUALITY.url, 'cov-sharp', i, got, rgb, coveragePlayed['cov-sharp'][i]);
       const apart = psnr(frame('cov-on', i), frame('cov-sharp', i));
-      console.log(`web.match: colour-sharpen pose ${i}: calf-play's frames with and without it are ${apart.toFixed(2)} dB apart`);
-      if (!(apart < 60)) problems.push(`colour-sharpen pose ${i}: calf-play's frame hardly changes (${apart.toFixed(2)} dB), too little to test it`);
-    }, (i, message) => problems.push(`colour-sharpen pose ${i}: ${message}`));
+      console.log(`web.match: quality options pose ${i}: calf-play's frames with and without them are ${apart.toFixed(2)} dB apart`);
+      if (!(apart < 60)) problems.push(`quality options pose ${i}: calf-play's frame hardly changes (${apart.toFixed(2)} dB), too little to test them`);
+    }, (i, message) => problems.push(`quality options pose ${i}: ${message}`));
   }
   await sharp.page.close();
   const badSharp = await openPage(browser, `http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/clips/coverage.calf&colour-sharpen=2`);
   console.log(`web.match: &colour-sharpen=2: ${badSharp.overlay}`);
   if (badSharp.ready || !badSharp.overlay.startsWith('CALF-E403 colour-sharpen=2: ')) problems.push(`colour-sharpen: &colour-sharpen=2 gave '${badSharp.overlay}'`);
   await badSharp.page.close();
+  const badHints = await openPage(browser, `http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/clips/coverage.calf&hints=5`);
+  console.log(`web.match: &hints=5: ${badHints.overlay}`);
+  if (badHints.ready || !badHints.overlay.startsWith('CALF-E403 hints=5: ')) problems.push(`hints: &hints=5 gave '${badHints.overlay}'`);
+  await badHints.page.close();
 }
 for (const p of problems) console.log(`web.match: FAIL ${p}`);
 if (problems.length === 0) rmSync(dir, { recursive: true, force: true });

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# calf-play's light-field march and blend options reach both renderers: each option below, given
+# a value other than its default, changes the frames calf-play writes (EXR, so that no change
+# hides in 8-bit rounding) of a tiny clip along its ground truth's eye path, with the GL renderer
+# (OSMesa) and the CPU reference alike; the same command without it writes the default's frames.
+# Usage: play_render_options.sh CALF_PLAY CLIP EYE_PATH WORK_DIR
+set -euo pipefail
+play=$1 clip=$2 eye=$3 work=$4
+rm -rf "$work"
+mkdir -p "$work"
+render() {  # renderer name options... -> frames in $work/renderer-name
+  local renderer=$1 name=$2
+  shift 2
+  "$play" "$clip" --headless --eye-path "$eye" --renderer "$renderer" --format exr \
+    --out "$work/$renderer-$name" "$@" > /dev/null
+}
+failed=0
+for renderer in gl cpu; do
+  render "$renderer" default
+  render "$renderer" default-again
+  if ! diff -r "$work/$renderer-default" "$work/$renderer-default-again" > /dev/null; then
+    echo "play_render_options: $renderer: two runs with the defaults differ" >&2
+    exit 1
+  fi
+  render "$renderer" hints4 --hints 4
+  # name|options: the hint options with 4 hint views, where vetoes and their margin decide
+  for case in "cam-decay|--cam-decay 2" "hint-vetoes|--hints 4 --hint-vetoes 0" \
+              "hint-margin|--hints 4 --hint-margin 8"; do
+    name=${case%%|*}
+    read -r -a options <<< "${case#*|}"
+    render "$renderer" "$name" "${options[@]}"
+    reference=default
+    # The hint options against 4 hint views at the defaults of the rest
+    if [ "$name" != cam-decay ]; then reference=hints4; fi
+    if diff -r "$work/$renderer-$reference" "$work/$renderer-$name" > /dev/null; then
+      echo "play_render_options: $renderer: ${case#*|} leaves the frames as they are" >&2
+      failed=1
+    else
+      echo "play_render_options: $renderer: ${case#*|} changes the frames"
+    fi
+  done
+done
+exit $failed
