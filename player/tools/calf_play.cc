@@ -242,6 +242,13 @@ static int command_main(int argc, char** argv) {
                  "must see a hint crossing to veto it")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app.add_option("--depth-decay", o.render.depth_decay,
+                 "light field: how fast a view's colour weight falls with its depth's "
+                 "disagreement at the hit, w_depth = exp(-D |ln(d_j / r)|); higher keeps views "
+                 "that see a slightly different surface out of the blend (docs/SILHOUETTES.md "
+                 "\"The march's quality knobs\")")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_option("--cam-decay", o.render.cam_decay,
                  "light field: view blending, w_cam = exp(-D |o - P_j| / |p - o|) (the eye's "
                  "distance from viewpoint P_j over the hit's distance); lower blends more views, "
@@ -320,9 +327,9 @@ static int command_main(int argc, char** argv) {
        "--compare-clip", "--breakdown", "--breakdown-lossless", "--contact-sheet", "--sheet-rows"});
   group("Light field renderer",
         {"--steps", "--rr", "--no-rr-replace", "--hints", "--hint-substeps", "--hint-vetoes",
-         "--hint-margin", "--cam-decay", "--mixed-texel-penalty", "--colour-sharpen",
-         "--colour-sharpen-jump", "--supersample", "--views", "--priority", "--frame-ms",
-         "--no-view-dependent"});
+         "--hint-margin", "--depth-decay", "--cam-decay", "--mixed-texel-penalty",
+         "--colour-sharpen", "--colour-sharpen-jump", "--supersample", "--views", "--priority",
+         "--frame-ms", "--no-view-dependent"});
   group("Light field coverage", {"--coverage", "--coverage-agreement", "--hint-coverage"});
   group("Surfels", {"--surfel-point-size", "--surfel-target-ms", "--surfel-clock", "--surfel-blend",
                     "--surfel-foveation"});

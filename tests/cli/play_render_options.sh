@@ -24,14 +24,15 @@ for renderer in gl cpu; do
   fi
   render "$renderer" hints4 --hints 4
   # name|options: the hint options with 4 hint views, where vetoes and their margin decide
-  for case in "cam-decay|--cam-decay 2" "hint-vetoes|--hints 4 --hint-vetoes 0" \
+  for case in "cam-decay|--cam-decay 2" "depth-decay|--depth-decay 5" \
+              "hint-vetoes|--hints 4 --hint-vetoes 0" \
               "hint-margin|--hints 4 --hint-margin 8"; do
     name=${case%%|*}
     read -r -a options <<< "${case#*|}"
     render "$renderer" "$name" "${options[@]}"
     reference=default
     # The hint options against 4 hint views at the defaults of the rest
-    if [ "$name" != cam-decay ]; then reference=hints4; fi
+    case $name in hint-*) reference=hints4 ;; esac
     if diff -r "$work/$renderer-$reference" "$work/$renderer-$name" > /dev/null; then
       echo "play_render_options: $renderer: ${case#*|} leaves the frames as they are" >&2
       failed=1

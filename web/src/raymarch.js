@@ -38,6 +38,7 @@ export const RENDER_PARAMETERS = [
   { name: 'hint-substeps', option: 'surface_hint_substeps', min: 1, max: 64, integer: true },
   { name: 'hint-vetoes', option: 'surface_hint_vetoes', min: 0, max: 65536, integer: true },
   { name: 'hint-margin', option: 'surface_hint_margin_texels', min: 0, max: Infinity, integer: false },
+  { name: 'depth-decay', option: 'depth_decay', min: 0, minExclusive: true, max: Infinity, integer: false },
   { name: 'cam-decay', option: 'cam_decay', min: 0, max: Infinity, integer: false },
 ];
 // The render options that `params` (URLSearchParams) give on top of RENDER_DEFAULTS; a value that
@@ -48,8 +49,9 @@ export function renderOptionsFromParams(params) {
     const text = params.get(p.name);
     if (text === null) continue;
     const x = Number(text);
-    if (text.trim() === '' || !Number.isFinite(x) || x < p.min || x > p.max || (p.integer && !Number.isInteger(x))) {
-      const range = p.max === Infinity ? `>= ${p.min}` : `in ${p.min}..${p.max}`;
+    const below = p.minExclusive ? x <= p.min : x < p.min;
+    if (text.trim() === '' || !Number.isFinite(x) || below || x > p.max || (p.integer && !Number.isInteger(x))) {
+      const range = p.max === Infinity ? `${p.minExclusive ? '>' : '>='} ${p.min}` : `in ${p.min}..${p.max}`;
       fail(E.playerOptions, `${p.name}=${text}: expected ${p.integer ? 'an integer' : 'a finite number'} ${range}`);
     }
     o[p.option] = x;

@@ -15,8 +15,8 @@
 // page's render ms at those options and with coverage read by neither rule. &hint-coverage=2 is
 // one overlay line, CALF-E403. Sharpened colour and the march's quality knobs: a page opened with
 // &colour-sharpen=0.2&steps=128&hints=4&hint-vetoes=0&cam-decay=10 holds those options and is within
-// MIN_DB of calf-play with the same, whose frames they must change; &colour-sharpen=2 and
-// &hints=5 are CALF-E403.
+// MIN_DB of calf-play with the same, whose frames they must change; &colour-sharpen=2, &hints=5
+// and &depth-decay=0 are CALF-E403.
 //
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM --clip CLIP EYE_PATH   (a given clip)
@@ -255,6 +255,10 @@ async function matchCoverage() {
   console.log(`web.match: &hints=5: ${badHints.overlay}`);
   if (badHints.ready || !badHints.overlay.startsWith('CALF-E403 hints=5: ')) problems.push(`hints: &hints=5 gave '${badHints.overlay}'`);
   await badHints.page.close();
+  const badDecay = await openPage(browser, `http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/clips/coverage.calf&depth-decay=0`);
+  console.log(`web.match: &depth-decay=0: ${badDecay.overlay}`);
+  if (badDecay.ready || !badDecay.overlay.startsWith('CALF-E403 depth-decay=0: ')) problems.push(`depth-decay: &depth-decay=0 gave '${badDecay.overlay}'`);
+  await badDecay.page.close();
 }
 for (const p of problems) console.log(`web.match: FAIL ${p}`);
 if (problems.length === 0) rmSync(dir, { recursive: true, force: true });
