@@ -14,8 +14,9 @@
 // MOVED_SHARE must be nearer calf-play's defaults than the frame without the rule. Prints the
 // page's render ms at those options and with coverage read by neither rule. &hint-coverage=2 is
 // one overlay line, CALF-E403. Sharpened colour and the march's quality knobs: a page opened with
-// &colour-sharpen=0.2&steps=128&hints=4&hint-vetoes=0&cam-decay=10 holds those options and is within
-// MIN_DB of calf-play with the same, whose frames they must change; &colour-sharpen=2, &hints=5
+// &colour-sharpen=0.2&steps=128&hints=4&hint-vetoes=0&cam-decay=10&depth-decay=2000 holds those
+// options and is within MIN_DB of calf-play with the same, whose frames they must change;
+// &colour-sharpen=2, &hints=5
 // and &depth-decay=0 are CALF-E403.
 //
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM
@@ -33,9 +34,9 @@ const MOVED_SHARE = 0.9;
 // The quality setting of docs/SILHOUETTES.md "The march's quality knobs" (at one ray a pixel: the
 // page has no supersampling): calf-play's options, the page's URL parameters, the option values.
 const QUALITY = {
-  native: ['--colour-sharpen', '0.2', '--steps', '128', '--hints', '4', '--hint-vetoes', '0', '--cam-decay', '10'],
-  url: 'colour-sharpen=0.2&steps=128&hints=4&hint-vetoes=0&cam-decay=10',
-  options: { colour_sharpen: 0.2, steps: 128, surface_hints: 4, surface_hint_vetoes: 0, cam_decay: 10 },
+  native: ['--colour-sharpen', '0.2', '--steps', '128', '--hints', '4', '--hint-vetoes', '0', '--cam-decay', '10', '--depth-decay', '2000'],
+  url: 'colour-sharpen=0.2&steps=128&hints=4&hint-vetoes=0&cam-decay=10&depth-decay=2000',
+  options: { colour_sharpen: 0.2, steps: 128, surface_hints: 4, surface_hint_vetoes: 0, cam_decay: 10, depth_decay: 2000 },
 };
 const chromium = process.argv[2] && !process.argv[2].startsWith('--') ? process.argv[2] : '/usr/bin/chromium';
 // --clip CLIP EYE_PATH: a measurement of a given clip (e.g. tools/demo.sh's) along a given eye
