@@ -16,8 +16,7 @@
 // one overlay line, CALF-E403. Sharpened colour and the march's quality knobs: a page opened with
 // &colour-sharpen=0.2&steps=128&hints=4&hint-vetoes=0&cam-decay=10&depth-decay=2000 holds those
 // options and is within MIN_DB of calf-play with the same, whose frames they must change;
-// &colour-sharpen=2, &hints=5
-// and &depth-decay=0 are CALF-E403.
+// &colour-sharpen=2, &hints=5 and &depth-decay=0 are CALF-E403.
 //
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM --clip CLIP EYE_PATH   (a given clip)
