@@ -40,6 +40,7 @@ export const RENDER_PARAMETERS = [
   { name: 'hint-margin', option: 'surface_hint_margin_texels', min: 0, max: Infinity, integer: false },
   { name: 'depth-decay', option: 'depth_decay', min: 0, minExclusive: true, max: Infinity, integer: false },
   { name: 'cam-decay', option: 'cam_decay', min: 0, max: Infinity, integer: false },
+  { name: 'supersample', option: 'supersample', min: 1, max: 8, integer: true },
 ];
 // The render options that `params` (URLSearchParams) give on top of RENDER_DEFAULTS; a value that
 // is not a number in its range is CALF-E403, as the native renderer's options.
