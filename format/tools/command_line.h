@@ -11,8 +11,10 @@
 // run_command(), so that an allocation that fails is one line too (CALF-E013, exit 1).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <new>
 #include <stdexcept>
 #include <string>
@@ -53,8 +55,50 @@ inline int usage_error(const char* command, const std::string& message) {
   return print_error(command, Status(ErrorId::kUsage, message + " (see --help)"), kExitUsage);
 }
 
+// The first value given to a floating-point option of `app` or of its parsed subcommands that is
+// not a finite number ("nan", "inf", "-infinity", ...), as "--option: value ..."; empty if none.
+// CLI11 reads such text as a double, and its range checks (CLI::Range, CLI::NonNegativeNumber)
+// let NaN through, as every comparison with NaN is false.
+inline std::string non_finite_option_value(const CLI::App& app) {
+  for (const CLI::Option* option : app.get_options()) {
+    if (option->count() == 0 || option->get_type_name().rfind("FLOAT", 0) != 0) continue;
+    for (const std::string& text : option->results()) {
+      char* end = nullptr;
+      const double value = std::strtod(text.c_str(), &end);
+      if (end != text.c_str() && !std::isfinite(value)) {
+        return option->get_name() + ": " + text + " is not a finite number";
+      }
+    }
+  }
+  for (const CLI::App* sub : app.get_subcommands()) {
+    std::string found = non_finite_option_value(*sub);
+    if (!found.empty()) return found;
+  }
+  return {};
+}
+
+// Checks for floating-point options that must be finite and >= `min` (> `min` when
+// `exclusive`), named as CLI11's own (NONNEGATIVE, POSITIVE) so --help reads the same. CLI11's
+// CLI::NonNegativeNumber and CLI::PositiveNumber accept "inf" and, like every comparison with it,
+// NaN; these reject both with a message that names the bound.
+inline CLI::Validator finite_at_least(double min, bool exclusive, const std::string& name) {
+  return CLI::Validator(
+      [min, exclusive](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0') return text + " is not a number";
+        if (std::isfinite(value) && (exclusive ? value > min : value >= min)) return {};
+        return text + " is not a finite number " + (exclusive ? "> " : ">= ") +
+               CLI::detail::to_string(min);
+      },
+      name);
+}
+inline const CLI::Validator kFiniteNonNegative = finite_at_least(0, false, "NONNEGATIVE");
+inline const CLI::Validator kFinitePositive = finite_at_least(0, true, "POSITIVE");
+
 // Parses the command line. Returns -1 when the command should go on, else the exit status to
-// return at once: 0 after --help / --version, 2 after a usage error (printed as one line).
+// return at once: 0 after --help / --version, 2 after a usage error (printed as one line),
+// among them a floating-point option given a value that is not a finite number.
 // Every command answers --version with "calf X.Y.Z" (help2man reads it for the man pages).
 inline int parse_command_line(CLI::App& app, const char* command, int argc, char** argv) {
   files::install_temp_file_cleanup();
@@ -68,6 +112,9 @@ inline int parse_command_line(CLI::App& app, const char* command, int argc, char
       if (c == '\n' || c == '\r') c = ' ';
     while (!message.empty() && message.back() == ' ') message.pop_back();
     return usage_error(command, message);
+  }
+  if (std::string bad = non_finite_option_value(app); !bad.empty()) {
+    return usage_error(command, bad);
   }
   return -1;
 }

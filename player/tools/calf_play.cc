@@ -240,14 +240,14 @@ static int command_main(int argc, char** argv) {
   app.add_option("--hint-margin", o.render.surface_hint_margin_texels,
                  "light field: how far in front of its surface, in its own texel angles, a view "
                  "must see a hint crossing to veto it")
-      ->check(CLI::NonNegativeNumber)
+      ->check(calf::tools::kFiniteNonNegative)
       ->capture_default_str();
   app.add_option("--depth-decay", o.render.depth_decay,
                  "light field: how fast a view's colour weight falls with its depth's "
                  "disagreement at the hit, w_depth = exp(-D |ln(d_j / r)|); higher keeps views "
                  "that see a slightly different surface out of the blend (docs/SILHOUETTES.md "
                  "\"The march's quality knobs\")")
-      ->check(CLI::PositiveNumber)
+      ->check(calf::tools::kFinitePositive)
       ->capture_default_str();
   app.add_option("--cam-decay", o.render.cam_decay,
                  "light field: view blending, w_cam = exp(-D |o - P_j| / |p - o|) (the eye's "
@@ -255,7 +255,7 @@ static int command_main(int argc, char** argv) {
                  "which gains on textured models and loses on glossy content "
                  "(docs/SILHOUETTES.md \"The march's quality knobs\"), and an eye on a "
                  "viewpoint then no longer copies that view alone")
-      ->check(CLI::NonNegativeNumber)
+      ->check(calf::tools::kFiniteNonNegative)
       ->capture_default_str();
   app.add_option("--mixed-texel-penalty", o.render.mixed_texel_penalty,
                  "light field: colour taps on a depth edge of their view (an anti-aliased "
@@ -276,7 +276,7 @@ static int command_main(int argc, char** argv) {
                  "light field, with --colour-sharpen: neighbours whose depth differs by more "
                  "than this many texel angles (2 / face size radians) are another surface and "
                  "stop the sharpening along their axis")
-      ->check(CLI::NonNegativeNumber)
+      ->check(calf::tools::kFiniteNonNegative)
       ->capture_default_str();
   app.add_option("--coverage", o.render.coverage,
                  "light field: how the renderer (GL or CPU) uses a clip's coverage stream (SPEC "
