@@ -53,6 +53,7 @@ uniform float footprint_limit;   // depth_footprint - 1e-9
 uniform float smooth_log_ratio;  // ln(1 + smooth_depth_ratio)
 uniform float depth_decay;
 uniform float cam_decay;
+uniform uint blend_views;        // LightfieldRenderOptions::blend_views (0: cam_decay)
 uniform float colour_depth_tolerance;
 uniform float colour_sharpen;             // LightfieldRenderOptions::colour_sharpen
 uniform float colour_sharpen_jump_texels;
@@ -541,12 +542,53 @@ vec3 tap_colour(CalfView v, ivec3 t, vec2 strength) {
   return clamp(c + sum, vec3(0.0), vec3(65504.0));  // what colour texels can hold
 }
 
+// ---- LightfieldCpuRenderer::blend_threshold (blend_views): the (K + 1)-th smallest
+// a_j = |o - P_j| / |p - o| of the views that see p (nearest texel within 3 / depth_decay of the
+// smallest disagreement), +inf where at most K do or all of them tie with the nearest ----
+const float BLEND_SEE_WINDOW = 3.0;    // kBlendSeeWindow
+const float BLEND_MIN_DISTANCE = 1e-9; // kBlendMinDistance
+float view_disagreement(CalfView v, vec3 p) {
+  vec3 x = p - v.position;
+  float r = length(x);
+  if (r <= min_view_distance) return INF;
+  int face = face_of(x);
+  vec2 uv = texel_coord(x, face, v.face_size);
+  uint code = depth_code(v, ivec3(clamp_texel(uv.x, v.face_size),
+                                  clamp_texel(uv.y, v.face_size), face));
+  return code == CALF_LOG16_SKY ? INF : log_disagreement(v, code, log(r));
+}
+
+float blend_threshold(vec3 o, vec3 p, float hit_distance) {
+  float dmin = INF;
+  for (uint k = 0u; k < view_count; ++k) dmin = min(dmin, view_disagreement(views[k], p));
+  if (dmin == INF) return INF;
+  float limit = dmin + BLEND_SEE_WINDOW / depth_decay;
+  uint keep = blend_views + 1u;
+  float smallest[9];
+  uint n = 0u;
+  for (uint k = 0u; k < view_count; ++k) {
+    if (!(view_disagreement(views[k], p) <= limit)) continue;
+    float a = length(o - views[k].position) / hit_distance;
+    for (uint i = 0u; i < n; ++i) {
+      if (a < smallest[i]) {
+        float t = smallest[i];
+        smallest[i] = a;
+        a = t;
+      }
+    }
+    if (n < keep) smallest[n++] = a;
+  }
+  if (n < keep) return INF;
+  return smallest[keep - 1u] > smallest[0] ? smallest[keep - 1u] : INF;
+}
+
 // ---- LightfieldCpuRenderer::shade_surface: SampleColor + CalculateColor ----
 // The weighted mean is accumulated online, rescaled whenever a larger log weight arrives: the
 // same exp(log_w - best) normalisation as the CPU's two passes, without an array of views.
 // best_colour: the colour of the best-weighted view (rr_replace_view_reflection starts from it).
 vec3 shade_surface(vec3 o, vec3 p, out int best_view, out vec3 best_colour) {
   float hit_distance = max(length(p - o), 1e-12);
+  float blend_t = blend_views > 0u ? blend_threshold(o, p, hit_distance) : INF;
   vec3 sum = vec3(0.0);
   float wsum = 0.0, best = -INF;
   best_view = -1;
@@ -590,7 +632,15 @@ vec3 shade_surface(vec3 o, vec3 p, out int best_view, out vec3 best_colour) {
       for (int t = 0; t < 4; ++t) c += a[t] / asum * tap_colour(v, taps.texel[t], strength);
       if (depth_aware_colour) log_w = -depth_decay * dmin + log(asum);
     }
-    log_w -= cam_decay * length(o - v.position) / hit_distance;
+    float a_cam = length(o - v.position) / hit_distance;
+    if (blend_views == 0u) {
+      log_w -= cam_decay * a_cam;
+    } else {
+      // The Unstructured Lumigraph's weight; blend_t = +inf gives 1 / a.
+      float w = max(0.0, 1.0 - a_cam / blend_t) / max(a_cam, BLEND_MIN_DISTANCE);
+      if (!(w > 0.0)) continue;
+      log_w += log(w);
+    }
     if (log_w > best) {
       float rescale = exp(best - log_w);
       sum *= rescale;

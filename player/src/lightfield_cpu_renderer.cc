@@ -13,6 +13,12 @@ namespace calf::player {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// LightfieldRenderOptions::blend_views: a view sees the hit when its w_depth is within
+// e^-kBlendSeeWindow of the best; a_j below kBlendMinDistance (an eye on the viewpoint) counts
+// as that, so 1 / a_j stays finite. The shader uses the same constants.
+constexpr double kBlendSeeWindow = 3;
+constexpr double kBlendMinDistance = 1e-9;
+constexpr uint32_t kMaxBlendViews = 8;
 
 Status option_error(const std::string& what) {
   return Status(ErrorId::kPlayerOptions, what);
@@ -89,6 +95,7 @@ Status validate_render_options(const LightfieldRenderOptions& o) {
   if (!(o.mixed_texel_bend_texels >= 0) || !std::isfinite(o.mixed_texel_bend_texels)) {
     return option_error("mixed_texel_bend_texels must be finite and >= 0");
   }
+  if (o.blend_views > 8) return option_error("blend_views is above 8");
   if (o.coverage > 4) return option_error("coverage is not 0, 1, 2, 3 or 4");
   if (!(o.coverage_threshold >= 0 && o.coverage_threshold <= 1)) {
     return option_error("coverage_threshold must be in [0, 1]");
@@ -585,9 +592,43 @@ bool LightfieldCpuRenderer::hint_confirmed(const Vec3& o, const Vec3& d, double 
 
 // SampleColor over the active views and their blend (CalculateColor). Weights are kept as
 // logarithms and normalised by the largest, so no view's weight underflows to zero.
+double LightfieldCpuRenderer::blend_threshold(const Vec3& o, const Vec3& p,
+                                              double hit_distance) const {
+  // The views that see p: their nearest texel's disagreement within kBlendSeeWindow / depth_decay
+  // of the smallest (w_depth within e^-kBlendSeeWindow of the best).
+  const auto disagreement = [&](const View& v) {
+    const Vec3 x = p - v.position();
+    const double r = length(x);
+    if (r <= min_view_distance_) return kInf;
+    const Texel t = texel_from_direction(x, v.face_size());
+    const uint16_t code = v.depth_code_at(t.face, t.x, t.y);
+    return code == kLog16Sky ? kInf : std::fabs(std::log(v.range().decode(code) / r));
+  };
+  double dmin = kInf;
+  for (const View* v : active_) dmin = std::min(dmin, disagreement(*v));
+  if (dmin == kInf) return kInf;
+  const double limit = dmin + kBlendSeeWindow / options_.depth_decay;
+  // The K + 1 smallest a_j of those views, ascending.
+  const uint32_t keep = options_.blend_views + 1;
+  double smallest[kMaxBlendViews + 1];
+  uint32_t n = 0;
+  for (const View* v : active_) {
+    if (!(disagreement(*v) <= limit)) continue;
+    double a = length(o - v->position()) / hit_distance;
+    for (uint32_t i = 0; i < n; ++i) {
+      if (a < smallest[i]) std::swap(a, smallest[i]);
+    }
+    if (n < keep) smallest[n++] = a;
+  }
+  if (n < keep) return kInf;
+  // K + 1 views as near as the nearest (ties): no view would keep a weight.
+  return smallest[keep - 1] > smallest[0] ? smallest[keep - 1] : kInf;
+}
+
 void LightfieldCpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* rgb, int* best_view,
                                           double* best_rgb, double* alpha) const {
   const double hit_distance = std::max(length(p - o), 1e-12);
+  const double blend_t = options_.blend_views > 0 ? blend_threshold(o, p, hit_distance) : kInf;
   double sum[3] = {0, 0, 0}, wsum = 0, best = -kInf;
   struct Contribution {
     double log_w, c[3], alpha;
@@ -647,7 +688,15 @@ void LightfieldCpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* 
       // Depth-aware: the view's w_depth is the bilinear blend of its taps' agreements.
       if (options_.depth_aware_colour) k.log_w = -options_.depth_decay * dmin + std::log(asum);
     }
-    k.log_w -= options_.cam_decay * length(o - v.position()) / hit_distance;
+    const double a = length(o - v.position()) / hit_distance;
+    if (options_.blend_views == 0) {
+      k.log_w -= options_.cam_decay * a;
+    } else {
+      // The Unstructured Lumigraph's weight; t = +inf gives 1 / a.
+      const double w = std::max(0.0, 1 - a / blend_t) / std::max(a, kBlendMinDistance);
+      if (!(w > 0)) continue;
+      k.log_w += std::log(w);
+    }
     if (k.log_w > best) {
       best = k.log_w;
       *best_view = static_cast<int>(vi);

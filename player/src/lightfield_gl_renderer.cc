@@ -191,6 +191,7 @@ Status LightfieldGlRenderer::draw(const Camera& camera, std::span<const uint32_t
   gl.Uniform1f(loc("smooth_log_ratio"), f(std::log1p(o.smooth_depth_ratio)));
   gl.Uniform1f(loc("depth_decay"), f(o.depth_decay));
   gl.Uniform1f(loc("cam_decay"), f(o.cam_decay));
+  gl.Uniform1ui(loc("blend_views"), o.blend_views);
   gl.Uniform1f(loc("colour_depth_tolerance"), f(o.colour_depth_tolerance));
   gl.Uniform1f(loc("colour_sharpen"), f(o.colour_sharpen));
   gl.Uniform1f(loc("colour_sharpen_jump_texels"), f(o.colour_sharpen_jump_texels));

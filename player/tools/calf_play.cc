@@ -257,6 +257,15 @@ static int command_main(int argc, char** argv) {
                  "viewpoint then no longer copies that view alone")
       ->check(calf::tools::kFiniteNonNegative)
       ->capture_default_str();
+  app.add_option("--blend-views", o.render.blend_views,
+                 "light field: 0 blends views by --cam-decay; K in 1..8 blends the K views "
+                 "nearest the eye that see the hit with the Unstructured Lumigraph's weights, "
+                 "max(0, 1 - a_j / t) / a_j (a_j = |o - P_j| / |p - o|, t that of the next "
+                 "view), which need no scale: one view where the eye stands near it, the "
+                 "nearest few where they are alike (docs/SILHOUETTES.md \"The march's quality "
+                 "knobs\")")
+      ->check(CLI::Range(0u, 8u))
+      ->capture_default_str();
   app.add_option("--mixed-texel-penalty", o.render.mixed_texel_penalty,
                  "light field: colour taps on a depth edge of their view (an anti-aliased "
                  "capture mixes both sides' colours there) keep e^-P of their weight, so colour "
@@ -327,7 +336,7 @@ static int command_main(int argc, char** argv) {
        "--compare-clip", "--breakdown", "--breakdown-lossless", "--contact-sheet", "--sheet-rows"});
   group("Light field renderer",
         {"--steps", "--rr", "--no-rr-replace", "--hints", "--hint-substeps", "--hint-vetoes",
-         "--hint-margin", "--depth-decay", "--cam-decay", "--mixed-texel-penalty",
+         "--hint-margin", "--depth-decay", "--cam-decay", "--blend-views", "--mixed-texel-penalty",
          "--colour-sharpen", "--colour-sharpen-jump", "--supersample", "--views", "--priority",
          "--frame-ms", "--no-view-dependent"});
   group("Light field coverage", {"--coverage", "--coverage-agreement", "--hint-coverage"});

@@ -587,6 +587,10 @@ int main(int argc, char** argv) {
   app.add_option("--smooth", base.smooth_depth_ratio, "smooth_depth_ratio")->capture_default_str();
   app.add_option("--depth-decay", base.depth_decay, "w_depth decay")->capture_default_str();
   app.add_option("--cam-decay", base.cam_decay, "w_cam decay")->capture_default_str();
+  app.add_option("--blend-views", base.blend_views,
+                 "blend_views: the Unstructured Lumigraph's weights over the K nearest views "
+                 "that see the hit instead of cam_decay (0 off, 1..8)")
+      ->capture_default_str();
   app.add_option("--colour-tolerance,--color-tolerance", base.colour_depth_tolerance,
                  "colour_depth_tolerance")
       ->capture_default_str();
@@ -769,7 +773,8 @@ int main(int argc, char** argv) {
 
   std::printf(
       "## %s: %zu views, face %u, %u frames; steps %u, refine %u, footprint %.2f, smooth "
-      "%.2f, depth_decay %.0f, cam_decay %.0f, colour tolerance %.2f, sharpen %.2f (jump %.1f "
+      "%.2f, depth_decay %.0f, cam_decay %.0f, blend views %u, colour tolerance %.2f, sharpen %.2f "
+      "(jump %.1f "
       "texels), mixed texels %.1f (bend %.2f "
       "texels), tight start %d, "
       "hints %u (margin %.3f texels, vetoes %u, substeps %u), rr_start %.3f, rr replace %d, "
@@ -777,7 +782,7 @@ int main(int argc, char** argv) {
       "agreement %u, unmix %.2f, layers %u, alpha rule %u, hint coverage %u)\n",
       m.scene.c_str(), m.viewpoints.size(), m.face_size, m.frame_count, base.steps,
       base.refine_steps, base.depth_footprint, base.smooth_depth_ratio, base.depth_decay,
-      base.cam_decay, base.colour_depth_tolerance, base.colour_sharpen,
+      base.cam_decay, base.blend_views, base.colour_depth_tolerance, base.colour_sharpen,
       base.colour_sharpen_jump_texels, base.mixed_texel_penalty, base.mixed_texel_bend_texels,
       base.tight_march_start, base.surface_hints, base.surface_hint_margin_texels,
       base.surface_hint_vetoes, base.surface_hint_substeps, base.rr_start,

@@ -24,7 +24,7 @@ for renderer in gl cpu; do
   fi
   render "$renderer" hints4 --hints 4
   # name|options: the hint options with 4 hint views, where vetoes and their margin decide
-  for case in "cam-decay|--cam-decay 2" "depth-decay|--depth-decay 5" \
+  for case in "cam-decay|--cam-decay 2" "depth-decay|--depth-decay 5" "blend-views|--blend-views 2" \
               "hint-vetoes|--hints 4 --hint-vetoes 0" \
               "hint-margin|--hints 4 --hint-margin 8"; do
     name=${case%%|*}

@@ -700,6 +700,80 @@ TEST(LightfieldCpuRenderer, ViewsWithoutCoverageRenderAsBefore) {
   EXPECT_EQ(a.depth, d.depth);
 }
 
+// LightfieldRenderOptions::blend_views: three views of the room's back wall, each painted one
+// colour (as view-dependent shading would make them differ); the eye's ray meets the wall at p,
+// where a_j = |o - P_j| / |p - o| is 0.025, 0.05 and 0.175. The colour is the mean of the views'
+// colours under the Unstructured Lumigraph's weights max(0, 1 - a_j / t) / a_j, computed here
+// from that formula: K = 1 and 2 keep the nearest one and two views, K = 3 (no fourth view)
+// weighs all three 1 / a_j, an eye on a viewpoint shows that view alone. Then a small sphere
+// hides p from the nearest view: it does not see p, so it does not take the nearest view's place
+// in the count, and K = 1 shows the next view's colour, not the hidden one's.
+TEST(LightfieldCpuRenderer, BlendViewsWeighsTheNearestViewsThatSeeThePoint) {
+  const float colours[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  constexpr uint32_t n = 64;
+  const auto painted = [&](const Scene& scene, const std::vector<Vec3>& at) {
+    ViewSet views = make_views(scene, at, n);
+    for (size_t i = 0; i < views.views.size(); ++i) {
+      std::vector<float> c(size_t{n} * n * 3);
+      for (size_t k = 0; k < c.size(); ++k) c[k] = colours[i][k % 3];
+      for (int f = 0; f < kCubeFaceCount; ++f) {
+        EXPECT_TRUE(
+            views.views[i].write_colour_rect(cube_face_from_index(f), {0, 0, n, n}, c).ok());
+      }
+    }
+    return views;
+  };
+  // Views at 0.1, 0.2 and 0.7 from the eye; depth_decay so small that every view weighs alike
+  // by its depth (and every view counts as seeing p).
+  Scene wall;  // the empty room: its back wall is z = -4
+  const Vec3 eye{0.1, 0, 0};
+  const ViewSet views = painted(wall, {{0, 0, 0}, {0.3, 0, 0}, {-0.6, 0, 0}});
+  const auto shade = [&](const ViewSet& set, const Vec3& o, const Vec3& p, uint32_t k,
+                         double depth_decay) {
+    LightfieldRenderOptions opt;
+    opt.blend_views = k;
+    opt.depth_decay = depth_decay;
+    opt.mixed_texel_penalty = 0;
+    const Expected<LightfieldCpuRenderer> r = LightfieldCpuRenderer::make(set, opt);
+    EXPECT_TRUE(r.ok());
+    const Vec3 d = p - o;
+    const double z = length(d);
+    return r->shade_at(o, {d.x / z, d.y / z, d.z / z}, z);
+  };
+  const Vec3 p{0.1, 0, -4};
+  const double a[3] = {0.1 / 4, 0.2 / 4, 0.7 / 4};
+  const auto expect_mix = [&](const RaySample& s, const double w[3], const char* what) {
+    const double sum = w[0] + w[1] + w[2];
+    for (int ch = 0; ch < 3; ++ch) {
+      EXPECT_NEAR(s.rgb[ch],
+                  (w[0] * colours[0][ch] + w[1] * colours[1][ch] + w[2] * colours[2][ch]) / sum,
+                  1e-4)
+          << what << " channel " << ch;
+    }
+  };
+  const double k1[3] = {(1 - a[0] / a[1]) / a[0], 0, 0};
+  expect_mix(shade(views, eye, p, 1, 1e-6), k1, "K = 1");
+  const double k2[3] = {(1 - a[0] / a[2]) / a[0], (1 - a[1] / a[2]) / a[1], 0};
+  expect_mix(shade(views, eye, p, 2, 1e-6), k2, "K = 2");
+  const double k3[3] = {1 / a[0], 1 / a[1], 1 / a[2]};
+  expect_mix(shade(views, eye, p, 3, 1e-6), k3, "K = 3");
+  const double on_view[3] = {0, 1, 0};
+  expect_mix(shade(views, {0.3, 0, 0}, {0.3, 0, -4}, 2, 1e-6), on_view, "eye on view 1");
+  // cam_decay's weights (K = 0) blend all three.
+  const RaySample broad = shade(views, eye, p, 0, 1e-6);
+  EXPECT_GT(broad.rgb[1], 0.1);
+  EXPECT_GT(broad.rgb[2], 0.01);
+
+  // The sphere hides p from view 1 (nearest the eye at 0.2, 0, 0; a = 0.025), not from views 0
+  // (0.125) and 2 (0.35).
+  Scene hidden;
+  hidden.spheres = {{{0.25, 0, -2}, 0.25}};
+  const ViewSet hidden_views = painted(hidden, {{-0.3, 0, 0}, {0.3, 0, 0}, {-1.2, 0, 0}});
+  const RaySample next = shade(hidden_views, {0.2, 0, 0}, p, 1, 500);
+  const double only_view_0[3] = {1, 0, 0};
+  expect_mix(next, only_view_0, "view 1 hidden, K = 1");
+}
+
 TEST(LightfieldCpuRenderer, ImageDoesNotDependOnThreadCount) {
   const Scene scene = room_with_spheres();
   const ViewSet views = make_views(scene, corner_views({0, 0, 0.5}, 1.0), 24);
@@ -940,6 +1014,9 @@ TEST(LightfieldCpuRenderer, RejectsBadOptionsAndCameras) {
   };
   LightfieldRenderOptions o;
   o.steps = 0;
+  EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
+  o = {};
+  o.blend_views = 9;
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
   o = {};
   o.near = 0;

@@ -15,7 +15,7 @@ export const MAX_ACTIVE_VIEWS = 256;  // kGlMaxActiveViews
 // calf-play's defaults (LightfieldRenderOptions, ViewSelectionOptions; headless: no frame budget).
 export const RENDER_DEFAULTS = {
   steps: 64, refine_steps: 8, depth_footprint: 0.9, smooth_depth_ratio: 0, min_view_distance: -1,
-  depth_decay: 500, cam_decay: 20, bilinear_colour: true, depth_aware_colour: true,
+  depth_decay: 500, cam_decay: 20, blend_views: 0, bilinear_colour: true, depth_aware_colour: true,
   colour_depth_tolerance: 0.1, colour_sharpen: 0, colour_sharpen_jump_texels: 8, mixed_texel_penalty: 3, mixed_texel_bend_texels: 5,
   tight_march_start: true, surface_hints: 1, surface_hint_margin_texels: 0.2, surface_hint_vetoes: 1,
   surface_hint_substeps: 4, supersample: 1, rr: false, rr_start: 0.05, rr_max_depth: 1,
@@ -40,6 +40,7 @@ export const RENDER_PARAMETERS = [
   { name: 'hint-margin', option: 'surface_hint_margin_texels', min: 0, max: Infinity, integer: false },
   { name: 'depth-decay', option: 'depth_decay', min: 0, minExclusive: true, max: Infinity, integer: false },
   { name: 'cam-decay', option: 'cam_decay', min: 0, max: Infinity, integer: false },
+  { name: 'blend-views', option: 'blend_views', min: 0, max: 8, integer: true },
   { name: 'supersample', option: 'supersample', min: 1, max: 8, integer: true },
 ];
 // The render options that `params` (URLSearchParams) give on top of RENDER_DEFAULTS; a value that
@@ -368,6 +369,7 @@ export function makeRaymarcher(gl, { views, faceSize, cellSize, options = { ...R
     gl.uniform1f(U('smooth_log_ratio'), Math.log1p(o.smooth_depth_ratio));
     gl.uniform1f(U('depth_decay'), o.depth_decay);
     gl.uniform1f(U('cam_decay'), o.cam_decay);
+    gl.uniform1ui(U('blend_views'), o.blend_views);
     gl.uniform1f(U('colour_depth_tolerance'), o.colour_depth_tolerance);
     gl.uniform1f(U('colour_sharpen'), o.colour_sharpen);
     gl.uniform1f(U('colour_sharpen_jump_texels'), o.colour_sharpen_jump_texels);

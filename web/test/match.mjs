@@ -15,9 +15,10 @@
 // page's render ms at those options and with coverage read by neither rule. &hint-coverage=2 is
 // one overlay line, CALF-E403. Sharpened colour, the march's quality knobs and eye rays per pixel:
 // a page opened with
-// &colour-sharpen=0.2&steps=128&hints=4&hint-vetoes=0&cam-decay=10&depth-decay=2000&supersample=2
+// &colour-sharpen=0.2&steps=128&hints=4&hint-vetoes=0&blend-views=3&supersample=2
 // holds those options and is within MIN_DB of calf-play with the same, whose frames they must
-// change; &colour-sharpen=2, &hints=5, &depth-decay=0 and &supersample=9 are CALF-E403.
+// change; &colour-sharpen=2, &hints=5, &depth-decay=0, &supersample=9 and &blend-views=9 are
+// CALF-E403.
 //
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM
 //   CALF_BIN=BUILD_DIR node web/test/match.mjs CHROMIUM --clip CLIP EYE_PATH   (a given clip)
@@ -35,10 +36,9 @@ const MOVED_SHARE = 0.9;
 // (it is measured at 4 x 4; 2 x 2 keeps the test's SwiftShader draws short): calf-play's options,
 // the page's URL parameters, the option values.
 const QUALITY = {
-  native: ['--colour-sharpen', '0.2', '--steps', '128', '--hints', '4', '--hint-vetoes', '0', '--cam-decay', '10', '--depth-decay', '2000',
-    '--supersample', '2'],
-  url: 'colour-sharpen=0.2&steps=128&hints=4&hint-vetoes=0&cam-decay=10&depth-decay=2000&supersample=2',
-  options: { colour_sharpen: 0.2, steps: 128, surface_hints: 4, surface_hint_vetoes: 0, cam_decay: 10, depth_decay: 2000, supersample: 2 },
+  native: ['--colour-sharpen', '0.2', '--steps', '128', '--hints', '4', '--hint-vetoes', '0', '--blend-views', '3', '--supersample', '2'],
+  url: 'colour-sharpen=0.2&steps=128&hints=4&hint-vetoes=0&blend-views=3&supersample=2',
+  options: { colour_sharpen: 0.2, steps: 128, surface_hints: 4, surface_hint_vetoes: 0, blend_views: 3, supersample: 2 },
 };
 const chromium = process.argv[2] && !process.argv[2].startsWith('--') ? process.argv[2] : '/usr/bin/chromium';
 // --clip CLIP EYE_PATH: a measurement of a given clip (e.g. tools/demo.sh's) along a given eye
@@ -262,10 +262,12 @@ async function matchCoverage() {
   console.log(`web.match: &depth-decay=0: ${badDecay.overlay}`);
   if (badDecay.ready || !badDecay.overlay.startsWith('CALF-E403 depth-decay=0: ')) problems.push(`depth-decay: &depth-decay=0 gave '${badDecay.overlay}'`);
   await badDecay.page.close();
-  const badRays = await openPage(browser, `http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/clips/coverage.calf&supersample=9`);
-  console.log(`web.match: &supersample=9: ${badRays.overlay}`);
-  if (badRays.ready || !badRays.overlay.startsWith('CALF-E403 supersample=9: ')) problems.push(`supersample: &supersample=9 gave '${badRays.overlay}'`);
-  await badRays.page.close();
+  for (const bad of ['supersample=9', 'blend-views=9']) {
+    const refused = await openPage(browser, `http://127.0.0.1:${port}/web/index.html?autoplay=0&clip=/clips/coverage.calf&${bad}`);
+    console.log(`web.match: &${bad}: ${refused.overlay}`);
+    if (refused.ready || !refused.overlay.startsWith(`CALF-E403 ${bad}: `)) problems.push(`&${bad} gave '${refused.overlay}'`);
+    await refused.page.close();
+  }
 }
 for (const p of problems) console.log(`web.match: FAIL ${p}`);
 if (problems.length === 0) rmSync(dir, { recursive: true, force: true });

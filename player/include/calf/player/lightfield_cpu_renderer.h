@@ -102,6 +102,17 @@ struct LightfieldRenderOptions {
   // w_cam decay per unit of |o - P_j| / |p - o| (the eye-to-viewpoint distance in units of the hit
   // distance). >= 0; 0 weighs all agreeing views equally.
   double cam_decay = 20;
+  // 0: w_cam as above. K in 1..8: instead, the weights of the Unstructured Lumigraph (Buehler,
+  // Bosse, McMillan, Gortler, Cohen 2001) over a_j = |o - P_j| / |p - o|, which blend the K
+  // views nearest the eye among those that see p and give a view the eye stands on all the
+  // weight: w_cam = max(0, 1 - a_j / t) / a_j, t the (K + 1)-th smallest a_j of the views that
+  // see p (+inf where there are at most K). A view sees p when its nearest texel's relative
+  // depth disagreement |ln(d_j / r)| is within 3 / depth_decay of the smallest (its w_depth
+  // within e^-3 of the best). w_depth multiplies as before. Unlike w_cam it has no scale to
+  // tune: the blend is as broad as the nearest views are alike, so it keeps an eye near one
+  // view of a dense rig on that view and blends the two nearest of a sparse ring
+  // (docs/SILHOUETTES.md "The march's quality knobs").
+  uint32_t blend_views = 0;
   // Bilinear colour within and across faces (true), or the nearest texel (false).
   bool bilinear_colour = true;
   // With bilinear colour: weigh each tap by its own depth agreement (true) or plain bilinear.
@@ -332,6 +343,8 @@ class LightfieldCpuRenderer {
     bool hinted = false;  // found by a surface hint
   };
   RaySample shade_hit(const Vec3& origin, const Vec3& direction, const Hit* hit) const;
+  // LightfieldRenderOptions::blend_views: the threshold t at hit p seen from o (+inf: none).
+  double blend_threshold(const Vec3& o, const Vec3& p, double hit_distance) const;
   double tap_purity(const View& v, const Texel& t) const;
   void tap_colour(const View& v, const Texel& t, const double strength[2], double rgb[3]) const;
   bool hint_confirmed(const Vec3& o, const Vec3& d, double zb, double zc, const View* h) const;
