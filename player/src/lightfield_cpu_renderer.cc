@@ -590,8 +590,9 @@ bool LightfieldCpuRenderer::hint_confirmed(const Vec3& o, const Vec3& d, double 
   return false;
 }
 
-// SampleColor over the active views and their blend (CalculateColor). Weights are kept as
-// logarithms and normalised by the largest, so no view's weight underflows to zero.
+// LightfieldRenderOptions::blend_views: the (K + 1)-th smallest a_j of the views that see p, the
+// threshold t of the Unstructured Lumigraph's weights; +inf where at most K views see p or K + 1
+// of them are as near as the nearest.
 double LightfieldCpuRenderer::blend_threshold(const Vec3& o, const Vec3& p,
                                               double hit_distance) const {
   // The views that see p: their nearest texel's disagreement within kBlendSeeWindow / depth_decay
@@ -625,6 +626,8 @@ double LightfieldCpuRenderer::blend_threshold(const Vec3& o, const Vec3& p,
   return smallest[keep - 1] > smallest[0] ? smallest[keep - 1] : kInf;
 }
 
+// SampleColor over the active views and their blend (CalculateColor). Weights are kept as
+// logarithms and normalised by the largest, so no view's weight underflows to zero.
 void LightfieldCpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* rgb, int* best_view,
                                           double* best_rgb, double* alpha) const {
   const double hit_distance = std::max(length(p - o), 1e-12);

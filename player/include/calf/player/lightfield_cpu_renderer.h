@@ -106,11 +106,11 @@ struct LightfieldRenderOptions {
   // Bosse, McMillan, Gortler, Cohen 2001) over a_j = |o - P_j| / |p - o|, which blend the K
   // views nearest the eye among those that see p and give a view the eye stands on all the
   // weight: w_cam = max(0, 1 - a_j / t) / a_j, t the (K + 1)-th smallest a_j of the views that
-  // see p (+inf where there are at most K). A view sees p when its nearest texel's relative
-  // depth disagreement |ln(d_j / r)| is within 3 / depth_decay of the smallest (its w_depth
-  // within e^-3 of the best). w_depth multiplies as before. Unlike w_cam it has no scale to
-  // tune: the blend is as broad as the nearest views are alike, so it keeps an eye near one
-  // view of a dense rig on that view and blends the two nearest of a sparse ring
+  // see p (+inf where there are at most K, or K + 1 as near as the nearest). A view sees p when its
+  // nearest texel's relative depth disagreement |ln(d_j / r)| is within 3 / depth_decay of the
+  // smallest (its w_depth within e^-3 of the best). w_depth multiplies as before. Unlike w_cam it
+  // has no scale to tune: the blend is as broad as the nearest views are alike, so it keeps an eye
+  // near one view of a dense rig on that view and blends the two nearest of a sparse ring
   // (docs/SILHOUETTES.md "The march's quality knobs").
   uint32_t blend_views = 0;
   // Bilinear colour within and across faces (true), or the nearest texel (false).
