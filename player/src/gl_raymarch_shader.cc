@@ -564,7 +564,7 @@ float blend_threshold(vec3 o, vec3 p, float hit_distance) {
   if (dmin == INF) return INF;
   float limit = dmin + BLEND_SEE_WINDOW / depth_decay;
   uint keep = blend_views + 1u;
-  float smallest[9];
+  float smallest[9];  // blend_views + 1, at most kMaxBlendViews + 1
   uint n = 0u;
   for (uint k = 0u; k < view_count; ++k) {
     if (!(view_disagreement(views[k], p) <= limit)) continue;

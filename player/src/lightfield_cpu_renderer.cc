@@ -95,7 +95,7 @@ Status validate_render_options(const LightfieldRenderOptions& o) {
   if (!(o.mixed_texel_bend_texels >= 0) || !std::isfinite(o.mixed_texel_bend_texels)) {
     return option_error("mixed_texel_bend_texels must be finite and >= 0");
   }
-  if (o.blend_views > 8) return option_error("blend_views is above 8");
+  if (o.blend_views > kMaxBlendViews) return option_error("blend_views is above 8");
   if (o.coverage > 4) return option_error("coverage is not 0, 1, 2, 3 or 4");
   if (!(o.coverage_threshold >= 0 && o.coverage_threshold <= 1)) {
     return option_error("coverage_threshold must be in [0, 1]");
