@@ -265,11 +265,20 @@ float coverage_margin(CalfView v, vec3 x, float r, float margin) {
     ivec2 cell = clamp(ivec2(floor((uv - floor(uv)) * 4.0)), ivec2(0), ivec2(3));
     uint mask = cov[nearest].x | cov[nearest].y << 8;
     if (!front[nearest]) mask = ~mask;
-    int grow = coverage_mode == 3u ? 1 : 0;  // mode 3: the front grown by one cell
+    int grow = coverage_mode == 2u ? 0 : 1;  // modes 3 and 5: the front grown by one cell
     for (int j = max(cell.y - grow, 0); j <= min(cell.y + grow, 3); ++j) {
       for (int i = max(cell.x - grow, 0); i <= min(cell.x + grow, 3); ++i) {
         covered = covered || ((mask >> uint(4 * j + i)) & 1u) != 0u;
       }
+    }
+    if (coverage_mode == 5u && !front[nearest]) {
+      // The nearest texel lies behind the front: its own surface where it fills the window; the
+      // surface behind where its other cells are only farther ones.
+      if (!covered) {
+        uint own = depth_code(v, taps.texel[nearest]);
+        return own == CALF_LOG16_SKY ? INF : float(own) - rcode;
+      }
+      if (cov[nearest].z == 0u) covered = false;
     }
   }
   if (covered || back < 0.0) return margin;

@@ -96,7 +96,7 @@ Status validate_render_options(const LightfieldRenderOptions& o) {
     return option_error("mixed_texel_bend_texels must be finite and >= 0");
   }
   if (o.blend_views > kMaxBlendViews) return option_error("blend_views is above 8");
-  if (o.coverage > 4) return option_error("coverage is not 0, 1, 2, 3 or 4");
+  if (o.coverage > 5) return option_error("coverage is not 0, 1, 2, 3, 4 or 5");
   if (!(o.coverage_threshold >= 0 && o.coverage_threshold <= 1)) {
     return option_error("coverage_threshold must be in [0, 1]");
   }
@@ -249,14 +249,26 @@ double coverage_margin(const View& v, const Vec3& x, double r, double margin, ui
     const int cx = cell(fc.u), cy = cell(fc.v);
     const uint32_t mask = front[nearest] ? cov[nearest].mask : ~uint32_t{cov[nearest].mask};
     covered = false;
-    // Mode 3 grows the front surface by one cell (a quarter texel) within the texel: one view's
-    // empty vote suffices, so each view's errors erode thin parts unless the test leans to
+    // Modes 3 and 5 grow the front surface by one cell (a quarter texel) within the texel: one
+    // view's empty vote suffices, so each view's errors erode thin parts unless the test leans to
     // occupied, as the footprint rule does by up to 0.9 texels.
-    const int grow = mode == 3 ? 1 : 0;
+    const int grow = mode == 2 ? 0 : 1;
     for (int j = std::max(cy - grow, 0); j <= std::min(cy + grow, 3); ++j) {
       for (int i = std::max(cx - grow, 0); i <= std::min(cx + grow, 3); ++i) {
         covered = covered || ((mask >> (4 * j + i)) & 1u);
       }
+    }
+    if (mode == 5 && !front[nearest]) {
+      // The texel the direction falls in lies behind the front, which a neighbour tap gave. Where
+      // its own surface fills the window, that surface is what the view sees along the
+      // direction: the farthest tap (another surface, or the sky) would carve it. Where its
+      // other cells are only farther surfaces, the front does not reach into it.
+      if (!covered) {
+        const Texel& t = taps.texel[nearest];
+        const uint16_t own = v.depth_code_at(t.face, t.x, t.y);
+        return own == kLog16Sky ? kInf : own - rcode;
+      }
+      if (cov[nearest].near == 0) covered = false;
     }
   }
   if (covered) return margin;

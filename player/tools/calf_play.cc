@@ -291,9 +291,10 @@ static int command_main(int argc, char** argv) {
                  "light field: how the renderer (GL or CPU) uses a clip's coverage stream (SPEC "
                  "11.1.11) in its emptiness test, as bench-player_quality --coverage uses a "
                  "capture set's: 0 off, 1 bilinear front shares, 2 cell mask, 3 grown cell mask, 4 "
-                 "every tap's cell; "
+                 "every tap's cell, 5 grown cell mask where a texel behind the front answers for "
+                 "its own cells; "
                  "clips without coverage play as with 0; the window's C key toggles it")
-      ->check(CLI::Range(0u, 4u));
+      ->check(CLI::Range(0u, 5u));
   app.add_option("--coverage-agreement", o.render.coverage_agreement,
                  "light field, with --coverage: a point that a view calls empty only through its "
                  "coverage is empty once this many views say so")

@@ -607,7 +607,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--coverage", base.coverage,
                  "coverage: 0 off, 1 bilinear front shares, 2 cell mask, 3 grown cell mask, 4 "
-                 "every tap's cell (views with coverage)")
+                 "every tap's cell, 5 grown cell mask where a texel behind the front answers for "
+                 "its own cells (views with coverage)")
       ->capture_default_str();
   app.add_option("--coverage-threshold", base.coverage_threshold, "coverage_threshold")
       ->capture_default_str();

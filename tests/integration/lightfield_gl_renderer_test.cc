@@ -480,7 +480,7 @@ TEST(LightfieldGlRenderer, MatchesCpuWithCoverage) {
   }
   const Camera room_cam = between_views_camera(80);
   o = {};
-  for (const uint32_t mode : {3u, 2u, 4u}) {
+  for (const uint32_t mode : {3u, 2u, 4u, 5u}) {
     o.coverage = mode;
     const Comparison c = compare(room_views, room_cam, o);
     const std::string what = "room, coverage " + std::to_string(mode) + " in every second view";
@@ -495,6 +495,19 @@ TEST(LightfieldGlRenderer, MatchesCpuWithCoverage) {
   report("room, coverage 3 in every view", every);
   EXPECT_GE(every.psnr, 45.0);
   expect_float_agreement(every, "room, every view");
+  // Mode 5 moves hits that mode 3 places (where a texel behind the front answers for itself).
+  o.coverage = 5;
+  const Comparison every5 = compare(all_covered, room_cam, o);
+  report("room, coverage 5 in every view", every5);
+  EXPECT_GE(every5.psnr, 45.0);
+  expect_float_agreement(every5, "room, every view, mode 5");
+  size_t moved5 = 0;
+  for (size_t k = 0; k < every.cpu.depth.size(); ++k) {
+    moved5 += !(std::fabs(every5.cpu.depth[k] / every.cpu.depth[k] - 1) < 1e-3);
+  }
+  std::printf("room: coverage 5 moves the hits of %zu of %u pixels from coverage 3's\n", moved5,
+              room_cam.width * room_cam.height);
+  EXPECT_GT(moved5, 0u);
   o.coverage = 0;
   const Comparison every_off = compare(all_covered, room_cam, o);
   size_t room_moved = 0;

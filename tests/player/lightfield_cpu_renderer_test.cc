@@ -1019,6 +1019,11 @@ TEST(LightfieldCpuRenderer, RejectsBadOptionsAndCameras) {
   o.blend_views = 9;
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
   o = {};
+  o.coverage = 5;
+  EXPECT_TRUE(LightfieldCpuRenderer::make(views, o).ok());
+  o.coverage = 6;
+  EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
+  o = {};
   o.near = 0;
   EXPECT_EQ(code(o), ErrorId::kPlayerOptions);
   o = {};
@@ -1162,6 +1167,53 @@ TEST(LightfieldCpuRenderer, RrReplacementReproducesTheViewAtItsViewpoint) {
   EXPECT_GE(p_replaced, 40.0);
   EXPECT_LT(p_alg4, p_replaced - 10);
   for (float c : replaced.color) ASSERT_GE(c, 0.0f);
+}
+
+// Coverage mode 5 against mode 3: small spheres in front of larger ones against the sky, four
+// views with coverage. Where the texel a direction falls in lies behind a front surface that a
+// neighbour tap within the footprint gave, mode 3 compares the point with the farthest tap (often
+// the sky) wherever that texel's cells do not show the front, and with the front wherever they
+// show anything else; mode 5 compares it with the texel's own surface where its cells show only
+// that, and with the surface behind where its other cells are only farther ones. Measured at 32²
+// faces, 96² eye: 327 pixels on the wrong side of a silhouette with mode 3 (24.33 dB), 291 with
+// mode 5 (24.36 dB); 571 without coverage.
+TEST(LightfieldCpuRenderer, CoverageMode5LetsTheTexelBehindTheFrontAnswerForItself) {
+  Scene scene;
+  scene.room = false;
+  scene.uniform_sky = true;
+  for (int i = 0; i < 5; ++i) {
+    scene.spheres.push_back({{-0.5 + 0.25 * i, 0.05 * (i % 2), -1.6}, 0.06});
+    scene.spheres.push_back({{-0.45 + 0.25 * i, -0.08, -2.2}, 0.1});
+  }
+  const std::vector<Vec3> four = {
+      {-0.3, 0.1, 0.2}, {0.3, -0.1, 0.2}, {0.1, 0.3, 0.1}, {-0.1, -0.3, 0.1}};
+  ViewSet views = make_views(scene, four, 32, false, 4);
+  for (View& v : views.views) testing::add_coverage(scene, &v);
+  Camera cam;
+  cam.position = {0.04, 0.03, 0.1};
+  cam.forward = {0, 0, -1};
+  cam.fov_y = 40 * kPi / 180;
+  cam.width = cam.height = 96;
+  const RenderedImage gt = ground_truth(scene, cam);
+  size_t wrong[2];
+  double p[2];
+  for (int k = 0; k < 2; ++k) {
+    LightfieldRenderOptions o;
+    o.steps = 128;
+    o.surface_hints = 4;
+    o.surface_hint_vetoes = 0;
+    o.coverage = k == 0 ? 3 : 5;
+    const RenderedImage img = render(views, cam, o);
+    wrong[k] = 0;
+    for (size_t i = 0; i < gt.depth.size(); ++i) {
+      wrong[k] += std::isfinite(img.depth[i]) != std::isfinite(gt.depth[i]);
+    }
+    p[k] = psnr(img.color, gt.color);
+    std::printf("coverage %u: %zu pixels on the wrong side of a silhouette, %.2f dB\n", o.coverage,
+                wrong[k], p[k]);
+  }
+  EXPECT_LT(static_cast<double>(wrong[1]), 0.95 * static_cast<double>(wrong[0]));
+  EXPECT_GE(p[1], p[0]);
 }
 
 }  // namespace

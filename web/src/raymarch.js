@@ -26,7 +26,7 @@ export const RENDER_DEFAULTS = {
 // named as calf-play's and bench-player_quality's options, with their ranges; the window player's
 // C key turns `coverage` on (its given mode, else 3) and off.
 export const RENDER_PARAMETERS = [
-  { name: 'coverage', option: 'coverage', min: 0, max: 4, integer: true },
+  { name: 'coverage', option: 'coverage', min: 0, max: 5, integer: true },
   { name: 'coverage-threshold', option: 'coverage_threshold', min: 0, max: 1, integer: false },
   { name: 'coverage-cluster', option: 'coverage_cluster', min: 0, max: Infinity, integer: false },
   { name: 'coverage-agreement', option: 'coverage_agreement', min: 1, max: 65536, integer: true },

@@ -169,7 +169,11 @@ struct LightfieldRenderOptions {
   // behind) against `coverage_threshold`; 2: the nearest texel's 4 x 4 cell mask; 3: that mask
   // grown by one cell; 4: each bilinear tap's cell nearest the direction (the direction's own
   // cell in the texel it falls in; a tap across a face seam gives its front share), their
-  // covered bits blended bilinearly against `coverage_threshold`. The front cluster: taps within a
+  // covered bits blended bilinearly against `coverage_threshold`; 5: mode 3, except where the
+  // nearest texel itself lies behind the front cluster (the front came from a neighbour tap
+  // within the footprint): where every cell of the grown window shows that texel's own surface
+  // the point is compared with it, and where its other cells show only farther surfaces (its
+  // near share is 0) with the surface behind. The front cluster: taps within a
   // relative depth `coverage_cluster` of the footprint's surface. Off by default: it lifts the
   // spider's silhouettes but carves thin parts of turntable at 128² faces unless coverage_agreement
   // asks for 2 or 3 views, which in turn gives back part of the spider's gain (docs/RENDERING.md
