@@ -265,14 +265,16 @@ float coverage_margin(CalfView v, vec3 x, float r, float margin) {
     ivec2 cell = clamp(ivec2(floor((uv - floor(uv)) * 4.0)), ivec2(0), ivec2(3));
     uint mask = cov[nearest].x | cov[nearest].y << 8;
     if (!front[nearest]) mask = ~mask;
-    int grow = coverage_mode == 2u ? 0 : 1;  // modes 3 and 5: the front grown by one cell
+    // Modes 3 and 5: the front grown by one cell, except (mode 5) into a texel behind it.
+    bool behind = coverage_mode == 5u && !front[nearest];
+    int grow = coverage_mode == 2u || behind ? 0 : 1;
     for (int j = max(cell.y - grow, 0); j <= min(cell.y + grow, 3); ++j) {
       for (int i = max(cell.x - grow, 0); i <= min(cell.x + grow, 3); ++i) {
         covered = covered || ((mask >> uint(4 * j + i)) & 1u) != 0u;
       }
     }
-    if (coverage_mode == 5u && !front[nearest]) {
-      // The nearest texel lies behind the front: its own surface where it fills the window; the
+    if (behind) {
+      // The nearest texel lies behind the front: its own surface where its cell shows it; the
       // surface behind where its other cells are only farther ones.
       if (!covered) {
         uint own = depth_code(v, taps.texel[nearest]);

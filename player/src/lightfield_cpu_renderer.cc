@@ -251,18 +251,21 @@ double coverage_margin(const View& v, const Vec3& x, double r, double margin, ui
     covered = false;
     // Modes 3 and 5 grow the front surface by one cell (a quarter texel) within the texel: one
     // view's empty vote suffices, so each view's errors erode thin parts unless the test leans to
-    // occupied, as the footprint rule does by up to 0.9 texels.
-    const int grow = mode == 2 ? 0 : 1;
+    // occupied, as the footprint rule does by up to 0.9 texels. Mode 5 does not grow a front that
+    // a neighbour tap gave into a texel behind it: there the texel's own cells say exactly how
+    // far the nearer surface reaches.
+    const bool behind = mode == 5 && !front[nearest];
+    const int grow = mode == 2 || behind ? 0 : 1;
     for (int j = std::max(cy - grow, 0); j <= std::min(cy + grow, 3); ++j) {
       for (int i = std::max(cx - grow, 0); i <= std::min(cx + grow, 3); ++i) {
         covered = covered || ((mask >> (4 * j + i)) & 1u);
       }
     }
-    if (mode == 5 && !front[nearest]) {
-      // The texel the direction falls in lies behind the front, which a neighbour tap gave. Where
-      // its own surface fills the window, that surface is what the view sees along the
-      // direction: the farthest tap (another surface, or the sky) would carve it. Where its
-      // other cells are only farther surfaces, the front does not reach into it.
+    if (behind) {
+      // The texel the direction falls in lies behind the front. Where its cell shows its own
+      // surface, that surface is what the view sees along the direction: the farthest tap
+      // (another surface, or the sky) would carve it. Where its other cells are only farther
+      // surfaces, the front does not reach into it.
       if (!covered) {
         const Texel& t = taps.texel[nearest];
         const uint16_t own = v.depth_code_at(t.face, t.x, t.y);

@@ -1173,10 +1173,10 @@ TEST(LightfieldCpuRenderer, RrReplacementReproducesTheViewAtItsViewpoint) {
 // views with coverage. Where the texel a direction falls in lies behind a front surface that a
 // neighbour tap within the footprint gave, mode 3 compares the point with the farthest tap (often
 // the sky) wherever that texel's cells do not show the front, and with the front wherever they
-// show anything else; mode 5 compares it with the texel's own surface where its cells show only
-// that, and with the surface behind where its other cells are only farther ones. Measured at 32²
-// faces, 96² eye: 327 pixels on the wrong side of a silhouette with mode 3 (24.33 dB), 291 with
-// mode 5 (24.36 dB); 571 without coverage.
+// show anything else, grown by a cell; mode 5 reads the texel's own cell: its own surface where
+// the cell shows it, the surface behind where the texel's other cells are only farther ones.
+// Measured at 32² faces, 96² eye: 327 pixels on the wrong side of a silhouette with mode 3
+// (24.33 dB), 129 with mode 5 (26.38 dB); 571 without coverage.
 TEST(LightfieldCpuRenderer, CoverageMode5LetsTheTexelBehindTheFrontAnswerForItself) {
   Scene scene;
   scene.room = false;
@@ -1212,8 +1212,8 @@ TEST(LightfieldCpuRenderer, CoverageMode5LetsTheTexelBehindTheFrontAnswerForItse
     std::printf("coverage %u: %zu pixels on the wrong side of a silhouette, %.2f dB\n", o.coverage,
                 wrong[k], p[k]);
   }
-  EXPECT_LT(static_cast<double>(wrong[1]), 0.95 * static_cast<double>(wrong[0]));
-  EXPECT_GE(p[1], p[0]);
+  EXPECT_LT(static_cast<double>(wrong[1]), 0.6 * static_cast<double>(wrong[0]));
+  EXPECT_GT(p[1], p[0] + 1);
 }
 
 }  // namespace

@@ -171,9 +171,10 @@ struct LightfieldRenderOptions {
   // cell in the texel it falls in; a tap across a face seam gives its front share), their
   // covered bits blended bilinearly against `coverage_threshold`; 5: mode 3, except where the
   // nearest texel itself lies behind the front cluster (the front came from a neighbour tap
-  // within the footprint): where every cell of the grown window shows that texel's own surface
-  // the point is compared with it, and where its other cells show only farther surfaces (its
-  // near share is 0) with the surface behind. The front cluster: taps within a
+  // within the footprint): there its own cell decides, not grown: where it shows the texel's own
+  // surface the point is compared with that surface, where it shows another one the front
+  // covers it if the texel has a nearer share, else the point is compared with the surface
+  // behind. The front cluster: taps within a
   // relative depth `coverage_cluster` of the footprint's surface. Off by default: it lifts the
   // spider's silhouettes but carves thin parts of turntable at 128² faces unless coverage_agreement
   // asks for 2 or 3 views, which in turn gives back part of the spider's gain (docs/RENDERING.md
