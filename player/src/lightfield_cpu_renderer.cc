@@ -359,6 +359,12 @@ int hint_cell_covered(const View& v, const Vec3& x, double r, int grow, bool at_
   return 0;
 }
 
+// |ln(d / r)| for v's depth code `code` (d its decoded depth) at distance r: the relative depth
+// disagreement w_depth decays with; +inf for sky. The shader's log_disagreement.
+double log_disagreement(const View& v, uint16_t code, double r) {
+  return code == kLog16Sky ? kInf : std::fabs(std::log(v.range().decode(code) / r));
+}
+
 // `texels` texel angles of v (2 / face size radians each, a texel's width at the face centre) as
 // a relative depth, in v's log-16 code units: the scale of the hint margin and the mixed-texel
 // bend.
@@ -618,7 +624,7 @@ double LightfieldCpuRenderer::blend_threshold(const Vec3& o, const Vec3& p,
     if (r <= min_view_distance_) return kInf;
     const Texel t = texel_from_direction(x, v.face_size());
     const uint16_t code = v.depth_code_at(t.face, t.x, t.y);
-    return code == kLog16Sky ? kInf : std::fabs(std::log(v.range().decode(code) / r));
+    return log_disagreement(v, code, r);
   };
   double dmin = kInf;
   for (const View* v : active_) dmin = std::min(dmin, disagreement(*v));
@@ -672,7 +678,7 @@ void LightfieldCpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* 
       max_alpha = std::max(max_alpha, view_alpha);
     }
     if (ncode == kLog16Sky) continue;  // this view sees past p: it has no colour for it
-    const double ndiff = std::fabs(std::log(v.range().decode(ncode) / r));
+    const double ndiff = log_disagreement(v, ncode, r);
     Contribution k{-options_.depth_decay * ndiff, {0, 0, 0}, view_alpha};
     if (!options_.bilinear_colour) {
       const float* col = v.colour_at(nearest.face, nearest.x, nearest.y);
@@ -682,7 +688,7 @@ void LightfieldCpuRenderer::shade_surface(const Vec3& o, const Vec3& p, double* 
       double diff[4], dmin = kInf;
       for (int t = 0; t < 4; ++t) {
         const uint16_t code = v.depth_code_at(taps.texel[t].face, taps.texel[t].x, taps.texel[t].y);
-        diff[t] = code == kLog16Sky ? kInf : std::fabs(std::log(v.range().decode(code) / r));
+        diff[t] = log_disagreement(v, code, r);
         if (taps.weight[t] > 0) dmin = std::min(dmin, diff[t]);
       }
       double a[4], asum = 0;
