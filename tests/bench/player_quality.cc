@@ -197,9 +197,9 @@ Status write_montage(const fs::path& file, const RenderedImage& ref, const Rende
   return write_png(file, {3 * w * k, h * k, out});
 }
 
-// Every k x k block averaged (linear colour; depth: the block's centre sample), for comparing
-// anti-aliased images: a ground truth rendered k times larger and a reconstruction rendered
-// at the same size, both filtered the same way (--supersample).
+// Every k x k block averaged (linear colour; depth: the block's sample (k/2, k/2), the centre
+// one for an odd k), for comparing anti-aliased images: a ground truth rendered k times larger
+// and a reconstruction rendered at the same size, both filtered the same way (--supersample).
 RenderedImage box_down(const RenderedImage& in, uint32_t k) {
   if (k == 1) return in;
   RenderedImage out;
@@ -412,8 +412,8 @@ std::vector<Score> measure(const char* section, std::vector<Pose>& poses, FrameC
       s.ssim = need(ssim(rgb_ref(img), rgb_ref(reference)));
       s.depth_ok = depth_ok_share(img, reference);
       if (g_breakdown) {
-        // The classes come from the box-filtered images' depths (each block's centre ray), so the
-        // camera is the compared images' size.
+        // The classes come from the box-filtered images' depths (each block's sample (K/2, K/2):
+        // the pixel centre's ray for an odd K), so the camera is the compared images' size.
         const Camera small = capture::camera_from_pose(p.pose, reference.width, reference.height);
         add_breakdown(img, reference, views, small, &breakdown[vi]);
       }
@@ -669,10 +669,10 @@ int main(int argc, char** argv) {
          "filtered, against the ground truth at its size (calf-play --supersample; 1..8)")
       ->capture_default_str();
   app.add_flag("--no-reproject", no_reproject, "skip the vp-reproj measurement");
-  app.add_flag(
-      "--breakdown", g_breakdown,
-      "print where the squared error sits: sky, grown, hole, edge, wrong depth, surface, "
-      "mirror, glass pixels (with --supersample: by the box-filtered images' centre depths)");
+  app.add_flag("--breakdown", g_breakdown,
+               "print where the squared error sits: sky, grown, hole, edge, wrong depth, surface, "
+               "mirror, glass pixels (with --supersample K: by the depth of each K x K block's "
+               "sample (K/2, K/2), the pixel centre for an odd K)");
   app.add_option("--out", out_dir, "write renders, references and heat maps (PNG) here");
   std::string montage_file, montage_arg = "0,3";
   uint32_t montage_window = 48, montage_scale = 4;
