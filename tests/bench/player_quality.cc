@@ -271,6 +271,10 @@ void shade_at_reference_depth(const LightfieldCpuRenderer& renderer, const Camer
 //   surface     the rest: the right surface away from edges (shading, texture, noise)
 //   mirror      `surface` pixels whose point a view with material sees as reflective only
 //   glass       ... as refractive (mirror-box's spheres): the view-dependent part
+// A pixel's depth: the reference's centre ray; the reconstruction's the nearest of its rays with
+// --render-supersample N (LightfieldCpuRenderer::render), so a boundary pixel whose centre sees
+// the farther surface may class as wrong depth; with --supersample K both images' block sample
+// (K/2, K/2), the centre for an odd K.
 enum ErrorClass { kSky, kGrown, kHole, kEdge, kWrongDepth, kSurface, kMirror, kGlass, kClassCount };
 const char* const kClassNames[kClassCount] = {"sky",         "grown",   "hole",   "edge",
                                               "wrong depth", "surface", "mirror", "glass"};
