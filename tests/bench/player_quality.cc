@@ -416,8 +416,8 @@ std::vector<Score> measure(const char* section, std::vector<Pose>& poses, FrameC
       s.ssim = need(ssim(rgb_ref(img), rgb_ref(reference)));
       s.depth_ok = depth_ok_share(img, reference);
       if (g_breakdown) {
-        // The classes come from the box-filtered images' depths (each block's sample (K/2, K/2):
-        // the pixel centre's ray for an odd K), so the camera is the compared images' size.
+        // With --supersample K the compared images are K times smaller than the render: the
+        // camera that names their pixels' directions is at their size.
         const Camera small = capture::camera_from_pose(p.pose, reference.width, reference.height);
         add_breakdown(img, reference, views, small, &breakdown[vi]);
       }
