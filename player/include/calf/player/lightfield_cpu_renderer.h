@@ -174,11 +174,10 @@ struct LightfieldRenderOptions {
   // within the footprint): there its own cell decides, not grown: where it shows the texel's own
   // surface the point is compared with that surface, where it shows another one the front
   // covers it if the texel has a nearer share, else the point is compared with the surface
-  // behind. The front cluster: taps within a
-  // relative depth `coverage_cluster` of the footprint's surface. Off by default: it lifts the
-  // spider's silhouettes but carves thin parts of turntable at 128² faces unless coverage_agreement
-  // asks for 2 or 3 views, which in turn gives back part of the spider's gain (docs/RENDERING.md
-  // "Coverage").
+  // behind. The front cluster: taps within a relative depth `coverage_cluster` of the
+  // footprint's surface. Off by default: it lifts the spider's silhouettes but carves thin parts
+  // of turntable at 128² faces unless coverage_agreement asks for 2 or 3 views, which in turn
+  // gives back part of the spider's gain (docs/RENDERING.md "Coverage").
   uint32_t coverage = 0;
   double coverage_threshold = 0.5;
   double coverage_cluster = 0.05;
