@@ -99,6 +99,16 @@ Texel texel_from_direction(const Vec3& d, uint32_t face_size) {
   return {c.face, clamp_texel(c.u), clamp_texel(c.v)};
 }
 
+Texel texel_beyond_face(CubeFace face, int64_t x, int64_t y, uint32_t face_size) {
+  if (x >= 0 && y >= 0 && x < face_size && y < face_size) {
+    return {face, static_cast<uint32_t>(x), static_cast<uint32_t>(y)};
+  }
+  // The texel centre continued in the face's plane, looked up again: lands on the neighbour.
+  const Vec3 d = direction_from_texel_coord(
+      {face, static_cast<double>(x) + 0.5, static_cast<double>(y) + 0.5}, face_size);
+  return texel_from_direction(d, face_size);
+}
+
 UprightFace upright_face(CubeFace face) {
   // up = -t_c's axis direction (row 0 of a face is t = 0, the top of the upright image).
   const FaceAxes& f = kFaceAxes[cube_face_index(face)];

@@ -1,112 +1,32 @@
-#include <algorithm>
 #include <array>
-#include <bit>
-#include <cmath>
 #include <vector>
 
 #include "calf/player/view_set.h"
-#include "sampling.h"
 
 namespace calf::player {
 
-namespace {
-
-// Where a neighbour's surface lies against the texel's own (format/CAPTURE.md "Coverage" names a
-// cell's surface the same way).
-enum class Side { kOwn, kNearer, kFarther, kNone };
-
-Side side_of(uint16_t own, uint16_t other, double tolerance_codes, double jump_codes) {
-  if (own == kLog16Sky) return other == kLog16Sky ? Side::kOwn : Side::kNearer;
-  if (other == kLog16Sky) return Side::kFarther;
-  const double d = static_cast<double>(other) - static_cast<double>(own);
-  if (d < -jump_codes) return Side::kNearer;
-  if (d > jump_codes) return Side::kFarther;
-  if (std::fabs(d) <= tolerance_codes) return Side::kOwn;
-  return Side::kNone;
-}
-
-}  // namespace
-
-void unmix_coverage_colour(View* view, double min_share, double min_jump) {
-  if (!view->has_coverage()) return;
+Expected<uint64_t> unmix_coverage_colour(View* view, const capture::CoverageUnmixOptions& options) {
+  if (!view->has_coverage()) return uint64_t{0};
   const uint32_t n = view->face_size();
-  // The capture's own-surface tolerance: min(4 / N, 0.05) as relative depth, in codes.
-  const double tolerance_codes = std::min(4.0 / n, 0.05) / view->range().relative_step();
-  // The other side: a neighbour at least min_jump (and the tolerance) nearer or farther.
-  const double jump_codes =
-      std::max(std::min(4.0 / n, 0.05), min_jump) / view->range().relative_step();
-  std::array<std::vector<float>, kCubeFaceCount> out;
+  std::array<std::vector<float>, kCubeFaceCount> colour;
+  capture::CoverageUnmixFaces faces;
+  faces.face_size = n;
+  faces.relative_step = view->range().relative_step();
   for (int f = 0; f < kCubeFaceCount; ++f) {
     const CubeFace face = cube_face_from_index(f);
-    const std::span<const float> in = view->colour_face(face);
-    out[f].assign(in.begin(), in.end());
-    for (uint32_t y = 0; y < n; ++y) {
-      for (uint32_t x = 0; x < n; ++x) {
-        const Coverage cov = view->coverage_at(face, x, y);
-        if (cov.mask == 0xFFFF) continue;
-        const double own = std::popcount(cov.mask) / 16.0;
-        const double share[2] = {cov.near, cov.far};  // the other surfaces' shares
-        const uint16_t code = view->depth_code_at(face, x, y);
-        // The centroid of the cells the texel's own surface does not cover, in texels from its
-        // centre: the side of the texel where the other surface lies.
-        double cx = 0, cy = 0;
-        for (int j = 0; j < 4; ++j) {
-          for (int i = 0; i < 4; ++i) {
-            if ((cov.mask >> (4 * j + i)) & 1u) continue;
-            cx += (i + 0.5) / 4 - 0.5;
-            cy += (j + 0.5) / 4 - 0.5;
-          }
-        }
-        // Per side (own, nearer, farther) the best neighbour among the eight: one wholly its own
-        // surface first, then the one that lies most towards the uncovered cells.
-        const float* pick[3] = {nullptr, nullptr, nullptr};
-        double best[3] = {-1e9, -1e9, -1e9};
-        for (int dy = -1; dy <= 1; ++dy) {
-          for (int dx = -1; dx <= 1; ++dx) {
-            if (dx == 0 && dy == 0) continue;
-            const Texel t = internal::texel_beyond_face(face, int64_t{x} + dx, int64_t{y} + dy, n);
-            const uint16_t other = view->depth_code_at(t.face, t.x, t.y);
-            const int s = static_cast<int>(side_of(code, other, tolerance_codes, jump_codes));
-            if (s == static_cast<int>(Side::kNone)) continue;
-            const double toward = (dx * cx + dy * cy) / std::sqrt(double(dx * dx + dy * dy));
-            // The own surface's colour comes from the side away from the uncovered cells.
-            double score = s == 0 ? -toward : toward;
-            if (view->coverage_at(t.face, t.x, t.y).mask == 0xFFFF) score += 10;
-            if (score > best[s]) {
-              best[s] = score;
-              pick[s] = view->colour_at(t.face, t.x, t.y);
-            }
-          }
-        }
-        float* c = &out[f][3 * (size_t{y} * n + x)];
-        if (own < min_share || own == 0) {
-          // Too little of the texel is its own surface to solve for it: take a neighbour on it.
-          if (pick[0]) std::copy(pick[0], pick[0] + 3, c);
-          continue;
-        }
-        if ((share[0] > 0 && !pick[1]) || (share[1] > 0 && !pick[2])) continue;
-        for (int ch = 0; ch < 3; ++ch) {
-          double rest = c[ch];
-          if (share[0] > 0) rest -= share[0] * pick[1][ch];
-          if (share[1] > 0) rest -= share[1] * pick[2][ch];
-          // In [0, c / own]: the other surfaces add light, never take it away. Where a
-          // neighbour shows the own surface, no farther from c than it: a wrong estimate of the
-          // other side (a texture, a light) must not be amplified by 1 / own.
-          double lo = 0, hi = c[ch] / own;
-          if (pick[0]) {
-            lo = std::min<double>(c[ch], pick[0][ch]);
-            hi = std::max<double>(c[ch], pick[0][ch]);
-          }
-          c[ch] = static_cast<float>(std::clamp(rest / own, lo, hi));
-        }
-      }
-    }
+    const std::span<const float> c = view->colour_face(face);
+    colour[f].assign(c.begin(), c.end());
+    faces.depth[f] = view->depth_face(face);
+    faces.coverage[f] = view->coverage_face(face);
+    faces.colour[f] = colour[f];
   }
+  CALF_ASSIGN_OR_RETURN(const uint64_t changed, capture::unmix_coverage_colour(faces, options));
   const PixelRect whole{0, 0, n, n};
   for (int f = 0; f < kCubeFaceCount; ++f) {
-    // The rect is the whole face and `out` holds it: the write cannot fail.
-    (void)view->write_colour_rect(cube_face_from_index(f), whole, out[f]);
+    // The rect is the whole face and `colour` holds it: the write cannot fail.
+    (void)view->write_colour_rect(cube_face_from_index(f), whole, colour[f]);
   }
+  return changed;
 }
 
 }  // namespace calf::player

@@ -308,7 +308,7 @@ double coverage_alpha_of_view(const View& v, const Vec3& x, double r, double clu
     const int64_t tx = cx >= 0 ? cx / 4 : -((-cx + 3) / 4),
                   ty = cy >= 0 ? cy / 4 : -((-cy + 3) / 4);
     const bool inside = tx >= 0 && ty >= 0 && tx < n && ty < n;
-    const Texel t = internal::texel_beyond_face(fc.face, tx, ty, n);
+    const Texel t = texel_beyond_face(fc.face, tx, ty, n);
     const uint16_t code = v.depth_code_at(t.face, t.x, t.y);
     const Coverage cov = v.coverage_at(t.face, t.x, t.y);
     const bool front = code != kLog16Sky && std::fabs(code - rcode) <= half;
@@ -382,8 +382,8 @@ bool mixed_texel(const View& v, const Texel& t, double bend_codes) {
   constexpr int kDx[4] = {-1, 1, 0, 0}, kDy[4] = {0, 0, -1, 1};
   int bend[2] = {0, 0};  // along x, along y: the neighbours' sum less twice t's code
   for (int k = 0; k < 4; ++k) {
-    const Texel u = internal::texel_beyond_face(t.face, int64_t{t.x} + kDx[k],
-                                                int64_t{t.y} + kDy[k], v.face_size());
+    const Texel u =
+        texel_beyond_face(t.face, int64_t{t.x} + kDx[k], int64_t{t.y} + kDy[k], v.face_size());
     const uint16_t other = v.depth_code_at(u.face, u.x, u.y);
     if ((other == kLog16Sky) != (code == kLog16Sky)) return true;
     bend[k / 2] += int{other} - int{code};
@@ -420,9 +420,8 @@ void LightfieldCpuRenderer::tap_colour(const View& v, const Texel& t, const doub
     bool same_surface = true;
     for (int s = 0; s < 2 && same_surface; ++s) {
       const int64_t step = s == 0 ? -1 : 1;
-      const Texel u =
-          internal::texel_beyond_face(t.face, int64_t{t.x} + (axis == 0 ? step : 0),
-                                      int64_t{t.y} + (axis == 1 ? step : 0), v.face_size());
+      const Texel u = texel_beyond_face(t.face, int64_t{t.x} + (axis == 0 ? step : 0),
+                                        int64_t{t.y} + (axis == 1 ? step : 0), v.face_size());
       const uint16_t other = v.depth_code_at(u.face, u.x, u.y);
       same_surface = (other == kLog16Sky) == (code == kLog16Sky) &&
                      (code == kLog16Sky || std::abs(int{other} - int{code}) <= jump_codes) &&

@@ -28,10 +28,10 @@ bool texel_point(const View& v, const Texel& t, Vec3* q) {
 bool tangent(const View& v, const Texel& t, int dx, int dy, const Vec3& centre, Vec3* out) {
   const uint32_t n = v.face_size();
   Vec3 a, b;
-  const bool ha = texel_point(
-      v, internal::texel_beyond_face(t.face, int64_t{t.x} + dx, int64_t{t.y} + dy, n), &a);
-  const bool hb = texel_point(
-      v, internal::texel_beyond_face(t.face, int64_t{t.x} - dx, int64_t{t.y} - dy, n), &b);
+  const bool ha =
+      texel_point(v, texel_beyond_face(t.face, int64_t{t.x} + dx, int64_t{t.y} + dy, n), &a);
+  const bool hb =
+      texel_point(v, texel_beyond_face(t.face, int64_t{t.x} - dx, int64_t{t.y} - dy, n), &b);
   if (!ha && !hb) return false;
   const double la = ha ? length(a - centre) : 0, lb = hb ? length(b - centre) : 0;
   if (ha && hb && la <= 2 * lb && lb <= 2 * la) {

@@ -4,16 +4,6 @@
 
 namespace calf::player::internal {
 
-Texel texel_beyond_face(CubeFace face, int64_t x, int64_t y, uint32_t n) {
-  if (x >= 0 && y >= 0 && x < n && y < n) {
-    return {face, static_cast<uint32_t>(x), static_cast<uint32_t>(y)};
-  }
-  // The texel centre continued in the face's plane, looked up again: lands on the neighbour.
-  const Vec3 d = direction_from_texel_coord(
-      {face, static_cast<double>(x) + 0.5, static_cast<double>(y) + 0.5}, n);
-  return texel_from_direction(d, n);
-}
-
 BilinearTaps bilinear_taps(const FaceTexelCoord& c, uint32_t n) {
   // Texel centres sit at half-integers: the taps are the centres around (u - 0.5, v - 0.5).
   const double u = c.u - 0.5, v = c.v - 0.5;

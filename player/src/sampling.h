@@ -22,10 +22,6 @@ struct BilinearTaps {
 };
 BilinearTaps bilinear_taps(const FaceTexelCoord& c, uint32_t n);
 
-// The texel of (face, x, y) where x or y may lie one texel off the face: re-projected onto the
-// neighbouring face through the cube conventions.
-Texel texel_beyond_face(CubeFace face, int64_t x, int64_t y, uint32_t n);
-
 // The per-axis strengths of sharpened colour taps (LightfieldRenderOptions::colour_sharpen) read
 // at bilinear fractions (ax, ay): k 4 a (1 - a) along each axis, 0 at a texel centre and k
 // halfway between two.

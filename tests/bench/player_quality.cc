@@ -83,7 +83,10 @@ class FrameCache {
       if (cache_.size() >= 4) cache_.clear();  // bounded memory on long paths
       it = cache_.emplace(frame, need(load_capture_views(reader_, frame))).first;
       if (unmix_min_share_ >= 0) {
-        for (View& v : it->second.views) unmix_coverage_colour(&v, unmix_min_share_, g_unmix_jump);
+        capture::CoverageUnmixOptions unmix;
+        unmix.min_share = unmix_min_share_;
+        unmix.min_jump = g_unmix_jump;
+        for (View& v : it->second.views) need(unmix_coverage_colour(&v, unmix));
       }
     }
     return it->second;

@@ -135,7 +135,12 @@ TEST(ViewSet, UnmixingRecoversTheOwnColourOfEdgeTexels) {
   ASSERT_TRUE(v.write_colour_rect(CubeFace::kNegZ, {0, 0, n, n}, sky_colour).ok());
   ASSERT_TRUE(v.write_coverage_rect(CubeFace::kNegZ, {0, 0, n, n}, sky_cov).ok());
 
-  unmix_coverage_colour(&v, 0.25, 0.1);
+  capture::CoverageUnmixOptions options;
+  options.min_share = 0.25;
+  options.min_jump = 0.1;
+  const Expected<uint64_t> changed = unmix_coverage_colour(&v, options);
+  ASSERT_TRUE(changed.ok()) << changed.status().message();
+  EXPECT_EQ(*changed, 9u);  // four texels on each side of the +Z edge, one on -Z
   for (uint32_t y = 0; y < n; ++y) {
     for (uint32_t x = 0; x < n; ++x) {
       const float* want = x < 4 ? a : b;
@@ -157,7 +162,30 @@ TEST(ViewSet, UnmixingLeavesViewsWithoutCoverageAlone) {
   std::vector<float> colour(3 * 16);
   for (size_t k = 0; k < colour.size(); ++k) colour[k] = 0.01f * k;
   ASSERT_TRUE(v.write_colour_rect(CubeFace::kPosX, {0, 0, 4, 4}, colour).ok());
-  unmix_coverage_colour(&v, 0, 0);
+  capture::CoverageUnmixOptions options;
+  options.min_share = 0;
+  const Expected<uint64_t> changed = unmix_coverage_colour(&v, options);
+  ASSERT_TRUE(changed.ok());
+  EXPECT_EQ(*changed, 0u);
+  const std::span<const float> got = v.colour_face(CubeFace::kPosX);
+  EXPECT_TRUE(std::equal(got.begin(), got.end(), colour.begin()));
+}
+
+// An option outside its range is an error, and the view keeps its colour.
+TEST(ViewSet, UnmixingRefusesOptionsOutOfRange) {
+  View v = make(4, false);
+  v.add_coverage();
+  std::vector<float> colour(3 * 16, 0.5f), cov(3 * 16);
+  for (size_t k = 0; k < 16; ++k) cov[3 * k + 2] = 0x00FF;
+  cov[0] = 0.5f;
+  ASSERT_TRUE(v.write_colour_rect(CubeFace::kPosX, {0, 0, 4, 4}, colour).ok());
+  ASSERT_TRUE(v.write_coverage_rect(CubeFace::kPosX, {0, 0, 4, 4}, cov).ok());
+  capture::CoverageUnmixOptions share;
+  share.min_share = 1.5;
+  EXPECT_EQ(unmix_coverage_colour(&v, share).status().id(), ErrorId::kCoverageUnmixInput);
+  capture::CoverageUnmixOptions jump;
+  jump.min_jump = -1;
+  EXPECT_EQ(unmix_coverage_colour(&v, jump).status().id(), ErrorId::kCoverageUnmixInput);
   const std::span<const float> got = v.colour_face(CubeFace::kPosX);
   EXPECT_TRUE(std::equal(got.begin(), got.end(), colour.begin()));
 }

@@ -80,6 +80,10 @@ struct Texel {
 };
 Texel texel_from_direction(const Vec3& d, uint32_t face_size);
 
+// The texel (x, y) of `face` where x or y may lie one texel off the face (faces of `face_size`
+// texels): re-projected onto the neighbouring face through these conventions.
+Texel texel_beyond_face(CubeFace face, int64_t x, int64_t y, uint32_t face_size);
+
 // Upright faces: how renderers other than OpenGL (Unity's and Maya's face cameras, image viewers)
 // see a calf face. Face f's upright camera sits at the cube's centre with a 90-degree square
 // field of view, looking along f's major axis with the up vector below; its image has row 0 at

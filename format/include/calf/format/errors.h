@@ -132,6 +132,8 @@ enum class ErrorKind : uint8_t {
   X(kShardOverlap, 164, kInvalidArgument, "two shards hold the same view or frame")              \
   X(kShardMissing, 165, kInvalidArgument, "a view or frame is in no shard")                      \
   X(kShardRange, 166, kInvalidArgument, "a shard's views or frames are outside the set")         \
+  /* coverage unmixing: 169 (calf/capture/coverage_unmix.h) */                                 \
+  X(kCoverageUnmixInput, 169, kInvalidArgument, "faces or options given to unmixing are unusable")\
   /* calf-capture: 170-199 */                                                                   \
   X(kSceneUnknown, 170, kInvalidArgument, "no built-in scene has that name")                    \
   X(kSceneLoad, 171, kCorrupt, "a scene file could not be imported")                            \

@@ -21,6 +21,7 @@
 #include <span>
 #include <vector>
 
+#include "calf/capture/coverage_unmix.h"
 #include "calf/format/cube.h"
 #include "calf/format/geometry.h"
 #include "calf/format/grid.h"
@@ -29,14 +30,9 @@
 
 namespace calf::player {
 
-// Per-texel coverage (format/CAPTURE.md "Coverage"): the shares of the texel's square whose first
-// surface lies nearer / farther than the texel's depth, and the 4 x 4 cell mask of the cells that
-// show the texel's own surface (bit 4 y + x for cell (x, y), x along the face's x). A view without
+// Per-texel coverage (format/CAPTURE.md "Coverage", calf/capture/coverage_unmix.h). A view without
 // coverage answers (0, 0, all cells): every texel wholly its own surface.
-struct Coverage {
-  float near = 0, far = 0;
-  uint16_t mask = 0xFFFF;
-};
+using Coverage = capture::TexelCoverage;
 
 // Per-texel material (paper 002 Sec. 6.1).
 struct Material {
@@ -83,6 +79,10 @@ class View {
   std::span<const uint16_t> depth_face(CubeFace f) const { return depth_[cube_face_index(f)]; }
   // Empty when the view has no material.
   std::span<const float> material_face(CubeFace f) const { return material_[cube_face_index(f)]; }
+  // Empty when the view has no coverage.
+  std::span<const Coverage> coverage_face(CubeFace f) const {
+    return coverage_[cube_face_index(f)];
+  }
 
   // Texel access for the renderers; x, y < face_size (asserted in debug).
   const float* colour_at(CubeFace f, uint32_t x, uint32_t y) const {
@@ -113,20 +113,11 @@ class View {
   std::array<std::vector<Coverage>, kCubeFaceCount> coverage_;
 };
 
-// Unmixed colour from coverage (docs/RENDERING.md "Coverage"). A texel on a depth edge holds the
-// anti-aliased mean of its own surface and the others its square shows:
-// c = a c_own + near c_nearer + far c_farther, with a the share of its own cells. This solves for
-// c_own, in linear light, taking c_nearer and c_farther from the texel's eight neighbours
-// (across face seams) whose depth lies nearer / farther than its own by more than
-// max(min_jump, the capture's own-surface tolerance min(4 / N, 0.05)) as relative depth: a
-// neighbour wholly its own surface first, then the one lying most towards the cells the texel's
-// surface does not cover. The result is clamped to [0, c / a], and where a neighbour (within the
-// tolerance) shows the texel's own surface, to the range between c and that neighbour's colour,
-// so that a wrong estimate of the other side is not amplified by 1 / a. Where a < `min_share` that
-// neighbour's colour is taken instead; a texel whose other sides have no neighbour keeps its
-// colour. Done once per view (all texels read before any is written), so any renderer can take
-// the texels; a view without coverage is unchanged.
-void unmix_coverage_colour(View* view, double min_share, double min_jump);
+// Unmixes the view's colour (calf/capture/coverage_unmix.h), so that any renderer can take its
+// texels. Returns how many texels changed; a view without coverage is unchanged (0). Errors:
+// CALF-E169 for an option outside its range; nothing is written then.
+[[nodiscard]] Expected<uint64_t> unmix_coverage_colour(
+    View* view, const capture::CoverageUnmixOptions& options);
 
 // The views one frame renders from. Views may differ in face size and depth range.
 struct ViewSet {
