@@ -42,6 +42,15 @@ Status validate_options(const LightfieldEncodeOptions& o) {
     return bad("--denoise-window " + std::to_string(o.denoise_window) + ": expected [0, " +
                std::to_string(kMaxDenoiseWindow) + "]");
   }
+  if (o.coverage_unmix) {
+    const capture::CoverageUnmixOptions& u = *o.coverage_unmix;
+    if (!(u.min_share >= 0 && u.min_share <= 1)) {
+      return bad("--coverage-unmix " + std::to_string(u.min_share) + ": expected [0, 1]");
+    }
+    if (!(u.min_jump >= 0 && u.min_jump <= 1e6)) {
+      return bad("--coverage-unmix-jump " + std::to_string(u.min_jump) + ": expected [0, 1e6]");
+    }
+  }
   if (o.depth_regions_per_side < 1 || o.depth_regions_per_side > 64) {
     return bad("depth regions per side " + std::to_string(o.depth_regions_per_side) +
                ": expected [1, 64]");
@@ -248,6 +257,12 @@ Expected<LightfieldAnalysis> analyse_lightfield(const capture::CaptureSetReader&
                                                 const LightfieldEncodeOptions& options) {
   CALF_RETURN_IF_ERROR(lightfield_internal::validate_options(options));
   const capture::CaptureManifest& m = input.manifest();
+  if (options.coverage_unmix && !(m.coverage && options.coverage)) {
+    return Status(ErrorId::kEncoderInput,
+                  m.coverage ? "unmixing needs the coverage stream, which the options drop"
+                             : "unmixing needs coverage, and the capture set has none "
+                               "(format/CAPTURE.md \"Coverage\")");
+  }
   CALF_RETURN_IF_ERROR(input.check_files());
   // The grids first: a bad cell size fails before any image is read.
   CALF_RETURN_IF_ERROR(FaceGrid::with_cell_size(m.face_size, options.cell_size).status());

@@ -80,6 +80,7 @@ void add_figures(LightfieldEncodeStats& total, const LightfieldEncodeStats& part
   total.material_views += part.material_views;
   total.min_colour_quality_db = std::min(total.min_colour_quality_db, part.min_colour_quality_db);
   total.colour_denoised += part.colour_denoised;
+  total.colour_unmixed += part.colour_unmixed;
   total.depth_max_rel_error = std::max(total.depth_max_rel_error, part.depth_max_rel_error);
   total.depth_sum_rel_error += part.depth_sum_rel_error;
   total.depth_finite_texels += part.depth_finite_texels;
@@ -197,6 +198,9 @@ Expected<LightfieldViewEncoding> encode_lightfield_view_frames(
                           denoise_static_colour(view.colour, view.depth, view.material, view.frames,
                                                 view.face_size, d));
     stats.colour_denoised += ds.averaged;
+  }
+  if (options.coverage_unmix && analysis.coverage && view.range) {
+    CALF_ASSIGN_OR_RETURN(stats.colour_unmixed, unmix_view_colour(*options.coverage_unmix, &view));
   }
 
   // The view's index chunk (SPEC §11.1 "View index chunk").

@@ -37,7 +37,7 @@ constexpr const char* kAnalysisKey = "calf.lightfield_analysis";
 constexpr const char* kAnalysisIdKey = "calf.lightfield_analysis_id";
 constexpr const char* kShardViewsKey = "calf.lightfield_shard_views";
 constexpr const char* kShardFramesKey = "calf.lightfield_shard_frames";  // "first-last"
-constexpr const char* kRecordMagic = "calf-lightfield-analysis 7";
+constexpr const char* kRecordMagic = "calf-lightfield-analysis 8";
 constexpr const char* kRecordMagicPrefix = "calf-lightfield-analysis ";
 
 std::string hex_double(double v) {
@@ -62,7 +62,10 @@ std::string analysis_record(const LightfieldAnalysis& a, const LightfieldEncodeO
     << "\nsegment_frames " << o.segment_frames << "\nmerge_static_groups "
     << (o.merge_static_groups ? 1 : 0) << "\ncolour_rdo " << hex_double(o.colour_rdo)
     << "\nbc1_fit " << static_cast<int>(o.bc1_fit) << "\ncoverage " << (o.coverage ? 1 : 0)
-    << "\nresolved_colour " << static_cast<int>(a.colour) << "\nviews " << a.views.size() << "\n";
+    << "\ncoverage_unmix " << (o.coverage_unmix ? 1 : 0) << " "
+    << hex_double(o.coverage_unmix ? o.coverage_unmix->min_share : 0.0) << " "
+    << hex_double(o.coverage_unmix ? o.coverage_unmix->min_jump : 0.0) << "\nresolved_colour "
+    << static_cast<int>(a.colour) << "\nviews " << a.views.size() << "\n";
   for (size_t v = 0; v < a.views.size(); ++v) {
     const LightfieldViewFacts& f = a.views[v];
     s << "view " << v << " " << (f.depth_range ? 1 : 0) << " "
@@ -176,6 +179,14 @@ Status parse_record(const std::string& path, const std::string& text, Lightfield
   o->bc1_fit = static_cast<Bc1Fit>(x);
   if (!field("coverage", 1)) return bad_record(path, "coverage");
   o->coverage = x != 0;
+  if (!field("coverage_unmix", 1)) return bad_record(path, "coverage_unmix");
+  {
+    capture::CoverageUnmixOptions u;
+    if (!read_double(in, &u.min_share) || !read_double(in, &u.min_jump)) {
+      return bad_record(path, "coverage_unmix");
+    }
+    if (x != 0) o->coverage_unmix = u;
+  }
   if (!field("resolved_colour", static_cast<uint64_t>(ColourCoding::kRgba16f)))
     return bad_record(path, "resolved_colour");
   *resolved_colour = x;

@@ -56,6 +56,11 @@ Status read_view(const capture::CaptureSetReader& input, uint32_t view,
                  const LightfieldViewFacts& expected, bool with_coverage, uint32_t first_frame,
                  uint32_t frame_count, ViewData* out);
 
+// Unmixes the colour of every frame of `view` (LightfieldEncodeOptions::coverage_unmix) from its
+// coverage, as a decoded clip gives it (shares in 16ths): lightfield_unmix.cc. Returns the
+// texel-frames changed. `view` has coverage and a depth range.
+Expected<uint64_t> unmix_view_colour(const capture::CoverageUnmixOptions& options, ViewData* view);
+
 // ---- Per-task output ----
 
 struct Pending {

@@ -302,21 +302,21 @@ TEST(LightfieldShardFrames, DenoisedShardsEqualOneMachineEncode) {
   ASSERT_TRUE(m.ok()) << m.to_string();
   EXPECT_TRUE(bytes_of(merged) == bytes_of(one));
 
-  // An analysis file of the record version before the window (6) is refused, naming it.
+  // An analysis file of the record version before baked unmixing (7) is refused, naming it.
   auto reader = container::Reader::open(a_path);
   ASSERT_TRUE(reader.ok());
   const std::string* record = reader->find_metadata("calf.lightfield_analysis");
   const std::string* id = reader->find_metadata("calf.lightfield_analysis_id");
   ASSERT_TRUE(record && id);
   std::string old = *record;
-  ASSERT_EQ(old.rfind("calf-lightfield-analysis 7\n", 0), 0u);
-  old.replace(0, std::string("calf-lightfield-analysis 7").size(), "calf-lightfield-analysis 6");
-  const size_t line = old.find("denoise_window 4\n");
+  ASSERT_EQ(old.rfind("calf-lightfield-analysis 8\n", 0), 0u);
+  old.replace(0, std::string("calf-lightfield-analysis 8").size(), "calf-lightfield-analysis 7");
+  const size_t line = old.find("\ncoverage_unmix 0 ");
   ASSERT_NE(line, std::string::npos);
-  old.erase(line, std::string("denoise_window 4\n").size());
-  const std::string v6 = (work / "v6.calf").string();
+  old.erase(line, old.find('\n', line + 1) - line);
+  const std::string v7 = (work / "v7.calf").string();
   {
-    auto w = container::Writer::create(v6);
+    auto w = container::Writer::create(v7);
     ASSERT_TRUE(w.ok());
     const auto* header = std::get_if<container::LightfieldTrackHeader>(&reader->tracks()[0].header);
     ASSERT_NE(header, nullptr);
@@ -325,10 +325,10 @@ TEST(LightfieldShardFrames, DenoisedShardsEqualOneMachineEncode) {
     ASSERT_TRUE(w->set_metadata("calf.lightfield_analysis_id", *id).ok());
     ASSERT_TRUE(w->finish().ok());
   }
-  auto refused = encoder::read_lightfield_analysis(v6);
+  auto refused = encoder::read_lightfield_analysis(v7);
   ASSERT_FALSE(refused.ok());
   expect_one_line(refused.status(), ErrorId::kShardFile);
-  EXPECT_NE(refused.status().message().find("record version '6'"), std::string::npos)
+  EXPECT_NE(refused.status().message().find("record version '7'"), std::string::npos)
       << refused.status().to_string();
 }
 

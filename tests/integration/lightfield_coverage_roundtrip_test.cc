@@ -25,6 +25,7 @@
 #include "calf/format/container.h"
 #include "calf/format/lightfield_layout.h"
 #include "calf/player/lightfield_representation.h"
+#include "calf/player/view_set.h"
 #include "clip_edit.h"
 #include "synthetic_capture.h"
 
@@ -219,6 +220,73 @@ TEST_F(LightfieldCoverage, DroppedOrAbsentCoverageLeavesTheClipAsWithout) {
   EXPECT_FALSE(decoder::track_has_coverage(r, 0));
   o.coverage = true;
   EXPECT_EQ(encode(root_ / "plain", o), without);
+}
+
+// Unmixing baked into the clip (LightfieldEncodeOptions::coverage_unmix) gives the CPU player's
+// views the colour that unmixing the plain clip's decoded views gives (calf/player/view_set.h),
+// up to the half floats of rgba16f colour; a set without coverage is refused, nothing written.
+TEST_F(LightfieldCoverage, BakedUnmixingIsWhatThePlayerUnmixesFromThePlainClip) {
+  encoder::LightfieldEncodeOptions o;
+  o.cell_size = 8;
+  o.colour = encoder::ColourCoding::kRgba16f;
+  o.depth = encoder::DepthCoding::kRaw16;
+  o.min_psnr_db = 200;  // every frame a colour keyframe: no frame blends keyframes
+  const std::vector<uint8_t> plain_bytes = encode(root_ / "cov", o);
+  capture::CoverageUnmixOptions unmix;
+  unmix.min_share = 0.25;
+  o.coverage_unmix = unmix;
+  encoder::LightfieldEncodeStats stats;
+  const std::vector<uint8_t> baked_bytes = encode(root_ / "cov", o, &stats);
+  EXPECT_GT(stats.colour_unmixed, 0u);
+  const container::Reader plain = open(plain_bytes);
+  const container::Reader baked = open(baked_bytes);
+  player::LightfieldOptions lo;
+  lo.decoder.view_dependent = false;
+  lo.decoder.background_thread = false;
+  auto plain_lf =
+      player::LightfieldRepresentation::open(plain, 0, lo, player::RenderBackend::kCpu, nullptr);
+  auto baked_lf =
+      player::LightfieldRepresentation::open(baked, 0, lo, player::RenderBackend::kCpu, nullptr);
+  ASSERT_TRUE(plain_lf.ok() && baked_lf.ok());
+  Camera cam;
+  cam.position = {0.25, 0, 0};
+  cam.width = 8;
+  cam.height = 8;
+  uint64_t differing = 0, unmixed = 0;
+  for (const uint32_t frame : {0u, 3u, 1u}) {
+    ASSERT_TRUE((*plain_lf)->prepare(frame, std::span<const Camera>(&cam, 1)).ok());
+    ASSERT_TRUE((*baked_lf)->prepare(frame, std::span<const Camera>(&cam, 1)).ok());
+    player::ViewSet views = *(*plain_lf)->cpu_views();
+    const player::ViewSet& want = *(*baked_lf)->cpu_views();
+    for (uint32_t v = 0; v < spec_.views; ++v) {
+      const player::ViewSet before = views;
+      const Expected<uint64_t> n = player::unmix_coverage_colour(&views.views[v], unmix);
+      ASSERT_TRUE(n.ok());
+      unmixed += *n;
+      for (uint32_t f = 0; f < 6; ++f) {
+        const CubeFace face = static_cast<CubeFace>(f);
+        const std::span<const float> got = views.views[v].colour_face(face);
+        const std::span<const float> baked_colour = want.views[v].colour_face(face);
+        const std::span<const float> plain_colour = before.views[v].colour_face(face);
+        for (size_t i = 0; i < got.size(); ++i) {
+          // rgba16f: half floats, 11 significant bits.
+          ASSERT_NEAR(baked_colour[i], got[i], std::ldexp(std::fabs(got[i]), -10) + 1e-6)
+              << "frame " << frame << " view " << v << " face " << f << " value " << i;
+          if (baked_colour[i] != plain_colour[i]) ++differing;
+        }
+      }
+    }
+  }
+  EXPECT_GT(unmixed, 0u);
+  EXPECT_GT(differing, 0u);  // the baked clip's colour is not the plain one's
+
+  ASSERT_TRUE(write_coverage_capture(root_ / "plain", spec_, false).ok());
+  const fs::path out = root_ / "unmixed.calf";
+  auto refused = encoder::encode_lightfield_file(root_ / "plain", out.string(), o);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().id(), ErrorId::kEncoderInput) << refused.status().to_string();
+  EXPECT_NE(refused.status().message().find("the capture set has none"), std::string::npos);
+  EXPECT_FALSE(fs::exists(out));
 }
 
 TEST_F(LightfieldCoverage, CoverageTheStreamCannotHoldIsRefusedWithE255) {

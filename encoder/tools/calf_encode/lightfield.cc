@@ -219,6 +219,22 @@ void add_options(CLI::App& app, LightfieldOptions& o) {
                "no coverage stream, a 1.1 file as for a set without coverage; without it a set "
                "with coverage gets the track's coverage stream (SPEC 11.1.11, a 1.2 file)")
       ->group(kLightfieldGroup);
+  app.add_option("--coverage-unmix", o.coverage_unmix,
+                 "bake unmixed colour into the clip: before colour coding, each texel on a depth "
+                 "edge of a capture set with coverage is solved for its own surface's colour "
+                 "(its anti-aliased colour less its neighbours' across the edge, by the shares "
+                 "coverage gives; docs/RENDERING.md \"Coverage\"), so that every player shows it; "
+                 "the value, 0..1, is the least share of its own surface a texel needs to be "
+                 "solved (below it the texel takes a neighbour's colour of its surface); "
+                 "0.25 with --coverage-unmix-jump 1000 (sky edges only) is the measured setting "
+                 "(docs/SILHOUETTES.md \"Unmixed colour at sky edges\"); without it colour is "
+                 "coded as captured")
+      ->group(kLightfieldGroup);
+  app.add_option("--coverage-unmix-jump", o.coverage_unmix_jump,
+                 "with --coverage-unmix: only neighbours at least this relative depth nearer or "
+                 "farther (beyond the capture's own-surface tolerance, min(4 / face size, 0.05)) "
+                 "count as the other side of an edge; 0..1e6, 0 by default; 1000: only the sky")
+      ->group(kLightfieldGroup);
   app.add_flag("--depth-fixed-groups", o.fixed_groups,
                "one depth / material chunk per K frames even where a tile does not change (the "
                "layout without static groups); without it a tile unchanged over whole "
@@ -289,6 +305,29 @@ int resolve(const CLI::App& app, const CommonOptions& common, LightfieldOptions*
   }
   o.merge_static_groups = !lf.fixed_groups;
   o.coverage = !lf.no_coverage;
+  if (given(app, "--coverage-unmix-jump") && !given(app, "--coverage-unmix")) {
+    return usage_error("calf-encode", "--coverage-unmix-jump needs --coverage-unmix");
+  }
+  if (given(app, "--coverage-unmix")) {
+    if (lf.no_coverage) {
+      return usage_error("calf-encode", "--coverage-unmix needs coverage; --no-coverage drops it");
+    }
+    if (!(lf.coverage_unmix >= 0 && lf.coverage_unmix <= 1)) {
+      return usage_error("calf-encode", "--coverage-unmix " + std::to_string(lf.coverage_unmix) +
+                                            ": expected a share in [0, 1]");
+    }
+    capture::CoverageUnmixOptions unmix;
+    unmix.min_share = lf.coverage_unmix;
+    if (given(app, "--coverage-unmix-jump")) {
+      if (!(lf.coverage_unmix_jump >= 0 && lf.coverage_unmix_jump <= 1e6)) {
+        return usage_error("calf-encode", "--coverage-unmix-jump " +
+                                              std::to_string(lf.coverage_unmix_jump) +
+                                              ": expected a relative depth in [0, 1e6]");
+      }
+      unmix.min_jump = lf.coverage_unmix_jump;
+    }
+    o.coverage_unmix = unmix;
+  }
   o.levels.compress_directory = !common.plain_directory;
   o.supercompression = common.supercompression;
   o.threads = common.threads;
@@ -390,6 +429,11 @@ int run(const CommonOptions& common, const LightfieldOptions& options) {
     std::fprintf(stderr, "  denoise: %llu of %llu texel-frames averaged over up to %u frames\n",
                  static_cast<unsigned long long>(stats->colour_denoised),
                  static_cast<unsigned long long>(stats->depth.raw / 2), o.denoise_window);
+  }
+  if (o.coverage_unmix) {
+    std::fprintf(stderr, "  unmix: %llu of %llu texel-frames unmixed\n",
+                 static_cast<unsigned long long>(stats->colour_unmixed),
+                 static_cast<unsigned long long>(stats->depth.raw / 2));
   }
   if (o.depth == encoder::DepthCoding::kBc5) {
     std::fprintf(stderr,

@@ -28,6 +28,8 @@ struct LightfieldOptions {
   std::string colour_rdo = "auto";  // lambda, or "auto" (each colour format's measured default)
   ColourCodec colour_codec = ColourCodec::kBc;
   bool no_coverage = false;
+  double coverage_unmix = -1;       // the minimum own share, < 0: off
+  double coverage_unmix_jump = -1;  // the minimum depth step, < 0: not given (0)
   bool fixed_groups = false;
   ShardOptions shard;  // a sharded encode's steps
 };

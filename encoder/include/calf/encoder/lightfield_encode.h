@@ -54,6 +54,7 @@
 #include <vector>
 
 #include "calf/capture/capture_set.h"
+#include "calf/capture/coverage_unmix.h"
 #include "calf/format/container.h"
 #include "calf/format/log_depth.h"
 #include "calf/format/status.h"
@@ -140,6 +141,13 @@ struct LightfieldEncodeOptions {
   // (SPEC §11.1.11) when the set has it; false drops it. A set without coverage is coded the same
   // either way.
   bool coverage = true;
+  // Unmixed colour at depth edges, baked into the clip (calf/capture/coverage_unmix.h): before any
+  // colour coding, each frame of each view with coverage solves its edge texels for their own
+  // surface's colour, as the CPU reference's unmixing does with the decoded coverage (shares in
+  // 16ths). Absent (the default): the colour is coded as captured. Needs a coverage stream
+  // (a capture set with coverage and `coverage` true). docs/SILHOUETTES.md "Unmixed colour at
+  // sky edges" measures {0.25, 1000}: sky edges only.
+  std::optional<capture::CoverageUnmixOptions> coverage_unmix;
   // Colour RDO strength (calf/encoder/bc_rdo.h): lambda, squared 8-bit sRGB error per estimated
   // bit saved, [0, 1e6]; 0 = off (the blocks as the BCn encoder made them). BC1, BC6H and BC7
   // keyframes; rgba8 / rgba16f ignore it. Applied to the keyframes after the
@@ -188,6 +196,8 @@ struct LightfieldEncodeStats {
   double min_colour_quality_db = 0;  // lowest temporal quality of any frame of any cell (+inf)
   // denoise_window > 1: texel-frames whose colour the pre-filter replaced by a temporal mean.
   uint64_t colour_denoised = 0;
+  // coverage_unmix: texel-frames whose colour unmixing changed.
+  uint64_t colour_unmixed = 0;
   // BC5 depth only: reconstruction error against the quantised input over every finite texel of
   // every frame, as relative depth error |z' / z - 1|, and texels whose sky-ness changed.
   double depth_max_rel_error = 0, depth_mean_rel_error = 0;
