@@ -76,6 +76,8 @@ uniform float rr_start;
 uniform uint rr_max_depth;
 uniform uvec2 image_size;
 uniform uint supersample;        // eye rays per pixel along each axis
+uniform uint ray_first;          // this pass's rays: [ray_first, ray_first + ray_count) of the
+uniform uint ray_count;          // supersample^2 grid, row-major
 uniform vec3 cam_forward;        // unit forward
 uniform vec3 cam_right;          // unit right * tan(fov_y / 2) * aspect
 uniform vec3 cam_up;             // unit up * tan(fov_y / 2)
@@ -834,19 +836,20 @@ void main() {
   uint i = uint(gl_FragCoord.x);
   uint j = image_size.y - 1u - uint(gl_FragCoord.y);  // row 0 at the top, like the CPU image
   // LightfieldCpuRenderer::render: supersample^2 rays through an even grid over the pixel, row-major, the
-  // colour their mean and the depth the nearest hit; 1 = the ray through the centre.
+  // colour their mean and the depth the nearest hit; 1 = the ray through the centre. A pass
+  // traces some of them and outputs their share of the mean; passes add up (GL_FUNC_ADD on rgb,
+  // GL_MIN on the depth).
   float n = float(supersample);
   vec3 sum = vec3(0.0);
   float z = INF;
-  for (uint sy = 0u; sy < supersample; ++sy) {
-    for (uint sx = 0u; sx < supersample; ++sx) {
-      float a = 2.0 * (float(i) + (float(sx) + 0.5) / n) / float(image_size.x) - 1.0;
-      float b = 1.0 - 2.0 * (float(j) + (float(sy) + 0.5) / n) / float(image_size.y);
-      vec3 d = normalize(cam_forward + a * cam_right + b * cam_up);
-      vec3 rgb;
-      z = min(z, trace(vec3(0.0), d, rgb));
-      sum += rgb;
-    }
+  for (uint r = ray_first; r < ray_first + ray_count; ++r) {
+    uint sx = r % supersample, sy = r / supersample;
+    float a = 2.0 * (float(i) + (float(sx) + 0.5) / n) / float(image_size.x) - 1.0;
+    float b = 1.0 - 2.0 * (float(j) + (float(sy) + 0.5) / n) / float(image_size.y);
+    vec3 d = normalize(cam_forward + a * cam_right + b * cam_up);
+    vec3 rgb;
+    z = min(z, trace(vec3(0.0), d, rgb));
+    sum += rgb;
   }
   out_colour = vec4(sum / (n * n), z);
 }

@@ -223,7 +223,21 @@ Status LightfieldGlRenderer::draw(const Camera& camera, std::span<const uint32_t
   }
   gl.Viewport(0, 0, static_cast<GLsizei>(camera.width), static_cast<GLsizei>(camera.height));
   gl.BindVertexArray(vao_);
-  gl.DrawArrays(GL_TRIANGLES, 0, 3);
+  // One pass per eye ray of a pixel, added up by blending: llvmpipe ends every loop of a shader
+  // invocation once all of them together have run 65535 iterations (its loop limiter), and one
+  // invocation marching 4 x 4 rays at 128 steps with 4 hint views runs past that.
+  const uint32_t rays = o.supersample * o.supersample;
+  gl.Uniform1ui(loc("ray_count"), 1);
+  if (rays > 1) {
+    gl.Enable(GL_BLEND);
+    gl.BlendEquationSeparate(GL_FUNC_ADD, GL_MIN);
+    gl.BlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ONE);
+  }
+  for (uint32_t ray = 0; ray < rays; ++ray) {
+    gl.Uniform1ui(loc("ray_first"), ray);
+    gl.DrawArrays(GL_TRIANGLES, 0, 3);
+  }
+  gl.Disable(GL_BLEND);
   gl.BindVertexArray(0);
   return check_gl_error(gl, "drawing the ray-march pass");
 }

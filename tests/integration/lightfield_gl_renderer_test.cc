@@ -259,6 +259,26 @@ TEST(LightfieldGlRenderer, MatchesCpuWithSupersampling) {
   }
 }
 
+// Many eye rays a pixel, each marching long: 4 x 4 rays of 256 steps with 4 hint views run about
+// 16 x 257 x (8 views + 4 x 4 hint substeps) = 99,000 loop iterations for one pixel. llvmpipe
+// ends every loop of a shader invocation once all of them together have run 65535 iterations;
+// one pass per ray keeps each invocation within it, and GL follows the CPU.
+TEST(LightfieldGlRenderer, MatchesCpuWhenAPixelsRaysMarchPastLlvmpipesLoopLimit) {
+  CALF_REQUIRE_GL();
+  const ViewSet views = tinted_views(32);
+  const Camera cam = between_views_camera(8);
+  LightfieldRenderOptions o;
+  o.supersample = 4;
+  o.steps = 256;
+  o.surface_hints = 4;
+  o.surface_hint_vetoes = 0;
+  const Comparison c = compare(views, cam, o);
+  report("supersample 4, 256 steps, surface hints 4", c);
+  EXPECT_GE(c.psnr, 45.0);
+  expect_float_agreement(c);
+  EXPECT_GE(c.depth_agree, 0.99);
+}
+
 // The Unstructured Lumigraph's weights (LightfieldRenderOptions::blend_views) on views tinted
 // each their own way, so that which views blend shows: they change the image against cam_decay's
 // weights, and GL follows the CPU with 3 views and with all 8. With K = 1 a view's weight drops

@@ -392,6 +392,10 @@ export function makeRaymarcher(gl, { views, faceSize, cellSize, options = { ...R
     gl.uniform1ui(U('rr_max_depth'), o.rr_max_depth);
     gl.uniform2ui(U('image_size'), camera.width, camera.height);
     gl.uniform1ui(U('supersample'), o.supersample);
+    // Every ray of the pixel in one pass (calf-play draws one pass per ray for llvmpipe's loop
+    // limit; browsers' GPUs have none).
+    gl.uniform1ui(U('ray_first'), 0);
+    gl.uniform1ui(U('ray_count'), o.supersample * o.supersample);
     gl.uniform3f(U('cam_forward'), ...rayForward);
     gl.uniform3f(U('cam_right'), ...rayRight);
     gl.uniform3f(U('cam_up'), ...rayUp);

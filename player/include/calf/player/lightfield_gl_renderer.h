@@ -74,8 +74,9 @@ class LightfieldGlRenderer {
 
   // Draws `camera` with `active_views` (as render()) into the framebuffer bound to
   // GL_DRAW_FRAMEBUFFER, viewport (0, 0, width, height) of the camera, output 0 = (rgb, radial
-  // distance): for a player that composites the result itself. Leaves program, textures and
-  // buffer bindings changed.
+  // distance): for a player that composites the result itself. With supersample > 1 it draws
+  // one pass per eye ray and blends them (rgb added, distance the minimum), so output 0 must be
+  // a float target holding (0, 0, 0, +inf). Leaves program, textures and buffer bindings changed.
   Status draw(const Camera& camera, std::span<const uint32_t> active_views = {});
 
  private:
