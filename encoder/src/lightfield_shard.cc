@@ -65,7 +65,8 @@ std::string analysis_record(const LightfieldAnalysis& a, const LightfieldEncodeO
     << "\ncoverage_unmix " << (o.coverage_unmix ? 1 : 0) << " "
     << hex_double(o.coverage_unmix ? o.coverage_unmix->min_share : 0.0) << " "
     << hex_double(o.coverage_unmix ? o.coverage_unmix->min_jump : 0.0) << "\nresolved_colour "
-    << static_cast<int>(a.colour) << "\nviews " << a.views.size() << "\n";
+    << static_cast<int>(a.colour) << "\ncoverage_stream " << (a.coverage ? 1 : 0) << "\nviews "
+    << a.views.size() << "\n";
   for (size_t v = 0; v < a.views.size(); ++v) {
     const LightfieldViewFacts& f = a.views[v];
     s << "view " << v << " " << (f.depth_range ? 1 : 0) << " "
@@ -112,7 +113,8 @@ bool read_double(std::istringstream& in, double* out) {
 // The record back into options and facts; the analysis itself is planned again from them, so a
 // record that does not fit its own header is refused.
 Status parse_record(const std::string& path, const std::string& text, LightfieldEncodeOptions* o,
-                    uint64_t* resolved_colour, std::vector<LightfieldViewFacts>* facts,
+                    uint64_t* resolved_colour, bool* coverage_stream,
+                    std::vector<LightfieldViewFacts>* facts,
                     std::vector<std::vector<uint64_t>>* pixels) {
   std::istringstream in(text);
   std::string line;
@@ -190,6 +192,8 @@ Status parse_record(const std::string& path, const std::string& text, Lightfield
   if (!field("resolved_colour", static_cast<uint64_t>(ColourCoding::kRgba16f)))
     return bad_record(path, "resolved_colour");
   *resolved_colour = x;
+  if (!field("coverage_stream", 1)) return bad_record(path, "coverage_stream");
+  *coverage_stream = x != 0;
   if (!field("views", container::kMaxViews)) return bad_record(path, "views");
   const uint64_t n = x;
   facts->assign(n, {});
@@ -376,8 +380,10 @@ Expected<LightfieldAnalysisFile> read_lightfield_analysis(const std::string& pat
   LightfieldAnalysisFile file;
   file.path = path;
   uint64_t resolved = 0;
+  bool coverage_stream = false;
   std::vector<LightfieldViewFacts> facts;
-  CALF_RETURN_IF_ERROR(parse_record(path, *record, &file.options, &resolved, &facts, &file.pixels));
+  CALF_RETURN_IF_ERROR(parse_record(path, *record, &file.options, &resolved, &coverage_stream,
+                                    &facts, &file.pixels));
   if (Status s = lightfield_internal::validate_options(file.options); !s.ok()) {
     return bad_record(path, s.message());
   }
@@ -387,6 +393,10 @@ Expected<LightfieldAnalysisFile> read_lightfield_analysis(const std::string& pat
   a.views = std::move(facts);
   a.colour = static_cast<ColourCoding>(resolved);
   a.hdr = a.colour == ColourCoding::kBc6h || a.colour == ColourCoding::kRgba16f;
+  a.coverage = coverage_stream;
+  if ((a.coverage && !file.options.coverage) || (file.options.coverage_unmix && !a.coverage)) {
+    return bad_record(path, "its coverage stream contradicts its options");
+  }
   if (a.views.size() != header->view_count || a.colour == ColourCoding::kAuto ||
       (header->flags & 1) != (a.hdr ? 1 : 0)) {
     return bad_record(path, "the record contradicts the track header");
@@ -486,6 +496,8 @@ Expected<LightfieldEncodeStats> encode_lightfield_shard(
       CALF_RETURN_IF_ERROR(writer.add_stored_chunk(keys, c.chunk).status());
     }
     total.colour_keyframes += enc.stats.colour_keyframes;
+    total.colour_denoised += enc.stats.colour_denoised;
+    total.colour_unmixed += enc.stats.colour_unmixed;
     total.colour.stored += enc.stats.colour.stored;
     total.depth.stored += enc.stats.depth.stored;
     total.material.stored += enc.stats.material.stored;

@@ -11,6 +11,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <span>
 #include <string>
 #include <vector>
@@ -22,6 +24,7 @@
 #include "calf/decoder/lightfield_reference.h"
 #include "calf/decoder/lightfield_verify.h"
 #include "calf/encoder/lightfield_encode.h"
+#include "calf/encoder/lightfield_shard.h"
 #include "calf/format/container.h"
 #include "calf/format/lightfield_layout.h"
 #include "calf/player/lightfield_representation.h"
@@ -287,6 +290,48 @@ TEST_F(LightfieldCoverage, BakedUnmixingIsWhatThePlayerUnmixesFromThePlainClip) 
   EXPECT_EQ(refused.status().id(), ErrorId::kEncoderInput) << refused.status().to_string();
   EXPECT_NE(refused.status().message().find("the capture set has none"), std::string::npos);
   EXPECT_FALSE(fs::exists(out));
+}
+
+// The analysis file records the unmixing options, and view shards of an unmixed encode merge into
+// the bytes of one encode (docs/FARM.md).
+TEST_F(LightfieldCoverage, ShardsOfAnUnmixedEncodeMergeIntoItsBytes) {
+  encoder::LightfieldEncodeOptions o;
+  o.cell_size = 8;
+  capture::CoverageUnmixOptions unmix;
+  unmix.min_share = 0.375;
+  unmix.min_jump = 0.125;
+  o.coverage_unmix = unmix;
+  const fs::path one = root_ / "one.calf";
+  ASSERT_TRUE(encoder::encode_lightfield_file(root_ / "cov", one.string(), o).ok());
+  const std::string analysis_path = (root_ / "analysis.calf").string();
+  ASSERT_TRUE(encoder::write_lightfield_analysis(root_ / "cov", analysis_path, o).ok());
+  auto analysis = encoder::read_lightfield_analysis(analysis_path);
+  ASSERT_TRUE(analysis.ok()) << analysis.status().to_string();
+  ASSERT_TRUE(analysis->options.coverage_unmix.has_value());
+  EXPECT_EQ(analysis->options.coverage_unmix->min_share, 0.375);
+  EXPECT_EQ(analysis->options.coverage_unmix->min_jump, 0.125);
+  std::vector<std::string> shards;
+  for (uint32_t v = 0; v < spec_.views; ++v) {
+    const std::string path = (root_ / ("shard" + std::to_string(v) + ".calf")).string();
+    const uint32_t views[1] = {v};
+    auto s =
+        encoder::encode_lightfield_shard(root_ / "cov", *analysis, views, 0, spec_.frames, 1, path);
+    ASSERT_TRUE(s.ok()) << s.status().to_string();
+    EXPECT_GT(s->colour_unmixed, 0u);
+    shards.push_back(path);
+  }
+  const std::string merged = (root_ / "merged.calf").string();
+  ASSERT_TRUE(encoder::merge_lightfield_shards(*analysis, shards, merged).ok());
+  const auto bytes_of = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::vector<uint8_t>((std::istreambuf_iterator<char>(in)),
+                                std::istreambuf_iterator<char>());
+  };
+  EXPECT_TRUE(bytes_of(merged) == bytes_of(one));
+  o.coverage_unmix.reset();
+  const fs::path plain = root_ / "plain.calf";
+  ASSERT_TRUE(encoder::encode_lightfield_file(root_ / "cov", plain.string(), o).ok());
+  EXPECT_FALSE(bytes_of(plain) == bytes_of(one));  // unmixing changed the clip
 }
 
 TEST_F(LightfieldCoverage, CoverageTheStreamCannotHoldIsRefusedWithE255) {
