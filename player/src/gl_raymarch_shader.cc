@@ -851,7 +851,13 @@ void main() {
     z = min(z, trace(vec3(0.0), d, rgb));
     sum += rgb;
   }
-  out_colour = vec4(sum / (n * n), z);
+  // llvmpipe ends every loop of an invocation once all of them together have run 65535
+  // iterations, and never resets the count: a loop of a uniform length run last finds whether
+  // any loop before was cut short. Such a pixel's distance is -1 (LightfieldGlRenderer::render
+  // refuses the image).
+  uint canary = 0u;
+  for (uint k = 0u; k <= ray_count; ++k) ++canary;
+  out_colour = vec4(sum / (n * n), canary == ray_count + 1u ? z : -1.0);
 }
 )glsl";
 

@@ -252,7 +252,18 @@ Status LightfieldGlRenderer::render(const Camera& camera, std::span<const uint32
   CALF_RETURN_IF_ERROR(
       target_->bind_and_clear(camera.width, camera.height, "the ray-march render target"));
   CALF_RETURN_IF_ERROR(draw(camera, active_views));
-  return target_->read_back("reading back the frame", out);
+  CALF_RETURN_IF_ERROR(target_->read_back("reading back the frame", out));
+  // The shader marks a pixel whose loops the driver cut short with distance -1.
+  const size_t cut = static_cast<size_t>(
+      std::count_if(out->depth.begin(), out->depth.end(), [](float z) { return z < 0; }));
+  if (cut > 0) {
+    return Status(ErrorId::kPlayerGl,
+                  std::to_string(cut) + " of " + std::to_string(out->depth.size()) +
+                      " pixels: the GL driver ended the ray-march's loops early (llvmpipe allows "
+                      "65535 loop iterations a pixel and ray); fewer steps or hint views, or the "
+                      "CPU renderer, render them whole");
+  }
+  return Status::Ok();
 }
 
 }  // namespace calf::player

@@ -279,6 +279,39 @@ TEST(LightfieldGlRenderer, MatchesCpuWhenAPixelsRaysMarchPastLlvmpipesLoopLimit)
   EXPECT_GE(c.depth_agree, 0.99);
 }
 
+// One ray that marches past llvmpipe's loop limit (2000 steps with 4 hint views of 4 substeps) is
+// refused with CALF-E404, not drawn cut short; one that stays within it (500 steps) renders as
+// the CPU does. Other drivers have no such limit: there both render.
+TEST(LightfieldGlRenderer, RefusesAMarchTheDriversLoopLimitCutShort) {
+  CALF_REQUIRE_GL();
+  const ViewSet views = tinted_views(32);
+  const Camera cam = between_views_camera(8);
+  LightfieldRenderOptions o;
+  o.surface_hints = 4;
+  o.surface_hint_vetoes = 0;
+  o.steps = 500;
+  const Comparison within = compare(views, cam, o);
+  expect_float_agreement(within);
+  o = *march_range_for(views, cam.position, o);
+  o.steps = 2000;
+  Expected<ViewSetUpload> up = updates_from_view_set(views);
+  ASSERT_TRUE(up.ok());
+  Expected<std::unique_ptr<GlViews>> gv = GlViews::make(gl_context()->gl(), up->layout);
+  ASSERT_TRUE(gv.ok());
+  ASSERT_TRUE((*gv)->apply(up->frame).ok());
+  Expected<std::unique_ptr<LightfieldGlRenderer>> gl = LightfieldGlRenderer::make(**gv, o);
+  ASSERT_TRUE(gl.ok());
+  RenderedImage image;
+  const Status s = (*gl)->render(cam, &image);
+  if (gl_context()->gl().renderer.find("llvmpipe") == std::string::npos) {
+    EXPECT_TRUE(s.ok()) << s.to_string();
+    return;
+  }
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.id(), ErrorId::kPlayerGl) << s.to_string();
+  EXPECT_NE(s.message().find(" of 64 pixels"), std::string::npos) << s.message();
+}
+
 // The Unstructured Lumigraph's weights (LightfieldRenderOptions::blend_views) on views tinted
 // each their own way, so that which views blend shows: they change the image against cam_decay's
 // weights, and GL follows the CPU with 3 views and with all 8. With K = 1 a view's weight drops

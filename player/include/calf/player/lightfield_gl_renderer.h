@@ -68,7 +68,8 @@ class LightfieldGlRenderer {
   // order; empty = every view) into `out` (resized): colour and radial distance per pixel, row 0
   // at the top, as LightfieldCpuRenderer::render. Errors: CALF-E403 for an invalid camera (as the
   // CPU renderer) or active view (validate_active_views, or more than the shader's view block
-  // holds), CALF-E412 when GL reports an error.
+  // holds), CALF-E412 when GL reports an error, CALF-E404 when the driver ended some pixel's
+  // march loops early (llvmpipe's loop limit; the image is not usable).
   Status render(const Camera& camera, std::span<const uint32_t> active_views, RenderedImage* out);
   Status render(const Camera& camera, RenderedImage* out) { return render(camera, {}, out); }
 
