@@ -77,7 +77,9 @@ class LightfieldGlRenderer {
   // GL_DRAW_FRAMEBUFFER, viewport (0, 0, width, height) of the camera, output 0 = (rgb, radial
   // distance): for a player that composites the result itself. With supersample > 1 it draws
   // one pass per eye ray and blends them (rgb added, distance the minimum), so output 0 must be
-  // a float target holding (0, 0, 0, +inf). Leaves program, textures and buffer bindings changed.
+  // a float target holding (0, 0, 0, +inf). A pixel whose march loops the driver ended early gets
+  // distance -1 (render() refuses such an image). Leaves program, textures and buffer bindings
+  // changed.
   Status draw(const Camera& camera, std::span<const uint32_t> active_views = {});
 
  private:
