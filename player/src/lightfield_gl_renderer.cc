@@ -233,8 +233,9 @@ Status LightfieldGlRenderer::draw(const Camera& camera, std::span<const uint32_t
     gl.BlendEquationSeparate(GL_FUNC_ADD, GL_MIN);
     gl.BlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ONE);
   }
+  const GLint ray_first = loc("ray_first");
   for (uint32_t ray = 0; ray < rays; ++ray) {
-    gl.Uniform1ui(loc("ray_first"), ray);
+    gl.Uniform1ui(ray_first, ray);
     gl.DrawArrays(GL_TRIANGLES, 0, 3);
   }
   gl.Disable(GL_BLEND);
