@@ -111,6 +111,7 @@ static int command_main(int argc, char** argv) {
   std::string clip;
   HeadlessArgs h;
   bool headless = false;
+  bool quality = false;  // --quality: with_quality_setting() under the options given
   PlaybackOptions play_options;
   LightfieldOptions& o =
       play_options.of<LightfieldOptions>();  // the knobs below are the light field's
@@ -310,6 +311,13 @@ static int command_main(int argc, char** argv) {
                  "filter, as the ground truth's), depth the nearest; anti-aliases silhouettes and "
                  "texture edges for N^2 the render time (1: the pixel centre's ray)")
       ->check(CLI::Range(1, 8));
+  app.add_flag("--quality", quality,
+               "light field: the quality setting, for offline renders and measurements: --steps "
+               "128 --hints 4 --hint-vetoes 0 --blend-views 3 --colour-sharpen 0.2 "
+               "--supersample 4, each unless given; +1.2 dB on the demo's interior clip for 35x "
+               "its render time, mostly the 16 eye rays a pixel (docs/SILHOUETTES.md \"The "
+               "march's quality knobs\"). Coverage stays --coverage's: which mode suits "
+               "depends on the content");
   app.add_option("--views", o.selection.max_active, "most active viewpoints per frame")
       ->check(CLI::Range(1, 65536));
   tools::add_enum_option(app, "--priority", o.selection.priority, kViewPriorities,
@@ -338,14 +346,27 @@ static int command_main(int argc, char** argv) {
   group("Light field renderer",
         {"--steps", "--rr", "--no-rr-replace", "--hints", "--hint-substeps", "--hint-vetoes",
          "--hint-margin", "--depth-decay", "--cam-decay", "--blend-views", "--mixed-texel-penalty",
-         "--colour-sharpen", "--colour-sharpen-jump", "--supersample", "--views", "--priority",
-         "--frame-ms", "--no-view-dependent"});
+         "--colour-sharpen", "--colour-sharpen-jump", "--supersample", "--quality", "--views",
+         "--priority", "--frame-ms", "--no-view-dependent"});
   group("Light field coverage", {"--coverage", "--coverage-agreement", "--hint-coverage"});
   group("Surfels", {"--surfel-point-size", "--surfel-target-ms", "--surfel-clock", "--surfel-blend",
                     "--surfel-foveation"});
   group("Tiles", {"--tiles-blend", "--tiles-occlusion-alpha", "--tiles-occlusion-epsilon"});
   group("Window", {"--width", "--height", "--fov", "--stereo", "--ipd", "--frames"});
   if (int rc = tools::parse_command_line(app, "calf-play", argc, argv); rc >= 0) return rc;
+  if (quality) {
+    // The quality setting's knobs, except those given on the command line.
+    const LightfieldRenderOptions q = with_quality_setting(o.render);
+    const auto unless_given = [&app](const char* option, auto& field, auto value) {
+      if (app.count(option) == 0) field = value;
+    };
+    unless_given("--steps", o.render.steps, q.steps);
+    unless_given("--hints", o.render.surface_hints, q.surface_hints);
+    unless_given("--hint-vetoes", o.render.surface_hint_vetoes, q.surface_hint_vetoes);
+    unless_given("--blend-views", o.render.blend_views, q.blend_views);
+    unless_given("--colour-sharpen", o.render.colour_sharpen, q.colour_sharpen);
+    unless_given("--supersample", o.render.supersample, q.supersample);
+  }
 
   tr.blend = *tiles_blend_from_name(tiles_blend);  // checked above
   if (Status st = validate_tiles_render_options(tr); !st.ok()) {

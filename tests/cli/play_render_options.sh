@@ -3,6 +3,7 @@
 # a value other than its default, changes the frames calf-play writes (EXR, so that no change
 # hides in 8-bit rounding) of a tiny clip along its ground truth's eye path, with the GL renderer
 # (OSMesa) and the CPU reference alike; the same command without it writes the default's frames.
+# --quality writes the frames of the options it stands for, under any of them given beside it.
 # Usage: play_render_options.sh CALF_PLAY CLIP EYE_PATH WORK_DIR
 set -euo pipefail
 play=$1 clip=$2 eye=$3 work=$4
@@ -40,5 +41,24 @@ for renderer in gl cpu; do
       echo "play_render_options: $renderer: ${case#*|} changes the frames"
     fi
   done
+  # --quality is its six knobs, and an option given beside it keeps its own value.
+  quality=(--steps 128 --hints 4 --hint-vetoes 0 --blend-views 3 --colour-sharpen 0.2)
+  render "$renderer" quality --quality
+  render "$renderer" quality-explicit "${quality[@]}" --supersample 4
+  render "$renderer" quality-ss2 --quality --supersample 2
+  render "$renderer" quality-ss2-explicit "${quality[@]}" --supersample 2
+  for pair in quality:quality-explicit quality-ss2:quality-ss2-explicit; do
+    if ! diff -r "$work/$renderer-${pair%%:*}" "$work/$renderer-${pair#*:}" > /dev/null; then
+      echo "play_render_options: $renderer: ${pair%%:*} differs from its options given one by one" >&2
+      failed=1
+    fi
+  done
+  for other in default quality-ss2; do
+    if diff -r "$work/$renderer-quality" "$work/$renderer-$other" > /dev/null; then
+      echo "play_render_options: $renderer: --quality renders the frames of $other" >&2
+      failed=1
+    fi
+  done
+  echo "play_render_options: $renderer: --quality is its options, and --supersample beside it counts"
 done
 exit $failed
