@@ -38,6 +38,7 @@ struct LightfieldRepresentation::Impl {
   std::vector<Vec3> viewpoints;
   Box3 volume;
   bool has_material = false;
+  bool coverage_decoded = false;  // the track has a coverage stream and it is decoded
 
   // GL path.
   std::unique_ptr<GlViews> gl_views;
@@ -95,12 +96,15 @@ Expected<std::unique_ptr<LightfieldRepresentation>> LightfieldRepresentation::op
   impl->options = options;
   // Both renderers read a clip's coverage (SPEC §11.1.11), the CPU reference into its views as it
   // reads a capture set's, the GL renderer into its coverage textures; it is decoded whatever
-  // LightfieldRenderOptions::coverage says, so that coverage can be turned on while playing.
+  // LightfieldRenderOptions::coverage says, so that coverage can be turned on while playing,
+  // unless keep_coverage is off and the options read none of it.
   decoder::LightfieldDecoderOptions decoder_options = options.decoder;
-  decoder_options.coverage = true;
+  decoder_options.coverage = options.keep_coverage || options.render.coverage != 0 ||
+                             options.render.surface_hint_coverage != 0;
   CALF_ASSIGN_OR_RETURN(decoder::LightfieldDecoder d,
                         decoder::LightfieldDecoder::open(reader, track, decoder_options));
   impl->decoder.emplace(std::move(d));
+  impl->coverage_decoded = impl->decoder->has_coverage() && decoder_options.coverage;
   const auto& h = impl->decoder->header();
   std::vector<decoder::LightfieldViewInfo> views;
   Box3 bounds{{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
@@ -127,7 +131,7 @@ Expected<std::unique_ptr<LightfieldRepresentation>> LightfieldRepresentation::op
       return Status(ErrorId::kPlayerGl, "the GL renderer needs a current OpenGL 4.5 context");
     }
     CALF_ASSIGN_OR_RETURN(GlTextureLayout layout, layout_for_clip(h, views, options.keep_bc5_depth,
-                                                                  impl->decoder->has_coverage()));
+                                                                  impl->coverage_decoded));
     CALF_ASSIGN_OR_RETURN(impl->gl_views, GlViews::make(*gl, std::move(layout)));
     CALF_ASSIGN_OR_RETURN(impl->lightfield_gl_renderer,
                           LightfieldGlRenderer::make(*impl->gl_views, options.render));
@@ -437,7 +441,11 @@ RepresentationStats LightfieldRepresentation::stats() const {
   // The coverage rule in use (the window's C key turns it on and off).
   std::string coverage = "off";
   if (d.options.render.coverage != 0) coverage = format("mode %u", d.options.render.coverage);
-  if (!d.decoder->has_coverage()) coverage += " (none in the clip)";
+  if (!d.decoder->has_coverage()) {
+    coverage += " (none in the clip)";
+  } else if (!d.coverage_decoded) {
+    coverage += " (not decoded)";
+  }
   out.entries.push_back({"coverage", coverage});
   // Sharpened colour taps (the window's K key turns them on and off).
   out.entries.push_back({"colour sharpen", d.options.render.colour_sharpen > 0

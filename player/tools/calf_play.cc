@@ -304,7 +304,9 @@ static int command_main(int argc, char** argv) {
          "--hint-coverage", o.render.surface_hint_coverage,
          "light field, with coverage: a surface hint's crossing ends the ray only where the "
          "hint view's coverage covers the ray's direction in its texel (the direction's "
-         "cell): 0 off, 1 on (default; clips without coverage play alike at 0 and 1)")
+         "cell): 0 off, 1 on (default; clips without coverage play alike at 0 and 1); headless, "
+         "--coverage 0 with --hint-coverage 0 leaves a clip's coverage stream undecoded: it "
+         "plays and costs as the clip without it")
       ->check(CLI::Range(0u, 1u));
   app.add_option("--supersample", o.render.supersample,
                  "light field: N x N eye rays per pixel on an even grid, colour their mean (a box "
@@ -388,6 +390,9 @@ static int command_main(int argc, char** argv) {
     }
   }
   if (headless && app.count("--frame-ms") == 0) o.selection.budget.target_frame_ms = 0;
+  // Headless options never change while playing: a coverage stream that they do not read is
+  // not decoded (the window keeps it for the C key).
+  if (headless) o.keep_coverage = false;
   if (headless) {
     if (h.eye_path.empty() && h.compare.empty()) {
       return contradiction("--headless needs --eye-path or --compare");

@@ -552,5 +552,71 @@ TEST_F(LightfieldCoverage, GlPlayerUsesTheClipsCoverageAsTheCpuPlayer) {
   EXPECT_TRUE(found);
 }
 
+// LightfieldOptions::keep_coverage off (calf-play --headless): options that read no coverage
+// (coverage 0, hint coverage 0) leave the stream undecoded, so the clip plays as the same clip
+// without it, frame for frame and bit for bit in both players, and decodes none of its bytes; a
+// rule that reads it still gets it.
+TEST_F(LightfieldCoverage, CoverageNothingReadsIsNotDecodedWhenItNeedNotBeKept) {
+  encoder::LightfieldEncodeOptions o;
+  o.cell_size = 8;
+  o.depth_keyframe_interval = 2;
+  const std::vector<uint8_t> with = encode(root_ / "cov", o);
+  o.coverage = false;
+  const std::vector<uint8_t> without = encode(root_ / "cov", o);
+  const container::Reader rw = open(with), rn = open(without);
+  player::LightfieldOptions lo;
+  lo.decoder.background_thread = false;
+  lo.render.steps = 96;
+  lo.render.coverage = 0;
+  lo.render.surface_hint_coverage = 0;
+  lo.keep_coverage = false;
+  Camera cam;
+  cam.position = {0.25, 0.02, 0.03};
+  cam.forward = {1, -0.05, 0.1};
+  cam.fov_y = 1.2;
+  cam.width = cam.height = 40;
+  const auto stat = [](const player::LightfieldRepresentation& lf, const std::string& name) {
+    for (const player::Statistic& st : lf.stats().entries) {
+      if (st.name == name) return st.value;
+    }
+    return std::string("(missing)");
+  };
+  for (const player::RenderBackend backend :
+       {player::RenderBackend::kCpu, player::RenderBackend::kGl}) {
+    const bool gl = backend == player::RenderBackend::kGl;
+    if (gl && test::gl_context() == nullptr) continue;
+    const player::GlFunctions* functions = gl ? &test::gl_context()->gl() : nullptr;
+    auto a = player::LightfieldRepresentation::open(rw, 0, lo, backend, functions);
+    auto b = player::LightfieldRepresentation::open(rn, 0, lo, backend, functions);
+    ASSERT_TRUE(a.ok()) << a.status().to_string();
+    ASSERT_TRUE(b.ok()) << b.status().to_string();
+    EXPECT_TRUE((*a)->has_coverage());
+    EXPECT_EQ(stat(**a, "coverage"), "off (not decoded)");
+    for (const uint32_t frame : {0u, 3u, 1u, 4u}) {
+      ASSERT_TRUE((*a)->prepare(frame, std::span<const Camera>(&cam, 1)).ok());
+      ASSERT_TRUE((*b)->prepare(frame, std::span<const Camera>(&cam, 1)).ok());
+      EXPECT_EQ(stat(**a, "updates"), stat(**b, "updates")) << "frame " << frame;
+      player::RenderedImage ia, ib;
+      ASSERT_TRUE((*a)->render(cam, &ia).ok());
+      ASSERT_TRUE((*b)->render(cam, &ib).ok());
+      EXPECT_EQ(ia.color, ib.color) << (gl ? "GL" : "CPU") << " frame " << frame;
+      EXPECT_EQ(ia.depth, ib.depth) << (gl ? "GL" : "CPU") << " frame " << frame;
+      if (!gl) {
+        for (const player::View& v : (*a)->cpu_views()->views) EXPECT_FALSE(v.has_coverage());
+      }
+    }
+    // Hint crossings confirmed by coverage read it: decoded.
+    player::LightfieldOptions hints = lo;
+    hints.render.surface_hint_coverage = 1;
+    auto c = player::LightfieldRepresentation::open(rw, 0, hints, backend, functions);
+    ASSERT_TRUE(c.ok()) << c.status().to_string();
+    EXPECT_EQ(stat(**c, "coverage"), "off");
+    ASSERT_TRUE((*c)->prepare(0, std::span<const Camera>(&cam, 1)).ok());
+    if (!gl) {
+      for (const player::View& v : (*c)->cpu_views()->views) EXPECT_TRUE(v.has_coverage());
+    }
+  }
+}
+
 }  // namespace
 }  // namespace calf

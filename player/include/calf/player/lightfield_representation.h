@@ -43,6 +43,12 @@ struct LightfieldOptions {
   decoder::LightfieldDecoderOptions decoder;
   // GL only: keep BC5 depth compressed on the GPU (gl_views.h explains the trade).
   bool keep_bc5_depth = false;
+  // Decode and upload the track's coverage stream (SPEC §11.1.11) even where `render` reads none
+  // of it (coverage 0 and surface_hint_coverage 0), so that set_render_options() can turn it on
+  // while playing (the window's C key). false: opened with such options, the representation
+  // reads none of the stream and decodes, renders and costs what the same clip without it does;
+  // coverage turned on later then changes nothing, as on a clip without coverage.
+  bool keep_coverage = true;
 };
 
 class LightfieldRepresentation final : public Representation {
@@ -79,7 +85,7 @@ class LightfieldRepresentation final : public Representation {
   // Whether any view carries material (the RR variant needs it).
   bool has_material() const;
   // Whether the track has a coverage stream (LightfieldRenderOptions::coverage needs it; SPEC
-  // §11.1.11).
+  // §11.1.11), whether or not it is decoded (LightfieldOptions::keep_coverage).
   bool has_coverage() const;
   // The CPU backend's views after the last prepare(), indexed like the clip (a view never active
   // yet is a one-texel placeholder), with the clip's coverage where it has a coverage stream;
