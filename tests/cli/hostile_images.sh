@@ -25,9 +25,11 @@ broken() {
   echo "(second line, so that the test fails)" >&2
   exit 99
 }
-# run COMMAND...: runs COMMAND --help, then COMMAND... under /usr/bin/time; the status in rc.
+# run COMMAND...: runs COMMAND --help (or $base --help where COMMAND only wraps the command, as
+# `sh -c 'ulimit ...'` does), then COMMAND... under /usr/bin/time; the status in rc.
+base=
 run() {
-  /usr/bin/time -f '%M %e' -o "$work/time-base" "$1" --help >/dev/null 2>&1
+  /usr/bin/time -f '%M %e' -o "$work/time-base" "${base:-$1}" --help >/dev/null 2>&1
   /usr/bin/time -f '%M %e' -o "$work/time" timeout 60 "$@"
   rc=$?
 }
@@ -72,6 +74,7 @@ ingest-exr-attribute) run "$bin/calf-ingest" seurat "$work/seurat_attribute.json
 ingest-equirect-face-size) run "$bin/calf-ingest" equirect --face-size 16384 "$work/equirect.json" "$work/out" ;;
 # the budget raised past what the machine gives (a 2 GB address space): CALF-E013, never an abort
 ingest-out-of-memory)
+  base=$bin/calf-ingest
   run sh -c 'ulimit -v 2097152 && exec "$@"' sh "$bin/calf-ingest" seurat --face-size 16384 \
     --max-image-pixels 4294967296 "$work/seurat_png.json" "$work/out" ;;
 # calf-capture: model textures, external and embedded
