@@ -1,6 +1,7 @@
 // Capture-set reader and writer (format/CAPTURE.md, "Images").
 #include "calf/capture/capture_set.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -38,6 +39,10 @@ std::string value_text(float v) {
 }
 
 }  // namespace
+
+double coverage_tolerance(uint32_t face_size) {
+  return std::min(4.0 / std::max(face_size, 1u), 0.05);
+}
 
 void ViewFrame::resize(uint32_t size, bool with_material, bool with_coverage) {
   face_size = size;

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "calf/capture/capture_set.h"
 #include "calf/format/log_depth.h"
 
 namespace calf::capture {
@@ -56,11 +57,10 @@ Expected<uint64_t> unmix_coverage_colour(const CoverageUnmixFaces& faces,
                  std::to_string(texels) + " texels");
     }
   }
-  // The capture's own-surface tolerance: min(4 / N, 0.05) as relative depth, in codes.
-  const double tolerance_codes = std::min(4.0 / n, 0.05) / faces.relative_step;
+  // The capture's own-surface tolerance, in codes.
+  const double tolerance_codes = coverage_tolerance(n) / faces.relative_step;
   // The other side: a neighbour at least min_jump (and the tolerance) nearer or farther.
-  const double jump_codes =
-      std::max(std::min(4.0 / n, 0.05), options.min_jump) / faces.relative_step;
+  const double jump_codes = std::max(coverage_tolerance(n), options.min_jump) / faces.relative_step;
   const auto index = [n](const Texel& t) { return size_t{t.y} * n + t.x; };
   // Neighbours read the input: every face's colour is kept until all are solved.
   std::array<std::vector<float>, kCubeFaceCount> in;

@@ -480,10 +480,6 @@ struct FrameTracer::Impl {
   }
 };
 
-float coverage_tolerance(uint32_t face_size) {
-  return std::min(0.05f, 4.0f / static_cast<float>(std::max(face_size, 1u)));
-}
-
 Status validate_render_options(const LightfieldRenderOptions& o) {
   auto bad = [](const std::string& what) { return Status(ErrorId::kCaptureOption, what); };
   if (o.threads > 256) return bad("threads " + std::to_string(o.threads) + " is outside 0..256");
@@ -638,7 +634,7 @@ RenderStats FrameTracer::render_cube(const Vec3& center, uint32_t view, uint32_t
                                      uint32_t face_size, bool with_material,
                                      capture::ViewFrame* out, bool with_coverage) const {
   out->resize(face_size, with_material, with_coverage);
-  const float coverage_tol = coverage_tolerance(face_size);
+  const float coverage_tol = static_cast<float>(capture::coverage_tolerance(face_size));
   const Impl& im = *impl_;
   const glm::vec3 o = to_fvec3(center);
   const uint32_t n = face_size;

@@ -41,6 +41,10 @@ inline constexpr uint32_t kMaxCaptureFaceSize = 16384;
 inline constexpr uint32_t kCaptureFormatVersion = 1;
 // Version 2 adds the optional coverage channels; a set without them is written as version 1.
 inline constexpr uint32_t kCaptureCoverageVersion = 2;
+// CAPTURE.md "Coverage": the relative depth within which a first hit counts as the texel's own
+// surface, |ln(z / d)| <= min(4 / N, 0.05): two texel angles of an N-texel face (a surface at up
+// to 76 degrees incidence stays within it across the texel), at most 5 %. Face size 0 counts as 1.
+double coverage_tolerance(uint32_t face_size);
 inline constexpr const char* kManifestFileName = "manifest.json";
 inline constexpr const char* kDefaultFilePattern = "view{view:03}_frame{frame:05}.exr";
 

@@ -69,10 +69,6 @@ struct LightfieldRenderOptions {
 // E177 when an option is outside its range.
 Status validate_render_options(const LightfieldRenderOptions& options);
 
-// The relative depth within which a colour sample's first hit counts as the texel's own surface
-// for coverage: 2 texel angles (4 / face size; a surface at up to 76 degrees incidence stays
-// within it across the texel), at most 5 %.
-float coverage_tolerance(uint32_t face_size);
 inline constexpr uint32_t kCoverageCells = 4;  // cells per texel side
 
 // Rays traced (primary, shadow, AO, secondary) and wall time, for Mrays/s.
@@ -103,9 +99,9 @@ class FrameTracer {
   // y, face_size); colour samples lie in its square, calf::direction_from_texel_coord.
   // `with_coverage`: also the coverage channels (format/CAPTURE.md "Coverage") from the first
   // hits of cell rays: a cell shows the texel's surface when its first hit is within a
-  // relative depth of coverage_tolerance(face_size) of the centre ray's (both sky, or both not),
-  // else nearer or farther. Coverage takes 16 intersection rays per texel, at the centres of a
-  // 4 x 4 grid of cells over the texel's square.
+  // relative depth of capture::coverage_tolerance(face_size) of the centre ray's (both sky, or both
+  // not), else nearer or farther. Coverage takes 16 intersection rays per texel, at the centres of
+  // a 4 x 4 grid of cells over the texel's square.
   RenderStats render_cube(const Vec3& center, uint32_t view, uint32_t frame, uint32_t face_size,
                           bool with_material, capture::ViewFrame* out,
                           bool with_coverage = false) const;
